@@ -1,0 +1,7 @@
+"""Mechanisms: geometry, pose/joint variables with units, search bounds and closed-form maps.
+
+One module per mechanism, registered in :mod:`fkopt.registry`.
+"""
+from .base import Mechanism, ParallelMechanism, SerialMechanism
+
+__all__ = ["Mechanism", "ParallelMechanism", "SerialMechanism"]

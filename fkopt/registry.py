@@ -1,0 +1,36 @@
+"""Name -> implementation maps for mechanisms and algorithms.
+
+Adding a mechanism or an algorithm is one new module plus one line here. Entries are
+``"module:Class"`` strings imported on first use, so listing names costs nothing.
+"""
+from __future__ import annotations
+
+import importlib
+
+from .errors import FkoptError, did_you_mean
+
+MECHANISMS: dict[str, str] = {
+    "3-rps": "fkopt.mechanisms.rps3:ThreeRPS",
+}
+
+ALGORITHMS: dict[str, str] = {
+    "abc": "fkopt.algorithms.abc:ABC",
+    "gabc": "fkopt.algorithms.gabc:GABC",
+}
+
+
+def _load(table: dict[str, str], kind: str, name: str):
+    try:
+        target = table[name]
+    except KeyError:
+        raise FkoptError(f"unknown {kind} '{name}'; allowed: {did_you_mean(name, table)}") from None
+    module, cls = target.split(":")
+    return getattr(importlib.import_module(module), cls)
+
+
+def mechanism_class(name: str):
+    return _load(MECHANISMS, "mechanism", name)
+
+
+def algorithm_class(name: str):
+    return _load(ALGORITHMS, "algorithm", name)
