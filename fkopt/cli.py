@@ -1,0 +1,271 @@
+"""The ``fkopt`` command line: a thin layer over the Python API and the experiment layer.
+
+Every user mistake ends as one line ``fkopt: error: ...`` on stderr and exit status 2;
+Ctrl-C ends with status 130. Neither prints a traceback.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+
+from . import registry
+from .errors import FkoptError
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics.")
+
+#: Algorithms tried in order for a single forward/inverse solve: the most reliable first.
+RELIABLE = ("gabc+lm", "lm", "gabc")
+
+
+def _console(stderr: bool = False):
+    from rich.console import Console
+    return Console(stderr=stderr, highlight=False)
+
+
+def parse_assignments(text: str, option: str) -> dict[str, float]:
+    """``"alpha=9,beta=13,z=622"`` -> {"alpha": 9.0, ...} with a clear error."""
+    out: dict[str, float] = {}
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        name, sep, value = part.partition("=")
+        if not sep:
+            raise FkoptError(f"{option}: expected name=value pairs separated by commas, got '{part}'")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise FkoptError(f"{option}: '{name.strip()}' needs a number, got '{value}'") from None
+    if not out:
+        raise FkoptError(f"{option}: no values given")
+    return out
+
+
+def load_geometry(path: Optional[Path]) -> dict:
+    if path is None:
+        return {}
+    import yaml
+    try:
+        data = yaml.safe_load(path.read_text())
+    except OSError as err:
+        raise FkoptError(f"{path}: cannot read ({err.strerror})") from None
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark else ""
+        raise FkoptError(f"{path}: malformed YAML{where}") from None
+    if not isinstance(data, dict):
+        raise FkoptError(f"{path}: expected a mapping of geometry keys")
+    return data
+
+
+def _mechanism(name: str, geometry: Optional[Path]):
+    from . import mechanism
+    return mechanism(name, **load_geometry(geometry))
+
+
+def _default_algorithm() -> str:
+    return next(a for a in RELIABLE if a in registry.ALGORITHMS)
+
+
+# -- commands ------------------------------------------------------------------------------------
+@app.command("list")
+def list_cmd(as_json: bool = typer.Option(False, "--json", help="machine-readable output")):
+    """List the mechanisms and algorithms fkopt knows."""
+    if as_json:
+        typer.echo(json.dumps({"mechanisms": list(registry.MECHANISMS), "algorithms": list(registry.ALGORITHMS)}))
+        return
+    from rich.table import Table
+    table = Table(title="mechanisms")
+    for col in ("name", "kind", "pose", "joints", "paper"):
+        table.add_column(col)
+    for name in registry.MECHANISMS:
+        m = registry.mechanism_class(name)()
+        mark = " (reconstruction)" if m.reconstruction else ""
+        table.add_row(name, m.kind, ", ".join(f"{n} [{u}]" for n, u in zip(m.pose_names, m.pose_units)),
+                      ", ".join(f"{n} [{u}]" for n, u in zip(m.joint_names, m.joint_units)),
+                      (m.paper or "") + mark)
+    con = _console()
+    con.print(table)
+    algos = Table(title="algorithms")
+    for col in ("name", "parameters (defaults)"):
+        algos.add_column(col)
+    for name in registry.ALGORITHMS:
+        cls = registry.algorithm_class(name)
+        params = ", ".join(f"{k}={f.default!r}" for k, f in cls.Params.model_fields.items())
+        algos.add_row(name, params)
+    con.print(algos)
+
+
+@app.command()
+def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"),
+        out: Path = typer.Option(Path("results"), "--out", help="results root; each experiment "
+                                 "writes OUT/<paper>/<name>/"),
+        quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
+    """Run experiment files and write their tables and figures."""
+    from .experiment.config import load_config
+    from .experiment.reports import summary_table, write_experiment
+    from .experiment.runner import run_experiment, validate_experiment
+
+    loaded = [(path, load_config(path)) for path in configs]
+    for path, config in loaded:          # fail on any bad file before running anything
+        try:
+            validate_experiment(config)
+        except FkoptError as err:
+            raise FkoptError(f"{path}: {err}") from None
+    con = _console()
+    for path, config in loaded:
+        if quiet:
+            er = run_experiment(config, source=str(path))
+        else:
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+            with Progress(TextColumn(f"[bold]{config.name}[/]"), BarColumn(), MofNCompleteColumn(),
+                          TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
+                          transient=True) as bar:
+                task = bar.add_task("", total=len(config.algorithms) * _n_cases(config))
+                er = run_experiment(config, source=str(path),
+                                    progress=lambda label, done, total: bar.update(task, completed=done,
+                                                                                   description=label))
+        folder = write_experiment(er, out)
+        if not quiet:
+            _print_summary(con, summary_table(er), folder, er.wall_s)
+
+
+def _n_cases(config) -> int:
+    return getattr(config.cases, "random", None) or len(config.cases)
+
+
+SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",
+         "success_rate": "success", "median_iterations_to_threshold": "med. it→thr",
+         "mean_evaluations": "mean evals"}
+
+
+def _print_summary(con, df, folder: Path, wall: float) -> None:
+    from rich.table import Table
+    cols = [c for c in ("case", "algorithm", *SHORT) if c in df]
+    if df["case"].nunique() > 8:   # many cases: one line per algorithm
+        df = df.groupby("algorithm", sort=False).agg({c: "median" for c in cols[2:]}).reset_index()
+        df.insert(0, "case", "median over cases")
+    table = Table(title=f"{folder}  ({wall:.2f} s)")
+    for c in cols:
+        table.add_column(SHORT.get(c, c), justify="right", no_wrap=c in ("case", "algorithm"))
+    for _, row in df.iterrows():
+        table.add_row(*[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]])
+    con.print(table)
+
+
+@app.command()
+def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
+       pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       algorithm: Optional[str] = typer.Option(None, "--algorithm", help="solver for a serial arm"),
+       seed: int = typer.Option(0, "--seed"),
+       as_json: bool = typer.Option(False, "--json")):
+    """Inverse kinematics: closed form for a parallel mechanism, solved for a serial arm."""
+    m = _mechanism(mech, geometry)
+    values = m.vector(parse_assignments(pose, "--pose"), m.pose_names, "--pose")
+    if m.kind == "parallel":
+        if algorithm:
+            raise FkoptError(f"--algorithm: '{mech}' has a closed-form inverse map; no solver is used")
+        joints = m.ik(values)
+        _emit({"joints": dict(zip(m.joint_names, map(float, joints)))}, as_json, m.joint_units)
+        return
+    from . import problems, solve
+    problem = problems.ik_problem(m, values)
+    name = algorithm or _default_algorithm()
+    res = solve(problem, name, population=50, iterations=500, runs=1, seed=seed)
+    q = res.x[0]
+    out = {"joints": dict(zip(m.joint_names, map(float, q))), "fitness": float(res.fitness[0]),
+           "objective": problem.objective, "algorithm": name}
+    if hasattr(problem, "position_error"):
+        out["position_error"] = float(problem.position_error(q))
+        out["rotation_error_deg"] = float(problem.rotation_error(q))
+    _emit(out, as_json, m.joint_units)
+
+
+@app.command()
+def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
+       joints: str = typer.Option(..., "--joints", help="e.g. d1=598.85,d2=671.92,d3=629.16"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       algorithm: Optional[str] = typer.Option(None, "--algorithm", help=f"default: first of {', '.join(RELIABLE)} available"),
+       seed: int = typer.Option(0, "--seed"),
+       tolerance: float = typer.Option(1e-6, "--tolerance", help="largest residual (joint units) accepted as a solution"),
+       all_solutions: bool = typer.Option(False, "--all-solutions", help="every distinct real solution in the bounds"),
+       as_json: bool = typer.Option(False, "--json")):
+    """Forward kinematics: solved for a parallel mechanism, closed form for a serial arm."""
+    m = _mechanism(mech, geometry)
+    values = m.vector(parse_assignments(joints, "--joints"), m.joint_names, "--joints")
+    if m.kind == "serial":
+        pose = m.fk(values)
+        _emit({"pose": dict(zip(m.pose_names, map(float, pose)))}, as_json, m.pose_units)
+        return
+    from . import fk_problem, solve
+    if all_solutions:
+        from .assembly import all_solutions as find_all, solutions_to_dict
+        found = find_all(m, values, seed=seed)
+        data = solutions_to_dict(found)
+        if as_json:
+            typer.echo(json.dumps(data))
+        else:
+            _console().print(f"{len(data['solutions'])} distinct solutions")
+            for s in data["solutions"]:
+                _console().print(s)
+        return
+    problem = fk_problem(m, values)
+    name = algorithm or _default_algorithm()
+    res = solve(problem, name, population=20, iterations=300, runs=1, seed=seed)
+    x = res.x[0]
+    residual = float(np.max(np.abs(problem.residuals(x))))
+    if not residual <= tolerance:
+        raise FkoptError(f"no pose within the bounds reproduces these joints: best residual {residual:.3g} "
+                         f"(joint units) at {', '.join(f'{n}={v:.6g}' for n, v in zip(m.pose_names, x))}")
+    _emit({"pose": dict(zip(m.pose_names, map(float, x))), "fitness": float(res.fitness[0]),
+           "residual": residual, "algorithm": name}, as_json, m.pose_units)
+
+
+def _emit(data: dict, as_json: bool, units) -> None:
+    if as_json:
+        typer.echo(json.dumps(data))
+        return
+    key = "joints" if "joints" in data else "pose"
+    for (name, value), unit in zip(data[key].items(), units):
+        typer.echo(f"{name:>8} = {value:.10g} {unit}")
+    for name, value in data.items():
+        if name != key:
+            typer.echo(f"{name:>8}: {value:.6g}" if isinstance(value, float) else f"{name:>8}: {value}")
+
+
+@app.command()
+def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s)"),
+          peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
+          out: Path = typer.Option(Path("bench"), "--out", help="folder for bench.csv and scaling.png")):
+    """Measure fkopt's speed (and peers') on this machine."""
+    from .bench import run as run_bench
+    run_bench(quick=quick, peers=peers, out=out)
+
+
+def main() -> None:
+    try:
+        app(standalone_mode=False)
+    except FkoptError as err:
+        print(f"fkopt: error: {err}", file=sys.stderr)
+        sys.exit(2)
+    except KeyboardInterrupt:
+        print("fkopt: interrupted (no results folder was left half-written)", file=sys.stderr)
+        sys.exit(130)
+    except Exception as err:  # click's usage errors (typer vendors click): no traceback either
+        kind = type(err).__name__
+        if kind == "Exit":
+            sys.exit(getattr(err, "exit_code", 0))
+        if kind == "Abort":
+            print("fkopt: interrupted", file=sys.stderr)
+            sys.exit(130)
+        if callable(getattr(err, "format_message", None)):
+            print(f"fkopt: error: {err.format_message()} (see fkopt --help)", file=sys.stderr)
+            sys.exit(2)
+        raise
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,191 @@
+"""Run an experiment: every algorithm on every case for ``runs`` seeded runs.
+
+Seeds: the (case, algorithm) task with case index c and algorithm label L gets the integer
+seed ``SeedSequence([seed, c, crc32(L)]).generate_state(1)[0]`` and its run k the k-th child
+stream of that (see :mod:`fkopt.streams`). Reordering algorithms in a file or running one
+algorithm alone therefore reproduces the same numbers.
+"""
+from __future__ import annotations
+
+import time
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .. import registry
+from ..errors import FkoptError
+from ..problems import fk_problem
+from ..rotations import wrap_degrees
+from ..solve import Result, make_algorithm, solve
+from .config import AlgorithmSpec, ExperimentConfig, RandomCases
+
+
+@dataclass
+class Case:
+    """One forward/inverse problem instance of an experiment."""
+
+    index: int
+    label: str
+    inputs: np.ndarray                 # what the solver must reproduce: joints (parallel) / pose (serial)
+    target: np.ndarray | None          # the true/nominal answer in the compared space (pose), if known
+    given_joints: np.ndarray | None = None     # joints as given in the file (parallel)
+    joints_from_pose: np.ndarray | None = None  # fkopt's inverse map of the nominal pose (parallel)
+    reference: np.ndarray | None = None
+    reference_label: str = "reference"
+    printed: dict = field(default_factory=dict)
+
+
+@dataclass
+class TaskRecord:
+    case: Case
+    spec: AlgorithmSpec
+    problem: object
+    result: Result
+    seed: int
+    wall_s: float
+    outputs: np.ndarray                # (runs, n_pose) the pose each run's answer corresponds to
+    position_error_history: np.ndarray | None = None
+
+
+@dataclass
+class ExperimentResult:
+    config: ExperimentConfig
+    mechanism: object
+    cases: list[Case]
+    records: list[TaskRecord]
+    wall_s: float
+    source: str | None = None
+
+    @property
+    def compared_names(self) -> tuple[str, ...]:
+        return self.mechanism.pose_names
+
+    @property
+    def compared_units(self) -> tuple[str, ...]:
+        return self.mechanism.pose_units
+
+
+def task_seed(seed: int, case_index: int, label: str) -> int:
+    state = np.random.SeedSequence([int(seed), int(case_index), zlib.crc32(label.encode())]).generate_state(1)
+    return int(state[0])
+
+
+def build_mechanism(config: ExperimentConfig):
+    cls = registry.mechanism_class(config.mechanism.name)
+    return cls(bounds=dict(config.mechanism.bounds), **config.mechanism.geometry)
+
+
+def _check_in_bounds(mech, pose: np.ndarray, where: str) -> None:
+    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    for name, v, a, b in zip(mech.unknown_names, pose, lo, hi):
+        if not a - 1e-9 <= v <= b + 1e-9:
+            raise FkoptError(f"{where}: {name}={v:g} is outside the workspace bounds [{a:g}, {b:g}] "
+                             f"(widen mechanism.bounds.{name} or move the pose)")
+
+
+def build_cases(config: ExperimentConfig, mech) -> list[Case]:
+    serial = mech.kind == "serial"
+    if isinstance(config.cases, RandomCases):
+        rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence(config.cases.seed)))
+        u = rng.random((config.cases.random, len(mech.unknown_names)))
+        x = mech.bounds[:, 0] + u * (mech.bounds[:, 1] - mech.bounds[:, 0])
+        cases = []
+        for i, xi in enumerate(x):
+            if serial:  # random joints -> a reachable target pose
+                pose = mech.fk(xi)
+                cases.append(Case(i, f"random-{i + 1}", inputs=pose, target=pose, given_joints=xi))
+            else:
+                cases.append(Case(i, f"random-{i + 1}", inputs=mech.ik(xi), target=xi))
+        return cases
+    cases = []
+    for i, spec in enumerate(config.cases):
+        where = f"cases[{i}]"
+        label = spec.label or f"case-{i + 1}"
+        reference = (mech.vector(spec.reference, mech.pose_names, f"{where}.reference")
+                     if spec.reference else None)
+        pose = mech.vector(spec.pose, mech.pose_names, f"{where}.pose") if spec.pose else None
+        joints = mech.vector(spec.joints, mech.joint_names, f"{where}.joints") if spec.joints else None
+        if serial:
+            if joints is not None:
+                _check_in_bounds(mech, joints, f"{where}.joints")
+            target = pose if pose is not None else mech.fk(joints)
+            cases.append(Case(i, label, inputs=target, target=target, given_joints=joints,
+                              reference=reference, reference_label=spec.reference_label, printed=spec.printed))
+            continue
+        from_pose = None
+        if pose is not None:
+            _check_in_bounds(mech, pose, f"{where}.pose")
+            from_pose = mech.ik(pose)
+        inputs = joints if joints is not None else from_pose
+        cases.append(Case(i, label, inputs=inputs, target=pose, given_joints=joints,
+                          joints_from_pose=from_pose, reference=reference,
+                          reference_label=spec.reference_label, printed=spec.printed))
+    return cases
+
+
+def build_problem(config: ExperimentConfig, mech, case: Case):
+    if mech.kind == "serial":
+        from .. import problems
+        if not hasattr(problems, "ik_problem"):
+            raise FkoptError(f"serial mechanism '{mech.name}' needs ik_problem, not available in this build")
+        kwargs = {"objective": config.objective} if config.objective else {}
+        return problems.ik_problem(mech, case.inputs, **kwargs)
+    kwargs = {"objective": config.objective} if config.objective else {}
+    return fk_problem(mech, case.inputs, **kwargs)
+
+
+def outputs_of(mech, x: np.ndarray) -> np.ndarray:
+    """What a solution is compared in: the pose itself (parallel) or fk(joints) (serial)."""
+    return mech.fk(x) if mech.kind == "serial" else x
+
+
+def pose_error(mech, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a - b| per pose variable, angle differences wrapped to [-180, 180)."""
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    angle = mech.angle_mask(mech.pose_units)
+    return np.abs(np.where(angle, wrap_degrees(d), d))
+
+
+def validate_experiment(config: ExperimentConfig):
+    """Build everything a run needs without running it (so bad input fails before any work)."""
+    mech = build_mechanism(config)
+    cases = build_cases(config, mech)
+    for spec in config.algorithms:
+        make_algorithm(spec.name, spec.params)   # unknown names/parameters fail here
+        if spec.start is not None:
+            x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
+            _check_in_bounds(mech, x0, f"algorithms[{spec.key}].start")
+    problems = [build_problem(config, mech, c) for c in cases]
+    return mech, cases, problems
+
+
+def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
+                   source: str | None = None) -> ExperimentResult:
+    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each."""
+    mech, cases, problems = validate_experiment(config)
+    records: list[TaskRecord] = []
+    total = len(cases) * len(config.algorithms)
+    start_all = time.perf_counter()
+    for case, problem in zip(cases, problems):
+        for spec in config.algorithms:
+            algo = make_algorithm(spec.name, spec.params)
+            seed = task_seed(config.seed, case.index, spec.key)
+            x0 = (mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
+                  if spec.start is not None else None)
+            start = time.perf_counter()
+            result = solve(problem, algo, population=spec.population or config.population,
+                           iterations=spec.iterations or config.iterations, runs=config.runs, seed=seed,
+                           target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
+                           batch=config.batch, snapshots=config.snapshots)
+            wall = time.perf_counter() - start
+            outputs = outputs_of(mech, result.x)
+            pos_hist = None
+            if hasattr(problem, "position_error"):
+                pos_hist = problem.position_error(result.x_history)
+            records.append(TaskRecord(case, spec, problem, result, seed, wall, outputs, pos_hist))
+            if progress:
+                progress(f"{case.label} / {spec.key}", len(records), total)
+    return ExperimentResult(config, mech, cases, records, time.perf_counter() - start_all, source)
