@@ -1,0 +1,28 @@
+import numpy as np
+import pytest
+
+
+class Sphere:
+    """f(x) = |x - c|^2 on a box; residuals x - c (for Newton/LM)."""
+
+    def __init__(self, dim=3, centre=0.3, half=5.0):
+        self.variable_names = tuple(f"x{i}" for i in range(dim))
+        self.variable_units = ("",) * dim
+        self.bounds = np.array([[-half, half]] * dim)
+        self.centre = np.full(dim, centre)
+
+    @property
+    def dim(self):
+        return len(self.variable_names)
+
+    def residuals(self, x):
+        return np.asarray(x) - self.centre
+
+    def fitness(self, x):
+        r = self.residuals(x)
+        return (r * r).sum(axis=-1)
+
+
+@pytest.fixture
+def sphere():
+    return Sphere()
