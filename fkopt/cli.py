@@ -246,6 +246,98 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     run_bench(quick=quick, peers=peers, out=out)
 
 
+@app.command()
+def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="folder of experiment files"),
+              out: Path = typer.Option(Path("results"), "--out", help="results root"),
+              quiet: bool = typer.Option(False, "--quiet", "-q")):
+    """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
+    import time
+    from rich.table import Table
+    from .experiment.config import load_config
+    from .experiment.reports import write_experiment
+    from .experiment.runner import run_experiment, validate_experiment
+    from .reproduce.report import write_report
+
+    files = sorted(configs.rglob("*.yaml"))
+    if not files:
+        raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
+    loaded = [(f, load_config(f)) for f in files]
+    for f, c in loaded:
+        try:
+            validate_experiment(c)
+        except FkoptError as err:
+            raise FkoptError(f"{f}: {err}") from None
+    con = _console()
+    done = []
+    start = time.perf_counter()
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
+                  TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
+                  disable=quiet) as bar:
+        overall = bar.add_task("", total=len(loaded), name="[bold]reproduce[/]")
+        for f, c in loaded:
+            task = bar.add_task("", total=len(c.algorithms) * _n_cases(c), name=f"  {c.paper}/{c.name}")
+            er = run_experiment(c, source=str(f), progress=lambda label, d, t: bar.update(
+                task, completed=d, description=label))
+            folder = write_experiment(er, out)
+            bar.remove_task(task)
+            bar.advance(overall)
+            done.append((f, folder, er.wall_s, len(list(folder.iterdir()))))
+    paths = write_report(out)
+    total = time.perf_counter() - start
+    if not quiet:
+        table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")
+        for col in ("config", "results", "files", "seconds"):
+            table.add_column(col)
+        for f, folder, wall, n in done:
+            table.add_row(str(f), str(folder), str(n), f"{wall:.1f}")
+        con.print(table)
+        con.print("report: " + ", ".join(str(p) for p in paths))
+
+
+@app.command()
+def report(results: Path = typer.Argument(Path("results"), help="results root")):
+    """Regenerate REPORT.md, TIMING.md and index.csv from stored results (no rerun)."""
+    from .reproduce.report import write_report
+    for p in write_report(results):
+        typer.echo(str(p))
+
+
+@app.command()
+def check(results: Path = typer.Argument(Path("results"), help="results root"),
+          subset: str = typer.Option("all", "--subset", help="all | ci"),
+          experiment: Optional[list[str]] = typer.Option(None, "--experiment", "-e",
+                                                         help="PAPER/NAME to check (repeatable)"),
+          quiet: bool = typer.Option(False, "--quiet", "-q")):
+    """Rerun stored experiments from their recorded config; fail if results drifted."""
+    from .reproduce.check import check_experiment, select
+    from .reproduce.store import Store
+    if subset not in ("all", "ci"):
+        raise FkoptError(f"--subset: '{subset}' unknown; allowed: all, ci")
+    exps = select(Store(results), subset)
+    if experiment:
+        wanted = set(experiment)
+        exps = [e for e in exps if f"{e.paper}/{e.name}" in wanted]
+        missing = wanted - {f"{e.paper}/{e.name}" for e in exps}
+        if missing:
+            raise FkoptError(f"--experiment: no stored experiment {sorted(missing)[0]} under {results}")
+    if not exps:
+        raise FkoptError(f"{results}: no stored experiments (folders with meta.json) to check")
+    failures = []
+    for e in exps:
+        bad = check_experiment(e)
+        failures += bad
+        if not quiet:
+            typer.echo(f"{'ok  ' if not bad else 'FAIL'} {e.paper}/{e.name}")
+    if failures:
+        for m in failures[:20]:
+            typer.echo(f"drift: {m}", err=True)
+        raise FkoptError(f"{len(failures)} value(s) drifted in {len({m.experiment for m in failures})} "
+                         f"experiment(s); first: {failures[0]}")
+    if not quiet:
+        typer.echo(f"{len(exps)} experiments match their stored results")
+
+
 def main() -> None:
     try:
         app(standalone_mode=False)

@@ -108,6 +108,9 @@ class ExperimentConfig(Strict):
     figures: list[Literal["variables", "snapshots", "extras", "cases"]] = Field(default_factory=list)
     #: Experiment-level printed values and notes for the report.
     printed: dict[str, Any] = Field(default_factory=dict)
+    #: Which regression check reruns it: "ci" (every CI run and `make check`) or "full"
+    #: (`make check` only, for experiments too long for CI).
+    check: Literal["ci", "full"] = "ci"
 
     @field_validator("algorithms")
     @classmethod

@@ -1,0 +1,14 @@
+"""Reproduction of the five source papers: run every config, write REPORT.md, check drift.
+
+* :mod:`.store`   -- read a results tree (CSV tables and meta.json of each experiment);
+* :mod:`.report`  -- ``results/REPORT.md`` (deterministic: tables beside the printed numbers,
+  figures, claims held/not held, known errors of the papers), ``results/TIMING.md`` (only
+  timings and time-based claims, which change on every run) and ``results/index.csv``;
+* :mod:`.check`   -- rerun stored experiments from their recorded config and compare;
+* one module per paper (``mao2017.py``, ...) with its notes and its claims, registered in
+  :data:`PAPERS`.
+"""
+
+PAPERS: dict[str, str] = {
+    "mao2017": "fkopt.reproduce.mao2017",
+}
