@@ -14,7 +14,7 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version as _version
 
 from .errors import FkoptError
-from .problems import FKProblem, fk_problem
+from .problems import FKProblem, IKProblem, fk_problem, ik_problem
 from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
 from .solve import Result, solve
 

@@ -11,6 +11,10 @@ from .errors import FkoptError, did_you_mean
 
 MECHANISMS: dict[str, str] = {
     "3-rps": "fkopt.mechanisms.rps3:ThreeRPS",
+    "3-rpupc-ups": "fkopt.mechanisms.rpupc_ups:ThreeRPUPcUPS",
+    "3-ppr": "fkopt.mechanisms.ppr3:ThreePPR",
+    "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",
+    "7dof-arm": "fkopt.mechanisms.dh_arm:SevenDofArm",
 }
 
 ALGORITHMS: dict[str, str] = {

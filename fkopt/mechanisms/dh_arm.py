@@ -1,0 +1,158 @@
+"""Serial arms from a standard Denavit-Hartenberg table; the 7-DOF arm of wang7dof.
+
+SPEC.md "wang7dof" (7-DOF redundant arm, inverse kinematics by ABC vs PSO). Standard DH:
+T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), theta_i = q_i + theta_offset_i, and the
+end-effector frame T = T_1 T_2 ... T_n = [n o a p]. The pose is (x, y, z) = p in the length
+unit of the table (mm) and the Z-Y-Z Euler angles printed by wang7dof, in degrees:
+
+    beta = atan2(sqrt(n_z^2 + o_z^2), a_z),  alpha = atan2(a_y, a_x),  gamma = atan2(o_z, -n_z),
+
+so beta is in [0, 180] and the angles are singular at sin(beta) = 0 (see
+:func:`fkopt.rotations.zyz_angles`); :meth:`DHArm.frame` gives the rotation matrix itself for
+the geodesic error of :class:`fkopt.problems.IKProblem`.
+
+``dh-arm`` takes any table as geometry (``a``, ``alpha`` [deg], ``d``, ``theta_offset`` [deg],
+``limits`` [[lo, hi] deg per joint]); without overrides it is wang7dof's table, which the preset
+``7dof-arm`` fixes: a = (0, 200, 250, 300, 200, 200, 100) mm, alpha = (-90, 90, -90, 90, -90,
+0, 0) deg (printed as "rad" but they are degrees), d = (500, 0, 0, 0, 0, 0, 50) mm, limits
+(-180, 180), (-90, 30), (-90, 120), (-90, 90) x 3, (-30, 90) (the last printed "900", a typo).
+Products are written elementwise (no matmul), so results are bit-identical for any batch shape.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pydantic import Field, ValidationError, model_validator
+
+from .. import rotations
+from ..errors import FkoptError, did_you_mean
+from .base import Geometry, SerialMechanism, describe_validation_error
+
+WANG7DOF = dict(
+    a=[0.0, 200.0, 250.0, 300.0, 200.0, 200.0, 100.0],
+    alpha=[-90.0, 90.0, -90.0, 90.0, -90.0, 0.0, 0.0],
+    d=[500.0, 0.0, 0.0, 0.0, 0.0, 0.0, 50.0],
+    limits=[(-180.0, 180.0), (-90.0, 30.0), (-90.0, 120.0), (-90.0, 90.0), (-90.0, 90.0),
+            (-90.0, 90.0), (-30.0, 90.0)],
+)
+
+
+class DHGeometry(Geometry):
+    a: list[float] = Field(default_factory=lambda: list(WANG7DOF["a"]),
+                           description="link lengths a_i (mm)")
+    alpha: list[float] = Field(default_factory=lambda: list(WANG7DOF["alpha"]),
+                               description="link twists alpha_i (deg)")
+    d: list[float] = Field(default_factory=lambda: list(WANG7DOF["d"]), description="link offsets d_i (mm)")
+    theta_offset: list[float] | None = Field(None, description="joint angle offsets (deg), default 0")
+    limits: list[tuple[float, float]] = Field(default_factory=lambda: list(WANG7DOF["limits"]),
+                                              description="joint limits [lower, upper] per joint (deg)")
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        n = len(self.a)
+        if n < 1:
+            raise ValueError("the DH table needs at least 1 joint (a is empty)")
+        lengths = {"a": n, "alpha": len(self.alpha), "d": len(self.d), "limits": len(self.limits)}
+        if self.theta_offset is not None:
+            lengths["theta_offset"] = len(self.theta_offset)
+        if len(set(lengths.values())) > 1:
+            raise ValueError("DH table columns must have equal lengths, got "
+                             + ", ".join(f"{k}={v}" for k, v in lengths.items()))
+        for i, (lo, hi) in enumerate(self.limits):
+            if not lo < hi:
+                raise ValueError(f"limits[{i}] (joint q{i + 1}): lower {lo:g} must be below upper {hi:g}")
+        values = [*self.a, *self.alpha, *self.d, *(self.theta_offset or []),
+                  *(v for pair in self.limits for v in pair)]
+        if not np.all(np.isfinite(values)):
+            raise ValueError("DH table values must be finite")
+        return self
+
+
+class DHArm(SerialMechanism):
+    """Serial arm with revolute joints q1..qn (deg) described by a standard DH table."""
+
+    name = "dh-arm"
+    pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
+    pose_units = ("mm", "mm", "mm", "deg", "deg", "deg")
+    Geometry = DHGeometry
+    # Class-level values describe the default (wang7dof) table; each instance sets its own.
+    joint_names = tuple(f"q{i + 1}" for i in range(len(WANG7DOF["a"])))
+    joint_units = ("deg",) * len(WANG7DOF["a"])
+    default_bounds = dict(zip(joint_names, WANG7DOF["limits"]))
+
+    def __init__(self, bounds: dict[str, Any] | None = None, **geometry: Any):
+        # The joint names and default bounds depend on the table: validate it first, then set
+        # them on the instance before the base class builds the bounds from joint_names.
+        try:
+            table = self.Geometry(**geometry)
+        except ValidationError as err:
+            allowed = did_you_mean("", self.Geometry.model_fields)
+            raise FkoptError(describe_validation_error(err, f"{self.name} geometry").replace("Value error, ", "")
+                             + f" (geometry keys: {allowed})") from None
+        n = len(table.a)
+        self.joint_names = tuple(f"q{i + 1}" for i in range(n))
+        self.joint_units = ("deg",) * n
+        self.default_bounds = {f"q{i + 1}": tuple(lim) for i, lim in enumerate(table.limits)}
+        super().__init__(bounds, **geometry)
+        g = self.geometry
+        self._a = tuple(float(v) for v in g.a)
+        self._d = tuple(float(v) for v in g.d)
+        self._ca = tuple(float(np.cos(np.radians(v))) for v in g.alpha)
+        self._sa = tuple(float(np.sin(np.radians(v))) for v in g.alpha)
+        self._offset = tuple(float(v) for v in (g.theta_offset or [0.0] * n))
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
+    @property
+    def reach(self) -> float:
+        """Upper bound of the distance from the base origin to the tool point: sum sqrt(a^2 + d^2)."""
+        return float(sum(np.hypot(a, d) for a, d in zip(self._a, self._d)))
+
+    def frame(self, joints):
+        """End-effector frame as (p, R): p = (px, py, pz) and R a :data:`rotations.Matrix`
+        (nested tuples of arrays shaped like the batch), computed elementwise."""
+        joints = np.asarray(joints, dtype=float)
+        if joints.shape[-1] != self.dof:
+            raise FkoptError(f"{self.name} joints: expected {self.dof} values "
+                             f"({', '.join(self.joint_names)}), got shape {joints.shape}")
+        R = None
+        p = None
+        for i in range(self.dof):
+            t = np.radians(joints[..., i] + self._offset[i])
+            ct, st = np.cos(t), np.sin(t)
+            ca, sa, a, d = self._ca[i], self._sa[i], self._a[i], self._d[i]
+            # A_i = Rz(t) Tz(d) Tx(a) Rx(alpha)
+            Ai = ((ct, -st * ca, st * sa), (st, ct * ca, -ct * sa), (0.0, sa, ca))
+            pi = (a * ct, a * st, d)
+            if R is None:
+                R = tuple(tuple(np.broadcast_to(v, ct.shape) * 1.0 for v in row) for row in Ai)
+                p = tuple(np.broadcast_to(v, ct.shape) * 1.0 for v in pi)
+                continue
+            p = tuple(R[r][0] * pi[0] + R[r][1] * pi[1] + R[r][2] * pi[2] + p[r] for r in range(3))
+            R = tuple(tuple(R[r][0] * Ai[0][c] + R[r][1] * Ai[1][c] + R[r][2] * Ai[2][c]
+                            for c in range(3)) for r in range(3))
+        return p, R
+
+    def fk(self, joints) -> np.ndarray:
+        p, R = self.frame(joints)
+        alpha, beta, gamma = rotations.zyz_angles(R)
+        return np.stack([p[0], p[1], p[2], np.degrees(alpha), np.degrees(beta), np.degrees(gamma)], axis=-1)
+
+    def fk_matrix(self, joints) -> np.ndarray:
+        """Homogeneous end-effector transforms shaped (..., 4, 4)."""
+        p, R = self.frame(joints)
+        top = rotations.to_array(R)
+        pos = np.stack(p, axis=-1)[..., None]
+        upper = np.concatenate([top, pos], axis=-1)
+        last = np.broadcast_to(np.array([0.0, 0.0, 0.0, 1.0]), upper.shape[:-2] + (1, 4))
+        return np.concatenate([upper, last], axis=-2)
+
+
+class SevenDofArm(DHArm):
+    """The 7-DOF redundant arm of wang7dof (SPEC.md "wang7dof"); the table can still be overridden."""
+
+    name = "7dof-arm"
+    paper = "wang7dof"
