@@ -20,6 +20,14 @@ MECHANISMS: dict[str, str] = {
 ALGORITHMS: dict[str, str] = {
     "abc": "fkopt.algorithms.abc:ABC",
     "gabc": "fkopt.algorithms.gabc:GABC",
+    "aco": "fkopt.algorithms.aco:ACO",
+    "pso": "fkopt.algorithms.pso:PSO",
+    "pabc": "fkopt.algorithms.pabc:PABC",
+    "nr": "fkopt.algorithms.nr:NR",
+    "lm": "fkopt.algorithms.lm:LM",
+    "abc+lm": "fkopt.algorithms.hybrid:ABCLM",
+    "gabc+lm": "fkopt.algorithms.hybrid:GABCLM",
+    "pso+lm": "fkopt.algorithms.hybrid:PSOLM",
 }
 
 
