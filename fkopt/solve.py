@@ -97,9 +97,9 @@ def make_algorithm(algorithm: str | Algorithm, params: dict[str, Any] | None = N
     return algorithm_class(algorithm)(**(params or {}))
 
 
-def validate_budget(population: int, iterations: int, runs: int) -> None:
-    if int(population) < 2:
-        raise FkoptError(f"population must be at least 2, got {population}")
+def validate_budget(population: int, iterations: int, runs: int, local: bool = False) -> None:
+    if int(population) < (1 if local else 2):
+        raise FkoptError(f"population must be at least {1 if local else 2}, got {population}")
     if int(iterations) < 1:
         raise FkoptError(f"iterations must be at least 1, got {iterations}")
     if int(runs) < 1:
@@ -118,7 +118,7 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
     (``nr``, ``lm``); ``run_ids`` selects which runs of the seed to compute (default 0..runs-1).
     """
     algo = make_algorithm(algorithm, params)
-    validate_budget(population, iterations, runs)
+    validate_budget(population, iterations, runs, algo.local)
     ids = np.arange(runs) if run_ids is None else np.asarray(run_ids, dtype=int)
     if x0 is not None:
         x0 = np.asarray(x0, dtype=float)

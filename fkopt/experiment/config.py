@@ -74,7 +74,8 @@ class AlgorithmSpec(Strict):
     name: str
     label: str | None = None
     params: dict[str, Any] = Field(default_factory=dict)
-    population: int | None = Field(None, ge=2)
+    #: Overrides the experiment's population (number of starts for the local methods nr/lm, >= 1).
+    population: int | None = Field(None, ge=1)
     iterations: int | None = Field(None, ge=1)
     #: Start point of local methods (nr, lm): {variable: value}.
     start: dict[str, float] | None = None
