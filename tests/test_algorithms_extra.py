@@ -127,6 +127,27 @@ def test_aco_pheromone_and_snapshots(rps):
     assert np.all(np.diff(res.evaluation_history, axis=1) == 10)
 
 
+@pytest.mark.parametrize("params", [{"step_rule": "adaptive"}, {"local_scale": "width"}])
+def test_aco_step_variants_solve_sphere(params):
+    res = fkopt.solve(SphereProblem(), "aco", population=30, iterations=1000, runs=2, seed=2, params=params)
+    assert np.all(res.fitness < 1e-10)
+
+
+def test_aco_solves_wu2015_case():
+    """wu2015 Sec. 5: (20 mm, 30 mm, 15 deg); both exact branches fit the inputs (ppr3.py)."""
+    m = fkopt.mechanism("3-ppr")
+    joints = m.ik([20, 30, 15])
+    res = fkopt.solve(fkopt.fk_problem(m, joints), "aco", population=30, iterations=1000, runs=4,
+                      seed=1, snapshots=[0, 500, 1000])
+    branches = m.fk_exact(joints)                                  # (2, 3)
+    err = np.abs(res.x[:, None, :] - branches[None]).max(axis=-1).min(axis=-1)
+    assert np.median(res.fitness) < 1e-8 and np.median(err) < 1e-3   # wu2015 Tab. 1: ~1e-4
+    spread = {t: np.ptp(res.snapshots[t], axis=1) for t in (0, 500, 1000)}   # (runs, 3)
+    assert np.all(spread[0][:, :2] > 60)                           # Fig. 4: ants spread over the box
+    assert np.all(spread[1000][:, 1] < spread[0][:, 1] / 3)        # Fig. 5-6: they gather (in y;
+    # along theta they line the valley joining the two branches theta = +-15 deg)
+
+
 def test_aco_transfer_probability_reading():
     tau = np.array([[-1.0, -1.5, -3.0, -1.0], [0.0, -2.0, 0.0, -1e-300]])
     P = ACO.transfer_probability(tau)

@@ -21,29 +21,41 @@ Ants within a factor 1 + P0 of the best pheromone search locally, the others glo
 and corresponds to P0' = P0 / (1 + P0).) If tau_b = 0 (an exact zero of f), P_j = 0 for ants
 at pheromone 0 and +inf for the others.
 
-Step sizes (not printed by wu2015; named parameters here). Each coordinate j moves by
-(2u - 1) * s * width_j, u ~ U[0, 1), width_j the box width, then the point is clipped:
+Step sizes (not printed by wu2015; named parameters here). A move adds (2u - 1) * h_j to each
+coordinate j (u ~ U[0, 1) per coordinate), then the point is clipped onto the box:
 
-* local search: s = local_step * shrink^((t - 1) / (T - 1)) at iteration t of T, i.e. a
-  geometric decay from ``local_step`` (default 0.1 of the box) at the first iteration to
-  ``local_step * shrink`` (default 1e-7 of that) at the last -- the MATLAB example's shrinking
-  radius lambda = 1/t made budget-relative so every budget ends at a fine resolution;
-* global search: s = ``global_step`` (default 0.5: a jump uniform over +- half the box width
-  around the ant, as the MATLAB example's (upper - lower)(rand - 0.5)), constant.
+* global search: h_j = ``global_step`` * width_j (default 0.5: a jump uniform over +- half the
+  box around the ant, as the MATLAB example's (upper - lower)(rand - 0.5)), constant;
+* local search: h_j = s * L_j, with
+  - L_j (``local_scale``): "common" (default) = the mean box width, the same length in every
+    coordinate (like the MATLAB example's absolute radius lambda), or "width" = width_j;
+  - s (``step_rule``): "schedule" (default) = ``local_step`` * ``shrink``^((t - 1)/(T - 1)) at
+    iteration t of T, a geometric decay from ``local_step`` (0.1) at the first iteration to
+    ``local_step * shrink`` (shrink = 1e-7) at the last -- the MATLAB example's shrinking radius
+    lambda = 1/t, made budget-relative so every budget ends at a fine resolution; or
+    "adaptive" = a per-ant radius starting at ``local_step``, multiplied by ``expand`` (1.5)
+    after a successful local move and by ``contract`` (0.9036 = 1.5^(-1/4), Rechenberg's 1/5
+    success rule) after a failed one -- not in the paper, offered because it is much stronger.
 
-Defaults: rho = 0.1 (the MATLAB example's 1 - Rho with Rho = 0.9). P0 = 2 (an ant searches
-locally while its pheromone is within a factor 3 of the best's), local_step = 0.1 and
-shrink = 1e-7 were tuned on a 3-D sphere (30 ants reach < 1e-15 in 1000 iterations) and on the
-3-RPS case (10 ants, 600 iterations, 200 runs: all < 1e-6, median ~1e-12). A faster decay
-(shrink 1e-9) gives a finer median but strands more runs in 3-RPS's narrow curved valley,
-where a lagging ant's shrinking step can no longer follow it; P0 = 0.2 (the MATLAB example)
-leaves too few ants searching locally once the best one is far ahead. Each
-iteration costs ``population`` evaluations (one per ant), so "after 500 moves" (wu2015
+Defaults: rho = 0.1 (the MATLAB example's 1 - Rho with Rho = 0.9), P0 = 10 (an ant searches
+locally while its pheromone is within a factor 11 of the best's; with the accumulated
+pheromone most ants search globally after the first iterations, ~3 % locally at the end).
+Tuned on a 3-D sphere (30 ants, 1000 iterations: < 1e-14), the 3-RPS case of mao2017 (10 ants,
+600 iterations, 200 runs: median 2e-12, all < 2e-11) and the 3-PPR case of wu2015 (30 ants, 1000
+iterations, 200 runs: median 9e-12, 6.5 % above 1e-6). Why: per-coordinate box-width scaling
+makes the 3-PPR valley ~5x worse conditioned than common scaling (condition of f 246 vs 50),
+so ants creep and the schedule outruns them (median 5e-3 with "width", 98 % above 1e-6); a faster decay
+(shrink 1e-9) or a smaller P0 (MATLAB's 0.2) strands more runs in those narrow valleys. With
+step_rule="adaptive": 3-PPR median 5e-12 (none above 1e-7), 3-RPS median 2e-19.
+
+Each iteration costs ``population`` evaluations (one per ant), so "after 500 moves" (wu2015
 Fig. 5) is iteration 500. ``state.x`` are the ant positions; the extras ``pheromone_best``
-(tau_b) and ``pheromone_mean`` (tau_m of the accumulated pheromone) are recorded per run and
-iteration (wu2015 Fig. 7).
+(tau_b) and ``pheromone_mean`` (tau_m, of the accumulated pheromone of eq. 19) are recorded per
+run and iteration (wu2015 Fig. 7).
 """
 from __future__ import annotations
+
+from typing import Literal
 
 import numpy as np
 from pydantic import Field
@@ -53,14 +65,22 @@ from .budget import BudgetAware
 
 
 class ACOParams(Params):
-    P0: float = Field(2.0, ge=0, description="transfer probability constant: P < P0 -> local search")
+    P0: float = Field(10.0, ge=0, description="transfer probability constant: P < P0 -> local search")
     rho: float = Field(0.1, ge=0, lt=1, description="pheromone residue in tau <- rho tau_old + tau_new")
-    local_step: float = Field(0.1, gt=0, description="local search half-width at the first "
-                              "iteration, fraction of the box width")
-    shrink: float = Field(1e-7, gt=0, le=1, description="local half-width at the last iteration "
-                          "divided by local_step (geometric decay over the iterations)")
-    global_step: float = Field(0.5, gt=0, description="global search half-width, fraction of the "
-                               "box width")
+    global_step: float = Field(0.5, gt=0, description="global search half-width, fraction of each "
+                               "coordinate's box width")
+    local_scale: Literal["common", "width"] = Field(
+        "common", description="length unit of local moves: the mean box width in every coordinate, "
+        "or each coordinate's own width")
+    local_step: float = Field(0.1, gt=0, description="local half-width at the first iteration "
+                              "(schedule) or initial per-ant half-width (adaptive), in local_scale units")
+    step_rule: Literal["schedule", "adaptive"] = Field(
+        "schedule", description="local half-width: geometric decay over the iterations, or per-ant "
+        "1/5 success rule")
+    shrink: float = Field(1e-7, gt=0, le=1, description="schedule: local half-width at the last "
+                          "iteration divided by local_step")
+    expand: float = Field(1.5, ge=1, description="adaptive: factor after a successful local move")
+    contract: float = Field(0.9036, gt=0, le=1, description="adaptive: factor after a failed local move")
 
 
 class ACO(BudgetAware):
@@ -72,6 +92,7 @@ class ACO(BudgetAware):
         x = uniform_in(problem.bounds, streams.uniform(population, problem.dim))
         f = problem.fitness(x)
         return State(x=x, f=f, tau=-f, aco_t=0, aco_span=self.budget(),
+                     step=np.full(f.shape, self.params.local_step),
                      evaluations=np.full(streams.runs, population, dtype=np.int64))
 
     def local_half_width(self, state) -> float:
@@ -84,7 +105,7 @@ class ACO(BudgetAware):
         """P_j = (tau_b - tau_j) / |tau_b| per run (see the module docstring), shape like tau."""
         best = tau.max(axis=1, keepdims=True)
         gap = best - tau
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             P = gap / np.abs(best)
         return np.where(gap == 0, 0.0, P)
 
@@ -93,12 +114,16 @@ class ACO(BudgetAware):
         state.aco_t += 1
         runs, population, dim = state.x.shape
         local = self.transfer_probability(state.tau) < p.P0
-        half = np.where(local, self.local_half_width(state), p.global_step)[..., None]
         width = problem.bounds[:, 1] - problem.bounds[:, 0]
+        unit = width if p.local_scale == "width" else np.full(dim, width.mean())
+        s = state.step if p.step_rule == "adaptive" else self.local_half_width(state)
+        h = np.where(local[..., None], np.asarray(s)[..., None] * unit, p.global_step * width)
         u = streams.uniform(population, dim)
-        cand = clip(state.x + (2.0 * u - 1.0) * half * width, problem.bounds)
+        cand = clip(state.x + (2.0 * u - 1.0) * h, problem.bounds)
         fc = problem.fitness(cand)
         better = fc < state.f
+        if p.step_rule == "adaptive":
+            state.step = np.where(local, state.step * np.where(better, p.expand, p.contract), state.step)
         state.x = np.where(better[..., None], cand, state.x)
         state.f = np.where(better, fc, state.f)
         state.tau = p.rho * state.tau - state.f
