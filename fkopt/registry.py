@@ -11,6 +11,8 @@ from .errors import FkoptError, did_you_mean
 
 MECHANISMS: dict[str, str] = {
     "3-rps": "fkopt.mechanisms.rps3:ThreeRPS",
+    "6-sps": "fkopt.mechanisms.sps6:SixSPS",
+    "6-sps-cmm": "fkopt.mechanisms.sps6:SixSPSCMM",
     "3-rpupc-ups": "fkopt.mechanisms.rpupc_ups:ThreeRPUPcUPS",
     "3-ppr": "fkopt.mechanisms.ppr3:ThreePPR",
     "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",

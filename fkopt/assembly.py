@@ -1,0 +1,629 @@
+"""All assembly modes: every distinct real forward solution inside the bounds.
+
+A swarm finds *one* pose whose inverse map matches the measured inputs; a parallel mechanism
+usually has several (a general 6-SPS platform up to 40, Dietmaier 1998). :func:`all_solutions`
+finds them all, numerically, for any :class:`~fkopt.mechanisms.base.ParallelMechanism` with as
+many inputs as pose variables:
+
+1. **Starts** come in rounds drawn from one seeded stream (:class:`fkopt.streams.RunStreams`).
+   For a 6-SPS platform a start is a rotation -- uniform on SO(3) (Shoemake's quaternions) when
+   the angle bounds cover a full turn, else uniform Euler angles inside the bounds -- and the
+   position that best satisfies, in least squares, the five *linear* equations obtained by
+   subtracting leg 1's equation |R q_i + t - b_i|^2 = L_i^2 from the others. Only rotations are
+   sampled, so no position box has to be guessed. For other mechanisms a start is uniform in
+   the bounds.
+2. **Damped Newton**, vectorised over all starts of a round: for 6-SPS on the leg equations
+   (|v_i|^2 - L_i^2) / (2 L_i) = 0 with the analytic Jacobian [v_i, (R q_i) x v_i] / L_i in the
+   position and a rotation vector (R <- exp([w]x) R, so no Euler singularity during the
+   search); for other mechanisms on ``FKProblem.residuals`` with a central-difference Jacobian.
+   Steps are capped (1 rad of rotation / a quarter of the bounds width) and halved up to 8
+   times until the squared residual decreases (backtracking line search). A start stops when
+   converged (then one more polishing step), diverged, stalled or out of iterations.
+3. **Deduplication** with the stated tolerance ``dedup``: two converged starts are one
+   solution when they differ by at most ``dedup`` in the normalised pose space -- length
+   variables divided by their bounds width, angle variables in radians compared modulo 2 pi,
+   and for 6-SPS the rotation compared by its matrix (max entry difference), so the Euler
+   equivalences (a, b, g) ~ (a + 180, 180 - b, g + 180) ~ (a + 360 k, ...) never split a
+   solution. For other mechanisms whose pose holds a Tait-Bryan triple (alpha, beta, gamma)
+   the triple is first mapped to the representative with beta in [-90, 90] (valid for every
+   Tait-Bryan sequence) when that representative has the same inputs.
+4. **Check**: the pose of each solution is written in the mechanism's own variables (Z-Y-X
+   Euler degrees for 6-SPS, angles moved into the bounds by multiples of 360 deg or by the
+   Euler equivalence), its residual ``max |ik(pose) - joints|`` recomputed with the
+   mechanism's inverse map; it is kept if that residual is at most ``tol * max(1, |joint|)``
+   for every joint and the pose is inside the bounds (solutions found outside are counted in
+   ``Solutions.outside``).
+
+Rounds continue until ``patience`` consecutive rounds bring no new solution (or ``max_starts``
+is reached); ``starts=N`` instead runs exactly N starts in one round. ``Solutions.history``
+records (starts, seconds, solutions found) after every round.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .errors import FkoptError
+from .mechanisms.base import Mechanism, ParallelMechanism
+from .problems import FKProblem
+from .streams import RunStreams
+
+
+@dataclass
+class Solution:
+    """One assembly mode: its pose (mechanism variables), residual max |ik - joints|, and how many starts found it."""
+
+    pose: dict[str, float]
+    residual: float
+    hits: int
+
+    @property
+    def x(self) -> np.ndarray:
+        return np.array(list(self.pose.values()))
+
+
+class Solutions(list):
+    """List of :class:`Solution` (most hits first) with the search's bookkeeping as attributes."""
+
+    starts: int = 0
+    time_s: float = 0.0
+    outside: int = 0
+    history: list[tuple[int, float, int]]
+    settings: dict[str, Any]
+
+    def poses(self) -> np.ndarray:
+        return np.array([s.x for s in self]) if len(self) else np.empty((0, 0))
+
+
+def solutions_to_dict(solutions: Solutions) -> dict[str, Any]:
+    """JSON-able form: ``{"solutions": [{"pose", "residual", "hits"}], "starts", "time_s", ...}``."""
+    return {
+        "solutions": [{"pose": {k: float(v) for k, v in s.pose.items()}, "residual": float(s.residual),
+                       "hits": int(s.hits)} for s in solutions],
+        "starts": int(getattr(solutions, "starts", 0)),
+        "time_s": float(getattr(solutions, "time_s", 0.0)),
+        "outside": int(getattr(solutions, "outside", 0)),
+        "history": [list(h) for h in getattr(solutions, "history", [])],
+    }
+
+
+# ------------------------------------------------------------------------------------------
+# Models: how a start is drawn, how a state is updated, how it maps to the mechanism's pose
+# ------------------------------------------------------------------------------------------
+class _Model:
+    """A state batch S (n, k) on which the damped Newton loop works."""
+
+    def starts(self, u: np.ndarray) -> np.ndarray:                      # u: (n, draws) uniforms
+        raise NotImplementedError
+
+    draws: int
+
+    def residual(self, S) -> np.ndarray:                                # (n, m)
+        raise NotImplementedError
+
+    def residual_jacobian(self, S) -> tuple[np.ndarray, np.ndarray]:    # (n, m), (n, m, m)
+        raise NotImplementedError
+
+    def step(self, S, dx) -> np.ndarray:
+        raise NotImplementedError
+
+    def cap(self, dx) -> np.ndarray:
+        """Factor (n,) <= 1 limiting the Newton step."""
+        raise NotImplementedError
+
+    def diverged(self, S) -> np.ndarray:
+        return np.zeros(len(S), dtype=bool)
+
+    def keys(self, S) -> np.ndarray:
+        """Coordinates (n, k) in which duplicates are within ``dedup`` (max norm)."""
+        raise NotImplementedError
+
+    def poses(self, S) -> np.ndarray:
+        """Mechanism pose vectors (n, dim), angles not yet moved into the bounds."""
+        raise NotImplementedError
+
+    def from_poses(self, X) -> np.ndarray:
+        """States of mechanism pose vectors (n, dim) (inverse of :meth:`poses`)."""
+        raise NotImplementedError
+
+
+def _rotation_from_quaternion(w, x, y, z):
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+
+
+def _zyx_matrix(a, b, g):
+    """(n, 3, 3) Z-Y-X Euler matrix, angles in radians (same convention as fkopt.rotations.zyx)."""
+    ca, sa, cb, sb, cg, sg = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(g), np.sin(g)
+    return np.stack([
+        np.stack([cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa], -1),
+        np.stack([sg * cb, sg * sb * sa + cg * ca, sg * sb * ca - cg * sa], -1),
+        np.stack([-sb, cb * sa, cb * ca], -1)], -2)
+
+
+def _zyx_angles(R):
+    """Z-Y-X Euler angles (degrees, beta in [-90, 90]) of (n, 3, 3) rotation matrices."""
+    beta = np.arctan2(-R[:, 2, 0], np.hypot(R[:, 0, 0], R[:, 1, 0]))
+    alpha = np.arctan2(R[:, 2, 1], R[:, 2, 2])
+    gamma = np.arctan2(R[:, 1, 0], R[:, 0, 0])
+    return np.degrees(np.stack([alpha, beta, gamma], -1))
+
+
+def _rotate(w, R):
+    """exp([w]x) R for rotation vectors w (n, 3) and row-major matrices R (n, 9), elementwise
+    (Rodrigues: exp([w]x) = I + a [w]x + b [w]x^2 with [w]x^2 = w w^T - |w|^2 I)."""
+    w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
+    th2 = w0 * w0 + w1 * w1 + w2 * w2
+    small = th2 < 1e-8
+    th = np.sqrt(np.where(small, 1.0, th2))
+    a = np.where(small, 1.0 - th2 / 6.0, np.sin(th) / th)
+    b = np.where(small, 0.5 - th2 / 24.0, (1.0 - np.cos(th)) / (th * th))
+    d = 1.0 - b * th2
+    bw0, bw1, bw2 = b * w0, b * w1, b * w2
+    aw0, aw1, aw2 = a * w0, a * w1, a * w2
+    E = ((bw0 * w0 + d, bw0 * w1 - aw2, bw0 * w2 + aw1),
+         (bw1 * w0 + aw2, bw1 * w1 + d, bw1 * w2 - aw0),
+         (bw2 * w0 - aw1, bw2 * w1 + aw0, bw2 * w2 + d))
+    out = np.empty((len(w), 9))
+    for k in range(3):
+        for j in range(3):
+            out[:, 3 * k + j] = E[k][0] * R[:, j] + E[k][1] * R[:, 3 + j] + E[k][2] * R[:, 6 + j]
+    return out
+
+
+#: Batch size from which the 6-SPS model evaluates legs elementwise rather than by matmul.
+_SOA_MIN = 256
+
+
+class _SixSPSModel(_Model):
+    """State S = (t (3), R (9 row-major)); t is the pose position p_s, l_i = R q_i + t - b_i."""
+
+    def __init__(self, mechanism, joints):
+        base, platform, probe = mechanism.points()
+        self.base = base
+        self.q = platform - probe
+        self.L = joints
+        self.L2 = joints * joints
+        self.inv_L = 1.0 / joints
+        self.half_inv_L = 0.5 / joints
+        self.qT = np.ascontiguousarray(self.q.T)
+        self.bT = np.ascontiguousarray(base.T)
+        self.mechanism = mechanism
+        ang = mechanism.bounds[3:6]
+        width = ang[:, 1] - ang[:, 0]
+        # Uniform on SO(3) when alpha and gamma turn fully and beta spans [-90, 90].
+        self.full = bool(width[0] >= 360 and width[2] >= 360 and ang[1, 0] <= -90 and ang[1, 1] >= 90)
+        self.angle_bounds = np.radians(ang)
+        self.scale = float(np.abs(joints).max() + np.linalg.norm(base, axis=1).max()
+                           + np.linalg.norm(self.q, axis=1).max())
+        self.draws = 3
+
+    def starts(self, u):
+        if self.full:
+            u1, u2, u3 = u[:, 0], 2 * np.pi * u[:, 1], 2 * np.pi * u[:, 2]
+            a, b = np.sqrt(1 - u1), np.sqrt(u1)
+            R = _rotation_from_quaternion(a * np.sin(u2), a * np.cos(u2), b * np.sin(u3), b * np.cos(u3))
+        else:
+            lo, hi = self.angle_bounds[:, 0], self.angle_bounds[:, 1]
+            e = lo + (hi - lo) * u
+            R = _zyx_matrix(e[:, 0], e[:, 1], e[:, 2])
+        # Position from the five linear equations (leg i minus leg 1), least squares.
+        w = np.einsum("nkj,ij->nik", R, self.q) - self.base        # R q_i - b_i
+        c = self.L2 - (w * w).sum(-1)                              # |t|^2 + 2 t.w_i = c_i
+        A = 2.0 * (w[:, 1:] - w[:, :1])
+        d = c[:, 1:] - c[:, :1]
+        AtA = np.einsum("nij,nik->njk", A, A) + 1e-12 * np.eye(3)
+        t = np.linalg.solve(AtA, np.einsum("nij,ni->nj", A, d)[..., None])[..., 0]
+        return np.concatenate([t, R.reshape(-1, 9)], axis=1)
+
+    def _legs(self, S):
+        t, R = S[:, :3], S[:, 3:].reshape(-1, 3, 3)
+        w = R @ self.qT                                            # (n, 3, 6): R q_i
+        v = w + (t[:, :, None] - self.bT)
+        f = ((v * v).sum(1) - self.L2) * self.half_inv_L
+        return f, v, w
+
+    def _legs_soa(self, S, jac):
+        """Same as :meth:`_legs` (+ Jacobian), elementwise per leg: faster for large batches."""
+        n = len(S)
+        t = S[:, 0], S[:, 1], S[:, 2]
+        R = [[S[:, 3 + 3 * k + j] for j in range(3)] for k in range(3)]
+        f = np.empty((6, n)).T
+        J = np.empty((n, 6, 6)) if jac else None
+        for i in range(6):
+            q, b = self.q[i], self.base[i]
+            w, v = [], []
+            acc = None
+            for k in range(3):
+                wk = None
+                for j in range(3):
+                    if q[j] != 0.0:
+                        wk = R[k][j] * q[j] if wk is None else wk + R[k][j] * q[j]
+                if wk is None:
+                    wk = np.zeros(n)
+                vk = wk + (t[k] - b[k])
+                w.append(wk)
+                v.append(vk)
+                acc = vk * vk if acc is None else acc + vk * vk
+            f[:, i] = (acc - self.L2[i]) * self.half_inv_L[i]
+            if jac:
+                il, Ji = self.inv_L[i], J[:, i]
+                Ji[:, 0], Ji[:, 1], Ji[:, 2] = v[0] * il, v[1] * il, v[2] * il
+                Ji[:, 3] = (w[1] * v[2] - w[2] * v[1]) * il             # (R q_i) x v_i
+                Ji[:, 4] = (w[2] * v[0] - w[0] * v[2]) * il
+                Ji[:, 5] = (w[0] * v[1] - w[1] * v[0]) * il
+        return f, J
+
+    def residual(self, S):
+        if len(S) >= _SOA_MIN:
+            return self._legs_soa(S, False)[0]
+        return self._legs(S)[0]
+
+    def residual_jacobian(self, S):
+        if len(S) >= _SOA_MIN:
+            return self._legs_soa(S, True)
+        f, v, w = self._legs(S)
+        J = np.empty((len(S), 6, 6))
+        J[:, :, :3] = np.swapaxes(v, 1, 2)
+        J[:, :, 3] = w[:, 1] * v[:, 2] - w[:, 2] * v[:, 1]          # (R q_i) x v_i
+        J[:, :, 4] = w[:, 2] * v[:, 0] - w[:, 0] * v[:, 2]
+        J[:, :, 5] = w[:, 0] * v[:, 1] - w[:, 1] * v[:, 0]
+        J *= self.inv_L[:, None]
+        return f, J
+
+    def step(self, S, dx):
+        out = np.empty_like(S)
+        out[:, :3] = S[:, :3] + dx[:, :3]
+        out[:, 3:] = _rotate(dx[:, 3:], S[:, 3:])
+        return out
+
+    def cap(self, dx):
+        rot = np.sqrt((dx[:, 3:] ** 2).sum(-1))
+        pos = np.sqrt((dx[:, :3] ** 2).sum(-1)) / self.scale
+        return 1.0 / np.maximum(1.0, np.maximum(rot, pos))
+
+    def diverged(self, S):
+        return np.abs(S[:, :3]).max(-1) > 100.0 * self.scale
+
+    def keys(self, S):
+        width = self.mechanism.bounds[:3, 1] - self.mechanism.bounds[:3, 0]
+        return np.concatenate([S[:, :3] / width, S[:, 3:]], axis=1)
+
+    def poses(self, S):
+        R = S[:, 3:].reshape(-1, 3, 3)
+        # Re-orthonormalise (Newton's products of exponentials drift at round-off level).
+        u, _, vt = np.linalg.svd(R)
+        R = u @ vt
+        return np.concatenate([S[:, :3], _zyx_angles(R)], axis=1)
+
+    def from_poses(self, X):
+        a = np.radians(X[:, 3:6])
+        R = _zyx_matrix(a[:, 0], a[:, 1], a[:, 2])
+        return np.concatenate([X[:, :3], R.reshape(-1, 9)], axis=1)
+
+
+class _GenericModel(_Model):
+    """Newton on FKProblem residuals in the mechanism's own pose variables (central differences)."""
+
+    def __init__(self, mechanism, joints):
+        self.problem = FKProblem(mechanism, joints)
+        self.mechanism = mechanism
+        self.lo, self.hi = mechanism.bounds[:, 0], mechanism.bounds[:, 1]
+        self.width = self.hi - self.lo
+        self.angle = mechanism.angle_mask(mechanism.pose_units)
+        self.h = 1e-6 * self.width
+        self.draws = len(self.lo)
+        self.triple = _euler_triple(mechanism)
+
+    def starts(self, u):
+        return self.lo + self.width * u
+
+    def residual(self, S):
+        return self.problem.residuals(S)
+
+    def residual_jacobian(self, S):
+        n, d = S.shape
+        E = np.eye(d) * self.h
+        pts = np.concatenate([S[:, None, :], S[:, None, :] + E, S[:, None, :] - E], axis=1)
+        r = self.problem.residuals(pts)                            # (n, 1 + 2d, m)
+        J = (r[:, 1:d + 1] - r[:, d + 1:]) / (2.0 * self.h[None, :, None])
+        return r[:, 0], np.swapaxes(J, 1, 2)
+
+    def step(self, S, dx):
+        return S + dx
+
+    def cap(self, dx):
+        return 1.0 / np.maximum(1.0, np.abs(dx / (0.25 * self.width)).max(-1))
+
+    def diverged(self, S):
+        return (np.abs((S - self.lo) / self.width) > 100.0).any(-1) | ~np.isfinite(S).all(-1)
+
+    def _canonical(self, S):
+        """Angles modulo 360, and a Tait-Bryan triple moved to beta in [-90, 90] when equivalent."""
+        S = S.copy()
+        if self.triple is not None:
+            a, b, g = self.triple
+            beta = _wrap(S[:, b])
+            flip = np.abs(beta) > 90.0
+            if flip.any():
+                alt = S[flip].copy()
+                alt[:, a] += 180.0
+                alt[:, b] = 180.0 - alt[:, b]
+                alt[:, g] += 180.0
+                ik_alt, ik_s = self.mechanism.ik(alt), self.mechanism.ik(S[flip])
+                same = np.abs(ik_alt - ik_s).max(-1) <= 1e-9 * (1.0 + np.abs(ik_s).max(-1))
+                idx = np.flatnonzero(flip)[same]
+                S[idx] = alt[same]
+        S[:, self.angle] = _wrap(S[:, self.angle])
+        return S
+
+    def keys(self, S):
+        C = self._canonical(S)
+        out = C / np.where(self.angle, 1.0, self.width)
+        out[:, self.angle] = np.radians(C[:, self.angle])
+        # Angles close to +-180 deg: compare through (cos, sin) so that -179.9999 ~ 179.9999.
+        return np.concatenate([out[:, ~self.angle], np.cos(out[:, self.angle]), np.sin(out[:, self.angle])], axis=1)
+
+    def poses(self, S):
+        return self._canonical(S)
+
+    def from_poses(self, X):
+        return np.array(X, dtype=float)
+
+
+def _euler_triple(mechanism):
+    names = mechanism.pose_names
+    if all(n in names for n in ("alpha", "beta", "gamma")):
+        idx = tuple(names.index(n) for n in ("alpha", "beta", "gamma"))
+        if all(mechanism.pose_units[i] == "deg" for i in idx):
+            return idx
+    return None
+
+
+def _wrap(d):
+    return (np.asarray(d) + 180.0) % 360.0 - 180.0
+
+
+# ------------------------------------------------------------------------------------------
+# Damped Newton, vectorised over starts
+# ------------------------------------------------------------------------------------------
+def _solve(J, f):
+    try:
+        return np.linalg.solve(J, -f[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return -np.einsum("nij,nj->ni", np.linalg.pinv(J), f)
+
+
+def _sumsq(f):
+    out = f[:, 0] * f[:, 0]
+    for k in range(1, f.shape[1]):
+        out += f[:, k] * f[:, k]
+    return out
+
+
+def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvings: int = 8):
+    """Damped Newton from every row of S. Returns (S, converged mask).
+
+    Rows that finish (converged and polished, stalled, singular, diverged) are written back
+    and dropped from the working arrays, so late iterations only cost what is still running.
+    """
+    out = S.copy()
+    conv = np.zeros(len(S), dtype=bool)
+    idx = np.arange(len(S))
+    S = S.copy()
+    f, J = model.residual_jacobian(S)
+    F = _sumsq(f)
+    polish = np.zeros(len(S), dtype=bool)
+    for _ in range(iterations):
+        if not len(idx):
+            break
+        dx = _solve(J, f)
+        ok = np.isfinite(dx).all(-1)
+        dx[~ok] = 0.0
+        dx *= model.cap(dx)[:, None]
+        # Backtracking: full step for all, then half steps, then the remaining halvings
+        # (1/4 ... 1/2^halvings) evaluated together, taking the longest that decreases F.
+        accepted = np.zeros(len(idx), dtype=bool)
+        pending = np.arange(len(idx))
+        for lams in ([1.0], [0.5], [0.5 ** h for h in range(2, halvings + 1)]):
+            if not len(pending):
+                break
+            k = len(lams)
+            rows = np.repeat(pending, k)
+            lam = np.tile(lams, len(pending))
+            cand = model.step(S[rows], dx[rows] * lam[:, None])
+            Fc = _sumsq(model.residual(cand))
+            # Polishing steps (already converged) are taken unconditionally.
+            good = (((Fc < F[rows]) | polish[rows]) & np.isfinite(Fc)).reshape(-1, k)
+            hit = good.any(-1)
+            first = np.argmax(good, axis=-1)
+            pick = np.flatnonzero(hit) * k + first[hit]
+            sel = pending[hit]
+            S[sel], F[sel] = cand[pick], Fc[pick]
+            accepted[sel] = True
+            pending = pending[~hit]
+        newly = (F <= ftol * ftol) & ~polish & ok
+        finished = polish | ~accepted | ~ok | model.diverged(S)
+        conv[idx[newly]] = True
+        polish |= newly
+        out[idx[finished]] = S[finished]
+        keep = ~finished
+        idx, S, F, polish = idx[keep], S[keep], F[keep], polish[keep]
+        if len(idx):
+            f, J = model.residual_jacobian(S)
+    out[idx] = S
+    return out, conv
+
+
+def _cluster(keys: np.ndarray, tol: float) -> np.ndarray:
+    """Label rows whose keys are within ``tol`` (max norm) of a representative: greedy, vectorised."""
+    labels = np.full(len(keys), -1)
+    k = 0
+    while True:
+        rest = np.flatnonzero(labels < 0)
+        if not len(rest):
+            return labels
+        near = np.abs(keys[rest] - keys[rest[0]]).max(-1) <= tol
+        labels[rest[near]] = k
+        k += 1
+
+
+def _into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> np.ndarray | None:
+    """Move angle variables into the bounds by multiples of 360 deg (and the Euler equivalence)."""
+    lo, hi = mechanism.bounds[:, 0], mechanism.bounds[:, 1]
+    angle = mechanism.angle_mask(mechanism.pose_units)
+    candidates = [x]
+    if triple is not None:
+        a, b, g = triple
+        alt = x.copy()
+        alt[a] += 180.0
+        alt[b] = 180.0 - alt[b]
+        alt[g] += 180.0
+        candidates.append(alt)
+    for c in candidates:
+        c = c.copy()
+        ok = True
+        for i in np.flatnonzero(angle):
+            v = lo[i] + (c[i] - lo[i]) % 360.0           # smallest representative >= lo
+            if v > hi[i] + 1e-9 and v - 360.0 >= lo[i] - 1e-9:
+                v -= 360.0                                 # round-off just below lo
+            if v > hi[i] + 1e-9:
+                ok = False
+                break
+            c[i] = v
+        if ok and mechanism.in_bounds(c):
+            # Prefer the plain wrap to [-180, 180) when that is inside the bounds too.
+            w = c.copy()
+            w[angle] = _wrap(w[angle])
+            return w if mechanism.in_bounds(w) else c
+    return None
+
+
+def _model_for(mechanism, joints):
+    from .mechanisms.sps6 import SixSPS
+    if isinstance(mechanism, SixSPS):
+        if np.any(joints <= 0):
+            raise FkoptError(f"{mechanism.name} joints: leg lengths must be positive, got {joints.tolist()}")
+        return _SixSPSModel(mechanism, joints)
+    return _GenericModel(mechanism, joints)
+
+
+def pose_distance(mechanism: ParallelMechanism, a, b) -> np.ndarray:
+    """Distance between poses ``a`` and ``b`` (..., dim) as :func:`all_solutions` dedupes them.
+
+    Max norm in the normalised pose space: length variables divided by their bounds width,
+    angles in radians modulo 2 pi (through cos and sin), and for 6-SPS the rotation compared
+    by its matrix entries, so Euler-equivalent poses are at distance ~0.
+    """
+    a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+    shape = a.shape[:-1]
+    A, B = a.reshape(-1, a.shape[-1]), b.reshape(-1, b.shape[-1])
+    model = _model_for(mechanism, np.atleast_1d(mechanism.ik(A[0])))
+    ka, kb = model.keys(model.from_poses(A)), model.keys(model.from_poses(B))
+    return np.abs(ka - kb).max(-1).reshape(shape)
+
+
+def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = None, seed: int = 0,
+                  tol: float = 1e-9, dedup: float = 1e-6, round_size: int | None = None,
+                  patience: int = 1, min_starts: int | None = None, max_starts: int = 200_000,
+                  iterations: int = 60) -> Solutions:
+    """Every distinct real forward solution of ``mechanism`` for ``joints`` inside its bounds.
+
+    ``starts``: run exactly this many starts (one round); by default rounds of ``round_size``
+    starts (2000 for 6-SPS, 200 otherwise) run until ``patience`` consecutive rounds add no
+    solution, after at least ``min_starts`` (default 2 rounds) and at most ``max_starts``.
+    ``tol``: accepted residual, ``max_i |ik(pose)_i - joints_i| / max(1, |joints_i|)``.
+    ``dedup``: duplicate tolerance in the normalised pose space (see the module docstring).
+    ``seed``: the start stream (``RunStreams(seed, [0])``); same seed, same answer.
+    """
+    if not isinstance(mechanism, ParallelMechanism):
+        raise FkoptError(f"all_solutions needs a parallel mechanism; '{mechanism.name}' is {mechanism.kind}")
+    if isinstance(joints, dict):
+        joints = mechanism.vector(joints, mechanism.joint_names, "joints")
+    joints = np.asarray(joints, dtype=float)
+    if joints.shape != (len(mechanism.joint_names),):
+        raise FkoptError(f"{mechanism.name} joints: expected {len(mechanism.joint_names)} values "
+                         f"({', '.join(mechanism.joint_names)}), got shape {joints.shape}")
+    if len(mechanism.joint_names) != len(mechanism.pose_names):
+        raise FkoptError(f"all_solutions needs as many joints as pose variables; {mechanism.name} has "
+                         f"{len(mechanism.joint_names)} and {len(mechanism.pose_names)}")
+    for name, value in (("tol", tol), ("dedup", dedup)):
+        if not value > 0:
+            raise FkoptError(f"all_solutions {name}: must be positive, got {value}")
+    if starts is not None and int(starts) < 1:
+        raise FkoptError(f"all_solutions starts: must be at least 1, got {starts}")
+
+    t0 = time.perf_counter()
+    model = _model_for(mechanism, joints)
+    triple = (3, 4, 5) if isinstance(model, _SixSPSModel) else _euler_triple(mechanism)
+    if starts is not None:
+        size, limit, need = int(starts), int(starts), int(starts)
+    else:
+        size = int(round_size or (2000 if isinstance(model, _SixSPSModel) else 200))
+        limit, need = int(max_starts), int(min_starts if min_starts is not None else 2 * size)
+    streams = RunStreams(seed, [0])
+    jscale = np.maximum(1.0, np.abs(joints))
+    ftol = 1e-3 * tol * float(jscale.min())           # Newton's own stop, well below the acceptance
+
+    reps = np.empty((0, 0))                           # representative states, one per solution found
+    rep_keys = np.empty((0, 0))
+    hits: list[int] = []
+    history: list[tuple[int, float, int]] = []
+    used, quiet = 0, 0
+    while used < limit:
+        n = min(size, limit - used)
+        S0 = model.starts(streams.uniform(n, model.draws)[0])
+        S, conv = _newton(model, S0, ftol=ftol, iterations=iterations)
+        used += n
+        good = conv & (np.abs(model.residual(S)) / jscale <= tol).all(-1)
+        S, keys = S[good], model.keys(S[good])
+        before = len(hits)
+        if len(S):
+            allk = keys if not len(rep_keys) else np.concatenate([rep_keys, keys])
+            labels = _cluster(allk, dedup)
+            old = len(hits)
+            new_labels = labels[old:]
+            # labels of the old representatives are 0..old-1 in order (each is its own cluster).
+            for lab in np.unique(new_labels):
+                count = int((new_labels == lab).sum())
+                if lab < old:
+                    hits[lab] += count
+                else:
+                    first = np.flatnonzero(new_labels == lab)[0]
+                    reps = S[first:first + 1] if not len(hits) else np.concatenate([reps, S[first:first + 1]])
+                    rep_keys = keys[first:first + 1] if not len(rep_keys) else np.concatenate(
+                        [rep_keys, keys[first:first + 1]])
+                    hits.append(count)
+        history.append((used, time.perf_counter() - t0, len(hits)))
+        quiet = quiet + 1 if len(hits) == before else 0
+        if used >= need and quiet >= patience:
+            break
+
+    out = Solutions()
+    out.outside = 0
+    rows = []
+    if len(hits):
+        poses = model.poses(reps)
+        for x, h in zip(poses, hits):
+            xb = _into_bounds(mechanism, x, triple)
+            if xb is None:
+                out.outside += 1
+                continue
+            r = FKProblem(mechanism, joints).residuals(xb)
+            if not (np.abs(r) / jscale <= tol).all():
+                continue
+            rows.append(Solution(pose=dict(zip(mechanism.pose_names, (float(v) for v in xb))),
+                                 residual=float(np.abs(r).max()), hits=int(h)))
+    rows.sort(key=lambda s: -s.hits)
+    out.extend(rows)
+    out.starts = used
+    out.time_s = time.perf_counter() - t0
+    out.history = history
+    out.settings = dict(seed=seed, tol=tol, dedup=dedup, round_size=size, patience=patience,
+                        iterations=iterations)
+    return out

@@ -1,0 +1,233 @@
+"""General 6-SPS Stewart-Gough platform, and the parallel CMM of liu2008 as a preset.
+
+Six legs of variable length join base point b_i (base frame) to platform point p_i (platform
+frame) through spherical joints. The pose is the position (x, y, z) of a point fixed to the
+platform -- the platform origin moved by the probe offset s, i.e. the probe tip -- and Z-Y-X
+Euler angles (alpha, beta, gamma) in degrees, R = Rz(gamma) Ry(beta) Rx(alpha)
+(SPEC.md "Rotation matrix used by mao2017 and liu2008"). The inverse map is closed-form
+(liu2008 eqs. (4)-(5)):
+
+    l_i = R p_i + p_s - R s - b_i,    leg length |l_i|,    i = 1..6.
+
+With s = 0 (the default) the position is that of the platform origin.
+
+* :class:`SixSPS` (``"6-sps"``) takes any six base and six platform points. The default
+  geometry is Dietmaier's general 6-6 platform, whose leg lengths
+  (1, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071) admit 40 real assemblies
+  (P. Dietmaier, "The Stewart-Gough platform of general geometry can have 40 real postures",
+  Advances in Robot Kinematics, 1998), the maximum possible.
+* :class:`SixSPSCMM` (``"6-sps-cmm"``) is liu2008 (SPEC.md "liu2008 -- 6-SPS parallel CMM"):
+  Liu, Liu, Wei (2008), "Measurement modeling for 6-DOF parallel-link coordinate measuring
+  machine based on particle swarm optimization", eqs. (1)-(5), Tab. 2: b_i and p_i on circles
+  of radius R_b = 0.5 m, R_p = 0.225 m at the angles of eq. (2) with short-side central angles
+  t_b = t_p = 30 deg, probe offset s = (0, 0, l_s), l_s = 0.180 m. Lengths in metres.
+
+Bounds (search box of the unknowns):
+
+* ``6-sps``: x, y, z in [-2 S, 2 S] with S = max|b_i| + max|p_i - s| (the size of the
+  mechanism; legs are not part of the geometry), all three angles in [-180, 180] (full turn).
+* ``6-sps-cmm``: a workspace around the CMM's home pose (R = I, z = 0.976 m for legs at
+  mid-range 0.86 m): x, y in [-0.2, 0.2] m, z in [0.7, 1.1] m, alpha, beta, gamma in
+  [-30, 30] deg. It contains the Tab. 3 solution. The paper prints no workspace; this is our
+  choice. ``bounds=FULL_TURN`` (or ``SixSPSCMM.full_turn_bounds()``) widens the angles to a full
+  turn for either mechanism.
+
+The inverse map is written structure-of-arrays, elementwise (no matmul), with the constant
+parts of every leg folded in advance, so it is bit-identical whatever the batch size and fast
+enough for swarm fitness evaluation (see :meth:`SixSPS.ik`).
+"""
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from .. import rotations
+from .base import Geometry, ParallelMechanism
+
+Vec3 = tuple[float, float, float]
+Points6 = tuple[Vec3, Vec3, Vec3, Vec3, Vec3, Vec3]
+_D2R = np.pi / 180.0
+
+#: Full-turn angle bounds, to pass as ``bounds=FULL_TURN`` (merged with the default position box).
+FULL_TURN: dict[str, tuple[float, float]] = {
+    "alpha": (-180.0, 180.0), "beta": (-180.0, 180.0), "gamma": (-180.0, 180.0)}
+
+#: Dietmaier's general 6-6 platform with 40 real assemblies (default geometry of "6-sps").
+DIETMAIER_BASE: Points6 = (
+    (0.0, 0.0, 0.0), (1.107915, 0.0, 0.0), (0.549094, 0.756063, 0.0),
+    (0.735077, -0.223935, 0.525991), (0.514188, -0.526063, -0.368418),
+    (0.590473, 0.094733, -0.205018))
+DIETMAIER_PLATFORM: Points6 = (
+    (0.0, 0.0, 0.0), (0.542805, 0.0, 0.0), (0.956919, -0.528915, 0.0),
+    (0.665885, -0.353482, 1.402538), (0.478359, 1.158742, 0.107672),
+    (-0.137087, -0.235121, 0.353913))
+#: Leg lengths of Dietmaier's example.
+DIETMAIER_LEGS = (1.0, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071)
+
+
+def general_bounds(base, platform, probe) -> dict[str, tuple[float, float]]:
+    """Default bounds of "6-sps": x, y, z in [-2 S, 2 S], S = max|b_i| + max|p_i - s|; full-turn angles."""
+    size = np.linalg.norm(base, axis=1).max() + np.linalg.norm(platform - probe, axis=1).max()
+    reach = float(2.0 * size) if size > 0 else 1.0
+    out = {v: (-reach, reach) for v in ("x", "y", "z")}
+    out.update(FULL_TURN)
+    return out
+
+
+class SixSPSGeometry(Geometry):
+    base: Points6 = Field(DIETMAIER_BASE, description="six base joints b_i [x, y, z] (base frame)")
+    platform: Points6 = Field(DIETMAIER_PLATFORM,
+                              description="six platform joints p_i [x, y, z] (platform frame)")
+    probe: Vec3 = Field((0.0, 0.0, 0.0),
+                        description="probe offset s in the platform frame; the pose locates p_s = origin + R s")
+
+
+class SixSPS(ParallelMechanism):
+    """General 6-SPS (Stewart-Gough) platform; leg i joins base i to platform i."""
+
+    name = "6-sps"
+    pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
+    pose_units = ("m", "m", "m", "deg", "deg", "deg")
+    joint_names = ("l1", "l2", "l3", "l4", "l5", "l6")
+    joint_units = ("m", "m", "m", "m", "m", "m")
+    Geometry = SixSPSGeometry
+    default_bounds: ClassVar[dict[str, tuple[float, float]]]  # set below from the default geometry
+
+    # -- geometry --------------------------------------------------------------------------
+    def points(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(base (6, 3), platform (6, 3), probe (3,)) as arrays."""
+        g = self.geometry
+        return (np.array(g.base, dtype=float), np.array(g.platform, dtype=float),
+                np.array(g.probe, dtype=float))
+
+    @classmethod
+    def full_turn_bounds(cls) -> dict[str, tuple[float, float]]:
+        """Angle bounds covering every rotation, to pass as ``bounds=``."""
+        return dict(FULL_TURN)
+
+    def _default_bounds(self) -> dict[str, tuple[float, float]]:
+        return general_bounds(*self.points())
+
+    def _make_bounds(self, overrides: dict[str, Any]) -> np.ndarray:
+        # Default bounds may depend on the geometry, which is validated before this is called.
+        self.default_bounds = self._default_bounds()
+        self._prepare()
+        return super()._make_bounds(overrides)
+
+    def _prepare(self) -> None:
+        """Fold the constants of the inverse map: l_i = R q_i + (p_s - b_i), q_i = p_i - s.
+
+        A coordinate j of q_i shared by all legs (e.g. z of a planar platform) contributes the
+        same R[:, j] q_j to every leg and is added once to the position; zero terms are skipped.
+        """
+        base, platform, probe = self.points()
+        q = platform - probe
+        self._common = tuple(float(q[0, j]) if np.all(q[:, j] == q[0, j]) else None for j in range(3))
+        legs = []
+        for i in range(6):
+            terms = [(j, float(q[i, j])) for j in range(3) if self._common[j] is None and q[i, j] != 0.0]
+            legs.append((terms, tuple(float(v) for v in base[i])))
+        self._legs = legs
+        self._q = q
+        self._base = base
+
+    # -- inverse map -----------------------------------------------------------------------
+    def ik(self, poses) -> np.ndarray:
+        """Leg lengths (..., 6) for poses (..., 6) = (x, y, z, alpha, beta, gamma).
+
+        Lean on purpose (it is the swarm's fitness): one transposing copy of the poses, the
+        rotation from :func:`fkopt.rotations.zyx`, then every leg accumulated in place in two
+        scratch arrays. The result is a view of a leg-major (6, ...) array, so the residual
+        and the sum over legs in :class:`fkopt.problems.FKProblem` run on contiguous rows.
+        """
+        p = np.asarray(poses, dtype=float)
+        shape = p.shape[:-1]
+        pt = np.empty((6,) + shape)
+        pt[...] = np.moveaxis(p, -1, 0)
+        ang = pt[3:6]
+        ang *= _D2R
+        R = rotations.zyx(ang[0], ang[1], ang[2])
+        # Point shared by all legs: p_s + sum_j R[:, j] q_j over the coordinates j common to all q_i.
+        t = [pt[0], pt[1], pt[2]]
+        for j, c in enumerate(self._common):
+            if c:
+                t = [t[k] + R[k][j] * c for k in range(3)]
+        out = np.empty((6,) + shape)
+        d = np.empty(shape)
+        tmp = np.empty(shape)
+        for i, (terms, b) in enumerate(self._legs):
+            acc = out[i, ...]
+            for k in range(3):
+                np.subtract(t[k], b[k], out=d)
+                for j, c in terms:
+                    np.multiply(R[k][j], c, out=tmp)
+                    d += tmp
+                if k == 0:
+                    np.multiply(d, d, out=acc)
+                else:
+                    d *= d
+                    acc += d
+            np.sqrt(acc, out=acc)
+        return np.moveaxis(out, 0, -1)
+
+    def ik_vectors(self, poses) -> np.ndarray:
+        """Leg vectors l_i (..., 6, 3) in the base frame (reference implementation, uses arrays)."""
+        p = np.asarray(poses, dtype=float)
+        R = rotations.to_array(rotations.zyx(*np.radians(np.moveaxis(p[..., 3:6], -1, 0))))
+        Rq = np.einsum("...kj,ij->...ik", R, self._q)
+        return Rq + p[..., None, 0:3] - self._base
+
+
+SixSPS.default_bounds = general_bounds(np.array(DIETMAIER_BASE), np.array(DIETMAIER_PLATFORM), np.zeros(3))
+
+
+class SixSPSCMMGeometry(Geometry):
+    Rb: float = Field(0.5, gt=0, description="base joint circle radius R_b (m)")
+    Rp: float = Field(0.225, gt=0, description="platform joint circle radius R_p (m)")
+    tb: float = Field(30.0, gt=0, lt=120, description="base short-side central angle theta_b (deg)")
+    tp: float = Field(30.0, gt=0, lt=120, description="platform short-side central angle theta_p (deg)")
+    ls: float = Field(0.180, description="probe offset l_s along the platform z axis (m)")
+    base: Points6 | None = Field(None, description="explicit base joints (replace Rb, tb)")
+    platform: Points6 | None = Field(None, description="explicit platform joints (replace Rp, tp)")
+
+    @model_validator(mode="after")
+    def _not_both(self):
+        fields = self.model_fields_set
+        if self.base is not None and fields & {"Rb", "tb"}:
+            raise ValueError("give either base or (Rb, tb), not both")
+        if self.platform is not None and fields & {"Rp", "tp"}:
+            raise ValueError("give either platform or (Rp, tp), not both")
+        return self
+
+
+class SixSPSCMM(SixSPS):
+    """The 6-DOF parallel CMM of liu2008 (eqs. (1)-(5), Tab. 2); pose is the probe tip."""
+
+    name = "6-sps-cmm"
+    paper = "liu2008"
+    Geometry = SixSPSCMMGeometry
+    # Workspace around the home pose (not printed in liu2008; our choice, contains Tab. 3).
+    default_bounds = {"x": (-0.2, 0.2), "y": (-0.2, 0.2), "z": (0.7, 1.1),
+                      "alpha": (-30.0, 30.0), "beta": (-30.0, 30.0), "gamma": (-30.0, 30.0)}
+
+    @staticmethod
+    def joint_angles(tb: float, tp: float) -> tuple[np.ndarray, np.ndarray]:
+        """theta_bi and theta_pi of liu2008 eq. (2), degrees."""
+        theta_b = np.array([60 - tb / 2, 60 + tb / 2, 180 - tb / 2, 180 + tb / 2, 300 - tb / 2, 300 + tb / 2])
+        theta_p = np.array([tp / 2, 120 - tp / 2, 120 + tp / 2, 240 - tp / 2, 240 + tp / 2, 360 - tp / 2])
+        return theta_b, theta_p
+
+    def points(self):
+        g = self.geometry
+        theta_b, theta_p = np.radians(self.joint_angles(g.tb, g.tp))
+        zero = np.zeros(6)
+        base = (np.array(g.base, dtype=float) if g.base is not None else
+                np.stack([g.Rb * np.cos(theta_b), g.Rb * np.sin(theta_b), zero], axis=1))
+        platform = (np.array(g.platform, dtype=float) if g.platform is not None else
+                    np.stack([g.Rp * np.cos(theta_p), g.Rp * np.sin(theta_p), zero], axis=1))
+        return base, platform, np.array([0.0, 0.0, g.ls])
+
+    def _default_bounds(self):
+        return dict(type(self).default_bounds)
