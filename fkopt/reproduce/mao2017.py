@@ -50,13 +50,17 @@ def claims(store) -> list[Claim]:
             verdict(aco.mean_fitness > 100 * max(abc.mean_fitness, gabc.mean_fitness, 1e-30)),
             f"mean final fitness ACO {g(aco.mean_fitness)} (median {g(aco.median_fitness)}) vs ABC "
             f"{g(abc.mean_fitness)}, GABC {g(gabc.mean_fitness)}"))
+        zhu = t3.table("summary").set_index("algorithm").get("median_iterations_to_threshold", {}).get("gabc_zhu2010")
+        zhu_text = (f"; with Zhu & Kwong's original GABC rule (not the paper's) {g(zhu)} iterations"
+                    if zhu is not None else "")
         out.append(Claim(
-            "Fig. 2: GABC converges fastest, in ~90 iterations, ABC in ~170",
-            verdict(gabc.median_iterations_to_threshold < abc.median_iterations_to_threshold),
+            "Fig. 2: GABC (eq. 19 as printed) converges fastest, in ~90 iterations, ABC in ~170",
+            verdict(gabc.median_iterations_to_threshold < abc.median_iterations_to_threshold
+                    and gabc.median_iterations_to_threshold < aco.median_iterations_to_threshold),
             f"median iterations to fitness < 1e-10: GABC {g(gabc.median_iterations_to_threshold)}, ABC "
             f"{g(abc.median_iterations_to_threshold)}, ACO {g(aco.median_iterations_to_threshold)}; "
             f"median evaluations: GABC {g(gabc.median_evaluations_to_threshold)}, ABC "
-            f"{g(abc.median_evaluations_to_threshold)}"))
+            f"{g(abc.median_evaluations_to_threshold)}{zhu_text}"))
         v = t3.table("values")
         err = v[v.algorithm.isin(["abc", "gabc"])]["mean_abs_error"].max()
         out.append(Claim(
@@ -91,11 +95,15 @@ def claims(store) -> list[Claim]:
     else:
         s, v = t6.table("summary"), t6.table("values")
         out.append(Claim(
-            "Tab. 6: GABC solves all five poses to fitness < 1e-5 with errors of a few 1e-4",
-            verdict(s.success_rate.min() == 1.0 and v.median_run_abs_error.max() < 1e-3),
-            f"success rate per pose {', '.join(g(x) for x in s.success_rate)}; largest median-run "
-            f"absolute error {g(v.median_run_abs_error.max())}; median iterations per pose "
+            "Tab. 6: GABC solves all five poses to fitness < 1e-5",
+            verdict(s.success_rate.min() == 1.0),
+            f"success rate per pose {', '.join(g(x) for x in s.success_rate)}; median iterations per pose "
             f"{', '.join(g(x) for x in s.median_iterations_to_threshold)}"))
+        out.append(Claim(
+            "Tab. 6: at that precision every pose variable is within ~3.4e-4 of the truth (10^-4 requirement)",
+            verdict(v.median_run_abs_error.max() <= 5e-4),
+            f"largest median-run absolute error {g(v.median_run_abs_error.max())}; largest mean absolute "
+            f"error over all runs {g(v.mean_abs_error.max())} (the paper's largest: 3.41e-4)"))
     pi = store.get("mao2017", "printed_inputs")
     if pi is None:
         out.append(missing("printed inputs", "mao2017/printed_inputs"))
