@@ -105,11 +105,10 @@ def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"
                                  "writes OUT/<paper>/<name>/"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
     """Run experiment files and write their tables and figures."""
-    from .experiment.config import load_config
     from .experiment.reports import summary_table, write_experiment
     from .experiment.runner import run_experiment, validate_experiment
 
-    loaded = [(path, load_config(path)) for path in configs]
+    loaded = [(path, _experiment_file(path)) for path in configs]
     for path, config in loaded:          # fail on any bad file before running anything
         try:
             validate_experiment(config)
@@ -135,6 +134,56 @@ def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"
 
 def _n_cases(config) -> int:
     return getattr(config.cases, "random", None) or len(config.cases)
+
+
+def _experiment_file(path: Path):
+    from .study.config import StudyConfig, load_any
+    config = load_any(path)
+    if isinstance(config, StudyConfig):
+        raise FkoptError(f"{path}: a study file (kind: study); run it with: fkopt study {path}")
+    return config
+
+
+@app.command()
+def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)"),
+          out: Path = typer.Option(Path("results"), "--out", help="results root; the study writes "
+                                   "OUT/<paper>/<name>/ (paper: studies unless the file says otherwise)"),
+          jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (local) or LocalCluster "
+                                   "workers (dask without --scheduler)"),
+          executor: str = typer.Option("local", "--executor", help="local | dask"),
+          scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of an existing Dask "
+                                                  "scheduler (with --executor dask)"),
+          resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted "
+                                      "run of the same study and run only the others"),
+          quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
+    """Run a workspace study: algorithms x poses x runs, statistics, tracking (see fkopt.study)."""
+    from .study.config import load_study
+    from .study.executors import validate_executor
+    from .study.reports import summary_table
+    from .study.runner import plan_tasks, run_study, validate_study
+
+    cfg = load_study(config)
+    validate_executor(executor, jobs, scheduler)
+    try:
+        _, poses = validate_study(cfg)
+    except FkoptError as err:
+        raise FkoptError(f"{config}: {err}") from None
+    kwargs = dict(jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, source=str(config))
+    if quiet:
+        result = run_study(cfg, out, **kwargs)
+    else:
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        con = _console()
+        with Progress(TextColumn(f"[bold]{cfg.name}[/]"), BarColumn(), MofNCompleteColumn(),
+                      TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
+                      transient=True) as bar:
+            task = bar.add_task("", total=len(plan_tasks(cfg, len(poses))))
+            result = run_study(cfg, out, progress=lambda label, done, total: bar.update(
+                task, completed=done, description=label), **kwargs)
+        reused = len(plan_tasks(cfg, len(poses))) - len(result.computed)
+        _print_summary(con, summary_table(result), result.folder, result.wall_s)
+        if reused:
+            con.print(f"resumed: {reused} finished task(s) reused, {len(result.computed)} computed")
 
 
 SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",
@@ -253,18 +302,24 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
     import time
     from rich.table import Table
-    from .experiment.config import load_config
     from .experiment.reports import write_experiment
     from .experiment.runner import run_experiment, validate_experiment
     from .reproduce.report import write_report
+    from .study.config import StudyConfig, load_any
+    from .study.runner import plan_tasks, run_study, validate_study
 
     files = sorted(configs.rglob("*.yaml"))
     if not files:
         raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
-    loaded = [(f, load_config(f)) for f in files]
+    loaded = [(f, load_any(f)) for f in files]     # experiments and studies (kind: study)
+    sizes = {}
     for f, c in loaded:
         try:
-            validate_experiment(c)
+            if isinstance(c, StudyConfig):
+                sizes[f] = len(plan_tasks(c, len(validate_study(c)[1])))
+            else:
+                validate_experiment(c)
+                sizes[f] = len(c.algorithms) * _n_cases(c)
         except FkoptError as err:
             raise FkoptError(f"{f}: {err}") from None
     con = _console()
@@ -276,10 +331,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                   disable=quiet) as bar:
         overall = bar.add_task("", total=len(loaded), name="[bold]reproduce[/]")
         for f, c in loaded:
-            task = bar.add_task("", total=len(c.algorithms) * _n_cases(c), name=f"  {c.paper}/{c.name}")
-            er = run_experiment(c, source=str(f), progress=lambda label, d, t: bar.update(
-                task, completed=d, description=label))
-            folder = write_experiment(er, out)
+            task = bar.add_task("", total=sizes[f], name=f"  {c.paper}/{c.name}")
+            update = lambda label, d, t: bar.update(task, completed=d, description=label)  # noqa: E731
+            if isinstance(c, StudyConfig):
+                er = run_study(c, out, source=str(f), progress=update)
+                folder = er.folder
+            else:
+                er = run_experiment(c, source=str(f), progress=update)
+                folder = write_experiment(er, out)
             bar.remove_task(task)
             bar.advance(overall)
             done.append((f, folder, er.wall_s, len(list(folder.iterdir()))))

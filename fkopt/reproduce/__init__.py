@@ -11,4 +11,5 @@
 
 PAPERS: dict[str, str] = {
     "mao2017": "fkopt.reproduce.mao2017",
+    "studies": "fkopt.reproduce.studies",
 }

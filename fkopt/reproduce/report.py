@@ -87,7 +87,7 @@ def experiment_section(exp: Experiment, root: Path) -> str:
         for caption, df in extra(exp):
             lines += [caption, "", md_table(df), ""]
     for fig in exp.figures():
-        if fig == "cases_time.png":
+        if fig.endswith("_time.png"):
             continue   # drawn from timings: shown in TIMING.md
         lines.append(f"![{exp.name} {fig}]({rel}/{fig})")
     lines.append("")
@@ -137,6 +137,9 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
             timing += [f"### {exp.title}", "", md_table(t), ""]
             if exp.has("cases_time.png"):
                 timing.append(f"![{exp.name} time per case]({exp.folder.relative_to(root)}/cases_time.png)\n")
+            for fig in exp.figures():
+                if fig.endswith("_time.png") and fig != "cases_time.png":
+                    timing.append(f"![{exp.name} {fig}]({exp.folder.relative_to(root)}/{fig})\n")
             index_rows += index_rows_of(exp)
         if mod is not None and hasattr(mod, "timing_claims"):
             timing += ["### Timing claims", "", claims_table(mod.timing_claims(store)), ""]

@@ -1,0 +1,14 @@
+"""Workspace studies: algorithms x poses x runs, with statistics, tracking and scale-out.
+
+* :mod:`.config`     -- the YAML schema (``kind: study``), :func:`load_study`, :func:`load_any`;
+* :mod:`.poses`      -- pose sets: uniform, grid, waypoints, circle;
+* :mod:`.runner`     -- tasks, task files, resume, merge: :func:`run_study`;
+* :mod:`.executors`  -- local processes or a Dask cluster;
+* :mod:`.statistics` -- ECDF of evaluations to target, Wilcoxon rank-sum tests with Holm;
+* :mod:`.reports`    -- the files of a study folder;
+* :mod:`.check`      -- rerun a stored study and compare (``fkopt check``).
+"""
+from .config import StudyConfig, load_any, load_study, study_from_dict
+from .runner import StudyResult, run_study
+
+__all__ = ["StudyConfig", "StudyResult", "load_any", "load_study", "run_study", "study_from_dict"]

@@ -1,0 +1,375 @@
+"""Files of a study folder ``OUT/<paper>/<name>/`` (conventions of :mod:`fkopt.experiment.reports`).
+
+Deterministic for a given config (whatever the executor, the number of jobs or a resume):
+
+* ``summary.csv``  one row per algorithm over all (pose, run) pairs (``case`` is ``all``, or
+  ``trajectory`` in tracking mode) with the columns of an experiment's summary (fitness
+  statistics, mean evaluations, success rate at the threshold, medians of iterations and
+  evaluations to it over the pairs that reached it) plus ``poses``; so ``fkopt report`` and
+  ``fkopt check`` read it like an experiment's;
+* ``poses.csv``    one row per (pose, algorithm): the pose, median/best final fitness, success
+  rate over the runs, median evaluations to the threshold, median absolute error per variable;
+* ``runs.csv``     one row per (pose, algorithm, run), with the start point in tracking mode;
+* ``ecdf.csv`` + ``ecdf.png``  fraction of (pose, run) pairs solved vs evaluations (log x);
+* ``stats.csv``    pairwise Wilcoxon rank-sum tests with Holm's correction
+  (:mod:`fkopt.study.statistics`);
+* ``heatmap.csv`` + ``heatmap.png``  (a grid over two variables) median final fitness and
+  success rate per grid point and algorithm;
+* ``tracking.csv`` + ``tracking.png``  (tracking mode) per step and algorithm: median fitness,
+  success rate, evaluations, largest error, whether the step was warm-started;
+* ``meta.json``    config, seed, seed rule, mechanism, versions (written last).
+
+Measured in seconds (change on every run): ``timing.csv`` (per algorithm, time per run) and,
+in tracking mode, ``tracking_timing.csv`` + ``tracking_time.png`` (time per step).
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..experiment.reports import FLOAT, LOG_FLOOR, _plt, _save, library_versions
+from .runner import StudyResult
+from .statistics import ecdf_table, pairwise_tests
+
+
+def _nanmedian(a) -> float:
+    a = np.asarray(a, dtype=float)
+    ok = ~np.isnan(a)
+    return float(np.median(a[ok])) if ok.any() else float("nan")
+
+
+def case_label(sr: StudyResult) -> str:
+    return "trajectory" if sr.config.mode == "tracking" else "all"
+
+
+# -- tables --------------------------------------------------------------------------------------
+def summary_table(sr: StudyResult) -> pd.DataFrame:
+    thr = sr.config.threshold
+    rows = []
+    for ar in sr.algorithms:
+        f = ar.fitness.ravel()
+        rows.append({
+            "case": case_label(sr), "algorithm": ar.key, "method": ar.spec.name,
+            "population": ar.population, "iterations": ar.iterations, "runs": sr.config.runs,
+            "mean_fitness": float(np.mean(f)), "std_fitness": float(np.std(f, ddof=1)) if f.size > 1 else 0.0,
+            "best_fitness": float(np.min(f)), "worst_fitness": float(np.max(f)),
+            "median_fitness": float(np.median(f)), "mean_evaluations": float(np.mean(ar.evaluations)),
+            "threshold": thr, "success_rate": float(np.mean(f < thr)),
+            "median_iterations_to_threshold": _nanmedian(ar.iterations_to),
+            "median_evaluations_to_threshold": _nanmedian(ar.evaluations_to),
+            "poses": len(sr.poses),
+        })
+    return pd.DataFrame(rows)
+
+
+def _pose_columns(sr: StudyResult, i: np.ndarray | int) -> dict:
+    cols = {f"{n}": sr.poses.points[i, j] for j, n in enumerate(sr.poses.names)}
+    if sr.mechanism.kind == "serial":
+        cols.update({f"target_{n}": sr.poses.targets[i, j] for j, n in enumerate(sr.compared_names)})
+    return cols
+
+
+def poses_table(sr: StudyResult) -> pd.DataFrame:
+    thr = sr.config.threshold
+    n = len(sr.poses)
+    idx = np.arange(n)
+    frames = []
+    for ar in sr.algorithms:
+        med_ev = np.array([_nanmedian(row) for row in ar.evaluations_to])
+        df = pd.DataFrame({"pose": idx + 1, "label": [sr.poses.label(i) for i in idx], **_pose_columns(sr, idx),
+                           "algorithm": ar.key, "median_fitness": np.median(ar.fitness, axis=1),
+                           "best_fitness": np.min(ar.fitness, axis=1),
+                           "success_rate": np.mean(ar.fitness < thr, axis=1),
+                           "median_evaluations_to_threshold": med_ev,
+                           "mean_evaluations": np.mean(ar.evaluations, axis=1)})
+        for j, name in enumerate(sr.compared_names):
+            df[f"median_abs_error_{name}"] = np.median(ar.errors[:, :, j], axis=1)
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def runs_table(sr: StudyResult) -> pd.DataFrame:
+    n, runs = len(sr.poses), sr.config.runs
+    pose = np.repeat(np.arange(n), runs)
+    run = np.tile(np.arange(runs), n)
+    frames = []
+    for ar in sr.algorithms:
+        df = pd.DataFrame({"pose": pose + 1, "algorithm": ar.key, "run": run,
+                           "task_seed": np.repeat(ar.seeds, runs),
+                           "final_fitness": ar.fitness.ravel(), "evaluations": ar.evaluations.ravel().astype(np.int64),
+                           "iterations_done": ar.iterations_done.ravel().astype(np.int64),
+                           "iterations_to_threshold": ar.iterations_to.ravel(),
+                           "evaluations_to_threshold": ar.evaluations_to.ravel()})
+        if ar.start is not None:
+            for j, name in enumerate(sr.poses.names):
+                df[f"start_{name}"] = ar.start[:, :, j].ravel()
+        for j, name in enumerate(sr.poses.names):
+            df[f"x_{name}"] = ar.x[:, :, j].ravel()
+        for j, name in enumerate(sr.compared_names):
+            df[f"abs_error_{name}"] = ar.errors[:, :, j].ravel()
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def timing_table(sr: StudyResult) -> pd.DataFrame:
+    runs = sr.config.runs
+    rows = []
+    for ar in sr.algorithms:
+        ms = ar.time_s / runs * 1e3
+        rows.append({"case": case_label(sr), "algorithm": ar.key, "runs": runs, "poses": len(sr.poses),
+                     "mean_ms_per_run": float(np.mean(ms)), "median_ms_per_run": float(np.median(ms)),
+                     "total_s": float(ar.wall_s)})
+    return pd.DataFrame(rows)
+
+
+def ecdf_of(sr: StudyResult) -> pd.DataFrame:
+    return ecdf_table({ar.key: ar.evaluations_to for ar in sr.algorithms})
+
+
+def stats_of(sr: StudyResult) -> pd.DataFrame:
+    samples = {"final_fitness": {ar.key: ar.fitness for ar in sr.algorithms},
+               "evaluations_to_threshold": {ar.key: ar.evaluations_to for ar in sr.algorithms}}
+    return pairwise_tests(samples, sr.config.alpha)
+
+
+def heatmap_table(sr: StudyResult) -> pd.DataFrame | None:
+    axes = sr.poses.grid_axes
+    if axes is None:
+        return None
+    names = sr.poses.names
+    j1, j2 = names.index(axes[0]), names.index(axes[1])
+    thr = sr.config.threshold
+    frames = []
+    for ar in sr.algorithms:
+        frames.append(pd.DataFrame({
+            axes[0]: sr.poses.points[:, j1], axes[1]: sr.poses.points[:, j2], "algorithm": ar.key,
+            "median_fitness": np.median(ar.fitness, axis=1), "success_rate": np.mean(ar.fitness < thr, axis=1),
+            "median_evaluations_to_threshold": [_nanmedian(row) for row in ar.evaluations_to],
+            **{f"median_abs_error_{n}": np.median(ar.errors[:, :, j], axis=1)
+               for j, n in enumerate(sr.compared_names)}}))
+    return pd.concat(frames, ignore_index=True)
+
+
+def tracking_table(sr: StudyResult) -> pd.DataFrame | None:
+    if sr.config.mode != "tracking":
+        return None
+    thr = sr.config.threshold
+    n = len(sr.poses)
+    frames = []
+    for ar in sr.algorithms:
+        warm = np.zeros(n, dtype=bool)
+        if ar.spec.warm_start:
+            warm[1:] = True
+        df = pd.DataFrame({"step": np.arange(n), "algorithm": ar.key, "warm_start": warm,
+                           **{n_: sr.poses.points[:, j] for j, n_ in enumerate(sr.poses.names)},
+                           "median_fitness": np.median(ar.fitness, axis=1),
+                           "success_rate": np.mean(ar.fitness < thr, axis=1),
+                           "median_evaluations": np.median(ar.evaluations, axis=1)})
+        for j, name in enumerate(sr.compared_names):
+            df[f"max_abs_error_{name}"] = ar.errors[:, :, j].max(axis=1)
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def tracking_timing_table(sr: StudyResult) -> pd.DataFrame | None:
+    if sr.config.mode != "tracking":
+        return None
+    runs = sr.config.runs
+    return pd.concat([pd.DataFrame({"step": np.arange(len(sr.poses)), "algorithm": ar.key,
+                                    "ms_per_run": ar.time_s / runs * 1e3}) for ar in sr.algorithms],
+                     ignore_index=True)
+
+
+# -- figures -------------------------------------------------------------------------------------
+def ecdf_figure(sr: StudyResult, ecdf: pd.DataFrame, path: Path) -> None:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    xmax = float(np.nanmax([np.nanmax(ar.evaluations) for ar in sr.algorithms] + [1.0]))
+    for ar in sr.algorithms:
+        d = ecdf[(ecdf.algorithm == ar.key) & ecdf.evaluations.notna()]
+        if d.empty:
+            ax.plot([], [], label=f"{ar.key} (none solved)")
+            continue
+        xs = np.concatenate([[d.evaluations.iloc[0]], d.evaluations.to_numpy(), [max(xmax, d.evaluations.max())]])
+        ys = np.concatenate([[0.0], d.fraction.to_numpy(), [d.fraction.iloc[-1]]])
+        ax.step(xs, ys, where="post", label=ar.key, lw=1.4)
+    ax.set_xscale("log")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("function evaluations")
+    ax.set_ylabel(f"fraction of (pose, run) pairs with fitness < {sr.config.threshold:g}")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
+    ax.set_title(f"{sr.config.title or sr.config.name}: {len(sr.poses)} poses x {sr.config.runs} runs",
+                 fontsize=9)
+    _save(fig, path)
+    plt.close(fig)
+
+
+def heatmap_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
+    """Rows: log10 median final fitness, success rate, median evaluations to the threshold."""
+    plt = _plt()
+    a1, a2 = sr.poses.grid_axes
+    n = len(sr.algorithms)
+    from matplotlib.colors import LogNorm
+    fig, axes = plt.subplots(3, n, figsize=(3.0 * n + 1.2, 8.0), squeeze=False, layout="constrained")
+    u1, u2 = np.unique(table[a1]), np.unique(table[a2])
+    h1 = (u1[1] - u1[0]) / 2 if u1.size > 1 else 0.5
+    h2 = (u2[1] - u2[0]) / 2 if u2.size > 1 else 0.5
+    ext = [u1[0] - h1, u1[-1] + h1, u2[0] - h2, u2[-1] + h2]
+    logf = np.log10(np.maximum(table["median_fitness"].to_numpy(dtype=float), LOG_FLOOR))
+    ev = table["median_evaluations_to_threshold"].to_numpy(dtype=float)
+    rows = [("median_fitness", "log10 median final fitness", "viridis", (logf.min(), max(logf.max(), logf.min() + 1e-9))),
+            ("success_rate", f"success rate (fitness < {sr.config.threshold:g})", "RdYlGn", (0.0, 1.0)),
+            ("median_evaluations_to_threshold", "median evaluations to the threshold\n(white: never reached)",
+             "magma_r", (np.nanmin(ev) if np.isfinite(ev).any() else 0.0,
+                         np.nanmax(ev) if np.isfinite(ev).any() else 1.0))]
+    for r, (col, label, cmap, (vmin, vmax)) in enumerate(rows):
+        im = None
+        for k, ar in enumerate(sr.algorithms):
+            d = table[table.algorithm == ar.key]
+            grid = np.full((u2.size, u1.size), np.nan)
+            vals = d[col].to_numpy(dtype=float)
+            if col == "median_fitness":
+                vals = np.log10(np.maximum(vals, LOG_FLOOR))
+            grid[np.searchsorted(u2, d[a2]), np.searchsorted(u1, d[a1])] = vals
+            ax = axes[r][k]
+            if col == "median_evaluations_to_threshold":   # counts differ by decades between methods
+                norm = LogNorm(vmin=max(vmin, 1.0), vmax=max(vmax, vmin * 1.01, 1.01))
+                im = ax.imshow(grid, origin="lower", extent=ext, aspect="auto", norm=norm, cmap=cmap)
+            else:
+                im = ax.imshow(grid, origin="lower", extent=ext, aspect="auto", vmin=vmin, vmax=vmax, cmap=cmap)
+            if r == len(rows) - 1:
+                ax.set_xlabel(a1)
+            if k == 0:
+                ax.set_ylabel(a2)
+            if r == 0:
+                ax.set_title(ar.key, fontsize=9)
+        fig.colorbar(im, ax=list(axes[r]), label=label)
+    fixed = getattr(sr.config.poses, "fixed", {})
+    fig.suptitle(f"{sr.config.title or sr.config.name}" + (f"\n(fixed: {', '.join(f'{k}={v:g}' for k, v in fixed.items())};"
+                                                         f" {sr.config.runs} runs per point)" if fixed else ""),
+                 fontsize=10)
+    _save(fig, path)
+    plt.close(fig)
+
+
+def tracking_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
+    plt = _plt()
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for ar in sr.algorithms:
+        d = table[table.algorithm == ar.key]
+        name = ar.key + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)")
+        axes[0].plot(d.step, np.maximum(d.median_fitness, LOG_FLOOR), marker=".", lw=1, label=name)
+        axes[1].plot(d.step, d.median_evaluations, marker=".", lw=1, label=name)
+    axes[0].axhline(sr.config.threshold, color="k", lw=0.8, ls="--")
+    axes[0].set_yscale("log")
+    axes[0].set_ylabel("final fitness (median over runs)")
+    axes[1].set_yscale("log")
+    axes[1].set_ylabel("evaluations per step (median)")
+    for ax in axes:
+        ax.set_xlabel("trajectory step")
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"{sr.config.title or sr.config.name}\n(each step warm-started from the previous "
+                 f"step's solution unless marked cold)", fontsize=10)
+    fig.tight_layout()
+    _save(fig, path)
+    plt.close(fig)
+
+
+def tracking_time_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6, 3.6))
+    for ar in sr.algorithms:
+        d = table[table.algorithm == ar.key]
+        ax.plot(d.step, d.ms_per_run, marker=".", lw=1,
+                label=ar.key + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)"))
+    ax.set_yscale("log")
+    ax.set_xlabel("trajectory step")
+    ax.set_ylabel("time per step and run (ms)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    _save(fig, path)
+    plt.close(fig)
+
+
+# -- folder --------------------------------------------------------------------------------------
+def meta(sr: StudyResult) -> dict:
+    from .. import __version__
+    objective = sr.config.objective
+    if objective is None:
+        from .runner import make_problem
+        objective = getattr(make_problem(sr.config, sr.mechanism, sr.poses.inputs[0]), "objective", None)
+    return {
+        "kind": "study", "experiment": sr.config.name, "paper": sr.config.paper, "title": sr.config.title,
+        "config_file": sr.source, "config": sr.config.model_dump(mode="json"), "seed": sr.config.seed,
+        "task_seeds": "pose (or step) i of algorithm L: fkopt.experiment.runner.task_seed(seed, i, L); "
+                      "run k: child k of that seed (fkopt.streams)",
+        "fingerprint": sr.config.fingerprint(), "poses": len(sr.poses),
+        "mechanism": sr.mechanism.describe(), "objective": objective,
+        "fkopt_version": __version__, "libraries": library_versions(),
+        "platform": {"system": platform.system(), "machine": platform.machine(),
+                     "python_implementation": platform.python_implementation()},
+    }
+
+
+def _atomic(folder: Path, name: str, write) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=Path(name).suffix, dir=folder)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, folder / name)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_tables(sr: StudyResult, folder: Path, figures: bool = True) -> list[str]:
+    """Write every file of the study into ``folder`` (each atomically; ``meta.json`` last)."""
+    folder = Path(folder)
+    written: list[str] = []
+
+    def csv(name, df):
+        if df is not None:
+            _atomic(folder, name, lambda p: df.to_csv(p, index=False, float_format=FLOAT))
+            written.append(name)
+
+    def fig(name, draw, *args):
+        if figures:
+            _atomic(folder, name, lambda p: draw(sr, *args, p))
+            written.append(name)
+
+    csv("summary.csv", summary_table(sr))
+    csv("timing.csv", timing_table(sr))
+    csv("poses.csv", poses_table(sr))
+    csv("runs.csv", runs_table(sr))
+    ecdf = ecdf_of(sr)
+    csv("ecdf.csv", ecdf)
+    fig("ecdf.png", ecdf_figure, ecdf)
+    csv("stats.csv", stats_of(sr))
+    heat = heatmap_table(sr)
+    if heat is not None:
+        csv("heatmap.csv", heat)
+        fig("heatmap.png", heatmap_figure, heat)
+    track = tracking_table(sr)
+    if track is not None:
+        csv("tracking.csv", track)
+        fig("tracking.png", tracking_figure, track)
+        ttime = tracking_timing_table(sr)
+        csv("tracking_timing.csv", ttime)
+        fig("tracking_time.png", tracking_time_figure, ttime)
+    text = json.dumps(meta(sr), indent=2, sort_keys=True, default=float) + "\n"
+    _atomic(folder, "meta.json", lambda p: p.write_text(text))
+    written.append("meta.json")
+    return written
+
+
+def write_study(sr: StudyResult, folder: Path) -> list[str]:
+    folder.mkdir(parents=True, exist_ok=True)
+    return write_tables(sr, folder)

@@ -1,0 +1,425 @@
+"""Run a study: plan tasks, run the missing ones on an executor, keep one file per task, merge.
+
+* A task is (pose chunk, algorithm) in ``independent`` mode and (trajectory, algorithm) in
+  ``tracking`` mode. :func:`run_task` computes one from a JSON-able payload (so it runs in
+  another process or on a Dask worker) and returns plain lists; the seeds come from
+  :func:`fkopt.experiment.runner.task_seed` per pose (or step), so a task's numbers do not
+  depend on where, when or next to what it ran.
+* Every finished task is written at once as ``OUT/<paper>/<name>/tasks/<task id>.json``
+  (a temporary file renamed into place, so a file is either complete or absent). An
+  interrupted study therefore loses at most the tasks that were running; ``resume=True``
+  (``fkopt study --resume``) keeps every task file whose config fingerprint matches and runs
+  only the others. Without ``resume`` the folder is started afresh.
+* When every task is there, :func:`merge` reads them back into a :class:`StudyResult` and
+  :mod:`fkopt.study.reports` writes the tables and figures; ``meta.json`` is written last, so a
+  folder with ``meta.json`` is a finished study (``tasks/`` stays, for a later ``--resume``).
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ..errors import FkoptError
+from ..experiment.runner import build_mechanism, task_seed
+from ..problems import fk_problem
+from ..solve import make_algorithm, solve
+from .config import StudyAlgorithmSpec, StudyConfig
+from .poses import PoseSet, build_poses
+
+TASKS = "tasks"
+STUDY_FILE = "study.json"
+
+
+# -- tasks ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Task:
+    algorithm: int      # index into config.algorithms
+    label: str          # the algorithm's label (its key)
+    chunk: int          # chunk index (0 for a whole trajectory)
+    start: int          # first pose index
+    stop: int           # one past the last pose index
+
+    @property
+    def id(self) -> str:
+        slug = re.sub(r"[^A-Za-z0-9_.+-]", "_", self.label)
+        return f"a{self.algorithm:02d}-{slug}-c{self.chunk:05d}"
+
+
+def plan_tasks(config: StudyConfig, n_poses: int) -> list[Task]:
+    """All tasks of a study, chunk by chunk (every algorithm of a chunk before the next)."""
+    if config.mode == "tracking":
+        return [Task(a, spec.key, 0, 0, n_poses) for a, spec in enumerate(config.algorithms)]
+    out = []
+    for c, start in enumerate(range(0, n_poses, config.chunk)):
+        stop = min(start + config.chunk, n_poses)
+        out += [Task(a, spec.key, c, start, stop) for a, spec in enumerate(config.algorithms)]
+    return out
+
+
+def make_problem(config: StudyConfig, mech, inputs: np.ndarray, bounds=None):
+    kwargs = {"objective": config.objective} if config.objective else {}
+    if bounds is not None:
+        kwargs["bounds"] = bounds
+    if mech.kind == "serial":
+        from ..problems import ik_problem
+        return ik_problem(mech, inputs, **kwargs)
+    return fk_problem(mech, inputs, **kwargs)
+
+
+def start_point(spec: StudyAlgorithmSpec, mech) -> np.ndarray | None:
+    if spec.start is None:
+        return None
+    if spec.start == "centre":
+        return mech.bounds.mean(axis=1)
+    x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
+    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    for name, v, a, b in zip(mech.unknown_names, x0, lo, hi):
+        if not a - 1e-9 <= v <= b + 1e-9:
+            raise FkoptError(f"algorithms[{spec.key}].start: {name}={v:g} is outside the workspace "
+                             f"bounds [{a:g}, {b:g}]")
+    return x0
+
+
+def validate_study(config: StudyConfig):
+    """Build everything a run needs without running it (bad input fails before any work)."""
+    mech = build_mechanism(config)
+    poses = build_poses(config, mech)
+    for spec in config.algorithms:
+        make_algorithm(spec.name, spec.params)
+        start_point(spec, mech)
+    make_problem(config, mech, poses.inputs[0])
+    return mech, poses
+
+
+@lru_cache(maxsize=4)
+def _context(config_json: str):
+    config = StudyConfig(**json.loads(config_json))
+    mech, poses = validate_study(config)
+    return config, mech, poses
+
+
+def payload(config: StudyConfig, task: Task) -> dict:
+    return {"config": config.model_dump_json(), "task": task.__dict__.copy()}
+
+
+def run_task(payload: dict) -> dict:
+    """Compute one task (in any process); returns a JSON-able record."""
+    config, mech, poses = _context(payload["config"])
+    task = Task(**payload["task"])
+    spec = config.algorithms[task.algorithm]
+    start = time.perf_counter()
+    if config.mode == "tracking":
+        rec = _track(config, mech, poses, spec, task)
+    else:
+        rec = _independent(config, mech, poses, spec, task)
+    rec.update({"id": task.id, "task": task.__dict__.copy(), "fingerprint": config.fingerprint(),
+                "wall_s": time.perf_counter() - start, "pid": os.getpid()})
+    return rec
+
+
+def _budget(config: StudyConfig, spec: StudyAlgorithmSpec) -> dict:
+    return dict(population=spec.population or config.population,
+                iterations=spec.iterations or config.iterations,
+                target=config.threshold, stop_at_target=config.stop_at_threshold)
+
+
+def _collect(rec: dict, r, thr: float, seconds: float) -> None:
+    rec["fitness"].append(r.fitness.tolist())
+    rec["evaluations"].append(r.evaluations.tolist())
+    rec["iterations_done"].append(r.iterations_done.tolist())
+    rec["iterations_to"].append(r.iterations_to(thr).tolist())
+    rec["evaluations_to"].append(r.evaluations_to(thr).tolist())
+    rec["x"].append(r.x.tolist())
+    rec["time_s"].append(seconds)
+
+
+def _empty(task: Task) -> dict:
+    return {"poses": list(range(task.start, task.stop)), "seeds": [], "fitness": [], "evaluations": [],
+            "iterations_done": [], "iterations_to": [], "evaluations_to": [], "x": [], "time_s": []}
+
+
+def _independent(config, mech, poses: PoseSet, spec, task: Task) -> dict:
+    rec = _empty(task)
+    x0 = start_point(spec, mech)
+    budget = _budget(config, spec)
+    for i in range(task.start, task.stop):
+        problem = make_problem(config, mech, poses.inputs[i])
+        seed = task_seed(config.seed, i, spec.key)
+        t0 = time.perf_counter()
+        r = solve(problem, make_algorithm(spec.name, spec.params), runs=config.runs, seed=seed, x0=x0, **budget)
+        rec["seeds"].append(seed)
+        _collect(rec, r, config.threshold, time.perf_counter() - t0)
+    return rec
+
+
+def _warm_box(mech, prev: np.ndarray, radius: float) -> np.ndarray:
+    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    half = radius * (hi - lo)
+    return np.column_stack([np.maximum(lo, prev - half), np.minimum(hi, prev + half)])
+
+
+def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
+    """Solve the trajectory in order; each step warm-starts from the previous step's solution."""
+    rec = _empty(task)
+    rec["start"] = []
+    algo = make_algorithm(spec.name, spec.params)
+    budget = _budget(config, spec)
+    runs, dim = config.runs, len(mech.unknown_names)
+    x0 = start_point(spec, mech)
+    prev = None
+    for t in range(task.start, task.stop):
+        seed = task_seed(config.seed, t, spec.key)
+        warm = spec.warm_start and prev is not None
+        t0 = time.perf_counter()
+        if algo.local or not warm:
+            start = prev if warm else x0
+            r = solve(make_problem(config, mech, poses.inputs[t]), algo, runs=runs, seed=seed, x0=start, **budget)
+            starts = (np.broadcast_to(start, (runs, dim)) if start is not None else np.full((runs, dim), np.nan))
+        else:   # a swarm searches a small box around each run's previous solution, run by run
+            parts = []
+            for k in range(runs):
+                box = _warm_box(mech, prev[k], config.tracking.radius)
+                problem = make_problem(config, mech, poses.inputs[t], bounds=box)
+                parts.append(solve(problem, algo, runs=1, run_ids=[k], seed=seed, x0=prev[k], **budget))
+            r = _stack(parts)
+            starts = prev
+        rec["seeds"].append(seed)
+        rec["start"].append(np.asarray(starts, dtype=float).tolist())
+        _collect(rec, r, config.threshold, time.perf_counter() - t0)
+        prev = np.array(r.x, dtype=float)
+    return rec
+
+
+@dataclass
+class _Stacked:
+    fitness: np.ndarray
+    evaluations: np.ndarray
+    iterations_done: np.ndarray
+    x: np.ndarray
+    to_it: np.ndarray
+    to_ev: np.ndarray
+
+    def iterations_to(self, thr):
+        return self.to_it
+
+    def evaluations_to(self, thr):
+        return self.to_ev
+
+
+def _stack(parts) -> _Stacked:
+    thr = parts[0].target
+    cat = lambda f: np.concatenate([f(p) for p in parts])  # noqa: E731
+    return _Stacked(cat(lambda p: p.fitness), cat(lambda p: p.evaluations), cat(lambda p: p.iterations_done),
+                    cat(lambda p: p.x), cat(lambda p: p.iterations_to(thr)), cat(lambda p: p.evaluations_to(thr)))
+
+
+# -- task files ----------------------------------------------------------------------------------
+def write_json_atomic(path: Path, data: dict) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and os.replace."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(data, fh, separators=(",", ":"))
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def read_task_files(folder: Path, fingerprint: str) -> dict[str, dict]:
+    """Finished tasks in ``folder/tasks`` (unreadable files are ignored: they are redone)."""
+    out = {}
+    for path in sorted((folder / TASKS).glob("a*.json")):
+        try:
+            rec = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        if rec.get("fingerprint") != fingerprint:
+            raise FkoptError(f"{path}: belongs to another version of the study (its config changed); "
+                             "rerun without --resume to start over")
+        out[rec["id"]] = rec
+    return out
+
+
+# -- merged result -------------------------------------------------------------------------------
+@dataclass
+class AlgorithmResult:
+    spec: StudyAlgorithmSpec
+    population: int
+    iterations: int
+    seeds: np.ndarray            # (n,)
+    fitness: np.ndarray          # (n, runs)
+    evaluations: np.ndarray      # (n, runs)
+    iterations_done: np.ndarray  # (n, runs)
+    iterations_to: np.ndarray    # (n, runs), NaN: never below the threshold
+    evaluations_to: np.ndarray   # (n, runs), NaN: never below the threshold
+    x: np.ndarray                # (n, runs, dim) solution in the unknowns
+    outputs: np.ndarray          # (n, runs, n_pose) the pose it corresponds to
+    errors: np.ndarray           # (n, runs, n_pose) |pose - target| (angles wrapped)
+    time_s: np.ndarray           # (n,) wall time of all runs of each pose/step
+    start: np.ndarray | None = None   # (n, runs, dim) tracking start points (NaN: cold swarm)
+    wall_s: float = 0.0
+
+    @property
+    def key(self) -> str:
+        return self.spec.key
+
+
+@dataclass
+class StudyResult:
+    config: StudyConfig
+    mechanism: object
+    poses: PoseSet
+    algorithms: list[AlgorithmResult]
+    wall_s: float
+    source: str | None = None
+    computed: list[str] = field(default_factory=list)   # task ids computed by this invocation
+    folder: Path | None = None
+
+    @property
+    def compared_names(self):
+        return self.mechanism.pose_names
+
+    @property
+    def compared_units(self):
+        return self.mechanism.pose_units
+
+    def get(self, label: str) -> AlgorithmResult:
+        return next(a for a in self.algorithms if a.key == label)
+
+
+def merge(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]) -> list[AlgorithmResult]:
+    from ..experiment.runner import outputs_of, pose_error
+    n, runs, dim = len(poses), config.runs, len(mech.unknown_names)
+    tasks = plan_tasks(config, n)
+    out = []
+    for a, spec in enumerate(config.algorithms):
+        arr = {k: np.full((n, runs), np.nan) for k in ("fitness", "evaluations", "iterations_done",
+                                                         "iterations_to", "evaluations_to")}
+        x = np.full((n, runs, dim), np.nan)
+        start = np.full((n, runs, dim), np.nan) if config.mode == "tracking" else None
+        seeds = np.zeros(n, dtype=np.int64)
+        time_s = np.zeros(n)
+        wall = 0.0
+        for task in (t for t in tasks if t.algorithm == a):
+            rec = records[task.id]
+            idx = np.asarray(rec["poses"], dtype=int)
+            for k in arr:
+                arr[k][idx] = np.asarray(rec[k], dtype=float)
+            x[idx] = np.asarray(rec["x"], dtype=float)
+            if start is not None:
+                start[idx] = np.asarray(rec["start"], dtype=float)
+            seeds[idx] = rec["seeds"]
+            time_s[idx] = rec["time_s"]
+            wall += rec["wall_s"]
+        outputs = outputs_of(mech, x)
+        errors = pose_error(mech, outputs, poses.targets[:, None, :])
+        out.append(AlgorithmResult(
+            spec=spec, population=spec.population or config.population,
+            iterations=spec.iterations or config.iterations, seeds=seeds, fitness=arr["fitness"],
+            evaluations=arr["evaluations"], iterations_done=arr["iterations_done"],
+            iterations_to=arr["iterations_to"], evaluations_to=arr["evaluations_to"], x=x,
+            outputs=outputs, errors=errors, time_s=time_s, start=start, wall_s=wall))
+    return out
+
+
+# -- driver --------------------------------------------------------------------------------------
+def study_folder(out: str | Path, config: StudyConfig) -> Path:
+    return Path(out) / config.paper / config.name
+
+
+def _prepare(folder: Path, config: StudyConfig, resume: bool) -> None:
+    study_file = folder / TASKS / STUDY_FILE
+    if resume and study_file.exists():
+        try:
+            stored = json.loads(study_file.read_text()).get("fingerprint")
+        except (OSError, ValueError):
+            stored = None
+        if stored not in (None, config.fingerprint()):
+            raise FkoptError(f"--resume: {folder} holds tasks of another version of study '{config.name}' "
+                             "(its config changed); rerun without --resume to start over")
+    elif not resume and folder.exists():
+        if not ((folder / "meta.json").exists() or (folder / TASKS).exists() or not any(folder.iterdir())):
+            raise FkoptError(f"{folder}: exists and is not a study folder; refusing to overwrite it")
+        shutil.rmtree(folder)
+    (folder / TASKS).mkdir(parents=True, exist_ok=True)
+    try:
+        (folder / "meta.json").unlink()     # the folder is unfinished until the merge writes it
+    except FileNotFoundError:
+        pass
+    write_json_atomic(study_file, {"name": config.name, "fingerprint": config.fingerprint(),
+                                   "config": config.model_dump(mode="json")})
+
+
+def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
+              scheduler: str | None = None, resume: bool = False,
+              progress: Callable[[str, int, int], None] | None = None, source: str | None = None,
+              write: bool = True) -> StudyResult:
+    """Run (or resume) a study into ``OUT/<paper>/<name>/`` and write its report files.
+
+    ``progress(label, done, total)`` is called after each finished task (``done`` counts the
+    tasks already on disk too). An exception raised by it (e.g. KeyboardInterrupt) stops the
+    study; every task finished so far stays on disk for ``resume=True``.
+    """
+    from .executors import execute, validate_executor
+    validate_executor(executor, jobs, scheduler)
+    mech, poses = validate_study(config)
+    folder = study_folder(out, config)
+    t_start = time.perf_counter()
+    _prepare(folder, config, resume)
+    fp = config.fingerprint()
+    records = read_task_files(folder, fp) if resume else {}
+    tasks = plan_tasks(config, len(poses))
+    pending = [t for t in tasks if t.id not in records]
+    computed: list[str] = []
+
+    def finished(rec: dict) -> None:
+        write_json_atomic(folder / TASKS / f"{rec['id']}.json", rec)
+        records[rec["id"]] = rec
+        computed.append(rec["id"])
+        if progress:
+            task = rec["task"]
+            where = (f"poses {task['start'] + 1}-{task['stop']}" if config.mode == "independent"
+                     else f"{task['stop'] - task['start']} steps")
+            progress(f"{task['label']} · {where}", len(records), len(tasks))
+
+    if progress and records:
+        progress("resumed", len(records), len(tasks))
+    execute(run_task, [payload(config, t) for t in pending], executor=executor, jobs=jobs,
+            scheduler=scheduler, on_result=finished)
+    missing = [t.id for t in tasks if t.id not in records]
+    if missing:  # pragma: no cover - execute() raises before this can happen
+        raise FkoptError(f"study '{config.name}': {len(missing)} task(s) did not finish (first: {missing[0]})")
+    result = StudyResult(config, mech, poses, merge(config, mech, poses, records),
+                         time.perf_counter() - t_start, source, computed, folder)
+    if write:
+        from .reports import write_study
+        write_study(result, folder)
+    return result
+
+
+def rerun_in_memory(config: StudyConfig) -> StudyResult:
+    """Every task computed in this process, nothing written (for checks and tests)."""
+    mech, poses = validate_study(config)
+    start = time.perf_counter()
+    records = {}
+    for t in plan_tasks(config, len(poses)):
+        rec = run_task(payload(config, t))
+        records[rec["id"]] = rec
+    return StudyResult(config, mech, poses, merge(config, mech, poses, records),
+                       time.perf_counter() - start)
