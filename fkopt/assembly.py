@@ -16,9 +16,11 @@ many inputs as pose variables:
    (|v_i|^2 - L_i^2) / (2 L_i) = 0 with the analytic Jacobian [v_i, (R q_i) x v_i] / L_i in the
    position and a rotation vector (R <- exp([w]x) R, so no Euler singularity during the
    search); for other mechanisms on ``FKProblem.residuals`` with a central-difference Jacobian.
-   Steps are capped (1 rad of rotation / a quarter of the bounds width) and halved up to 8
-   times until the squared residual decreases (backtracking line search). A start stops when
-   converged (then one more polishing step), diverged, stalled or out of iterations.
+   Steps are capped (6-SPS: 2 rad of rotation and one mechanism size of translation; others:
+   a quarter of the bounds width) and halved up to 8 times until the squared residual
+   decreases (backtracking line search). A start stops when converged (then one more
+   polishing step), diverged, stalled or out of ``iterations`` (60: the rarest basins of
+   Dietmaier's example are mostly reached by slow, heavily damped starts).
 3. **Deduplication** with the stated tolerance ``dedup``: two converged starts are one
    solution when they differ by at most ``dedup`` in the normalised pose space -- length
    variables divided by their bounds width, angle variables in radians compared modulo 2 pi,
@@ -34,14 +36,21 @@ many inputs as pose variables:
    for every joint and the pose is inside the bounds (solutions found outside are counted in
    ``Solutions.outside``).
 
-Rounds continue until ``patience`` consecutive rounds bring no new solution (or ``max_starts``
-is reached); ``starts=N`` instead runs exactly N starts in one round. ``Solutions.history``
-records (starts, seconds, solutions found) after every round.
+Rounds continue until ``patience`` consecutive rounds bring no new solution in the bounds,
+after at least ``min_starts`` (or until ``max_starts``); ``starts=N`` instead runs exactly N
+starts in one round. ``Solutions.history`` records (starts, seconds, solutions in the bounds)
+after every round.
+
+Measured on Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``):
+all 40 real solutions, residuals ~1e-15, in the first round of 2000 starts for 10 seeds out
+of 10 (~0.2 s), and ~0.3-0.45 s of CPU for the whole search with its confirming round
+(4000 starts). The rarest basin is hit by ~0.3 % of the starts, so 2000 starts miss it with
+probability ~0.3 % and the confirming round makes an early stop with 39 unlikely (~1e-5).
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -68,14 +77,18 @@ class Solution:
 class Solutions(list):
     """List of :class:`Solution` (most hits first) with the search's bookkeeping as attributes."""
 
+    names: tuple[str, ...] = ()
+    #: starts used, wall time (s), distinct real solutions found outside the bounds
     starts: int = 0
     time_s: float = 0.0
     outside: int = 0
+    #: (starts so far, seconds so far, solutions in the bounds so far) after every round
     history: list[tuple[int, float, int]]
     settings: dict[str, Any]
 
     def poses(self) -> np.ndarray:
-        return np.array([s.x for s in self]) if len(self) else np.empty((0, 0))
+        """Poses (n, dim), rows in the order of the list."""
+        return np.array([s.x for s in self]).reshape(len(self), len(self.names))
 
 
 def solutions_to_dict(solutions: Solutions) -> dict[str, Any]:
@@ -283,7 +296,9 @@ class _SixSPSModel(_Model):
         return out
 
     def cap(self, dx):
-        rot = np.sqrt((dx[:, 3:] ** 2).sum(-1))
+        # At most 2 rad of rotation (measured: smaller caps shrink the rarest basins of
+        # Dietmaier's example, 1 rad by a third) and one mechanism size of translation.
+        rot = np.sqrt((dx[:, 3:] ** 2).sum(-1)) / 2.0
         pos = np.sqrt((dx[:, :3] ** 2).sum(-1)) / self.scale
         return 1.0 / np.maximum(1.0, np.maximum(rot, pos))
 
@@ -422,8 +437,11 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     for _ in range(iterations):
         if not len(idx):
             break
+        bad = ~(np.isfinite(J).all((1, 2)) & np.isfinite(f).all(-1))
+        if bad.any():                                  # e.g. a pose outside the inverse map's domain
+            J[bad], f[bad] = np.eye(J.shape[-1]), 0.0
         dx = _solve(J, f)
-        ok = np.isfinite(dx).all(-1)
+        ok = np.isfinite(dx).all(-1) & ~bad
         dx[~ok] = 0.0
         dx *= model.cap(dx)[:, None]
         # Backtracking: full step for all, then half steps, then the remaining halvings
@@ -570,60 +588,56 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     jscale = np.maximum(1.0, np.abs(joints))
     ftol = 1e-3 * tol * float(jscale.min())           # Newton's own stop, well below the acceptance
 
-    reps = np.empty((0, 0))                           # representative states, one per solution found
-    rep_keys = np.empty((0, 0))
+    problem = FKProblem(mechanism, joints)
+    rep_keys: list[np.ndarray] = []                   # one key per distinct solution found
     hits: list[int] = []
+    found: list[tuple[np.ndarray, float] | None] = []  # (pose in bounds, residual), None: outside
     history: list[tuple[int, float, int]] = []
     used, quiet = 0, 0
     while used < limit:
         n = min(size, limit - used)
         S0 = model.starts(streams.uniform(n, model.draws)[0])
-        S, conv = _newton(model, S0, ftol=ftol, iterations=iterations)
+        with np.errstate(all="ignore"):                 # diverging starts may overflow
+            S, conv = _newton(model, S0, ftol=ftol, iterations=iterations)
         used += n
         good = conv & (np.abs(model.residual(S)) / jscale <= tol).all(-1)
         S, keys = S[good], model.keys(S[good])
-        before = len(hits)
+        inside_before = sum(f is not None for f in found)
         if len(S):
-            allk = keys if not len(rep_keys) else np.concatenate([rep_keys, keys])
-            labels = _cluster(allk, dedup)
             old = len(hits)
-            new_labels = labels[old:]
-            # labels of the old representatives are 0..old-1 in order (each is its own cluster).
-            for lab in np.unique(new_labels):
-                count = int((new_labels == lab).sum())
+            labels = _cluster(np.concatenate([np.array(rep_keys), keys]) if old else keys, dedup)[old:]
+            # The old representatives, mutually farther apart than dedup, keep labels 0..old-1.
+            for lab in np.unique(labels):
+                members = np.flatnonzero(labels == lab)
                 if lab < old:
-                    hits[lab] += count
-                else:
-                    first = np.flatnonzero(new_labels == lab)[0]
-                    reps = S[first:first + 1] if not len(hits) else np.concatenate([reps, S[first:first + 1]])
-                    rep_keys = keys[first:first + 1] if not len(rep_keys) else np.concatenate(
-                        [rep_keys, keys[first:first + 1]])
-                    hits.append(count)
-        history.append((used, time.perf_counter() - t0, len(hits)))
-        quiet = quiet + 1 if len(hits) == before else 0
+                    hits[lab] += len(members)
+                    continue
+                first = members[0]
+                rep_keys.append(keys[first])
+                hits.append(len(members))
+                found.append(_check(mechanism, problem, model.poses(S[first:first + 1])[0], triple, jscale, tol))
+        inside = sum(f is not None for f in found)
+        history.append((used, time.perf_counter() - t0, inside))
+        quiet = quiet + 1 if inside == inside_before else 0
         if used >= need and quiet >= patience:
             break
 
-    out = Solutions()
-    out.outside = 0
-    rows = []
-    if len(hits):
-        poses = model.poses(reps)
-        for x, h in zip(poses, hits):
-            xb = _into_bounds(mechanism, x, triple)
-            if xb is None:
-                out.outside += 1
-                continue
-            r = FKProblem(mechanism, joints).residuals(xb)
-            if not (np.abs(r) / jscale <= tol).all():
-                continue
-            rows.append(Solution(pose=dict(zip(mechanism.pose_names, (float(v) for v in xb))),
-                                 residual=float(np.abs(r).max()), hits=int(h)))
-    rows.sort(key=lambda s: -s.hits)
-    out.extend(rows)
+    out = Solutions(sorted((Solution(pose=dict(zip(mechanism.pose_names, map(float, f[0]))), residual=f[1], hits=h)
+                            for f, h in zip(found, hits) if f is not None), key=lambda s: -s.hits))
+    out.names = tuple(mechanism.pose_names)
+    out.outside = sum(f is None for f in found)
     out.starts = used
     out.time_s = time.perf_counter() - t0
     out.history = history
     out.settings = dict(seed=seed, tol=tol, dedup=dedup, round_size=size, patience=patience,
                         iterations=iterations)
     return out
+
+
+def _check(mechanism, problem, x, triple, jscale, tol):
+    """(pose moved into the bounds, residual) of a converged solution, or None if outside/inexact."""
+    xb = _into_bounds(mechanism, x, triple)
+    if xb is None:
+        return None
+    r = np.abs(problem.residuals(xb))
+    return (xb, float(r.max())) if (r / jscale <= tol).all() else None
