@@ -142,10 +142,12 @@ def test_missing_file():
 
 
 def test_stored_configs_validate():
-    from fkopt.experiment.config import load_config
     from fkopt.experiment.runner import validate_experiment
+    from fkopt.study.config import StudyConfig, load_any
+    from fkopt.study.runner import validate_study
     root = Path(__file__).resolve().parents[1] / "configs"
     files = sorted(root.rglob("*.yaml"))
     assert files
-    for f in files:
-        validate_experiment(load_config(f))
+    for f in files:   # experiments, and studies (kind: study, configs/studies/)
+        config = load_any(f)
+        validate_study(config) if isinstance(config, StudyConfig) else validate_experiment(config)
