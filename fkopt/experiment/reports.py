@@ -10,11 +10,13 @@ the figures drawn from timings, ``cases_time.png``):
 * ``values.csv``      per variable: target, the median run's value and error (the run whose final
   fitness is the lower median), the best run's, and the mean absolute error over all runs;
 * ``inputs.csv``      (only when a case gives both joints and a pose) given vs computed inputs;
-* ``runs.csv``        one row per run;
+* ``runs.csv``        one row per run (incl. ``iterations_to_best``: first iteration at which the
+  run's final best-so-far fitness was reached);
 * ``convergence.csv`` best-so-far fitness per iteration: median and quartiles over runs, mean
   evaluations; ``convergence.png`` the same on a log scale (vs iterations and vs evaluations);
 * optional figures (``figures:`` in the config): ``variables.png``, ``snapshot_<t>.png``,
-  ``extras.png``, ``cases.png`` + ``cases_time.png``, ``position_error.png``;
+  ``extras.png``, ``cases.png`` + ``cases_time.png`` (+ ``cases_position_error.png`` for
+  serial arms), ``position_error.png``;
 * ``meta.json``       config, seeds, fkopt/library versions, platform.
 
 A folder is written into a temporary sibling first and renamed into place, so a failed or
@@ -143,7 +145,9 @@ def runs_table(er: ExperimentResult) -> pd.DataFrame:
         r = rec.result
         df = pd.DataFrame({"case": rec.case.label, "algorithm": rec.spec.key, "run": r.run_ids,
                            "task_seed": rec.seed, "final_fitness": r.fitness, "evaluations": r.evaluations,
-                           "iterations_done": r.iterations_done})
+                           "iterations_done": r.iterations_done,
+                           # first iteration at which the run's final best-so-far fitness was reached
+                           "iterations_to_best": np.argmax(r.history <= r.history[:, -1:], axis=1)})
         if thr is not None:
             df["iterations_to_threshold"] = r.iterations_to(thr)
             df["evaluations_to_threshold"] = r.evaluations_to(thr)
@@ -361,6 +365,22 @@ def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, tim
         _save(fig, folder / name)
         plt.close(fig)
         written.append(name)
+    if er.mechanism.kind == "serial":   # wang7dof Fig. 7a: final position error per pose
+        fig, ax = plt.subplots(figsize=(7, 3.5))
+        for spec in er.config.algorithms:
+            y = [float(np.median(r.position_error_history[:, -1])) for r in er.records
+                 if r.spec.key == spec.key and r.position_error_history is not None]
+            if y:
+                ax.plot(np.arange(1, len(y) + 1), np.maximum(y, LOG_FLOOR), marker="o", ms=3, lw=0.8,
+                        label=spec.key)
+        ax.set_yscale("log")
+        ax.set_xlabel("case")
+        ax.set_ylabel("median final position error")
+        ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+        _save(fig, folder / "cases_position_error.png")
+        plt.close(fig)
+        written.append("cases_position_error.png")
     return written
 
 

@@ -12,4 +12,6 @@
 PAPERS: dict[str, str] = {
     "mao2017": "fkopt.reproduce.mao2017",
     "studies": "fkopt.reproduce.studies",
+    "liu2008": "fkopt.reproduce.liu2008",
+    "wang7dof": "fkopt.reproduce.wang7dof",
 }

@@ -1,0 +1,98 @@
+"""liu2008 (6-SPS parallel CMM, PSO): configs, the printed case, a small run of every config, claims."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fkopt.experiment.config import ExperimentConfig, load_config
+from fkopt.experiment.reports import write_experiment
+from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.mechanisms.sps6 import SixSPSCMM
+from fkopt.problems import fk_problem
+from fkopt.reproduce import PAPERS, liu2008
+from fkopt.reproduce.claims import HELD, NOT_HELD
+from fkopt.reproduce.report import build_report
+from fkopt.reproduce.store import Store
+from fkopt.solve import solve
+
+CONFIGS = sorted((Path(__file__).resolve().parents[1] / "configs" / "liu2008").glob("*.yaml"))
+LEGS = np.array(liu2008.PRINTED_LEGS)
+EXACT = np.array([0.039860473384495845, 0.09593004555681638, 0.9252345609285073,
+                  -12.697325274301523, 6.40309494118661, 15.133205922920425])
+PSO_PAPER = dict(inertia="linear", w_max=0.5, w_min=0.1, c1=1.8, c2=1.8, v_max=1.0)
+
+
+def test_configs_validate_and_cover_the_paper():
+    names = {p.stem for p in CONFIGS}
+    assert {"tab3_fig4", "tab3_fig4_squared", "baselines"} <= names
+    assert set(liu2008.EXPERIMENTS) == names
+    assert PAPERS["liu2008"] == "fkopt.reproduce.liu2008"
+    for path in CONFIGS:
+        cfg = load_config(path)
+        assert cfg.paper == "liu2008" and cfg.name == path.stem
+        validate_experiment(cfg)
+    main = load_config(CONFIGS[[p.stem for p in CONFIGS].index("tab3_fig4")])
+    assert main.objective == "absolute" and main.threshold == 5e-7 and main.stop_at_threshold
+    assert main.population == 80 and main.iterations == 500
+    assert main.algorithms[0].params == PSO_PAPER
+
+
+def test_exact_solution_reproduces_the_printed_legs():
+    mech = SixSPSCMM()
+    assert np.allclose(mech.ik(EXACT[None])[0], LEGS, atol=1e-14)
+    # SPEC.md's 8-digit exact solution agrees
+    spec = np.array([0.03986047, 0.09593005, 0.92523456, -12.6973253, 6.4030949, 15.1332059])
+    assert np.all(np.abs(spec - EXACT) < 6e-8)
+
+
+def test_printed_pose_is_the_rounded_exact_solution_and_misses_the_legs_by_054_um():
+    df = liu2008._printed_pose_legs()
+    assert 0.54e0 < np.abs(df.difference_um).max() < 0.55
+    assert np.abs(df.difference_um).sum() > 0.5       # above the paper's own 0.5 um precision
+    assert np.all(np.abs(np.array(liu2008.PRINTED_POSE) - EXACT) <= liu2008.PRINTED_HALF_UNIT)
+
+
+def test_paper_pso_reaches_half_a_micrometre():
+    pr = fk_problem(SixSPSCMM(), LEGS, objective="absolute")
+    r = solve(pr, "pso", population=80, iterations=150, runs=3, seed=1, target=5e-7, stop_at_target=True,
+              params=PSO_PAPER)
+    assert np.all(r.success(5e-7))
+    assert np.all(np.abs(r.x[:, :3] - EXACT[:3]) < 2e-6)
+
+
+@pytest.fixture(scope="module")
+def small_results(tmp_path_factory):
+    root = tmp_path_factory.mktemp("results")
+    for path in CONFIGS:
+        data = load_config(path).model_dump()
+        data.update(runs=2, iterations=40)
+        er = run_experiment(ExperimentConfig(**data), source=str(path))
+        write_experiment(er, root)
+    return root
+
+
+def test_small_runs_write_the_expected_files(small_results):
+    store = Store(small_results)
+    exp = store.get("liu2008", "tab3_fig4")
+    assert {"summary.csv", "runs.csv", "values.csv", "convergence.png", "variables.png"} <= set(
+        p.name for p in exp.folder.iterdir())
+    runs = exp.table("runs")
+    assert {"iterations_to_best", "iterations_to_threshold", "abs_error_x"} <= set(runs.columns)
+    v = exp.table("values")
+    assert {"exact_solution", "median_run_error_vs_exact_solution", "printed_value"} <= set(v.columns)
+    assert exp.meta["objective"] == "absolute"
+    assert store.get("liu2008", "tab3_fig4_squared").meta["objective"] == "squared"
+    assert set(store.get("liu2008", "baselines").table("summary").algorithm) == {"pso", "lm", "pso+lm"}
+
+
+def test_claims_and_report_run_on_small_results(small_results):
+    store = Store(small_results)
+    claims = liu2008.claims(store)
+    assert len(claims) >= 5
+    printed = [c for c in claims if c.text.startswith("Tab. 3: the printed pose")]
+    assert printed and printed[0].verdict == HELD
+    assert all(c.verdict in (HELD, NOT_HELD) for c in claims)
+    assert liu2008.timing_claims(store)
+    report, timing, _ = build_report(small_results)
+    assert "## liu2008" in report and "Leg lengths of the printed Tab. 3 pose" in report
+    assert "Timing claims" in timing

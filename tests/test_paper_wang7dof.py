@@ -1,0 +1,110 @@
+"""wang7dof (7-DOF arm IK, ABC vs PSO): configs, the printed case, a small run of every config, claims."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fkopt.experiment.config import ExperimentConfig, load_config
+from fkopt.experiment.reports import write_experiment
+from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.mechanisms.dh_arm import SevenDofArm
+from fkopt.problems import ik_problem
+from fkopt.reproduce import PAPERS, wang7dof
+from fkopt.reproduce.claims import HELD, NOT_CHECKABLE, NOT_HELD
+from fkopt.reproduce.report import build_report
+from fkopt.reproduce.store import Store
+
+CONFIGS = sorted((Path(__file__).resolve().parents[1] / "configs" / "wang7dof").glob("*.yaml"))
+TARGET = np.array(wang7dof.TARGET_JOINTS)
+
+
+def _config(stem):
+    return load_config(next(p for p in CONFIGS if p.stem == stem))
+
+
+def test_configs_validate_and_cover_the_paper():
+    names = {p.stem for p in CONFIGS}
+    assert set(wang7dof.EXPERIMENTS) == names == {"tab2_tab3_fig5_fig6", "fig7", "baselines"}
+    assert PAPERS["wang7dof"] == "fkopt.reproduce.wang7dof"
+    for path in CONFIGS:
+        cfg = load_config(path)
+        assert cfg.paper == "wang7dof" and cfg.name == path.stem
+        assert cfg.objective == "paper"           # every result states its objective
+        validate_experiment(cfg)
+        pops = {a.name: a.population for a in cfg.algorithms}
+        assert pops["abc"] == 100 and pops["pso"] == 300
+    assert any(load_config(p).check == "ci" for p in CONFIGS)
+    t2 = _config("tab2_tab3_fig5_fig6")
+    assert t2.printed["table2"]["abc"]["q7"] == 72.68 and t2.printed["table2"]["pso"]["q1"] == 48.282
+
+
+def test_target_pose_matches_spec():
+    pose = SevenDofArm().fk(TARGET[None])[0]
+    assert np.allclose(pose, [-247.4874, 1009.6194, 500.0, -135.0, 90.0, -90.0], atol=1e-4)
+
+
+def test_printed_joint_solutions_do_not_reach_the_target():
+    df = wang7dof.printed_solutions_table(_StubExp(_config("tab2_tab3_fig5_fig6"))).set_index("printed_solution")
+    assert df.loc["abc", "position_error_mm"] == pytest.approx(85.88, abs=0.01)    # SPEC: 86 mm
+    assert df.loc["pso", "position_error_mm"] == pytest.approx(126.08, abs=0.01)   # SPEC: 126 mm
+    assert (df.geodesic_error_deg > 60).all()
+
+
+def test_exact_joints_have_zero_errors():
+    mech = SevenDofArm()
+    pr = ik_problem(mech, mech.fk(TARGET[None])[0], objective="paper")
+    e = wang7dof.errors_of(pr, TARGET)
+    assert all(float(v[0]) < 1e-9 for v in e.values())
+
+
+class _StubExp:
+    """Just enough of a stored Experiment for printed_solutions_table."""
+
+    def __init__(self, cfg):
+        self.config = cfg.model_dump(mode="json")
+
+
+@pytest.fixture(scope="module")
+def small_results(tmp_path_factory):
+    root = tmp_path_factory.mktemp("results")
+    for path in CONFIGS:
+        data = load_config(path).model_dump()
+        data.update(runs=2, iterations=15)
+        if isinstance(data["cases"], dict):
+            data["cases"] = {**data["cases"], "random": 2}
+        for a in data["algorithms"]:
+            a["population"] = min(a["population"] or 10, 20)
+            if a["iterations"]:
+                a["iterations"] = 10
+        er = run_experiment(ExperimentConfig(**data), source=str(path))
+        write_experiment(er, root)
+    return root
+
+
+def test_small_runs_write_the_expected_files(small_results):
+    store = Store(small_results)
+    exp = store.get("wang7dof", "tab2_tab3_fig5_fig6")
+    files = {p.name for p in exp.folder.iterdir()}
+    assert {"summary.csv", "runs.csv", "convergence.png", "position_error.png"} <= files
+    runs = exp.table("runs")
+    assert {"iterations_to_best", "position_error", "x_q7", "pose_gamma"} <= set(runs.columns)
+    assert (runs.iterations_to_best <= runs.iterations_done).all()
+    assert exp.meta["objective"] == "paper"
+    f7 = store.get("wang7dof", "fig7")
+    assert {"cases.png", "cases_time.png", "cases_position_error.png"} <= {p.name for p in f7.folder.iterdir()}
+    t3 = wang7dof.table3(exp)
+    assert list(t3.algorithm) == ["abc", "pso"] and "printed_iterations_to_best" in t3
+    t2 = wang7dof.table2(exp)
+    assert t2.solution.iloc[0] == "target" and len(t2) == 5
+
+
+def test_claims_and_report_run_on_small_results(small_results):
+    store = Store(small_results)
+    claims = wang7dof.claims(store)
+    assert len(claims) >= 8
+    assert all(c.verdict in (HELD, NOT_HELD, NOT_CHECKABLE) for c in claims)
+    assert claims[0].text.startswith("Tab. 2") and claims[0].verdict == NOT_HELD
+    assert len(wang7dof.timing_claims(store)) == 3
+    report, timing, _ = build_report(small_results)
+    assert "## wang7dof" in report and "printed joint solutions" in report
+    assert "objective `paper`" in report
