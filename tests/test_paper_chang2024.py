@@ -1,0 +1,113 @@
+"""chang2024 reproduction: configs, the printed case, a small run of each config kind, claims."""
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from fkopt.experiment.config import ExperimentConfig, load_config
+from fkopt.experiment.reports import write_tables
+from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.problems import fk_problem
+from fkopt.registry import mechanism_class
+from fkopt.reproduce import PAPERS, chang2024
+from fkopt.reproduce.claims import NOT_CHECKABLE, Claim
+from fkopt.reproduce.store import Store
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = sorted((ROOT / "configs" / "chang2024").glob("*.yaml"))
+
+
+def test_registered_and_every_experiment_has_a_config():
+    assert PAPERS["chang2024"] == "fkopt.reproduce.chang2024"
+    names = {load_config(p).name for p in CONFIGS}
+    assert names == set(chang2024.EXPERIMENTS)
+
+
+@pytest.mark.parametrize("path", CONFIGS, ids=[p.stem for p in CONFIGS])
+def test_configs_validate_with_printed_settings(path):
+    cfg = load_config(path)
+    assert cfg.paper == "chang2024" and cfg.mechanism.name == "3-rpupc-ups"
+    validate_experiment(cfg)
+    assert cfg.population == 100 and cfg.iterations == 300
+    for a in cfg.algorithms:
+        if a.name in ("pso", "pabc"):
+            assert (a.params["w"], a.params["c1"], a.params["c2"]) == (0.8, 2, 2)
+        if a.name == "pabc":
+            assert a.params["switch"] == 0.5
+    if cfg.name == "tab1_fig7":
+        assert cfg.runs == 30 and cfg.check == "ci"
+    if cfg.name == "tab2":
+        assert cfg.cases.random == 50 and "cases" in cfg.figures
+
+
+def test_printed_case_inputs_and_exact_solution():
+    mech = mechanism_class("3-rpupc-ups")()
+    pose = np.array([25.0, 34.0, 23.0, 360.0])
+    joints = mech.ik(pose)
+    np.testing.assert_allclose(joints[:3], [332.048, 390.904, 402.294], atol=5e-4)
+    assert abs(joints[3] - (-14.4389)) < 5e-5
+    assert mech.in_bounds(pose)
+    prob = fk_problem(mech, joints)
+    assert prob.fitness(pose) == 0.0
+    # the printed (rounded) inputs are 1e-3-close, so the fitness of the pose against them is tiny
+    printed = fk_problem(mech, [332.048, 390.904, 402.294, -14.4389])
+    assert printed.fitness(pose) < 1e-6
+    table = chang2024.inputs_table()
+    assert (table.difference.abs() < 5e-4).all()
+
+
+def _small(path, tmp_path, **over):
+    data = yaml.safe_load(Path(path).read_text())
+    data.update(over)
+    cfg = ExperimentConfig(**data)
+    er = run_experiment(cfg, source=str(path))
+    folder = tmp_path / "chang2024" / cfg.name
+    folder.mkdir(parents=True)
+    return write_tables(er, folder)
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    root = tmp_path_factory.mktemp("results")
+    cfg = ROOT / "configs" / "chang2024"
+    files = {
+        "tab1_fig7": _small(cfg / "tab1_fig7.yaml", root, runs=3, iterations=20, population=20),
+        "tab2": _small(cfg / "tab2.yaml", root, cases={"random": 3, "seed": 1}, iterations=20, population=20),
+        "baselines": _small(cfg / "baselines.yaml", root, runs=2, iterations=20, population=20),
+    }
+    return Store(root), files
+
+
+def test_small_runs_write_the_expected_files(store):
+    st, files = store
+    assert {"summary.csv", "timing.csv", "values.csv", "runs.csv", "convergence.png"} <= set(files["tab1_fig7"])
+    assert {"cases.png", "cases_time.png"} <= set(files["tab2"])
+    s = st.get("chang2024", "tab1_fig7").table("summary")
+    assert list(s.algorithm) == ["abc", "pso", "pabc"]
+    assert "printed_error_order" in s.columns
+    # P-ABC: PSO for half the iterations (population evaluations), ABC after (about twice that)
+    ev = s.set_index("algorithm").mean_evaluations
+    assert ev["pso"] < ev["pabc"] < ev["abc"]
+    t2 = st.get("chang2024", "tab2").table("summary")
+    assert t2["case"].nunique() == 3
+
+
+def test_extra_tables_and_claims_run(store):
+    st, _ = store
+    for name in chang2024.EXPERIMENTS:
+        for caption, df in chang2024.extra_tables(st.get("chang2024", name)):
+            assert isinstance(caption, str) and isinstance(df, pd.DataFrame) and not df.empty
+    poses = chang2024.poses_table(st.get("chang2024", "tab2"))
+    assert len(poses) == 3 and {"fitness_abc", "fitness_pso", "fitness_pabc"} <= set(poses.columns)
+    claims = chang2024.claims(st) + chang2024.timing_claims(st)
+    assert all(isinstance(c, Claim) for c in claims)
+    assert len(claims) >= 10
+    assert all(c.verdict != NOT_CHECKABLE for c in claims)
+
+
+def test_claims_without_results_are_not_checkable(tmp_path):
+    claims = chang2024.claims(Store(tmp_path))
+    assert claims[0].verdict == "held"          # the inverse map needs no results
+    assert all(c.verdict == NOT_CHECKABLE for c in claims[1:])
