@@ -398,13 +398,15 @@ def check(results: Path = typer.Argument(Path("results"), help="results root"),
 
 
 def main() -> None:
+    interrupted = ("fkopt: interrupted (no results folder was left half-written; the finished tasks of a "
+                   "study are kept: fkopt study CONFIG --resume continues)")
     try:
-        app(standalone_mode=False)
+        code = app(standalone_mode=False)
     except FkoptError as err:
         print(f"fkopt: error: {err}", file=sys.stderr)
         sys.exit(2)
     except KeyboardInterrupt:
-        print("fkopt: interrupted (no results folder was left half-written)", file=sys.stderr)
+        print(interrupted, file=sys.stderr)
         sys.exit(130)
     except Exception as err:  # click's usage errors (typer vendors click): no traceback either
         kind = type(err).__name__
@@ -417,6 +419,11 @@ def main() -> None:
             print(f"fkopt: error: {err.format_message()} (see fkopt --help)", file=sys.stderr)
             sys.exit(2)
         raise
+    if code == 130:   # typer (>= 0.12) turns Ctrl-C into a returned 130 when not standalone
+        print(interrupted, file=sys.stderr)
+        sys.exit(130)
+    if isinstance(code, int) and code:
+        sys.exit(code)
 
 if __name__ == "__main__":
     main()

@@ -234,6 +234,26 @@ def test_cli_study_and_resume(tmp_path, cli):
     assert "2 finished task(s) reused, 0 computed" in stdout
 
 
+def test_cli_ctrl_c_keeps_finished_tasks(tmp_path, cli, monkeypatch):
+    import fkopt.study.runner as runner
+    study = tmp_path / "s.yaml"
+    study.write_text(yaml.safe_dump(small().model_dump(mode="json")))
+    real, calls = runner.run_task, []
+
+    def interrupted_on_third(payload):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(payload)
+    monkeypatch.setattr(runner, "run_task", interrupted_on_third)
+    code, _, err = cli("study", study, "--out", tmp_path, "--quiet")
+    assert code == 130 and "interrupted" in err and "--resume" in err
+    assert len(list((tmp_path / "studies" / "small" / TASKS).glob("a*.json"))) == 2
+    monkeypatch.setattr(runner, "run_task", real)
+    code, _, err = cli("study", study, "--out", tmp_path, "--quiet", "--resume")
+    assert code == 0 and (tmp_path / "studies" / "small" / "meta.json").exists()
+
+
 # -- statistics ------------------------------------------------------------------------------------
 def test_holm_matches_hand_computation():
     # sorted: 0.005*4 = 0.02, 0.01*3 = 0.03, 0.03*2 = 0.06, 0.04*1 = 0.04 -> max(0.06, 0.04) = 0.06

@@ -68,7 +68,13 @@ def _processes(fn, payloads, jobs, on_result) -> None:
         for fut in as_completed(futures):
             on_result(fut.result())
     except BaseException:
+        # Stop at once (Ctrl-C, a failed task): tasks already queued to a worker cannot be
+        # cancelled, so the workers are terminated (their results would be thrown away anyway).
+        procs = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
+        for proc in procs:
+            if proc.is_alive():
+                proc.terminate()
         raise
     pool.shutdown(wait=True)
 
