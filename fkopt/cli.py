@@ -300,6 +300,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
               out: Path = typer.Option(Path("results"), "--out", help="results root"),
               quiet: bool = typer.Option(False, "--quiet", "-q")):
     """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
+    import shutil
     import time
     from rich.table import Table
     from .experiment.reports import write_experiment
@@ -311,11 +312,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     files = sorted(configs.rglob("*.yaml"))
     if not files:
         raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
-    loaded = [(f, load_any(f)) for f in files]     # experiments and studies (kind: study)
+    from .experiment.assembly import AssemblyConfig, run_assembly, write_assembly
+    loaded = [(f, load_any(f)) for f in files]     # experiments, studies and assembly-mode files (kind:)
     sizes = {}
     for f, c in loaded:
         try:
-            if isinstance(c, StudyConfig):
+            if isinstance(c, AssemblyConfig):
+                sizes[f] = 1
+            elif isinstance(c, StudyConfig):
                 sizes[f] = len(plan_tasks(c, len(validate_study(c)[1])))
             else:
                 validate_experiment(c)
@@ -333,9 +337,15 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
         for f, c in loaded:
             task = bar.add_task("", total=sizes[f], name=f"  {c.paper}/{c.name}")
             update = lambda label, d, t: bar.update(task, completed=d, description=label)  # noqa: E731
-            if isinstance(c, StudyConfig):
+            if isinstance(c, AssemblyConfig):
+                mech, sols, wall = run_assembly(c)
+                folder = write_assembly(c, mech, sols, wall, out, str(f))
+                er = type("Done", (), {"wall_s": wall})
+            elif isinstance(c, StudyConfig):
                 er = run_study(c, out, source=str(f), progress=update)
                 folder = er.folder
+                # Task files exist for --resume; a finished reproduction keeps only its results.
+                shutil.rmtree(folder / "tasks", ignore_errors=True)
             else:
                 er = run_experiment(c, source=str(f), progress=update)
                 folder = write_experiment(er, out)

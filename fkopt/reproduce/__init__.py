@@ -13,7 +13,8 @@ PAPERS: dict[str, str] = {
     "mao2017": "fkopt.reproduce.mao2017",
     "chang2024": "fkopt.reproduce.chang2024",
     "wu2015": "fkopt.reproduce.wu2015",
-    "studies": "fkopt.reproduce.studies",
     "liu2008": "fkopt.reproduce.liu2008",
     "wang7dof": "fkopt.reproduce.wang7dof",
+    "assembly": "fkopt.reproduce.assembly",
+    "studies": "fkopt.reproduce.studies",
 }

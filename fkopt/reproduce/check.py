@@ -121,6 +121,9 @@ COMPARED = ("summary.csv", "values.csv", "inputs.csv")
 
 def check_experiment(exp: Experiment, config: ExperimentConfig | None = None) -> list[Mismatch]:
     """Rerun ``exp`` from its recorded (or the given) config and compare the stored tables."""
+    if exp.config.get("kind") == "assembly":  # all assembly modes (fkopt.experiment.assembly)
+        from ..experiment.assembly import check_assembly
+        return check_assembly(exp, config)
     if exp.config.get("kind") == "study":     # a workspace study (fkopt.study)
         from ..study.check import check_study
         return check_study(exp, config)

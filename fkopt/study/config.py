@@ -261,8 +261,11 @@ def load_any(path: str | Path):
     path = Path(path)
     data = _read_yaml(path)
     if isinstance(data, dict) and "kind" in data:
+        from ..experiment.assembly import KIND as ASSEMBLY, assembly_from_dict
+        if data["kind"] == ASSEMBLY:
+            return assembly_from_dict(data, str(path))
         if data["kind"] != KIND:
-            raise FkoptError(f"{path}: kind: '{data['kind']}' unknown; allowed: {KIND} "
+            raise FkoptError(f"{path}: kind: '{data['kind']}' unknown; allowed: {KIND}, {ASSEMBLY} "
                              "(an experiment file has no kind)")
         return study_from_dict(data, str(path))
     return load_config(path)

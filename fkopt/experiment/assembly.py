@@ -1,0 +1,133 @@
+"""Assembly-mode experiments (``kind: assembly``): every real forward solution of one input.
+
+A file names a parallel mechanism (with geometry), the measured joints, the seed and search
+settings of :func:`fkopt.assembly.all_solutions`, and optionally the known number of real
+solutions (``expected``; e.g. 40 for Dietmaier's 6-6 platform). The folder gets
+
+* ``solutions.csv`` -- every solution found inside the bounds, sorted by pose, with its residual
+  ``max |ik(pose) - joints|`` (relative to max(1, |joint|)) and how many starts reached it;
+* ``summary.csv``   -- the count against ``expected`` and the residual statistics, in the column
+  names experiments use (so ``fkopt check`` and the report read it the same way);
+* ``timing.csv``    -- wall time of the search (the only non-deterministic file);
+* ``meta.json``     -- config, seed, versions.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import pandas as pd
+from pydantic import Field, ValidationError
+
+from ..errors import FkoptError
+from .config import MechanismSpec, Strict, _one_line
+
+KIND = "assembly"
+
+
+class AssemblyConfig(Strict):
+    kind: Literal["assembly"]
+    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    paper: str = "assembly"
+    title: str = ""
+    description: str = ""
+    mechanism: MechanismSpec
+    joints: dict[str, float]
+    seed: int = 0
+    #: Starts per round of the multi-start Newton (default: the solver's own, 2000 for 6-SPS).
+    population: int | None = Field(None, ge=1)
+    #: Newton iterations per start.
+    iterations: int = Field(60, ge=1)
+    runs: Literal[1] = 1
+    tol: float = Field(1e-9, gt=0)
+    dedup: float = Field(1e-6, gt=0)
+    #: Known number of real solutions, for the report.
+    expected: int | None = Field(None, ge=0)
+    printed: dict[str, Any] = Field(default_factory=dict)
+    check: Literal["ci", "full"] = "ci"
+
+
+def assembly_from_dict(data: dict, where: str) -> AssemblyConfig:
+    try:
+        return AssemblyConfig(**data)
+    except ValidationError as err:
+        raise FkoptError(f"{where}: {_one_line(err)}") from None
+
+
+def run_assembly(config: AssemblyConfig):
+    """(mechanism, solutions, wall seconds)."""
+    from ..assembly import all_solutions
+    from .runner import build_mechanism
+    mech = build_mechanism(config)
+    start = time.perf_counter()
+    sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
+                         tol=config.tol, dedup=config.dedup, iterations=config.iterations)
+    return mech, sols, time.perf_counter() - start
+
+
+def tables(config: AssemblyConfig, mech, sols, wall: float):
+    rows = [{**{n: float(v) for n, v in s.pose.items()}, "residual": float(s.residual), "hits": int(s.hits)}
+            for s in sols]
+    solutions = pd.DataFrame(rows, columns=[*mech.pose_names, "residual", "hits"])
+    solutions = solutions.sort_values(list(mech.pose_names), kind="stable").reset_index(drop=True)
+    solutions.insert(0, "solution", np.arange(1, len(solutions) + 1))
+    res = solutions["residual"].to_numpy() if len(solutions) else np.array([np.nan])
+    summary = pd.DataFrame([{
+        "case": "given joints", "algorithm": "all_solutions", "method": "newton-multistart",
+        "population": int(sols.settings["round_size"]),
+        "iterations": config.iterations, "runs": 1,
+        "solutions_found": len(solutions), "expected": config.expected if config.expected is not None else np.nan,
+        "starts": int(sols.starts), "outside_bounds": int(getattr(sols, "outside", 0)),
+        "median_fitness": float(np.median(res)), "mean_fitness": float(np.mean(res)),
+        "best_fitness": float(np.min(res)), "worst_fitness": float(np.max(res)),
+        "mean_evaluations": float(sols.starts),
+    }])
+    timing = pd.DataFrame([{"case": "given joints", "algorithm": "all_solutions", "total_s": wall,
+                            "solver_time_s": float(sols.time_s),
+                            **{f"printed_{k}": v for k, v in config.printed.items() if k.endswith("_s")}}])
+    return summary, solutions, timing
+
+
+def write_assembly(config: AssemblyConfig, mech, sols, wall: float, out: Path, source: str | None) -> Path:
+    from .reports import FLOAT, library_versions
+    from .. import __version__
+    final = Path(out) / config.paper / config.name
+    final.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
+    try:
+        summary, solutions, timing = tables(config, mech, sols, wall)
+        summary.to_csv(tmp / "summary.csv", index=False, float_format=FLOAT)
+        solutions.to_csv(tmp / "solutions.csv", index=False, float_format="%.12g")
+        timing.to_csv(tmp / "timing.csv", index=False, float_format=FLOAT)
+        meta = {"experiment": config.name, "paper": config.paper, "title": config.title, "kind": KIND,
+                "config_file": source, "config": config.model_dump(mode="json"), "seed": config.seed,
+                "mechanism": mech.describe(), "objective": "all real solutions (multi-start Newton)",
+                "fkopt_version": __version__, "libraries": library_versions()}
+        (tmp / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True, default=float) + "\n")
+        if final.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{final.name}.old.", dir=final.parent))
+            os.replace(final, old / "x")
+            os.replace(tmp, final)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, final)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return final
+
+
+def check_assembly(exp, config: AssemblyConfig | None = None):
+    """Rerun a stored assembly experiment and compare its summary (count exactly)."""
+    from ..reproduce.check import compare_tables
+    config = config or AssemblyConfig(**exp.config)
+    mech, sols, wall = run_assembly(config)
+    summary, _, _ = tables(config, mech, sols, wall)
+    summary = pd.read_csv(pd.io.common.StringIO(summary.to_csv(index=False)))
+    return compare_tables(f"{exp.paper}/{exp.name}", "summary.csv", exp.table("summary"), summary)
