@@ -304,10 +304,11 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     import time
     from rich.table import Table
     from .experiment.reports import write_experiment
-    from .experiment.runner import run_experiment, validate_experiment
+    from .experiment.runner import run_experiment
     from .reproduce.report import write_report
-    from .study.config import StudyConfig, load_any
-    from .study.runner import plan_tasks, run_study, validate_study
+    from .experiment.kinds import load_any, validate_any
+    from .study.config import StudyConfig
+    from .study.runner import run_study
 
     files = sorted(configs.rglob("*.yaml"))
     if not files:
@@ -317,13 +318,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     sizes = {}
     for f, c in loaded:
         try:
-            if isinstance(c, AssemblyConfig):
-                sizes[f] = 1
-            elif isinstance(c, StudyConfig):
-                sizes[f] = len(plan_tasks(c, len(validate_study(c)[1])))
-            else:
-                validate_experiment(c)
-                sizes[f] = len(c.algorithms) * _n_cases(c)
+            sizes[f] = validate_any(c)
         except FkoptError as err:
             raise FkoptError(f"{f}: {err}") from None
     con = _console()

@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 import zlib
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Callable
 
 import numpy as np

@@ -1,9 +1,8 @@
 """mao2017: 3-RPS forward kinematics, ACO vs ABC vs GABC (SPEC.md "mao2017")."""
 from __future__ import annotations
 
-import numpy as np
 
-from .claims import NOT_CHECKABLE, Claim, g, missing, verdict
+from .claims import Claim, g, missing, verdict
 
 TITLE = ("Mao, Xie, Wu, Yuan (2017), Forward kinematics optimization of 3-RPS parallel manipulator "
          "based on global-best artificial bee colony algorithm (paper 000_cc8e52ccaff28014.txt)")
