@@ -34,5 +34,6 @@ def algorithm(name: str, **params):
     return algorithm_class(name)(**params)
 
 
-__all__ = ["FkoptError", "FKProblem", "Result", "algorithm", "fk_problem", "mechanism", "solve",
+__all__ = ["FkoptError", "FKProblem", "IKProblem", "Result", "algorithm", "fk_problem", "ik_problem",
+           "mechanism", "solve",
            "MECHANISMS", "ALGORITHMS", "__version__"]

@@ -56,7 +56,8 @@ class ThreeRPUPcUPS(ParallelMechanism):
         R, c = self.geometry.R, self.geometry.c
         # R_p = Rx(-a) Ry(-b) Rz(g): normal n = R_p e_z and second column R_p e_y, written out.
         nx, ny, nz = -sb, sa * cb, ca * cb
-        ex, ey, ez = -sg * cb, ca * cg - sa * sb * sg, -sa * cg - ca * sb * sg
+        # (its z component does not enter delta, which is measured in the horizontal plane)
+        ex, ey = -sg * cb, ca * cg - sa * sb * sg
         # u = unit(e_y x n) = unit(n_z, 0, -n_x), oriented towards +X
         hu = np.hypot(nz, nx) * np.where(nz < 0, -1.0, 1.0)
         ux, uz = nz / hu, -nx / hu
