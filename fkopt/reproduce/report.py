@@ -44,6 +44,8 @@ def _summary_view(exp: Experiment) -> pd.DataFrame:
         s = agg
     if s["case"].nunique() == 1:
         s = s.drop(columns=["case"])
+    if "runs" in s and (s["runs"] == 1).all():   # one run per case: no spread to show
+        s = s.drop(columns=[c for c in ("std_fitness",) if c in s])
     return s.dropna(axis=1, how="all")
 
 
