@@ -10,14 +10,25 @@ distributions are derived from them (``floor(u * n)``). Uniforms are drawn per r
 chunks and buffered: PCG64's ``random()`` consumes exactly one 64-bit output per double, so the
 sequence a run sees does not depend on the chunk size or on how many other runs share the
 batch. This keeps the hot loop free of per-run Python calls except once per chunk.
+
+Consumption order. Each call ``uniform(*shape)`` takes the next ``prod(shape)`` values of every
+run's sequence, in C order of ``shape``; so one call ``uniform(3, n)`` hands out exactly the
+numbers that three calls ``uniform(n)`` would, in the same order. What an algorithm draws,
+and in which order, is documented in its module (see :mod:`fkopt.algorithms.abc`).
+
+Speed. ``uniform`` returns a view into the buffer (no copy, no per-run call): a slice and a
+reshape, about a microsecond whatever the number of runs. Each value is handed out once, so an
+algorithm may overwrite the view it got without affecting any other draw.
 """
 from __future__ import annotations
 
 from collections.abc import Sequence
+from math import prod
 
 import numpy as np
 
-CHUNK = 4096
+#: Uniforms buffered per run and refill (any value gives the same numbers; this one is fast).
+CHUNK = 8192
 
 
 def run_seed_sequence(seed: int, run: int) -> np.random.SeedSequence:
@@ -33,34 +44,53 @@ class RunStreams:
         self.run_ids = [int(k) for k in run_ids]
         self._generators = [np.random.Generator(np.random.PCG64(run_seed_sequence(self.seed, k)))
                             for k in self.run_ids]
-        self._buffer = np.empty((len(self.run_ids), 0))
+        self._runs = len(self.run_ids)
+        self._buffer = np.empty((self._runs, 0))
         self._pos = 0
+        self._size = 0
 
     @property
     def runs(self) -> int:
-        return len(self.run_ids)
+        return self._runs
+
+    def _refill(self, n: int) -> None:
+        """Keep the unread tail and append at least ``n`` fresh values per run."""
+        tail = self._size - self._pos
+        fresh = max(n, CHUNK)
+        buf = np.empty((self._runs, tail + fresh))
+        buf[:, :tail] = self._buffer[:, self._pos:]
+        for row, g in zip(buf, self._generators):
+            g.random(out=row[tail:])
+        self._buffer, self._pos, self._size = buf, 0, tail + fresh
 
     def uniform(self, *shape: int) -> np.ndarray:
-        """Uniforms in [0, 1) shaped (runs, *shape); each run's values come from its own stream."""
-        n = int(np.prod(shape)) if shape else 1
-        if self._pos + n > self._buffer.shape[1]:
-            fresh = max(n, CHUNK)
-            new = np.stack([g.random(fresh) for g in self._generators]) if self._generators \
-                else np.empty((0, fresh))
-            self._buffer = np.concatenate([self._buffer[:, self._pos:], new], axis=1)
-            self._pos = 0
-        out = self._buffer[:, self._pos:self._pos + n]
-        self._pos += n
-        return out.reshape((self.runs, *shape))
+        """Uniforms in [0, 1) shaped (runs, *shape); each run's values come from its own stream.
+
+        The result is a view of the buffer (see the module docstring).
+        """
+        n = prod(shape)
+        if self._pos + n > self._size:
+            self._refill(n)
+        pos = self._pos
+        self._pos = pos + n
+        out = self._buffer[:, pos:pos + n]
+        if len(shape) == 1:
+            return out
+        return out.reshape((self._runs, *shape))
 
     def integers(self, high: int, *shape: int) -> np.ndarray:
-        """Integers in [0, high) shaped (runs, *shape)."""
-        return np.minimum((self.uniform(*shape) * high).astype(np.intp), high - 1)
+        """Integers in [0, high) shaped (runs, *shape): ``floor(u * high)``.
+
+        ``u * high < high`` holds in floating point for every u < 1 (the product of
+        1 - 2**-53 and any integer below 2**52 rounds below it), so no clamp is needed.
+        """
+        return (self.uniform(*shape) * high).astype(np.intp)
 
     def index_other_than(self, n: int, exclude: np.ndarray) -> np.ndarray:
         """Uniform indices in [0, n) shaped like ``exclude`` (runs, ...), never equal to ``exclude``.
 
-        Used for ABC's random neighbour k != i.
+        Used for ABC's random neighbour k != i: ``k = floor(u (n - 1))``, then ``k + (k >= i)``.
         """
         k = self.integers(n - 1, *exclude.shape[1:])
-        return k + (k >= exclude)
+        k += k >= exclude
+        return k

@@ -12,21 +12,45 @@ Choices fkopt makes where the papers are silent (documented, each a named parame
   iteration of the same population -- compare algorithms at equal evaluations too.
 * The neighbour move changes one random coordinate j: v_ij = x_ij + phi (x_ij - x_kj),
   phi ~ U[-1, 1], k != i random, then clipped to the bounds.
+* Onlooker roulette: with cumulative qualities c_1 <= ... <= c_SN and u ~ U[0, 1), an onlooker
+  takes the first source i with c_i > u * c_SN (source 0 in the degenerate case where every
+  quality is 0, i.e. every fitness is infinite).
 * Onlookers of one phase act synchronously (vectorised): a source chosen by several onlookers
-  keeps the best of their candidates if it beats the source; each failed attempt adds one to
-  its trial counter. Karaboga's sequential loop lets a later onlooker see an earlier one's
-  improvement within the phase; the difference is immaterial to convergence and lets every
-  run and every bee advance in a handful of array operations.
-* ``limit`` defaults to SN * dim (Karaboga & Basturk 2007).
+  keeps the best of their candidates (the lowest fitness; on a tie the onlooker that comes
+  first) if it beats the source; each failed attempt adds one to its trial counter.
+  Karaboga's sequential loop lets a later onlooker see an earlier one's improvement within
+  the phase; the difference is immaterial to convergence and lets every run and every bee
+  advance in a handful of array operations.
+* ``limit`` defaults to SN * dim (Karaboga & Basturk 2007). A scout replaces the source with
+  the most trials (the first of equals) when its counter exceeds ``limit``; at most one per
+  run and iteration.
 * The best-so-far solution is memorised before the scout phase, so abandoning a stale best
   source never loses it.
+* A NaN fitness is treated as +inf (never selected, never accepted).
+
+Random numbers (the order matters for reproducibility; see :mod:`fkopt.streams`). Per
+iteration and run, in this order:
+
+1. employed phase, one block of 3*SN uniforms: SN for the coordinates j = floor(u * dim), SN
+   for the neighbours k = floor(u * (SN - 1)), k += (k >= i), SN for phi = 2u - 1 (then, for
+   GABC's ``zhu2010`` rule, SN more for psi);
+2. onlooker phase: SN uniforms for the roulette, then the same block as 1. for the moves;
+3. scout phase: dim uniforms for a fresh source, drawn every iteration whether or not a scout
+   flies, so that each run's stream advances the same way whatever happens in other runs.
+
+Speed. At the sizes of the papers (30 runs x 10 bees x 3 variables) the cost of an iteration is
+the number of numpy calls, not arithmetic; the phases are written to keep that number small:
+one draw per phase, index arithmetic on flattened (runs * SN) arrays instead of
+``take_along_axis``, the onlooker duplicates resolved by two ``np.minimum.at`` scatters (no
+sort), and the roulette as one broadcast comparison for small colonies or a vectorised
+binary search for large ones (the same integers either way).
 """
 from __future__ import annotations
 
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, uniform_in
+from .base import Algorithm, Params, State, row_offsets, uniform_in
 
 
 class ABCParams(Params):
@@ -35,8 +59,64 @@ class ABCParams(Params):
 
 
 def quality(f: np.ndarray) -> np.ndarray:
-    """Karaboga's fit(f): 1/(1+f) for f >= 0, 1+|f| otherwise."""
-    return np.where(f >= 0, 1.0 / (1.0 + np.abs(f)), 1.0 + np.abs(f))
+    """Karaboga's fit(f): 1/(1+f) for f >= 0, 1+|f| (= 1-f) otherwise."""
+    return np.where(f >= 0, 1.0 / (1.0 + f), 1.0 - f)
+
+
+#: Colonies up to this size use the dense (runs, SN, SN) roulette comparison; larger ones a
+#: binary search (O(SN log SN)). Both give the same indices.
+DENSE_ROULETTE = 32
+
+
+def roulette(cdf: np.ndarray, u: np.ndarray, dense: bool | None = None) -> np.ndarray:
+    """Per run, the first index i with ``cdf[r, i] > u[r, m]`` (0 if there is none).
+
+    ``cdf`` (runs, n) is non-decreasing along axis 1, ``u`` (runs, m); returns (runs, m) indices.
+    """
+    runs, n = cdf.shape
+    if dense is None:
+        dense = n <= DENSE_ROULETTE
+    if dense:
+        return (cdf[:, None, :] > u[:, :, None]).argmax(axis=2)
+    # Binary search for the count of entries <= u (the first index with cdf > u).
+    flat = cdf.ravel()
+    base = (row_offsets(runs, n) - 1)[:, None]
+    count = np.zeros(u.shape, dtype=np.intp)
+    step = 1 << (n.bit_length() - 1)
+    while step:
+        trial = count + step
+        ok = trial <= n
+        idx = np.minimum(trial, n)
+        idx += base
+        ok &= flat[idx] <= u
+        count = np.where(ok, trial, count)
+        step >>= 1
+    count[count == n] = 0
+    return count
+
+
+class _Aux:
+    """Index arrays an ABC needs for a given (runs, population, dim), built once per state."""
+
+    __slots__ = ("shape", "sources", "offsets", "scale", "cand", "lo", "hi", "width", "ids")
+
+    def __init__(self, shape, bounds):
+        runs, population, dim = shape
+        self.shape = shape
+        self.sources = np.broadcast_to(np.arange(population), (runs, population))
+        self.offsets = row_offsets(runs, population)[:, None]       # (runs, 1)
+        self.scale = np.array([[dim], [population - 1], [2.0]])     # u -> j, k, 2u
+        self.cand = (np.arange(runs * population) * dim).reshape(runs, population)
+        self.lo, self.hi = bounds[:, 0].copy(), bounds[:, 1].copy()
+        self.width = self.hi - self.lo
+        self.ids = np.arange(runs * population)
+
+
+def _aux(state: State, problem) -> _Aux:
+    aux = state.__dict__.get("_abc_aux")
+    if aux is None or aux.shape != state.x.shape:
+        aux = state._abc_aux = _Aux(state.x.shape, np.asarray(problem.bounds, dtype=float))
+    return aux
 
 
 class ABC(Algorithm):
@@ -47,86 +127,173 @@ class ABC(Algorithm):
     # -- phases ------------------------------------------------------------------------------
     def initialize(self, problem, population, streams, x0):
         x = uniform_in(problem.bounds, streams.uniform(population, problem.dim))
-        f = problem.fitness(x)
+        f = np.fmin(problem.fitness(x), np.inf)
         runs = streams.runs
         limit = self.params.limit or population * problem.dim
         return State(x=x, f=f, trial=np.zeros(f.shape, dtype=np.int64), limit=limit,
                      evaluations=np.full(runs, population, dtype=np.int64))
 
+    #: Does the move read the best-so-far point (then it is refreshed between the phases)?
+    uses_best = False
+
     def iterate(self, state, problem, streams):
+        # The scout of the previous iteration's trials flies first; its fresh source is
+        # evaluated together with the employed candidates (one fitness call, not two).
+        self.scout_phase(state, problem, streams, evaluate=False)
         self.employed_phase(state, problem, streams)
-        self.update_best(state)
+        if self.uses_best:
+            self.update_best(state)
         self.onlooker_phase(state, problem, streams)
-        self.update_best(state)
-        self.scout_phase(state, problem, streams)
 
     def step(self, state, xs, xk, phi, streams):
-        """The move added to the chosen coordinate (overridden by GABC)."""
+        """The move added to the chosen coordinate, on whole rows (overridden by GABC).
+
+        ``xs``, ``xk``: the sources and neighbours, (runs, n, dim); ``phi``: (runs, n, 1). Only
+        coordinate j of the result is used. A subclass that overrides only :meth:`step` gets
+        this whole-row evaluation; fkopt's own classes override :meth:`move` as well, which
+        computes the same numbers on the chosen coordinate alone (faster).
+        """
         return phi * (xs - xk)
+
+    def move(self, state, xs, xk, j, phi, streams):
+        """New value of the chosen coordinate j, before clipping: ``xs + step``.
+
+        ``xs``, ``xk``, ``j``, ``phi``: (runs, n) -- coordinate j of the source and of the
+        neighbour, the coordinate index and phi.
+        """
+        return xs + phi * (xs - xk)
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        # A subclass customising only the whole-row step keeps its semantics (slower path).
+        cls._row_step = cls.step is not ABC.step and cls.move is ABC.move
+        # A customised move may read state.best_x: refresh it between the phases unless the
+        # subclass says otherwise.
+        if "uses_best" not in cls.__dict__ and (cls.step is not ABC.step or cls.move is not ABC.move):
+            cls.uses_best = True
+
+    _row_step = False
 
     def candidates(self, state, sources, problem, streams):
         """Neighbour candidates of ``sources`` (runs, n): one coordinate moved towards/away from k."""
+        aux = _aux(state, problem)
         x = state.x
-        population, dim = x.shape[1], x.shape[2]
-        j = streams.integers(dim, sources.shape[1])
-        k = streams.index_other_than(population, sources)
-        phi = 2.0 * streams.uniform(sources.shape[1]) - 1.0
-        xs = np.take_along_axis(x, sources[..., None], axis=1)
-        xk = np.take_along_axis(x, k[..., None], axis=1)
-        moved = xs + self.step(state, xs, xk, phi[..., None], streams)
-        v = np.where(np.arange(dim) == j[..., None], moved, xs)
-        return clip(v, problem.bounds)
+        runs, population, dim = x.shape
+        n = sources.shape[1]
+        w = streams.uniform(3, n) * aux.scale
+        jk = w[:, :2].astype(np.intp)
+        j, k = jk[:, 0], jk[:, 1]
+        k += k >= sources
+        phi = w[:, 2] - 1.0
+        k += aux.offsets
+        employed = sources is aux.sources
+        if self._row_step:
+            x2 = x.reshape(runs * population, dim)
+            xs = x if employed else x2[sources + aux.offsets]
+            moved = xs + self.step(state, xs, x2[k], phi[..., None], streams)
+            v = np.where(np.arange(dim) == j[..., None], moved, xs)
+            np.maximum(v, aux.lo, out=v)
+            np.minimum(v, aux.hi, out=v)
+            return v
+        # Only coordinate j changes: work on flat (runs, n) arrays of that coordinate.
+        xf = x.reshape(-1)
+        pos = (aux.cand if n == population else (np.arange(runs * n) * dim).reshape(runs, n)) + j
+        if employed:
+            v = x.copy()
+            src = pos
+        else:
+            v = x.reshape(runs * population, dim).take(sources + aux.offsets, axis=0)
+            src = (sources + aux.offsets) * dim
+            src += j
+        k *= dim
+        k += j
+        m = self.move(state, xf[src], xf[k], j, phi, streams)
+        np.maximum(m, aux.lo[j], out=m)
+        np.minimum(m, aux.hi[j], out=m)
+        v.reshape(-1)[pos] = m
+        return v
 
     def employed_phase(self, state, problem, streams):
-        runs, population = state.f.shape
-        sources = np.broadcast_to(np.arange(population), (runs, population))
-        v = self.candidates(state, sources, problem, streams)
-        fv = problem.fitness(v)
+        aux = _aux(state, problem)
+        population = state.f.shape[1]
+        v = self.candidates(state, aux.sources, problem, streams)
+        pending = state.__dict__.pop("_abc_pending", None)
+        if pending is None:
+            fv = np.fmin(problem.fitness(v), np.inf)
+        else:   # fresh scout sources placed by scout_phase(evaluate=False): evaluate them too
+            slots, fresh, count = pending
+            both = np.fmin(problem.fitness(np.concatenate([v.reshape(-1, v.shape[-1]), fresh])), np.inf)
+            fv = both[:v.shape[0] * population].reshape(state.f.shape)
+            f = state.f.copy()
+            f.reshape(-1)[slots] = both[v.shape[0] * population:]
+            state.f = f
+            state.evaluations = state.evaluations + count
         better = fv < state.f
         state.x = np.where(better[..., None], v, state.x)
         state.f = np.where(better, fv, state.f)
-        state.trial = np.where(better, 0, state.trial + 1)
+        trial = state.trial + 1
+        trial[better] = 0
+        state.trial = trial
         state.evaluations = state.evaluations + population
 
     def onlooker_phase(self, state, problem, streams):
+        aux = _aux(state, problem)
         runs, population = state.f.shape
-        fit = quality(state.f)
-        cdf = np.cumsum(fit, axis=1)
+        cdf = quality(state.f).cumsum(axis=1)
         u = streams.uniform(population) * cdf[:, -1:]
-        sources = np.minimum((cdf[:, None, :] <= u[:, :, None]).sum(axis=2), population - 1)
+        sources = roulette(cdf, u)
         v = self.candidates(state, sources, problem, streams)
-        fv = problem.fitness(v).ravel()
-        # Resolve onlookers that chose the same source: keep the best candidate per source.
-        flat = (np.arange(runs)[:, None] * population + sources).ravel()
-        order = np.lexsort((fv, flat))
-        grouped = flat[order]
-        first = np.ones(grouped.size, dtype=bool)
-        first[1:] = grouped[1:] != grouped[:-1]
-        win = order[first]
-        target = flat[win]
-        f = state.f.reshape(-1).copy()
-        x = state.x.reshape(runs * population, -1).copy()
-        trial = state.trial.reshape(-1) + np.bincount(flat, minlength=runs * population)
-        ok = fv[win] < f[target]
-        target, win = target[ok], win[ok]
-        f[target] = fv[win]
-        x[target] = v.reshape(runs * population, -1)[win]
-        trial[target] = 0
-        state.f = f.reshape(runs, population)
-        state.x = x.reshape(state.x.shape)
+        fv = np.fmin(problem.fitness(v), np.inf).ravel()
+        # Resolve onlookers that chose the same source: per source, the lowest candidate
+        # fitness, and the first onlooker reaching it.
+        size = runs * population
+        flat = (sources + aux.offsets).ravel()
+        best = np.full(size, np.inf)
+        np.minimum.at(best, flat, fv)
+        hit = fv == best[flat]
+        first = np.full(size, size)
+        np.minimum.at(first, flat[hit], aux.ids[hit])
+        f = state.f.ravel()
+        ok = best < f
+        np.minimum(first, size - 1, out=first)
+        x2 = state.x.reshape(size, -1)
+        state.x = np.where(ok[:, None], v.reshape(size, -1)[first], x2).reshape(state.x.shape)
+        state.f = np.where(ok, best, f).reshape(runs, population)
+        trial = state.trial.ravel() + np.bincount(flat, minlength=size)
+        trial[ok] = 0
         state.trial = trial.reshape(runs, population)
         state.evaluations = state.evaluations + population
 
-    def scout_phase(self, state, problem, streams):
-        runs = state.f.shape[0]
-        worst = np.argmax(state.trial, axis=1)
-        rows = np.arange(runs)
-        scout = state.trial[rows, worst] > state.limit
-        # Draw for every run so each run's stream advances the same way whatever the others do.
-        fresh = uniform_in(problem.bounds, streams.uniform(problem.dim))
-        if scout.any():
-            ff = problem.fitness(fresh)
-            state.x[rows[scout], worst[scout]] = fresh[scout]
-            state.f[rows[scout], worst[scout]] = ff[scout]
-            state.trial[rows[scout], worst[scout]] = 0
+    def scout_phase(self, state, problem, streams, evaluate: bool = True):
+        """Abandon the source with the most trials (first of equals) if they exceed ``limit``.
+
+        With ``evaluate=False`` the fresh sources are placed with fitness +inf and evaluated by
+        the next :meth:`employed_phase` (together with its candidates, before its greedy step).
+        """
+        aux = _aux(state, problem)
+        runs, population = state.f.shape
+        # Drawn for every run so each run's stream advances the same way whatever the others do.
+        u = streams.uniform(problem.dim)
+        trial = state.trial
+        if trial.max() <= state.limit:
+            return
+        worst = trial.argmax(axis=1)
+        worst += aux.offsets[:, 0]
+        scout = trial.reshape(-1)[worst] > state.limit
+        rows = np.flatnonzero(scout)
+        slots = worst[rows]
+        fresh = aux.lo + u[rows] * aux.width
+        x = state.x.reshape(runs * population, -1).copy()
+        x[slots] = fresh
+        state.x = x.reshape(state.x.shape)
+        t = trial.reshape(-1).copy()
+        t[slots] = 0
+        state.trial = t.reshape(runs, population)
+        f = state.f.reshape(-1).copy()
+        if evaluate:
+            f[slots] = np.fmin(problem.fitness(fresh), np.inf)
             state.evaluations = state.evaluations + scout
+        else:
+            f[slots] = np.inf
+            state._abc_pending = (slots, fresh, scout)
+        state.f = f.reshape(runs, population)

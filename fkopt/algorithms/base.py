@@ -17,6 +17,7 @@ iteration on, so its numbers do not depend on the other runs of the batch.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any, ClassVar
 
 import numpy as np
@@ -57,6 +58,18 @@ class RunRecord:
     iterations_done: np.ndarray        # (runs,) iterations actually used (< iterations if stopped)
     extras: dict[str, np.ndarray] = field(default_factory=dict)       # name -> (runs, iterations + 1)
     snapshots: dict[int, np.ndarray] = field(default_factory=dict)    # iteration -> (runs, population, dim)
+
+
+@lru_cache(maxsize=64)
+def row_offsets(runs: int, population: int) -> np.ndarray:
+    """``arange(runs) * population`` (read-only, cached): flat index of each run's first agent.
+
+    ``row_offsets(R, P) + i`` turns per-run agent indices (R,) into indices of the flattened
+    (R * P) arrays -- cheaper than fancy indexing with two index arrays.
+    """
+    out = np.arange(runs, dtype=np.intp) * population
+    out.flags.writeable = False
+    return out
 
 
 def clip(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:
@@ -107,13 +120,21 @@ class Algorithm:
     # -- shared --------------------------------------------------------------------------------
     @staticmethod
     def update_best(state: State) -> None:
-        """Fold the memory ``state.x``/``state.f`` into the best-so-far of each run."""
-        i = np.argmin(state.f, axis=1)
-        runs = np.arange(state.f.shape[0])
-        f = state.f[runs, i]
-        better = f < state.best_f
-        state.best_f = np.where(better, f, state.best_f)
-        state.best_x = np.where(better[:, None], state.x[runs, i], state.best_x)
+        """Fold the memory ``state.x``/``state.f`` into the best-so-far of each run.
+
+        The first minimum of each run wins; arrays are replaced (never written in place), and
+        only when some run improved.
+        """
+        f = state.f
+        runs, population = f.shape
+        flat = f.argmin(axis=1)
+        flat += row_offsets(runs, population)
+        fb = f.ravel()[flat]
+        better = fb < state.best_f
+        if better.any():
+            state.best_f = np.where(better, fb, state.best_f)
+            xb = state.x.reshape(runs * population, -1)[flat]
+            state.best_x = np.where(better[:, None], xb, state.best_x)
 
     def minimize(self, problem, *, population: int, iterations: int, streams: RunStreams,
                  target: float | None = None, stop_at_target: bool = False,
@@ -134,29 +155,36 @@ class Algorithm:
         done_at = np.full(runs, iterations)
 
         def record(t: int) -> None:
-            keep = done[:, None]
-            if t == 0:
-                history[:, 0], x_history[:, 0], evals[:, 0] = state.best_f, state.best_x, state.evaluations
-            else:
+            if t == 0 or not frozen:
+                history[:, t] = state.best_f
+                x_history[:, t] = state.best_x
+                evals[:, t] = state.evaluations
+                for key, value in self.extras(state).items():
+                    extra_hist.setdefault(key, np.empty((runs, iterations + 1)))[:, t] = value
+            else:   # runs that reached the target keep their values
                 history[:, t] = np.where(done, history[:, t - 1], state.best_f)
-                x_history[:, t] = np.where(keep, x_history[:, t - 1], state.best_x)
+                x_history[:, t] = np.where(done[:, None], x_history[:, t - 1], state.best_x)
                 evals[:, t] = np.where(done, evals[:, t - 1], state.evaluations)
-            for key, value in self.extras(state).items():
-                arr = extra_hist.setdefault(key, np.empty((runs, iterations + 1)))
-                arr[:, t] = value if t == 0 else np.where(done, arr[:, t - 1], value)
+                for key, value in self.extras(state).items():
+                    arr = extra_hist[key]
+                    arr[:, t] = np.where(done, arr[:, t - 1], value)
             if t in wanted:
                 snaps[t] = np.array(state.x, copy=True)
 
+        frozen = False   # does any run hold its records (reached the target)?
         record(0)
         last = iterations
+        watch = stop_at_target and target is not None
         for t in range(1, iterations + 1):
-            if stop_at_target and target is not None:
+            if watch:
                 newly = ~done & (history[:, t - 1] < target)
-                done_at[newly] = t - 1
-                done |= newly
-                if done.all():
-                    last = t - 1
-                    break
+                if newly.any():
+                    done_at[newly] = t - 1
+                    done |= newly
+                    frozen = True
+                    if done.all():
+                        last = t - 1
+                        break
             self.iterate(state, problem, streams)
             self.update_best(state)
             record(t)

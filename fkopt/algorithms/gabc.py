@@ -17,6 +17,7 @@ from typing import Literal
 from pydantic import Field
 
 from .abc import ABC, ABCParams
+from .base import row_offsets
 
 
 class GABCParams(ABCParams):
@@ -28,6 +29,7 @@ class GABCParams(ABCParams):
 class GABC(ABC):
     name = "gabc"
     Params = GABCParams
+    uses_best = True
 
     def step(self, state, xs, xk, phi, streams):
         best = state.best_x[:, None, :]
@@ -35,3 +37,11 @@ class GABC(ABC):
             return phi * (xs - xk) + phi * (best - xk)
         psi = self.params.C * streams.uniform(xs.shape[1])[..., None]
         return phi * (xs - xk) + psi * (best - xs)
+
+    def move(self, state, xs, xk, j, phi, streams):
+        """:meth:`step` on the chosen coordinate only (same numbers, same draws)."""
+        best = state.best_x.reshape(-1)[j + row_offsets(*state.best_x.shape)[:, None]]
+        if self.params.rule == "mao2017":
+            return xs + (phi * (xs - xk) + phi * (best - xk))
+        psi = self.params.C * streams.uniform(xs.shape[1])
+        return xs + (phi * (xs - xk) + psi * (best - xs))

@@ -23,6 +23,10 @@ from .. import rotations
 from .base import Geometry, ParallelMechanism
 
 
+_HALF_DEG = np.pi / 360.0          # degrees -> half-angle in radians
+_S3 = 0.5 * np.sqrt(3.0)           # sin(120 deg)
+
+
 class ThreeRPSGeometry(Geometry):
     ra: float = Field(274.0, gt=0, description="base joint circle radius r_a (mm)")
     rb: float = Field(158.0, gt=0, description="platform joint circle radius r_b (mm)")
@@ -57,6 +61,59 @@ class ThreeRPS(ParallelMechanism):
         return g, xe, ye
 
     def ik(self, poses) -> np.ndarray:
+        """Leg lengths (..., 3) of poses (..., 3): eq. (10) with eq. (6) substituted.
+
+        Lean form (about 45 array operations, no sin/cos/arctan): with the half-angle tangents
+        t = tan(angle / 2), sin = 2t / (1 + t^2), cos = (1 - t^2) / (1 + t^2); the parasitic
+        rotation tan(gamma) = sa sb / (ca + cb) gives cos(gamma) = 1 / sqrt(1 + tan^2) and
+        sin(gamma) = tan(gamma) cos(gamma) (|gamma| < 90 deg). Substituting x_e = (r_b/2)(R00 - R11)
+        and y_e = -r_b R10 into d_i = |R B_i + p - A_i| (phi = 0, 120, 240 deg) leaves
+
+            d_1^2 = (1.5 r_b R00 - 0.5 r_b R11 - r_a)^2 + (z - r_b sb)^2      (leg 1 has dy = 0),
+            d_2,3^2 = (a_x +- b_x)^2 + (a_y +- b_y)^2 + (a_z +- b_z)^2,
+
+        a_x = (r_a - r_b R11)/2, b_x = (sqrt3/2) r_b R01, a_y = -1.5 r_b R10, b_y = -sqrt3 a_x,
+        a_z = z + r_b sb / 2, b_z = (sqrt3/2) r_b cb sa. The same numbers as the textbook
+        evaluation (:meth:`ik_reference`) to ~1e-13 mm, elementwise (batch-size independent).
+        """
+        poses = np.asarray(poses, dtype=float)
+        shape = poses.shape[:-1]
+        p = poses.reshape(-1, 3).T                          # (3, n) view
+        ra, rb = self.geometry.ra, self.geometry.rb
+        t = np.tan(np.multiply(p[:2], _HALF_DEG, order="C"))
+        t2 = t * t
+        r = 1.0 / (1.0 + t2)
+        s = (t + t) * r
+        c = (1.0 - t2) * r
+        sa, sb = s
+        ca, cb = c
+        z = p[2]
+        tg = sa * sb / (ca + cb)
+        cg = 1.0 / np.sqrt(1.0 + tg * tg)
+        sg = tg * cg
+        sbsa = sb * sa
+        R00 = cg * cb
+        R10 = sg * cb
+        R11 = sg * sbsa + cg * ca
+        R01 = cg * sbsa - sg * ca
+        out = np.empty((z.shape[0], 3))
+        e = (1.5 * rb) * R00 - (0.5 * rb) * R11 - ra
+        f = z - rb * sb
+        np.sqrt(e * e + f * f, out=out[:, 0])
+        ax = 0.5 * ra - (0.5 * rb) * R11
+        bx = (_S3 * rb) * R01
+        ay = (-1.5 * rb) * R10
+        by = (-2.0 * _S3) * ax
+        az = z + (0.5 * rb) * sb
+        bz = (_S3 * rb) * (cb * sa)
+        u, v, w = ax + bx, ay + by, az + bz
+        np.sqrt(u * u + v * v + w * w, out=out[:, 1])
+        u, v, w = ax - bx, ay - by, az - bz
+        np.sqrt(u * u + v * v + w * w, out=out[:, 2])
+        return out.reshape(shape + (3,))
+
+    def ik_reference(self, poses) -> np.ndarray:
+        """Eq. (10) evaluated as printed (rotation matrix, parasitic motion, three legs); slower."""
         poses = np.asarray(poses, dtype=float)
         a, b, z = np.radians(poses[..., 0]), np.radians(poses[..., 1]), poses[..., 2]
         g, xe, ye = self._parasitic(a, b)
