@@ -1,0 +1,415 @@
+"""``fkopt bench``: measure fkopt's speed on this machine (and, optionally, peers' speed).
+
+Sections of the table (and of ``bench.csv``: columns section, item, value, unit, note):
+
+1. ``throughput`` -- batched fitness evaluations per second at a batch of 10,000 points
+   (shape (1, 10000, dim)) for every registered mechanism (parallel: ``fk_problem``, serial:
+   ``ik_problem``), and the cost of one single-point call (µs). Best of several calls.
+2. ``mao2017`` -- the whole Tab. 3 experiment (ACO, ABC, GABC; 30 runs x 600 iterations x
+   population 10 on the 3-RPS case alpha=9, beta=13, z=622): wall time, amortised ms per run,
+   evaluations per run, beside the paper's MATLAB times. Best of 3 repetitions (1 in quick mode).
+3. ``peers`` (``peers=True``) -- NiaPy ``ArtificialBeeColonyAlgorithm`` and MEALPY
+   ``OriginalABC`` on fkopt's own 3-RPS fitness, called one point at a time, same budget
+   (10 food sources, 600 iterations, limit = population * dim = 30 as fkopt's ABC default),
+   timed in this process; ratio = peer ms per run / fkopt's amortised GABC ms per run. Skipped
+   with a message when a package is missing or fails. pygmo ``bee_colony`` only if importable.
+4. ``exact`` -- 6-SPS (CMM) forward kinematics of 1000 random poses solved exactly by the
+   batched ``lm`` in one call (see :class:`PoseBatchProblem`); ms per pose and success rate.
+5. ``scaling`` -- GABC on the 3-RPS case with population 10..1000 (30 runs) and runs 1..1000
+   (population 10): wall time and ns per evaluation; plotted into ``scaling.png``.
+
+Timings are wall-clock on whatever else the machine is doing; tests never assert them.
+"""
+from __future__ import annotations
+
+import os
+import platform
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .problems import fk_problem, ik_problem
+from .registry import MECHANISMS
+from .rotations import wrap_degrees
+
+#: mao2017 Tab. 3: mean time per run (ms) in MATLAB on an i7-4510U.
+PAPER_MS = {"aco": 250.6, "abc": 362.4, "gabc": 361.3}
+MAO_POSE = (9.0, 13.0, 622.0)
+THROUGHPUT_TARGET = 3e6      # evaluations/s wanted for 6-sps-cmm at batch 1e4
+EXACT_TARGET_MS = 0.3        # ms per pose wanted for the batched exact 6-SPS solve
+
+
+# -- helpers ---------------------------------------------------------------------------------
+class _Rows:
+    def __init__(self):
+        self.rows: list[dict] = []
+
+    def add(self, section, item, value, unit, note=""):
+        self.rows.append(dict(section=section, item=item, value=float(value), unit=unit, note=note))
+
+
+def _best_call_time(fn, min_time: float, min_calls: int = 5) -> float:
+    """Smallest wall time of one ``fn()`` call over at least ``min_calls`` calls / ``min_time`` s."""
+    fn()   # warm-up
+    best, spent, n = np.inf, 0.0, 0
+    while n < min_calls or spent < min_time:
+        t = time.perf_counter()
+        fn()
+        dt = time.perf_counter() - t
+        best, spent, n = min(best, dt), spent + dt, n + 1
+    return best
+
+
+def _single_call_time(fn, min_time: float) -> float:
+    """Mean wall time of one cheap call, from loops of 200 calls (best loop)."""
+    fn()
+    best, spent = np.inf, 0.0
+    while spent < min_time or best == np.inf:
+        t = time.perf_counter()
+        for _ in range(200):
+            fn()
+        dt = time.perf_counter() - t
+        best, spent = min(best, dt / 200), spent + dt
+    return best
+
+
+def _uniform(bounds: np.ndarray, shape, rng) -> np.ndarray:
+    lo, hi = bounds[:, 0], bounds[:, 1]
+    return lo + rng.random((*shape, len(lo))) * (hi - lo)
+
+
+def mao_problem():
+    from . import mechanism
+    m = mechanism("3-rps")
+    return fk_problem(m, m.ik(np.array(MAO_POSE)))
+
+
+# -- 1. throughput ---------------------------------------------------------------------------
+def bench_throughput(rows: _Rows, quick: bool, rng) -> None:
+    from . import mechanism
+    min_time = 0.1 if quick else 0.5
+    for name in MECHANISMS:
+        m = mechanism(name)
+        x = _uniform(m.bounds, (1, 10_000), rng)
+        if m.kind == "parallel":
+            problem = fk_problem(m, m.ik(x[0, 0]))
+            how = "fk_problem(m, m.ik(pose0))"
+        else:
+            problem = ik_problem(m, m.fk(x[0, 0]))
+            how = "ik_problem(m, m.fk(q0))"
+        t = _best_call_time(lambda: problem.fitness(x), min_time)
+        rate = x.shape[1] / t
+        note = how
+        if name == "6-sps-cmm":
+            note += f"; target >= {THROUGHPUT_TARGET / 1e6:g} M/s: {'met' if rate >= THROUGHPUT_TARGET else 'NOT met'}"
+        rows.add("throughput", f"{name} batch 1e4", rate, "evals/s", note)
+        x1 = x[0, 0].copy()
+        t1 = _single_call_time(lambda: problem.fitness(x1), min_time / 2)
+        rows.add("throughput", f"{name} single point", t1 * 1e6, "µs/call", "fitness(x) with x shaped (dim,)")
+
+
+# -- 2. the mao2017 Tab. 3 experiment ----------------------------------------------------------
+def bench_mao2017(rows: _Rows, quick: bool) -> dict[str, float]:
+    from .solve import solve
+    problem = mao_problem()
+    reps = 1 if quick else 3
+    per_run: dict[str, float] = {}
+    for algo in ("aco", "abc", "gabc"):
+        best, result = np.inf, None
+        for _ in range(reps):
+            t = time.perf_counter()
+            result = solve(problem, algo, population=10, iterations=600, runs=30, seed=1)
+            best = min(best, time.perf_counter() - t)
+        ms = best / 30 * 1e3
+        per_run[algo] = ms
+        rep = f"best of {reps}" if reps > 1 else "1 repetition"
+        rows.add("mao2017", f"{algo} 30 runs total", best, "s", f"30 runs x 600 it x pop 10, {rep}")
+        rows.add("mao2017", f"{algo} per run (amortised)", ms, "ms/run",
+                 f"paper (MATLAB, i7-4510U) {PAPER_MS[algo]} ms/run: x{PAPER_MS[algo] / ms:.0f} faster")
+        rows.add("mao2017", f"{algo} evaluations per run", float(np.mean(result.evaluations)), "evals",
+                 f"mean final fitness {float(np.mean(result.fitness)):.3g}")
+    return per_run
+
+
+# -- 3. peers --------------------------------------------------------------------------------
+def _peer_niapy(problem, runs: int):
+    from niapy.algorithms.basic import ArtificialBeeColonyAlgorithm
+    from niapy.problems import Problem
+    from niapy.task import Task
+
+    class FkoptFitness(Problem):
+        def __init__(self):
+            super().__init__(dimension=problem.dim, lower=problem.bounds[:, 0], upper=problem.bounds[:, 1])
+
+        def _evaluate(self, x):
+            return float(problem.fitness(x))
+
+    out = []
+    for k in range(runs):
+        # NiaPy's population_size counts employed + onlooker bees: 20 -> 10 food sources.
+        algo = ArtificialBeeColonyAlgorithm(population_size=20, limit=30, seed=k)
+        task = Task(problem=FkoptFitness(), max_iters=600)
+        t = time.perf_counter()
+        _, best_f = algo.run(task)
+        out.append((time.perf_counter() - t, task.evals, float(best_f)))
+    return out, "niapy.ArtificialBeeColonyAlgorithm(population_size=20 (10 sources), limit=30), max_iters=600"
+
+
+def _peer_mealpy(problem, runs: int):
+    from mealpy import FloatVar
+    from mealpy.swarm_based.ABC import OriginalABC
+
+    def obj(x):
+        return float(problem.fitness(x))
+
+    spec = {"obj_func": obj, "bounds": FloatVar(lb=problem.bounds[:, 0].tolist(), ub=problem.bounds[:, 1].tolist()),
+            "minmax": "min", "log_to": None}
+    out = []
+    for k in range(runs):
+        model = OriginalABC(epoch=600, pop_size=10, n_limits=30)
+        t = time.perf_counter()
+        best = model.solve(spec, seed=k)
+        out.append((time.perf_counter() - t, model.nfe_counter, float(best.target.fitness)))
+    return out, "mealpy OriginalABC(epoch=600, pop_size=10, n_limits=30)"
+
+
+def _peer_pygmo(problem, runs: int):
+    import pygmo as pg
+
+    class UDP:
+        def fitness(self, x):
+            return [float(problem.fitness(np.asarray(x)))]
+
+        def get_bounds(self):
+            return (problem.bounds[:, 0].tolist(), problem.bounds[:, 1].tolist())
+
+    out = []
+    for k in range(runs):
+        prob = pg.problem(UDP())
+        algo = pg.algorithm(pg.bee_colony(gen=600, limit=30, seed=k))
+        t = time.perf_counter()
+        pop = algo.evolve(pg.population(prob, 10, seed=k))
+        out.append((time.perf_counter() - t, prob.get_fevals(), float(pop.champion_f[0])))
+    return out, "pygmo bee_colony(gen=600, limit=30), population 10"
+
+
+def bench_peers(rows: _Rows, quick: bool, fkopt_gabc_ms: float | None, messages: list[str]) -> None:
+    from .solve import solve
+    problem = mao_problem()
+    runs = 3 if quick else 10
+    # fkopt alone, one run at a time (no batching), for an apples-to-apples single-run figure
+    times = []
+    for k in range(runs):
+        t = time.perf_counter()
+        r = solve(problem, "gabc", population=10, iterations=600, runs=1, seed=1, run_ids=[k])
+        times.append(time.perf_counter() - t)
+    rows.add("peers", "fkopt gabc, one run alone", np.median(times) * 1e3, "ms/run",
+             f"median of {runs} single runs; evals {int(r.evaluations[0])}, final f {float(r.fitness[0]):.3g}")
+    peers = [("niapy", _peer_niapy), ("mealpy", _peer_mealpy)]
+    try:
+        import pygmo  # noqa: F401
+        peers.append(("pygmo", _peer_pygmo))
+    except Exception:
+        messages.append("peer pygmo skipped: not importable")
+    for name, fn in peers:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                out, how = fn(problem, runs)
+        except ImportError as err:
+            messages.append(f"peer {name} skipped: not installed ({err}); pip install 'fkopt[bench]'")
+            continue
+        except Exception as err:   # a peer's own failure must not stop the benchmark
+            messages.append(f"peer {name} skipped: {type(err).__name__}: {err}")
+            continue
+        t = np.array([o[0] for o in out])
+        ev = np.array([o[1] for o in out], dtype=float)
+        f = np.array([o[2] for o in out])
+        ms = float(np.median(t) * 1e3)
+        rows.add("peers", f"{name} per run", ms, "ms/run", f"median of {runs} runs; {how}")
+        rows.add("peers", f"{name} evaluations per run", float(ev.mean()), "evals", "")
+        rows.add("peers", f"{name} final fitness (median)", float(np.median(f)), "", "")
+        if fkopt_gabc_ms:
+            rows.add("peers", f"{name} / fkopt gabc amortised", ms / fkopt_gabc_ms, "x",
+                     f"fkopt gabc {fkopt_gabc_ms:.3g} ms/run amortised over 30 batched runs")
+
+
+# -- 4. exact solves of many 6-SPS poses at once ----------------------------------------------
+class PoseBatchProblem:
+    """Forward kinematics of N poses of one parallel mechanism as ONE problem for batched ``lm``.
+
+    ``FKProblem`` holds one joint vector. Here run k solves pose k, but :mod:`fkopt.algorithms.lm`
+    evaluates accepted trial points as a flat (k, dim) array, so the run of a point cannot be
+    recovered from its position in the batch. The pose index therefore travels with the point
+    as an extra, last variable ``pose_index`` (bounds [-0.5, N - 0.5], start value k): the
+    residuals ignore it except to pick ``joints[round(index)]``, so its Jacobian column is
+    exactly zero, its LM step exactly zero, and it never moves.
+    """
+
+    def __init__(self, mechanism, joints):
+        self.mechanism = mechanism
+        self.joints = np.asarray(joints, dtype=float)          # (N, m)
+        n = len(self.joints)
+        self.variable_names = (*mechanism.pose_names, "pose_index")
+        self.variable_units = (*mechanism.pose_units, "")
+        self.bounds = np.vstack([mechanism.bounds, [-0.5, n - 0.5]])
+        self._angle = mechanism.angle_mask(mechanism.joint_units)
+
+    @property
+    def dim(self) -> int:
+        return len(self.variable_names)
+
+    def start(self) -> np.ndarray:
+        """One start row per run: centre of the pose bounds, and the run's own pose index."""
+        x0 = np.empty((len(self.joints), self.dim))
+        x0[:, :-1] = self.mechanism.bounds.mean(axis=1)
+        x0[:, -1] = np.arange(len(self.joints))
+        return x0
+
+    def residuals(self, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        idx = np.rint(x[..., -1]).astype(np.intp)
+        r = self.mechanism.ik(x[..., :-1]) - self.joints[idx]
+        if self._angle.any():
+            r = np.where(self._angle, wrap_degrees(r), r)
+        return r
+
+    def fitness(self, x) -> np.ndarray:
+        r = self.residuals(x)
+        return (r * r).sum(axis=-1)
+
+
+def bench_exact(rows: _Rows, quick: bool, rng) -> None:
+    from . import mechanism
+    from .solve import solve
+    m = mechanism("6-sps-cmm")
+    n = 1000
+    poses = _uniform(m.bounds, (n,), rng)
+    legs = m.ik(poses)
+    problem = PoseBatchProblem(m, legs)
+    x0 = problem.start()
+    reps = 1 if quick else 3
+    times, result = [], None
+    for _ in range(reps):
+        t = time.perf_counter()
+        result = solve(problem, "lm", population=1, iterations=50, runs=n, x0=x0)
+        times.append(time.perf_counter() - t)
+    x = result.x[:, :-1]
+    err = np.abs(m.ik(x) - legs).max(axis=-1)
+    ok = err < 1e-9
+    ms = float(np.median(times)) / n * 1e3
+    rows.add("exact", "6-sps-cmm lm per pose", ms, "ms/pose",
+             f"{n} random poses in one batched lm call (50 it, start = centre of bounds), median of {reps}; "
+             f"target < {EXACT_TARGET_MS} ms: {'met' if ms < EXACT_TARGET_MS else 'NOT met'}")
+    rows.add("exact", "6-sps-cmm lm success", ok.mean() * 100, "%", "max |ik(x) - legs| < 1e-9")
+    found = np.abs(x - poses).max(axis=-1) < 1e-6
+    rows.add("exact", "6-sps-cmm lm found the drawn pose", found.mean() * 100, "%",
+             "others: another assembly mode with the same legs, or a miss")
+    rows.add("exact", "6-sps-cmm lm evaluations per pose", float(np.mean(result.evaluations)), "evals",
+             "residual evaluations")
+
+
+# -- 5. scaling ------------------------------------------------------------------------------
+def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, float]]]:
+    from .solve import solve
+    problem = mao_problem()
+    iterations = 50 if quick else 200
+    pops = (10, 100, 1000) if quick else (10, 30, 100, 300, 1000)
+    runs_list = (1, 100, 1000) if quick else (1, 10, 100, 1000)
+    curves: dict[str, list[tuple[int, float, float]]] = {"population": [], "runs": []}
+    for label, cases in (("population", [(p, 30) for p in pops]), ("runs", [(10, r) for r in runs_list])):
+        for pop, runs in cases:
+            t = time.perf_counter()
+            res = solve(problem, "gabc", population=pop, iterations=iterations, runs=runs, seed=1)
+            dt = time.perf_counter() - t
+            ns = dt / float(res.evaluations.sum()) * 1e9
+            curves[label].append((pop if label == "population" else runs, dt, ns))
+            item = f"gabc pop {pop}, {runs} runs"
+            rows.add("scaling", item + " time", dt, "s", f"{iterations} iterations")
+            rows.add("scaling", item + " per evaluation", ns, "ns/eval", "")
+    return curves
+
+
+def plot_scaling(curves, path: Path, iterations: int) -> None:
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(10, 4))
+    for ax, key, xlabel in zip(fig.subplots(1, 2), ("population", "runs"),
+                               ("population (30 runs)", "runs (population 10)")):
+        pts = np.array(curves[key], dtype=float)
+        if not len(pts):
+            continue
+        ax.loglog(pts[:, 0], pts[:, 2], "o-", color="C0", label="ns per evaluation")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("ns per evaluation", color="C0")
+        ax2 = ax.twinx()
+        ax2.loglog(pts[:, 0], pts[:, 1], "s--", color="C1", label="wall time")
+        ax2.set_ylabel("wall time (s)", color="C1")
+        ax.set_title(f"gabc on 3-RPS, {iterations} iterations")
+        ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+# -- entry point -----------------------------------------------------------------------------
+def machine() -> dict[str, str]:
+    cpu = platform.processor() or "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {"cpus": str(os.cpu_count()), "cpu": cpu, "numpy": np.__version__,
+            "python": platform.python_version()}
+
+
+def _fmt(v: float) -> str:
+    if v == 0 or not np.isfinite(v):
+        return f"{v:g}"
+    if abs(v) >= 1e5 or abs(v) < 1e-3:
+        return f"{v:.3e}"
+    return f"{v:.4g}"
+
+
+def run(quick: bool = False, peers: bool = False, out="bench") -> pd.DataFrame:
+    """Run the benchmark; print a table, write ``out/bench.csv`` and ``out/scaling.png``."""
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    if not console.is_terminal:   # files and pipes: wide enough for the notes
+        console = Console(width=200)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(20240601)
+    rows = _Rows()
+    messages: list[str] = []
+    start = time.perf_counter()
+
+    bench_throughput(rows, quick, rng)
+    per_run = bench_mao2017(rows, quick)
+    if peers:
+        bench_peers(rows, quick, per_run.get("gabc"), messages)
+    bench_exact(rows, quick, rng)
+    curves = bench_scaling(rows, quick)
+    plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
+
+    df = pd.DataFrame(rows.rows, columns=["section", "item", "value", "unit", "note"])
+    df.to_csv(out / "bench.csv", index=False)
+
+    info = machine()
+    table = Table(title=f"fkopt bench{' (quick)' if quick else ''}: {info['cpus']} CPUs, {info['cpu']}, "
+                        f"numpy {info['numpy']}")
+    for col in ("section", "item", "value", "unit", "note"):
+        table.add_column(col, justify="right" if col == "value" else "left")
+    for r in rows.rows:
+        table.add_row(r["section"], r["item"], _fmt(r["value"]), r["unit"], r["note"])
+    console.print(table)
+    for msg in messages:
+        console.print(msg)
+    console.print(f"total {time.perf_counter() - start:.1f} s; wrote {out / 'bench.csv'} and {out / 'scaling.png'}")
+    return df
