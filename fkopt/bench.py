@@ -192,8 +192,31 @@ def _peer_pygmo(problem, runs: int):
         algo = pg.algorithm(pg.bee_colony(gen=600, limit=30, seed=k))
         t = time.perf_counter()
         pop = algo.evolve(pg.population(prob, 10, seed=k))
-        out.append((time.perf_counter() - t, prob.get_fevals(), float(pop.champion_f[0])))
+        out.append((time.perf_counter() - t, pop.problem.get_fevals(), float(pop.champion_f[0])))
     return out, "pygmo bee_colony(gen=600, limit=30), population 10"
+
+
+def _peer_npea(problem, runs: int):
+    import contextlib
+    import io
+
+    from npea.ABC_ import GABC
+
+    calls = [0]
+
+    def f(x):
+        calls[0] += 1
+        return float(problem.fitness(np.asarray(x)))
+
+    out = []
+    for k in range(runs):
+        calls[0] = 0
+        t = time.perf_counter()
+        with contextlib.redirect_stdout(io.StringIO()):   # npea prints its parameters
+            _, fit, _ = GABC(f, popsize=10, limit=30, C=1.5, lb=problem.bounds[:, 0].tolist(),
+                             ub=problem.bounds[:, 1].tolist(), MaxFEs=12_000, seed=k)
+        out.append((time.perf_counter() - t, calls[0], float(fit)))
+    return out, "npEA GABC(popsize=10, limit=30, C=1.5, MaxFEs=12000) (vectorised moves, per-point fitness)"
 
 
 def bench_peers(rows: _Rows, quick: bool, fkopt_gabc_ms: float | None, messages: list[str]) -> None:
@@ -215,6 +238,7 @@ def bench_peers(rows: _Rows, quick: bool, fkopt_gabc_ms: float | None, messages:
         peers.append(("pygmo", _peer_pygmo))
     except Exception:
         messages.append("peer pygmo skipped: not importable")
+    peers.append(("npea", _peer_npea))
     for name, fn in peers:
         try:
             with warnings.catch_warnings():
