@@ -25,4 +25,4 @@ bench:
 	fkopt bench
 
 clean:
-	rm -rf build dist *.egg-info .pytest_cache bench
+	rm -rf build dist *.egg-info .pytest_cache
