@@ -14,9 +14,6 @@ solutions (``expected``; e.g. 40 for Dietmaier's 6-6 platform). The folder gets
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 from typing import Any, Literal
@@ -95,12 +92,10 @@ def tables(config: AssemblyConfig, mech, sols, wall: float):
 
 
 def write_assembly(config: AssemblyConfig, mech, sols, wall: float, out: Path, source: str | None) -> Path:
-    from .reports import FLOAT, library_versions
+    from .reports import FLOAT, library_versions, write_atomically
     from .. import __version__
-    final = Path(out) / config.paper / config.name
-    final.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
-    try:
+
+    def write(tmp: Path) -> None:
         summary, solutions, timing = tables(config, mech, sols, wall)
         summary.to_csv(tmp / "summary.csv", index=False, float_format=FLOAT)
         solutions.to_csv(tmp / "solutions.csv", index=False, float_format="%.12g")
@@ -110,17 +105,8 @@ def write_assembly(config: AssemblyConfig, mech, sols, wall: float, out: Path, s
                 "mechanism": mech.describe(), "objective": "all real solutions (multi-start Newton)",
                 "fkopt_version": __version__, "libraries": library_versions()}
         (tmp / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True, default=float) + "\n")
-        if final.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{final.name}.old.", dir=final.parent))
-            os.replace(final, old / "x")
-            os.replace(tmp, final)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, final)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return final
+
+    return write_atomically(Path(out) / config.paper / config.name, write)
 
 
 def check_assembly(exp, config: AssemblyConfig | None = None):

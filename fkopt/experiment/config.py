@@ -87,6 +87,15 @@ class AlgorithmSpec(Strict):
         return self.label or self.name
 
 
+def unique_labels(algos):
+    """Algorithm entries are told apart by label (or name): they must be unique."""
+    keys = [a.key for a in algos]
+    dup = {k for k in keys if keys.count(k) > 1}
+    if dup:
+        raise ValueError(f"algorithm labels must be unique, '{sorted(dup)[0]}' repeats (add 'label:')")
+    return algos
+
+
 class ExperimentConfig(Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
     paper: str | None = None
@@ -116,11 +125,7 @@ class ExperimentConfig(Strict):
     @field_validator("algorithms")
     @classmethod
     def _unique_labels(cls, algos):
-        keys = [a.key for a in algos]
-        dup = {k for k in keys if keys.count(k) > 1}
-        if dup:
-            raise ValueError(f"algorithm labels must be unique, '{sorted(dup)[0]}' repeats (add 'label:')")
-        return algos
+        return unique_labels(algos)
 
     @model_validator(mode="after")
     def _stop_needs_threshold(self):

@@ -451,13 +451,17 @@ def experiment_folder(out: Path, er_or_config) -> Path:
     return Path(out) / (config.paper or "experiments") / config.name
 
 
-def write_experiment(er: ExperimentResult, out: Path) -> Path:
-    """Write the folder atomically: into a temporary sibling, then renamed into place."""
-    final = experiment_folder(out, er)
+def write_atomically(final: Path, write) -> Path:
+    """Call ``write(tmp)`` on a temporary sibling folder of ``final``, then rename it into place.
+
+    A failed or interrupted write leaves ``final`` as it was (old results or nothing), never
+    half-written.
+    """
+    final = Path(final)
     final.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
     try:
-        write_tables(er, tmp)
+        write(tmp)
         if final.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{final.name}.old.", dir=final.parent))
             os.replace(final, old / "x")
@@ -469,3 +473,8 @@ def write_experiment(er: ExperimentResult, out: Path) -> Path:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return final
+
+
+def write_experiment(er: ExperimentResult, out: Path) -> Path:
+    """Write the experiment's folder atomically (see :func:`write_atomically`)."""
+    return write_atomically(experiment_folder(out, er), lambda tmp: write_tables(er, tmp))

@@ -66,7 +66,7 @@ import yaml
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
-from ..experiment.config import AlgorithmSpec, MechanismSpec, Strict, _one_line
+from ..experiment.config import AlgorithmSpec, MechanismSpec, Strict, _one_line, unique_labels
 
 KIND = "study"
 #: Fields that never change the numbers (left out of the resume fingerprint).
@@ -160,11 +160,7 @@ class StudyConfig(Strict):
     @field_validator("algorithms")
     @classmethod
     def _unique_labels(cls, algos):
-        keys = [a.key for a in algos]
-        dup = {k for k in keys if keys.count(k) > 1}
-        if dup:
-            raise ValueError(f"algorithm labels must be unique, '{sorted(dup)[0]}' repeats (add 'label:')")
-        return algos
+        return unique_labels(algos)
 
     @model_validator(mode="after")
     def _mode(self):
