@@ -98,7 +98,7 @@ def roulette(cdf: np.ndarray, u: np.ndarray, dense: bool | None = None) -> np.nd
 class _Aux:
     """Index arrays an ABC needs for a given (runs, population, dim), built once per state."""
 
-    __slots__ = ("shape", "sources", "offsets", "scale", "cand", "lo", "hi", "width", "ids")
+    __slots__ = ("shape", "sources", "offsets", "scale", "cand", "lo", "hi", "width", "ids", "inf", "none")
 
     def __init__(self, shape, bounds):
         runs, population, dim = shape
@@ -110,6 +110,8 @@ class _Aux:
         self.lo, self.hi = bounds[:, 0].copy(), bounds[:, 1].copy()
         self.width = self.hi - self.lo
         self.ids = np.arange(runs * population)
+        self.inf = np.full(runs * population, np.inf)
+        self.none = np.full(runs * population, runs * population)
 
 
 def _aux(state: State, problem) -> _Aux:
@@ -176,6 +178,11 @@ class ABC(Algorithm):
 
     def candidates(self, state, sources, problem, streams):
         """Neighbour candidates of ``sources`` (runs, n): one coordinate moved towards/away from k."""
+        return self._propose(state, sources, problem, streams)[0]
+
+    def _propose(self, state, sources, problem, streams):
+        """``(v, pos, new, old)``: the candidates and, on the fast path, the flat positions of
+        their moved coordinate in ``v`` with its new (clipped) and old values (else Nones)."""
         aux = _aux(state, problem)
         x = state.x
         runs, population, dim = x.shape
@@ -194,7 +201,7 @@ class ABC(Algorithm):
             v = np.where(np.arange(dim) == j[..., None], moved, xs)
             np.maximum(v, aux.lo, out=v)
             np.minimum(v, aux.hi, out=v)
-            return v
+            return v, None, None, None
         # Only coordinate j changes: work on flat (runs, n) arrays of that coordinate.
         xf = x.reshape(-1)
         pos = (aux.cand if n == population else (np.arange(runs * n) * dim).reshape(runs, n)) + j
@@ -207,16 +214,17 @@ class ABC(Algorithm):
             src += j
         k *= dim
         k += j
-        m = self.move(state, xf[src], xf[k], j, phi, streams)
-        np.maximum(m, aux.lo[j], out=m)
-        np.minimum(m, aux.hi[j], out=m)
+        old = xf.take(src)
+        m = self.move(state, old, xf.take(k), j, phi, streams)
+        np.maximum(m, aux.lo.take(j), out=m)
+        np.minimum(m, aux.hi.take(j), out=m)
         v.reshape(-1)[pos] = m
-        return v
+        return v, pos, m, old
 
     def employed_phase(self, state, problem, streams):
         aux = _aux(state, problem)
         population = state.f.shape[1]
-        v = self.candidates(state, aux.sources, problem, streams)
+        v, pos, m, old = self._propose(state, aux.sources, problem, streams)
         pending = state.__dict__.pop("_abc_pending", None)
         if pending is None:
             fv = np.fmin(problem.fitness(v), np.inf)
@@ -229,11 +237,13 @@ class ABC(Algorithm):
             state.f = f
             state.evaluations = state.evaluations + count
         better = fv < state.f
-        state.x = np.where(better[..., None], v, state.x)
+        if pos is None:
+            state.x = np.where(better[..., None], v, state.x)
+        else:   # v is x with one coordinate moved: put the old value back where it failed
+            v.reshape(-1)[pos] = np.where(better, m, old)
+            state.x = v
         state.f = np.where(better, fv, state.f)
-        trial = state.trial + 1
-        trial[better] = 0
-        state.trial = trial
+        state.trial = np.where(better, 0, state.trial + 1)
         state.evaluations = state.evaluations + population
 
     def onlooker_phase(self, state, problem, streams):
@@ -248,20 +258,20 @@ class ABC(Algorithm):
         # fitness, and the first onlooker reaching it.
         size = runs * population
         flat = (sources + aux.offsets).ravel()
-        best = np.full(size, np.inf)
+        best = aux.inf.copy()
         np.minimum.at(best, flat, fv)
-        hit = fv == best[flat]
-        first = np.full(size, size)
+        hit = fv == best.take(flat)
+        first = aux.none.copy()
         np.minimum.at(first, flat[hit], aux.ids[hit])
         f = state.f.ravel()
         ok = best < f
         np.minimum(first, size - 1, out=first)
-        x2 = state.x.reshape(size, -1)
-        state.x = np.where(ok[:, None], v.reshape(size, -1)[first], x2).reshape(state.x.shape)
+        shape = state.x.shape
+        won = v.reshape(size, -1).take(first, axis=0).reshape(-1)
+        state.x = np.where(ok.repeat(shape[-1]), won, state.x.reshape(-1)).reshape(shape)
         state.f = np.where(ok, best, f).reshape(runs, population)
-        trial = state.trial.ravel() + np.bincount(flat, minlength=size)
-        trial[ok] = 0
-        state.trial = trial.reshape(runs, population)
+        trial = state.trial.reshape(-1) + np.bincount(flat, minlength=size)
+        state.trial = np.where(ok, 0, trial).reshape(runs, population)
         state.evaluations = state.evaluations + population
 
     def scout_phase(self, state, problem, streams, evaluate: bool = True):
