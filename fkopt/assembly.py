@@ -561,12 +561,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     """
     if not isinstance(mechanism, ParallelMechanism):
         raise FkoptError(f"all_solutions needs a parallel mechanism; '{mechanism.name}' is {mechanism.kind}")
-    if isinstance(joints, dict):
-        joints = mechanism.vector(joints, mechanism.joint_names, "joints")
-    joints = np.asarray(joints, dtype=float)
-    if joints.shape != (len(mechanism.joint_names),):
-        raise FkoptError(f"{mechanism.name} joints: expected {len(mechanism.joint_names)} values "
-                         f"({', '.join(mechanism.joint_names)}), got shape {joints.shape}")
+    joints = mechanism.as_values(joints, mechanism.joint_names, "joints")
     if len(mechanism.joint_names) != len(mechanism.pose_names):
         raise FkoptError(f"all_solutions needs as many joints as pose variables; {mechanism.name} has "
                          f"{len(mechanism.joint_names)} and {len(mechanism.pose_names)}")

@@ -50,14 +50,7 @@ class FKProblem(Problem):
         if not isinstance(mechanism, ParallelMechanism):
             raise FkoptError(f"fk_problem needs a parallel mechanism; '{mechanism.name}' is {mechanism.kind} "
                              "(use ik_problem for a serial arm)")
-        if isinstance(joints, dict):
-            joints = mechanism.vector(joints, mechanism.joint_names, "joints")
-        joints = np.asarray(joints, dtype=float)
-        if joints.shape != (len(mechanism.joint_names),):
-            raise FkoptError(f"{mechanism.name} joints: expected {len(mechanism.joint_names)} values "
-                             f"({', '.join(mechanism.joint_names)}), got shape {joints.shape}")
-        if not np.all(np.isfinite(joints)):
-            raise FkoptError(f"{mechanism.name} joints: values must be finite, got {joints.tolist()}")
+        joints = mechanism.as_values(joints, mechanism.joint_names, "joints")
         if objective not in OBJECTIVES:
             raise FkoptError(f"objective '{objective}' unknown; allowed: {', '.join(OBJECTIVES)}")
         self.mechanism = mechanism
@@ -124,14 +117,7 @@ class IKProblem(Problem):
         if not isinstance(mechanism, SerialMechanism):
             raise FkoptError(f"ik_problem needs a serial arm; '{mechanism.name}' is {mechanism.kind} "
                              "(use fk_problem for a parallel mechanism)")
-        if isinstance(pose, dict):
-            pose = mechanism.vector(pose, mechanism.pose_names, "target pose")
-        pose = np.asarray(pose, dtype=float)
-        if pose.shape != (len(mechanism.pose_names),) or pose.shape != (6,):
-            raise FkoptError(f"{mechanism.name} target pose: expected 6 values "
-                             f"({', '.join(mechanism.pose_names)}), got shape {pose.shape}")
-        if not np.all(np.isfinite(pose)):
-            raise FkoptError(f"{mechanism.name} target pose: values must be finite, got {pose.tolist()}")
+        pose = mechanism.as_values(pose, mechanism.pose_names, "target pose")   # serial arms: 6 values
         if objective not in IK_OBJECTIVES:
             raise FkoptError(f"objective '{objective}' unknown; allowed: {', '.join(IK_OBJECTIVES)}")
         for key, w in (("w_p", w_p), ("w_r", w_r)):

@@ -107,6 +107,19 @@ class Mechanism:
                              f"(needs {', '.join(names)})")
         return np.array([float(values[n]) for n in names])
 
+    def as_values(self, values, names: tuple[str, ...], what: str) -> np.ndarray:
+        """Measured joints or a target pose, given by name (dict) or in order (sequence), as a
+        finite float vector of ``len(names)`` values; anything else is a one-line error."""
+        if isinstance(values, dict):
+            values = self.vector(values, names, what)
+        values = np.asarray(values, dtype=float)
+        if values.shape != (len(names),):
+            raise FkoptError(f"{self.name} {what}: expected {len(names)} values "
+                             f"({', '.join(names)}), got shape {values.shape}")
+        if not np.all(np.isfinite(values)):
+            raise FkoptError(f"{self.name} {what}: values must be finite, got {values.tolist()}")
+        return values
+
     def angle_mask(self, units: tuple[str, ...]) -> np.ndarray:
         return np.array([u == "deg" for u in units])
 
