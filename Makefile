@@ -22,7 +22,7 @@ check:
 	fkopt check results --subset all
 
 bench:
-	fkopt bench
+	fkopt bench --out bench
 
 clean:
 	rm -rf build dist *.egg-info .pytest_cache

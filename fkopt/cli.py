@@ -6,6 +6,7 @@ Ctrl-C ends with status 130. Neither prints a traceback.
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Optional
@@ -33,12 +34,18 @@ def parse_assignments(text: str, option: str) -> dict[str, float]:
     out: dict[str, float] = {}
     for part in filter(None, (p.strip() for p in text.split(","))):
         name, sep, value = part.partition("=")
-        if not sep:
+        name = name.strip()
+        if not sep or not name:
             raise FkoptError(f"{option}: expected name=value pairs separated by commas, got '{part}'")
+        if name in out:
+            raise FkoptError(f"{option}: '{name}' is given twice")
         try:
-            out[name.strip()] = float(value)
+            number = float(value)
         except ValueError:
-            raise FkoptError(f"{option}: '{name.strip()}' needs a number, got '{value}'") from None
+            raise FkoptError(f"{option}: '{name}' needs a number, got '{value}'") from None
+        if not math.isfinite(number):
+            raise FkoptError(f"{option}: '{name}' needs a finite number, got '{value.strip()}'")
+        out[name] = number
     if not out:
         raise FkoptError(f"{option}: no values given")
     return out
@@ -47,18 +54,8 @@ def parse_assignments(text: str, option: str) -> dict[str, float]:
 def load_geometry(path: Optional[Path]) -> dict:
     if path is None:
         return {}
-    import yaml
-    try:
-        data = yaml.safe_load(path.read_text())
-    except OSError as err:
-        raise FkoptError(f"{path}: cannot read ({err.strerror})") from None
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise FkoptError(f"{path}: malformed YAML{where}") from None
-    if not isinstance(data, dict):
-        raise FkoptError(f"{path}: expected a mapping of geometry keys")
-    return data
+    from .files import load_mapping
+    return load_mapping(path, "geometry keys")
 
 
 def _mechanism(name: str, geometry: Optional[Path]):
@@ -103,45 +100,64 @@ def list_cmd(as_json: bool = typer.Option(False, "--json", help="machine-readabl
 def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"),
         out: Path = typer.Option(Path("results"), "--out", help="results root; each experiment "
                                  "writes OUT/<paper>/<name>/"),
+        force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
+                                   "whose result-changing fields differ"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
     """Run experiment files and write their tables and figures."""
-    from .experiment.reports import summary_table, write_experiment
-    from .experiment.runner import run_experiment, validate_experiment
+    from .experiment.kinds import load_any, prepare_output, run_config, validate_any
 
-    loaded = [(path, _experiment_file(path)) for path in configs]
-    for path, config in loaded:          # fail on any bad file before running anything
+    planned, folders = [], {}
+    for path in configs:          # fail on any bad file or output folder before running anything
+        config = load_any(path)
+        if getattr(config, "kind", None) == "study":
+            raise FkoptError(f"{path}: a study file (kind: study); run it with: fkopt study {path}")
+        tasks = validate_any(config, str(path))
         try:
-            validate_experiment(config)
+            folder = prepare_output(config, out, force)
         except FkoptError as err:
             raise FkoptError(f"{path}: {err}") from None
+        if folder in folders:
+            raise FkoptError(f"{path}: writes {folder}, like {folders[folder]}; paper/name must differ")
+        folders[folder] = path
+        planned.append((path, config, tasks))
     con = _console()
-    for path, config in loaded:
-        if quiet:
-            er = run_experiment(config, source=str(path))
-        else:
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-            with Progress(TextColumn(f"[bold]{config.name}[/]"), BarColumn(), MofNCompleteColumn(),
-                          TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
-                          transient=True) as bar:
-                task = bar.add_task("", total=len(config.algorithms) * _n_cases(config))
-                er = run_experiment(config, source=str(path),
-                                    progress=lambda label, done, total: bar.update(task, completed=done,
-                                                                                   description=label))
-        folder = write_experiment(er, out)
+    for path, config, tasks in planned:
+        with _progress(con, config.name, tasks, quiet) as progress:
+            outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True)
         if not quiet:
-            _print_summary(con, summary_table(er), folder, er.wall_s)
+            _print_outcome(con, outcome)
 
 
-def _n_cases(config) -> int:
-    return getattr(config.cases, "random", None) or len(config.cases)
+class _progress:
+    """A rich progress bar as a ``progress(label, done, total)`` callback (None when quiet)."""
+
+    def __init__(self, con, name: str, total: int, quiet: bool):
+        self.con, self.name, self.total, self.quiet = con, name, total, quiet
+
+    def __enter__(self):
+        if self.quiet:
+            return None
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        self.bar = Progress(TextColumn(f"[bold]{self.name}[/]"), BarColumn(), MofNCompleteColumn(),
+                            TextColumn("{task.description}"), TimeElapsedColumn(), console=self.con,
+                            transient=True)
+        self.bar.__enter__()
+        task = self.bar.add_task("", total=self.total)
+        return lambda label, done, total: self.bar.update(task, completed=done, description=label)
+
+    def __exit__(self, *exc):
+        if not self.quiet:
+            self.bar.__exit__(*exc)
+        return False
 
 
-def _experiment_file(path: Path):
-    from .study.config import StudyConfig, load_any
-    config = load_any(path)
-    if isinstance(config, StudyConfig):
-        raise FkoptError(f"{path}: a study file (kind: study); run it with: fkopt study {path}")
-    return config
+def _print_outcome(con, outcome) -> None:
+    from .experiment.runner import ExperimentResult
+    if isinstance(outcome.result, ExperimentResult):
+        from .experiment.reports import summary_table
+        _print_summary(con, summary_table(outcome.result), outcome.folder, outcome.wall_s)
+    else:
+        con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s)")
 
 
 @app.command()
@@ -155,33 +171,27 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
                                                   "scheduler (with --executor dask)"),
           resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted "
                                       "run of the same study and run only the others"),
+          force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
+                                     "whose result-changing fields differ"),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
     """Run a workspace study: algorithms x poses x runs, statistics, tracking (see fkopt.study)."""
+    from .experiment.kinds import prepare_output, run_config, validate_any
     from .study.config import load_study
     from .study.executors import validate_executor
-    from .study.reports import summary_table
-    from .study.runner import plan_tasks, run_study, validate_study
 
     cfg = load_study(config)
     validate_executor(executor, jobs, scheduler)
-    try:
-        _, poses = validate_study(cfg)
-    except FkoptError as err:
-        raise FkoptError(f"{config}: {err}") from None
-    kwargs = dict(jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, source=str(config))
-    if quiet:
-        result = run_study(cfg, out, **kwargs)
-    else:
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-        con = _console()
-        with Progress(TextColumn(f"[bold]{cfg.name}[/]"), BarColumn(), MofNCompleteColumn(),
-                      TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
-                      transient=True) as bar:
-            task = bar.add_task("", total=len(plan_tasks(cfg, len(poses))))
-            result = run_study(cfg, out, progress=lambda label, done, total: bar.update(
-                task, completed=done, description=label), **kwargs)
-        reused = len(plan_tasks(cfg, len(poses))) - len(result.computed)
+    tasks = validate_any(cfg, str(config))
+    prepare_output(cfg, out, force)
+    con = _console()
+    with _progress(con, cfg.name, tasks, quiet) as progress:
+        outcome = run_config(cfg, out, source=str(config), progress=progress, force=force, checked=True,
+                             jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
+    if not quiet:
+        from .study.reports import summary_table
+        result = outcome.result
         _print_summary(con, summary_table(result), result.folder, result.wall_s)
+        reused = tasks - len(result.computed)
         if reused:
             con.print(f"resumed: {reused} finished task(s) reused, {len(result.computed)} computed")
 
@@ -210,7 +220,7 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
        geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="solver for a serial arm"),
-       seed: int = typer.Option(0, "--seed"),
+       seed: int = typer.Option(0, "--seed", min=0),
        as_json: bool = typer.Option(False, "--json")):
     """Inverse kinematics: closed form for a parallel mechanism, solved for a serial arm."""
     m = _mechanism(mech, geometry)
@@ -239,7 +249,7 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        joints: str = typer.Option(..., "--joints", help="e.g. d1=598.85,d2=671.92,d3=629.16"),
        geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help=f"default: first of {', '.join(RELIABLE)} available"),
-       seed: int = typer.Option(0, "--seed"),
+       seed: int = typer.Option(0, "--seed", min=0),
        tolerance: float = typer.Option(1e-6, "--tolerance", help="largest residual (joint units) accepted as a solution"),
        all_solutions: bool = typer.Option(False, "--all-solutions", help="every distinct real solution in the bounds"),
        as_json: bool = typer.Option(False, "--json")):
@@ -289,9 +299,12 @@ def _emit(data: dict, as_json: bool, units) -> None:
 @app.command()
 def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s)"),
           peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
-          out: Path = typer.Option(Path("bench"), "--out", help="folder for bench.csv and scaling.png")):
+          out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
+                                   "(the committed measurements are rewritten only with --out bench)")):
     """Measure fkopt's speed (and peers') on this machine."""
     from .bench import run as run_bench
+    from .files import output_folder
+    output_folder(out)                 # a writable folder, not a file: before measuring anything
     run_bench(quick=quick, peers=peers, out=out)
 
 
@@ -300,61 +313,37 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
               out: Path = typer.Option(Path("results"), "--out", help="results root"),
               quiet: bool = typer.Option(False, "--quiet", "-q")):
     """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
-    import shutil
     import time
-    from rich.table import Table
-    from .experiment.reports import write_experiment
-    from .experiment.runner import run_experiment
-    from .reproduce.report import write_report
-    from .experiment.kinds import load_any, validate_any
-    from .study.config import StudyConfig
-    from .study.runner import run_study
-
-    files = sorted(configs.rglob("*.yaml"))
-    if not files:
-        raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
-    from .experiment.assembly import AssemblyConfig, run_assembly, write_assembly
-    loaded = [(f, load_any(f)) for f in files]     # experiments, studies and assembly-mode files (kind:)
-    sizes = {}
-    for f, c in loaded:
-        try:
-            sizes[f] = validate_any(c)
-        except FkoptError as err:
-            raise FkoptError(f"{f}: {err}") from None
-    con = _console()
-    done = []
-    start = time.perf_counter()
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.table import Table
+    from .reproduce.report import write_report
+    from .reproduce.run import plan, run_all
+
+    planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
+    con = _console()
+    start = time.perf_counter()
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
                   disable=quiet) as bar:
-        overall = bar.add_task("", total=len(loaded), name="[bold]reproduce[/]")
-        for f, c in loaded:
-            task = bar.add_task("", total=sizes[f], name=f"  {c.paper}/{c.name}")
-            update = lambda label, d, t: bar.update(task, completed=d, description=label)  # noqa: E731
-            if isinstance(c, AssemblyConfig):
-                mech, sols, wall = run_assembly(c)
-                folder = write_assembly(c, mech, sols, wall, out, str(f))
-                er = type("Done", (), {"wall_s": wall})
-            elif isinstance(c, StudyConfig):
-                er = run_study(c, out, source=str(f), progress=update)
-                folder = er.folder
-                # Task files exist for --resume; a finished reproduction keeps only its results.
-                shutil.rmtree(folder / "tasks", ignore_errors=True)
-            else:
-                er = run_experiment(c, source=str(f), progress=update)
-                folder = write_experiment(er, out)
-            bar.remove_task(task)
+        overall = bar.add_task("", total=len(planned), name="[bold]reproduce[/]")
+        current = {}
+
+        def started(p):
+            current["task"] = task = bar.add_task("", total=p.tasks, name=f"  {p.config.paper}/{p.config.name}")
+            return lambda label, d, t: bar.update(task, completed=d, description=label)
+
+        def finished(d):
+            bar.remove_task(current.pop("task"))
             bar.advance(overall)
-            done.append((f, folder, er.wall_s, len(list(folder.iterdir()))))
+        done = run_all(planned, out, started=started, finished=finished)
     paths = write_report(out)
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")
         for col in ("config", "results", "files", "seconds"):
             table.add_column(col)
-        for f, folder, wall, n in done:
-            table.add_row(str(f), str(folder), str(n), f"{wall:.1f}")
+        for d in done:
+            table.add_row(str(d.path), str(d.folder), str(d.files), f"{d.wall_s:.1f}")
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
 
@@ -363,22 +352,32 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
 def report(results: Path = typer.Argument(Path("results"), help="results root")):
     """Regenerate REPORT.md, TIMING.md and index.csv from stored results (no rerun)."""
     from .reproduce.report import write_report
+    from .reproduce.store import Store
+    Store(results).require_readable()
     for p in write_report(results):
         typer.echo(str(p))
 
 
 @app.command()
-def check(results: Path = typer.Argument(Path("results"), help="results root"),
+def check(results: Path = typer.Argument(Path("results"), help="results root, a paper folder "
+                                         "(results/mao2017) or one experiment folder"),
           subset: str = typer.Option("all", "--subset", help="all | ci"),
           experiment: Optional[list[str]] = typer.Option(None, "--experiment", "-e",
                                                          help="PAPER/NAME to check (repeatable)"),
           quiet: bool = typer.Option(False, "--quiet", "-q")):
-    """Rerun stored experiments from their recorded config; fail if results drifted."""
+    """Rerun stored results from their recorded config; exit 1 if anything drifted.
+
+    Exact when the platform fingerprint in env.json matches this machine, by documented
+    tolerances otherwise (fkopt.compare); a missing or unreadable meta.json is a failure.
+    """
     from .reproduce.check import check_experiment, select
-    from .reproduce.store import Store
+    from .reproduce.store import locate
     if subset not in ("all", "ci"):
         raise FkoptError(f"--subset: '{subset}' unknown; allowed: all, ci")
-    exps = select(Store(results), subset)
+    if not results.is_dir():
+        raise FkoptError(f"{results}: no such results folder")
+    store, paper, name = locate(results)
+    exps = select(store, subset, paper, name)
     if experiment:
         wanted = set(experiment)
         exps = [e for e in exps if f"{e.paper}/{e.name}" in wanted]
@@ -386,7 +385,7 @@ def check(results: Path = typer.Argument(Path("results"), help="results root"),
         if missing:
             raise FkoptError(f"--experiment: no stored experiment {sorted(missing)[0]} under {results}")
     if not exps:
-        raise FkoptError(f"{results}: no stored experiments (folders with meta.json) to check")
+        raise FkoptError(f"{results}: no stored results (folders with meta.json) to check")
     failures = []
     for e in exps:
         bad = check_experiment(e)
@@ -396,23 +395,37 @@ def check(results: Path = typer.Argument(Path("results"), help="results root"),
     if failures:
         for m in failures[:20]:
             typer.echo(f"drift: {m}", err=True)
-        raise FkoptError(f"{len(failures)} value(s) drifted in {len({m.experiment for m in failures})} "
-                         f"experiment(s); first: {failures[0]}")
+        typer.echo(f"fkopt: check failed: {len(failures)} mismatch(es) in "
+                   f"{len({m.experiment for m in failures})} experiment(s); first: {failures[0]}", err=True)
+        raise typer.Exit(1)
     if not quiet:
         typer.echo(f"{len(exps)} experiments match their stored results")
 
 
 def main() -> None:
-    interrupted = ("fkopt: interrupted (no results folder was left half-written; the finished tasks of a "
-                   "study are kept: fkopt study CONFIG --resume continues)")
+    """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
+    from .files import one_line
+    interrupted = ("fkopt: interrupted (previous results are kept; the finished tasks of a "
+                   "study are kept too: fkopt study CONFIG --resume continues)")
+
+    def fail(message: str) -> None:
+        print(f"fkopt: error: {one_line(message)}", file=sys.stderr)
+        sys.exit(2)
+
     try:
         code = app(standalone_mode=False)
     except FkoptError as err:
-        print(f"fkopt: error: {err}", file=sys.stderr)
-        sys.exit(2)
+        fail(str(err))
     except KeyboardInterrupt:
         print(interrupted, file=sys.stderr)
         sys.exit(130)
+    except MemoryError:
+        fail("out of memory; reduce runs, population, iterations or cases")
+    except RecursionError:
+        fail("input nested too deeply")
+    except OSError as err:   # the file system refused (disk full, permissions): not a bug of fkopt
+        where = f"{err.filename}: " if err.filename else ""
+        fail(f"{where}{err.strerror or err}")
     except Exception as err:  # click's usage errors (typer vendors click): no traceback either
         kind = type(err).__name__
         if kind == "Exit":
@@ -421,14 +434,14 @@ def main() -> None:
             print("fkopt: interrupted", file=sys.stderr)
             sys.exit(130)
         if callable(getattr(err, "format_message", None)):
-            print(f"fkopt: error: {err.format_message()} (see fkopt --help)", file=sys.stderr)
-            sys.exit(2)
+            fail(f"{err.format_message()} (see fkopt --help)")
         raise
     if code == 130:   # typer (>= 0.12) turns Ctrl-C into a returned 130 when not standalone
         print(interrupted, file=sys.stderr)
         sys.exit(130)
     if isinstance(code, int) and code:
         sys.exit(code)
+
 
 if __name__ == "__main__":
     main()

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from fkopt.errors import FkoptError
 from fkopt.study import load_any, run_study, study_from_dict
-from fkopt.study.runner import TASKS, plan_tasks, validate_study
+from fkopt.study.runner import TASKS, plan_tasks, validate_study, work_folder
 from fkopt.study.statistics import ecdf_table, holm, pairwise_tests
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -191,15 +191,18 @@ def test_resume_after_interruption_matches_uninterrupted_run(tmp_path):
     with pytest.raises(Interrupt):
         run_study(config, tmp_path / "cut", progress=stop_after(4))
     folder = tmp_path / "cut" / "studies" / "small"
-    files = sorted((folder / TASKS).glob("a*.json"))
-    assert len(files) == 4 and not (folder / "meta.json").exists()
-    assert not list((folder / TASKS).glob(".*"))       # no half-written temporary files
+    work = work_folder(tmp_path / "cut", config)         # unfinished: tasks kept beside the result
+    files = sorted((work / TASKS).glob("a*.json"))
+    assert len(files) == 4 and not folder.exists()
+    assert not list((work / TASKS).glob(".*"))         # no half-written temporary files
     files[1].unlink()                                   # a task lost, e.g. never written
     kept = {p.name: p.stat().st_mtime_ns for p in files if p.exists()}
     resumed = run_study(config, tmp_path / "cut", resume=True)
     assert len(resumed.computed) == 6 - 3               # the 3 kept tasks were not recomputed
     assert not set(resumed.computed) & {n.removesuffix(".json") for n in kept}
-    assert {p.name: p.stat().st_mtime_ns for p in files if p.name in kept} == kept
+    kept_now = {p.name: p.stat().st_mtime_ns for p in (folder / TASKS).glob("a*.json") if p.name in kept}
+    assert kept_now == kept                             # moved into the finished folder, not rewritten
+    assert not work.exists()
     same_files(full.folder, resumed.folder)
 
     # a finished study: delete the merged output and two task files, resume recomputes only those
@@ -248,7 +251,7 @@ def test_cli_ctrl_c_keeps_finished_tasks(tmp_path, cli, monkeypatch):
     monkeypatch.setattr(runner, "run_task", interrupted_on_third)
     code, _, err = cli("study", study, "--out", tmp_path, "--quiet")
     assert code == 130 and "interrupted" in err and "--resume" in err
-    assert len(list((tmp_path / "studies" / "small" / TASKS).glob("a*.json"))) == 2
+    assert len(list((work_folder(tmp_path, small()) / TASKS).glob("a*.json"))) == 2
     monkeypatch.setattr(runner, "run_task", real)
     code, _, err = cli("study", study, "--out", tmp_path, "--quiet", "--resume")
     assert code == 0 and (tmp_path / "studies" / "small" / "meta.json").exists()

@@ -9,38 +9,39 @@ solutions (``expected``; e.g. 40 for Dietmaier's 6-6 platform). The folder gets
 * ``summary.csv``   -- the count against ``expected`` and the residual statistics, in the column
   names experiments use (so ``fkopt check`` and the report read it the same way);
 * ``timing.csv``    -- wall time of the search (the only non-deterministic file);
-* ``meta.json``     -- config, seed, versions.
+* ``meta.json``     -- config, seed, mechanism, digests of the CSVs; ``env.json`` -- versions, platform.
 """
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
-from pydantic import Field, ValidationError
+from pydantic import Field, ValidationError, field_validator
 
 from ..errors import FkoptError
-from .config import MechanismSpec, Strict, _one_line
+from ..files import error_line
+from .kinds import Kind, Outcome
+from .config import MAX_ITERATIONS, MAX_POPULATION, MechanismSpec, Seed, Strict, safe_component
 
 KIND = "assembly"
 
 
 class AssemblyConfig(Strict):
     kind: Literal["assembly"]
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str
     paper: str = "assembly"
     title: str = ""
     description: str = ""
     mechanism: MechanismSpec
     joints: dict[str, float]
-    seed: int = 0
+    seed: int = Seed()
     #: Starts per round of the multi-start Newton (default: the solver's own, 2000 for 6-SPS).
-    population: int | None = Field(None, ge=1)
+    population: int | None = Field(None, ge=1, le=MAX_POPULATION)
     #: Newton iterations per start.
-    iterations: int = Field(60, ge=1)
+    iterations: int = Field(60, ge=1, le=MAX_ITERATIONS)
     runs: Literal[1] = 1
     tol: float = Field(1e-9, gt=0)
     dedup: float = Field(1e-6, gt=0)
@@ -49,12 +50,21 @@ class AssemblyConfig(Strict):
     printed: dict[str, Any] = Field(default_factory=dict)
     check: Literal["ci", "full"] = "ci"
 
+    @field_validator("name", "paper")
+    @classmethod
+    def _component(cls, value, info):
+        return safe_component(value, info.field_name)
+
+    @property
+    def folder_parts(self) -> tuple[str, str]:
+        return (self.paper, self.name)
+
 
 def assembly_from_dict(data: dict, where: str) -> AssemblyConfig:
     try:
         return AssemblyConfig(**data)
     except ValidationError as err:
-        raise FkoptError(f"{where}: {_one_line(err)}") from None
+        raise FkoptError(f"{where}: {error_line(err, data=data)}") from None
 
 
 def run_assembly(config: AssemblyConfig):
@@ -91,29 +101,50 @@ def tables(config: AssemblyConfig, mech, sols, wall: float):
     return summary, solutions, timing
 
 
+def meta(config: AssemblyConfig, mech, source: str | None) -> dict:
+    return {"experiment": config.name, "paper": config.paper, "title": config.title, "kind": KIND,
+            "config_file": source, "config": config.model_dump(mode="json"), "seed": config.seed,
+            "mechanism": mech.describe(), "objective": "all real solutions (multi-start Newton)"}
+
+
+def write_files(config: AssemblyConfig, mech, sols, wall: float, folder: Path, source: str | None,
+                timing: bool = True) -> None:
+    """Every file of the folder (``timing=False``: only the deterministic ones, for ``fkopt check``)."""
+    from .reports import FLOAT, write_meta
+    summary, solutions, times = tables(config, mech, sols, wall)
+    summary.to_csv(folder / "summary.csv", index=False, float_format=FLOAT)
+    solutions.to_csv(folder / "solutions.csv", index=False, float_format="%.12g")
+    if timing:
+        times.to_csv(folder / "timing.csv", index=False, float_format=FLOAT)
+    write_meta(folder, meta(config, mech, source))
+
+
 def write_assembly(config: AssemblyConfig, mech, sols, wall: float, out: Path, source: str | None) -> Path:
-    from .reports import FLOAT, library_versions, write_atomically
-    from .. import __version__
-
-    def write(tmp: Path) -> None:
-        summary, solutions, timing = tables(config, mech, sols, wall)
-        summary.to_csv(tmp / "summary.csv", index=False, float_format=FLOAT)
-        solutions.to_csv(tmp / "solutions.csv", index=False, float_format="%.12g")
-        timing.to_csv(tmp / "timing.csv", index=False, float_format=FLOAT)
-        meta = {"experiment": config.name, "paper": config.paper, "title": config.title, "kind": KIND,
-                "config_file": source, "config": config.model_dump(mode="json"), "seed": config.seed,
-                "mechanism": mech.describe(), "objective": "all real solutions (multi-start Newton)",
-                "fkopt_version": __version__, "libraries": library_versions()}
-        (tmp / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True, default=float) + "\n")
-
-    return write_atomically(Path(out) / config.paper / config.name, write)
+    """Write the folder aside and swap it into place (the previous result stays until then)."""
+    from ..files import output_folder, write_atomically
+    return write_atomically(output_folder(out, *config.folder_parts),
+                            lambda tmp: write_files(config, mech, sols, wall, tmp, source))
 
 
-def check_assembly(exp, config: AssemblyConfig | None = None):
-    """Rerun a stored assembly experiment and compare its summary (count exactly)."""
-    from ..reproduce.check import compare_tables
-    config = config or AssemblyConfig(**exp.config)
+# -- the pipeline kind (fkopt.experiment.kinds) ------------------------------------------------------
+def _validate(config: AssemblyConfig) -> tuple[int, int]:
+    from .runner import build_mechanism
+    mech = build_mechanism(config)
+    if mech.kind != "parallel":
+        raise FkoptError(f"mechanism '{mech.name}' is {mech.kind}; assembly modes need a parallel mechanism")
+    mech.vector(config.joints, mech.joint_names, "joints")
+    starts = config.population or 2000
+    return 1, starts * len(mech.unknown_names) ** 2 * 8 * 40
+
+
+def _run(config: AssemblyConfig, out, *, source=None, progress=None, **_):
     mech, sols, wall = run_assembly(config)
-    summary, _, _ = tables(config, mech, sols, wall)
-    summary = pd.read_csv(pd.io.common.StringIO(summary.to_csv(index=False)))
-    return compare_tables(f"{exp.paper}/{exp.name}", "summary.csv", exp.table("summary"), summary)
+    return Outcome(write_assembly(config, mech, sols, wall, out, source), wall, sols)
+
+
+def _rerun_files(config: AssemblyConfig, folder: Path, source: str | None) -> None:
+    mech, sols, wall = run_assembly(config)
+    write_files(config, mech, sols, wall, folder, source, timing=False)
+
+
+ASSEMBLY = Kind(KIND, assembly_from_dict, _validate, _run, _rerun_files)

@@ -32,14 +32,38 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
+from ..files import check_component, error_line, load_mapping
+
+#: Documented upper limits (README "Bad input"); a memory estimate refuses smaller jobs that
+#: still cannot fit (:func:`fkopt.experiment.kinds.check_memory`).
+MAX_RUNS = 100_000
+MAX_POPULATION = 100_000
+MAX_ITERATIONS = 1_000_000
+MAX_CASES = 100_000
+#: Seeds are non-negative integers below 2**63 (numpy SeedSequence entropy).
+MAX_SEED = 2**63 - 1
+
+
+def Seed(default: int = 0):
+    return Field(default, ge=0, le=MAX_SEED)
 
 
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    #: Unknown fields are errors; NaN and inf are never accepted as numbers.
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+def safe_component(value, field: str):
+    """pydantic-side check of ``paper``/``name`` (see :func:`fkopt.files.check_component`)."""
+    if value is None:
+        return value
+    try:
+        return check_component(value, field)
+    except FkoptError as err:
+        raise ValueError(str(err).split(": ", 1)[1]) from None
 
 
 class MechanismSpec(Strict):
@@ -66,8 +90,8 @@ class CaseSpec(Strict):
 
 
 class RandomCases(Strict):
-    random: int = Field(ge=1, description="number of random cases")
-    seed: int = 0
+    random: int = Field(ge=1, le=MAX_CASES, description="number of random cases")
+    seed: int = Seed()
 
 
 class AlgorithmSpec(Strict):
@@ -75,8 +99,8 @@ class AlgorithmSpec(Strict):
     label: str | None = None
     params: dict[str, Any] = Field(default_factory=dict)
     #: Overrides the experiment's population (number of starts for the local methods nr/lm, >= 1).
-    population: int | None = Field(None, ge=1)
-    iterations: int | None = Field(None, ge=1)
+    population: int | None = Field(None, ge=1, le=MAX_POPULATION)
+    iterations: int | None = Field(None, ge=1, le=MAX_ITERATIONS)
     #: Start point of local methods (nr, lm): {variable: value}.
     start: dict[str, float] | None = None
     #: The paper's printed statistics for this algorithm (mean_fitness, std_fitness, time_ms, ...).
@@ -97,7 +121,7 @@ def unique_labels(algos):
 
 
 class ExperimentConfig(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str
     paper: str | None = None
     title: str = ""
     description: str = ""
@@ -105,10 +129,10 @@ class ExperimentConfig(Strict):
     objective: str | None = None
     cases: list[CaseSpec] | RandomCases
     algorithms: list[AlgorithmSpec] = Field(min_length=1)
-    population: int = Field(10, ge=2)
-    iterations: int = Field(100, ge=1)
-    runs: int = Field(30, ge=1)
-    seed: int = 0
+    population: int = Field(10, ge=2, le=MAX_POPULATION)
+    iterations: int = Field(100, ge=1, le=MAX_ITERATIONS)
+    runs: int = Field(30, ge=1, le=MAX_RUNS)
+    seed: int = Seed()
     threshold: float | None = Field(None, gt=0)
     stop_at_threshold: bool = False
     batch: bool = True
@@ -127,6 +151,23 @@ class ExperimentConfig(Strict):
     def _unique_labels(cls, algos):
         return unique_labels(algos)
 
+    @field_validator("name", "paper")
+    @classmethod
+    def _component(cls, value, info):
+        return safe_component(value, info.field_name)
+
+    @field_validator("cases")
+    @classmethod
+    def _some_cases(cls, cases):
+        if isinstance(cases, list) and not 1 <= len(cases) <= MAX_CASES:
+            raise ValueError(f"needs 1 to {MAX_CASES} cases, got {len(cases)}")
+        return cases
+
+    @property
+    def folder_parts(self) -> tuple[str, str]:
+        """``(paper, name)``: the results folder is ``OUT/<paper>/<name>/``."""
+        return (self.paper or "experiments", self.name)
+
     @model_validator(mode="after")
     def _stop_needs_threshold(self):
         if self.stop_at_threshold and self.threshold is None:
@@ -134,33 +175,34 @@ class ExperimentConfig(Strict):
         return self
 
 
-def _one_line(err: ValidationError) -> str:
-    first = err.errors()[0]
-    loc = ".".join(str(p) for p in first["loc"] if not str(p).startswith(("function-", "list[", "RandomCases")))
-    msg = first["msg"].removeprefix("Value error, ")
-    if first["type"] == "extra_forbidden":
-        msg = "unknown field"
-    return f"{loc}: {msg}" if loc else msg
+#: Fields that never change the numbers: a stored result made from a config differing only
+#: in these may be replaced without ``--force`` (and a resumed study may differ in them).
+NOT_NUMERIC = ("title", "description", "printed", "check")
+
+
+def numeric_fields(config: dict) -> dict:
+    """The result-changing part of a config mapping (``model_dump(mode="json")``)."""
+    data = {k: v for k, v in config.items() if k not in NOT_NUMERIC}
+    for key in ("algorithms", "cases"):
+        if isinstance(data.get(key), list):
+            data[key] = [{k: v for k, v in a.items() if k != "printed"} if isinstance(a, dict) else a
+                         for a in data[key]]
+    return data
+
+
+
+def _one_line(err: ValidationError, data: dict | None = None) -> str:
+    return error_line(err, data=data)
+
+
+def experiment_from_dict(data: dict, where: str) -> ExperimentConfig:
+    try:
+        return ExperimentConfig(**data)
+    except ValidationError as err:
+        raise FkoptError(f"{where}: {error_line(err, data=data)}") from None
 
 
 def load_config(path: str | Path) -> ExperimentConfig:
     """Read and validate an experiment file; errors name the file, line or field."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as err:
-        raise FkoptError(f"{path}: cannot read ({err.strerror})") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.MarkedYAMLError as err:
-        mark = err.problem_mark
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "?"
-        raise FkoptError(f"{path}: malformed YAML at {where}: {err.problem}") from None
-    except yaml.YAMLError as err:
-        raise FkoptError(f"{path}: malformed YAML: {err}") from None
-    if not isinstance(data, dict):
-        raise FkoptError(f"{path}: expected a mapping of experiment fields at the top level")
-    try:
-        return ExperimentConfig(**data)
-    except ValidationError as err:
-        raise FkoptError(f"{path}: {_one_line(err)}") from None
+    data = load_mapping(path, "experiment fields")
+    return experiment_from_dict(data, str(path))

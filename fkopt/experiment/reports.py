@@ -17,25 +17,26 @@ the figures drawn from timings, ``cases_time.png``):
 * optional figures (``figures:`` in the config): ``variables.png``, ``snapshot_<t>.png``,
   ``extras.png``, ``cases.png`` + ``cases_time.png`` (+ ``cases_position_error.png`` for
   serial arms), ``position_error.png``;
-* ``meta.json``       config, seeds, fkopt/library versions, platform.
+* ``meta.json``       what the config and the seed fix: config, seeds (per case and algorithm),
+  mechanism, objective, and the SHA-256 of every deterministic CSV (``files``);
+* ``env.json``        where it ran: fkopt and library versions, platform, the platform fingerprint
+  (:mod:`fkopt.provenance`); like ``timing.csv`` it changes with the machine.
 
-A folder is written into a temporary sibling first and renamed into place, so a failed or
-interrupted run never leaves a half-written results folder.
+A folder is written into a temporary sibling first and swapped into place
+(:func:`fkopt.files.write_atomically`), so a failed or interrupted run never leaves a
+half-written results folder and never loses the previous one.
 """
 from __future__ import annotations
 
-import json
-import os
-import platform
-import shutil
-import sys
-import tempfile
-from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ..compare import file_digests
+from ..files import nanmedian as _nanmedian
+from ..files import output_folder, write_atomically, write_json
+from ..provenance import ENV_FILE, LIBRARIES, environment, library_versions  # noqa: F401 (re-exported)
 from .runner import ExperimentResult, pose_error
 
 FLOAT = "%.10g"
@@ -43,13 +44,6 @@ FLOAT = "%.10g"
 LOG_FLOOR = 1e-32
 #: Beyond this many cases, convergence curves are pooled over all (case, run) pairs.
 MAX_CASE_CURVES = 6
-LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich")
-
-
-def _nanmedian(a) -> float:
-    a = np.asarray(a, dtype=float)
-    return float(np.median(a[~np.isnan(a)])) if np.any(~np.isnan(a)) else float("nan")
-
 
 # -- tables ------------------------------------------------------------------------------------
 def summary_table(er: ExperimentResult) -> pd.DataFrame:
@@ -385,18 +379,8 @@ def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, tim
 
 
 # -- folder --------------------------------------------------------------------------------------
-def library_versions() -> dict[str, str]:
-    out = {"python": sys.version.split()[0]}
-    for lib in LIBRARIES:
-        try:
-            out[lib] = version(lib)
-        except PackageNotFoundError:
-            pass
-    return out
-
-
 def meta(er: ExperimentResult) -> dict:
-    from .. import __version__
+    """What the config and the seed fix (nothing about the machine: that is :func:`environment`)."""
     return {
         "experiment": er.config.name, "paper": er.config.paper, "title": er.config.title,
         "config_file": er.source, "config": er.config.model_dump(mode="json"),
@@ -404,14 +388,20 @@ def meta(er: ExperimentResult) -> dict:
         "task_seeds": [{"case": r.case.label, "algorithm": r.spec.key, "seed": r.seed} for r in er.records],
         "mechanism": er.mechanism.describe(),
         "objective": getattr(er.records[0].problem, "objective", None),
-        "fkopt_version": __version__, "libraries": library_versions(),
-        "platform": {"system": platform.system(), "machine": platform.machine(),
-                     "python_implementation": platform.python_implementation()},
     }
 
 
-def write_tables(er: ExperimentResult, folder: Path) -> list[str]:
-    """Write every file of the experiment into ``folder`` (which must exist); returns the names."""
+def write_meta(folder: Path, data: dict) -> None:
+    """``meta.json`` (with the digests of the CSVs already in ``folder``) and ``env.json``."""
+    write_json(folder / "meta.json", {**data, "files": file_digests(folder)})
+    write_json(folder / ENV_FILE, environment())
+
+
+def write_tables(er: ExperimentResult, folder: Path, figures: bool = True) -> list[str]:
+    """Write every file of the experiment into ``folder`` (which must exist); returns the names.
+
+    ``figures=False`` writes only the tables and meta.json (what ``fkopt check`` compares).
+    """
     folder = Path(folder)
     written = []
 
@@ -427,6 +417,15 @@ def write_tables(er: ExperimentResult, folder: Path) -> list[str]:
     csv("inputs.csv", inputs_table(er))
     csv("runs.csv", runs_table(er))
     csv("convergence.csv", convergence_table(er))
+    if figures:
+        written += write_figures(er, folder, summary, timing)
+    write_meta(folder, meta(er))
+    written += ["meta.json", ENV_FILE]
+    return written
+
+
+def write_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, timing: pd.DataFrame) -> list[str]:
+    written = []
     convergence_figure(er, folder / "convergence.png")
     written.append("convergence.png")
     figs = set(er.config.figures)
@@ -441,40 +440,15 @@ def write_tables(er: ExperimentResult, folder: Path) -> list[str]:
         written += cases_figures(er, folder, summary, timing)
     if er.mechanism.kind == "serial" and position_error_figure(er, folder / "position_error.png"):
         written.append("position_error.png")
-    (folder / "meta.json").write_text(json.dumps(meta(er), indent=2, sort_keys=True, default=float) + "\n")
-    written.append("meta.json")
     return written
 
 
 def experiment_folder(out: Path, er_or_config) -> Path:
+    """``OUT/<paper>/<name>``, checked (safe names, inside OUT, writable) before any computation."""
     config = getattr(er_or_config, "config", er_or_config)
-    return Path(out) / (config.paper or "experiments") / config.name
-
-
-def write_atomically(final: Path, write) -> Path:
-    """Call ``write(tmp)`` on a temporary sibling folder of ``final``, then rename it into place.
-
-    A failed or interrupted write leaves ``final`` as it was (old results or nothing), never
-    half-written.
-    """
-    final = Path(final)
-    final.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
-    try:
-        write(tmp)
-        if final.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{final.name}.old.", dir=final.parent))
-            os.replace(final, old / "x")
-            os.replace(tmp, final)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, final)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return final
+    return output_folder(out, *config.folder_parts)
 
 
 def write_experiment(er: ExperimentResult, out: Path) -> Path:
-    """Write the experiment's folder atomically (see :func:`write_atomically`)."""
+    """Write the experiment's folder aside, then swap it into place (:func:`write_atomically`)."""
     return write_atomically(experiment_folder(out, er), lambda tmp: write_tables(er, tmp))

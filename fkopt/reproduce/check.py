@@ -1,152 +1,110 @@
-"""Regression check: rerun stored experiments from their recorded config and compare.
+"""Regression check: rerun stored results from their recorded config and compare (``fkopt check``).
 
-Comparison rules (documented tolerances that survive another machine's floating point):
+One checker for every kind of config (experiments, studies, assembly searches). For each
+results folder ``<paper>/<name>/``:
 
-* exact-by-construction numbers -- ``inputs.csv`` (inverse maps of printed poses), the
-  ``target``/reference columns of ``values.csv``, counts (population, iterations, runs) and the
-  printed values -- must agree to 1e-9 (relative) or exactly;
-* results of the local exact methods (``nr``, ``lm``) are compared like swarm statistics below,
-  because where they converge they converge to the same point: the values differ in the last bits
-  at most;
-* swarm statistics of ``summary.csv``: fitness columns in log10, both values below
-  ``FITNESS_FLOOR`` count as equal (the noise floor of double precision), otherwise
-  |log10 a - log10 b| <= ``LOG10_TOL`` decades; success rates within ``RATE_TOL``; medians of
-  iterations/evaluations to the threshold within ``COUNT_RTOL`` (relative);
-* ``values.csv`` median-run values within max(1e-6 * scale, 10 x the stored mean absolute error);
-* single runs (``runs.csv``) and curves are not compared (medians, not single runs), and
-  timing columns never are.
+1. ``meta.json`` must exist and be readable, with the config; a missing or unreadable
+   ``meta.json`` is a failure (never skipped);
+2. every deterministic file must still have the SHA-256 recorded in ``meta.json`` when it was
+   written (``files``), and no recorded file may be missing -- any edit of any stored table is
+   caught, on any platform;
+3. the config is validated and rerun in this process into a scratch folder; the deterministic
+   files (all CSVs but the timing files, and ``meta.json``) are compared **byte for byte** when
+   the platform fingerprint stored in ``env.json`` equals this machine's, and by the documented
+   distribution-level tolerances of :mod:`fkopt.compare` otherwise.
 
-A mismatch names the experiment, the file, the row, the column and both values.
+A mismatch names the experiment, the file, the row, the column and both values. Figures are
+not compared (they depend on the plotting library's version).
 """
 from __future__ import annotations
 
-import math
+import json
 import shutil
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
 
-import pandas as pd
-
-from ..experiment.config import ExperimentConfig
-from ..experiment.reports import write_tables
-from ..experiment.runner import run_experiment
+from ..compare import (FITNESS_FLOOR, LOG10_TOL, RATE_TOL, COUNT_RTOL, EXACT_RTOL, Mismatch,  # noqa: F401
+                       compare_folders, compare_tables, deterministic_files, sha256)
+from ..errors import FkoptError
+from ..experiment.kinds import from_dict, rerun_files
+from ..provenance import ENV_FILE, fingerprint
 from .store import Experiment, Store
 
-FITNESS_FLOOR = 1e-20
-LOG10_TOL = 1.0
-RATE_TOL = 0.1
-COUNT_RTOL = 0.25
-EXACT_RTOL = 1e-9
-
-FITNESS_COLS = ("mean_fitness", "std_fitness", "best_fitness", "worst_fitness", "median_fitness")
-RATE_COLS = ("success_rate",)
-COUNT_COLS = ("median_iterations_to_threshold", "median_evaluations_to_threshold", "mean_evaluations")
-KEY_COLS = ("case", "algorithm", "variable", "joint")
+#: Compared first (so the first mismatch is the most telling), then the rest, meta.json last.
+FIRST = ("summary.csv", "values.csv", "inputs.csv")
 
 
-@dataclass
-class Mismatch:
-    experiment: str
-    file: str
-    row: str
-    column: str
-    stored: object
-    rerun: object
-    rule: str
-
-    def __str__(self) -> str:
-        return (f"{self.experiment}: {self.file} [{self.row}] column '{self.column}': stored {self.stored!r}, "
-                f"rerun {self.rerun!r} ({self.rule})")
+def _label(exp: Experiment) -> str:
+    return f"{exp.paper}/{exp.name}"
 
 
-def _close_fitness(a: float, b: float) -> bool:
-    if math.isnan(a) or math.isnan(b):
-        return math.isnan(a) and math.isnan(b)
-    if a < FITNESS_FLOOR and b < FITNESS_FLOOR:
-        return True
-    return abs(math.log10(max(a, 1e-300)) - math.log10(max(b, 1e-300))) <= LOG10_TOL
-
-
-def _close_rel(a: float, b: float, rtol: float, atol: float = 0.0) -> bool:
-    if isinstance(a, str) or isinstance(b, str):
-        return a == b
-    if math.isnan(a) or math.isnan(b):
-        return math.isnan(a) and math.isnan(b)
-    return abs(a - b) <= atol + rtol * max(abs(a), abs(b))
-
-
-def compare_tables(name: str, file: str, stored: pd.DataFrame, rerun: pd.DataFrame) -> list[Mismatch]:
-    out: list[Mismatch] = []
-    if list(stored.columns) != list(rerun.columns) or len(stored) != len(rerun):
-        return [Mismatch(name, file, "-", "shape", f"{len(stored)} rows {list(stored.columns)}",
-                         f"{len(rerun)} rows {list(rerun.columns)}", "same rows and columns")]
-    keys = [k for k in KEY_COLS if k in stored.columns]
-    for i in range(len(stored)):
-        s, r = stored.iloc[i], rerun.iloc[i]
-        row = " / ".join(str(s[k]) for k in keys) or str(i)
-        for col in stored.columns:
-            a, b = s[col], r[col]
-            if col in keys:
-                ok, rule = a == b, "identical"
-            elif col.endswith("_ms") or col in ("total_s",):
-                continue
-            elif col in FITNESS_COLS:
-                ok, rule = _close_fitness(float(a), float(b)), f"log10 within {LOG10_TOL}, floor {FITNESS_FLOOR:g}"
-            elif col in RATE_COLS:
-                ok, rule = _close_rel(float(a), float(b), 0, RATE_TOL), f"within {RATE_TOL}"
-            elif col in COUNT_COLS:
-                ok, rule = _close_rel(float(a), float(b), COUNT_RTOL), f"relative {COUNT_RTOL}"
-            elif file == "values.csv" and col in ("median_run_value", "best_run_value") or col.startswith("median_run_error_vs"):
-                tol = max(1e-6 * max(1.0, abs(float(b))), 10 * float(s.get("mean_abs_error", 0) or 0))
-                ok, rule = _close_rel(float(a), float(b), 0, tol), f"within {tol:.3g}"
-            elif file == "values.csv" and col.endswith("_error") or col in ("median_run", "mean_abs_error"):
-                continue   # errors of single runs follow from the values compared above
-            elif pd.api.types.is_number(a) and pd.api.types.is_number(b):
-                ok, rule = _close_rel(float(a), float(b), EXACT_RTOL, 1e-12), f"exact to {EXACT_RTOL:g}"
-            else:
-                ok, rule = (str(a) == str(b)) or (pd.isna(a) and pd.isna(b)), "identical"
-            if not ok:
-                out.append(Mismatch(name, file, row, col, _py(a), _py(b), rule))
+def integrity(exp: Experiment) -> list[Mismatch]:
+    """Stored files against the digests recorded in meta.json."""
+    label = _label(exp)
+    recorded = exp.meta.get("files")
+    if not isinstance(recorded, dict):
+        return [Mismatch(label, "meta.json", "-", "files", "no file digests", "digests",
+                         "meta.json records the SHA-256 of every table (regenerate the result)")]
+    out = []
+    for name in sorted(set(recorded) | set(n for n in deterministic_files(exp.folder) if n != "meta.json")):
+        path = exp.folder / name
+        if name not in recorded:
+            out.append(Mismatch(label, name, "-", "file", "present", "not recorded in meta.json", "recorded"))
+        elif not path.is_file():
+            out.append(Mismatch(label, name, "-", "file", "missing", "recorded in meta.json", "present"))
+        else:
+            digest = sha256(path)
+            if digest != recorded[name]:
+                out.append(Mismatch(label, name, "-", "sha256", digest[:16], str(recorded[name])[:16],
+                                    "unchanged since written (SHA-256 in meta.json)"))
     return out
 
 
-def _py(v):
-    return v.item() if hasattr(v, "item") else v
+def same_platform(exp: Experiment) -> bool:
+    """Does the fingerprint in the stored env.json equal this machine's?"""
+    try:
+        stored = json.loads((exp.folder / ENV_FILE).read_text(encoding="utf-8")).get("fingerprint")
+    except (OSError, ValueError, AttributeError):
+        return False
+    return stored == fingerprint()
 
 
-COMPARED = ("summary.csv", "values.csv", "inputs.csv")
+def check_experiment(exp: Experiment, config=None, exact: bool | None = None) -> list[Mismatch]:
+    """Mismatches of one stored result (any kind) against a rerun; ``[]`` when it matches.
 
-
-def check_experiment(exp: Experiment, config: ExperimentConfig | None = None) -> list[Mismatch]:
-    """Rerun ``exp`` from its recorded (or the given) config and compare the stored tables."""
-    if exp.config.get("kind") == "assembly":  # all assembly modes (fkopt.experiment.assembly)
-        from ..experiment.assembly import check_assembly
-        return check_assembly(exp, config)
-    if exp.config.get("kind") == "study":     # a workspace study (fkopt.study)
-        from ..study.check import check_study
-        return check_study(exp, config)
-    config = config or ExperimentConfig(**exp.config)
-    result = run_experiment(config, source=exp.meta.get("config_file"))
+    ``exact`` forces the byte-for-byte (True) or the tolerant (False) comparison; by default it
+    is chosen by the platform fingerprint.
+    """
+    label = _label(exp)
+    problem = exp.meta_error()
+    if problem:
+        return [Mismatch(label, "meta.json", "-", "file", problem, "a readable meta.json with the config",
+                         "present and readable")]
+    out = integrity(exp)
+    if config is None:
+        try:
+            config = from_dict(dict(exp.config), f"{label}/meta.json config")
+        except FkoptError as err:
+            return out + [Mismatch(label, "meta.json", "-", "config", str(err), "a valid config", "valid")]
+    exact = same_platform(exp) if exact is None else exact
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-check-"))
     try:
-        write_tables(result, tmp)
-        label = f"{exp.paper}/{exp.name}"
-        out: list[Mismatch] = []
-        for file in COMPARED:
-            stored_exists, rerun_exists = exp.has(file), (tmp / file).exists()
-            if stored_exists != rerun_exists:
-                out.append(Mismatch(label, file, "-", "file", stored_exists, rerun_exists, "present in both"))
-            elif stored_exists:
-                out += compare_tables(label, file, exp.table(file), pd.read_csv(tmp / file))
-        return out
+        rerun_files(config, tmp, exp.meta.get("config_file"))
+        names = sorted(set(deterministic_files(exp.folder)) | set(deterministic_files(tmp)))
+        order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
+        order += ["meta.json"]
+        out += compare_folders(label, exp.folder, tmp, exact, files=order)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    return out
 
 
-def select(store: Store, subset: str = "all") -> list[Experiment]:
-    """Experiments to check: ``all``, or ``ci`` (those whose config has ``check: ci``, the default)."""
-    exps = store.experiments()
+def select(store: Store, subset: str = "all", paper: str | None = None, name: str | None = None) -> list[Experiment]:
+    """Results folders to check: ``all``, or ``ci`` (those whose config has ``check: ci``, the
+    default). Folders without a readable meta.json are always selected (and fail)."""
+    exps = store.folders(paper)
+    if name is not None:
+        exps = [e for e in exps if e.name == name]
     if subset == "ci":
-        exps = [e for e in exps if e.config.get("check", "ci") == "ci"]
+        exps = [e for e in exps if e.meta_error() or e.config.get("check", "ci") == "ci"]
     return exps

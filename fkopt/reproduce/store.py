@@ -23,7 +23,20 @@ class Experiment:
 
     @cached_property
     def meta(self) -> dict:
-        return json.loads((self.folder / "meta.json").read_text())
+        data = json.loads((self.folder / "meta.json").read_text(encoding="utf-8"))
+        if not isinstance(data, dict) or not isinstance(data.get("config"), dict):
+            raise ValueError("no 'config' mapping")
+        return data
+
+    def meta_error(self) -> str | None:
+        """Why meta.json cannot be used (missing, unreadable, not JSON, no config), or None."""
+        try:
+            self.meta
+        except FileNotFoundError:
+            return "missing"
+        except (OSError, UnicodeDecodeError, ValueError) as err:
+            return f"unreadable ({type(err).__name__}: {str(err)[:80]})"
+        return None
 
     @property
     def config(self) -> dict:
@@ -65,5 +78,41 @@ class Store:
         folder = self.root / paper / name
         return Experiment(folder) if (folder / "meta.json").exists() else None
 
+    def require_readable(self) -> None:
+        """One-line error unless the root is a folder whose results all have a readable meta.json."""
+        from ..errors import FkoptError
+        if not self.root.is_dir():
+            raise FkoptError(f"{self.root}: no such results folder")
+        exps = self.folders()
+        if not exps:
+            raise FkoptError(f"{self.root}: no stored results (folders <paper>/<name>/ with meta.json)")
+        for e in exps:
+            problem = e.meta_error()
+            if problem and problem != "missing":
+                raise FkoptError(f"{e.folder / 'meta.json'}: {problem}")
+
+    def folders(self, paper: str | None = None) -> list[Experiment]:
+        """Every results folder ``<paper>/<name>/`` holding a file, with or without meta.json
+        (hidden folders -- unfinished or temporary -- are not results)."""
+        papers = [self.root / paper] if paper else sorted(p for p in self.root.iterdir() if p.is_dir())
+        out = []
+        for p in papers:
+            if p.name.startswith(".") or not p.is_dir():
+                continue
+            for f in sorted(p.iterdir()):
+                if f.is_dir() and not f.name.startswith(".") and any(x.is_file() for x in f.iterdir()):
+                    out.append(Experiment(f))
+        return out
+
     def papers(self) -> list[str]:
         return sorted({e.paper for e in self.experiments()})
+
+
+def locate(path: str | Path) -> tuple[Store, str | None, str | None]:
+    """``(store, paper, name)`` for a results root, a paper folder or one experiment folder."""
+    path = Path(path)
+    if (path / "meta.json").exists() or (path / "summary.csv").exists():
+        return Store(path.parent.parent), path.parent.name, path.name
+    if any(path.glob("*/meta.json")) or any(path.glob("*/summary.csv")):
+        return Store(path.parent), path.name, None
+    return Store(path), None, None

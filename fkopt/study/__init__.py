@@ -6,7 +6,7 @@
 * :mod:`.executors`  -- local processes or a Dask cluster;
 * :mod:`.statistics` -- ECDF of evaluations to target, Wilcoxon rank-sum tests with Holm;
 * :mod:`.reports`    -- the files of a study folder;
-* :mod:`.check`      -- rerun a stored study and compare (``fkopt check``).
+* :mod:`.kind`       -- studies as a kind of the one config pipeline (load, run, write, check).
 """
 from .config import StudyConfig, load_any, load_study, study_from_dict
 from .runner import StudyResult, run_study

@@ -62,15 +62,14 @@ import json
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
-from ..experiment.config import AlgorithmSpec, MechanismSpec, Strict, _one_line, unique_labels
+from ..experiment.config import (MAX_CASES, MAX_ITERATIONS, MAX_POPULATION, MAX_RUNS, NOT_NUMERIC,  # noqa: F401
+                                 AlgorithmSpec, MechanismSpec, Seed, Strict, safe_component, unique_labels)
+from ..files import error_line, load_mapping
 
 KIND = "study"
-#: Fields that never change the numbers (left out of the resume fingerprint).
-NOT_NUMERIC = ("title", "description", "printed", "check")
 
 
 class StudyAlgorithmSpec(AlgorithmSpec):
@@ -81,8 +80,8 @@ class StudyAlgorithmSpec(AlgorithmSpec):
 
 
 class UniformPoses(Strict):
-    uniform: int = Field(ge=1, description="number of poses uniform in the bounds")
-    seed: int = 0
+    uniform: int = Field(ge=1, le=MAX_CASES, description="number of poses uniform in the bounds")
+    seed: int = Seed()
 
 
 class GridPoses(Strict):
@@ -93,16 +92,21 @@ class GridPoses(Strict):
     @classmethod
     def _points(cls, grid):
         for name, (lo, hi, n) in grid.items():
-            if n < 1:
-                raise ValueError(f"grid.{name}: needs at least 1 point, got {n}")
+            if not 1 <= n <= MAX_CASES:
+                raise ValueError(f"grid.{name}: needs 1 to {MAX_CASES} points, got {n}")
             if n > 1 and not lo < hi:
                 raise ValueError(f"grid.{name}: lower {lo:g} must be below upper {hi:g}")
+        total = 1
+        for _, _, n in grid.values():
+            total *= n
+        if total > MAX_CASES:
+            raise ValueError(f"the grid has {total} points, more than the {MAX_CASES} allowed")
         return grid
 
 
 class WaypointPoses(Strict):
     waypoints: list[dict[str, float]] = Field(min_length=2)
-    points: int = Field(ge=2, description="poses along the polyline, both ends included")
+    points: int = Field(ge=2, le=MAX_CASES, description="poses along the polyline, both ends included")
 
 
 class CircleSpec(Strict):
@@ -120,7 +124,7 @@ class CircleSpec(Strict):
 
 class CirclePoses(Strict):
     circle: CircleSpec
-    points: int = Field(ge=3, description="poses on the closed circle")
+    points: int = Field(ge=3, le=MAX_CASES, description="poses on the closed circle")
 
 
 PoseSet = UniformPoses | GridPoses | WaypointPoses | CirclePoses
@@ -134,7 +138,7 @@ class TrackingSpec(Strict):
 
 class StudyConfig(Strict):
     kind: Literal["study"]
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str
     paper: str = "studies"
     title: str = ""
     description: str = ""
@@ -142,10 +146,10 @@ class StudyConfig(Strict):
     objective: str | None = None
     poses: PoseSet
     algorithms: list[StudyAlgorithmSpec] = Field(min_length=1)
-    population: int = Field(10, ge=2)
-    iterations: int = Field(100, ge=1)
-    runs: int = Field(5, ge=1)
-    seed: int = 0
+    population: int = Field(10, ge=2, le=MAX_POPULATION)
+    iterations: int = Field(100, ge=1, le=MAX_ITERATIONS)
+    runs: int = Field(5, ge=1, le=MAX_RUNS)
+    seed: int = Seed()
     threshold: float = Field(1e-10, gt=0)
     stop_at_threshold: bool = False
     chunk: int = Field(20, ge=1, description="poses per task (independent mode)")
@@ -162,6 +166,15 @@ class StudyConfig(Strict):
     def _unique_labels(cls, algos):
         return unique_labels(algos)
 
+    @field_validator("name", "paper")
+    @classmethod
+    def _component(cls, value, info):
+        return safe_component(value, info.field_name)
+
+    @property
+    def folder_parts(self) -> tuple[str, str]:
+        return (self.paper, self.name)
+
     @model_validator(mode="after")
     def _mode(self):
         if self.mode == "tracking" and isinstance(self.poses, (UniformPoses, GridPoses)):
@@ -175,21 +188,6 @@ class StudyConfig(Strict):
         data["algorithms"] = [{k: v for k, v in a.items() if k != "printed"} for a in data["algorithms"]]
         text = json.dumps(data, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-def _read_yaml(path: Path) -> Any:
-    try:
-        text = path.read_text()
-    except OSError as err:
-        raise FkoptError(f"{path}: cannot read ({err.strerror})") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.MarkedYAMLError as err:
-        mark = err.problem_mark
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "?"
-        raise FkoptError(f"{path}: malformed YAML at {where}: {err.problem}") from None
-    except yaml.YAMLError as err:
-        raise FkoptError(f"{path}: malformed YAML: {err}") from None
 
 
 def _pose_set_error(data: dict) -> str | None:
@@ -217,51 +215,21 @@ def study_from_dict(data: dict, where: str = "study") -> StudyConfig:
         raise FkoptError(f"{where}: {_study_error(err, data)}") from None
 
 
+POSE_BRANCHES = {"poses": {"uniform": "UniformPoses", "grid": "GridPoses", "waypoints": "WaypointPoses",
+                            "circle": "CirclePoses"}}
+
+
 def _study_error(err: ValidationError, data: dict) -> str:
     """One line; a union of pose sets reports the branch the user meant (by its key)."""
-    errors = err.errors()
-    poses = data.get("poses") if isinstance(data.get("poses"), dict) else {}
-    branch = {"uniform": "UniformPoses", "grid": "GridPoses", "waypoints": "WaypointPoses",
-              "circle": "CirclePoses"}
-    wanted = next((v for k, v in branch.items() if k in poses), None)
-    for e in errors:
-        loc = [str(p) for p in e["loc"]]
-        if loc and loc[0] == "poses" and wanted and len(loc) > 1 and loc[1] != wanted:
-            continue
-        loc = [p for p in loc if p not in branch.values() and not p.startswith(("function-", "list[", "literal["))]
-        msg = e["msg"].removeprefix("Value error, ")
-        if e["type"] == "extra_forbidden":
-            msg = "unknown field"
-        return f"{'.'.join(loc)}: {msg}" if loc else msg
-    return _one_line(err)
+    return error_line(err, POSE_BRANCHES, data)
 
 
 def load_study(path: str | Path) -> StudyConfig:
     """Read and validate a study file (``kind: study``)."""
-    path = Path(path)
-    data = _read_yaml(path)
-    if not isinstance(data, dict):
-        raise FkoptError(f"{path}: expected a mapping of study fields at the top level")
-    return study_from_dict(data, str(path))
-
-
-def is_study_file(path: str | Path) -> bool:
-    """Does the file declare ``kind: <anything>``? (Experiments have no ``kind``.)"""
-    data = _read_yaml(Path(path))
-    return isinstance(data, dict) and "kind" in data
+    return study_from_dict(load_mapping(path, "study fields"), str(path))
 
 
 def load_any(path: str | Path):
-    """An :class:`ExperimentConfig` or a :class:`StudyConfig`, by the file's ``kind``."""
-    from ..experiment.config import load_config
-    path = Path(path)
-    data = _read_yaml(path)
-    if isinstance(data, dict) and "kind" in data:
-        from ..experiment.assembly import KIND as ASSEMBLY, assembly_from_dict
-        if data["kind"] == ASSEMBLY:
-            return assembly_from_dict(data, str(path))
-        if data["kind"] != KIND:
-            raise FkoptError(f"{path}: kind: '{data['kind']}' unknown; allowed: {KIND}, {ASSEMBLY} "
-                             "(an experiment file has no kind)")
-        return study_from_dict(data, str(path))
-    return load_config(path)
+    """An experiment, study or assembly config, by the file's ``kind`` (:mod:`fkopt.experiment.kinds`)."""
+    from ..experiment.kinds import load_any as load
+    return load(path)

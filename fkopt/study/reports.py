@@ -17,31 +17,26 @@ Deterministic for a given config (whatever the executor, the number of jobs or a
   success rate per grid point and algorithm;
 * ``tracking.csv`` + ``tracking.png``  (tracking mode) per step and algorithm: median fitness,
   success rate, evaluations, largest error, whether the step was warm-started;
-* ``meta.json``    config, seed, seed rule, mechanism, versions (written last).
+* ``meta.json``    config, seed, seed rule, mechanism, digests of the CSVs (written last);
+  ``env.json`` -- versions and platform (:mod:`fkopt.provenance`), like the timing files.
 
 Measured in seconds (change on every run): ``timing.csv`` (per algorithm, time per run) and,
 in tracking mode, ``tracking_timing.csv`` + ``tracking_time.png`` (time per step).
 """
 from __future__ import annotations
 
-import json
-import os
-import platform
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..experiment.reports import FLOAT, LOG_FLOOR, _plt, _save, library_versions
-from .runner import StudyResult
+from ..experiment.reports import FLOAT, LOG_FLOOR, _plt, _save, write_meta
+from ..files import nanmedian as _nanmedian
+from ..files import write_file_atomically
+from ..provenance import ENV_FILE
 from .statistics import ecdf_table, pairwise_tests
 
-
-def _nanmedian(a) -> float:
-    a = np.asarray(a, dtype=float)
-    ok = ~np.isnan(a)
-    return float(np.median(a[ok])) if ok.any() else float("nan")
+# StudyResult (fkopt.study.runner) is only named in annotations: the runner imports this module.
 
 
 def case_label(sr: StudyResult) -> str:
@@ -301,11 +296,12 @@ def tracking_time_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> No
 
 # -- folder --------------------------------------------------------------------------------------
 def meta(sr: StudyResult) -> dict:
-    from .. import __version__
+    """What the config and the seed fix (the environment goes to env.json)."""
     objective = sr.config.objective
     if objective is None:
-        from .runner import make_problem
-        objective = getattr(make_problem(sr.config, sr.mechanism, sr.poses.inputs[0]), "objective", None)
+        from ..problems import fk_problem, ik_problem
+        make = ik_problem if sr.mechanism.kind == "serial" else fk_problem
+        objective = getattr(make(sr.mechanism, sr.poses.inputs[0]), "objective", None)
     return {
         "kind": "study", "experiment": sr.config.name, "paper": sr.config.paper, "title": sr.config.title,
         "config_file": sr.source, "config": sr.config.model_dump(mode="json"), "seed": sr.config.seed,
@@ -313,21 +309,11 @@ def meta(sr: StudyResult) -> dict:
                       "run k: child k of that seed (fkopt.streams)",
         "fingerprint": sr.config.fingerprint(), "poses": len(sr.poses),
         "mechanism": sr.mechanism.describe(), "objective": objective,
-        "fkopt_version": __version__, "libraries": library_versions(),
-        "platform": {"system": platform.system(), "machine": platform.machine(),
-                     "python_implementation": platform.python_implementation()},
     }
 
 
 def _atomic(folder: Path, name: str, write) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=Path(name).suffix, dir=folder)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.replace(tmp, folder / name)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_file_atomically(folder / name, write)
 
 
 def write_tables(sr: StudyResult, folder: Path, figures: bool = True) -> list[str]:
@@ -364,12 +350,12 @@ def write_tables(sr: StudyResult, folder: Path, figures: bool = True) -> list[st
         ttime = tracking_timing_table(sr)
         csv("tracking_timing.csv", ttime)
         fig("tracking_time.png", tracking_time_figure, ttime)
-    text = json.dumps(meta(sr), indent=2, sort_keys=True, default=float) + "\n"
-    _atomic(folder, "meta.json", lambda p: p.write_text(text))
-    written.append("meta.json")
+    write_meta(folder, meta(sr))
+    written += ["meta.json", ENV_FILE]
     return written
 
 
 def write_study(sr: StudyResult, folder: Path) -> list[str]:
+    """Write into ``folder`` in place (the runner writes aside and swaps instead)."""
     folder.mkdir(parents=True, exist_ok=True)
     return write_tables(sr, folder)

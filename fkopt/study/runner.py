@@ -5,14 +5,18 @@
   another process or on a Dask worker) and returns plain lists; the seeds come from
   :func:`fkopt.experiment.runner.task_seed` per pose (or step), so a task's numbers do not
   depend on where, when or next to what it ran.
-* Every finished task is written at once as ``OUT/<paper>/<name>/tasks/<task id>.json``
-  (a temporary file renamed into place, so a file is either complete or absent). An
-  interrupted study therefore loses at most the tasks that were running; ``resume=True``
-  (``fkopt study --resume``) keeps every task file whose config fingerprint matches and runs
-  only the others. Without ``resume`` the folder is started afresh.
-* When every task is there, :func:`merge` reads them back into a :class:`StudyResult` and
-  :mod:`fkopt.study.reports` writes the tables and figures; ``meta.json`` is written last, so a
-  folder with ``meta.json`` is a finished study (``tasks/`` stays, for a later ``--resume``).
+* An unfinished run works in the hidden sibling ``OUT/<paper>/.<name>.partial/`` (see
+  :func:`work_folder`); the previous result ``OUT/<paper>/<name>/`` is not touched until the new
+  one is complete. Every finished task is written at once as ``tasks/<task id>.json`` there (a
+  temporary file renamed into place, so a file is either complete or absent). An interrupted
+  study therefore loses at most the tasks that were running; ``resume=True``
+  (``fkopt study --resume``) keeps every task file whose config fingerprint matches (from the
+  unfinished run, or else from the finished folder's ``tasks/``) and runs only the others.
+  Without ``resume`` the unfinished run is started afresh.
+* When every task is there, :func:`merge` reads them back into a :class:`StudyResult`;
+  :mod:`fkopt.study.reports` writes the tables and figures into a temporary folder, the task
+  files move into its ``tasks/`` (unless ``keep_tasks=False``), and the folder is swapped into
+  place (:func:`fkopt.files.write_atomically`); then the ``.partial`` folder is removed.
 """
 from __future__ import annotations
 
@@ -20,7 +24,6 @@ import json
 import os
 import re
 import shutil
-import tempfile
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -30,6 +33,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import FkoptError
+from ..files import output_folder, write_atomically, write_json_atomically
 from ..experiment.runner import build_mechanism, task_seed
 from ..problems import fk_problem
 from ..solve import make_algorithm, solve
@@ -226,19 +230,7 @@ def _stack(parts) -> _Stacked:
 # -- task files ----------------------------------------------------------------------------------
 def write_json_atomic(path: Path, data: dict) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder and os.replace."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh, separators=(",", ":"))
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    write_json_atomically(path, data, separators=(",", ":"))
 
 
 def read_task_files(folder: Path, fingerprint: str) -> dict[str, dict]:
@@ -343,25 +335,29 @@ def study_folder(out: str | Path, config: StudyConfig) -> Path:
     return Path(out) / config.paper / config.name
 
 
-def _prepare(folder: Path, config: StudyConfig, resume: bool) -> None:
-    study_file = folder / TASKS / STUDY_FILE
+def work_folder(out: str | Path, config: StudyConfig) -> Path:
+    """Where an unfinished run keeps its task files: ``OUT/<paper>/.<name>.partial/``."""
+    return Path(out) / config.paper / f".{config.name}.partial"
+
+
+def _prepare(final: Path, work: Path, config: StudyConfig, resume: bool) -> None:
+    study_file = work / TASKS / STUDY_FILE
+    if not resume:
+        shutil.rmtree(work, ignore_errors=True)
+    elif not work.exists() and (final / TASKS).is_dir():
+        # resume a finished study: start from a copy of its task files (the folder stays as it is)
+        (work / TASKS).mkdir(parents=True)
+        for path in (final / TASKS).glob("*.json"):
+            shutil.copy2(path, work / TASKS / path.name)
     if resume and study_file.exists():
         try:
             stored = json.loads(study_file.read_text()).get("fingerprint")
         except (OSError, ValueError):
             stored = None
         if stored not in (None, config.fingerprint()):
-            raise FkoptError(f"--resume: {folder} holds tasks of another version of study '{config.name}' "
+            raise FkoptError(f"--resume: {final} holds tasks of another version of study '{config.name}' "
                              "(its config changed); rerun without --resume to start over")
-    elif not resume and folder.exists():
-        if not ((folder / "meta.json").exists() or (folder / TASKS).exists() or not any(folder.iterdir())):
-            raise FkoptError(f"{folder}: exists and is not a study folder; refusing to overwrite it")
-        shutil.rmtree(folder)
-    (folder / TASKS).mkdir(parents=True, exist_ok=True)
-    try:
-        (folder / "meta.json").unlink()     # the folder is unfinished until the merge writes it
-    except FileNotFoundError:
-        pass
+    (work / TASKS).mkdir(parents=True, exist_ok=True)
     write_json_atomic(study_file, {"name": config.name, "fingerprint": config.fingerprint(),
                                    "config": config.model_dump(mode="json")})
 
@@ -369,27 +365,30 @@ def _prepare(folder: Path, config: StudyConfig, resume: bool) -> None:
 def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
               scheduler: str | None = None, resume: bool = False,
               progress: Callable[[str, int, int], None] | None = None, source: str | None = None,
-              write: bool = True) -> StudyResult:
+              write: bool = True, keep_tasks: bool = True) -> StudyResult:
     """Run (or resume) a study into ``OUT/<paper>/<name>/`` and write its report files.
 
     ``progress(label, done, total)`` is called after each finished task (``done`` counts the
     tasks already on disk too). An exception raised by it (e.g. KeyboardInterrupt) stops the
-    study; every task finished so far stays on disk for ``resume=True``.
+    study; every task finished so far stays in :func:`work_folder` for ``resume=True``, and a
+    previous result stays complete. ``keep_tasks=False`` drops the task files once the study
+    is written (``fkopt reproduce``).
     """
     from .executors import execute, validate_executor
     validate_executor(executor, jobs, scheduler)
     mech, poses = validate_study(config)
-    folder = study_folder(out, config)
+    folder = output_folder(out, *config.folder_parts)   # safe, inside OUT, writable: before any work
+    work = work_folder(out, config)
     t_start = time.perf_counter()
-    _prepare(folder, config, resume)
+    _prepare(folder, work, config, resume)
     fp = config.fingerprint()
-    records = read_task_files(folder, fp) if resume else {}
+    records = read_task_files(work, fp) if resume else {}
     tasks = plan_tasks(config, len(poses))
     pending = [t for t in tasks if t.id not in records]
     computed: list[str] = []
 
     def finished(rec: dict) -> None:
-        write_json_atomic(folder / TASKS / f"{rec['id']}.json", rec)
+        write_json_atomic(work / TASKS / f"{rec['id']}.json", rec)
         records[rec["id"]] = rec
         computed.append(rec["id"])
         if progress:
@@ -408,8 +407,15 @@ def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1
     result = StudyResult(config, mech, poses, merge(config, mech, poses, records),
                          time.perf_counter() - t_start, source, computed, folder)
     if write:
-        from .reports import write_study
-        write_study(result, folder)
+        from .reports import write_tables
+
+        def fill(tmp: Path) -> None:
+            write_tables(result, tmp)
+            if keep_tasks:
+                os.replace(work / TASKS, tmp / TASKS)
+
+        write_atomically(folder, fill)
+        shutil.rmtree(work, ignore_errors=True)
     return result
 
 

@@ -1,0 +1,321 @@
+"""Shared file helpers (floor 0): safe YAML, safe output paths, write-aside-then-swap, error lines.
+
+Every config file, geometry file and results folder of fkopt goes through this module, once:
+
+* :func:`load_yaml` -- the one YAML reader. Refused with a one-line :class:`FkoptError`: files
+  larger than :data:`MAX_YAML_BYTES`, bytes that are not UTF-8, YAML aliases (``*name``; anchors
+  and aliases are refused altogether, so a tiny file cannot expand into gigabytes -- fkopt's
+  configs never need them), duplicate keys (the error names the key and its line), nesting deeper
+  than :data:`MAX_YAML_DEPTH`, and malformed YAML (line and column). Only plain data is built
+  (``yaml.SafeLoader``): no tag ever runs code.
+* :func:`check_component` -- ``paper`` and ``name`` are single safe path components:
+  :data:`COMPONENT_PATTERN` (a letter or digit first, then letters, digits, ``_ . + -``, at most
+  :data:`MAX_COMPONENT` characters), so never ``.``, ``..``, a separator or a hidden name.
+* :func:`output_folder` -- resolves ``OUT/<paper>/<name>`` (symbolic links included) and refuses it
+  unless it lies inside ``OUT``; checks that ``OUT`` is (or can be made) a writable folder, not a
+  file, before any computation starts. Every command that writes (run, study, reproduce, assembly
+  searches, bench, export) calls it first: ``output_folder(out)`` checks the folder itself,
+  ``output_folder(out, "a", "b")`` a folder below it.
+* :func:`write_atomically` -- write a folder aside (a hidden temporary sibling), then swap it into
+  place with one ``renameat2(RENAME_EXCHANGE)`` system call (two renames with signals blocked
+  where that call does not exist). The previous result stays complete until the new one is.
+* :func:`write_file_atomically` -- the same for one file (task files, JSON, CSV).
+* :func:`error_line` -- one line from a pydantic ``ValidationError`` (field path and message).
+* :func:`nanmedian` -- median over the non-NaN values (NaN if there are none).
+"""
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import re
+import shutil
+import signal
+import tempfile
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from .errors import FkoptError
+
+#: Largest config or geometry file read (bytes).
+MAX_YAML_BYTES = 1 << 20
+#: Deepest nesting of YAML collections accepted.
+MAX_YAML_DEPTH = 32
+#: ``paper`` and ``name``: one path component, letter or digit first.
+MAX_COMPONENT = 64
+COMPONENT_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$"
+_COMPONENT = re.compile(COMPONENT_PATTERN)
+
+
+# -- YAML ------------------------------------------------------------------------------------------
+def _loader():
+    import yaml
+
+    class Loader(yaml.SafeLoader):
+        """SafeLoader without aliases, without duplicate keys, with bounded depth."""
+
+        depth = 0
+
+        def compose_node(self, parent, index):
+            if self.check_event(yaml.AliasEvent):
+                event = self.peek_event()
+                raise yaml.composer.ComposerError(None, None, "YAML aliases (*name) are not accepted "
+                                                  "in fkopt files; write the values out", event.start_mark)
+            event = self.peek_event()
+            if getattr(event, "anchor", None):
+                raise yaml.composer.ComposerError(None, None, "YAML anchors (&name) are not accepted "
+                                                  "in fkopt files; write the values out", event.start_mark)
+            self.depth += 1
+            try:
+                if self.depth > MAX_YAML_DEPTH:
+                    raise yaml.composer.ComposerError(None, None, f"nested deeper than {MAX_YAML_DEPTH} "
+                                                      "levels", event.start_mark)
+                return super().compose_node(parent, index)
+            finally:
+                self.depth -= 1
+
+        def construct_mapping(self, node, deep=False):
+            seen = {}
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    hash(key)
+                except TypeError:
+                    raise yaml.constructor.ConstructorError(None, None, "a mapping key must be a plain "
+                                                            "value", key_node.start_mark) from None
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key '{key}' (first at line {seen[key] + 1})",
+                        key_node.start_mark)
+                seen[key] = key_node.start_mark.line
+            return super().construct_mapping(node, deep=deep)
+
+    return Loader
+
+
+def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> str:
+    """The UTF-8 text of a user file, at most ``max_bytes``; every failure is one line."""
+    path = Path(path)
+    try:
+        if path.is_dir():
+            raise FkoptError(f"{path}: is a folder, expected a file")
+        with open(path, "rb") as fh:
+            data = fh.read(max_bytes + 1)
+    except OSError as err:
+        raise FkoptError(f"{path}: cannot read ({err.strerror or err})") from None
+    if len(data) > max_bytes:
+        raise FkoptError(f"{path}: larger than the {max_bytes} bytes accepted for this file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise FkoptError(f"{path}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset {err.start})") from None
+
+
+def load_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
+    """Parse a YAML file with the limits above; errors name the file and the line."""
+    import yaml
+    text = read_text(path, max_bytes)
+    try:
+        return yaml.load(text, Loader=_loader())  # noqa: S506 - a SafeLoader subclass
+    except yaml.MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise FkoptError(f"{path}: malformed YAML{where}: {err.problem or err.context}") from None
+    except yaml.YAMLError as err:
+        raise FkoptError(f"{path}: malformed YAML: {err}") from None
+    except RecursionError:
+        raise FkoptError(f"{path}: nested too deeply") from None
+
+
+def load_mapping(path: str | Path, what: str) -> dict:
+    """A YAML file whose top level must be a mapping (``what`` says of what)."""
+    data = load_yaml(path)
+    if not isinstance(data, dict):
+        raise FkoptError(f"{path}: expected a mapping of {what} at the top level")
+    bad = [k for k in data if not isinstance(k, str)]
+    if bad:
+        raise FkoptError(f"{path}: field names must be text, got {bad[0]!r}")
+    return data
+
+
+# -- pydantic errors -------------------------------------------------------------------------------
+def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dict | None = None) -> str:
+    """One line ``field.path: message`` from a pydantic ``ValidationError``.
+
+    ``branches`` maps a union field to ``{key in the user's mapping: branch tag}``, so that the
+    error of the branch the user meant (by its key) is reported, not the first branch tried.
+    """
+    errors = err.errors()
+    wanted: dict[str, str] = {}
+    tags: set[str] = set()
+    for field, table in (branches or {}).items():
+        tags |= set(table.values())
+        value = (data or {}).get(field)
+        if isinstance(value, dict):
+            hit = next((tag for key, tag in table.items() if key in value), None)
+            if hit:
+                wanted[field] = hit
+    for e in errors:
+        loc = [str(p) for p in e["loc"]]
+        if loc and loc[0] in wanted and len(loc) > 1 and loc[1] in tags and loc[1] != wanted[loc[0]]:
+            continue
+        loc = [p for p in loc if p not in tags and not p.startswith(("function-", "list[", "literal[",
+                                                                      "RandomCases"))]
+        msg = e["msg"].removeprefix("Value error, ")
+        if e["type"] == "extra_forbidden":
+            msg = "unknown field"
+        return f"{'.'.join(loc)}: {msg}" if loc else msg
+    return str(err).splitlines()[0]
+
+
+# -- paths -----------------------------------------------------------------------------------------
+def check_component(value: Any, field: str) -> str:
+    """``value`` as one safe path component, else a one-line error naming ``field``."""
+    if not isinstance(value, str) or not _COMPONENT.match(value):
+        shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
+        raise FkoptError(f"{field}: {shown} is not a single safe folder name: letters, digits and "
+                         f"_ . + - only, a letter or digit first, at most {MAX_COMPONENT} characters")
+    return value
+
+
+def output_folder(out: str | Path, *parts: str, option: str = "--out") -> Path:
+    """``OUT/parts...`` checked before any computation; returns the path (unresolved, for messages).
+
+    Checks: each part is a safe component; ``OUT`` is a folder or can be created as one (not a
+    file); it is writable (a temporary entry is created and removed in the parent of the
+    result); the resolved result (symbolic links included) lies inside the resolved ``OUT``.
+    The parent of the result is created (the result itself is not: writers swap it in).
+    """
+    out = Path(out)
+    for i, part in enumerate(parts):
+        check_component(part, ("paper", "name")[i] if len(parts) == 2 else "name")
+    target = out.joinpath(*parts)
+    if out.exists() and not out.is_dir():
+        raise FkoptError(f"{option}: {out} is a file, not a folder")
+    base = out.resolve()
+    resolved = target.resolve()
+    if resolved != base and base not in resolved.parents:
+        raise FkoptError(f"{option}: {target} resolves to {resolved}, outside {out}; refusing to write there")
+    if target.exists() and not target.is_dir():
+        raise FkoptError(f"{option}: {target} exists and is a file, not a results folder")
+    parent = target.parent if parts else target
+    for p in [parent, *parent.parents]:
+        if p.exists():
+            if not p.is_dir():
+                raise FkoptError(f"{option}: {p} is a file, not a folder")
+            break
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".fkopt-probe-", dir=parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as err:
+        raise FkoptError(f"{option}: cannot write into {parent} ({err.strerror or err})") from None
+    return target
+
+
+# -- atomic writes ---------------------------------------------------------------------------------
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Atomically swap two paths (Linux ``renameat2``); False where unsupported."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        fn = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    if fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    errno = ctypes.get_errno()
+    if errno in (22, 38, 95):      # EINVAL, ENOSYS, EOPNOTSUPP: file system or kernel without it
+        return False
+    raise OSError(errno, os.strerror(errno), str(b))
+
+
+def swap_into_place(new: Path, final: Path) -> None:
+    """Put folder ``new`` at ``final``; a previous ``final`` is removed only after the swap."""
+    if not final.exists():
+        os.replace(new, final)
+        return
+    if _exchange(new, final):
+        shutil.rmtree(new, ignore_errors=True)     # ``new`` now holds the previous result
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{final.name}.old-", dir=final.parent))
+    blocked = {signal.SIGINT, signal.SIGTERM}
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, blocked) if hasattr(signal, "pthread_sigmask") else None
+    try:
+        os.replace(final, old / "x")
+        os.replace(new, final)
+    finally:
+        if mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def write_atomically(final: str | Path, write: Callable[[Path], Any]) -> Path:
+    """Call ``write(tmp)`` on a hidden temporary sibling of ``final``, then swap it into place.
+
+    A failed or interrupted write (exception, Ctrl-C, kill -9) leaves ``final`` as it was (the
+    previous result or nothing); a killed process may leave a hidden ``.<name>.new-*`` folder.
+    """
+    final = Path(final)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.new-", dir=final.parent))
+    try:
+        os.chmod(tmp, 0o777 & ~_umask())      # mkdtemp makes it private; a results folder is not
+        write(tmp)
+        swap_into_place(tmp, final)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return final
+
+
+def write_file_atomically(path: str | Path, write: Callable[[Path], Any]) -> None:
+    """Call ``write(tmp)`` on a temporary file beside ``path``, fsync it, rename it into place."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_json_atomically(path: str | Path, data: Any, **dump) -> None:
+    text = json.dumps(data, **dump)
+    write_file_atomically(path, lambda p: p.write_text(text + ("\n" if dump.get("indent") else "")))
+
+
+def write_json(path: str | Path, data: Any) -> None:
+    """The one JSON layout of results files (sorted keys, indent 2, newline at the end)."""
+    Path(path).write_text(json.dumps(data, indent=2, sort_keys=True, default=float) + "\n")
+
+
+# -- numbers ---------------------------------------------------------------------------------------
+def nanmedian(a) -> float:
+    """Median over the non-NaN values; NaN when there are none (no numpy warning)."""
+    a = np.asarray(a, dtype=float)
+    ok = ~np.isnan(a)
+    return float(np.median(a[ok])) if ok.any() else float("nan")
+
+
+def one_line(text: str, limit: int = 2000) -> str:
+    """``text`` safe to print as one line: control characters escaped, long text cut."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+    return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -1,0 +1,41 @@
+"""Studies as a kind of the one config pipeline (:mod:`fkopt.experiment.kinds`)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..experiment.kinds import Kind, Outcome
+from .config import StudyConfig, study_from_dict
+
+
+def _validate(config: StudyConfig) -> tuple[int, int]:
+    from .runner import plan_tasks, validate_study
+    mech, poses = validate_study(config)
+    dim, n = len(mech.unknown_names), len(poses)
+    work = kept = 0
+    for spec in config.algorithms:
+        pop = spec.population or config.population
+        its = spec.iterations or config.iterations
+        # one solve at a time: its population arrays and per-run histories
+        work = max(work, config.runs * (pop * dim * 12 + (its + 1) * (3 + dim)) * 8)
+        # kept for every (pose, run): fitness, counts, solution, as JSON task records (~10x)
+        kept += n * config.runs * (dim + 6) * 8 * 10
+    return len(plan_tasks(config, n)), work + kept
+
+
+def _run(config: StudyConfig, out, *, source=None, progress=None, jobs: int = 1, executor: str = "local",
+         scheduler: str | None = None, resume: bool = False, keep_tasks: bool = True, **_) -> Outcome:
+    from .runner import run_study
+    result = run_study(config, out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,
+                       progress=progress, source=source, keep_tasks=keep_tasks)
+    return Outcome(result.folder, result.wall_s, result)
+
+
+def _rerun_files(config: StudyConfig, folder: Path, source: str | None) -> None:
+    from .reports import write_tables
+    from .runner import rerun_in_memory
+    result = rerun_in_memory(config)
+    result.source = source
+    write_tables(result, folder, figures=False)
+
+
+STUDY = Kind("study", lambda data, where: study_from_dict(data, where), _validate, _run, _rerun_files)
