@@ -61,12 +61,12 @@ def _loader():
         def compose_node(self, parent, index):
             if self.check_event(yaml.AliasEvent):
                 event = self.peek_event()
-                raise yaml.composer.ComposerError(None, None, "YAML aliases (*name) are not accepted "
-                                                  "in fkopt files; write the values out", event.start_mark)
+                raise yaml.composer.ComposerError(None, None, "YAML anchors and aliases (&name, *name) "
+                                                  "are not accepted in fkopt files; write the values out", event.start_mark)
             event = self.peek_event()
             if getattr(event, "anchor", None):
-                raise yaml.composer.ComposerError(None, None, "YAML anchors (&name) are not accepted "
-                                                  "in fkopt files; write the values out", event.start_mark)
+                raise yaml.composer.ComposerError(None, None, "YAML anchors and aliases (&name, *name) "
+                                                  "are not accepted in fkopt files; write the values out", event.start_mark)
             self.depth += 1
             try:
                 if self.depth > MAX_YAML_DEPTH:
@@ -157,12 +157,16 @@ def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dic
             hit = next((tag for key, tag in table.items() if key in value), None)
             if hit:
                 wanted[field] = hit
+        elif isinstance(value, list):
+            wanted[field] = "list["
     for e in errors:
         loc = [str(p) for p in e["loc"]]
-        if loc and loc[0] in wanted and len(loc) > 1 and loc[1] in tags and loc[1] != wanted[loc[0]]:
-            continue
-        loc = [p for p in loc if p not in tags and not p.startswith(("function-", "list[", "literal[",
-                                                                      "RandomCases"))]
+        if loc and loc[0] in wanted and len(loc) > 1:
+            branch = loc[1]
+            union = branch in tags or branch.startswith("list[")
+            if union and not branch.startswith(wanted[loc[0]]):
+                continue
+        loc = [p for p in loc if p not in tags and not p.startswith(("function-", "list[", "literal["))]
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
             msg = "unknown field"

@@ -191,15 +191,19 @@ def numeric_fields(config: dict) -> dict:
 
 
 
+#: ``cases`` is a list of cases or ``{random: N}``: report the error of the form the user wrote.
+CASE_BRANCHES = {"cases": {"random": "RandomCases"}}
+
+
 def _one_line(err: ValidationError, data: dict | None = None) -> str:
-    return error_line(err, data=data)
+    return error_line(err, CASE_BRANCHES, data)
 
 
 def experiment_from_dict(data: dict, where: str) -> ExperimentConfig:
     try:
         return ExperimentConfig(**data)
     except ValidationError as err:
-        raise FkoptError(f"{where}: {error_line(err, data=data)}") from None
+        raise FkoptError(f"{where}: {_one_line(err, data)}") from None
 
 
 def load_config(path: str | Path) -> ExperimentConfig:

@@ -1,0 +1,321 @@
+"""Hostile and faulty input (issue 10): every one gets exit 2 and exactly one line on stderr, and
+nothing is written anywhere -- previous results stay byte-identical, nothing appears outside the
+out folder. Interrupted reruns (SIGINT to the process group, kill -9) keep the previous result.
+
+The corpus runs in this process (``fkopt.cli.main`` with argv), so it stays fast; the interrupt
+tests need real processes.
+"""
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from fkopt.cli import main
+
+BASE = {
+    "name": "fresh", "paper": "test", "title": "hostile base",
+    "mechanism": {"name": "3-rps"},
+    "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}],
+    "algorithms": [{"name": "gabc"}],
+    "population": 4, "iterations": 5, "runs": 2, "seed": 1,
+}
+STUDY = {
+    "kind": "study", "name": "fresh", "mechanism": {"name": "3-rps"}, "poses": {"uniform": 2, "seed": 1},
+    "algorithms": [{"name": "gabc"}], "population": 4, "iterations": 5, "runs": 2, "seed": 1,
+}
+ASSEMBLY = {"kind": "assembly", "name": "fresh", "mechanism": {"name": "3-rps"},
+            "joints": {"d1": 598.85, "d2": 671.92, "d3": 629.16}, "population": 50, "iterations": 20}
+
+
+def yaml_of(data) -> str:
+    return yaml.safe_dump(data, sort_keys=False)
+
+
+def with_(base, **change):
+    data = {**base, **change}
+    return yaml_of({k: v for k, v in data.items() if v is not DROP})
+
+
+DROP = object()
+BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+    for p, c in zip("abcdefgh", "bcdefghi")) + "printed: *i\n"
+
+#: (id, file contents (text or bytes) or None, argv template) -- ``{f}`` is the file, ``{out}``
+#: the results root, ``{root}`` the sandbox. Expected: exit 2, one line, fragments in it.
+CORPUS = [
+    # -- paper / name: single safe path components ------------------------------------------------
+    ("name-dotdot", with_(BASE, name=".."), ["run", "{f}", "--out", "{out}"], ["name", "single safe folder name"]),
+    ("name-dot", with_(BASE, name="."), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("name-slash", with_(BASE, name="a/b"), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("name-absolute", with_(BASE, name="/etc"), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("name-5000", with_(BASE, name="x" * 5000), ["run", "{f}", "--out", "{out}"], ["name", "at most 64"]),
+    ("name-empty", with_(BASE, name=""), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("name-hidden", with_(BASE, name=".hidden"), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("name-number", with_(BASE, name=123), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("name-newline", with_(BASE, name="a\nb"), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("paper-dotdot", with_(BASE, paper="..", name="configs"), ["run", "{f}", "--out", "{out}"], ["paper"]),
+    ("paper-absolute", with_(BASE, paper="/tmp", name="important"), ["run", "{f}", "--out", "{out}"], ["paper"]),
+    ("paper-traversal", with_(BASE, paper="a/../.."), ["run", "{f}", "--out", "{out}"], ["paper"]),
+    ("paper-backslash", with_(BASE, paper="a\\b"), ["run", "{f}", "--out", "{out}"], ["paper"]),
+    ("study-name-dotdot", with_(STUDY, name=".."), ["study", "{f}", "--out", "{out}"], ["name"]),
+    ("study-paper-absolute", with_(STUDY, paper="/tmp"), ["study", "{f}", "--out", "{out}"], ["paper"]),
+    ("assembly-name-dotdot", with_(ASSEMBLY, name=".."), ["run", "{f}", "--out", "{out}"], ["name"]),
+    ("assembly-paper-absolute", with_(ASSEMBLY, paper="/tmp"), ["run", "{f}", "--out", "{out}"], ["paper"]),
+    # -- numbers and limits -------------------------------------------------------------------------
+    ("seed-negative", with_(BASE, seed=-1), ["run", "{f}", "--out", "{out}"], ["seed", "greater than or equal to 0"]),
+    ("seed-huge", with_(BASE, seed=2**70), ["run", "{f}", "--out", "{out}"], ["seed"]),
+    ("random-seed-negative", with_(BASE, cases={"random": 2, "seed": -5}), ["run", "{f}", "--out", "{out}"], ["seed"]),
+    ("cases-empty", with_(BASE, cases=[]), ["run", "{f}", "--out", "{out}"], ["cases", "1 to"]),
+    ("cases-random-zero", with_(BASE, cases={"random": 0}), ["run", "{f}", "--out", "{out}"], ["random"]),
+    ("cases-random-1e9", with_(BASE, cases={"random": 10**9}), ["run", "{f}", "--out", "{out}"], ["random", "less than or equal"]),
+    ("runs-1e9", with_(BASE, runs=10**9), ["run", "{f}", "--out", "{out}"], ["runs", "less than or equal"]),
+    ("population-1e9", with_(BASE, population=10**9), ["run", "{f}", "--out", "{out}"], ["population"]),
+    ("iterations-1e9", with_(BASE, iterations=10**9), ["run", "{f}", "--out", "{out}"], ["iterations"]),
+    ("memory-estimate", with_(BASE, runs=100_000, population=100_000, iterations=1_000_000),
+     ["run", "{f}", "--out", "{out}"], ["GiB of memory", "available"]),
+    ("threshold-nan", with_(BASE, threshold=float("nan")), ["run", "{f}", "--out", "{out}"], ["threshold"]),
+    ("threshold-inf", with_(BASE, threshold=float("inf")), ["run", "{f}", "--out", "{out}"], ["threshold"]),
+    ("pose-nan", with_(BASE, cases=[{"pose": {"alpha": float("nan"), "beta": 0, "z": 600}}]),
+     ["run", "{f}", "--out", "{out}"], ["cases"]),
+    ("population-text", with_(BASE, population="many"), ["run", "{f}", "--out", "{out}"], ["population"]),
+    ("study-uniform-1e9", with_(STUDY, poses={"uniform": 10**9}), ["study", "{f}", "--out", "{out}"], ["poses"]),
+    ("study-seed-negative", with_(STUDY, seed=-1), ["study", "{f}", "--out", "{out}"], ["seed"]),
+    ("study-grid-huge", with_(STUDY, poses={"grid": {"alpha": [-1, 1, 1000], "beta": [-1, 1, 1000]},
+                                            "fixed": {"z": 550}}), ["study", "{f}", "--out", "{out}"], ["grid"]),
+    ("study-runs-1e9", with_(STUDY, runs=10**9), ["study", "{f}", "--out", "{out}"], ["runs"]),
+    # -- YAML itself --------------------------------------------------------------------------------
+    ("yaml-duplicate-key", yaml_of(BASE) + "runs: 3\n", ["run", "{f}", "--out", "{out}"], ["duplicate key 'runs'"]),
+    ("yaml-alias-bomb", yaml_of(BASE) + BOMB, ["run", "{f}", "--out", "{out}"], ["anchors and aliases"]),
+    ("yaml-anchor", yaml_of(BASE).replace("population: 4", "population: &p 4\nruns2: *p"),
+     ["run", "{f}", "--out", "{out}"], ["anchors and aliases"]),
+    ("yaml-not-utf8", b"name: \xff\xfe\n", ["run", "{f}", "--out", "{out}"], ["not UTF-8"]),
+    ("yaml-latin1", yaml_of(BASE).replace("hostile base", "caf\u00e9").encode("latin-1"),
+     ["run", "{f}", "--out", "{out}"], ["not UTF-8"]),
+    ("yaml-too-large", yaml_of(BASE) + "#" * (1 << 20) + "\n", ["run", "{f}", "--out", "{out}"], ["larger than"]),
+    ("yaml-deep", "a: " + "[" * 5000 + "]" * 5000 + "\n", ["run", "{f}", "--out", "{out}"], ["nested"]),
+    ("yaml-list", "- 1\n- 2\n", ["run", "{f}", "--out", "{out}"], ["expected a mapping"]),
+    ("yaml-empty", "", ["run", "{f}", "--out", "{out}"], ["expected a mapping"]),
+    ("yaml-scalar", "hello\n", ["run", "{f}", "--out", "{out}"], ["expected a mapping"]),
+    ("yaml-python-tag", "name: !!python/object/apply:os.system ['touch pwned']\n", ["run", "{f}", "--out", "{out}"],
+     ["malformed YAML"]),
+    ("yaml-malformed", "name: x\nmechanism: {name: 3-rps\n", ["run", "{f}", "--out", "{out}"], ["malformed YAML at line"]),
+    ("yaml-int-key", "1: 2\n", ["run", "{f}", "--out", "{out}"], ["field names must be text"]),
+    ("yaml-control-chars", with_(BASE, title="x", colour="\x1b[31mred\x07"), ["run", "{f}", "--out", "{out}"],
+     ["unknown field"]),
+    # -- schema --------------------------------------------------------------------------------------
+    ("unknown-field", with_(BASE, colour=1), ["run", "{f}", "--out", "{out}"], ["colour", "unknown field"]),
+    ("kind-unknown", with_(BASE, kind="survey"), ["run", "{f}", "--out", "{out}"], ["kind: 'survey' unknown"]),
+    ("kind-not-text", with_(BASE, kind=[1]), ["run", "{f}", "--out", "{out}"], ["kind"]),
+    ("mechanism-unknown", with_(BASE, mechanism={"name": "4-rps"}), ["run", "{f}", "--out", "{out}"], ["unknown mechanism"]),
+    ("bounds-reversed", with_(BASE, mechanism={"name": "3-rps", "bounds": {"z": [700, 400]}}),
+     ["run", "{f}", "--out", "{out}"], ["bounds.z"]),
+    ("pose-outside", with_(BASE, cases=[{"pose": {"alpha": 9, "beta": 13, "z": 5000}}]),
+     ["run", "{f}", "--out", "{out}"], ["z=5000"]),
+    ("algorithm-unknown", with_(BASE, algorithms=[{"name": "bee"}]), ["run", "{f}", "--out", "{out}"], ["unknown algorithm"]),
+    ("algorithm-param", with_(BASE, algorithms=[{"name": "abc", "params": {"limit": -1}}]),
+     ["run", "{f}", "--out", "{out}"], ["limit"]),
+    ("algorithm-duplicate", with_(BASE, algorithms=[{"name": "abc"}, {"name": "abc"}]),
+     ["run", "{f}", "--out", "{out}"], ["unique"]),
+    ("algorithms-empty", with_(BASE, algorithms=[]), ["run", "{f}", "--out", "{out}"], ["algorithms"]),
+    ("stop-without-threshold", with_(BASE, stop_at_threshold=True), ["run", "{f}", "--out", "{out}"], ["threshold"]),
+    ("study-via-run", yaml_of(STUDY), ["run", "{f}", "--out", "{out}"], ["fkopt study"]),
+    ("assembly-serial", with_(ASSEMBLY, mechanism={"name": "7dof-arm"}), ["run", "{f}", "--out", "{out}"], ["parallel"]),
+    # -- geometry files and CLI arguments -------------------------------------------------------------
+    ("geometry-not-utf8", b"ra: \xff\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
+     ["not UTF-8"]),
+    ("geometry-duplicate", "ra: 1\nra: 2\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
+     ["duplicate key 'ra'"]),
+    ("geometry-list", "- 1\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
+     ["expected a mapping"]),
+    ("geometry-bomb", BOMB, ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"], ["anchors and aliases"]),
+    ("geometry-missing", None, ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{root}/nope.yaml"],
+     ["cannot read"]),
+    ("fk-seed-negative", None, ["fk", "3-rps", "--joints", "d1=598.85,d2=671.92,d3=629.16", "--seed", "-1"], ["--seed"]),
+    ("ik-nan", None, ["ik", "3-rps", "--pose", "alpha=nan,beta=0,z=600"], ["finite"]),
+    ("ik-inf", None, ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=inf"], ["finite"]),
+    ("ik-duplicate", None, ["ik", "3-rps", "--pose", "alpha=1,alpha=2,beta=0,z=600"], ["'alpha' is given twice"]),
+    ("fk-duplicate", None, ["fk", "3-rps", "--joints", "d1=1,d1=2,d2=3,d3=4"], ["'d1' is given twice"]),
+    ("fk-empty-name", None, ["fk", "3-rps", "--joints", "=1"], ["name=value"]),
+    ("run-missing-file", None, ["run", "{root}/nope.yaml", "--out", "{out}"], ["cannot read"]),
+    ("run-folder-as-file", None, ["run", "{root}", "--out", "{out}"], ["is a folder"]),
+    ("study-jobs-zero", yaml_of(STUDY), ["study", "{f}", "--out", "{out}", "--jobs", "0"], ["--jobs"]),
+    ("study-executor", yaml_of(STUDY), ["study", "{f}", "--out", "{out}", "--executor", "mpi"], ["--executor"]),
+    ("check-subset", None, ["check", "{out}", "--subset", "some"], ["--subset"]),
+    ("check-missing", None, ["check", "{root}/nope"], ["no such results folder"]),
+    ("report-missing", None, ["report", "{root}/nope"], ["no such results folder"]),
+    ("reproduce-missing", None, ["reproduce", "--configs", "{root}/nope", "--out", "{out}"], ["not a folder"]),
+    ("unknown-command", None, ["frobnicate"], ["No such command"]),
+    ("unknown-option", None, ["run", "--colour"], ["--colour"]),
+    # -- output locations --------------------------------------------------------------------------------
+    ("out-is-file", yaml_of(BASE), ["run", "{f}", "--out", "{root}/afile"], ["is a file"]),
+    ("out-below-file", yaml_of(BASE), ["run", "{f}", "--out", "{root}/afile/sub"], ["is a file"]),
+    ("out-unwritable", yaml_of(BASE), ["run", "{f}", "--out", "/proc/fkopt-out"], ["cannot write"]),
+    ("out-symlink-escape", with_(BASE, paper="link"), ["run", "{f}", "--out", "{out}"], ["outside"]),
+    ("out-result-is-file", with_(BASE, paper="test", name="afile"), ["run", "{f}", "--out", "{out}"], ["is a file"]),
+    ("out-not-results", with_(BASE, paper="test", name="notes"), ["run", "{f}", "--out", "{out}"],
+     ["not a results folder"]),
+    ("out-other-config", with_(BASE, name="small", seed=99), ["run", "{f}", "--out", "{out}"], ["--force"]),
+    ("out-second-bad", yaml_of(BASE), ["run", "{f}", "{root}/nope.yaml", "--out", "{out}"], ["cannot read"]),
+    ("study-out-file", yaml_of(STUDY), ["study", "{f}", "--out", "{root}/afile"], ["is a file"]),
+    ("study-other-config", with_(STUDY, name="small", seed=99), ["study", "{f}", "--out", "{out}"], ["--force"]),
+    ("bench-out-file", None, ["bench", "--quick", "--out", "{root}/afile"], ["is a file"]),
+    ("reproduce-out-file", None, ["reproduce", "--configs", "{root}/configs", "--out", "{root}/afile"], ["is a file"]),
+    ("reproduce-clash", None, ["reproduce", "--configs", "{root}/clash", "--out", "{out}"], ["paper/name must differ"]),
+    ("report-corrupt-meta", None, ["report", "{root}/corrupt"], ["meta.json", "unreadable"]),
+]
+
+
+def snapshot(root: Path) -> dict:
+    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*")) if p.is_file() and not p.is_symlink()}
+
+
+def run_cli(monkeypatch, capsys, argv):
+    monkeypatch.setattr(sys, "argv", ["fkopt", *argv])
+    try:
+        main()
+        code = 0
+    except SystemExit as exc:
+        code = exc.code or 0
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture(scope="module")
+def sandbox(tmp_path_factory):
+    """A sandbox with previous results (an experiment and a study), a decoy ``configs/`` and
+    folders that hostile inputs aim at."""
+    root = tmp_path_factory.mktemp("hostile")
+    out = root / "out"
+    (root / "configs").mkdir()
+    (root / "configs" / "keep.yaml").write_text(yaml_of(BASE))
+    outside = root / "outside"
+    outside.mkdir()
+    (outside / "important.txt").write_text("do not touch\n")
+    (root / "afile").write_text("a file\n")
+    for name, data, cmd in (("small", BASE, "run"), ("small", STUDY, "study")):
+        cfg = root / f"prev-{cmd}.yaml"
+        cfg.write_text(yaml_of({**data, "name": name}))
+        proc = subprocess.run([sys.executable, "-m", "fkopt.cli", cmd, str(cfg), "--out", str(out), "-q"],
+                              capture_output=True, text=True, timeout=300)
+        assert proc.returncode == 0, proc.stderr
+    (out / "test" / "afile").write_text("a file where a result would go\n")
+    (out / "test" / "notes").mkdir()
+    (out / "test" / "notes" / "todo.txt").write_text("not a result\n")
+    (out / "link").symlink_to(outside, target_is_directory=True)
+    clash = root / "clash"
+    clash.mkdir()
+    for i in (1, 2):
+        (clash / f"c{i}.yaml").write_text(yaml_of(BASE))
+    corrupt = root / "corrupt" / "paper" / "exp"
+    corrupt.mkdir(parents=True)
+    (corrupt / "meta.json").write_text("{not json")
+    (corrupt / "summary.csv").write_text("case,algorithm\n")
+    (root / "inputs").mkdir()
+    return root
+
+
+@pytest.mark.parametrize("case", CORPUS, ids=[c[0] for c in CORPUS])
+def test_hostile_input(case, sandbox, monkeypatch, capsys):
+    ident, content, argv, fragments = case
+    root, out = sandbox, sandbox / "out"
+    f = root / "inputs" / f"{ident}.yaml"
+    if content is not None:
+        (f.write_bytes if isinstance(content, bytes) else f.write_text)(content)
+    before = snapshot(root)
+    monkeypatch.chdir(root)          # a relative path written by mistake would land in the sandbox
+    code, stdout, err = run_cli(monkeypatch, capsys, [a.format(f=f, out=out, root=root) for a in argv])
+    lines = err.strip().splitlines()
+    assert code == 2, (code, err)
+    assert len(lines) == 1, err
+    assert lines[0].startswith("fkopt: error: ") and "Traceback" not in err + stdout
+    for frag in fragments:
+        assert frag in lines[0], lines[0]
+    assert snapshot(root) == before, "a hostile input wrote or changed a file"
+    assert not any(p.name.startswith(".fkopt-probe") or ".new-" in p.name for p in root.rglob(".*"))
+
+
+def test_corpus_is_large_enough():
+    assert len(CORPUS) >= 60
+
+
+def test_check_with_corrupt_meta_fails_with_status_1(sandbox, monkeypatch, capsys):
+    code, _, err = run_cli(monkeypatch, capsys, ["check", str(sandbox / "corrupt"), "-q"])
+    assert code == 1
+    assert "meta.json" in err and "Traceback" not in err
+    assert err.strip().splitlines()[-1].startswith("fkopt: check failed:")
+
+
+def test_check_with_missing_meta_is_a_failure(sandbox, tmp_path, monkeypatch, capsys):
+    import shutil
+    results = tmp_path / "results"
+    shutil.copytree(sandbox / "out" / "test" / "small", results / "test" / "small")
+    (results / "test" / "small" / "meta.json").unlink()
+    code, _, err = run_cli(monkeypatch, capsys, ["check", str(results), "-q"])
+    assert code == 1 and "test/small: meta.json" in err and "missing" in err
+
+
+# -- interrupted reruns keep the previous result ----------------------------------------------------
+SLOW = {**BASE, "name": "small", "population": 40, "iterations": 3000, "runs": 60,
+        "algorithms": [{"name": "abc"}, {"name": "gabc"}, {"name": "pso"}]}
+SLOW_STUDY = {**STUDY, "name": "small", "poses": {"uniform": 400, "seed": 1}, "population": 20,
+              "iterations": 400, "runs": 5, "chunk": 400}
+
+
+def _interrupt(tmp_path, prev, slow, command, how):
+    out = tmp_path / "out"
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml_of(prev))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(Path(__file__).resolve().parents[1]),
+                                                                         os.environ.get("PYTHONPATH")]))}
+    proc = subprocess.run([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q"],
+                          capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0, proc.stderr
+    before = snapshot(out)
+    cfg.write_text(yaml_of(slow))
+    p = subprocess.Popen([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q",
+                          "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True, env=env)
+    time.sleep(3.0)                  # imports and validation take about a second; then it computes
+    assert p.poll() is None, "the rerun finished before it could be interrupted; make SLOW slower"
+    os.killpg(p.pid, how)
+    _, err = p.communicate(timeout=60)
+    # hidden siblings (.<name>.partial: a study's finished tasks for --resume; .<name>.new-*: a
+    # killed writer's scratch) are not results
+    after = {k: v for k, v in snapshot(out).items() if not any(part.startswith(".") for part in k.split("/"))}
+    assert after == before, f"previous result changed (exit {p.returncode}): {err[-500:]}"
+    if how == signal.SIGINT:
+        assert p.returncode == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGKILL], ids=["sigint", "kill-9"])
+def test_interrupted_experiment_rerun_keeps_previous_result(tmp_path, how):
+    _interrupt(tmp_path, {**BASE, "name": "small"}, SLOW, "run", how)
+
+
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGKILL], ids=["sigint", "kill-9"])
+def test_interrupted_study_rerun_keeps_previous_result(tmp_path, how):
+    _interrupt(tmp_path, {**STUDY, "name": "small"}, SLOW_STUDY, "study", how)
+
+
+def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, monkeypatch, capsys):
+    cfg = tmp_path / "c.yaml"
+    out = tmp_path / "out"
+    cfg.write_text(yaml_of({**BASE, "name": "small"}))
+    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])[0] == 0
+    # title/printed/check changes are not result-changing: replaced without --force
+    cfg.write_text(yaml_of({**BASE, "name": "small", "title": "renamed", "check": "full"}))
+    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])[0] == 0
+    cfg.write_text(yaml_of({**BASE, "name": "small", "seed": 2}))
+    code, _, err = run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])
+    assert code == 2 and "--force" in err
+    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q", "--force"])[0] == 0
+    assert json.loads((out / "test" / "small" / "meta.json").read_text())["seed"] == 2
