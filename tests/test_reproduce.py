@@ -74,3 +74,87 @@ def test_report_is_generated_not_edited():
         assert f"## {paper}" in report
     assert "**held**" in report
     assert set(index["paper"]) >= set(PAPERS)
+
+
+# -- teeth per file kind (issue 10 point 7) ---------------------------------------------------------
+def _copy(tmp_path, paper="mao2017", name="tab6"):
+    dst = tmp_path / "results" / paper / name
+    shutil.copytree(RESULTS / paper / name, dst)
+    return dst
+
+
+def _resign(folder):
+    """Record the digests of the edited files, as if a drifted fkopt had written them."""
+    from fkopt.compare import file_digests
+    meta = json.loads((folder / "meta.json").read_text())
+    meta["files"] = file_digests(folder)
+    (folder / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+
+
+def _edit_csv(folder, file, row, column, change):
+    import pandas as pd
+    path = folder / file
+    df = pd.read_csv(path)
+    df[column] = df[column].astype(float)
+    df.loc[row, column] = change(df.loc[row, column])
+    df.to_csv(path, index=False, float_format="%.10g")
+
+
+EDITS = {   # file kind -> a small edit
+    "summary.csv": lambda f: _edit_csv(f, "summary.csv", 0, "mean_fitness", lambda v: v * 1.0000001),
+    "values.csv": lambda f: _edit_csv(f, "values.csv", 0, "median_run_value", lambda v: v + 1e-7),
+    "runs.csv": lambda f: _edit_csv(f, "runs.csv", 3, "final_fitness", lambda v: v * 1.001),
+    "convergence.csv": lambda f: _edit_csv(f, "convergence.csv", 7, "median", lambda v: v * 1.001),
+}
+
+
+def test_integrity_catches_any_edit_of_any_table(tmp_path):
+    from fkopt.reproduce.check import integrity
+    for file, edit in EDITS.items():
+        folder = _copy(tmp_path / file)
+        assert integrity(Store(folder.parents[1]).get("mao2017", "tab6")) == []
+        edit(folder)
+        bad = integrity(Store(folder.parents[1]).get("mao2017", "tab6"))
+        assert [m.file for m in bad] == [file] and "SHA-256" in bad[0].rule
+
+
+def test_exact_check_names_every_edited_file(tmp_path):
+    folder = _copy(tmp_path)
+    for edit in EDITS.values():
+        edit(folder)
+    meta = json.loads((folder / "meta.json").read_text())
+    meta["objective"] = "absolute"                     # meta.json: a field the config fixes
+    (folder / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    _resign(folder)                                    # digests agree: only the rerun can tell
+    bad = check_experiment(Store(folder.parents[1]).get("mao2017", "tab6"), exact=True)
+    assert {m.file for m in bad} == {*EDITS, "meta.json"}
+    assert all("mao2017/tab6" in str(m) and "line" in m.row for m in bad)
+
+
+def test_tolerances_catch_the_edits_of_issue_10(tmp_path):
+    """Another platform (tolerant mode) still catches mean fitness x5, success 1 -> 0.95, median
+    iterations +18 %, mean evaluations +2 % (runs/convergence edits: the digests, above)."""
+    folder = _copy(tmp_path)
+    _edit_csv(folder, "summary.csv", 0, "mean_fitness", lambda v: v * 5)
+    _edit_csv(folder, "summary.csv", 1, "success_rate", lambda v: 0.95)
+    _edit_csv(folder, "summary.csv", 2, "median_iterations_to_threshold", lambda v: v * 1.18)
+    _edit_csv(folder, "summary.csv", 3, "mean_evaluations", lambda v: v * 1.02)
+    _resign(folder)
+    bad = check_experiment(Store(folder.parents[1]).get("mao2017", "tab6"), exact=False)
+    named = {(m.file, m.column) for m in bad}
+    assert named == {("summary.csv", "mean_fitness"), ("summary.csv", "success_rate"),
+                     ("summary.csv", "median_iterations_to_threshold"), ("summary.csv", "mean_evaluations")}
+
+
+def test_unedited_copy_passes_both_modes(tmp_path):
+    folder = _copy(tmp_path)
+    exp = Store(folder.parents[1]).get("mao2017", "tab6")
+    assert check_experiment(exp, exact=False) == []
+
+
+def test_check_accepts_a_paper_folder(tmp_path):
+    folder = _copy(tmp_path)
+    proc = subprocess.run([sys.executable, "-m", "fkopt.cli", "check", str(folder.parent)],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "ok   mao2017/tab6" in proc.stdout and "1 experiments match" in proc.stdout
