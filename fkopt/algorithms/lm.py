@@ -13,9 +13,10 @@ Choices fkopt makes:
 
 * Batched in numpy (scipy.optimize.least_squares works one point at a time): A and g are
   written as elementwise products summed over the residual axis (no matmul), and the dim x dim
-  systems are solved with ``np.linalg.solve`` on the stacked matrices. Results do not depend on
-  how many points share the batch in practice, but bit-identity across batch sizes is not
-  promised for lm/nr (LAPACK), unlike the swarms.
+  systems are solved with ``np.linalg.solve`` on the stacked matrices. numpy copies each
+  matrix of the stack into its own buffer and calls LAPACK ``gesv`` once per matrix, so a
+  point's numbers do not depend on the batch size or on its neighbours: bit-identical with one
+  numpy/LAPACK build on one CPU (tested), but not across builds or CPUs (other kernels).
 * Bounds by projection: the trial point is clipped onto the box (so LM can stall on a bound
   when the unconstrained step points outside; the 3-RPS solutions are interior).
 * Jacobian by central differences, as in :mod:`fkopt.algorithms.nr` (``jac_step`` of the box
