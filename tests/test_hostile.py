@@ -90,6 +90,8 @@ CORPUS = [
     ("study-seed-negative", with_(STUDY, seed=-1), ["study", "{f}", "--out", "{out}"], ["seed"]),
     ("study-grid-huge", with_(STUDY, poses={"grid": {"alpha": [-1, 1, 1000], "beta": [-1, 1, 1000]},
                                             "fixed": {"z": 550}}), ["study", "{f}", "--out", "{out}"], ["grid"]),
+    ("study-label-5000", with_(STUDY, algorithms=[{"name": "gabc", "label": "l" * 5000}]),
+     ["study", "{f}", "--out", "{out}"], ["label"]),
     ("study-runs-1e9", with_(STUDY, runs=10**9), ["study", "{f}", "--out", "{out}"], ["runs"]),
     # -- YAML itself --------------------------------------------------------------------------------
     ("yaml-duplicate-key", yaml_of(BASE) + "runs: 3\n", ["run", "{f}", "--out", "{out}"], ["duplicate key 'runs'"]),

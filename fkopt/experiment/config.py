@@ -35,7 +35,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
-from ..files import check_component, error_line, load_mapping
+from ..files import MAX_COMPONENT, check_component, error_line, load_mapping
 
 #: Documented upper limits (README "Bad input"); a memory estimate refuses smaller jobs that
 #: still cannot fit (:func:`fkopt.experiment.kinds.check_memory`).
@@ -96,7 +96,8 @@ class RandomCases(Strict):
 
 class AlgorithmSpec(Strict):
     name: str
-    label: str | None = None
+    #: Tells entries apart (names task files of a study, so it is bounded).
+    label: str | None = Field(None, min_length=1, max_length=MAX_COMPONENT)
     params: dict[str, Any] = Field(default_factory=dict)
     #: Overrides the experiment's population (number of starts for the local methods nr/lm, >= 1).
     population: int | None = Field(None, ge=1, le=MAX_POPULATION)

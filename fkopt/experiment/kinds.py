@@ -20,6 +20,11 @@ and adding a config kind is one module plus one line here. Everything else is sh
   inside ``--out``, writable, not a file) and the overwrite policy (:func:`check_overwrite`);
 * :func:`run_config` -- run and write (aside, then swapped into place);
 * :func:`rerun_files` -- rerun into a scratch folder, for ``fkopt check``.
+
+Not yet one pipeline (left for a later step, issue 11): a study still has its own runner and
+report tables rather than being "an experiment whose cases come from a pose set", and each kind
+still lists its own output files in its ``reports`` module (adding an output kind touches that
+kind's writer, and :data:`fkopt.compare.SHAPE_ONLY` when it holds single runs or curves).
 """
 from __future__ import annotations
 
