@@ -321,3 +321,16 @@ def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, monkeypatch, cap
     assert code == 2 and "--force" in err
     assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q", "--force"])[0] == 0
     assert json.loads((out / "test" / "small" / "meta.json").read_text())["seed"] == 2
+
+
+def test_hidden_scratch_folders_are_not_results(tmp_path, monkeypatch, capsys):
+    """A writer killed before its swap leaves a complete hidden copy: report and check skip it."""
+    import shutil
+    from fkopt.reproduce.store import Store
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml_of({**BASE, "name": "small"}))
+    out = tmp_path / "out"
+    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])[0] == 0
+    shutil.copytree(out / "test" / "small", out / "test" / ".small.new-x1y2")
+    assert [e.name for e in Store(out).experiments()] == ["small"]
+    assert [e.name for e in Store(out).folders()] == ["small"]

@@ -72,7 +72,9 @@ class Store:
 
     def experiments(self, paper: str | None = None) -> list[Experiment]:
         pattern = f"{paper}/*/meta.json" if paper else "*/*/meta.json"
-        return [Experiment(p.parent) for p in sorted(self.root.glob(pattern))]
+        # hidden folders (.<name>.new-*, .<name>.partial: unfinished writes) are not results
+        return [Experiment(p.parent) for p in sorted(self.root.glob(pattern))
+                if not any(part.startswith(".") for part in p.relative_to(self.root).parts)]
 
     def get(self, paper: str, name: str) -> Experiment | None:
         folder = self.root / paper / name
