@@ -6,7 +6,8 @@ Every config file, geometry file and results folder of fkopt goes through this m
   larger than :data:`MAX_YAML_BYTES`, bytes that are not UTF-8, YAML aliases (``*name``; anchors
   and aliases are refused altogether, so a tiny file cannot expand into gigabytes -- fkopt's
   configs never need them), duplicate keys (the error names the key and its line), nesting deeper
-  than :data:`MAX_YAML_DEPTH`, and malformed YAML (line and column). Only plain data is built
+  than :data:`MAX_YAML_DEPTH`, NaN and infinite numbers (``.nan``, ``.inf``, ``1e400``: no
+  field of any fkopt file takes them), and malformed YAML (line and column). Only plain data is built
   (``yaml.SafeLoader``): no tag ever runs code.
 * :func:`check_component` -- ``paper`` and ``name`` are single safe path components:
   :data:`COMPONENT_PATTERN` (a letter or digit first, then letters, digits, ``_ . + -``, at most
@@ -76,6 +77,14 @@ def _loader():
             finally:
                 self.depth -= 1
 
+        def construct_yaml_float(self, node):
+            value = super().construct_yaml_float(node)
+            if value != value or value in (float("inf"), float("-inf")):
+                raise yaml.constructor.ConstructorError(None, None, f"'{node.value}' is not a finite "
+                                                        "number (NaN and inf are not accepted)",
+                                                        node.start_mark)
+            return value
+
         def construct_mapping(self, node, deep=False):
             seen = {}
             for key_node, _ in node.value:
@@ -92,6 +101,7 @@ def _loader():
                 seen[key] = key_node.start_mark.line
             return super().construct_mapping(node, deep=deep)
 
+    Loader.add_constructor("tag:yaml.org,2002:float", Loader.construct_yaml_float)
     return Loader
 
 
