@@ -121,14 +121,16 @@ def unique_labels(algos):
     return algos
 
 
-class ExperimentConfig(Strict):
+class RunConfig(Strict):
+    """What every config that runs algorithms x targets x runs shares (experiments, studies):
+    names, mechanism, objective, algorithms, budget, seed, threshold, printed values."""
+
     name: str
     paper: str | None = None
     title: str = ""
     description: str = ""
     mechanism: MechanismSpec
     objective: str | None = None
-    cases: list[CaseSpec] | RandomCases
     algorithms: list[AlgorithmSpec] = Field(min_length=1)
     population: int = Field(10, ge=2, le=MAX_POPULATION)
     iterations: int = Field(100, ge=1, le=MAX_ITERATIONS)
@@ -136,11 +138,6 @@ class ExperimentConfig(Strict):
     seed: int = Seed()
     threshold: float | None = Field(None, gt=0)
     stop_at_threshold: bool = False
-    batch: bool = True
-    snapshots: list[int] = Field(default_factory=list)
-    #: Extra figures: variables (best-so-far pose vs iteration), snapshots (population scatter),
-    #: extras (algorithm records such as ACO pheromone), cases (per-case error and time).
-    figures: list[Literal["variables", "snapshots", "extras", "cases"]] = Field(default_factory=list)
     #: Experiment-level printed values and notes for the report.
     printed: dict[str, Any] = Field(default_factory=dict)
     #: Which regression check reruns it: "ci" (every CI run and `make check`) or "full"
@@ -157,13 +154,6 @@ class ExperimentConfig(Strict):
     def _component(cls, value, info):
         return safe_component(value, info.field_name)
 
-    @field_validator("cases")
-    @classmethod
-    def _some_cases(cls, cases):
-        if isinstance(cases, list) and not 1 <= len(cases) <= MAX_CASES:
-            raise ValueError(f"needs 1 to {MAX_CASES} cases, got {len(cases)}")
-        return cases
-
     @property
     def folder_parts(self) -> tuple[str, str]:
         """``(paper, name)``: the results folder is ``OUT/<paper>/<name>/``."""
@@ -174,6 +164,24 @@ class ExperimentConfig(Strict):
         if self.stop_at_threshold and self.threshold is None:
             raise ValueError("stop_at_threshold needs a threshold")
         return self
+
+
+class ExperimentConfig(RunConfig):
+    """A :class:`RunConfig` whose targets are listed (or drawn at random) as cases."""
+
+    cases: list[CaseSpec] | RandomCases
+    batch: bool = True
+    snapshots: list[int] = Field(default_factory=list)
+    #: Extra figures: variables (best-so-far pose vs iteration), snapshots (population scatter),
+    #: extras (algorithm records such as ACO pheromone), cases (per-case error and time).
+    figures: list[Literal["variables", "snapshots", "extras", "cases"]] = Field(default_factory=list)
+
+    @field_validator("cases")
+    @classmethod
+    def _some_cases(cls, cases):
+        if isinstance(cases, list) and not 1 <= len(cases) <= MAX_CASES:
+            raise ValueError(f"needs 1 to {MAX_CASES} cases, got {len(cases)}")
+        return cases
 
 
 #: Fields that never change the numbers: a stored result made from a config differing only

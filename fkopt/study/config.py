@@ -66,7 +66,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
 from ..experiment.config import (MAX_CASES, MAX_ITERATIONS, MAX_POPULATION, MAX_RUNS, NOT_NUMERIC,  # noqa: F401
-                                 AlgorithmSpec, MechanismSpec, Seed, Strict, safe_component, unique_labels)
+                                 AlgorithmSpec, MechanismSpec, RunConfig, Seed, Strict)
 from ..files import error_line, load_mapping
 
 KIND = "study"
@@ -136,44 +136,21 @@ class TrackingSpec(Strict):
     radius: float = Field(0.05, gt=0, le=1)
 
 
-class StudyConfig(Strict):
+class StudyConfig(RunConfig):
+    """A :class:`~fkopt.experiment.config.RunConfig` whose targets come from a pose set, plus the
+    study's own settings (chunks, tracking, statistics)."""
+
     kind: Literal["study"]
-    name: str
     paper: str = "studies"
-    title: str = ""
-    description: str = ""
-    mechanism: MechanismSpec
-    objective: str | None = None
     poses: PoseSet
     algorithms: list[StudyAlgorithmSpec] = Field(min_length=1)
-    population: int = Field(10, ge=2, le=MAX_POPULATION)
-    iterations: int = Field(100, ge=1, le=MAX_ITERATIONS)
     runs: int = Field(5, ge=1, le=MAX_RUNS)
-    seed: int = Seed()
     threshold: float = Field(1e-10, gt=0)
-    stop_at_threshold: bool = False
     chunk: int = Field(20, ge=1, description="poses per task (independent mode)")
     mode: Literal["independent", "tracking"] = "independent"
     tracking: TrackingSpec = Field(default_factory=TrackingSpec)
     #: Significance level of the pairwise Wilcoxon rank-sum tests (after Holm's correction).
     alpha: float = Field(0.05, gt=0, lt=1)
-    #: Experiment-level printed values and notes for the report (never fkopt's numbers).
-    printed: dict[str, Any] = Field(default_factory=dict)
-    check: Literal["ci", "full"] = "ci"
-
-    @field_validator("algorithms")
-    @classmethod
-    def _unique_labels(cls, algos):
-        return unique_labels(algos)
-
-    @field_validator("name", "paper")
-    @classmethod
-    def _component(cls, value, info):
-        return safe_component(value, info.field_name)
-
-    @property
-    def folder_parts(self) -> tuple[str, str]:
-        return (self.paper, self.name)
 
     @model_validator(mode="after")
     def _mode(self):
