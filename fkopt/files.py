@@ -27,6 +27,7 @@ Every config file, geometry file and results folder of fkopt goes through this m
 from __future__ import annotations
 
 import ctypes
+import errno
 import json
 import os
 import re
@@ -245,17 +246,21 @@ def _exchange(a: Path, b: Path) -> bool:
     fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
     if fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
         return True
-    errno = ctypes.get_errno()
-    if errno in (22, 38, 95):      # EINVAL, ENOSYS, EOPNOTSUPP: file system or kernel without it
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):   # file system or kernel without it
         return False
-    raise OSError(errno, os.strerror(errno), str(b))
+    raise OSError(code, os.strerror(code), str(b))
 
 
 def swap_into_place(new: Path, final: Path) -> None:
     """Put folder ``new`` at ``final``; a previous ``final`` is removed only after the swap."""
     if not final.exists():
-        os.replace(new, final)
-        return
+        try:
+            os.replace(new, final)
+            return
+        except OSError as err:   # another run put a result there meanwhile: swap with it instead
+            if err.errno not in (errno.ENOTEMPTY, errno.EEXIST):
+                raise
     if _exchange(new, final):
         shutil.rmtree(new, ignore_errors=True)     # ``new`` now holds the previous result
         return

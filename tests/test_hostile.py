@@ -342,3 +342,26 @@ def test_hidden_scratch_folders_are_not_results(tmp_path, monkeypatch, capsys):
     shutil.copytree(out / "test" / "small", out / "test" / ".small.new-x1y2")
     assert [e.name for e in Store(out).experiments()] == ["small"]
     assert [e.name for e in Store(out).folders()] == ["small"]
+
+
+def test_swap_keeps_previous_until_replaced(tmp_path):
+    """write_atomically: a failing writer leaves the previous folder; a finished one replaces it;
+    a result that appeared meanwhile is swapped out, not an error."""
+    from fkopt.files import swap_into_place, write_atomically
+    final = tmp_path / "r"
+    write_atomically(final, lambda t: (t / "a.csv").write_text("1\n"))
+
+    def broken(t):
+        (t / "a.csv").write_text("half")
+        raise RuntimeError("disk full")
+    with pytest.raises(RuntimeError):
+        write_atomically(final, broken)
+    assert (final / "a.csv").read_text() == "1\n" and sorted(p.name for p in tmp_path.iterdir()) == ["r"]
+    write_atomically(final, lambda t: (t / "b.csv").write_text("2\n"))
+    assert sorted(p.name for p in final.iterdir()) == ["b.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r"]
+    new = tmp_path / ".r.new-x"
+    new.mkdir()
+    (new / "c.csv").write_text("3\n")
+    swap_into_place(new, final)
+    assert sorted(p.name for p in final.iterdir()) == ["c.csv"] and not new.exists()
