@@ -60,13 +60,12 @@ from __future__ import annotations
 import hashlib
 import json
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
-from ..experiment.config import (MAX_CASES, MAX_ITERATIONS, MAX_POPULATION, MAX_RUNS, NOT_NUMERIC,  # noqa: F401
-                                 AlgorithmSpec, MechanismSpec, RunConfig, Seed, Strict)
+from ..experiment.config import MAX_CASES, MAX_RUNS, NOT_NUMERIC, AlgorithmSpec, RunConfig, Seed, Strict
 from ..files import error_line, load_mapping
 
 KIND = "study"
