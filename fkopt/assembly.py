@@ -15,7 +15,8 @@ many inputs as pose variables:
 2. **Damped Newton**, vectorised over all starts of a round: for 6-SPS on the leg equations
    (|v_i|^2 - L_i^2) / (2 L_i) = 0 with the analytic Jacobian [v_i, (R q_i) x v_i] / L_i in the
    position and a rotation vector (R <- exp([w]x) R, so no Euler singularity during the
-   search); for other mechanisms on ``FKProblem.residuals`` with a central-difference Jacobian.
+   search); for other mechanisms on ``FKProblem.residuals`` with ``FKProblem.jacobian`` (central
+   differences only for a mechanism without an analytic Jacobian).
    Steps are capped (6-SPS: 2 rad of rotation and one mechanism size of translation; others:
    a quarter of the bounds width) and halved up to 8 times until the squared residual
    decreases (backtracking line search). A start stops when converged (then one more
@@ -323,7 +324,8 @@ class _SixSPSModel(_Model):
 
 
 class _GenericModel(_Model):
-    """Newton on FKProblem residuals in the mechanism's own pose variables (central differences)."""
+    """Newton on FKProblem residuals in the mechanism's own pose variables (the mechanism's
+    analytic Jacobian; central differences for a mechanism without one)."""
 
     def __init__(self, mechanism, joints):
         self.problem = FKProblem(mechanism, joints)
@@ -342,6 +344,8 @@ class _GenericModel(_Model):
         return self.problem.residuals(S)
 
     def residual_jacobian(self, S):
+        if self.problem.has_jacobian:
+            return self.problem.residuals(S), self.problem.jacobian(S)
         n, d = S.shape
         E = np.eye(d) * self.h
         pts = np.concatenate([S[:, None, :], S[:, None, :] + E, S[:, None, :] - E], axis=1)

@@ -136,6 +136,66 @@ class DHArm(SerialMechanism):
                             for c in range(3)) for r in range(3))
         return p, R
 
+    def frame_jacobian(self, joints) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """End-effector position (..., 3), rotation (..., 3, 3) and frame Jacobian (..., 6, n).
+
+        Rows 0-2 of the Jacobian are d(position)/dq (length unit per degree), rows 3-5 the
+        angular velocity in the base frame per degree of joint motion (rad/deg): column i is
+        (z_{i-1} x (p - p_{i-1}), z_{i-1}) * pi/180, z_{i-1} and p_{i-1} the axis and origin of
+        joint i (standard DH: the frame before T_i). The Z-Y-Z Euler angles of the pose are
+        singular at sin(beta) = 0, so the frame (angular velocity) is the well-defined derivative;
+        :meth:`euler_rates` turns it into Euler-angle rates away from the singularity.
+        Batched 4x4 products over the leading axes (one matmul per joint, whatever the batch).
+        """
+        q = np.asarray(joints, dtype=float)
+        if q.shape[-1] != self.dof:
+            raise FkoptError(f"{self.name} joints: expected {self.dof} values "
+                             f"({', '.join(self.joint_names)}), got shape {q.shape}")
+        shape = q.shape[:-1]
+        n = self.dof
+        t = np.radians(q.reshape(-1, n) + self._offset)
+        ct, st = np.cos(t), np.sin(t)
+        A = np.zeros(t.shape + (4, 4))
+        ca, sa = np.array(self._ca), np.array(self._sa)
+        A[..., 0, 0], A[..., 0, 1], A[..., 0, 2], A[..., 0, 3] = ct, -st * ca, st * sa, np.array(self._a) * ct
+        A[..., 1, 0], A[..., 1, 1], A[..., 1, 2], A[..., 1, 3] = st, ct * ca, -ct * sa, np.array(self._a) * st
+        A[..., 2, 1], A[..., 2, 2], A[..., 2, 3] = sa, ca, np.array(self._d)
+        A[..., 3, 3] = 1.0
+        z = np.empty(t.shape + (3,))
+        o = np.empty(t.shape + (3,))
+        z[:, 0], o[:, 0] = (0.0, 0.0, 1.0), 0.0
+        T = A[:, 0]
+        for i in range(1, n):
+            z[:, i], o[:, i] = T[:, :3, 2], T[:, :3, 3]
+            T = T @ A[:, i]
+        p, R = T[:, :3, 3], T[:, :3, :3]
+        J = np.empty((len(t), 6, n))
+        J[:, :3] = np.swapaxes(np.cross(z, p[:, None, :] - o), 1, 2)
+        J[:, 3:] = np.swapaxes(z, 1, 2)
+        J *= np.pi / 180.0
+        return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
+
+    def jacobian(self, joints) -> np.ndarray:
+        """The frame Jacobian (..., 6, n) of :meth:`frame_jacobian`."""
+        return self.frame_jacobian(joints)[2]
+
+    @staticmethod
+    def euler_rates(R, omega) -> np.ndarray:
+        """Z-Y-Z Euler-angle rates (..., 3, k) of angular velocities omega (..., 3, k) at
+        rotations R (..., 3, 3): with w = (w_x, w_y, w_z), alpha' = w_z - cos(beta) gamma',
+        beta' = -sin(alpha) w_x + cos(alpha) w_y, gamma' = (cos(alpha) w_x + sin(alpha) w_y) / sin(beta)
+        (from w = alpha' e_z + beta' Rz(alpha) e_y + gamma' Rz(alpha) Ry(beta) e_z); infinite at
+        sin(beta) = 0, the singularity of the angles themselves."""
+        R = np.asarray(R)
+        al = np.arctan2(R[..., 1, 2], R[..., 0, 2])[..., None]
+        sb = np.hypot(R[..., 2, 0], R[..., 2, 1])[..., None]
+        cb = R[..., 2, 2][..., None]
+        wx, wy, wz = omega[..., 0, :], omega[..., 1, :], omega[..., 2, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gd = (np.cos(al) * wx + np.sin(al) * wy) / sb
+        bd = -np.sin(al) * wx + np.cos(al) * wy
+        return np.stack([wz - cb * gd, bd, gd], axis=-2)
+
     def fk(self, joints) -> np.ndarray:
         p, R = self.frame(joints)
         alpha, beta, gamma = rotations.zyz_angles(R)

@@ -172,6 +172,37 @@ class SixSPS(ParallelMechanism):
             np.sqrt(acc, out=acc)
         return np.moveaxis(out, 0, -1)
 
+    def jacobian(self, poses) -> np.ndarray:
+        """d(leg lengths)/d(pose), shaped (..., 6, 6), in the public units (m per m, m per degree).
+
+        With v_i = R q_i + p_s - b_i and l_i = |v_i|: dl_i/dp_s = v_i / l_i, and for the Z-Y-X
+        angles dR/dalpha = R [e_x]x, dR/dbeta = [Rz(gamma) e_y]x R, dR/dgamma = [e_z]x R, so
+        dl_i/dtheta = (v_i / l_i) . (axis_theta x R q_i) with axis_alpha = R e_x,
+        axis_beta = Rz(gamma) e_y, axis_gamma = e_z (times pi/180 for degrees).
+        Vectorised over the leading axes (batched 3x3 products).
+        """
+        p = np.asarray(poses, dtype=float)
+        shape = p.shape[:-1]
+        p = p.reshape(-1, 6)
+        a = p[:, 3:6] * _D2R
+        ca, cb, cg = np.cos(a).T
+        sa, sb, sg = np.sin(a).T
+        R = np.empty((len(p), 3, 3))
+        R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa
+        R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = sg * cb, sg * sb * sa + cg * ca, sg * sb * ca - cg * sa
+        R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = -sb, cb * sa, cb * ca
+        w = R @ self._q.T                                       # (n, 3, 6): R q_i
+        v = w + (p[:, :3, None] - self._base.T)
+        u = v / np.sqrt((v * v).sum(axis=1, keepdims=True))    # unit legs (n, 3, 6)
+        m = np.cross(w, u, axis=1)                              # R q_i x u_i; axis . m = u . (axis x R q_i)
+        J = np.empty((len(p), 6, 6))
+        J[:, :, 0:3] = np.swapaxes(u, 1, 2)
+        J[:, :, 3] = np.einsum("nk,nki->ni", R[:, :, 0], m)
+        J[:, :, 4] = -sg[:, None] * m[:, 0] + cg[:, None] * m[:, 1]
+        J[:, :, 5] = m[:, 2]
+        J[:, :, 3:] *= _D2R
+        return J.reshape(shape + (6, 6))
+
     def ik_vectors(self, poses) -> np.ndarray:
         """Leg vectors l_i (..., 6, 3) in the base frame (reference implementation, uses arrays)."""
         p = np.asarray(poses, dtype=float)
