@@ -170,8 +170,13 @@ class DHArm(SerialMechanism):
             T = T @ A[:, i]
         p, R = T[:, :3, 3], T[:, :3, :3]
         J = np.empty((len(t), 6, n))
-        J[:, :3] = np.swapaxes(np.cross(z, p[:, None, :] - o), 1, 2)
-        J[:, 3:] = np.swapaxes(z, 1, 2)
+        d = p[:, None, :] - o                                      # (k, n, 3)
+        zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
+        dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
+        J[:, 0] = zy * dz - zz * dy
+        J[:, 1] = zz * dx - zx * dz
+        J[:, 2] = zx * dy - zy * dx
+        J[:, 3], J[:, 4], J[:, 5] = zx, zy, zz
         J *= np.pi / 180.0
         return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
 

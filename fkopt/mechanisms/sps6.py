@@ -173,7 +173,12 @@ class SixSPS(ParallelMechanism):
         return np.moveaxis(out, 0, -1)
 
     def jacobian(self, poses) -> np.ndarray:
-        """d(leg lengths)/d(pose), shaped (..., 6, 6), in the public units (m per m, m per degree).
+        """d(leg lengths)/d(pose), shaped (..., 6, 6); see :meth:`ik_jacobian`."""
+        return self.ik_jacobian(poses)[1]
+
+    def ik_jacobian(self, poses) -> tuple[np.ndarray, np.ndarray]:
+        """Leg lengths (..., 6) and d(leg lengths)/d(pose) (..., 6, 6), in the public units
+        (m per m, m per degree), from the same leg vectors (one pass for Newton's r and J).
 
         With v_i = R q_i + p_s - b_i and l_i = |v_i|: dl_i/dp_s = v_i / l_i, and for the Z-Y-X
         angles dR/dalpha = R [e_x]x, dR/dbeta = [Rz(gamma) e_y]x R, dR/dgamma = [e_z]x R, so
@@ -193,15 +198,19 @@ class SixSPS(ParallelMechanism):
         R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = -sb, cb * sa, cb * ca
         w = R @ self._q.T                                       # (n, 3, 6): R q_i
         v = w + (p[:, :3, None] - self._base.T)
-        u = v / np.sqrt((v * v).sum(axis=1, keepdims=True))    # unit legs (n, 3, 6)
-        m = np.cross(w, u, axis=1)                              # R q_i x u_i; axis . m = u . (axis x R q_i)
+        lengths = np.sqrt((v * v).sum(axis=1))
+        u = v / lengths[:, None, :]                             # unit legs (n, 3, 6)
+        w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
+        u0, u1, u2 = u[:, 0], u[:, 1], u[:, 2]
+        # m = R q_i x u_i, so that axis . m = u_i . (axis x R q_i)
+        m0, m1, m2 = w1 * u2 - w2 * u1, w2 * u0 - w0 * u2, w0 * u1 - w1 * u0
         J = np.empty((len(p), 6, 6))
-        J[:, :, 0:3] = np.swapaxes(u, 1, 2)
-        J[:, :, 3] = np.einsum("nk,nki->ni", R[:, :, 0], m)
-        J[:, :, 4] = -sg[:, None] * m[:, 0] + cg[:, None] * m[:, 1]
-        J[:, :, 5] = m[:, 2]
+        J[:, :, 0], J[:, :, 1], J[:, :, 2] = u0, u1, u2
+        J[:, :, 3] = R[:, 0, 0, None] * m0 + R[:, 1, 0, None] * m1 + R[:, 2, 0, None] * m2
+        J[:, :, 4] = -sg[:, None] * m0 + cg[:, None] * m1
+        J[:, :, 5] = m2
         J[:, :, 3:] *= _D2R
-        return J.reshape(shape + (6, 6))
+        return lengths.reshape(shape + (6,)), J.reshape(shape + (6, 6))
 
     def ik_vectors(self, poses) -> np.ndarray:
         """Leg vectors l_i (..., 6, 3) in the base frame (reference implementation, uses arrays)."""
