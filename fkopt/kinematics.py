@@ -20,21 +20,28 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
 arm's length unit, Z-Y-Z Euler angles in degrees as :meth:`DHArm.fk` prints them), every joint
 inside its limits. A bounded damped least-squares method on the 6 residuals
 (position error, L * rotation vector of R R_t^T with L = ``orientation_scale`` length units per
-radian; the geodesic orientation error, no Euler differences):
+radian, default the arm's reach; the geodesic orientation error, no Euler differences):
 
-* step d = J^T (J J^T + lambda I)^{-1} (-r) (minimum-norm damped least squares for a redundant
-  arm), lambda adapted per row as in Levenberg-Marquardt (accept a step when |r|^2 decreases);
+* step d = J^T (J J^T + mu I)^{-1} (-r) (minimum-norm damped least squares for a redundant
+  arm), mu = lambda * trace(J J^T) / 6 with lambda adapted per candidate as in
+  Levenberg-Marquardt (start ``damping`` = 0.3, x ``down`` = 0.1 after a step that decreases
+  |r|^2, x ``up`` = 10 otherwise); the joint step is capped at ``step_cap`` radians; the
+  orientation rows use the exact derivative of the rotation vector (inverse left Jacobian of SO(3));
 * joint limits handled by the method (saturation in the null space, as in Flacco, De Luca,
   Khatib 2012, "Motion control of redundant robots under joint constraints: saturation in the
   null space"): a joint whose step would leave its range is fixed at the limit, its column
   removed, and the remaining joints re-solved for the residual left over (up to 3 passes) -- the
   redundancy absorbs the saturation instead of the step being clipped;
 * optional secondary objective in the null space of the task, ``rest`` > 0: pull every joint
-  towards mid-range with gain ``rest`` (d += (I - J^+ J) rest (mid - q) / half-range^2 ...);
-* seeded random restarts: a row that has not converged after 30 iterations, or stalls (lambda
-  above 1e6), restarts from joints uniform inside the limits, drawn from
-  ``numpy.random.default_rng([seed, restart])`` (row k of the batch takes row k of each draw),
-  at most ``restarts`` times. These restarts are inverse's global stage.
+  towards mid-range, d += (I - J^+ J) z with z = rest (mid - q) / half-range^2 and J^+ the damped
+  pseudo-inverse above (off by default: it slows convergence to the task);
+* seeded random restarts: a candidate that has not converged after ``iterations`` (12) steps, or
+  stalls (lambda above 1e6), restarts from joints uniform inside the limits, drawn from
+  a counter-based hash of (seed, row index, draw number), at most ``restarts`` times; when
+  fewer than ``fill`` candidates remain in the batch, every unsolved row gets more candidates at
+  once (so a single pose is solved from ~``fill`` starts side by side). These restarts are
+  inverse's global stage (seeded random restarts of a local method with limits, rather than a
+  swarm). Same poses and seed give the same answer; a row's answer may differ between batches.
 
 **Verdicts.** ``solved`` is true only when the closed form of the answer reproduces the input
 within ``tol`` and the answer is inside the bounds: forward, max |ik(pose) - joints| <= ``tol``
