@@ -97,3 +97,14 @@ def test_fk_problem_uses_the_analytic_jacobian():
     np.testing.assert_array_equal(problem.jacobian(pose), m.jacobian(pose))
     res = fkopt.solve(problem, "nr", x0=[20, 30, 20, 350], iterations=20)
     np.testing.assert_allclose(res.x[0], pose, atol=1e-8)
+
+
+def test_arm_frame_jacobian_elementwise_path_matches_products():
+    m = fkopt.mechanism("7dof-arm")
+    rng = np.random.default_rng(2)
+    b = m.bounds
+    Q = b[:, 0] + rng.random((300, 7)) * (b[:, 1] - b[:, 0])   # >= the elementwise batch size
+    big = m.frame_jacobian(Q)
+    small = m.frame_jacobian(Q[:50])                           # 4x4 products
+    for a, c in zip(big, small):
+        np.testing.assert_allclose(a[:50], c, atol=1e-9)
