@@ -2,7 +2,7 @@
 against central differences at random poses (hypothesis), in the public units (degrees)."""
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import assume, given, settings, strategies as st
 
 import fkopt
 from fkopt.algorithms.nr import jacobian_cost
@@ -34,6 +34,8 @@ def test_parallel_jacobian_matches_differences(name, u):
     # 6-sps: full-turn angle box; stay away from the Z-Y-X singularity beta = +-90
     x = point_in(m, u, 0.4 if name == "6-sps" else 1.0)
     h = 1e-6 * (m.bounds[:, 1] - m.bounds[:, 0])
+    if name.startswith("6-sps"):
+        assume(m.ik(x).min() > 1e-3)             # a zero-length leg has no derivative
     J = m.jacobian(x)
     F = central(m.ik, x, h)
     assert J.shape == (len(m.joint_names), len(m.pose_names))
