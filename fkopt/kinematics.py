@@ -196,101 +196,123 @@ def _sumsq(r):
     return np.einsum("...i,...i->...", r, r)
 
 
-def _newton(res: _Residuals, x: np.ndarray, idx: np.ndarray, ftol: float, evals: np.ndarray,
+def _newton(res: _Residuals, x: np.ndarray, idx: np.ndarray, ftol: float, evals,
             iterations: int = 30, halvings: int = 10):
-    """Damped Newton from rows x (k, n) for batch rows ``idx``; returns (x, max |r|)."""
+    """Damped Newton from rows x (k, n) for batch rows ``idx``.
+
+    Returns (x, max |r|) with r the residual at the returned x, as evaluated by the loop (the
+    mechanism's closed form, ``ik_jacobian``). Rows stop when max |r| <= ftol, when no step
+    along the Newton direction decreases |r|^2, or after ``iterations``.
+    """
     bounds = res.m.bounds
-    cap = 0.25 * (bounds[:, 1] - bounds[:, 0])
+    inv_cap = 4.0 / (bounds[:, 1] - bounds[:, 0])
     x = np.array(x, dtype=float)
     out_x = x.copy()
     out_r = np.full(len(x), np.inf)
+    calls = np.ones(len(x), dtype=np.int64)            # rj calls per row (counted at exit)
     act = np.arange(len(x))
     r, J, ne, nj = res.rj(x, idx)
-    evals[0][idx] += ne
-    evals[1][idx] += nj
     F = _sumsq(r)
+    square = J.shape[-1] == J.shape[-2]
+    it = 1
     for _ in range(iterations):
         rmax = np.abs(r).max(axis=-1)
-        done = (rmax <= ftol) | ~np.isfinite(rmax)
+        done = ~(rmax > ftol)                              # converged, or not finite
         if done.any():
             out_x[act[done]], out_r[act[done]] = x[done], rmax[done]
+            calls[act[done]] = it
             keep = ~done
             act, x, r, J, F = act[keep], x[keep], r[keep], J[keep], F[keep]
             if not len(act):
                 break
-        try:
-            d = -np.linalg.solve(J, r[..., None])[..., 0] if J.shape[-1] == J.shape[-2] else None
-        except np.linalg.LinAlgError:
-            d = None
-        if d is None or not np.isfinite(d).all():
-            # singular somewhere: least squares with a little damping for every row
-            A = np.swapaxes(J, -1, -2) @ J
-            A += 1e-9 * np.trace(A, axis1=-2, axis2=-1)[:, None, None] * np.eye(A.shape[-1])
-            d = -np.linalg.solve(A, (np.swapaxes(J, -1, -2) @ r[..., None]))[..., 0]
-            d[~np.isfinite(d)] = 0.0
-        d *= np.minimum(1.0, 1.0 / np.max(np.abs(d) / cap, axis=-1))[:, None]
-        xt = x + d
-        rt, Jt, ne, nj = res.rj(xt, idx[act])
-        evals[0][idx[act]] += ne
-        evals[1][idx[act]] += nj
+        d = None
+        if square:
+            try:
+                d = np.linalg.solve(J, r[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                d = None
+        big = None if d is None else np.max(np.abs(d) * inv_cap, axis=-1)
+        if big is None or not (big <= 1.0).all():
+            if big is None or not np.isfinite(big).all():
+                # singular somewhere: least squares with a little damping for every row
+                Jt = np.swapaxes(J, -1, -2)
+                A = Jt @ J
+                A += 1e-9 * np.trace(A, axis1=-2, axis2=-1)[:, None, None] * np.eye(A.shape[-1])
+                d = np.linalg.solve(A, Jt @ r[..., None])[..., 0]
+                d[~np.isfinite(d)] = 0.0
+                big = np.max(np.abs(d) * inv_cap, axis=-1)
+            d /= np.maximum(big, 1.0)[:, None]             # steps capped at 1/4 of the box width
+        xt = x - d
+        rt, Jt, _, _ = res.rj(xt, idx[act])
+        it += 1
         Ft = _sumsq(rt)
         bad = ~(Ft < F)
-        step = 1.0
-        for _ in range(halvings):
-            if not bad.any():
+        if bad.any():
+            ia = idx[act]
+            step = 1.0
+            fresh = np.zeros(len(act), dtype=bool)
+            for _ in range(halvings):
+                step *= 0.5
+                b = np.flatnonzero(bad)
+                xb = x[b] - step * d[b]
+                rb = res.r(xb, ia[b])
+                evals[0][ia[b]] += 1
+                Fb = _sumsq(rb)
+                ok = Fb < F[b]
+                xt[b[ok]], rt[b[ok]], Ft[b[ok]] = xb[ok], rb[ok], Fb[ok]
+                fresh[b[ok]] = True
+                bad[b[ok]] = False
+                if not bad.any():
+                    break
+            if bad.any():                   # no decrease along the step: stalled, stop those rows
+                b = np.flatnonzero(bad)
+                out_x[act[b]], out_r[act[b]] = x[b], np.abs(r[b]).max(axis=-1)
+                calls[act[b]] = it
+            fresh = np.flatnonzero(fresh)   # J at backtracked points is not known yet
+            if len(fresh):
+                _, Jf, _, _ = res.rj(xt[fresh], ia[fresh])
+                Jt[fresh] = Jf
+                evals[0][ia[fresh]] += ne
+                evals[1][ia[fresh]] += nj
+            moved = ~bad
+            act, x, r, J, F = act[moved], xt[moved], rt[moved], Jt[moved], Ft[moved]
+            if not len(act):
                 break
-            step *= 0.5
-            b = np.flatnonzero(bad)
-            xb = x[b] + step * d[b]
-            rb = res.r(xb, idx[act[b]])
-            evals[0][idx[act[b]]] += 1
-            Fb = _sumsq(rb)
-            ok = Fb < F[b]
-            xt[b[ok]], rt[b[ok]], Ft[b[ok]] = xb[ok], rb[ok], Fb[ok]
-            bad[b[ok]] = False
-        if bad.any():                       # no decrease along the step: stalled, stop those rows
-            b = np.flatnonzero(bad)
-            out_x[act[b]], out_r[act[b]] = x[b], np.abs(r[b]).max(axis=-1)
-        moved = np.flatnonzero(~bad)
-        fresh = np.flatnonzero(~bad & (step < 1.0))   # J at backtracked points is not known yet
-        if len(fresh):
-            _, Jf, ne, nj = res.rj(xt[fresh], idx[act[fresh]])
-            Jt[fresh] = Jf
-            evals[0][idx[act[fresh]]] += ne
-            evals[1][idx[act[fresh]]] += nj
-        act, x, r, J, F = act[moved], xt[moved], rt[moved], Jt[moved], Ft[moved]
-        if not len(act):
-            break
+        else:
+            x, r, J, F = xt, rt, Jt, Ft
     if len(act):
         out_x[act], out_r[act] = x, np.abs(r).max(axis=-1)
+        calls[act] = it
+    evals[0][idx] += calls * ne
+    evals[1][idx] += calls * nj
     return out_x, out_r
 
 
-def _into_bounds(mechanism: Mechanism, x: np.ndarray) -> np.ndarray:
-    """Angle variables moved by multiples of 360 deg to the representative inside the bounds
-    (when there is one; the smallest one >= the lower bound)."""
+def _verify(mechanism, L, x, resid, tol):
+    """Angle variables moved by multiples of 360 deg into the bounds (when possible), and the
+    verdict: (x, max |ik(x) - L| with angle joints wrapped, solved). ``resid`` is the residual
+    the solver evaluated at x (the closed form via ``ik_jacobian``); rows whose angles moved are
+    evaluated again with ``ik``."""
     angle = mechanism.angle_mask(mechanism.unknown_units)
-    if not angle.any():
-        return x
-    x = x.copy()
-    lo = mechanism.bounds[angle, 0]
-    hi = mechanism.bounds[angle, 1]
-    a = x[:, angle]
-    moved = lo + (a - lo) % 360.0
-    inside = (a >= lo) & (a <= hi)
-    x[:, angle] = np.where(inside | (moved > hi), a, moved)
-    return x
-
-
-def _verify(mechanism, L, x, tol):
-    """(max |ik(x) - L| with angle joints wrapped, solved) using the mechanism's own ik."""
-    r = mechanism.ik(x) - L
-    angle = mechanism.angle_mask(mechanism.joint_units)
-    if angle.any():
-        r[:, angle] = (r[:, angle] + 180.0) % 360.0 - 180.0
-    resid = np.abs(r).max(axis=-1)
+    inside = mechanism.in_bounds(x)
     resid = np.where(np.isfinite(resid), resid, np.inf)
-    return resid, (resid <= tol) & mechanism.in_bounds(x)
+    if angle.any() and not inside.all():
+        out = np.flatnonzero(~inside)
+        lo, hi = mechanism.bounds[angle, 0], mechanism.bounds[angle, 1]
+        a = x[np.ix_(out, np.flatnonzero(angle))]
+        moved = lo + (a - lo) % 360.0
+        a = np.where(((a >= lo) & (a <= hi)) | (moved > hi), a, moved)
+        x = x.copy()
+        x[np.ix_(out, np.flatnonzero(angle))] = a
+        r = mechanism.ik(x[out]) - L[out]
+        jang = mechanism.angle_mask(mechanism.joint_units)
+        if jang.any():
+            r[:, jang] = (r[:, jang] + 180.0) % 360.0 - 180.0
+        ro = np.abs(r).max(axis=-1)
+        resid = resid.copy()
+        resid[out] = np.where(np.isfinite(ro), ro, np.inf)
+        inside = mechanism.in_bounds(x)
+    return x, resid, (resid <= tol) & inside
 
 
 def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: int = 0,
@@ -321,9 +343,8 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
     ftol = 0.01 * tol
     all_rows = np.arange(N)
     with np.errstate(all="ignore"):
-        x, _ = _newton(res, x0, all_rows, ftol, evals)
-        x = _into_bounds(m, x)
-        resid, solved = _verify(m, L, x, tol)
+        x, rx = _newton(res, x0, all_rows, ftol, evals)
+        x, resid, solved = _verify(m, L, x, rx, tol)
         stage = np.where(solved, 0, -1)
         todo = np.flatnonzero(~solved)
         if len(todo):                                   # deterministic restarts
@@ -332,9 +353,8 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
             for s in starts:
                 if not len(todo):
                     break
-                xs, _ = _newton(res, np.broadcast_to(s, (len(todo), n)), todo, ftol, evals)
-                xs = _into_bounds(m, xs)
-                rs, ok = _verify(m, L[todo], xs, tol)
+                xs, rs = _newton(res, np.broadcast_to(s, (len(todo), n)), todo, ftol, evals)
+                xs, rs, ok = _verify(m, L[todo], xs, rs, tol)
                 better = ok | (~solved[todo] & (rs < resid[todo]))
                 x[todo[better]], resid[todo[better]] = xs[better], rs[better]
                 solved[todo[ok]] = True
@@ -348,8 +368,9 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
             out = solve(problem, "gabc+lm", population=20, iterations=300, runs=1, seed=seed,
                         run_ids=[int(k)])
             evals[0][k] += int(out.evaluations[0])
-            xs = _into_bounds(m, out.x[:1])
-            rs, ok = _verify(m, L[k:k + 1], xs, tol)
+            xs = out.x[:1]
+            rs = np.abs(problem.residuals(xs)).max(axis=-1)
+            xs, rs, ok = _verify(m, L[k:k + 1], xs, rs, tol)
             if ok[0] or rs[0] < resid[k]:
                 x[k], resid[k] = xs[0], rs[0]
             if ok[0]:
