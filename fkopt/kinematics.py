@@ -489,7 +489,9 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     best_m = np.full(N, np.inf)
     to_deg = 180.0 / np.pi
 
-    # slots: K candidates per row, slot s works for row own[s]
+    # slots: K candidates per row (more when the batch is small), slot s works for row own[s]
+    if N * K < fill:
+        K = max(K, fill // N)
     own = np.repeat(np.arange(N), K)
     q = np.repeat(q0, K, axis=0)
     if K > 1:
@@ -499,8 +501,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
 
     def evaluate(qa, rows):
         p, R, J = m.frame_jacobian(qa * to_deg)
-        np.add.at(ev_r, rows, 1)
-        np.add.at(ev_j, rows, 1)
+        evaluated.append(rows)                        # counted per row at the end
         e = _rotation_error(R, Rt[rows])
         dp = p - pt[rows]
         r = np.concatenate([dp, L * e], axis=-1)
@@ -511,6 +512,19 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         J[:, 3:] *= L
         return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
 
+    evaluated: list[np.ndarray] = []
+
+    def fold(sl):
+        """Fold slots ``sl`` into the best answer of their rows (smallest merit wins)."""
+        merit = np.maximum(pe[sl] / tp, re[sl] / tr)
+        order = np.lexsort((merit, own[sl]))
+        first = np.ones(len(sl), dtype=bool)
+        first[1:] = own[sl][order[1:]] != own[sl][order[:-1]]
+        top = order[first]
+        better = merit[top] < best_m[own[sl][top]]
+        rows = own[sl][top[better]]
+        best_q[rows], best_m[rows] = q[sl][top[better]], merit[top[better]]
+
     r, J, pe, re = evaluate(q, own)
     lam = np.full(len(q), damping)
     S = _sumsq(r)
@@ -519,18 +533,15 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     with np.errstate(all="ignore"):
         while len(own):
             # -- bookkeeping: best per row, finished rows, stuck slots ------------------------
-            merit = np.maximum(pe / tp, re / tr)
-            order = np.lexsort((merit, own))
-            first = np.ones(len(own), dtype=bool)
-            first[1:] = own[order[1:]] != own[order[:-1]]
-            top = order[first]
-            better = merit[top] < best_m[own[top]]
-            rows = own[top[better]]
-            best_q[rows], best_m[rows] = q[top[better]], merit[top[better]]
-            done[own[merit <= 1.0]] = True
+            conv = (pe <= tp) & (re <= tr)
+            if conv.any():
+                cs = np.flatnonzero(conv)
+                best_q[own[cs]], best_m[own[cs]] = q[cs], np.maximum(pe[cs] / tp, re[cs] / tr)
+                done[own[cs]] = True
             stuck = ~done[own] & ((age >= iterations) | (lam > 1e6))
             if stuck.any():                            # seeded random restarts (budget per row)
                 sl = np.flatnonzero(stuck)
+                fold(sl)
                 rows = own[sl]
                 cnt = np.zeros(N, dtype=np.int64)
                 _, inv, counts = np.unique(rows, return_inverse=True, return_counts=True)
@@ -550,6 +561,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     lam[sl], age[sl] = damping, 0
             keep = ~done[own] & (age < iterations) & (lam <= 1e6)
             if not keep.all():
+                fold(np.flatnonzero(~keep & ~done[own]))
                 own, q, r, J, pe, re, lam, S, age = (a[keep] for a in (own, q, r, J, pe, re, lam, S, age))
             if len(own) < fill:                        # few rows left: give each more candidates
                 rows_left = np.unique(own)
@@ -604,6 +616,11 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             lam = np.where(ok, np.maximum(lam * down, 1e-12), lam * up)
             q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qn[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
             age += 1
+    if len(own):
+        fold(np.arange(len(own)))
+    if evaluated:
+        ev_r += np.bincount(np.concatenate(evaluated), minlength=N)
+        ev_j[:] = ev_r
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
     qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])

@@ -160,31 +160,44 @@ class DHArm(SerialMechanism):
         if len(t) >= _SOA_MIN:
             p, R, J = self._frame_jacobian_soa(t)
             return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
-        ct, st = np.cos(t), np.sin(t)
-        A = np.zeros(t.shape + (4, 4))
-        ca, sa = np.array(self._ca), np.array(self._sa)
-        A[..., 0, 0], A[..., 0, 1], A[..., 0, 2], A[..., 0, 3] = ct, -st * ca, st * sa, np.array(self._a) * ct
-        A[..., 1, 0], A[..., 1, 1], A[..., 1, 2], A[..., 1, 3] = st, ct * ca, -ct * sa, np.array(self._a) * st
-        A[..., 2, 1], A[..., 2, 2], A[..., 2, 3] = sa, ca, np.array(self._d)
-        A[..., 3, 3] = 1.0
-        z = np.empty(t.shape + (3,))
-        o = np.empty(t.shape + (3,))
-        z[:, 0], o[:, 0] = (0.0, 0.0, 1.0), 0.0
-        T = A[:, 0]
+        # A_i = C0_i + cos(t_i) C1_i + sin(t_i) C2_i (constant 4x4 parts of the DH transform)
+        C0, C1, C2 = self._dh_parts()
+        A = C0 + np.cos(t)[..., None, None] * C1 + np.sin(t)[..., None, None] * C2
+        Ts = np.empty(t.shape + (4, 4))                            # frame before joint i+1 ... after
+        Ts[:, 0] = A[:, 0]
         for i in range(1, n):
-            z[:, i], o[:, i] = T[:, :3, 2], T[:, :3, 3]
-            T = T @ A[:, i]
+            np.matmul(Ts[:, i - 1], A[:, i], out=Ts[:, i])
+        T = Ts[:, -1]
         p, R = T[:, :3, 3], T[:, :3, :3]
         J = np.empty((len(t), 6, n))
-        d = p[:, None, :] - o                                      # (k, n, 3)
-        zx, zy, zz = z[..., 0], z[..., 1], z[..., 2]
-        dx, dy, dz = d[..., 0], d[..., 1], d[..., 2]
+        # joint i's axis z_{i-1} and origin o_{i-1}: base frame for i = 0, else frame i-1
+        zx, zy, zz = np.empty((len(t), n)), np.empty((len(t), n)), np.empty((len(t), n))
+        zx[:, 0], zy[:, 0], zz[:, 0] = 0.0, 0.0, 1.0
+        zx[:, 1:], zy[:, 1:], zz[:, 1:] = Ts[:, :-1, 0, 2], Ts[:, :-1, 1, 2], Ts[:, :-1, 2, 2]
+        dx, dy, dz = np.empty((len(t), n)), np.empty((len(t), n)), np.empty((len(t), n))
+        dx[:, 0], dy[:, 0], dz[:, 0] = p[:, 0], p[:, 1], p[:, 2]
+        dx[:, 1:] = p[:, 0, None] - Ts[:, :-1, 0, 3]
+        dy[:, 1:] = p[:, 1, None] - Ts[:, :-1, 1, 3]
+        dz[:, 1:] = p[:, 2, None] - Ts[:, :-1, 2, 3]
         J[:, 0] = zy * dz - zz * dy
         J[:, 1] = zz * dx - zx * dz
         J[:, 2] = zx * dy - zy * dx
         J[:, 3], J[:, 4], J[:, 5] = zx, zy, zz
         J *= np.pi / 180.0
         return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
+
+    def _dh_parts(self):
+        """Constant (n, 4, 4) parts C0, C1, C2 with A_i = C0 + cos(theta) C1 + sin(theta) C2."""
+        if getattr(self, "_parts", None) is None:
+            n = self.dof
+            C0, C1, C2 = np.zeros((n, 4, 4)), np.zeros((n, 4, 4)), np.zeros((n, 4, 4))
+            for i in range(n):
+                ca, sa, a, d = self._ca[i], self._sa[i], self._a[i], self._d[i]
+                C0[i, 2, 1], C0[i, 2, 2], C0[i, 2, 3], C0[i, 3, 3] = sa, ca, d, 1.0
+                C1[i, 0, 0], C1[i, 1, 1], C1[i, 1, 2], C1[i, 0, 3] = 1.0, ca, -sa, a
+                C2[i, 1, 0], C2[i, 0, 1], C2[i, 0, 2], C2[i, 1, 3] = 1.0, -ca, sa, a
+            self._parts = (C0, C1, C2)
+        return self._parts
 
     def _frame_jacobian_soa(self, t):
         """:meth:`frame_jacobian` for many rows (k, n) of joint angles in radians, elementwise
