@@ -110,3 +110,16 @@ def test_arm_frame_jacobian_elementwise_path_matches_products():
     small = m.frame_jacobian(Q[:50])                           # 4x4 products
     for a, c in zip(big, small):
         np.testing.assert_allclose(a[:50], c, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["6-sps", "6-sps-cmm"])
+def test_sps_ik_jacobian_elementwise_path_matches(name):
+    m = fkopt.mechanism(name)
+    rng = np.random.default_rng(5)
+    b = m.bounds
+    X = b[:, 0] + rng.random((400, 6)) * (b[:, 1] - b[:, 0])   # >= the elementwise batch size
+    v, J = m.ik_jacobian(X)
+    v2, J2 = m.ik_jacobian(X[:40])
+    np.testing.assert_allclose(v, m.ik(X), rtol=1e-14)
+    np.testing.assert_allclose(v[:40], v2, rtol=1e-14)
+    np.testing.assert_allclose(J[:40], J2, atol=1e-14)

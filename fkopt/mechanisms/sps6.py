@@ -49,6 +49,8 @@ from .base import Geometry, ParallelMechanism
 Vec3 = tuple[float, float, float]
 Points6 = tuple[Vec3, Vec3, Vec3, Vec3, Vec3, Vec3]
 _D2R = np.pi / 180.0
+#: Batch size from which :meth:`SixSPS.ik_jacobian` works elementwise per leg.
+_SOA_MIN = 256
 
 #: Full-turn angle bounds, to pass as ``bounds=FULL_TURN`` (merged with the default position box).
 FULL_TURN: dict[str, tuple[float, float]] = {
@@ -189,6 +191,9 @@ class SixSPS(ParallelMechanism):
         p = np.asarray(poses, dtype=float)
         shape = p.shape[:-1]
         p = p.reshape(-1, 6)
+        if len(p) >= _SOA_MIN:
+            lengths, J = self._ik_jacobian_soa(p)
+            return lengths.reshape(shape + (6,)), J.reshape(shape + (6, 6))
         a = p[:, 3:6] * _D2R
         ca, cb, cg = np.cos(a).T
         sa, sb, sg = np.sin(a).T
@@ -211,6 +216,38 @@ class SixSPS(ParallelMechanism):
         J[:, :, 5] = m2
         J[:, :, 3:] *= _D2R
         return lengths.reshape(shape + (6,)), J.reshape(shape + (6, 6))
+
+    def _ik_jacobian_soa(self, p):
+        """:meth:`ik_jacobian` for many poses (n, 6), elementwise per leg (structure of arrays)."""
+        n = len(p)
+        pt = np.ascontiguousarray(p.T)
+        ang = pt[3:6] * _D2R
+        R = rotations.zyx(ang[0], ang[1], ang[2])
+        sg, cg = np.sin(ang[2]), np.cos(ang[2])
+        lengths = np.empty((n, 6))
+        J = np.empty((n, 6, 6))
+        for i in range(6):
+            q, b = self._q[i], self._base[i]
+            w = []
+            for k in range(3):
+                wk = None
+                for j in range(3):
+                    if q[j] != 0.0:
+                        wk = R[k][j] * q[j] if wk is None else wk + R[k][j] * q[j]
+                w.append(np.zeros(n) if wk is None else wk)
+            v = [w[k] + (pt[k] - b[k]) for k in range(3)]
+            L = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            lengths[:, i] = L
+            inv = 1.0 / L
+            u = [v[k] * inv for k in range(3)]
+            m0 = w[1] * u[2] - w[2] * u[1]
+            m1 = w[2] * u[0] - w[0] * u[2]
+            m2 = w[0] * u[1] - w[1] * u[0]
+            J[:, i, 0], J[:, i, 1], J[:, i, 2] = u
+            J[:, i, 3] = (R[0][0] * m0 + R[1][0] * m1 + R[2][0] * m2) * _D2R
+            J[:, i, 4] = (cg * m1 - sg * m0) * _D2R
+            J[:, i, 5] = m2 * _D2R
+        return lengths, J
 
     def ik_vectors(self, poses) -> np.ndarray:
         """Leg vectors l_i (..., 6, 3) in the base frame (reference implementation, uses arrays)."""
