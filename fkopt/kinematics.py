@@ -290,6 +290,64 @@ def _newton(res: _Residuals, x: np.ndarray, idx: np.ndarray, ftol: float, evals,
     return out_x, out_r
 
 
+def _newton1(res: _Residuals, x: np.ndarray, ftol: float, evals, iterations: int = 30,
+             halvings: int = 10):
+    """:func:`_newton` for one row (batch of 1) with Python scalars for the tests: the same
+    iteration, a fraction of the numpy calls (the cost of a single pose is per-call overhead)."""
+    bounds = res.m.bounds
+    inv_cap = 4.0 / (bounds[:, 1] - bounds[:, 0])
+    idx = np.zeros(1, dtype=np.intp)
+    rj = res.rj
+    r, J, ne, nj = rj(x[None], idx)
+    r, J = r[0], J[0]
+    F = float(r @ r)
+    calls, extra = 1, 0
+    for _ in range(iterations):
+        rmax = float(np.abs(r).max())
+        if not rmax > ftol:
+            break
+        try:
+            d = np.linalg.solve(J, r) if J.shape[0] == J.shape[1] else None
+        except np.linalg.LinAlgError:
+            d = None
+        big = np.inf if d is None else float((np.abs(d) * inv_cap).max())
+        if not big <= 1.0:
+            if not np.isfinite(big):
+                A = J.T @ J
+                A += 1e-9 * np.trace(A) * np.eye(len(A))
+                d = np.linalg.solve(A, J.T @ r)
+                d[~np.isfinite(d)] = 0.0
+                big = float((np.abs(d) * inv_cap).max())
+            if big > 1.0:
+                d = d / big
+        xt = x - d
+        rt, Jt, _, _ = rj(xt[None], idx)
+        rt, Jt = rt[0], Jt[0]
+        calls += 1
+        Ft = float(rt @ rt)
+        if not Ft < F:
+            step, moved = 1.0, False
+            for _ in range(halvings):
+                step *= 0.5
+                xb = x - step * d
+                rb = res.r(xb[None], idx)[0]
+                extra += 1
+                Fb = float(rb @ rb)
+                if Fb < F:
+                    xt, rt, Ft, moved = xb, rb, Fb, True
+                    break
+            if not moved:
+                break
+            _, Jt, _, _ = rj(xt[None], idx)
+            Jt = Jt[0]
+            calls += 1
+        x, r, J, F = xt, rt, Jt, Ft
+    evals[0][0] += calls * ne + extra
+    evals[1][0] += calls * nj
+    rmax = float(np.abs(r).max())
+    return x[None], np.array([rmax if np.isfinite(rmax) else np.inf])
+
+
 def _verify(mechanism, L, x, resid, tol):
     """Angle variables moved by multiples of 360 deg into the bounds (when possible), and the
     verdict: (x, max |ik(x) - L| with angle joints wrapped, solved). ``resid`` is the residual
@@ -345,7 +403,10 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
     ftol = 0.01 * tol
     all_rows = np.arange(N)
     with np.errstate(all="ignore"):
-        x, rx = _newton(res, x0, all_rows, ftol, evals)
+        if N == 1:
+            x, rx = _newton1(res, np.array(x0[0], dtype=float), ftol, evals)
+        else:
+            x, rx = _newton(res, x0, all_rows, ftol, evals)
         x, resid, solved = _verify(m, L, x, rx, tol)
         stage = np.where(solved, 0, -1)
         todo = np.flatnonzero(~solved)
