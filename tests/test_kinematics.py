@@ -129,3 +129,16 @@ def test_ik_cli_exit_codes():
     assert "position error" in swarm.stderr
     assert cli("ik", "7dof-arm", "--pose", "x=0,y=0,z=5000,alpha=0,beta=0,gamma=0").returncode == 2
     assert cli("ik", "3-rps", "--pose", "alpha=50,beta=0,z=600").returncode == 2
+
+
+@pytest.mark.parametrize("args", [["list", "--json"],
+                                  ["fk", "6-sps-cmm", "--joints", "l1=0.75,l2=0.78,l3=0.8,l4=0.9,l5=0.87,l6=0.85"],
+                                  ["ik", "3-rps", "--pose", "alpha=9,beta=13,z=622"]])
+def test_light_commands_import_no_heavy_layers(args):
+    proc = subprocess.run([sys.executable, "-X", "importtime", "-m", "fkopt.cli", *args],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-500:]
+    imported = {line.split("|")[-1].strip() for line in proc.stderr.splitlines() if "|" in line}
+    heavy = {m for m in imported if m.split(".")[0] in ("pandas", "matplotlib")
+             or m.startswith(("fkopt.experiment", "fkopt.study", "fkopt.reproduce"))}
+    assert not heavy, sorted(heavy)
