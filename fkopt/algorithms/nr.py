@@ -10,8 +10,9 @@ Choices fkopt makes (the paper prints none of them):
 
 * Jacobian: ``problem.jacobian`` when the problem has an analytic one (``has_jacobian``: every
   built-in mechanism), charged as 1 evaluation. Otherwise (fallback) central differences,
-  vectorised over every (run, start) point at once: the 2*dim perturbed points x +- h_j e_j of all points are evaluated in one ``residuals`` call,
-  h_j = ``jac_step`` * (box width of coordinate j) (default 1e-6 of the width: central
+  vectorised over every (run, start) point at once: the 2*dim perturbed points x +- h_j e_j
+  of all points are evaluated in one ``residuals`` call, h_j = ``jac_step`` * (box width of
+  coordinate j) (default 1e-6 of the width: central
   differences err by O(h^2), rounding by O(eps |r| / h), both far below what Newton needs).
 * Start points: ``x0`` given as one point (dim,) is used by every run; as (n, dim) row k is
   the start of run k (rows are indexed by run id, so batch and one-run-at-a-time modes agree).
