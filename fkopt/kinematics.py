@@ -10,7 +10,8 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
    r(x) = ik(x) - joints with the mechanism's analytic Jacobian (``ik_jacobian``; central
    differences for a mechanism without one), from ``start`` or the centre of the bounds. A step
    that does not decrease |r|^2 is halved (up to 10 times); steps are capped at a quarter of the
-   box width per coordinate. At most 30 iterations.
+   box width per coordinate. At most 30 iterations. A single row takes the same iteration with
+   scalar tests (its cost is numpy's per-call overhead).
 2. Rows not solved restart the same Newton from a few deterministic starts: the centre moved by
    +-1/4 of the box width along each coordinate (2 n starts), all rows at once.
 3. Rows still not solved go to a seeded global search, one row at a time: ``gabc+lm``
@@ -39,18 +40,22 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   pseudo-inverse above (off by default: it slows convergence to the task);
 * seeded random restarts: a candidate that has not converged after ``iterations`` (12) steps, or
   stalls (lambda above 1e6), restarts from joints uniform inside the limits, drawn from
-  a counter-based hash of (seed, row index, draw number), at most ``restarts`` times; when
-  fewer than ``fill`` candidates remain in the batch, every unsolved row gets more candidates at
-  once (so a single pose is solved from ~``fill`` starts side by side). These restarts are
+  a counter-based hash of (seed, row index, draw number), at most ``restarts`` times. A batch
+  of N < ``fill`` rows starts with ``fill // N`` candidates per row (``start``, or mid-range,
+  and random ones: a single pose is solved from 32 starts side by side), and whenever fewer
+  than ``fill`` candidates remain, every unsolved row gets more at once. These restarts are
   inverse's global stage (seeded random restarts of a local method with limits, rather than a
   swarm). Same poses and seed give the same answer; a row's answer may differ between batches.
 
 **Verdicts.** ``solved`` is true only when the closed form of the answer reproduces the input
 within ``tol`` and the answer is inside the bounds: forward, max |ik(pose) - joints| <= ``tol``
 (joint units; default 1e-9) and the pose inside ``mechanism.bounds`` (angles may be moved by
-multiples of 360 deg); any assembly mode that does so is a solution. Inverse, distance between
+multiples of 360 deg); any assembly mode that does so is a solution. The residual is the one
+the Newton loop evaluated at the answer with ``ik_jacobian`` (the same closed form; a row whose
+angles were moved into the bounds is evaluated again with ``ik``). Inverse, distance between
 fk(joints) and the target position <= ``tol[0]`` (length unit; default 1e-6) and geodesic angle
-<= ``tol[1]`` (radians; default 1e-6), every joint inside its limits.
+<= ``tol[1]`` (radians; default 1e-6), every joint inside its limits, evaluated with the arm's
+elementwise :meth:`DHArm.frame` (the numbers of ``fk``), not with the solver's products.
 
 **Evaluations** are counted per row and separately: ``evaluations["residual"]`` counts
 evaluations of the closed form (the inverse map for forward, the arm's forward map for inverse),
