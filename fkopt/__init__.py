@@ -8,12 +8,16 @@ Python API::
     problem = fkopt.fk_problem(m, joints)           # forward kinematics as a minimisation
     result = fkopt.solve(problem, "gabc", population=10, iterations=600, runs=30, seed=1)
     result.x[result.median_run], result.history     # per-run answers and best-so-far curves
+
+    fk = fkopt.forward("6-sps-cmm", legs)           # exact solvers, batched over leading axes:
+    ik = fkopt.inverse("7dof-arm", poses)           # .pose / .joints, .residual, .solved, .evaluations
 """
 from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version as _version
 
 from .errors import FkoptError
+from .kinematics import ForwardResult, InverseResult, forward, inverse
 from .problems import FKProblem, IKProblem, fk_problem, ik_problem
 from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
 from .solve import Result, solve
@@ -35,5 +39,5 @@ def algorithm(name: str, **params):
 
 
 __all__ = ["FkoptError", "FKProblem", "IKProblem", "Result", "algorithm", "fk_problem", "ik_problem",
-           "mechanism", "solve",
+           "mechanism", "solve", "forward", "inverse", "ForwardResult", "InverseResult",
            "MECHANISMS", "ALGORITHMS", "__version__"]

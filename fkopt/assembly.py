@@ -15,7 +15,8 @@ many inputs as pose variables:
 2. **Damped Newton**, vectorised over all starts of a round: for 6-SPS on the leg equations
    (|v_i|^2 - L_i^2) / (2 L_i) = 0 with the analytic Jacobian [v_i, (R q_i) x v_i] / L_i in the
    position and a rotation vector (R <- exp([w]x) R, so no Euler singularity during the
-   search); for other mechanisms on ``FKProblem.residuals`` with a central-difference Jacobian.
+   search); for other mechanisms on ``FKProblem.residuals`` with ``FKProblem.jacobian`` (central
+   differences only for a mechanism without an analytic Jacobian).
    Steps are capped (6-SPS: 2 rad of rotation and one mechanism size of translation; others:
    a quarter of the bounds width) and halved up to 8 times until the squared residual
    decreases (backtracking line search). A start stops when converged (then one more
@@ -37,7 +38,8 @@ many inputs as pose variables:
    ``Solutions.outside``).
 
 Rounds continue until ``patience`` consecutive rounds bring no new solution in the bounds,
-after at least ``min_starts`` (or until ``max_starts``); ``starts=N`` instead runs exactly N
+after at least ``min_starts`` (or until ``max_starts``), or until ``maximum`` distinct real
+solutions are known (40 for a 6-SPS platform: no more can exist); ``starts=N`` instead runs exactly N
 starts in one round. ``Solutions.history`` records (starts, seconds, solutions in the bounds)
 after every round.
 
@@ -323,7 +325,8 @@ class _SixSPSModel(_Model):
 
 
 class _GenericModel(_Model):
-    """Newton on FKProblem residuals in the mechanism's own pose variables (central differences)."""
+    """Newton on FKProblem residuals in the mechanism's own pose variables (the mechanism's
+    analytic Jacobian; central differences for a mechanism without one)."""
 
     def __init__(self, mechanism, joints):
         self.problem = FKProblem(mechanism, joints)
@@ -342,6 +345,8 @@ class _GenericModel(_Model):
         return self.problem.residuals(S)
 
     def residual_jacobian(self, S):
+        if self.problem.has_jacobian:
+            return self.problem.residuals(S), self.problem.jacobian(S)
         n, d = S.shape
         E = np.eye(d) * self.h
         pts = np.concatenate([S[:, None, :], S[:, None, :] + E, S[:, None, :] - E], axis=1)
@@ -549,7 +554,7 @@ def pose_distance(mechanism: ParallelMechanism, a, b) -> np.ndarray:
 def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = None, seed: int = 0,
                   tol: float = 1e-9, dedup: float = 1e-6, round_size: int | None = None,
                   patience: int = 1, min_starts: int | None = None, max_starts: int = 200_000,
-                  iterations: int = 60) -> Solutions:
+                  iterations: int = 60, maximum: int | None = None) -> Solutions:
     """Every distinct real forward solution of ``mechanism`` for ``joints`` inside its bounds.
 
     ``starts``: run exactly this many starts (one round); by default rounds of ``round_size``
@@ -558,6 +563,10 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     ``tol``: accepted residual, ``max_i |ik(pose)_i - joints_i| / max(1, |joints_i|)``.
     ``dedup``: duplicate tolerance in the normalised pose space (see the module docstring).
     ``seed``: the start stream (``RunStreams(seed, [0])``); same seed, same answer.
+    ``maximum``: the most assembly modes the mechanism can have; the search stops as soon as
+    that many distinct real solutions (inside or outside the bounds) are found, since no more
+    can exist. Default 40 for a 6-SPS platform (the number of complex solutions of the general
+    6-6 Stewart-Gough platform: Raghavan 1993, Ronga & Vust 1995), none otherwise.
     """
     if not isinstance(mechanism, ParallelMechanism):
         raise FkoptError(f"all_solutions needs a parallel mechanism; '{mechanism.name}' is {mechanism.kind}")
@@ -580,6 +589,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         size = int(round_size or (2000 if isinstance(model, _SixSPSModel) else 200))
         limit, need = int(max_starts), int(min_starts if min_starts is not None else 2 * size)
     streams = RunStreams(seed, [0])
+    cap = maximum if maximum is not None else (40 if isinstance(model, _SixSPSModel) else None)
     jscale = np.maximum(1.0, np.abs(joints))
     ftol = 1e-3 * tol * float(jscale.min())           # Newton's own stop, well below the acceptance
 
@@ -616,6 +626,8 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         quiet = quiet + 1 if inside == inside_before else 0
         if used >= need and quiet >= patience:
             break
+        if cap is not None and len(found) >= cap:     # every assembly mode is found
+            break
 
     out = Solutions(sorted((Solution(pose=dict(zip(mechanism.pose_names, map(float, f[0]))), residual=f[1], hits=h)
                             for f, h in zip(found, hits) if f is not None), key=lambda s: -s.hits))
@@ -625,7 +637,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     out.time_s = time.perf_counter() - t0
     out.history = history
     out.settings = dict(seed=seed, tol=tol, dedup=dedup, round_size=size, patience=patience,
-                        iterations=iterations)
+                        iterations=iterations, maximum=cap)
     return out
 
 

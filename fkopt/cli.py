@@ -215,32 +215,66 @@ def _print_summary(con, df, folder: Path, wall: float) -> None:
     con.print(table)
 
 
+def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
+    """A computed answer that is not a solution within tolerance: the best answer on stdout
+    (JSON with ``"solved": false``, or nothing), one line on stderr, exit status 1."""
+    if as_json:
+        typer.echo(json.dumps(data))
+    print(f"fkopt: error: {message}", file=sys.stderr)
+    raise typer.Exit(1)
+
+
 @app.command()
 def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
        geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
-       algorithm: Optional[str] = typer.Option(None, "--algorithm", help="solver for a serial arm"),
+       algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered swarm/local solver for "
+                                               "a serial arm instead of fkopt.inverse"),
        seed: int = typer.Option(0, "--seed", min=0),
+       position_tol: float = typer.Option(1e-6, "--position-tol", help="largest accepted position error "
+                                          "(the arm's length unit)"),
+       orientation_tol: float = typer.Option(1e-6, "--orientation-tol", help="largest accepted geodesic "
+                                             "orientation error (radians)"),
        as_json: bool = typer.Option(False, "--json")):
-    """Inverse kinematics: closed form for a parallel mechanism, solved for a serial arm."""
+    """Inverse kinematics: closed form for a parallel mechanism, fkopt.inverse for a serial arm.
+
+    Exit 1 (one line on stderr) when the answer is not a solution within the tolerances; exit 2
+    for bad input (non-finite values, a pose outside the workspace or beyond the arm's reach)."""
     m = _mechanism(mech, geometry)
-    values = m.vector(parse_assignments(pose, "--pose"), m.pose_names, "--pose")
+    values = m.as_values(parse_assignments(pose, "--pose"), m.pose_names, "--pose")
     if m.kind == "parallel":
         if algorithm:
             raise FkoptError(f"--algorithm: '{mech}' has a closed-form inverse map; no solver is used")
+        if not m.in_bounds(values):
+            box = ", ".join(f"{n} [{lo:g}, {hi:g}]" for n, (lo, hi) in zip(m.pose_names, m.bounds.tolist()))
+            raise FkoptError(f"--pose: outside the workspace of {mech} ({box})")
         joints = m.ik(values)
         _emit({"joints": dict(zip(m.joint_names, map(float, joints)))}, as_json, m.joint_units)
         return
-    from . import problems, solve
-    problem = problems.ik_problem(m, values)
-    name = algorithm or _default_algorithm()
-    res = solve(problem, name, population=50, iterations=500, runs=1, seed=seed)
-    q = res.x[0]
-    out = {"joints": dict(zip(m.joint_names, map(float, q))), "fitness": float(res.fitness[0]),
-           "objective": problem.objective, "algorithm": name}
-    if hasattr(problem, "position_error"):
-        out["position_error"] = float(problem.position_error(q))
-        out["rotation_error_deg"] = float(problem.rotation_error(q))
+    for name, value in (("--position-tol", position_tol), ("--orientation-tol", orientation_tol)):
+        if not (np.isfinite(value) and value > 0):
+            raise FkoptError(f"{name}: must be a positive number, got {value}")
+    if algorithm:
+        from . import problems, solve
+        problem = problems.ik_problem(m, values, objective="geodesic")
+        res = solve(problem, algorithm, population=50, iterations=500, runs=1, seed=seed)
+        q = res.x[0]
+        perr = float(problem.position_error(q))
+        rerr = float(np.radians(problem.rotation_error(q, "geodesic")))
+        out = {"joints": dict(zip(m.joint_names, map(float, q))), "position_error": perr,
+               "rotation_error_rad": rerr, "fitness": float(res.fitness[0]), "objective": problem.objective,
+               "solved": bool(perr <= position_tol and rerr <= orientation_tol), "algorithm": algorithm}
+    else:
+        from .kinematics import inverse
+        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed)
+        out = r.as_dict()
+        out["algorithm"] = "inverse"
+        perr, rerr = out["position_error"], out["rotation_error_rad"]
+    if not out["solved"]:
+        unit = m.pose_units[0]
+        _not_solved(f"no joints within the limits reach this pose: best position error {perr:.3g} {unit}, "
+                    f"orientation error {rerr:.3g} rad (tolerances {position_tol:g} {unit}, "
+                    f"{orientation_tol:g} rad)", out, as_json, m.joint_units)
     _emit(out, as_json, m.joint_units)
 
 
@@ -248,19 +282,28 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
 def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        joints: str = typer.Option(..., "--joints", help="e.g. d1=598.85,d2=671.92,d3=629.16"),
        geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
-       algorithm: Optional[str] = typer.Option(None, "--algorithm", help=f"default: first of {', '.join(RELIABLE)} available"),
+       algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered solver (e.g. gabc+lm) "
+                                               "instead of fkopt.forward"),
        seed: int = typer.Option(0, "--seed", min=0),
-       tolerance: float = typer.Option(1e-6, "--tolerance", help="largest residual (joint units) accepted as a solution"),
+       tolerance: float = typer.Option(1e-9, "--tolerance", help="largest residual max |ik(pose) - joints| "
+                                       "(joint units) accepted as a solution"),
        all_solutions: bool = typer.Option(False, "--all-solutions", help="every distinct real solution in the bounds"),
        as_json: bool = typer.Option(False, "--json")):
-    """Forward kinematics: solved for a parallel mechanism, closed form for a serial arm."""
+    """Forward kinematics: fkopt.forward for a parallel mechanism, closed form for a serial arm.
+
+    Exit 1 (one line on stderr) when no pose within the bounds reproduces the joints within
+    --tolerance (the best residual is reported); exit 2 for bad input."""
     m = _mechanism(mech, geometry)
-    values = m.vector(parse_assignments(joints, "--joints"), m.joint_names, "--joints")
+    values = m.as_values(parse_assignments(joints, "--joints"), m.joint_names, "--joints")
     if m.kind == "serial":
+        if not m.in_bounds(values):
+            box = ", ".join(f"{n} [{lo:g}, {hi:g}]" for n, (lo, hi) in zip(m.joint_names, m.bounds.tolist()))
+            raise FkoptError(f"--joints: outside the joint limits of {mech} ({box})")
         pose = m.fk(values)
         _emit({"pose": dict(zip(m.pose_names, map(float, pose)))}, as_json, m.pose_units)
         return
-    from . import fk_problem, solve
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise FkoptError(f"--tolerance: must be a positive number, got {tolerance}")
     if all_solutions:
         from .assembly import all_solutions as find_all, solutions_to_dict
         found = find_all(m, values, seed=seed)
@@ -272,16 +315,27 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
             for s in data["solutions"]:
                 _console().print(s)
         return
-    problem = fk_problem(m, values)
-    name = algorithm or _default_algorithm()
-    res = solve(problem, name, population=20, iterations=300, runs=1, seed=seed)
-    x = res.x[0]
-    residual = float(np.max(np.abs(problem.residuals(x))))
-    if not residual <= tolerance:
-        raise FkoptError(f"no pose within the bounds reproduces these joints: best residual {residual:.3g} "
-                         f"(joint units) at {', '.join(f'{n}={v:.6g}' for n, v in zip(m.pose_names, x))}")
-    _emit({"pose": dict(zip(m.pose_names, map(float, x))), "fitness": float(res.fitness[0]),
-           "residual": residual, "algorithm": name}, as_json, m.pose_units)
+    if algorithm:
+        from . import fk_problem, solve
+        problem = fk_problem(m, values)
+        res = solve(problem, algorithm, population=20, iterations=300, runs=1, seed=seed)
+        x = res.x[0]
+        residual = float(np.max(np.abs(problem.residuals(x))))
+        out = {"pose": dict(zip(m.pose_names, map(float, x))), "residual": residual,
+               "solved": bool(residual <= tolerance and m.in_bounds(x)), "algorithm": algorithm}
+    else:
+        from .kinematics import forward
+        r = forward(m, values, tol=tolerance, seed=seed)
+        out = r.as_dict()
+        out["algorithm"] = "forward"
+        x = r.pose
+    rr = m.ik(x) - values
+    out["fitness"] = float(np.sum(rr * rr))
+    if not out["solved"]:
+        _not_solved(f"no pose within the bounds reproduces these joints: best residual {out['residual']:.3g} "
+                    f"(joint units; tolerance {tolerance:g}) at "
+                    f"{', '.join(f'{n}={v:.6g}' for n, v in out['pose'].items())}", out, as_json, m.pose_units)
+    _emit(out, as_json, m.pose_units)
 
 
 def _emit(data: dict, as_json: bool, units) -> None:
@@ -292,6 +346,8 @@ def _emit(data: dict, as_json: bool, units) -> None:
     for (name, value), unit in zip(data[key].items(), units):
         typer.echo(f"{name:>8} = {value:.10g} {unit}")
     for name, value in data.items():
+        if isinstance(value, dict) and name != key:
+            value = ", ".join(f"{k} {v}" for k, v in value.items())
         if name != key:
             typer.echo(f"{name:>8}: {value:.6g}" if isinstance(value, float) else f"{name:>8}: {value}")
 

@@ -37,6 +37,14 @@ class Problem:
     def residuals(self, x) -> np.ndarray:
         raise NotImplementedError
 
+    #: True when :meth:`jacobian` is analytic (solvers use it instead of central differences).
+    has_jacobian: bool = False
+
+    def jacobian(self, x) -> np.ndarray:
+        """d(residuals)/dx (..., m, dim); NotImplementedError when the mechanism has no analytic
+        Jacobian (solvers then fall back to central differences)."""
+        raise NotImplementedError
+
 
 class FKProblem(Problem):
     """Forward kinematics of a parallel mechanism: find the pose whose inverse map gives ``joints``.
@@ -60,12 +68,20 @@ class FKProblem(Problem):
         self.variable_units = mechanism.pose_units
         self.bounds = mechanism.bounds if bounds is None else np.asarray(bounds, dtype=float)
         self._angle = mechanism.angle_mask(mechanism.joint_units)
+        self.has_jacobian = hasattr(mechanism, "jacobian")
 
     def residuals(self, x) -> np.ndarray:
         r = self.mechanism.ik(x) - self.joints
         if self._angle.any():
             r = np.where(self._angle, wrap_degrees(r), r)
         return r
+
+    def jacobian(self, x) -> np.ndarray:
+        """d(residuals)/d(pose) (..., m, dim) = the mechanism's analytic ``jacobian`` (the
+        wrap of angle-valued joints has derivative 1 wherever it is continuous)."""
+        if not hasattr(self.mechanism, "jacobian"):
+            raise NotImplementedError
+        return self.mechanism.jacobian(x)
 
     def fitness(self, x) -> np.ndarray:
         r = self.residuals(x)
@@ -82,6 +98,22 @@ def fk_problem(mechanism: Mechanism, joints, **kwargs) -> FKProblem:
 #: Orientation errors of :class:`IKProblem`: "paper" = Euclidean norm of the wrapped Z-Y-Z Euler
 #: differences (wang7dof), "geodesic" = rotation angle of R_target^T R.
 IK_OBJECTIVES = ("paper", "geodesic")
+
+
+def so3_right_jacobian_inverse(e) -> np.ndarray:
+    """J_r^{-1}(e) (..., 3, 3) of rotation vectors e (..., 3): d log(M) = J_r^{-1} (M^T dM)^vee."""
+    e = np.asarray(e, dtype=float)
+    th2 = (e * e).sum(-1)
+    th = np.sqrt(th2)
+    small = th2 < 1e-8
+    ths = np.where(small, 1.0, th)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.where(small, 1.0 / 12.0 + th2 / 720.0,
+                     1.0 / (ths * ths) - (1.0 + np.cos(ths)) / (2.0 * ths * np.sin(ths)))
+    K = np.zeros(e.shape[:-1] + (3, 3))
+    K[..., 0, 1], K[..., 0, 2], K[..., 1, 2] = -e[..., 2], e[..., 1], -e[..., 0]
+    K[..., 1, 0], K[..., 2, 0], K[..., 2, 1] = e[..., 2], -e[..., 1], e[..., 0]
+    return np.eye(3) + 0.5 * K + c[..., None, None] * (K @ K)
 
 
 def _norm3(a, b, c):
@@ -143,6 +175,7 @@ class IKProblem(Problem):
         self.bounds = mechanism.bounds if bounds is None else np.asarray(bounds, dtype=float)
         self._euler_target = np.radians(self.target[3:])
         self._R_target = rotations.zyz(*self._euler_target)
+        self.has_jacobian = hasattr(mechanism, "frame_jacobian")
 
     # -- pieces ------------------------------------------------------------------------------
     def _frame(self, x):
@@ -167,6 +200,29 @@ class IKProblem(Problem):
         e = self._euler_diff(R) if self.objective == "paper" else rotations.rotation_vector(self._R_target, R)
         return np.stack([self.w_p * dp[0], self.w_p * dp[1], self.w_p * dp[2],
                          self.w_r * e[0], self.w_r * e[1], self.w_r * e[2]], axis=-1)
+
+    def jacobian(self, x) -> np.ndarray:
+        """d(residuals)/d(joints) (..., 6, n) from the arm's frame Jacobian (``frame_jacobian``).
+
+        Position rows: w_p dp/dq. Orientation rows: paper objective, w_r times the Z-Y-Z
+        Euler rates (:meth:`DHArm.euler_rates`, infinite at sin(beta) = 0); geodesic, w_r times
+        d log(R_t^T R) = J_r^{-1}(e) R^T omega with the inverse right Jacobian of SO(3)
+        J_r^{-1}(e) = I + [e]x / 2 + (1/theta^2 - (1 + cos theta) / (2 theta sin theta)) [e]x^2.
+        """
+        if not hasattr(self.mechanism, "frame_jacobian"):
+            raise NotImplementedError
+        x = np.asarray(x, dtype=float)
+        _, R, J = self.mechanism.frame_jacobian(x)
+        out = np.empty(J.shape)
+        out[..., :3, :] = self.w_p * J[..., :3, :]
+        if self.objective == "paper":
+            out[..., 3:, :] = self.w_r * self.mechanism.euler_rates(R, J[..., 3:, :])
+            return out
+        body = np.swapaxes(R, -1, -2) @ J[..., 3:, :]               # R^T omega
+        Rs = tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3))
+        e = np.stack(rotations.rotation_vector(self._R_target, Rs), axis=-1)
+        out[..., 3:, :] = self.w_r * (so3_right_jacobian_inverse(e) @ body)
+        return out
 
     def fitness(self, x) -> np.ndarray:
         p, R = self._frame(x)

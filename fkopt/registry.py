@@ -27,6 +27,7 @@ ALGORITHMS: dict[str, str] = {
     "pabc": "fkopt.algorithms.pabc:PABC",
     "nr": "fkopt.algorithms.nr:NR",
     "lm": "fkopt.algorithms.lm:LM",
+    "dls": "fkopt.algorithms.dls:DLS",
     "abc+lm": "fkopt.algorithms.hybrid:ABCLM",
     "gabc+lm": "fkopt.algorithms.hybrid:GABCLM",
     "pso+lm": "fkopt.algorithms.hybrid:PSOLM",

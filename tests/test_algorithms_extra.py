@@ -202,8 +202,8 @@ def test_nr_quadratic_convergence_on_rps(rps):
         if a < 1.0 and b > 1e-24:                             # above the rounding floor (~1e-26)
             assert b <= 10 * a * a                            # |r_{k+1}| <~ C |r_k|^2
     np.testing.assert_allclose(res.x[0], [9, 13, 622], atol=1e-9)
-    assert res.evaluation_history[0, 0] == 7                 # r and the central-difference J: 1 + 2*3
-    assert res.evaluation_history[0, 1] == 14
+    assert res.evaluation_history[0, 0] == 2                 # r and the analytic J (1 + 1)
+    assert res.evaluation_history[0, 1] == 4
     assert res.extras["singular"].max() == 0
 
 
@@ -277,7 +277,7 @@ def test_hybrid_phases(rps, name):
     np.testing.assert_array_equal(res.evaluation_history[:, :31], swarm.evaluation_history)
     assert np.all(np.diff(res.history, axis=1) <= 0)
     d = np.diff(res.evaluation_history[:, 30:], axis=1)
-    assert np.all(d[:, 0] >= 1 + 2 * 3 + 1)                  # LM start (r, J) + first trial
+    assert np.all(d[:, 0] >= 1 + 1 + 1)                      # LM start (r, analytic J) + first trial
     assert np.all(d[:, 1:] <= 1 + 2 * 3)                     # then at most one trial + J per run
     assert np.all(res.fitness < 1e-18)
     assert fkopt.algorithm(name).swarm_phase(600) == 120     # default: 20 % of the iterations

@@ -19,8 +19,8 @@ Choices fkopt makes:
   numpy/LAPACK build on one CPU (tested), but not across builds or CPUs (other kernels).
 * Bounds by projection: the trial point is clipped onto the box (so LM can stall on a bound
   when the unconstrained step points outside; the 3-RPS solutions are interior).
-* Jacobian by central differences, as in :mod:`fkopt.algorithms.nr` (``jac_step`` of the box
-  width), recomputed only at accepted points.
+* Jacobian: the problem's analytic one when it has one, else central differences, as in
+  :mod:`fkopt.algorithms.nr` (``jac_step`` of the box width); recomputed only at accepted points.
 * Start points as in :mod:`fkopt.algorithms.nr`: ``x0`` (one point, or one row per run id), or
   ``population`` uniform random starts per run when ``x0`` is None.
 * A point stops (frozen, no more evaluations) when its fitness is 0, when an accepted step is
@@ -28,8 +28,9 @@ Choices fkopt makes:
   possible at working precision).
 * ``state.f`` is ``problem.fitness`` (the reported objective); acceptance uses S(x). For the
   default squared objective they coincide.
-* Evaluations: residual evaluations, 1 + 2*dim per point at the start, then per active point
-  and iteration 1 for the trial plus 2*dim when it is accepted (new Jacobian).
+* Evaluations: 1 + c per point at the start, then per active point and iteration 1 for the
+  trial plus c when it is accepted (new Jacobian); c = 1 for an analytic Jacobian, 2*dim for
+  central differences.
 """
 from __future__ import annotations
 
@@ -37,7 +38,7 @@ import numpy as np
 from pydantic import Field
 
 from .base import Algorithm, Params, State, clip
-from .nr import jacobian, jacobian_steps, residuals_of, scaled_step, start_points
+from .nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, scaled_step, start_points
 
 
 class LMParams(Params):
@@ -74,7 +75,7 @@ class LMCore:
         ok = np.isfinite(s) & np.all(np.isfinite(J), axis=(-2, -1))
         st = State(x=np.array(x, dtype=float), f=np.array(f, dtype=float), r=r, s=s, J=J, h=h,
                    lam=np.full(s.shape, self.params.damping), active=ok & (f > 0))
-        return st, np.full(x.shape[0], x.shape[1] * (1 + 2 * problem.dim), dtype=np.int64)
+        return st, np.full(x.shape[0], x.shape[1] * (1 + jacobian_cost(problem)), dtype=np.int64)
 
     def step(self, st: State, problem) -> np.ndarray:
         """One trial step of every active point; returns evaluations used per run."""
@@ -107,7 +108,7 @@ class LMCore:
             st.s[rows, cols] = s_try[accept]
             st.f[rows, cols] = problem.fitness(xa)
             st.J[rows, cols] = jacobian(problem, xa, st.h)
-            evals += np.bincount(rows, minlength=runs) * 2 * problem.dim
+            evals += np.bincount(rows, minlength=runs) * jacobian_cost(problem)
         st.lam[act] = lam
         finite_J = np.all(np.isfinite(st.J[act]), axis=(-2, -1))
         st.active[act] = ~small & (lam <= p.lambda_max) & (st.f[act] > 0) & finite_J

@@ -8,9 +8,11 @@ unknowns):
 
 Choices fkopt makes (the paper prints none of them):
 
-* Jacobian: central differences, vectorised over every (run, start) point at once: the 2*dim
-  perturbed points x +- h_j e_j of all points are evaluated in one ``residuals`` call,
-  h_j = ``jac_step`` * (box width of coordinate j) (default 1e-6 of the width: central
+* Jacobian: ``problem.jacobian`` when the problem has an analytic one (``has_jacobian``: every
+  built-in mechanism), charged as 1 evaluation. Otherwise (fallback) central differences,
+  vectorised over every (run, start) point at once: the 2*dim perturbed points x +- h_j e_j
+  of all points are evaluated in one ``residuals`` call, h_j = ``jac_step`` * (box width of
+  coordinate j) (default 1e-6 of the width: central
   differences err by O(h^2), rounding by O(eps |r| / h), both far below what Newton needs).
 * Start points: ``x0`` given as one point (dim,) is used by every run; as (n, dim) row k is
   the start of run k (rows are indexed by run id, so batch and one-run-at-a-time modes agree).
@@ -30,8 +32,8 @@ Choices fkopt makes (the paper prints none of them):
   the start *every* point of some run has a singular Jacobian (and none is already a solution),
   ``initialize`` raises FkoptError("... singular Jacobian at start point ...") -- that is a bad
   start chosen by the user, so the API and the CLI both report it.
-* Evaluations are residual evaluations: 1 + 2*dim per point at the start (r and J) and per step
-  (r and J at the new point); frozen points cost nothing.
+* Evaluations: 1 (r) + 1 (analytic J) or 2*dim (central differences) per point at the start and
+  per step (r and J at the new point); frozen points cost nothing.
 """
 from __future__ import annotations
 
@@ -94,7 +96,25 @@ def jacobian_steps(bounds: np.ndarray, jac_step: float) -> np.ndarray:
     return jac_step * (bounds[:, 1] - bounds[:, 0])
 
 
+def analytic_jacobian(problem) -> bool:
+    """Does the problem supply its own (analytic) ``jacobian``? Else central differences."""
+    return bool(getattr(problem, "has_jacobian", False))
+
+
+def jacobian_cost(problem) -> int:
+    """Evaluations charged for one Jacobian: 1 when analytic (one call of ``problem.jacobian``,
+    costing about one residual evaluation), 2*dim residual evaluations by central differences."""
+    return 1 if analytic_jacobian(problem) else 2 * problem.dim
+
+
 def jacobian(problem, x: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """``problem.jacobian(x)`` when the problem has one, else central differences (below)."""
+    if analytic_jacobian(problem):
+        return np.asarray(problem.jacobian(x), dtype=float)
+    return fd_jacobian(problem, x, h)
+
+
+def fd_jacobian(problem, x: np.ndarray, h: np.ndarray) -> np.ndarray:
     """Central-difference Jacobian (..., m, dim) of the residuals at points x (..., dim)."""
     dim = x.shape[-1]
     e = np.eye(dim) * h
@@ -144,7 +164,7 @@ class NR(Algorithm):
         active = (f > 0) & ~singular & np.isfinite(f)
         n = x.shape[1]
         return State(x=x, f=f, r=r, J=J, h=h, active=active, singular=singular,
-                     evaluations=np.full(streams.runs, n * (1 + 2 * problem.dim), dtype=np.int64))
+                     evaluations=np.full(streams.runs, n * (1 + jacobian_cost(problem)), dtype=np.int64))
 
     def extras(self, state):
         return {"singular": state.singular.any(axis=1).astype(float)}
@@ -172,4 +192,4 @@ class NR(Algorithm):
         state.J[act] = np.where(keep[..., None], J_new, J)
         state.singular[act] = singular
         state.active[act] = ok & ~singular & ~small & (f_new > 0)
-        state.evaluations = state.evaluations + act.sum(axis=1) * (1 + 2 * problem.dim)
+        state.evaluations = state.evaluations + act.sum(axis=1) * (1 + jacobian_cost(problem))

@@ -151,6 +151,13 @@ class ParallelMechanism(Mechanism):
         """Actuator inputs for poses shaped (..., len(pose_names)) -> (..., len(joint_names))."""
         raise NotImplementedError
 
+    # Mechanisms with an analytic Jacobian define ``jacobian(poses) -> (..., m, n)``:
+    # d(actuator inputs)/d(pose) in the public units (per degree for angles).
+
+    def ik_jacobian(self, poses) -> tuple[np.ndarray, np.ndarray]:
+        """``(ik(poses), jacobian(poses))``; mechanisms may compute both in one pass."""
+        return self.ik(poses), self.jacobian(poses)
+
 
 class SerialMechanism(Mechanism):
     """Closed form is the forward map joints -> pose; IK is solved numerically."""

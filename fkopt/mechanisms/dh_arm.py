@@ -29,6 +29,9 @@ from .. import rotations
 from ..errors import FkoptError, did_you_mean
 from .base import Geometry, SerialMechanism, describe_validation_error
 
+#: Batch size from which :meth:`DHArm.frame_jacobian` works elementwise rather than by 4x4 products.
+_SOA_MIN = 128
+
 WANG7DOF = dict(
     a=[0.0, 200.0, 250.0, 300.0, 200.0, 200.0, 100.0],
     alpha=[-90.0, 90.0, -90.0, 90.0, -90.0, 0.0, 0.0],
@@ -135,6 +138,125 @@ class DHArm(SerialMechanism):
             R = tuple(tuple(R[r][0] * Ai[0][c] + R[r][1] * Ai[1][c] + R[r][2] * Ai[2][c]
                             for c in range(3)) for r in range(3))
         return p, R
+
+    def frame_jacobian(self, joints) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """End-effector position (..., 3), rotation (..., 3, 3) and frame Jacobian (..., 6, n).
+
+        Rows 0-2 of the Jacobian are d(position)/dq (length unit per degree), rows 3-5 the
+        angular velocity in the base frame per degree of joint motion (rad/deg): column i is
+        (z_{i-1} x (p - p_{i-1}), z_{i-1}) * pi/180, z_{i-1} and p_{i-1} the axis and origin of
+        joint i (standard DH: the frame before T_i). The Z-Y-Z Euler angles of the pose are
+        singular at sin(beta) = 0, so the frame (angular velocity) is the well-defined derivative;
+        :meth:`euler_rates` turns it into Euler-angle rates away from the singularity.
+        Batched 4x4 products over the leading axes (one matmul per joint, whatever the batch).
+        """
+        q = np.asarray(joints, dtype=float)
+        if q.shape[-1] != self.dof:
+            raise FkoptError(f"{self.name} joints: expected {self.dof} values "
+                             f"({', '.join(self.joint_names)}), got shape {q.shape}")
+        shape = q.shape[:-1]
+        n = self.dof
+        t = np.radians(q.reshape(-1, n) + self._offset)
+        if len(t) >= _SOA_MIN:
+            p, R, J = self._frame_jacobian_soa(t)
+            return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
+        # A_i = C0_i + cos(t_i) C1_i + sin(t_i) C2_i (constant 4x4 parts of the DH transform)
+        C0, C1, C2 = self._dh_parts()
+        A = C0 + np.cos(t)[..., None, None] * C1 + np.sin(t)[..., None, None] * C2
+        Ts = np.empty(t.shape + (4, 4))                            # frame before joint i+1 ... after
+        Ts[:, 0] = A[:, 0]
+        for i in range(1, n):
+            np.matmul(Ts[:, i - 1], A[:, i], out=Ts[:, i])
+        T = Ts[:, -1]
+        p, R = T[:, :3, 3], T[:, :3, :3]
+        J = np.empty((len(t), 6, n))
+        # joint i's axis z_{i-1} and origin o_{i-1}: base frame for i = 0, else frame i-1
+        zx, zy, zz = np.empty((len(t), n)), np.empty((len(t), n)), np.empty((len(t), n))
+        zx[:, 0], zy[:, 0], zz[:, 0] = 0.0, 0.0, 1.0
+        zx[:, 1:], zy[:, 1:], zz[:, 1:] = Ts[:, :-1, 0, 2], Ts[:, :-1, 1, 2], Ts[:, :-1, 2, 2]
+        dx, dy, dz = np.empty((len(t), n)), np.empty((len(t), n)), np.empty((len(t), n))
+        dx[:, 0], dy[:, 0], dz[:, 0] = p[:, 0], p[:, 1], p[:, 2]
+        dx[:, 1:] = p[:, 0, None] - Ts[:, :-1, 0, 3]
+        dy[:, 1:] = p[:, 1, None] - Ts[:, :-1, 1, 3]
+        dz[:, 1:] = p[:, 2, None] - Ts[:, :-1, 2, 3]
+        J[:, 0] = zy * dz - zz * dy
+        J[:, 1] = zz * dx - zx * dz
+        J[:, 2] = zx * dy - zy * dx
+        J[:, 3], J[:, 4], J[:, 5] = zx, zy, zz
+        J *= np.pi / 180.0
+        return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
+
+    def _dh_parts(self):
+        """Constant (n, 4, 4) parts C0, C1, C2 with A_i = C0 + cos(theta) C1 + sin(theta) C2."""
+        if getattr(self, "_parts", None) is None:
+            n = self.dof
+            C0, C1, C2 = np.zeros((n, 4, 4)), np.zeros((n, 4, 4)), np.zeros((n, 4, 4))
+            for i in range(n):
+                ca, sa, a, d = self._ca[i], self._sa[i], self._a[i], self._d[i]
+                C0[i, 2, 1], C0[i, 2, 2], C0[i, 2, 3], C0[i, 3, 3] = sa, ca, d, 1.0
+                C1[i, 0, 0], C1[i, 1, 1], C1[i, 1, 2], C1[i, 0, 3] = 1.0, ca, -sa, a
+                C2[i, 1, 0], C2[i, 0, 1], C2[i, 0, 2], C2[i, 1, 3] = 1.0, -ca, sa, a
+            self._parts = (C0, C1, C2)
+        return self._parts
+
+    def _frame_jacobian_soa(self, t):
+        """:meth:`frame_jacobian` for many rows (k, n) of joint angles in radians, elementwise
+        (structure of arrays): faster than k small 4x4 products from a few hundred rows on."""
+        k, n = t.shape
+        tt = np.ascontiguousarray(t.T)
+        ct, st = np.cos(tt), np.sin(tt)
+        J = np.empty((k, 6, n))
+        zs, os_ = [], []
+        R = p = None
+        for i in range(n):
+            c, s_ = ct[i], st[i]
+            ca, sa, a, d = self._ca[i], self._sa[i], self._a[i], self._d[i]
+            if R is None:
+                zs.append((0.0, 0.0, 1.0))
+                os_.append((0.0, 0.0, 0.0))
+                R = [[c, -s_ * ca, s_ * sa], [s_, c * ca, -c * sa], [np.zeros(k), np.full(k, sa), np.full(k, ca)]]
+                p = [a * c, a * s_, np.full(k, d)]
+                continue
+            zs.append((R[0][2], R[1][2], R[2][2]))
+            os_.append((p[0], p[1], p[2]))
+            p = [R[r][0] * (a * c) + R[r][1] * (a * s_) + (R[r][2] * d + p[r]) for r in range(3)]
+            R = [[R[r][0] * c + R[r][1] * s_,
+                  (R[r][1] * c - R[r][0] * s_) * ca + R[r][2] * sa,
+                  (R[r][0] * s_ - R[r][1] * c) * sa + R[r][2] * ca] for r in range(3)]
+        for i in range(n):
+            zx, zy, zz = zs[i]
+            dx, dy, dz = p[0] - os_[i][0], p[1] - os_[i][1], p[2] - os_[i][2]
+            J[:, 0, i] = zy * dz - zz * dy
+            J[:, 1, i] = zz * dx - zx * dz
+            J[:, 2, i] = zx * dy - zy * dx
+            J[:, 3, i], J[:, 4, i], J[:, 5, i] = zx, zy, zz
+        J *= np.pi / 180.0
+        Rm = np.empty((k, 3, 3))
+        for r in range(3):
+            for c_ in range(3):
+                Rm[:, r, c_] = R[r][c_]
+        return np.stack(p, axis=-1), Rm, J
+
+    def jacobian(self, joints) -> np.ndarray:
+        """The frame Jacobian (..., 6, n) of :meth:`frame_jacobian`."""
+        return self.frame_jacobian(joints)[2]
+
+    @staticmethod
+    def euler_rates(R, omega) -> np.ndarray:
+        """Z-Y-Z Euler-angle rates (..., 3, k) of angular velocities omega (..., 3, k) at
+        rotations R (..., 3, 3): with w = (w_x, w_y, w_z), alpha' = w_z - cos(beta) gamma',
+        beta' = -sin(alpha) w_x + cos(alpha) w_y, gamma' = (cos(alpha) w_x + sin(alpha) w_y) / sin(beta)
+        (from w = alpha' e_z + beta' Rz(alpha) e_y + gamma' Rz(alpha) Ry(beta) e_z); infinite at
+        sin(beta) = 0, the singularity of the angles themselves."""
+        R = np.asarray(R)
+        al = np.arctan2(R[..., 1, 2], R[..., 0, 2])[..., None]
+        sb = np.hypot(R[..., 2, 0], R[..., 2, 1])[..., None]
+        cb = R[..., 2, 2][..., None]
+        wx, wy, wz = omega[..., 0, :], omega[..., 1, :], omega[..., 2, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gd = (np.cos(al) * wx + np.sin(al) * wy) / sb
+        bd = -np.sin(al) * wx + np.cos(al) * wy
+        return np.stack([wz - cb * gd, bd, gd], axis=-2)
 
     def fk(self, joints) -> np.ndarray:
         p, R = self.frame(joints)

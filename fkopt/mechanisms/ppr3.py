@@ -68,6 +68,20 @@ class ThreePPR(ParallelMechanism):
         d3 = F[2, 0] * s + F[2, 1] * c + y
         return np.stack([d1, d2, d3], axis=-1)
 
+    def jacobian(self, poses) -> np.ndarray:
+        """d(d_1, d_2, d_3)/d(x, y, theta), shaped (..., 3, 3): mm per mm and mm per degree."""
+        poses = np.asarray(poses, dtype=float)
+        t = np.radians(poses[..., 2])
+        c, s = np.cos(t), np.sin(t)
+        F = self.F
+        k = np.pi / 180.0
+        J = np.zeros(poses.shape[:-1] + (3, 3))
+        J[..., 0, 0] = J[..., 1, 0] = J[..., 2, 1] = 1.0
+        J[..., 0, 2] = (-F[0, 0] * s - F[0, 1] * c) * k
+        J[..., 1, 2] = (-F[1, 0] * s - F[1, 1] * c) * k
+        J[..., 2, 2] = (F[2, 0] * c - F[2, 1] * s) * k
+        return J
+
     def fk_exact(self, joints) -> np.ndarray:
         """Both closed-form forward solutions, shaped (..., 2, 3), sorted by theta (ascending).
 

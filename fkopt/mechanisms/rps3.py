@@ -112,6 +112,53 @@ class ThreeRPS(ParallelMechanism):
         np.sqrt(u * u + v * v + w * w, out=out[:, 2])
         return out.reshape(shape + (3,))
 
+    def jacobian(self, poses) -> np.ndarray:
+        """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
+
+        The parasitic motion is differentiated too (eq. 6): with u = sa sb / (ca + cb),
+        dgamma/dalpha = sb (1 + ca cb) / ((ca + cb)^2 (1 + u^2)) (alpha <-> beta for beta), and
+        dR/dalpha = R [e_x]x + gamma_alpha [e_z]x R, dR/dbeta = [Rz(gamma) e_y]x R + gamma_beta [e_z]x R;
+        x_e = (r_b/2)(R00 - R11) and y_e = -r_b R10 follow from dR. Then
+        dd_i = v_i . (dR B_i + dp) / d_i with v_i = R B_i + p - A_i.
+        """
+        poses = np.asarray(poses, dtype=float)
+        shape = poses.shape[:-1]
+        P = poses.reshape(-1, 3)
+        a, b, z = np.radians(P[:, 0]), np.radians(P[:, 1]), P[:, 2]
+        ra, rb = self.geometry.ra, self.geometry.rb
+        sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+        den = ca + cb
+        u = sa * sb / den
+        k = (1.0 + ca * cb) / (den * den * (1.0 + u * u))
+        ga, gb = sb * k, sa * k                              # dgamma/dalpha, dgamma/dbeta (rad/rad)
+        g = np.arctan(u)
+        R = rotations.to_array(rotations.zyx(a, b, g))       # (n, 3, 3)
+        sg, cg = np.sin(g), np.cos(g)
+
+        def cross_left(axis, M):                             # [axis]x M, axis (n, 3)
+            return np.cross(axis[:, :, None], M, axis=1)
+
+        ez = np.broadcast_to([0.0, 0.0, 1.0], (len(P), 3))
+        ey_g = np.stack([-sg, cg, np.zeros_like(sg)], axis=-1)
+        Ex = np.zeros((3, 3))
+        Ex[1, 2], Ex[2, 1] = -1.0, 1.0                       # [e_x]x
+        dRa = R @ Ex + ga[:, None, None] * cross_left(ez, R)
+        dRb = cross_left(ey_g, R) + gb[:, None, None] * cross_left(ez, R)
+        phi = 2.0 * np.pi * np.arange(3) / 3.0
+        B = rb * np.stack([np.cos(phi), np.sin(phi), np.zeros(3)])      # (3, 3 legs)
+        A = ra * np.stack([np.cos(phi), np.sin(phi), np.zeros(3)])
+        p = np.stack([0.5 * rb * (R[:, 0, 0] - R[:, 1, 1]), -rb * R[:, 1, 0], z], axis=-1)
+        v = R @ B + (p[:, :, None] - A)                       # (n, 3, legs)
+        d = np.sqrt((v * v).sum(axis=1))
+        J = np.empty((len(P), 3, 3))
+        for col, dR in ((0, dRa), (1, dRb)):
+            dp = np.stack([0.5 * rb * (dR[:, 0, 0] - dR[:, 1, 1]), -rb * dR[:, 1, 0],
+                           np.zeros(len(P))], axis=-1)
+            dv = dR @ B + dp[:, :, None]
+            J[:, :, col] = (v * dv).sum(axis=1) / d * (np.pi / 180.0)
+        J[:, :, 2] = v[:, 2] / d
+        return J.reshape(shape + (3, 3))
+
     def ik_reference(self, poses) -> np.ndarray:
         """Eq. (10) evaluated as printed (rotation matrix, parasitic motion, three legs); slower."""
         poses = np.asarray(poses, dtype=float)

@@ -73,3 +73,52 @@ class ThreeRPUPcUPS(ParallelMechanism):
         dx, dy = c * ex, c * ey - R
         delta = np.degrees(np.arctan2(dx, -dy))
         return np.stack([l1, l2, l3, delta], axis=-1)
+
+    def jacobian(self, poses) -> np.ndarray:
+        """d(l1, l2, l3, delta)/d(alpha, beta, gamma, z), shaped (..., 4, 4), public units
+        (mm per degree, mm per mm, degree per degree) -- the derivative of the reconstruction
+        above, written out: n' from R_p, the unit vectors u, v by the quotient rule
+        (d(n_z/h) = n_x (n_x dn_z - n_z dn_x) / h^3 with h = hypot(n_z, n_x)), the legs by
+        dl = (C - B) . dC / l, delta by d atan2(dX, -dY)."""
+        poses = np.asarray(poses, dtype=float)
+        a, b, g = (np.radians(poses[..., i]) for i in range(3))
+        z = poses[..., 3]
+        sa, ca, sb, cb, sg, cg = np.sin(a), np.cos(a), np.sin(b), np.cos(b), np.sin(g), np.cos(g)
+        R, c = self.geometry.R, self.geometry.c
+        zero = np.zeros_like(a)
+        nx, ny, nz = -sb, sa * cb, ca * cb
+        # derivatives of n with respect to (alpha, beta, gamma), radians
+        dnx = (zero, -cb, zero)
+        dny = (ca * cb, -sa * sb, zero)
+        dnz = (-sa * cb, -ca * sb, zero)
+        su = np.where(nz < 0, -1.0, 1.0)
+        hu = np.hypot(nz, nx)
+        ux, uz = su * nz / hu, -su * nx / hu
+        sv = np.where(nz > 0, -1.0, 1.0)
+        hv = np.hypot(nz, ny)
+        vy, vz = sv * nz / hv, -sv * ny / hv
+        l1 = np.sqrt((R - c * ux) ** 2 + (z - c * uz) ** 2)
+        l3 = np.sqrt((c * ux - R) ** 2 + (z + c * uz) ** 2)
+        l2 = np.sqrt((c * vy + R) ** 2 + (z + c * vz) ** 2)
+        ex, ey = -sg * cb, ca * cg - sa * sb * sg
+        dex = (zero, sg * sb, -cg * cb)
+        dey = (-sa * cg - ca * sb * sg, -sa * cb * sg, -ca * sg - sa * sb * cg)
+        DX, DY = c * ex, c * ey - R
+        q = DX * DX + DY * DY
+        J = np.empty(poses.shape[:-1] + (4, 4))
+        k = np.pi / 180.0
+        hu3, hv3 = hu ** 3, hv ** 3
+        for j in range(3):
+            dux = su * nx * (nx * dnz[j] - nz * dnx[j]) / hu3
+            duz = -su * nz * (nz * dnx[j] - nx * dnz[j]) / hu3
+            dvy = sv * ny * (ny * dnz[j] - nz * dny[j]) / hv3
+            dvz = -sv * nz * (nz * dny[j] - ny * dnz[j]) / hv3
+            J[..., 0, j] = k * c * (-(R - c * ux) * dux - (z - c * uz) * duz) / l1
+            J[..., 2, j] = k * c * ((c * ux - R) * dux + (z + c * uz) * duz) / l3
+            J[..., 1, j] = k * c * ((c * vy + R) * dvy + (z + c * vz) * dvz) / l2
+            J[..., 3, j] = c * (-DY * dex[j] + DX * dey[j]) / q
+        J[..., 0, 3] = (z - c * uz) / l1
+        J[..., 1, 3] = (z + c * vz) / l2
+        J[..., 2, 3] = (z + c * uz) / l3
+        J[..., 3, 3] = 0.0
+        return J

@@ -49,6 +49,8 @@ from .base import Geometry, ParallelMechanism
 Vec3 = tuple[float, float, float]
 Points6 = tuple[Vec3, Vec3, Vec3, Vec3, Vec3, Vec3]
 _D2R = np.pi / 180.0
+#: Batch size from which :meth:`SixSPS.ik_jacobian` works elementwise per leg.
+_SOA_MIN = 256
 
 #: Full-turn angle bounds, to pass as ``bounds=FULL_TURN`` (merged with the default position box).
 FULL_TURN: dict[str, tuple[float, float]] = {
@@ -171,6 +173,81 @@ class SixSPS(ParallelMechanism):
                     acc += d
             np.sqrt(acc, out=acc)
         return np.moveaxis(out, 0, -1)
+
+    def jacobian(self, poses) -> np.ndarray:
+        """d(leg lengths)/d(pose), shaped (..., 6, 6); see :meth:`ik_jacobian`."""
+        return self.ik_jacobian(poses)[1]
+
+    def ik_jacobian(self, poses) -> tuple[np.ndarray, np.ndarray]:
+        """Leg lengths (..., 6) and d(leg lengths)/d(pose) (..., 6, 6), in the public units
+        (m per m, m per degree), from the same leg vectors (one pass for Newton's r and J).
+
+        With v_i = R q_i + p_s - b_i and l_i = |v_i|: dl_i/dp_s = v_i / l_i, and for the Z-Y-X
+        angles dR/dalpha = R [e_x]x, dR/dbeta = [Rz(gamma) e_y]x R, dR/dgamma = [e_z]x R, so
+        dl_i/dtheta = (v_i / l_i) . (axis_theta x R q_i) with axis_alpha = R e_x,
+        axis_beta = Rz(gamma) e_y, axis_gamma = e_z (times pi/180 for degrees).
+        Vectorised over the leading axes (batched 3x3 products).
+        """
+        p = np.asarray(poses, dtype=float)
+        shape = p.shape[:-1]
+        p = p.reshape(-1, 6)
+        if len(p) >= _SOA_MIN:
+            lengths, J = self._ik_jacobian_soa(p)
+            return lengths.reshape(shape + (6,)), J.reshape(shape + (6, 6))
+        a = p[:, 3:6] * _D2R
+        ca, cb, cg = np.cos(a).T
+        sa, sb, sg = np.sin(a).T
+        R = np.empty((len(p), 3, 3))
+        R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa
+        R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = sg * cb, sg * sb * sa + cg * ca, sg * sb * ca - cg * sa
+        R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = -sb, cb * sa, cb * ca
+        w = R @ self._q.T                                       # (n, 3, 6): R q_i
+        v = w + (p[:, :3, None] - self._base.T)
+        lengths = np.sqrt((v * v).sum(axis=1))
+        u = v / lengths[:, None, :]                             # unit legs (n, 3, 6)
+        w0, w1, w2 = w[:, 0], w[:, 1], w[:, 2]
+        u0, u1, u2 = u[:, 0], u[:, 1], u[:, 2]
+        # m = R q_i x u_i, so that axis . m = u_i . (axis x R q_i)
+        m0, m1, m2 = w1 * u2 - w2 * u1, w2 * u0 - w0 * u2, w0 * u1 - w1 * u0
+        J = np.empty((len(p), 6, 6))
+        J[:, :, 0], J[:, :, 1], J[:, :, 2] = u0, u1, u2
+        J[:, :, 3] = R[:, 0, 0, None] * m0 + R[:, 1, 0, None] * m1 + R[:, 2, 0, None] * m2
+        J[:, :, 4] = -sg[:, None] * m0 + cg[:, None] * m1
+        J[:, :, 5] = m2
+        J[:, :, 3:] *= _D2R
+        return lengths.reshape(shape + (6,)), J.reshape(shape + (6, 6))
+
+    def _ik_jacobian_soa(self, p):
+        """:meth:`ik_jacobian` for many poses (n, 6), elementwise per leg (structure of arrays)."""
+        n = len(p)
+        pt = np.ascontiguousarray(p.T)
+        ang = pt[3:6] * _D2R
+        R = rotations.zyx(ang[0], ang[1], ang[2])
+        sg, cg = np.sin(ang[2]), np.cos(ang[2])
+        lengths = np.empty((n, 6))
+        J = np.empty((n, 6, 6))
+        for i in range(6):
+            q, b = self._q[i], self._base[i]
+            w = []
+            for k in range(3):
+                wk = None
+                for j in range(3):
+                    if q[j] != 0.0:
+                        wk = R[k][j] * q[j] if wk is None else wk + R[k][j] * q[j]
+                w.append(np.zeros(n) if wk is None else wk)
+            v = [w[k] + (pt[k] - b[k]) for k in range(3)]
+            L = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+            lengths[:, i] = L
+            inv = 1.0 / L
+            u = [v[k] * inv for k in range(3)]
+            m0 = w[1] * u[2] - w[2] * u[1]
+            m1 = w[2] * u[0] - w[0] * u[2]
+            m2 = w[0] * u[1] - w[1] * u[0]
+            J[:, i, 0], J[:, i, 1], J[:, i, 2] = u
+            J[:, i, 3] = (R[0][0] * m0 + R[1][0] * m1 + R[2][0] * m2) * _D2R
+            J[:, i, 4] = (cg * m1 - sg * m0) * _D2R
+            J[:, i, 5] = m2 * _D2R
+        return lengths, J
 
     def ik_vectors(self, poses) -> np.ndarray:
         """Leg vectors l_i (..., 6, 3) in the base frame (reference implementation, uses arrays)."""

@@ -1,0 +1,704 @@
+"""Practical exact solvers: ``fkopt.forward`` (parallel mechanisms) and ``fkopt.inverse`` (serial arms).
+
+:func:`fkopt.solve` is the optimiser-level API (runs, populations, convergence histories) used
+to compare algorithms. These two functions are the domain-level API: give joints (or poses),
+batched over any leading axes, get poses (or joints) back with a verdict per row.
+
+**forward(mechanism, joints[..., m])** -- the pose whose closed-form inverse map gives ``joints``.
+
+1. Local stage, vectorised over all rows (no per-row Python loop): damped Newton on
+   r(x) = ik(x) - joints with the mechanism's analytic Jacobian (``ik_jacobian``; central
+   differences for a mechanism without one), from ``start`` or the centre of the bounds. A step
+   that does not decrease |r|^2 is halved (up to 10 times); steps are capped at a quarter of the
+   box width per coordinate. At most 30 iterations. A single row takes the same iteration with
+   scalar tests (its cost is numpy's per-call overhead).
+2. Rows not solved restart the same Newton from a few deterministic starts: the centre moved by
+   +-1/4 of the box width along each coordinate (2 n starts), all rows at once.
+3. Rows still not solved go to a seeded global search, one row at a time: ``gabc+lm``
+   (population 20, 300 iterations, seed ``seed``, run id = row index) through :func:`fkopt.solve`.
+
+**inverse(arm, poses[..., 6])** -- joints whose end-effector pose is ``poses`` (x, y, z in the
+arm's length unit, Z-Y-Z Euler angles in degrees as :meth:`DHArm.fk` prints them), every joint
+inside its limits. A bounded damped least-squares method on the 6 residuals
+(position error, L * rotation vector of R R_t^T with L = ``orientation_scale`` length units per
+radian, default the arm's reach; the geodesic orientation error, no Euler differences):
+
+* step d = J^T (J J^T + mu I)^{-1} (-r) (minimum-norm damped least squares for a redundant
+  arm), mu = lambda * trace(J J^T) / 6 with lambda adapted per candidate as in
+  Levenberg-Marquardt (start ``damping`` = 0.3, x ``down`` = 0.1 after a step that decreases
+  |r|^2, x ``up`` = 10 otherwise); the joint step is capped at ``step_cap`` radians; the
+  orientation rows use the angular velocity (the derivative of the rotation vector at zero
+  error; ``exact_rotation=True`` applies the inverse left Jacobian of SO(3) -- measured: the
+  same number of Jacobian evaluations on 1000 random poses, so the cheaper one is the default);
+* joint limits handled by the method (saturation in the null space, as in Flacco, De Luca,
+  Khatib 2012, "Motion control of redundant robots under joint constraints: saturation in the
+  null space"): a joint whose step would leave its range is fixed at the limit, its column
+  removed, and the remaining joints re-solved for the residual left over (up to 3 passes) -- the
+  redundancy absorbs the saturation instead of the step being clipped;
+* optional secondary objective in the null space of the task, ``rest`` > 0: pull every joint
+  towards mid-range, d += (I - J^+ J) z with z = rest (mid - q) / half-range^2 and J^+ the damped
+  pseudo-inverse above (off by default: it slows convergence to the task);
+* seeded random restarts: a candidate that has not converged after ``iterations`` (12) steps, or
+  stalls (lambda above 1e6), restarts from joints uniform inside the limits, drawn from
+  a counter-based hash of (seed, row index, draw number), at most ``restarts`` times. A batch
+  of N < ``fill`` rows starts with ``fill // N`` candidates per row (``start``, or mid-range,
+  and random ones: a single pose is solved from 32 starts side by side), and whenever fewer
+  than ``fill`` candidates remain, every unsolved row gets more at once. These restarts are
+  inverse's global stage (seeded random restarts of a local method with limits, rather than a
+  swarm). Same poses and seed give the same answer; a row's answer may differ between batches.
+
+**Verdicts.** ``solved`` is true only when the closed form of the answer reproduces the input
+within ``tol`` and the answer is inside the bounds: forward, max |ik(pose) - joints| <= ``tol``
+(joint units; default 1e-9) and the pose inside ``mechanism.bounds`` (angles may be moved by
+multiples of 360 deg); any assembly mode that does so is a solution. The residual is the one
+the Newton loop evaluated at the answer with ``ik_jacobian`` (the same closed form; a row whose
+angles were moved into the bounds is evaluated again with ``ik``). Inverse, distance between
+fk(joints) and the target position <= ``tol[0]`` (length unit; default 1e-6) and geodesic angle
+<= ``tol[1]`` (radians; default 1e-6), every joint inside its limits, evaluated with the arm's
+elementwise :meth:`DHArm.frame` (the numbers of ``fk``), not with the solver's products.
+
+**Evaluations** are counted per row and separately: ``evaluations["residual"]`` counts
+evaluations of the closed form (the inverse map for forward, the arm's forward map for inverse),
+``evaluations["jacobian"]`` evaluations of its analytic Jacobian (each also yields the closed
+form at the same point: one call of ``ik_jacobian``/``frame_jacobian`` counts one of each). A
+mechanism without analytic Jacobian is differentiated by central differences, counted as
+2 n residual evaluations and no Jacobian evaluation. The global stage of forward adds
+:attr:`fkopt.Result.evaluations` of its run (swarm fitness evaluations plus LM's, an analytic
+Jacobian counted as one) to ``residual``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import FkoptError
+from .mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
+from .problems import so3_right_jacobian_inverse
+
+#: Default forward tolerance: max |ik(pose) - joints| in the joint units.
+FORWARD_TOL = 1e-9
+#: Default inverse tolerances: (position in the arm's length unit, orientation in radians).
+INVERSE_TOL = (1e-6, 1e-6)
+
+
+@dataclass
+class ForwardResult:
+    """Poses found by :func:`forward`, shaped like the input's leading axes.
+
+    ``pose`` (..., n) in the mechanism's pose units (NaN-free: the best point found when not
+    solved); ``residual`` (...) max |ik(pose) - joints| in joint units; ``solved`` (...) bool;
+    ``stage`` (...) 0 local Newton, 1 deterministic restarts, 2 global search, -1 not solved;
+    ``evaluations`` {"residual": (...), "jacobian": (...)} per row (see the module docstring).
+    """
+
+    mechanism: str
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    pose: np.ndarray
+    residual: np.ndarray
+    solved: np.ndarray
+    stage: np.ndarray
+    evaluations: dict[str, np.ndarray] = field(default_factory=dict)
+    tol: float = FORWARD_TOL
+
+    def as_dict(self, index=()) -> dict:
+        """One row (``index`` into the leading axes) as plain Python values."""
+        return {"pose": dict(zip(self.names, map(float, self.pose[index]))),
+                "residual": float(self.residual[index]), "solved": bool(self.solved[index]),
+                "stage": int(self.stage[index]),
+                "evaluations": {k: int(v[index]) for k, v in self.evaluations.items()}}
+
+
+@dataclass
+class InverseResult:
+    """Joints found by :func:`inverse`, shaped like the input's leading axes.
+
+    ``joints`` (..., n) degrees, always inside the limits; ``position_error`` (...) in the arm's
+    length unit and ``rotation_error`` (...) geodesic, radians, of fk(joints) against the target;
+    ``residual`` (...) max of the two errors measured in their tolerances' units
+    (max(position_error / tol[0], rotation_error / tol[1]) <= 1 means solved);
+    ``solved`` (...) bool; ``restarts`` (...) random restarts used;
+    ``evaluations`` {"residual": (...), "jacobian": (...)} per row.
+    """
+
+    mechanism: str
+    names: tuple[str, ...]
+    joints: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+    residual: np.ndarray
+    solved: np.ndarray
+    restarts: np.ndarray
+    evaluations: dict[str, np.ndarray] = field(default_factory=dict)
+    tol: tuple[float, float] = INVERSE_TOL
+
+    def as_dict(self, index=()) -> dict:
+        return {"joints": dict(zip(self.names, map(float, self.joints[index]))),
+                "position_error": float(self.position_error[index]),
+                "rotation_error_rad": float(self.rotation_error[index]),
+                "solved": bool(self.solved[index]), "restarts": int(self.restarts[index]),
+                "evaluations": {k: int(v[index]) for k, v in self.evaluations.items()}}
+
+
+def _mechanism(mechanism, kind: type, what: str) -> Mechanism:
+    if isinstance(mechanism, str):
+        from .registry import mechanism_class
+        mechanism = mechanism_class(mechanism)()
+    if not isinstance(mechanism, kind):
+        other = "inverse" if what == "forward" else "forward"
+        raise FkoptError(f"{what} needs a {'parallel mechanism' if kind is ParallelMechanism else 'serial arm'}; "
+                         f"'{mechanism.name}' is {mechanism.kind} (use fkopt.{other})")
+    return mechanism
+
+
+def _values(mechanism: Mechanism, values, names, what: str) -> np.ndarray:
+    a = np.asarray(values, dtype=float)
+    if a.ndim == 0 or a.shape[-1] != len(names):
+        raise FkoptError(f"{mechanism.name} {what}: expected (..., {len(names)}) values "
+                         f"({', '.join(names)}), got shape {a.shape}")
+    bad = ~np.isfinite(a).all(axis=-1)
+    if bad.any():
+        row = a.reshape(-1, len(names))[int(np.flatnonzero(bad.ravel())[0])]
+        raise FkoptError(f"{mechanism.name} {what}: values must be finite, got {row.tolist()}")
+    return a
+
+
+# ----------------------------------------------------------------------------------------------
+# forward
+# ----------------------------------------------------------------------------------------------
+class _Residuals:
+    """r(x) = ik(x) - joints (angle joints wrapped) and J for rows ``idx`` of the batch."""
+
+    def __init__(self, mechanism: ParallelMechanism, joints: np.ndarray):
+        self.m = mechanism
+        self.L = joints
+        self.angle = mechanism.angle_mask(mechanism.joint_units)
+        self.analytic = hasattr(mechanism, "jacobian")
+        w = mechanism.bounds[:, 1] - mechanism.bounds[:, 0]
+        self.h = 1e-6 * w
+
+    def _wrap(self, r):
+        if self.angle.any():
+            r[..., self.angle] = (r[..., self.angle] + 180.0) % 360.0 - 180.0
+        return r
+
+    def r(self, x, idx):
+        return self._wrap(self.m.ik(x) - self.L[idx])
+
+    def rj(self, x, idx):
+        """(r, J, residual evaluations, jacobian evaluations) per call."""
+        if self.analytic:
+            v, J = self.m.ik_jacobian(x)
+            return self._wrap(v - self.L[idx]), J, 1, 1
+        n = x.shape[-1]
+        E = np.eye(n) * self.h
+        pts = np.concatenate([x[:, None], x[:, None] + E, x[:, None] - E], axis=1)
+        r = self._wrap(self.m.ik(pts) - self.L[idx][:, None])
+        J = (r[:, 1:n + 1] - r[:, n + 1:]) / (2.0 * self.h[None, :, None])
+        return r[:, 0], np.swapaxes(J, 1, 2), 1 + 2 * n, 0
+
+
+def _sumsq(r):
+    return np.einsum("...i,...i->...", r, r)
+
+
+def _newton(res: _Residuals, x: np.ndarray, idx: np.ndarray, ftol: float, evals,
+            iterations: int = 30, halvings: int = 10):
+    """Damped Newton from rows x (k, n) for batch rows ``idx``.
+
+    Returns (x, max |r|) with r the residual at the returned x, as evaluated by the loop (the
+    mechanism's closed form, ``ik_jacobian``). Rows stop when max |r| <= ftol, when no step
+    along the Newton direction decreases |r|^2, or after ``iterations``.
+    """
+    bounds = res.m.bounds
+    inv_cap = 4.0 / (bounds[:, 1] - bounds[:, 0])
+    x = np.array(x, dtype=float)
+    out_x = x.copy()
+    out_r = np.full(len(x), np.inf)
+    calls = np.ones(len(x), dtype=np.int64)            # rj calls per row (counted at exit)
+    act = np.arange(len(x))
+    r, J, ne, nj = res.rj(x, idx)
+    F = _sumsq(r)
+    square = J.shape[-1] == J.shape[-2]
+    it = 1
+    for _ in range(iterations):
+        rmax = np.abs(r).max(axis=-1)
+        done = ~(rmax > ftol)                              # converged, or not finite
+        if done.any():
+            out_x[act[done]], out_r[act[done]] = x[done], rmax[done]
+            calls[act[done]] = it
+            keep = ~done
+            act, x, r, J, F = act[keep], x[keep], r[keep], J[keep], F[keep]
+            if not len(act):
+                break
+        d = None
+        if square:
+            try:
+                d = np.linalg.solve(J, r[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                d = None
+        big = None if d is None else np.max(np.abs(d) * inv_cap, axis=-1)
+        if big is None or not (big <= 1.0).all():
+            if big is None or not np.isfinite(big).all():
+                # singular somewhere: least squares with a little damping for every row
+                Jt = np.swapaxes(J, -1, -2)
+                A = Jt @ J
+                A += 1e-9 * np.trace(A, axis1=-2, axis2=-1)[:, None, None] * np.eye(A.shape[-1])
+                d = np.linalg.solve(A, Jt @ r[..., None])[..., 0]
+                d[~np.isfinite(d)] = 0.0
+                big = np.max(np.abs(d) * inv_cap, axis=-1)
+            d /= np.maximum(big, 1.0)[:, None]             # steps capped at 1/4 of the box width
+        xt = x - d
+        rt, Jt, _, _ = res.rj(xt, idx[act])
+        it += 1
+        Ft = _sumsq(rt)
+        bad = ~(Ft < F)
+        if bad.any():
+            ia = idx[act]
+            step = 1.0
+            fresh = np.zeros(len(act), dtype=bool)
+            for _ in range(halvings):
+                step *= 0.5
+                b = np.flatnonzero(bad)
+                xb = x[b] - step * d[b]
+                rb = res.r(xb, ia[b])
+                evals[0][ia[b]] += 1
+                Fb = _sumsq(rb)
+                ok = Fb < F[b]
+                xt[b[ok]], rt[b[ok]], Ft[b[ok]] = xb[ok], rb[ok], Fb[ok]
+                fresh[b[ok]] = True
+                bad[b[ok]] = False
+                if not bad.any():
+                    break
+            if bad.any():                   # no decrease along the step: stalled, stop those rows
+                b = np.flatnonzero(bad)
+                out_x[act[b]], out_r[act[b]] = x[b], np.abs(r[b]).max(axis=-1)
+                calls[act[b]] = it
+            fresh = np.flatnonzero(fresh)   # J at backtracked points is not known yet
+            if len(fresh):
+                _, Jf, _, _ = res.rj(xt[fresh], ia[fresh])
+                Jt[fresh] = Jf
+                evals[0][ia[fresh]] += ne
+                evals[1][ia[fresh]] += nj
+            moved = ~bad
+            act, x, r, J, F = act[moved], xt[moved], rt[moved], Jt[moved], Ft[moved]
+            if not len(act):
+                break
+        else:
+            x, r, J, F = xt, rt, Jt, Ft
+    if len(act):
+        out_x[act], out_r[act] = x, np.abs(r).max(axis=-1)
+        calls[act] = it
+    evals[0][idx] += calls * ne
+    evals[1][idx] += calls * nj
+    return out_x, out_r
+
+
+def _newton1(res: _Residuals, x: np.ndarray, ftol: float, evals, iterations: int = 30,
+             halvings: int = 10):
+    """:func:`_newton` for one row (batch of 1) with Python scalars for the tests: the same
+    iteration, a fraction of the numpy calls (the cost of a single pose is per-call overhead)."""
+    bounds = res.m.bounds
+    inv_cap = 4.0 / (bounds[:, 1] - bounds[:, 0])
+    idx = np.zeros(1, dtype=np.intp)
+    rj = res.rj
+    r, J, ne, nj = rj(x[None], idx)
+    r, J = r[0], J[0]
+    F = float(r @ r)
+    calls, extra = 1, 0
+    for _ in range(iterations):
+        rmax = float(np.abs(r).max())
+        if not rmax > ftol:
+            break
+        try:
+            d = np.linalg.solve(J, r) if J.shape[0] == J.shape[1] else None
+        except np.linalg.LinAlgError:
+            d = None
+        big = np.inf if d is None else float((np.abs(d) * inv_cap).max())
+        if not big <= 1.0:
+            if not np.isfinite(big):
+                A = J.T @ J
+                A += 1e-9 * np.trace(A) * np.eye(len(A))
+                d = np.linalg.solve(A, J.T @ r)
+                d[~np.isfinite(d)] = 0.0
+                big = float((np.abs(d) * inv_cap).max())
+            if big > 1.0:
+                d = d / big
+        xt = x - d
+        rt, Jt, _, _ = rj(xt[None], idx)
+        rt, Jt = rt[0], Jt[0]
+        calls += 1
+        Ft = float(rt @ rt)
+        if not Ft < F:
+            step, moved = 1.0, False
+            for _ in range(halvings):
+                step *= 0.5
+                xb = x - step * d
+                rb = res.r(xb[None], idx)[0]
+                extra += 1
+                Fb = float(rb @ rb)
+                if Fb < F:
+                    xt, rt, Ft, moved = xb, rb, Fb, True
+                    break
+            if not moved:
+                break
+            _, Jt, _, _ = rj(xt[None], idx)
+            Jt = Jt[0]
+            calls += 1
+        x, r, J, F = xt, rt, Jt, Ft
+    evals[0][0] += calls * ne + extra
+    evals[1][0] += calls * nj
+    rmax = float(np.abs(r).max())
+    return x[None], np.array([rmax if np.isfinite(rmax) else np.inf])
+
+
+def _verify(mechanism, L, x, resid, tol):
+    """Angle variables moved by multiples of 360 deg into the bounds (when possible), and the
+    verdict: (x, max |ik(x) - L| with angle joints wrapped, solved). ``resid`` is the residual
+    the solver evaluated at x (the closed form via ``ik_jacobian``); rows whose angles moved are
+    evaluated again with ``ik``."""
+    angle = mechanism.angle_mask(mechanism.unknown_units)
+    inside = mechanism.in_bounds(x)
+    resid = np.where(np.isfinite(resid), resid, np.inf)
+    if angle.any() and not inside.all():
+        out = np.flatnonzero(~inside)
+        lo, hi = mechanism.bounds[angle, 0], mechanism.bounds[angle, 1]
+        a = x[np.ix_(out, np.flatnonzero(angle))]
+        moved = lo + (a - lo) % 360.0
+        a = np.where(((a >= lo) & (a <= hi)) | (moved > hi), a, moved)
+        x = x.copy()
+        x[np.ix_(out, np.flatnonzero(angle))] = a
+        r = mechanism.ik(x[out]) - L[out]
+        jang = mechanism.angle_mask(mechanism.joint_units)
+        if jang.any():
+            r[:, jang] = (r[:, jang] + 180.0) % 360.0 - 180.0
+        ro = np.abs(r).max(axis=-1)
+        resid = resid.copy()
+        resid[out] = np.where(np.isfinite(ro), ro, np.inf)
+        inside = mechanism.in_bounds(x)
+    return x, resid, (resid <= tol) & inside
+
+
+def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: int = 0,
+            global_search: bool = True) -> ForwardResult:
+    """Forward kinematics of a parallel mechanism for joints (..., m), batched over leading axes.
+
+    ``mechanism``: a registered name or a :class:`ParallelMechanism`. ``start``: start pose(s)
+    (n,) or (..., n) (default: centre of the bounds). ``tol``: largest accepted
+    max |ik(pose) - joints|, joint units. ``seed``: the global stage's seed.
+    ``global_search=False`` stops after the deterministic starts. See the module docstring.
+    """
+    m = _mechanism(mechanism, ParallelMechanism, "forward")
+    if not (np.isfinite(tol) and tol > 0):
+        raise FkoptError(f"forward tol: must be a positive number, got {tol}")
+    J0 = _values(m, joints, m.joint_names, "joints")
+    shape = J0.shape[:-1]
+    L = J0.reshape(-1, J0.shape[-1])
+    N, n = len(L), len(m.pose_names)
+    bounds = m.bounds
+    centre = bounds.mean(axis=1)
+    if start is None:
+        x0 = np.broadcast_to(centre, (N, n))
+    else:
+        s = _values(m, start, m.pose_names, "start")
+        x0 = np.broadcast_to(s, shape + (n,)).reshape(N, n)
+    res = _Residuals(m, L)
+    evals = (np.zeros(N, dtype=np.int64), np.zeros(N, dtype=np.int64))
+    ftol = 0.01 * tol
+    all_rows = np.arange(N)
+    with np.errstate(all="ignore"):
+        if N == 1:
+            x, rx = _newton1(res, np.array(x0[0], dtype=float), ftol, evals)
+        else:
+            x, rx = _newton(res, x0, all_rows, ftol, evals)
+        x, resid, solved = _verify(m, L, x, rx, tol)
+        stage = np.where(solved, 0, -1)
+        todo = np.flatnonzero(~solved)
+        if len(todo):                                   # deterministic restarts
+            quarter = 0.25 * (bounds[:, 1] - bounds[:, 0])
+            starts = np.concatenate([centre + np.diag(quarter), centre - np.diag(quarter)])
+            for s in starts:
+                if not len(todo):
+                    break
+                xs, rs = _newton(res, np.broadcast_to(s, (len(todo), n)), todo, ftol, evals)
+                xs, rs, ok = _verify(m, L[todo], xs, rs, tol)
+                better = ok | (~solved[todo] & (rs < resid[todo]))
+                x[todo[better]], resid[todo[better]] = xs[better], rs[better]
+                solved[todo[ok]] = True
+                stage[todo[ok]] = 1
+                todo = todo[~ok]
+    if global_search and len(todo):
+        from .problems import fk_problem
+        from .solve import solve
+        for k in todo:
+            problem = fk_problem(m, L[k])
+            out = solve(problem, "gabc+lm", population=20, iterations=300, runs=1, seed=seed,
+                        run_ids=[int(k)])
+            evals[0][k] += int(out.evaluations[0])
+            xs = out.x[:1]
+            rs = np.abs(problem.residuals(xs)).max(axis=-1)
+            xs, rs, ok = _verify(m, L[k:k + 1], xs, rs, tol)
+            if ok[0] or rs[0] < resid[k]:
+                x[k], resid[k] = xs[0], rs[0]
+            if ok[0]:
+                solved[k], stage[k] = True, 2
+    return ForwardResult(
+        mechanism=m.name, names=tuple(m.pose_names), units=tuple(m.pose_units),
+        pose=x.reshape(shape + (n,)), residual=resid.reshape(shape), solved=solved.reshape(shape),
+        stage=stage.reshape(shape),
+        evaluations={"residual": evals[0].reshape(shape), "jacobian": evals[1].reshape(shape)},
+        tol=float(tol))
+
+
+# ----------------------------------------------------------------------------------------------
+# inverse
+# ----------------------------------------------------------------------------------------------
+_D2R = np.pi / 180.0
+
+
+def _zyz_matrix(euler_deg: np.ndarray) -> np.ndarray:
+    a, b, g = np.radians(euler_deg).T
+    ca, sa, cb, sb, cg, sg = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(g), np.sin(g)
+    R = np.empty((len(a), 3, 3))
+    R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+    R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+    R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = -sb * cg, sb * sg, cb
+    return R
+
+
+def _rotation_error(R: np.ndarray, Rt: np.ndarray) -> np.ndarray:
+    """Rotation vector (k, 3) of R Rt^T (base frame), angle in [0, pi] radians."""
+    M = R @ np.swapaxes(Rt, -1, -2)
+    v = np.stack([M[:, 2, 1] - M[:, 1, 2], M[:, 0, 2] - M[:, 2, 0], M[:, 1, 0] - M[:, 0, 1]], axis=-1)
+    s = 0.5 * np.sqrt(_sumsq(v))                                   # sin(angle)
+    c = 0.5 * (M[:, 0, 0] + M[:, 1, 1] + M[:, 2, 2] - 1.0)         # cos(angle)
+    angle = np.arctan2(s, c)
+    k = np.where(s > 1e-12, angle / np.where(s > 1e-12, 2.0 * s, 1.0), 0.5)
+    return v * k[:, None]
+
+
+_M64 = np.uint64(0xFFFFFFFFFFFFFFFF)
+
+
+def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.ndarray:
+    """Uniforms in [0, 1) shaped (k, n), a pure function of (seed, row, draw, coordinate):
+    SplitMix64's finaliser (Steele, Lea, Flood 2014) over a combined 64-bit counter. Each row
+    of a batch thus gets the same restarts alone or in any batch."""
+    with np.errstate(over="ignore"):
+        c = (np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15)
+             ^ (row.astype(np.uint64) << np.uint64(20)) ^ (draw.astype(np.uint64) << np.uint64(4)))
+        z = c[:, None] + np.arange(1, n + 1, dtype=np.uint64) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        z = z ^ (z >> np.uint64(31))
+    return (z >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
+
+
+def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts: int = 200,
+            starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
+            iterations: int = 12, damping: float = 0.3, step_cap: float = 2.0,
+            down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False) -> InverseResult:
+    """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
+
+    ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
+    ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles (deg), as ``arm.fk``
+    returns them. ``start``: start joints (n,) or (..., n) inside the limits (default mid-range).
+    ``tol``: (position, orientation in radians). ``seed``: the restarts' stream. ``starts``:
+    candidates solved side by side per row (the start and ``starts - 1`` random ones);
+    ``restarts``: most random restarts per row. ``rest``: gain of the null-space pull towards
+    mid-range (0: off). ``orientation_scale``: length units per radian weighing orientation
+    against position in the least squares (default the arm's reach). ``iterations``: per
+    candidate before it restarts. See the module docstring.
+    """
+    m = _mechanism(arm, SerialMechanism, "inverse")
+    if not hasattr(m, "frame_jacobian"):
+        raise FkoptError(f"inverse needs an arm with an analytic frame Jacobian; '{m.name}' has none "
+                         "(use fkopt.solve with an ik_problem)")
+    try:
+        tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
+    except (TypeError, ValueError):
+        raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
+    if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
+        raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
+    P0 = _values(m, poses, m.pose_names, "target pose")
+    shape = P0.shape[:-1]
+    P = P0.reshape(-1, 6)
+    N, n = len(P), m.dof
+    reach = m.reach
+    dist = np.sqrt(_sumsq(P[:, :3]))
+    far = dist > reach * (1.0 + 1e-12)
+    if far.any():
+        k = int(np.flatnonzero(far)[0])
+        unit = m.pose_units[0]
+        raise FkoptError(f"{m.name} target ({P[k, 0]:g}, {P[k, 1]:g}, {P[k, 2]:g}) unreachable "
+                         f"(distance {dist[k]:.1f} {unit} > reach {reach:.1f} {unit})")
+    lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    if start is None:
+        q0 = np.broadcast_to(mid, (N, n))
+    else:
+        s = _values(m, start, m.joint_names, "start")
+        q0 = np.broadcast_to(s, shape + (n,)).reshape(N, n)
+        if not m.in_bounds(q0).all():
+            box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
+            raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
+        q0 = np.radians(q0)
+    K = max(1, int(starts))
+    L = float(orientation_scale) if orientation_scale else reach
+    pt, Rt = P[:, :3], _zyz_matrix(P[:, 3:])
+    eye6 = np.eye(6)
+    ev_r = np.zeros(N, dtype=np.int64)
+    ev_j = np.zeros(N, dtype=np.int64)
+    drawn = np.zeros(N, dtype=np.int64)            # random starts drawn per row
+    best_q = np.array(q0, dtype=float)
+    best_m = np.full(N, np.inf)
+    to_deg = 180.0 / np.pi
+
+    # slots: K candidates per row (more when the batch is small), slot s works for row own[s]
+    if N * K < fill:
+        K = max(K, fill // N)
+    own = np.repeat(np.arange(N), K)
+    q = np.repeat(q0, K, axis=0)
+    if K > 1:
+        rnd = np.flatnonzero(np.arange(N * K) % K > 0)
+        q[rnd] = lo + (hi - lo) * _uniform_hash(seed, own[rnd], drawn[own[rnd]] + (np.arange(N * K)[rnd] % K) - 1, n)
+        drawn += K - 1
+
+    def evaluate(qa, rows):
+        p, R, J = m.frame_jacobian(qa * to_deg)
+        evaluated.append(rows)                        # counted per row at the end
+        e = _rotation_error(R, Rt[rows])
+        dp = p - pt[rows]
+        r = np.concatenate([dp, L * e], axis=-1)
+        J *= to_deg                                    # per radian of joint motion
+        # d e = J_l^{-1}(e) omega (left Jacobian of SO(3): e = log(R R_t^T), dR = [omega]x R)
+        if exact_rotation:
+            J[:, 3:] = so3_right_jacobian_inverse(-e) @ J[:, 3:]
+        J[:, 3:] *= L
+        return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
+
+    evaluated: list[np.ndarray] = []
+
+    def fold(sl):
+        """Fold slots ``sl`` into the best answer of their rows (smallest merit wins)."""
+        merit = np.maximum(pe[sl] / tp, re[sl] / tr)
+        order = np.lexsort((merit, own[sl]))
+        first = np.ones(len(sl), dtype=bool)
+        first[1:] = own[sl][order[1:]] != own[sl][order[:-1]]
+        top = order[first]
+        better = merit[top] < best_m[own[sl][top]]
+        rows = own[sl][top[better]]
+        best_q[rows], best_m[rows] = q[sl][top[better]], merit[top[better]]
+
+    r, J, pe, re = evaluate(q, own)
+    lam = np.full(len(q), damping)
+    S = _sumsq(r)
+    age = np.zeros(len(q), dtype=np.int64)
+    done = np.zeros(N, dtype=bool)
+    with np.errstate(all="ignore"):
+        while len(own):
+            # -- bookkeeping: best per row, finished rows, stuck slots ------------------------
+            conv = (pe <= tp) & (re <= tr)
+            if conv.any():
+                cs = np.flatnonzero(conv)
+                best_q[own[cs]], best_m[own[cs]] = q[cs], np.maximum(pe[cs] / tp, re[cs] / tr)
+                done[own[cs]] = True
+            stuck = ~done[own] & ((age >= iterations) | (lam > 1e6))
+            if stuck.any():                            # seeded random restarts (budget per row)
+                sl = np.flatnonzero(stuck)
+                fold(sl)
+                rows = own[sl]
+                cnt = np.zeros(N, dtype=np.int64)
+                _, inv, counts = np.unique(rows, return_inverse=True, return_counts=True)
+                rank = np.empty(len(sl), dtype=np.int64)
+                order_sl = np.argsort(rows, kind="stable")
+                starts_of = np.concatenate([[0], np.cumsum(counts)[:-1]])
+                rank[order_sl] = np.arange(len(sl)) - np.repeat(starts_of, counts)
+                k = drawn[rows] + rank
+                ok = k < restarts + (K - 1)
+                sl, rows, k = sl[ok], rows[ok], k[ok]
+                np.add.at(cnt, rows, 1)
+                drawn += cnt
+                if len(sl):
+                    q[sl] = lo + (hi - lo) * _uniform_hash(seed, rows, k, n)
+                    r[sl], J[sl], pe[sl], re[sl] = evaluate(q[sl], rows)
+                    S[sl] = _sumsq(r[sl])
+                    lam[sl], age[sl] = damping, 0
+            keep = ~done[own] & (age < iterations) & (lam <= 1e6)
+            if not keep.all():
+                fold(np.flatnonzero(~keep & ~done[own]))
+                own, q, r, J, pe, re, lam, S, age = (a[keep] for a in (own, q, r, J, pe, re, lam, S, age))
+            if len(own) < fill:                        # few rows left: give each more candidates
+                rows_left = np.unique(own)
+                extra = (fill - len(own)) // max(len(rows_left), 1)
+                if extra > 0:
+                    give = np.minimum(extra, restarts + (K - 1) - drawn[rows_left])
+                    rows = np.repeat(rows_left, np.maximum(give, 0))
+                    if len(rows):
+                        k = drawn[rows] + (np.arange(len(rows)) - np.repeat(np.cumsum(np.maximum(give, 0)) - np.maximum(give, 0), np.maximum(give, 0)))
+                        drawn[rows_left] += np.maximum(give, 0)
+                        qa = lo + (hi - lo) * _uniform_hash(seed, rows, k, n)
+                        ra, Ja, pa, rea = evaluate(qa, rows)
+                        own = np.concatenate([own, rows])
+                        q, r, J = np.concatenate([q, qa]), np.concatenate([r, ra]), np.concatenate([J, Ja])
+                        pe, re = np.concatenate([pe, pa]), np.concatenate([re, rea])
+                        lam = np.concatenate([lam, np.full(len(rows), damping)])
+                        S = np.concatenate([S, _sumsq(ra)])
+                        age = np.concatenate([age, np.zeros(len(rows), dtype=np.int64)])
+            if not len(own):
+                break
+            # -- one damped least-squares step with saturation in the null space --------------
+            Jt_ = np.swapaxes(J, 1, 2)
+            mu = lam * (J * J).sum(axis=(1, 2)) / 6.0       # damping scaled to J
+            A = J @ Jt_
+            A[:, range(6), range(6)] += mu[:, None]
+            d = (Jt_ @ np.linalg.solve(A, -r[..., None]))[..., 0]
+            if rest > 0:
+                z = rest * (mid - q) / (half * half)
+                d += z - (Jt_ @ np.linalg.solve(A, J @ z[..., None]))[..., 0]
+            d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
+            qn = q + d
+            out = (qn < lo) | (qn > hi)
+            if out.any():
+                free = (~out).astype(float)
+                fixed = np.where(out, np.clip(qn, lo, hi) - q, 0.0)
+                for _ in range(2):
+                    Jf = J * free[:, None, :]
+                    rr = r + (J @ fixed[..., None])[..., 0]
+                    A = Jf @ np.swapaxes(Jf, 1, 2)
+                    A[:, range(6), range(6)] += mu[:, None]
+                    d = (np.swapaxes(Jf, 1, 2) @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
+                    qn = q + d
+                    out = ((qn < lo) | (qn > hi)) & (free > 0)
+                    if not out.any():
+                        break
+                    fixed = np.where(out, np.clip(qn, lo, hi) - q, fixed)
+                    free = np.where(out, 0.0, free)
+                qn = np.clip(qn, lo, hi)
+            rt, Jn, pet, ret = evaluate(qn, own)
+            St = _sumsq(rt)
+            ok = St < S
+            lam = np.where(ok, np.maximum(lam * down, 1e-12), lam * up)
+            q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qn[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
+            age += 1
+    if len(own):
+        fold(np.arange(len(own)))
+    if evaluated:
+        ev_r += np.bincount(np.concatenate(evaluated), minlength=N)
+        ev_j[:] = ev_r
+    # verdict from the arm's own closed form (its elementwise frame), not the solver's products
+    from .rotations import to_array
+    qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])
+    pf, Rf = m.frame(qd)
+    pf, Rf = np.stack(pf, axis=-1), to_array(Rf)
+    perr = np.sqrt(_sumsq(pf - pt))
+    rerr = np.sqrt(_sumsq(_rotation_error(Rf, Rt)))
+    ok = (perr <= tp) & (rerr <= tr) & m.in_bounds(qd)
+    return InverseResult(
+        mechanism=m.name, names=tuple(m.joint_names), joints=qd.reshape(shape + (n,)),
+        position_error=perr.reshape(shape), rotation_error=rerr.reshape(shape),
+        residual=np.maximum(perr / tp, rerr / tr).reshape(shape), solved=ok.reshape(shape),
+        restarts=np.maximum(drawn - (K - 1), 0).reshape(shape),
+        evaluations={"residual": ev_r.reshape(shape), "jacobian": ev_j.reshape(shape)},
+        tol=(tp, tr))

@@ -1,0 +1,144 @@
+"""fkopt.forward / fkopt.inverse: batched exact solvers, verdicts checked against the closed forms,
+and the fk/ik commands' exit codes (0 solved, 1 not a solution, 2 bad input)."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import fkopt
+from fkopt.errors import FkoptError
+
+FKOPT = [sys.executable, "-m", "fkopt.cli"]
+
+
+def cli(*args):
+    return subprocess.run([*FKOPT, *args], capture_output=True, text=True, timeout=300)
+
+
+def random_poses(m, n, seed=0):
+    b = m.bounds
+    return b[:, 0] + np.random.default_rng(seed).random((n, len(b))) * (b[:, 1] - b[:, 0])
+
+
+@pytest.mark.parametrize("name", ["3-rps", "3-ppr", "3-rpupc-ups", "6-sps-cmm"])
+def test_forward_batch_reproduces_the_joints(name):
+    m = fkopt.mechanism(name)
+    X = random_poses(m, 60).reshape(3, 20, -1)
+    L = m.ik(X)
+    r = fkopt.forward(m, L)
+    assert r.pose.shape == X.shape and r.solved.shape == (3, 20)
+    assert r.solved.all()
+    # the verdict is the closed form's: another assembly mode in the bounds counts as a solution
+    err = np.abs(m.ik(r.pose) - L).max(axis=-1)
+    assert np.all(err <= r.tol) and np.all(m.in_bounds(r.pose))
+    np.testing.assert_allclose(r.residual, err, atol=1e-12)   # (angle joints are wrapped)
+    assert np.all(r.evaluations["jacobian"] >= 1) and np.all(r.evaluations["residual"] >= r.evaluations["jacobian"])
+
+
+def test_forward_liu2008_case_and_single_row_shapes():
+    m = fkopt.mechanism("6-sps-cmm")
+    r = fkopt.forward(m, [0.750, 0.780, 0.800, 0.900, 0.870, 0.850])
+    assert r.pose.shape == (6,) and bool(r.solved)
+    np.testing.assert_allclose(r.pose, [0.03986047, 0.09593005, 0.92523456, -12.6973253, 6.4030949, 15.1332059],
+                               atol=1e-7)
+    assert r.as_dict()["solved"] is True
+
+
+def test_forward_unreachable_is_not_solved_with_its_best_residual():
+    r = fkopt.forward("3-rps", [100.0, 900.0, 600.0], global_search=False)
+    assert not r.solved and r.residual > 1 and r.stage == -1
+
+
+def test_forward_bad_input():
+    with pytest.raises(FkoptError, match="finite"):
+        fkopt.forward("3-rps", [np.nan, 1, 2])
+    with pytest.raises(FkoptError, match="expected"):
+        fkopt.forward("3-rps", [1, 2])
+    with pytest.raises(FkoptError, match="fkopt.inverse"):
+        fkopt.forward("7dof-arm", np.zeros(7))
+
+
+def test_inverse_random_reachable_poses_within_limits():
+    m = fkopt.mechanism("7dof-arm")
+    Q = random_poses(m, 40, seed=3)
+    P = m.fk(Q)
+    r = fkopt.inverse(m, P, seed=1)
+    assert r.solved.all()
+    assert np.all(m.in_bounds(r.joints, tol=0.0))
+    problem = fkopt.ik_problem(m, P[7], objective="geodesic")
+    assert problem.position_error(r.joints[7]) <= 1e-6
+    assert np.radians(problem.rotation_error(r.joints[7])) <= 1e-6
+    # same poses and seed, same answer
+    again = fkopt.inverse(m, P, seed=1)
+    np.testing.assert_array_equal(again.joints, r.joints)
+
+
+def test_inverse_orientation_tolerance_is_separate_and_in_radians():
+    m = fkopt.mechanism("7dof-arm")
+    P = m.fk([45, 0, 45, 0, 45, 0, 0])
+    P[3] += 0.5                                  # alpha off by 0.5 deg: not exactly reachable? still reachable
+    r = fkopt.inverse(m, P, tol=(1e-6, 1e-6))
+    assert r.solved                               # a redundant arm reaches the turned pose as well
+    strict = fkopt.inverse(m, P, tol=(1e-6, 1e-300), restarts=0)
+    assert not strict.solved and strict.residual > 1
+
+
+def test_inverse_null_space_rest_keeps_solving():
+    m = fkopt.mechanism("7dof-arm")
+    P = m.fk(random_poses(m, 10, seed=4))
+    r = fkopt.inverse(m, P, rest=0.05)
+    assert r.solved.mean() >= 0.9
+
+
+def test_inverse_bad_input():
+    with pytest.raises(FkoptError, match="unreachable"):
+        fkopt.inverse("7dof-arm", [0, 0, 5000, 0, 0, 0])
+    with pytest.raises(FkoptError, match="finite"):
+        fkopt.inverse("7dof-arm", [0, 0, np.inf, 0, 0, 0])
+    with pytest.raises(FkoptError, match="limits"):
+        fkopt.inverse("7dof-arm", [300, 300, 800, 0, 90, 0], start=[0, 100, 0, 0, 0, 0, 0])
+
+
+def test_fk_cli_exit_codes():
+    ok = cli("fk", "6-sps-cmm", "--joints", "l1=0.75,l2=0.78,l3=0.8,l4=0.9,l5=0.87,l6=0.85", "--json")
+    assert ok.returncode == 0, ok.stderr
+    out = json.loads(ok.stdout)
+    assert out["solved"] and out["residual"] <= 1e-9
+    bad = cli("fk", "3-rps", "--joints", "d1=100,d2=900,d3=600")
+    assert bad.returncode == 1 and len(bad.stderr.strip().splitlines()) == 1
+    assert "best residual" in bad.stderr
+    assert cli("fk", "3-rps", "--joints", "d1=nan,d2=900,d3=600").returncode == 2
+    swarm = cli("fk", "3-rps", "--joints", "d1=598.84582586,d2=671.91712863,d3=629.16156603",
+                "--algorithm", "gabc+lm", "--tolerance", "1e-6", "--json")
+    assert swarm.returncode == 0 and json.loads(swarm.stdout)["algorithm"] == "gabc+lm"
+
+
+def test_ik_cli_exit_codes():
+    m = fkopt.mechanism("7dof-arm")
+    pose = m.fk([45, 0, 45, 0, 45, 0, 0])
+    arg = ",".join(f"{n}={v!r}" for n, v in zip(m.pose_names, pose.tolist()))
+    ok = cli("ik", "7dof-arm", "--pose", arg, "--json")
+    assert ok.returncode == 0, ok.stderr
+    q = np.array(list(json.loads(ok.stdout)["joints"].values()))
+    assert np.all(m.in_bounds(q)) and np.abs(m.fk(q)[:3] - pose[:3]).max() < 1e-5
+    # a swarm alone does not reach 1e-6 mm in its budget: reported, exit 1, one line
+    swarm = cli("ik", "7dof-arm", "--pose", arg, "--algorithm", "pso")
+    assert swarm.returncode == 1 and len(swarm.stderr.strip().splitlines()) == 1
+    assert "position error" in swarm.stderr
+    assert cli("ik", "7dof-arm", "--pose", "x=0,y=0,z=5000,alpha=0,beta=0,gamma=0").returncode == 2
+    assert cli("ik", "3-rps", "--pose", "alpha=50,beta=0,z=600").returncode == 2
+
+
+@pytest.mark.parametrize("args", [["list", "--json"],
+                                  ["fk", "6-sps-cmm", "--joints", "l1=0.75,l2=0.78,l3=0.8,l4=0.9,l5=0.87,l6=0.85"],
+                                  ["ik", "3-rps", "--pose", "alpha=9,beta=13,z=622"]])
+def test_light_commands_import_no_heavy_layers(args):
+    proc = subprocess.run([sys.executable, "-X", "importtime", "-m", "fkopt.cli", *args],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-500:]
+    imported = {line.split("|")[-1].strip() for line in proc.stderr.splitlines() if "|" in line}
+    heavy = {m for m in imported if m.split(".")[0] in ("pandas", "matplotlib")
+             or m.startswith(("fkopt.experiment", "fkopt.study", "fkopt.reproduce"))}
+    assert not heavy, sorted(heavy)
