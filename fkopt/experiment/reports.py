@@ -170,6 +170,31 @@ def runs_table(er: ExperimentResult) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
+def trace_table(er: ExperimentResult) -> pd.DataFrame | None:
+    """Per-run best-so-far fitness where it changed (lossless step function), with evaluations.
+
+    Rows: iteration 0, every iteration whose best-so-far differs from the previous one, and the
+    run's last iteration. The best-so-far after ``E`` evaluations is the value of the last row
+    with ``evaluations <= E``: what equal-evaluation comparisons of the claims use. Written only
+    for experiments of at most ``MAX_CASE_CURVES`` cases and more than one run (size).
+    """
+    if len(er.cases) > MAX_CASE_CURVES or er.config.runs < 2:
+        return None
+    frames = []
+    for rec in er.records:
+        r = rec.result
+        h, ev = r.history, r.evaluation_history
+        keep = np.zeros(h.shape, dtype=bool)
+        keep[:, 0] = True
+        keep[:, 1:] = h[:, 1:] != h[:, :-1]
+        keep[np.arange(r.runs), r.iterations_done] = True
+        keep &= np.arange(h.shape[1]) <= r.iterations_done[:, None]
+        k, t = np.nonzero(keep)
+        frames.append(pd.DataFrame({"case": rec.case.label, "algorithm": rec.spec.key, "run": r.run_ids[k],
+                                    "iteration": t, "evaluations": ev[k, t], "best_fitness": h[k, t]}))
+    return pd.concat(frames, ignore_index=True)
+
+
 def convergence_table(er: ExperimentResult) -> pd.DataFrame:
     frames = []
     for label, algo, hist, evals, pos in _curves(er):
@@ -426,6 +451,7 @@ def write_tables(er: ExperimentResult, folder: Path) -> list[str]:
     csv("values.csv", values_table(er))
     csv("inputs.csv", inputs_table(er))
     csv("runs.csv", runs_table(er))
+    csv("trace.csv", trace_table(er))
     csv("convergence.csv", convergence_table(er))
     convergence_figure(er, folder / "convergence.png")
     written.append("convergence.png")
