@@ -1,12 +1,14 @@
 """Reports: turn an :class:`ExperimentResult` into CSV tables, figures and ``meta.json``.
 
-Files of one experiment folder (all deterministic for a given seed except ``timing.csv`` and
+Files of one experiment folder (all deterministic for a given seed except ``timing.csv``, ``timing_runs.csv`` and
 the figures drawn from timings, ``cases_time.png``):
 
 * ``summary.csv``     final fitness statistics per case and algorithm over all runs (mean, std,
   best, worst, median), evaluations, success rate and iterations/evaluations to the threshold
   (medians over the runs that reached it), the paper's printed values beside them;
-* ``timing.csv``      mean/median time per run (ms; amortised over the batch) beside the printed time;
+* ``timing.csv``      time per run (ms) measured one run at a time on a sample of runs (median,
+  quartiles; see :mod:`.timing`), the batch's amortised time beside it, the printed time;
+  ``timing_runs.csv`` every timed run;
 * ``values.csv``      per variable: target, the median run's value and error (the run whose final
   fitness is the lower median), the best run's, and the mean absolute error over all runs;
 * ``inputs.csv``      (only when a case gives both joints and a pose) given vs computed inputs;
@@ -78,17 +80,29 @@ def summary_table(er: ExperimentResult) -> pd.DataFrame:
 
 
 def timing_table(er: ExperimentResult) -> pd.DataFrame:
+    """Time per run measured one run at a time on a sample of runs (:mod:`.timing`)."""
     rows = []
     for rec in er.records:
-        t = rec.result.time_per_run * 1e3
+        if rec.single_run_s is None:
+            continue
+        t = rec.single_run_s * 1e3
+        q25, med, q75 = np.percentile(t, [25, 50, 75])
         row = {"case": rec.case.label, "algorithm": rec.spec.key, "runs": rec.result.runs,
-               "batch": er.config.batch, "mean_ms_per_run": float(np.mean(t)),
-               "median_ms_per_run": float(np.median(t)), "total_s": rec.wall_s}
+               "timed_runs": len(t), "mean_ms_per_run": float(np.mean(t)), "median_ms_per_run": float(med),
+               "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
+               "amortised_ms_per_run": float(np.mean(rec.result.time_per_run) * 1e3), "total_s": rec.wall_s}
         for k, v in rec.spec.printed.items():
             if k.endswith("_ms"):
                 row[f"printed_{k}"] = v
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def timing_runs_table(er: ExperimentResult) -> pd.DataFrame:
+    """Every timed single run (ms): what timing claims test for a difference."""
+    return pd.DataFrame([{"case": rec.case.label, "algorithm": rec.spec.key, "run": int(k), "ms": float(s * 1e3)}
+                         for rec in er.records if rec.single_run_s is not None
+                         for k, s in zip(rec.single_run_ids, rec.single_run_s)])
 
 
 def values_table(er: ExperimentResult) -> pd.DataFrame:
@@ -448,6 +462,7 @@ def write_tables(er: ExperimentResult, folder: Path) -> list[str]:
     summary, timing = summary_table(er), timing_table(er)
     csv("summary.csv", summary)
     csv("timing.csv", timing)
+    csv("timing_runs.csv", timing_runs_table(er))
     csv("values.csv", values_table(er))
     csv("inputs.csv", inputs_table(er))
     csv("runs.csv", runs_table(er))
