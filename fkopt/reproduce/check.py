@@ -14,7 +14,9 @@ Comparison rules (documented tolerances that survive another machine's floating 
   iterations/evaluations to the threshold within ``COUNT_RTOL`` (relative);
 * ``values.csv`` median-run values within max(1e-6 * scale, 10 x the stored mean absolute error);
 * single runs (``runs.csv``) and curves are not compared (medians, not single runs), and
-  timing columns never are.
+  timing columns never are;
+* the paper's claims recomputed with the rerun in place must keep the verdicts stored in
+  ``<paper>/claims.csv`` (:func:`fkopt.reproduce.claims.rerun_verdict_drift`).
 
 A mismatch names the experiment, the file, the row, the column and both values.
 """
@@ -139,7 +141,8 @@ def check_experiment(exp: Experiment, config: ExperimentConfig | None = None) ->
                 out.append(Mismatch(label, file, "-", "file", stored_exists, rerun_exists, "present in both"))
             elif stored_exists:
                 out += compare_tables(label, file, exp.table(file), pd.read_csv(tmp / file))
-        return out
+        from .claims import rerun_verdict_drift   # a claim's verdict must not change either
+        return out + rerun_verdict_drift(exp, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
