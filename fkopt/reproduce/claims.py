@@ -149,6 +149,19 @@ def _from_trace(exp, algo, column, budget, case) -> np.ndarray:
     return np.asarray(out)
 
 
+def first_below(exp, algo: str, level: float, case: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per run: (iteration, evaluations) at which the best-so-far first went below ``level``
+    (inf where it never did), from trace.csv."""
+    t = exp.table("trace")
+    t = t[t.algorithm == algo] if case is None else t[(t.algorithm == algo) & (t["case"] == case)]
+    its, evs = [], []
+    for _, grp in t.groupby("run", sort=True):
+        hit = grp[grp.best_fitness < level]
+        its.append(float(hit.iteration.iloc[0]) if len(hit) else np.inf)
+        evs.append(float(hit.evaluations.iloc[0]) if len(hit) else np.inf)
+    return np.asarray(its), np.asarray(evs)
+
+
 def equal_budget(exp, a: str, b: str, names: dict[str, str], case: str | None = None,
                  iteration: int | None = None) -> tuple[Comparison, Comparison, float]:
     """(equal iterations, equal evaluations, the evaluations used) comparisons of ``a`` vs ``b``.
