@@ -162,35 +162,51 @@ def first_below(exp, algo: str, level: float, case: str | None = None) -> tuple[
     return np.asarray(its), np.asarray(evs)
 
 
+def evaluations_at(exp, algo: str, iteration: int | None = None, case: str | None = None) -> float:
+    """Evaluations spent after ``iteration``: mean over runs (convergence.csv); at the end (default)
+    the median over runs (runs.csv)."""
+    if iteration is None:
+        r = exp.table("runs")
+        r = r[r.algorithm == algo] if case is None else r[(r.algorithm == algo) & (r["case"] == case)]
+        return float(r.evaluations.median())
+    c = exp.table("convergence")
+    c = c[(c.algorithm == algo) & (c.iteration == iteration)]
+    if case is not None:
+        c = c[c["case"] == case]
+    return float(c.mean_evaluations.iloc[0])
+
+
 def equal_budget(exp, a: str, b: str, names: dict[str, str], case: str | None = None,
-                 iteration: int | None = None) -> tuple[Comparison, Comparison, float]:
+                 iteration: int | None = None) -> tuple[Comparison, Comparison | None, float]:
     """(equal iterations, equal evaluations, the evaluations used) comparisons of ``a`` vs ``b``.
 
-    Equal evaluations: each run's best-so-far after the evaluations the cheaper of the two spent
-    (the smaller median of the runs' evaluations at the end of the iterations).
+    Equal iterations: each run's best-so-far after ``iteration`` (default: the end). Equal
+    evaluations: each run's best-so-far after the evaluations the cheaper of the two spent in
+    those iterations (median over its runs); None without a stored trace.
     """
-    r = exp.table("runs")
-    ev = {x: float(r[r.algorithm == x].evaluations.median()) for x in (a, b)}
-    budget = min(ev.values())
+    budget = min(evaluations_at(exp, x, iteration, case) for x in (a, b))
     it = compare(names.get(a, a), at_iteration(exp, a, iteration, case), names.get(b, b),
                  at_iteration(exp, b, iteration, case))
+    if not exp.has("trace.csv"):
+        return it, None, budget
     evc = compare(names.get(a, a), at_evaluations(exp, a, budget, case), names.get(b, b),
                   at_evaluations(exp, b, budget, case))
     return it, evc, budget
 
 
-def better_claim(text: str, better: str, it: Comparison, ev: Comparison, budget: float,
+def better_claim(text: str, better: str, it: Comparison, ev: Comparison | None, budget: float,
                  iterations: int, paper_measure: str = "iterations") -> Claim:
     """'``better`` is more precise than the other': held iff significantly lower on the paper's measure."""
-    decisive, other = (it, ev) if paper_measure == "iterations" else (ev, it)
-    ok = decisive.lower == better
-    evidence = (f"equal iterations ({iterations}): {it.text()}; equal evaluations ({budget:.0f}): {ev.text()}; "
+    decisive = it if paper_measure == "iterations" or ev is None else ev
+    ev_text = ev.text() if ev is not None else "not stored (no per-run trace for experiments of many cases)"
+    evidence = (f"equal iterations ({iterations}): {it.text()}; equal evaluations ({budget:.0f}): {ev_text}; "
                 f"verdict on equal {paper_measure} (the paper's budget)")
-    numbers = {"p_iterations": it.p, "p_evaluations": ev.p, "lower_iterations": it.lower,
-               "lower_evaluations": ev.lower, "median_a_iterations": it.median_a,
-               "median_b_iterations": it.median_b, "median_a_evaluations": ev.median_a,
-               "median_b_evaluations": ev.median_b, "evaluations": budget}
-    return Claim(text, verdict(ok), evidence, numbers)
+    numbers = {"p_iterations": it.p, "lower_iterations": it.lower, "median_a_iterations": it.median_a,
+               "median_b_iterations": it.median_b, "evaluations": budget}
+    if ev is not None:
+        numbers.update({"p_evaluations": ev.p, "lower_evaluations": ev.lower, "median_a_evaluations": ev.median_a,
+                        "median_b_evaluations": ev.median_b})
+    return Claim(text, verdict(decisive.lower == better), evidence, numbers)
 
 
 def timing_comparison(exp, a: str, b: str, names: dict[str, str]) -> Comparison | None:
