@@ -115,7 +115,11 @@ class ExperimentConfig(Strict):
     snapshots: list[int] = Field(default_factory=list)
     #: Extra figures: variables (best-so-far pose vs iteration), snapshots (population scatter),
     #: extras (algorithm records such as ACO pheromone), cases (per-case error and time).
-    figures: list[Literal["variables", "snapshots", "extras", "cases"]] = Field(default_factory=list)
+    figures: list[Literal["variables", "snapshots", "extras", "cases", "time"]] = Field(default_factory=list)
+    #: File stems of the figures, named after the paper figure they mirror, by fkopt's figure kind
+    #: (convergence, variables, snapshot_<t>, extras, cases, cases_time, cases_position_error,
+    #: position_error, time), e.g. {convergence: fig2}; kinds not named keep the kind as stem.
+    figure_names: dict[str, str] = Field(default_factory=dict)
     #: Experiment-level printed values and notes for the report.
     printed: dict[str, Any] = Field(default_factory=dict)
     #: Which regression check reruns it: "ci" (every CI run and `make check`) or "full"
