@@ -432,7 +432,7 @@ def snapshot_figures(er: ExperimentResult, folder: Path) -> list[str]:
                 ax.set_xlabel(f"{names[i]} ({units[i]})")
                 ax.set_ylabel(f"{names[j]} ({units[j]})")
                 ax.grid(False)
-                fig.colorbar(im, ax=ax, label=f"log10 min over {names[k]} of f")
+                fig.colorbar(im, ax=ax, label=f"log10 of f, minimised over {names[k]}")
             row[0].legend(loc="upper left", fontsize=7, frameon=True)
             row[0].set_title(f"{names_of[rec.spec.key]}, case {rec.case.label}: {t} moves (run 0)")
         fig.tight_layout()

@@ -59,6 +59,53 @@ NOTES = [
 ]
 
 
+#: Fig. 3's 20 s trajectory is lost with eqs. (25)-(30): fkopt's choice (documented, not the paper's)
+#: moves from the home pose (0, 0, 0 deg, 360 mm) to the printed case (25, 34, 23 deg, 360 mm) with a
+#: quintic time law s(t) = 10 u^3 - 15 u^4 + 6 u^5, u = t / 20 s (zero velocity and acceleration at
+#: both ends).
+FIG3_TRAJECTORY = {"duration_s": 20.0, "start": {"alpha": 0.0, "beta": 0.0, "gamma": 0.0, "z": 360.0},
+                   "end": CASE_POSE}
+
+
+def fig3_inputs(samples: int = 201) -> pd.DataFrame:
+    """Fig. 3: the four inputs (l1, l2, l3 in mm, delta in deg) along FIG3_TRAJECTORY."""
+    mech = _mechanism()
+    t = np.linspace(0.0, FIG3_TRAJECTORY["duration_s"], samples)
+    u = t / FIG3_TRAJECTORY["duration_s"]
+    s = 10 * u ** 3 - 15 * u ** 4 + 6 * u ** 5
+    a = mech.vector(FIG3_TRAJECTORY["start"], mech.pose_names, "start")
+    b = mech.vector(FIG3_TRAJECTORY["end"], mech.pose_names, "end")
+    poses = a + s[:, None] * (b - a)
+    inputs = mech.ik(poses)
+    return pd.DataFrame({"t_s": t, **{n: inputs[:, j] for j, n in enumerate(mech.joint_names)}})
+
+
+def figures(exp) -> list[str]:
+    """Figures drawn from the model alone at report time: Fig. 3 (inputs along the trajectory)."""
+    if exp.name != "tab1_fig7":
+        return []
+    from ..experiment import plotting
+    df = fig3_inputs()
+    mech = _mechanism()
+    plt = plotting.plt()
+    fig, axes = plt.subplots(1, 2, figsize=(8.4, 3.2))
+    for n, unit in zip(mech.joint_names, mech.joint_units):
+        ax = axes[0] if unit == "mm" else axes[1]
+        ax.plot(df.t_s, df[n], label=n)
+    axes[0].set_ylabel("leg length l (mm)")
+    axes[1].set_ylabel("leg 4 input angle δ (deg)")
+    for ax in axes:
+        ax.set_xlabel("time t (s)")
+        ax.legend()
+    fig.suptitle("chang2024 Fig. 3: active-joint inputs along a 20 s trajectory (reconstructed model; the "
+                 "trajectory is fkopt's choice,\nhome (0, 0, 0°, 360 mm) → case (25°, 34°, 23°, 360 mm), quintic "
+                 "time law; the paper's was lost)", fontsize=8)
+    fig.tight_layout()
+    names = plotting.save(fig, exp.folder / "fig3.png")
+    plt.close(fig)
+    return names
+
+
 # -- helpers -----------------------------------------------------------------------------------
 def _mechanism(exp=None):
     from .. import registry

@@ -88,6 +88,9 @@ def experiment_section(exp: Experiment, root: Path) -> str:
     if extra:
         for caption, df in extra(exp):
             lines += [caption, "", md_table(df), ""]
+    draw = getattr(paper_module(exp.paper), "figures", None)
+    if draw:   # figures of the model alone (e.g. chang2024 Fig. 3), drawn at report time
+        draw(exp)
     for fig in exp.figures():
         if fig.endswith("_time.png"):
             continue   # drawn from timings: shown in TIMING.md
