@@ -256,6 +256,9 @@ def claims(store) -> list[Claim]:
         c.numbers["orders"] = float(gain)
         out.append(c)
         half = T // 2   # 150 of 300: P-ABC's switch from PSO to ABC
+    if t1 is not None and not t1.has("trace.csv"):
+        out.append(missing("Fig. 7 claims", "chang2024/tab1_fig7/trace.csv (per-run traces)"))
+    elif t1 is not None:
         vs = {b: equal_budget(t1, "abc", b, NAMES, iteration=half) for b in ("pso", "pabc")}
         out.append(Claim(
             "Fig. 7: in the first 150 iterations ABC converges faster than PSO and P-ABC",
