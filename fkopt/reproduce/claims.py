@@ -89,11 +89,11 @@ class Comparison:
 
     @property
     def median_a(self) -> float:
-        return float(np.median(self.values_a))
+        return float(np.median(self.values_a)) if self.values_a.size else float("nan")
 
     @property
     def median_b(self) -> float:
-        return float(np.median(self.values_b))
+        return float(np.median(self.values_b)) if self.values_b.size else float("nan")
 
     @property
     def lower(self) -> str | None:
@@ -118,7 +118,9 @@ def compare(a: str, values_a, b: str, values_b) -> Comparison:
     """Two-sided Mann-Whitney U test; identical samples are no difference (p = 1)."""
     from scipy.stats import mannwhitneyu
     va, vb = np.asarray(values_a, float), np.asarray(values_b, float)
-    if np.array_equal(np.sort(va), np.sort(vb)) or np.unique(np.concatenate([va, vb])).size == 1:
+    if va.size == 0 or vb.size == 0:   # nothing to compare: no evidence of a difference
+        p = 1.0
+    elif np.array_equal(np.sort(va), np.sort(vb)) or np.unique(np.concatenate([va, vb])).size == 1:
         p = 1.0
     else:
         p = float(mannwhitneyu(va, vb, alternative="two-sided").pvalue)
