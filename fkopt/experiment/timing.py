@@ -12,8 +12,8 @@ times measured here:
   call; one untimed short warm-up solve precedes the task's first timed run.
 * **Sample**: runs ``0 .. n-1`` of each (case, algorithm) task with
   ``n = max(1, ceil(TIMING_RUNS / cases))`` (all runs if fewer), on the first ``TIMING_RUNS``
-  cases of the experiment; so a single-case experiment times 10 runs per algorithm, a 50-pose
-  experiment one run on each of 10 poses. This keeps ``make reproduce`` within its budget.
+  cases of the experiment; so a single-case experiment times 8 runs per algorithm, a 50-pose
+  experiment one run on each of 8 poses. This keeps ``make reproduce`` within its budget.
 * **Spread**: the sample's median and quartiles are reported; two algorithms' times differ only
   if a two-sided Mann-Whitney rank test over the sampled runs rejects equality at alpha = 0.05
   (verdict *within noise* otherwise; see :mod:`fkopt.reproduce.claims`).
@@ -30,7 +30,7 @@ import numpy as np
 from ..solve import solve
 
 #: Timed runs per algorithm (spread over the first TIMING_RUNS cases; see the module docstring).
-TIMING_RUNS = 10
+TIMING_RUNS = 8
 
 
 def sample_plan(n_cases: int, runs: int) -> tuple[int, int]:
