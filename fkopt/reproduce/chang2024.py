@@ -49,9 +49,8 @@ NOTES = [
     "P-ABC over ABC and single P-ABC solves within 0.5 s; those are what fkopt is compared with "
     "(`printed_error_order` in the tables). Tab. 2's 50 poses are unknown: fkopt draws 50 poses "
     "uniformly in its search box (seed 2024).",
-    "**Reduced budget:** Tab. 2 runs each algorithm once per pose (the paper's Tab. 2 also reports one "
-    "solve per pose) instead of 30 times, to keep 50 poses x 3 algorithms x population 100 x 300 "
-    "iterations at ~20 s of CPU; Tab. 1 keeps the printed 30 runs.",
+    "**Budget:** the runs per pose of Tab. 2 and of Tab. 1 are given in each experiment's header below "
+    "(the paper's Tab. 2 reports one solve per pose).",
     "Cost per iteration differs: an ABC iteration costs 2 x population evaluations, a PSO iteration "
     "population, a P-ABC run 1.5 x population on average, so at the same 300 iterations ABC spends a "
     "third more evaluations than P-ABC (compare `mean_evaluations`).",

@@ -43,14 +43,13 @@ NOTES = [
     "v(t): no inertia weight (w = 1) and no constants. `pso_eq10` runs that form (w = 1, c1 = c2 = 2 as "
     "in Kennedy & Eberhart 1995, velocity clamp 0.2 x box width, without which w = 1 diverges) beside "
     "fkopt's constriction PSO.",
-    "**Reduced for the time budget:** Tab. 3 uses 30 runs (paper 50) and Fig. 7 10 random reachable "
-    "poses with 1 run each (paper 100 poses): a single 7-DOF run of 500 iterations costs ~1 s of numpy "
-    "call overhead. `baselines` reruns the first 10 runs of Tab. 3 exactly (same seed) beside "
+    "**Budget:** runs and random poses of each experiment are in its header below (the paper: 50 runs, "
+    "100 poses); `baselines` reruns the first runs of Tab. 3 exactly (same seed) beside "
     "Levenberg-Marquardt and ABC+LM.",
     "\"Iterations to best\" is the first iteration at which a run's final best-so-far fitness was "
     "reached (`iterations_to_best` in runs.csv); swarms that still improve by tiny steps at the end "
-    "get values near 500. \"Time to best\" (TIMING.md) is the time per run scaled by "
-    "iterations_to_best / 500.",
+    "get values near 500. \"Time to best\" (TIMING.md) is each timed single run's time scaled by "
+    "its iterations_to_best / 500.",
     "**Known errors in the paper:** (1) the printed joint solutions of Tab. 2 do not reach the target "
     "under the paper's own DH table: fk puts ABC's solution 85.9 mm and PSO's 126.1 mm from the target "
     "position, 104 and 69 deg off in orientation (table below), so the paper's solutions cannot be "
