@@ -13,7 +13,10 @@ times measured here:
 * **Sample**: runs ``0 .. n-1`` of each (case, algorithm) task with
   ``n = max(1, ceil(TIMING_RUNS / cases))`` (all runs if fewer), on the first ``TIMING_RUNS``
   cases of the experiment; so a single-case experiment times 8 runs per algorithm, a 50-pose
-  experiment one run on each of 8 poses. This keeps ``make reproduce`` within its budget.
+  experiment one run on each of 8 poses. A task stops adding runs once it has spent
+  ``TIMING_BUDGET_S`` seconds on timed runs, but never with fewer than ``TIMING_MIN_RUNS``
+  (5: the fewest with which a rank test can reach p < 0.05). This keeps ``make reproduce``
+  within its budget.
 * **Spread**: the sample's median and quartiles are reported; two algorithms' times differ only
   if a two-sided Mann-Whitney rank test over the sampled runs rejects equality at alpha = 0.05
   (verdict *within noise* otherwise; see :mod:`fkopt.reproduce.claims`).
@@ -31,6 +34,10 @@ from ..solve import solve
 
 #: Timed runs per algorithm (spread over the first TIMING_RUNS cases; see the module docstring).
 TIMING_RUNS = 8
+#: A task times at least this many runs (if it has them) ...
+TIMING_MIN_RUNS = 5
+#: ... and stops adding runs once its timed runs took this long (s).
+TIMING_BUDGET_S = 3.0
 
 
 def sample_plan(n_cases: int, runs: int) -> tuple[int, int]:
@@ -51,13 +58,14 @@ def time_single_runs(config, records) -> None:
                       x0=None if spec.start is None else _start(rec),
                       batch=False, params=spec.params)
         solve(rec.problem, spec.name, iterations=2, run_ids=[0], **kwargs)   # warm-up, untimed
-        ids = np.arange(per)
-        seconds = np.empty(per)
-        for i, k in enumerate(ids):
+        seconds = []
+        for k in range(per):
             start = time.perf_counter()
             solve(rec.problem, spec.name, iterations=spec.iterations or config.iterations, run_ids=[k], **kwargs)
-            seconds[i] = time.perf_counter() - start
-        rec.single_run_ids, rec.single_run_s = ids, seconds
+            seconds.append(time.perf_counter() - start)
+            if len(seconds) >= TIMING_MIN_RUNS and sum(seconds) > TIMING_BUDGET_S:
+                break
+        rec.single_run_ids, rec.single_run_s = np.arange(len(seconds)), np.array(seconds)
 
 
 def _start(rec) -> np.ndarray:
