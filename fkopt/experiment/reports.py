@@ -358,13 +358,16 @@ def variables_figure(er: ExperimentResult, path: Path) -> list[str]:
         for j, ax in enumerate(flat[:len(names)]):
             ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key])
     case = recs[0].case
-    truth = case.target if er.mechanism.kind == "parallel" else case.given_joints
+    if er.mechanism.kind == "parallel":
+        truth, what = ((case.target, "true value") if case.target is not None
+                       else (case.reference, case.reference_label.replace("_", " ")))
+    else:
+        truth, what = case.given_joints, "joints defining the target"
     for j, ax in enumerate(flat[:len(names)]):
         ax.set_title(f"{names[j]} ({units[j]})")
         ax.set_xlabel("iteration")
         if truth is not None:
-            ax.axhline(truth[j], color="k", lw=0.8, ls="--",
-                       label="true value" if er.mechanism.kind == "parallel" else "joints defining the target")
+            ax.axhline(truth[j], color="k", lw=0.8, ls="--", label=what)
     for ax in flat[len(names):]:
         ax.set_visible(False)
     flat[0].legend(fontsize=7)
@@ -533,6 +536,7 @@ def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, tim
                 plotting.mark_zero(ax, floor)
         _case_axis(ax, len(er.cases))
         ax.set_ylabel(ylabel)
+        ax.set_title(er.config.title or er.config.name, fontsize=9)
         ax.legend()
         written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
@@ -552,6 +556,7 @@ def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, tim
         ax.set_yscale("log")
         _case_axis(ax, len(er.cases))
         ax.set_ylabel(f"{agg}final position error (mm)")
+        ax.set_title(er.config.title or er.config.name, fontsize=9)
         ax.legend()
         written += _save(fig, folder / figure_file(er, "cases_position_error"))
         plt.close(fig)
