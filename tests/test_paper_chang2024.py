@@ -12,7 +12,7 @@ from fkopt.experiment.runner import run_experiment, validate_experiment
 from fkopt.problems import fk_problem
 from fkopt.registry import mechanism_class
 from fkopt.reproduce import PAPERS, chang2024
-from fkopt.reproduce.claims import NOT_CHECKABLE, Claim
+from fkopt.reproduce.claims import NOT_CHECKABLE
 from fkopt.reproduce.store import Store
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -13,7 +13,7 @@ from fkopt.experiment.runner import run_experiment, validate_experiment
 from fkopt.problems import fk_problem
 from fkopt.registry import mechanism_class
 from fkopt.reproduce import PAPERS, wu2015
-from fkopt.reproduce.claims import NOT_CHECKABLE, Claim
+from fkopt.reproduce.claims import NOT_CHECKABLE
 from fkopt.reproduce.store import Store
 from fkopt.solve import solve
 

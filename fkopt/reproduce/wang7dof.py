@@ -4,8 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .claims import (Claim, compare, equal_budget, faster_claim, g, missing, p_text, timing_comparison,
-                     verdict)
+from .claims import Claim, compare, equal_budget, faster_claim, g, missing, verdict
 
 TITLE = ("Wang et al., Inverse kinematics of a redundant manipulator based on the artificial bee "
          "colony algorithm: 7-DOF arm, ABC vs PSO (paper 004_9e97004859498dea.txt)")
