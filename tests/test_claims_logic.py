@@ -106,10 +106,10 @@ def test_check_fails_when_a_verdict_changes(tmp_path):
         df.to_csv(path, index=False)
     file = root / "mao2017" / "claims.csv"
     df = pd.read_csv(file)
-    row = df.index[df.claim.str.startswith("Tab. 5/Fig. 3")][0]
+    row = df.index[df.claim.str.startswith("Fig. 3: stopping")][0]
     df.loc[row, "verdict"] = HELD if df.loc[row, "verdict"] != HELD else NOT_HELD
     df.to_csv(file, index=False)
     bad = check_experiment(Store(root).get("mao2017", "tab4_tab5_fig3"))
     verdicts = [m for m in bad if m.column == "verdict"]
     assert len(verdicts) == 1 and verdicts[0].file == "claims.csv"
-    assert "stored" in str(verdicts[0]) and "Tab. 5/Fig. 3" in str(verdicts[0])
+    assert "stored" in str(verdicts[0]) and "Fig. 3: stopping" in str(verdicts[0])
