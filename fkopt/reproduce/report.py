@@ -88,9 +88,6 @@ def experiment_section(exp: Experiment, root: Path) -> str:
     if extra:
         for caption, df in extra(exp):
             lines += [caption, "", md_table(df), ""]
-    draw = getattr(paper_module(exp.paper), "figures", None)
-    if draw:   # figures of the model alone (e.g. chang2024 Fig. 3), drawn at report time
-        draw(exp)
     for fig in exp.figures():
         if fig.endswith("_time.png"):
             continue   # drawn from timings: shown in TIMING.md
@@ -197,8 +194,19 @@ def claims_files(root: str | Path) -> dict[Path, pd.DataFrame]:
     return out
 
 
+def draw_paper_figures(root: str | Path) -> list[Path]:
+    """Figures of the models alone (e.g. chang2024 Fig. 3), drawn into their experiment's folder."""
+    out = []
+    for exp in Store(root).experiments():
+        draw = getattr(paper_module(exp.paper), "figures", None)
+        if draw:
+            out += [exp.folder / name for name in draw(exp)]
+    return out
+
+
 def write_report(root: str | Path) -> list[Path]:
     root = Path(root)
+    figures = draw_paper_figures(root)
     report, timing, index = build_report(root)
     paths = [root / "REPORT.md", root / "TIMING.md", root / "index.csv"]
     paths[0].write_text(report)
@@ -207,4 +215,4 @@ def write_report(root: str | Path) -> list[Path]:
     for path, df in claims_files(root).items():
         df.to_csv(path, index=False)
         paths.append(path)
-    return paths
+    return paths + figures
