@@ -56,7 +56,7 @@ KEY_COLS = ("case", "algorithm", "variable", "joint", "run", "iteration", "task_
 SHAPE_ONLY = ("runs.csv", "convergence.csv", "poses.csv", "ecdf.csv", "stats.csv", "tracking.csv",
               "heatmap.csv", "solutions.csv")
 #: Never deterministic: wall-clock measurements and the environment.
-TIMING_FILES = ("timing.csv", "tracking_timing.csv", "env.json")
+TIMING_FILES = ("timing.csv", "timing_runs.csv", "tracking_timing.csv", "env.json")
 
 
 @dataclass

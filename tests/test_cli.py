@@ -149,5 +149,16 @@ def test_stored_configs_validate():
     root = Path(__file__).resolve().parents[1] / "configs"
     files = sorted(root.rglob("*.yaml"))
     assert files
+    from fkopt.experiment.assembly import AssemblyConfig
+    from fkopt.experiment.config import RandomCases
+    from fkopt.study.config import StudyConfig
     for f in files:   # experiments, studies (kind: study) and assembly modes (kind: assembly)
-        assert validate_any(load_any(f)) >= 1, f
+        cfg = load_any(f)
+        tasks = validate_any(cfg)
+        if isinstance(cfg, AssemblyConfig):
+            assert tasks == 1, f
+        elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block
+            assert tasks > 0 and tasks % len(cfg.algorithms) == 0, f
+        else:                                # every algorithm on every case
+            cases = cfg.cases.random if isinstance(cfg.cases, RandomCases) else len(cfg.cases)
+            assert tasks == len(cfg.algorithms) * cases, f

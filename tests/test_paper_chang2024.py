@@ -12,7 +12,7 @@ from fkopt.experiment.runner import run_experiment, validate_experiment
 from fkopt.problems import fk_problem
 from fkopt.registry import mechanism_class
 from fkopt.reproduce import PAPERS, chang2024
-from fkopt.reproduce.claims import NOT_CHECKABLE, Claim
+from fkopt.reproduce.claims import NOT_CHECKABLE
 from fkopt.reproduce.store import Store
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,8 +82,10 @@ def store(tmp_path_factory):
 
 def test_small_runs_write_the_expected_files(store):
     st, files = store
-    assert {"summary.csv", "timing.csv", "values.csv", "runs.csv", "convergence.png"} <= set(files["tab1_fig7"])
-    assert {"cases.png", "cases_time.png"} <= set(files["tab2"])
+    assert {"summary.csv", "timing.csv", "values.csv", "runs.csv", "trace.csv", "fig7.png", "fig7.pdf"} <= set(
+        files["tab1_fig7"])
+    assert {"tab2_poses.png", "tab2_poses_time.png"} <= set(files["tab2"])
+    assert "trace.csv" not in files["tab2"] or st.get("chang2024", "tab2").table("summary")["case"].nunique() <= 6
     s = st.get("chang2024", "tab1_fig7").table("summary")
     assert list(s.algorithm) == ["abc", "pso", "pabc"]
     assert "printed_error_order" in s.columns
@@ -101,10 +103,19 @@ def test_extra_tables_and_claims_run(store):
             assert isinstance(caption, str) and isinstance(df, pd.DataFrame) and not df.empty
     poses = chang2024.poses_table(st.get("chang2024", "tab2"))
     assert len(poses) == 3 and {"fitness_abc", "fitness_pso", "fitness_pabc"} <= set(poses.columns)
-    claims = chang2024.claims(st) + chang2024.timing_claims(st)
-    assert all(isinstance(c, Claim) for c in claims)
-    assert len(claims) >= 10
-    assert all(c.verdict != NOT_CHECKABLE for c in claims)
+    claims = {c.text: c for c in chang2024.claims(st)}
+    inputs = claims["Sec. 3.3: the case (25 deg, 34 deg, 23 deg, 360 mm) has inputs l = (332.048, 390.904, "
+                    "402.294) mm, delta = -14.4389 deg (reconstructed model)"]
+    assert inputs.verdict == "held"
+    assert abs(inputs.numbers["difference_l1"] - 3.5e-4) < 1e-5 and abs(inputs.numbers["difference_delta"]) < 5e-5
+    # the error measure f_PS was lost: absolute error levels cannot be judged
+    orders = claims["Tab. 1: mean error over 30 runs of order 1e-18 (ABC), 1e-10 (PSO), 1e-20 (P-ABC)"]
+    assert orders.verdict == NOT_CHECKABLE
+    # comparisons are rank tests at equal iterations with equal evaluations beside
+    better = claims["Tab. 1: P-ABC is more precise than ABC (error level 1e-18 -> 1e-20)"]
+    assert 0 <= better.numbers["p_iterations"] <= 1 and 0 <= better.numbers["p_evaluations"] <= 1
+    assert better.numbers["evaluations"] < float(st.get("chang2024", "tab1_fig7").table("runs").evaluations.max())
+    assert better.verdict == ("held" if better.numbers["lower_iterations"] == "P-ABC" else "not held")
 
 
 def test_claims_without_results_are_not_checkable(tmp_path):

@@ -57,6 +57,8 @@ experiment went from 4.8 M to 2.3 M instructions, about half of it the two fitne
 """
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 from pydantic import Field
 
@@ -66,6 +68,11 @@ from .base import Algorithm, Params, State, row_offsets, uniform_in
 class ABCParams(Params):
     limit: int | None = Field(None, ge=1, description="trials without improvement before a source "
                               "is abandoned by a scout; default population * dim")
+    selection: Literal["raw", "karaboga"] = Field(
+        "raw", description="what the greedy selection and the best-so-far memory compare: raw f "
+        "(raw, default) or Karaboga's quality fit = 1/(1+f) (karaboga); in double precision "
+        "1/(1+f) == 1 for f below ~1.1e-16, so karaboga cannot tell improvements apart under that "
+        "floor and keeps the first source found below it (mao2017 Tab. 3's ~5e-17)")
 
 
 def quality(f: np.ndarray) -> np.ndarray:
@@ -231,6 +238,23 @@ class ABC(Algorithm):
         v.reshape(-1)[pos] = m
         return v, pos, m, old
 
+    def better(self, new: np.ndarray, old: np.ndarray) -> np.ndarray:
+        """Greedy selection: does ``new`` replace ``old``? (``selection`` parameter)."""
+        if self.params.selection == "karaboga":
+            return quality(new) > quality(old)
+        return new < old
+
+    def update_best(self, state: State) -> None:
+        """As :meth:`Algorithm.update_best`; with ``selection: karaboga`` compared on quality."""
+        if self.params.selection != "karaboga":
+            return Algorithm.update_best(state)
+        runs, population = state.f.shape
+        flat = state.f.argmin(axis=1) + row_offsets(runs, population)
+        fb = state.f.ravel()[flat]
+        better = quality(fb) > quality(state.best_f)
+        state.best_f = np.where(better, fb, state.best_f)
+        state.best_x = np.where(better[:, None], state.x.reshape(runs * population, -1)[flat], state.best_x)
+
     def employed_phase(self, state, problem, streams):
         aux = _aux(state, problem)
         population = state.f.shape[1]
@@ -246,7 +270,7 @@ class ABC(Algorithm):
             f.reshape(-1)[slots] = both[v.shape[0] * population:]
             state.f = f
             state.evaluations = state.evaluations + count
-        better = fv < state.f
+        better = self.better(fv, state.f)
         if pos is None:
             state.x = np.where(better[..., None], v, state.x)
         else:   # v is x with one coordinate moved: put the old value back where it failed
@@ -274,7 +298,7 @@ class ABC(Algorithm):
         first = aux.none.copy()
         np.minimum.at(first, flat[hit], aux.ids[hit])
         f = state.f.ravel()
-        ok = best < f
+        ok = self.better(best, f)
         np.minimum(first, size - 1, out=first)
         shape = state.x.shape
         won = v.reshape(size, -1).take(first, axis=0).reshape(-1)

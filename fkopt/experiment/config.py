@@ -138,6 +138,10 @@ class RunConfig(Strict):
     seed: int = Seed()
     threshold: float | None = Field(None, gt=0)
     stop_at_threshold: bool = False
+    #: File stems of the figures, named after the paper figure they mirror, by fkopt's figure kind
+    #: (convergence, variables, snapshot_<t>, extras, cases, cases_time, cases_position_error,
+    #: position_error, time), e.g. {convergence: fig2}; kinds not named keep the kind as stem.
+    figure_names: dict[str, str] = Field(default_factory=dict)
     #: Experiment-level printed values and notes for the report.
     printed: dict[str, Any] = Field(default_factory=dict)
     #: Which regression check reruns it: "ci" (every CI run and `make check`) or "full"
@@ -173,8 +177,9 @@ class ExperimentConfig(RunConfig):
     batch: bool = True
     snapshots: list[int] = Field(default_factory=list)
     #: Extra figures: variables (best-so-far pose vs iteration), snapshots (population scatter),
-    #: extras (algorithm records such as ACO pheromone), cases (per-case error and time).
-    figures: list[Literal["variables", "snapshots", "extras", "cases"]] = Field(default_factory=list)
+    #: extras (algorithm records such as ACO pheromone), cases (per-case error and time), time
+    #: (time of each timed run).
+    figures: list[Literal["variables", "snapshots", "extras", "cases", "time"]] = Field(default_factory=list)
 
     @field_validator("cases")
     @classmethod

@@ -1,22 +1,28 @@
 """Reports: turn an :class:`ExperimentResult` into CSV tables, figures and ``meta.json``.
 
-Files of one experiment folder (all deterministic for a given seed except ``timing.csv`` and
+Files of one experiment folder (all deterministic for a given seed except ``timing.csv``, ``timing_runs.csv`` and
 the figures drawn from timings, ``cases_time.png``):
 
 * ``summary.csv``     final fitness statistics per case and algorithm over all runs (mean, std,
   best, worst, median), evaluations, success rate and iterations/evaluations to the threshold
   (medians over the runs that reached it), the paper's printed values beside them;
-* ``timing.csv``      mean/median time per run (ms; amortised over the batch) beside the printed time;
+* ``timing.csv``      time per run (ms) measured one run at a time on a sample of runs (median,
+  quartiles; see :mod:`.timing`), the batch's amortised time beside it, the printed time;
+  ``timing_runs.csv`` every timed run;
 * ``values.csv``      per variable: target, the median run's value and error (the run whose final
   fitness is the lower median), the best run's, and the mean absolute error over all runs;
 * ``inputs.csv``      (only when a case gives both joints and a pose) given vs computed inputs;
 * ``runs.csv``        one row per run (incl. ``iterations_to_best``: first iteration at which the
   run's final best-so-far fitness was reached);
+* ``trace.csv``       per-run best-so-far fitness where it changed, with evaluations (equal-evaluation
+  comparisons of the claims);
 * ``convergence.csv`` best-so-far fitness per iteration: median and quartiles over runs, mean
   evaluations; ``convergence.png`` the same on a log scale (vs iterations and vs evaluations);
 * optional figures (``figures:`` in the config): ``variables.png``, ``snapshot_<t>.png``,
   ``extras.png``, ``cases.png`` + ``cases_time.png`` (+ ``cases_position_error.png`` for
-  serial arms), ``position_error.png``;
+  serial arms), ``time.png``, ``position_error.png``; each figure is named after the paper
+  figure it mirrors when the config's ``figure_names`` says so (``{convergence: fig2}`` ->
+  ``fig2.png``) and has a PDF twin (:mod:`.plotting`);
 * ``meta.json``       what the config and the seed fix: config, seeds (per case and algorithm),
   mechanism, objective, and the SHA-256 of every deterministic CSV (``files``);
 * ``env.json``        where it ran: fkopt and library versions, platform, the platform fingerprint
@@ -37,6 +43,7 @@ from ..compare import file_digests
 from ..files import nanmedian as _nanmedian
 from ..files import output_folder, write_atomically, write_json
 from ..provenance import ENV_FILE, LIBRARIES, environment, library_versions  # noqa: F401 (re-exported)
+from . import plotting
 from .runner import ExperimentResult, pose_error
 
 FLOAT = "%.10g"
@@ -72,17 +79,29 @@ def summary_table(er: ExperimentResult) -> pd.DataFrame:
 
 
 def timing_table(er: ExperimentResult) -> pd.DataFrame:
+    """Time per run measured one run at a time on a sample of runs (:mod:`.timing`)."""
     rows = []
     for rec in er.records:
-        t = rec.result.time_per_run * 1e3
+        if rec.single_run_s is None:
+            continue
+        t = rec.single_run_s * 1e3
+        q25, med, q75 = np.percentile(t, [25, 50, 75])
         row = {"case": rec.case.label, "algorithm": rec.spec.key, "runs": rec.result.runs,
-               "batch": er.config.batch, "mean_ms_per_run": float(np.mean(t)),
-               "median_ms_per_run": float(np.median(t)), "total_s": rec.wall_s}
+               "timed_runs": len(t), "mean_ms_per_run": float(np.mean(t)), "median_ms_per_run": float(med),
+               "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
+               "amortised_ms_per_run": float(np.mean(rec.result.time_per_run) * 1e3), "total_s": rec.wall_s}
         for k, v in rec.spec.printed.items():
             if k.endswith("_ms"):
                 row[f"printed_{k}"] = v
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def timing_runs_table(er: ExperimentResult) -> pd.DataFrame:
+    """Every timed single run (ms): what timing claims test for a difference."""
+    return pd.DataFrame([{"case": rec.case.label, "algorithm": rec.spec.key, "run": int(k), "ms": float(s * 1e3)}
+                         for rec in er.records if rec.single_run_s is not None
+                         for k, s in zip(rec.single_run_ids, rec.single_run_s)])
 
 
 def values_table(er: ExperimentResult) -> pd.DataFrame:
@@ -164,6 +183,31 @@ def runs_table(er: ExperimentResult) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
+def trace_table(er: ExperimentResult) -> pd.DataFrame | None:
+    """Per-run best-so-far fitness where it changed (lossless step function), with evaluations.
+
+    Rows: iteration 0, every iteration whose best-so-far differs from the previous one, and the
+    run's last iteration. The best-so-far after ``E`` evaluations is the value of the last row
+    with ``evaluations <= E``: what equal-evaluation comparisons of the claims use. Written only
+    for experiments of at most ``MAX_CASE_CURVES`` cases and more than one run (size).
+    """
+    if len(er.cases) > MAX_CASE_CURVES or er.config.runs < 2:
+        return None
+    frames = []
+    for rec in er.records:
+        r = rec.result
+        h, ev = r.history, r.evaluation_history
+        keep = np.zeros(h.shape, dtype=bool)
+        keep[:, 0] = True
+        keep[:, 1:] = h[:, 1:] != h[:, :-1]
+        keep[np.arange(r.runs), r.iterations_done] = True
+        keep &= np.arange(h.shape[1]) <= r.iterations_done[:, None]
+        k, t = np.nonzero(keep)
+        frames.append(pd.DataFrame({"case": rec.case.label, "algorithm": rec.spec.key, "run": r.run_ids[k],
+                                    "iteration": t, "evaluations": ev[k, t], "best_fitness": h[k, t]}))
+    return pd.concat(frames, ignore_index=True)
+
+
 def convergence_table(er: ExperimentResult) -> pd.DataFrame:
     frames = []
     for label, algo, hist, evals, pos in _curves(er):
@@ -194,188 +238,345 @@ def _curves(er: ExperimentResult):
 
 
 # -- figures -------------------------------------------------------------------------------------
+# Style, names, units and the honest drawing of zeros: :mod:`.plotting`.
 def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    plt.rcParams.update({"figure.dpi": 110, "font.size": 9, "svg.hashsalt": "fkopt"})
-    return plt
+    return plotting.plt()
 
 
-def _save(fig, path: Path) -> None:
-    # Fixed metadata so that a rerun writes a byte-identical PNG.
-    fig.savefig(path, metadata={"Software": None}, bbox_inches="tight")
+def _save(fig, path: Path) -> list[str]:
+    return plotting.save(fig, path)
 
 
-def convergence_figure(er: ExperimentResult, path: Path) -> None:
+def figure_file(er: ExperimentResult, kind: str) -> str:
+    """The PNG name of a figure kind: the paper figure it mirrors (config ``figure_names``) or the kind."""
+    return er.config.figure_names.get(kind, kind) + ".png"
+
+
+def _spec_names(er: ExperimentResult) -> dict[str, str]:
+    return {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+
+
+def _curve_sets(er: ExperimentResult):
+    """(name, spec, history, evaluations, position errors, iterations done) per drawn curve; with
+    more than MAX_CASE_CURVES cases the runs of all cases are pooled per algorithm."""
+    names = _spec_names(er)
+    pooled = len(er.cases) > MAX_CASE_CURVES
+    for spec in er.config.algorithms:
+        recs = [r for r in er.records if r.spec.key == spec.key]
+        groups = [recs] if pooled else [[r] for r in recs]
+        for grp in groups:
+            name = names[spec.key] if pooled or len(er.cases) == 1 else f"{names[spec.key]} · {grp[0].case.label}"
+            pos = [r.position_error_history for r in grp]
+            yield (name, spec, np.concatenate([r.result.history for r in grp]),
+                   np.concatenate([r.result.evaluation_history for r in grp]),
+                   np.concatenate(pos) if pos[0] is not None else None,
+                   np.concatenate([r.result.iterations_done for r in grp]))
+
+
+def _band(ax, xs, values, floor, name, color=None, end=None):
+    """Median (and quartile band over several runs) of ``values`` (runs, iterations) up to ``end``."""
+    v = np.maximum(values, floor)
+    stop = v.shape[1] if end is None else int(end) + 1
+    xs = xs[:stop]
+    if v.shape[0] == 1:
+        line, = ax.plot(xs, v[0, :stop], label=name, color=color)
+    else:
+        q25, med, q75 = np.percentile(v[:, :stop], [25, 50, 75], axis=0)
+        line, = ax.plot(xs, med, label=name, color=color)
+        ax.fill_between(xs, q25, q75, color=line.get_color(), alpha=0.18, lw=0)
+    if end is not None and stop < values.shape[1]:
+        y = v[0, stop - 1] if v.shape[0] == 1 else np.median(v[:, stop - 1])
+        ax.plot(xs[-1], y, marker="|", ms=9, mew=1.5, color=line.get_color())
+    return line
+
+
+def convergence_figure(er: ExperimentResult, path: Path) -> list[str]:
+    """Best-so-far fitness vs iteration and vs function evaluations (median and quartiles of the
+    runs, or the run itself). Runs that stop at the threshold end where (the median run) stopped
+    (a bar); P-ABC's switch from PSO to ABC is marked with a triangle."""
     plt = _plt()
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
-    zero = False
-    for label, algo, hist, evals, _ in _curves(er):
-        name = algo if len(er.cases) == 1 else f"{algo} · {label}"
-        zero |= bool((hist <= 0).any())
-        h = np.maximum(hist, LOG_FLOOR)
-        q25, med, q75 = np.percentile(h, [25, 50, 75], axis=0)
-        it = np.arange(h.shape[1])
-        ev = evals.mean(axis=0)
-        for ax, xs in zip(axes, (it, ev)):
-            line, = ax.plot(xs, med, label=name, lw=1.4)
-            ax.fill_between(xs, q25, q75, color=line.get_color(), alpha=0.2, lw=0)
+    curves = list(_curve_sets(er))
+    floor = plotting.floor_of(*[c[2] for c in curves])
+    zero = any(bool((c[2] <= 0).any()) for c in curves)
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
+    single = all(c[2].shape[0] == 1 for c in curves)
+    for name, spec, hist, evals, _, done in curves:
+        end = float(np.median(done)) if er.config.stop_at_threshold else None
+        end = None if end is not None and end >= hist.shape[1] - 1 else end
+        it = np.arange(hist.shape[1])
+        line = _band(axes[0], it, hist, floor, name, end=end)
+        _band(axes[1], evals.mean(axis=0), hist, floor, name, color=line.get_color(), end=end)
+        if spec.name == "pabc":
+            sw = int(round(float(spec.params.get("switch", 0.5)) * (hist.shape[1] - 1)))
+            y = np.median(np.maximum(hist[:, sw], floor))
+            for ax, x in zip(axes, (sw, evals.mean(axis=0)[sw])):
+                ax.plot(x, y, marker="v", ms=7, color=line.get_color(), zorder=5)
+            axes[0].annotate("switch PSO → ABC", (sw, y), textcoords="offset points", xytext=(4, 8), fontsize=7,
+                             color=line.get_color())
+    runs = curves[0][2].shape[0]
+    what = "best-so-far " + plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))
+    axes[0].set_ylabel(what)
     for ax, xl in zip(axes, ("iteration", "function evaluations (mean over runs)")):
         ax.set_yscale("log")
         ax.set_xlabel(xl)
-        ax.grid(True, which="major", alpha=0.3)
-    axes[0].set_ylabel("best-so-far fitness (median, IQR band)")
-    axes[0].legend(fontsize=7)
-    title = er.config.title or er.config.name
-    if zero:
-        title += f"  (fitness 0 drawn at {LOG_FLOOR:g})"
-    fig.suptitle(title, fontsize=10)
-    _save(fig, path)
+        if zero:
+            plotting.mark_zero(ax, floor)
+    axes[0].legend(loc="best")
+    note = "one run" if single else f"median of {runs} runs, band: quartiles"
+    if er.config.stop_at_threshold:
+        note += f"; runs stop at f < {er.config.threshold:g} (bar: median stop)"
+    fig.suptitle(f"{er.config.title or er.config.name}\n({note})", fontsize=9)
+    fig.tight_layout()
+    names = _save(fig, path)
     plt.close(fig)
+    return names
 
 
-def variables_figure(er: ExperimentResult, path: Path) -> None:
-    """Best-so-far value of each unknown vs iteration for the median run (liu2008 Fig. 4a)."""
+def variables_figure(er: ExperimentResult, path: Path) -> list[str]:
+    """Best-so-far value of each unknown vs iteration for the median run (liu2008 Fig. 4a, wang7dof
+    Fig. 4), with the true value dashed (for a redundant arm: the joints that defined the target,
+    one of many solutions)."""
     plt = _plt()
     recs = [r for r in er.records if r.case.index == 0]
     names = recs[0].result.variable_names
-    fig, axes = plt.subplots(1, len(names), figsize=(2.6 * len(names), 3), squeeze=False)
+    units = er.mechanism.unknown_units
+    spec_names = _spec_names(er)
+    cols = min(len(names), 4)
+    rows = int(np.ceil(len(names) / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(2.4 * cols, 2.2 * rows), squeeze=False)
+    flat = axes.ravel()
     for rec in recs:
         r = rec.result
         xh = r.x_history[r.median_run]
-        for j, ax in enumerate(axes[0]):
-            ax.plot(np.arange(xh.shape[0]), xh[:, j], label=rec.spec.key)
-            ax.set_title(names[j])
-            ax.set_xlabel("iteration")
-    if recs[0].case.target is not None and er.mechanism.kind == "parallel":
-        for j, ax in enumerate(axes[0]):
-            ax.axhline(recs[0].case.target[j], color="k", lw=0.8, ls="--")
-    axes[0][0].legend(fontsize=7)
-    fig.suptitle(f"{er.config.title or er.config.name}: best-so-far variables (median run)", fontsize=10)
+        end = int(r.iterations_done[r.median_run]) + 1
+        for j, ax in enumerate(flat[:len(names)]):
+            ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key])
+    case = recs[0].case
+    if er.mechanism.kind == "parallel":
+        truth, what = ((case.target, "true value") if case.target is not None
+                       else (case.reference, case.reference_label.replace("_", " ")))
+    else:
+        truth, what = case.given_joints, "joints defining the target"
+    for j, ax in enumerate(flat[:len(names)]):
+        ax.set_title(f"{names[j]} ({units[j]})")
+        ax.set_xlabel("iteration")
+        if truth is not None:
+            ax.axhline(truth[j], color="k", lw=0.8, ls="--", label=what)
+    for ax in flat[len(names):]:
+        ax.set_visible(False)
+    flat[0].legend(fontsize=7)
+    runs = recs[0].result.runs
+    fig.suptitle(f"{er.config.title or er.config.name}\nbest-so-far variables of the median run "
+                 f"(of {runs}), case {case.label}" if runs > 1 else
+                 f"{er.config.title or er.config.name}\nbest-so-far variables, case {case.label}", fontsize=9)
     fig.tight_layout()
-    _save(fig, path)
+    out = _save(fig, path)
     plt.close(fig)
+    return out
+
+
+def _shading(problem, bounds, i, j, k, n=121, m=41):
+    """log10 of min over variable k of f on an n x n grid of variables (i, j)."""
+    gi = np.linspace(*bounds[i], n)
+    gj = np.linspace(*bounds[j], n)
+    gk = np.linspace(*bounds[k], m)
+    X = np.empty((n, n, m, 3))
+    X[..., i] = gi[None, :, None]
+    X[..., j] = gj[:, None, None]
+    X[..., k] = gk[None, None, :]
+    f = problem.fitness(X.reshape(-1, 3)).reshape(n, n, m).min(axis=2)
+    return gi, gj, np.log10(np.maximum(f, 1e-12))
 
 
 def snapshot_figures(er: ExperimentResult, folder: Path) -> list[str]:
-    """Population scatter at the snapshot iterations, first case, run 0 (wu2015 Figs. 4-6)."""
+    """Population at the snapshot iterations, first case, run 0 (wu2015 Figs. 4-6): two projections
+    shaded by log10 of the fitness (minimised over the third variable), the true pose and, where the
+    mechanism has several exact forward solutions, the mirror solution(s)."""
     plt = _plt()
     written = []
     recs = [r for r in er.records if r.case.index == 0]
+    names_of = _spec_names(er)
     for t in er.config.snapshots:
-        fig = plt.figure(figsize=(4.5 * len(recs), 4))
-        for i, rec in enumerate(recs):
-            if t not in rec.result.snapshots:
-                continue
+        panels = []
+        for rec in recs:
+            if t in rec.result.snapshots and rec.result.snapshots[t].shape[-1] == 3:
+                panels.append(rec)
+        if not panels:
+            continue
+        fig, axes = plt.subplots(len(panels), 2, figsize=(8.4, 3.6 * len(panels)), squeeze=False)
+        for row, rec in zip(axes, panels):
             pts = rec.result.snapshots[t][0]
             names = rec.result.variable_names
-            b = rec.problem.bounds
-            if pts.shape[1] >= 3:
-                ax = fig.add_subplot(1, len(recs), i + 1, projection="3d")
-                ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], s=8, marker="*")
-                if rec.case.target is not None and er.mechanism.kind == "parallel":
-                    ax.scatter(*rec.case.target[:3], s=60, c="r", marker="o")
-                ax.set_zlim(*b[2])
-                ax.set_zlabel(names[2])
-            else:
-                ax = fig.add_subplot(1, len(recs), i + 1)
-                ax.scatter(pts[:, 0], pts[:, 1], s=8, marker="*")
-            ax.set_xlim(*b[0])
-            ax.set_ylim(*b[1])
-            ax.set_xlabel(names[0])
-            ax.set_ylabel(names[1])
-            ax.set_title(f"{rec.spec.key}: iteration {t}", fontsize=9)
-        name = f"snapshot_{t}.png"
-        _save(fig, folder / name)
+            units = er.mechanism.unknown_units
+            b = np.asarray(rec.problem.bounds, float)
+            truth = rec.case.target if er.mechanism.kind == "parallel" else None
+            others = []
+            if truth is not None and hasattr(er.mechanism, "fk_exact"):
+                sols = np.atleast_2d(er.mechanism.fk_exact(rec.case.inputs))
+                others = [sol for sol in sols if np.max(np.abs(sol - truth)) > 1e-6 and er.mechanism.in_bounds(sol)]
+            for ax, (i, j, k) in zip(row, ((0, 1, 2), (0, 2, 1))):
+                gi, gj, z = _shading(rec.problem, b, i, j, k)
+                im = ax.pcolormesh(gi, gj, z, cmap="Greys_r", shading="auto", rasterized=True)
+                ax.scatter(pts[:, i], pts[:, j], s=7, marker="o", color="tab:orange", lw=0, label="ants")
+                if truth is not None:
+                    ax.plot(truth[i], truth[j], marker="*", ms=12, color="tab:red", ls="none", mec="k", mew=0.5,
+                            label="true pose")
+                for n_o, sol in enumerate(others):
+                    ax.plot(sol[i], sol[j], marker="D", ms=7, color="tab:cyan", ls="none", mec="k", mew=0.5,
+                            label="mirror solution (same inputs)" if n_o == 0 else None)
+                ax.set_xlim(*b[i])
+                ax.set_ylim(*b[j])
+                ax.set_xlabel(f"{names[i]} ({units[i]})")
+                ax.set_ylabel(f"{names[j]} ({units[j]})")
+                ax.grid(False)
+                fig.colorbar(im, ax=ax, label=f"log10 of f, minimised over {names[k]}")
+            row[0].legend(loc="upper left", fontsize=7, frameon=True)
+            row[0].set_title(f"{names_of[rec.spec.key]}, case {rec.case.label}: {t} moves (run 0)")
+        fig.tight_layout()
+        written += _save(fig, folder / figure_file(er, f"snapshot_{t}"))
         plt.close(fig)
-        written.append(name)
     return written
 
 
-def extras_figure(er: ExperimentResult, path: Path) -> bool:
-    """Median over runs of each algorithm extra record vs iteration (wu2015 Fig. 7)."""
+def extras_figure(er: ExperimentResult, path: Path) -> list[str]:
+    """Median over runs of each algorithm record vs iteration (wu2015 Fig. 7). Pheromone is
+    tau = -f <= 0, so it is drawn as -tau on a log axis (the best pheromone's -tau is the best f)."""
     recs = [r for r in er.records if r.case.index == 0 and r.result.extras]
     if not recs:
-        return False
+        return []
     plt = _plt()
+    names = _spec_names(er)
     keys = sorted({k for r in recs for k in r.result.extras})
-    fig, axes = plt.subplots(1, len(keys), figsize=(4.5 * len(keys), 3.5), squeeze=False)
+    fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.4), squeeze=False)
+    unit = plotting.fitness_label(er.mechanism, getattr(recs[0].problem, "objective", None)).split("(")[-1].rstrip(")")
     for rec in recs:
         for ax, k in zip(axes[0], keys):
-            if k in rec.result.extras:
-                v = rec.result.extras[k]
-                ax.plot(np.arange(v.shape[1]), np.median(v, axis=0), label=rec.spec.key)
-                ax.set_title(k)
-                ax.set_xlabel("iteration")
-                if np.all(v > 0) or np.all(v < 0):
-                    ax.set_yscale("symlog" if np.any(v < 0) else "log", **({"linthresh": 1e-12} if np.any(v < 0) else {}))
-    axes[0][0].legend(fontsize=7)
+            if k not in rec.result.extras:
+                continue
+            v = rec.result.extras[k]
+            neg = k.startswith("pheromone") and np.all(v <= 0)
+            y = -v if neg else v
+            floor = plotting.floor_of(y)
+            label = names[rec.spec.key] + ("" if v.shape[0] == 1 else f" (median of {v.shape[0]} runs)")
+            ax.plot(np.arange(v.shape[1]), np.maximum(np.median(y, axis=0), floor), label=label)
+            if np.all(y >= 0):
+                ax.set_yscale("log")
+            what = k.replace("pheromone_", "").replace("_", " ")
+            ax.set_title(f"{what} pheromone τ, drawn as −τ" if neg else k)
+            ax.set_ylabel(f"−τ_{what} ({unit})" if neg else k)
+            ax.set_xlabel("colony move (iteration)")
+    axes[0][0].legend()
+    fig.suptitle(f"{er.config.title or er.config.name}: case {recs[0].case.label}", fontsize=9)
     fig.tight_layout()
-    _save(fig, path)
+    out = _save(fig, path)
     plt.close(fig)
-    return True
+    return out
 
 
-def position_error_figure(er: ExperimentResult, path: Path) -> bool:
-    """Best-so-far position error vs iteration (wang7dof Figs. 5/6)."""
-    curves = [c for c in _curves(er) if c[4] is not None]
+def position_error_figure(er: ExperimentResult, path: Path) -> list[str]:
+    """Best-so-far position error (mm) vs iteration (wang7dof Figs. 5/6a)."""
+    curves = [c for c in _curve_sets(er) if c[4] is not None]
     if not curves:
-        return False
+        return []
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    for label, algo, _, _, pos in curves:
-        p = np.maximum(pos, LOG_FLOOR)
-        q25, med, q75 = np.percentile(p, [25, 50, 75], axis=0)
-        line, = ax.plot(np.arange(p.shape[1]), med, label=algo if label in ("all",) or len(er.cases) == 1 else f"{algo} · {label}")
-        ax.fill_between(np.arange(p.shape[1]), q25, q75, color=line.get_color(), alpha=0.2, lw=0)
+    fig, ax = plt.subplots(figsize=(5.5, 3.8))
+    floor = plotting.floor_of(*[c[4] for c in curves])
+    for name, _, _, _, pos, _ in curves:
+        _band(ax, np.arange(pos.shape[1]), pos, floor, name)
     ax.set_yscale("log")
+    if any(bool((c[4] <= 0).any()) for c in curves):
+        plotting.mark_zero(ax, floor)
     ax.set_xlabel("iteration")
-    ax.set_ylabel("position error of best-so-far (median, IQR)")
-    ax.legend(fontsize=7)
-    ax.grid(True, alpha=0.3)
-    _save(fig, path)
+    runs = curves[0][4].shape[0]
+    ax.set_ylabel("position error of the best-so-far (mm)")
+    ax.set_title(f"{er.config.title or er.config.name}\n"
+                 + ("one run" if runs == 1 else f"median of {runs} runs, band: quartiles"), fontsize=9)
+    ax.legend()
+    out = _save(fig, path)
     plt.close(fig)
-    return True
+    return out
+
+
+def _case_axis(ax, n: int) -> None:
+    ax.set_xlabel("pose (case index)")
+    ax.set_xlim(0.3, n + 0.7)
 
 
 def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, timing: pd.DataFrame) -> list[str]:
-    """Per-case median final fitness (deterministic) and time per run (timing) figures."""
+    """Per case (independent poses: markers, no lines): final fitness (deterministic), time per run
+    (timed single runs) and, for serial arms, the final position error (wang7dof Fig. 7)."""
     plt = _plt()
+    names = _spec_names(er)
+    markers = "osD^v<>"
+    runs = er.config.runs
+    agg = "median over runs of the " if runs > 1 else ""
     written = []
-    for name, table, col, ylabel in (("cases.png", summary, "median_fitness", "median final fitness"),
-                                     ("cases_time.png", timing, "median_ms_per_run", "time per run (ms)")):
-        fig, ax = plt.subplots(figsize=(7, 3.5))
-        for algo, grp in table.groupby("algorithm", sort=False):
+    fit_label = plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))
+    order = {c.label: c.index + 1 for c in er.cases}
+    panels = [("cases", summary, "median_fitness", f"{agg}final {fit_label}", True)]
+    if timing is not None and len(timing):
+        panels.append(("cases_time", timing, "median_ms_per_run", "time per run, one run at a time (ms)", False))
+    for kind, table, col, ylabel, log in panels:
+        fig, ax = plt.subplots(figsize=(7, 3.4))
+        floor = plotting.floor_of(table[col].to_numpy(float)) if log else None
+        for n, (algo, grp) in enumerate(table.groupby("algorithm", sort=False)):
+            x = grp["case"].map(order).to_numpy(float)
             y = grp[col].to_numpy(dtype=float)
-            ax.plot(np.arange(1, len(y) + 1), np.maximum(y, LOG_FLOOR) if col.endswith("fitness") else y,
-                    marker="o", ms=3, lw=0.8, label=algo)
-        if col.endswith("fitness"):
+            ax.plot(x, np.maximum(y, floor) if log else y, ls="none", marker=markers[n % len(markers)], ms=4,
+                    label=names.get(algo, algo))
+        if log:
             ax.set_yscale("log")
-        ax.set_xlabel("case")
+            if (table[col] <= 0).any():
+                plotting.mark_zero(ax, floor)
+        _case_axis(ax, len(er.cases))
         ax.set_ylabel(ylabel)
-        ax.legend(fontsize=7)
-        ax.grid(True, alpha=0.3)
-        _save(fig, folder / name)
+        ax.set_title(er.config.title or er.config.name, fontsize=9)
+        ax.legend()
+        written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
-        written.append(name)
     if er.mechanism.kind == "serial":   # wang7dof Fig. 7a: final position error per pose
-        fig, ax = plt.subplots(figsize=(7, 3.5))
-        for spec in er.config.algorithms:
-            y = [float(np.median(r.position_error_history[:, -1])) for r in er.records
-                 if r.spec.key == spec.key and r.position_error_history is not None]
-            if y:
-                ax.plot(np.arange(1, len(y) + 1), np.maximum(y, LOG_FLOOR), marker="o", ms=3, lw=0.8,
-                        label=spec.key)
+        fig, ax = plt.subplots(figsize=(7, 3.4))
+        ys = []
+        for n, spec in enumerate(er.config.algorithms):
+            recs = [r for r in er.records if r.spec.key == spec.key and r.position_error_history is not None]
+            if recs:
+                y = np.array([float(np.median(r.position_error_history[:, -1])) for r in recs])
+                ys.append(y)
+                ax.plot([r.case.index + 1 for r in recs], y, ls="none", marker=markers[n % len(markers)], ms=4,
+                        label=names[spec.key])
+        floor = plotting.floor_of(*ys)
+        for line in ax.get_lines():
+            line.set_ydata(np.maximum(line.get_ydata(), floor))
         ax.set_yscale("log")
-        ax.set_xlabel("case")
-        ax.set_ylabel("median final position error")
-        ax.legend(fontsize=7)
-        ax.grid(True, alpha=0.3)
-        _save(fig, folder / "cases_position_error.png")
+        _case_axis(ax, len(er.cases))
+        ax.set_ylabel(f"{agg}final position error (mm)")
+        ax.set_title(er.config.title or er.config.name, fontsize=9)
+        ax.legend()
+        written += _save(fig, folder / figure_file(er, "cases_position_error"))
         plt.close(fig)
-        written.append("cases_position_error.png")
     return written
+
+
+def time_figure(er: ExperimentResult, path: Path) -> list[str]:
+    """Time of every timed single run per algorithm (wang7dof Fig. 6b): points and their median."""
+    recs = [r for r in er.records if r.single_run_s is not None]
+    if not recs:
+        return []
+    plt = _plt()
+    names = _spec_names(er)
+    fig, ax = plt.subplots(figsize=(5, 3.4))
+    for n, spec in enumerate(er.config.algorithms):
+        ms = np.concatenate([r.single_run_s for r in recs if r.spec.key == spec.key]) * 1e3
+        x = n + np.linspace(-0.15, 0.15, len(ms)) if len(ms) > 1 else np.array([float(n)])
+        ax.plot(x, ms, ls="none", marker="o", ms=4, alpha=0.7)
+        ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
+    ax.set_xticks(range(len(er.config.algorithms)), [names[s.key] for s in er.config.algorithms])
+    ax.set_ylabel("time per run, one run at a time (ms)")
+    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} timed runs per algorithm (bar: median)",
+                 fontsize=9)
+    out = _save(fig, path)
+    plt.close(fig)
+    return out
 
 
 # -- folder --------------------------------------------------------------------------------------
@@ -413,9 +614,11 @@ def write_tables(er: ExperimentResult, folder: Path, figures: bool = True) -> li
     summary, timing = summary_table(er), timing_table(er)
     csv("summary.csv", summary)
     csv("timing.csv", timing)
+    csv("timing_runs.csv", timing_runs_table(er))
     csv("values.csv", values_table(er))
     csv("inputs.csv", inputs_table(er))
     csv("runs.csv", runs_table(er))
+    csv("trace.csv", trace_table(er))
     csv("convergence.csv", convergence_table(er))
     if figures:
         written += write_figures(er, folder, summary, timing)
@@ -426,20 +629,20 @@ def write_tables(er: ExperimentResult, folder: Path, figures: bool = True) -> li
 
 def write_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, timing: pd.DataFrame) -> list[str]:
     written = []
-    convergence_figure(er, folder / "convergence.png")
-    written.append("convergence.png")
+    written += convergence_figure(er, folder / figure_file(er, "convergence"))
     figs = set(er.config.figures)
     if "variables" in figs:
-        variables_figure(er, folder / "variables.png")
-        written.append("variables.png")
+        written += variables_figure(er, folder / figure_file(er, "variables"))
     if "snapshots" in figs:
         written += snapshot_figures(er, folder)
-    if "extras" in figs and extras_figure(er, folder / "extras.png"):
-        written.append("extras.png")
+    if "extras" in figs:
+        written += extras_figure(er, folder / figure_file(er, "extras"))
     if "cases" in figs:
         written += cases_figures(er, folder, summary, timing)
-    if er.mechanism.kind == "serial" and position_error_figure(er, folder / "position_error.png"):
-        written.append("position_error.png")
+    if "time" in figs:
+        written += time_figure(er, folder / figure_file(er, "time"))
+    if er.mechanism.kind == "serial":
+        written += position_error_figure(er, folder / figure_file(er, "position_error"))
     return written
 
 

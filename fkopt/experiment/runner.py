@@ -20,6 +20,7 @@ from ..problems import fk_problem
 from ..rotations import wrap_degrees
 from ..solve import Result, make_algorithm, solve
 from .config import AlgorithmSpec, ExperimentConfig, RandomCases
+from .timing import time_single_runs
 
 
 @dataclass
@@ -47,6 +48,8 @@ class TaskRecord:
     wall_s: float
     outputs: np.ndarray                # (runs, n_pose) the pose each run's answer corresponds to
     position_error_history: np.ndarray | None = None
+    single_run_ids: np.ndarray | None = None   # runs timed alone (see .timing)
+    single_run_s: np.ndarray | None = None
 
 
 @dataclass
@@ -187,4 +190,5 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
             records.append(TaskRecord(case, spec, problem, result, seed, wall, outputs, pos_hist))
             if progress:
                 progress(f"{case.label} / {spec.key}", len(records), total)
+    time_single_runs(config, records)
     return ExperimentResult(config, mech, cases, records, time.perf_counter() - start_all, source)

@@ -12,6 +12,8 @@ results folder ``<paper>/<name>/``:
    files (all CSVs but the timing files, and ``meta.json``) are compared **byte for byte** when
    the platform fingerprint stored in ``env.json`` equals this machine's, and by the documented
    distribution-level tolerances of :mod:`fkopt.compare` otherwise.
+4. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
+   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.claims.rerun_verdict_drift`).
 
 A mismatch names the experiment, the file, the row, the column and both values. Figures are
 not compared (they depend on the plotting library's version).
@@ -94,6 +96,8 @@ def check_experiment(exp: Experiment, config=None, exact: bool | None = None) ->
         order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
         order += ["meta.json"]
         out += compare_folders(label, exp.folder, tmp, exact, files=order)
+        from .claims import rerun_verdict_drift   # a claim's verdict must not change either
+        out += rerun_verdict_drift(exp, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return out

@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..experiment.reports import FLOAT, LOG_FLOOR, _plt, _save, write_meta
+from ..experiment import plotting
+from ..experiment.reports import FLOAT, _plt, _save, write_meta
 from ..files import nanmedian as _nanmedian
 from ..files import write_file_atomically
 from ..provenance import ENV_FILE
@@ -182,6 +183,19 @@ def tracking_timing_table(sr: StudyResult) -> pd.DataFrame | None:
 
 
 # -- figures -------------------------------------------------------------------------------------
+def _name(ar) -> str:
+    """The algorithm as the papers name it (cold starts of tracking marked)."""
+    name = plotting.algorithm_name(ar.spec.name, ar.spec.params)
+    if ar.spec.label and ar.spec.label != ar.spec.name and "cold" in ar.spec.label:
+        name += " (cold)"
+    return name
+
+
+def _axis(sr: StudyResult, var: str) -> str:
+    units = dict(zip(sr.mechanism.unknown_names, sr.mechanism.unknown_units))
+    return f"{var} ({units[var]})" if var in units else var
+
+
 def ecdf_figure(sr: StudyResult, ecdf: pd.DataFrame, path: Path) -> None:
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -189,11 +203,11 @@ def ecdf_figure(sr: StudyResult, ecdf: pd.DataFrame, path: Path) -> None:
     for ar in sr.algorithms:
         d = ecdf[(ecdf.algorithm == ar.key) & ecdf.evaluations.notna()]
         if d.empty:
-            ax.plot([], [], label=f"{ar.key} (none solved)")
+            ax.plot([], [], label=f"{_name(ar)} (none solved)")
             continue
         xs = np.concatenate([[d.evaluations.iloc[0]], d.evaluations.to_numpy(), [max(xmax, d.evaluations.max())]])
         ys = np.concatenate([[0.0], d.fraction.to_numpy(), [d.fraction.iloc[-1]]])
-        ax.step(xs, ys, where="post", label=ar.key, lw=1.4)
+        ax.step(xs, ys, where="post", label=_name(ar), lw=1.4)
     ax.set_xscale("log")
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlabel("function evaluations")
@@ -217,9 +231,11 @@ def heatmap_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
     h1 = (u1[1] - u1[0]) / 2 if u1.size > 1 else 0.5
     h2 = (u2[1] - u2[0]) / 2 if u2.size > 1 else 0.5
     ext = [u1[0] - h1, u1[-1] + h1, u2[0] - h2, u2[-1] + h2]
-    logf = np.log10(np.maximum(table["median_fitness"].to_numpy(dtype=float), LOG_FLOOR))
+    floor = plotting.floor_of(table["median_fitness"].to_numpy(dtype=float))
+    logf = np.log10(np.maximum(table["median_fitness"].to_numpy(dtype=float), floor))
     ev = table["median_evaluations_to_threshold"].to_numpy(dtype=float)
-    rows = [("median_fitness", "log10 median final fitness", "viridis", (logf.min(), max(logf.max(), logf.min() + 1e-9))),
+    zero = "\n(exact 0 drawn at the floor " + f"{floor:.0e})" if (table["median_fitness"] <= 0).any() else ""
+    rows = [("median_fitness", "log10 median final fitness" + zero, "viridis", (logf.min(), max(logf.max(), logf.min() + 1e-9))),
             ("success_rate", f"success rate (fitness < {sr.config.threshold:g})", "RdYlGn", (0.0, 1.0)),
             ("median_evaluations_to_threshold", "median evaluations to the threshold\n(white: never reached)",
              "magma_r", (np.nanmin(ev) if np.isfinite(ev).any() else 0.0,
@@ -231,7 +247,7 @@ def heatmap_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
             grid = np.full((u2.size, u1.size), np.nan)
             vals = d[col].to_numpy(dtype=float)
             if col == "median_fitness":
-                vals = np.log10(np.maximum(vals, LOG_FLOOR))
+                vals = np.log10(np.maximum(vals, floor))
             grid[np.searchsorted(u2, d[a2]), np.searchsorted(u1, d[a1])] = vals
             ax = axes[r][k]
             if col == "median_evaluations_to_threshold":   # counts differ by decades between methods
@@ -239,12 +255,13 @@ def heatmap_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
                 im = ax.imshow(grid, origin="lower", extent=ext, aspect="auto", norm=norm, cmap=cmap)
             else:
                 im = ax.imshow(grid, origin="lower", extent=ext, aspect="auto", vmin=vmin, vmax=vmax, cmap=cmap)
+            ax.grid(False)
             if r == len(rows) - 1:
-                ax.set_xlabel(a1)
+                ax.set_xlabel(_axis(sr, a1))
             if k == 0:
-                ax.set_ylabel(a2)
+                ax.set_ylabel(_axis(sr, a2))
             if r == 0:
-                ax.set_title(ar.key, fontsize=9)
+                ax.set_title(_name(ar), fontsize=9)
         fig.colorbar(im, ax=list(axes[r]), label=label)
     fixed = getattr(sr.config.poses, "fixed", {})
     fig.suptitle(f"{sr.config.title or sr.config.name}" + (f"\n(fixed: {', '.join(f'{k}={v:g}' for k, v in fixed.items())};"
@@ -259,8 +276,9 @@ def tracking_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     for ar in sr.algorithms:
         d = table[table.algorithm == ar.key]
-        name = ar.key + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)")
-        axes[0].plot(d.step, np.maximum(d.median_fitness, LOG_FLOOR), marker=".", lw=1, label=name)
+        name = _name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)")
+        floor = plotting.floor_of(table.median_fitness.to_numpy(dtype=float))
+        axes[0].plot(d.step, np.maximum(d.median_fitness, floor), marker=".", lw=1, label=name)
         axes[1].plot(d.step, d.median_evaluations, marker=".", lw=1, label=name)
     axes[0].axhline(sr.config.threshold, color="k", lw=0.8, ls="--")
     axes[0].set_yscale("log")
@@ -284,7 +302,7 @@ def tracking_time_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> No
     for ar in sr.algorithms:
         d = table[table.algorithm == ar.key]
         ax.plot(d.step, d.ms_per_run, marker=".", lw=1,
-                label=ar.key + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)"))
+                label=_name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)"))
     ax.set_yscale("log")
     ax.set_xlabel("trajectory step")
     ax.set_ylabel("time per step and run (ms)")

@@ -1,0 +1,72 @@
+"""The one timing method of fkopt's reports: the papers' mode, one run at a time.
+
+The papers time one run of an algorithm after another (MATLAB or Java loops). fkopt's batch mode
+advances all runs of a task together, and the batch's wall time divided by the runs (the
+*amortised* time, kept in ``timing.csv`` as ``amortised_ms_per_run`` for information) answers a
+different question: it favours algorithms whose per-iteration cost is numpy overhead, and it can
+reverse a comparison. Every timing figure and timing claim of fkopt's reports therefore uses the
+times measured here:
+
+* **Mode**: each sampled run is solved alone (``solve(..., batch=False, run_ids=[k])``, the same
+  stream as in the batch, so the same numbers) and timed with ``time.perf_counter`` around that
+  call; one untimed short warm-up solve precedes the task's first timed run.
+* **Sample**: runs ``0 .. n-1`` of each (case, algorithm) task with
+  ``n = max(1, ceil(TIMING_RUNS / cases))`` (all runs if fewer), on the first ``TIMING_RUNS``
+  cases of the experiment; so a single-case experiment times 8 runs per algorithm, a 50-pose
+  experiment one run on each of 8 poses. A task stops adding runs once it has spent
+  ``TIMING_BUDGET_S`` seconds on timed runs, but never with fewer than ``TIMING_MIN_RUNS``
+  (5: the fewest with which a rank test can reach p < 0.05). This keeps ``make reproduce``
+  within its budget.
+* **Spread**: the sample's median and quartiles are reported; two algorithms' times differ only
+  if a two-sided Mann-Whitney rank test over the sampled runs rejects equality at alpha = 0.05
+  (verdict *within noise* otherwise; see :mod:`fkopt.reproduce.claims`).
+
+Per-run times go to ``timing_runs.csv``; the summary to ``timing.csv``.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ..solve import solve
+
+#: Timed runs per algorithm (spread over the first TIMING_RUNS cases; see the module docstring).
+TIMING_RUNS = 8
+#: A task times at least this many runs (if it has them) ...
+TIMING_MIN_RUNS = 5
+#: ... and stops adding runs once its timed runs took this long (s).
+TIMING_BUDGET_S = 3.0
+
+
+def sample_plan(n_cases: int, runs: int) -> tuple[int, int]:
+    """(cases timed, runs timed per case) of an experiment."""
+    cases = min(n_cases, TIMING_RUNS)
+    return cases, min(runs, max(1, math.ceil(TIMING_RUNS / n_cases)))
+
+
+def time_single_runs(config, records) -> None:
+    """Set ``record.single_run_ids`` and ``record.single_run_s`` (seconds) on every task record."""
+    n_cases, per = sample_plan(len({r.case.index for r in records}), config.runs)
+    for rec in records:
+        if rec.case.index >= n_cases:
+            continue
+        spec = rec.spec
+        kwargs = dict(population=spec.population or config.population, runs=1, seed=rec.seed,
+                      target=config.threshold, stop_at_target=config.stop_at_threshold,
+                      x0=None if spec.start is None else _start(rec),
+                      batch=False, params=spec.params)
+        solve(rec.problem, spec.name, iterations=2, run_ids=[0], **kwargs)   # warm-up, untimed
+        seconds = []
+        for k in range(per):
+            start = time.perf_counter()
+            solve(rec.problem, spec.name, iterations=spec.iterations or config.iterations, run_ids=[k], **kwargs)
+            seconds.append(time.perf_counter() - start)
+            if len(seconds) >= TIMING_MIN_RUNS and sum(seconds) > TIMING_BUDGET_S:
+                break
+        rec.single_run_ids, rec.single_run_s = np.arange(len(seconds)), np.array(seconds)
+
+
+def _start(rec) -> np.ndarray:
+    return np.asarray([rec.spec.start[n] for n in rec.problem.variable_names], dtype=float)
