@@ -18,3 +18,9 @@ PAPERS: dict[str, str] = {
     "assembly": "fkopt.reproduce.assembly",
     "studies": "fkopt.reproduce.studies",
 }
+
+
+def paper_module(key: str):
+    """The module of a paper key (its notes and claims), or None for a folder that is no paper."""
+    import importlib
+    return importlib.import_module(PAPERS[key]) if key in PAPERS else None

@@ -242,7 +242,7 @@ def verdict_changes(root: str | Path) -> list[tuple[str, str, str, str]]:
     """(paper, claim, stored verdict, recomputed verdict) for every claim whose verdict computed
     from the results under ``root`` differs from the stored ``<paper>/claims.csv`` (``(absent)``
     when a claim appeared or disappeared)."""
-    from .report import paper_module
+    from . import paper_module
     from .store import Store
     root = Path(root)
     store = Store(root)

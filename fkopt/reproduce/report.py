@@ -6,21 +6,16 @@ measured in seconds lives in TIMING.md, which changes on every run. Never edit e
 """
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
 
 import pandas as pd
 
-from . import PAPERS
+from . import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
 from .claims import CLAIMS_FILE, RULES, Claim, claims_frame
 from ..experiment.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
 from .store import Experiment, Store
 
 MAX_VALUE_ROWS = 60
-
-
-def paper_module(key: str):
-    return importlib.import_module(PAPERS[key]) if key in PAPERS else None
 
 
 def md_table(df: pd.DataFrame) -> str:

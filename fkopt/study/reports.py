@@ -345,9 +345,11 @@ def write_tables(sr: StudyResult, folder: Path, figures: bool = True) -> list[st
             written.append(name)
 
     def fig(name, draw, *args):
+        # Drawn in place: the folder is a scratch copy swapped in whole, and a figure is two files
+        # (PNG and its PDF twin, fkopt.experiment.plotting.save).
         if figures:
-            _atomic(folder, name, lambda p: draw(sr, *args, p))
-            written.append(name)
+            draw(sr, *args, folder / name)
+            written.extend([name, str(Path(name).with_suffix(".pdf"))])
 
     csv("summary.csv", summary_table(sr))
     csv("timing.csv", timing_table(sr))
