@@ -3,7 +3,9 @@
 Seeds: the (case, algorithm) task with case index c and algorithm label L gets the integer
 seed ``SeedSequence([seed, c, crc32(L)]).generate_state(1)[0]`` and its run k the k-th child
 stream of that (see :mod:`fkopt.streams`). Reordering algorithms in a file or running one
-algorithm alone therefore reproduces the same numbers.
+algorithm alone therefore reproduces the same numbers -- and so does batching: each algorithm
+solves all cases of the experiment in one :func:`fkopt.solve` call (cases x runs rows), passing
+these per-case seeds, and the result is sliced back into one record per (case, algorithm).
 """
 from __future__ import annotations
 
@@ -161,30 +163,50 @@ def validate_experiment(config: ExperimentConfig):
     return mech, cases, problems
 
 
+def batched_problem(config: ExperimentConfig, mech, cases: list[Case]):
+    """One problem with a case axis holding every case's inputs (see :mod:`fkopt.problems`)."""
+    inputs = np.stack([c.inputs for c in cases])
+    kwargs = {"objective": config.objective} if config.objective else {}
+    if mech.kind == "serial":
+        from ..problems import ik_problem
+        return ik_problem(mech, inputs, **kwargs)
+    return fk_problem(mech, inputs, **kwargs)
+
+
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
                    source: str | None = None) -> ExperimentResult:
-    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each."""
+    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each.
+
+    Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
+    each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
+    """
     mech, cases, problems = validate_experiment(config)
+    batched = batched_problem(config, mech, cases)
+    keep_x = "variables" in config.figures or mech.kind == "serial"   # variables.png, position error
     records: list[TaskRecord] = []
     total = len(cases) * len(config.algorithms)
     start_all = time.perf_counter()
-    for case, problem in zip(cases, problems):
-        for spec in config.algorithms:
-            algo = make_algorithm(spec.name, spec.params)
-            seed = task_seed(config.seed, case.index, spec.key)
-            x0 = (mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
-                  if spec.start is not None else None)
-            start = time.perf_counter()
-            result = solve(problem, algo, population=spec.population or config.population,
-                           iterations=spec.iterations or config.iterations, runs=config.runs, seed=seed,
-                           target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
-                           batch=config.batch, snapshots=config.snapshots)
-            wall = time.perf_counter() - start
-            outputs = outputs_of(mech, result.x)
-            pos_hist = None
-            if hasattr(problem, "position_error"):
-                pos_hist = problem.position_error(result.x_history)
-            records.append(TaskRecord(case, spec, problem, result, seed, wall, outputs, pos_hist))
+    by_algorithm: list[list[TaskRecord]] = []
+    for spec in config.algorithms:
+        algo = make_algorithm(spec.name, spec.params)
+        seeds = [task_seed(config.seed, case.index, spec.key) for case in cases]
+        x0 = (mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
+              if spec.start is not None else None)
+        start = time.perf_counter()
+        result = solve(batched, algo, population=spec.population or config.population,
+                       iterations=spec.iterations or config.iterations, runs=config.runs, seed=seeds,
+                       target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
+                       batch=config.batch, snapshots=config.snapshots, x_history=keep_x)
+        wall = (time.perf_counter() - start) / len(cases)     # amortised over the cases
+        recs = []
+        for i, (case, problem) in enumerate(zip(cases, problems)):
+            r = result.case(i)
+            pos_hist = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
+            recs.append(TaskRecord(case, spec, problem, r, seeds[i], wall, outputs_of(mech, r.x), pos_hist))
             if progress:
-                progress(f"{case.label} / {spec.key}", len(records), total)
+                progress(f"{case.label} / {spec.key}", len(records) + len(recs), total)
+        records += recs
+        by_algorithm.append(recs)
+    # case-major order, as the reports expect (every algorithm of case 1, then case 2, ...)
+    records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
     return ExperimentResult(config, mech, cases, records, time.perf_counter() - start_all, source)
