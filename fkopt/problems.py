@@ -299,3 +299,47 @@ def ik_problem(mechanism: Mechanism, pose, objective: Literal["paper", "geodesic
     """Pair a serial arm with a target pose (x, y, z, alpha, beta, gamma: Z-Y-Z Euler in deg),
     or with several (array (cases, 6)): a problem with a case axis."""
     return IKProblem(mechanism, pose, objective=objective, w_p=w_p, w_r=w_r, **kwargs)
+
+
+class BoxedProblem(Problem):
+    """``problem`` searched in one box per case, through the unit box: the variables y in
+    [0, 1]^dim map to x = lo_c + y (hi_c - lo_c) for case c.
+
+    Algorithms take one box (dim, 2) for a whole batch; this lets rows of one batch search
+    different boxes -- tracking's swarm around each run's previous solution. ``to_x(y)`` maps
+    answers back. Width-relative settings (PSO's ``v_max_fraction``, LM's ``jac_step`` and
+    ``tol``, ACO's steps) mean the same in both coordinates; absolute ones (PSO ``v_max``) do not.
+    """
+
+    def __init__(self, problem: Problem, lo, hi):
+        lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+        cases = problem.cases
+        if cases is None or lo.shape != (cases, problem.dim) or hi.shape != lo.shape:
+            raise FkoptError(f"BoxedProblem needs a problem with cases and boxes (cases, {problem.dim})")
+        if not np.all(hi > lo):
+            raise FkoptError("BoxedProblem: every box needs hi > lo")
+        self.problem = problem
+        self.lo, self.width = lo, hi - lo
+        self.cases = cases
+        self._case_arrays = ("lo", "width")
+        self._shapes = {}
+        self.variable_names = problem.variable_names
+        self.variable_units = ("1",) * problem.dim
+        self.bounds = np.array([[0.0, 1.0]] * problem.dim)
+
+    def take(self, index) -> "BoxedProblem":
+        out = super().take(index)
+        out.problem = self.problem.take(index)
+        return out
+
+    def to_x(self, y) -> np.ndarray:
+        """Points y (cases, ..., dim) in the unit box as points of the problem."""
+        y = np.asarray(y, dtype=float)
+        self._check_cases(y)
+        return self._along(self.lo, y.ndim - 1) + y * self._along(self.width, y.ndim - 1)
+
+    def fitness(self, y) -> np.ndarray:
+        return self.problem.fitness(self.to_x(y))
+
+    def residuals(self, y) -> np.ndarray:
+        return self.problem.residuals(self.to_x(y))
