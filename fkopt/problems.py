@@ -129,6 +129,7 @@ class FKProblem(Problem):
         self.variable_units = mechanism.pose_units
         self.bounds = mechanism.bounds if bounds is None else np.asarray(bounds, dtype=float)
         self._angle = mechanism.angle_mask(mechanism.joint_units)
+        self._angle_idx = np.flatnonzero(self._angle)
 
     def residuals(self, x) -> np.ndarray:
         if self.cases is None:
@@ -137,8 +138,10 @@ class FKProblem(Problem):
             x = np.asarray(x, dtype=float)
             self._check_cases(x)
             r = self.mechanism.ik(x) - self._along(self.joints, x.ndim - 1)
-        if self._angle.any():
-            r = np.where(self._angle, wrap_degrees(r), r)
+        if self._angle.all():
+            r = wrap_degrees(r)
+        elif self._angle.any():   # wrap only the angle columns (the same numbers, less work)
+            r[..., self._angle_idx] = wrap_degrees(r[..., self._angle_idx])
         return r
 
     def fitness(self, x) -> np.ndarray:

@@ -8,13 +8,18 @@ own stream, ``run_seed_sequence(seed of its case, run id)`` (:mod:`fkopt.streams
 gives bit-identical numbers alone (solved with the seed recorded for it, ``result.seeds[c]``),
 inside a batch, in chunks, or one run at a time.
 
-Chunks. Rows are advanced :data:`CHUNK_ROWS` at a time (``chunk_rows`` overrides it). The
-results never depend on the chunk size (each row's numbers are its own); the speed does: at
-a few rows the per-iteration cost of numpy calls dominates, at many thousands of rows the
-working arrays leave the CPU caches. ``fkopt bench`` (section ``cases``) measured GABC on
-3-RPS (population 10) at 1000 rows per chunk as fast as any other size within noise and
-1.3-2.3x faster than 10,000 rows at once. With ``batch=False`` every row is solved on its own,
-one after the other -- the reference mode that proves batching never changes the numbers.
+Chunks. Rows are advanced in chunks of :data:`CHUNK_POINTS` // population rows (``chunk_rows``
+overrides it): about 10,000 points of the population per chunk, e.g. 1000 rows of a
+population of 10 or 100 rows of 100. The results never depend on the chunk size (each row's
+numbers are its own); the speed does: at a few rows the per-iteration cost of numpy calls
+dominates, beyond ~10^4 points the working arrays leave the CPU caches. Measured on the 2-core
+development machine (busy, so ratios rather than absolute times): GABC on 3-RPS, population 10,
+3000 rows: 621 / 471 / 522 / 562 ns per evaluation at 300 / 600 / 1000 / 1500 rows per chunk
+(10,000 rows at once were 1.3-2.3x slower than 10 x 1000); ABC on the 7-DOF arm, population 100,
+100 rows: 2391 / 2058 / 1886 / 1644 ns at 10 / 25 / 50 / 100 rows per chunk; P-ABC's ABC on
+3RPUPc-UPS, population 100: 100 rows per chunk 1.5x faster than 500. ``fkopt bench`` (section
+``cases``) keeps measuring it. With ``batch=False`` every row is solved on its own, one after
+the other -- the reference mode that proves batching never changes the numbers.
 
 Memory. The records kept for every row (best-so-far fitness and evaluations per iteration,
 algorithm extras, snapshots, and the best-so-far point per iteration only with
@@ -34,8 +39,8 @@ from .errors import FkoptError
 from .registry import algorithm_class
 from .streams import CHUNK, RunStreams, case_seed
 
-#: Rows (case x run pairs) advanced together; chosen by measurement (module docstring).
-CHUNK_ROWS = 1000
+#: Points (rows x population) advanced together; chosen by measurement (module docstring).
+CHUNK_POINTS = 10_000
 #: Largest estimated memory of one solve (bytes): 2 GiB.
 MEMORY_LIMIT = 2 * 1024 ** 3
 
@@ -236,7 +241,7 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
     case, or one per case and run. ``run_ids`` selects which runs of the seed to compute
     (default 0..runs-1). ``snapshots``: iterations at which the population is kept;
     ``x_history``: keep the best-so-far point of every iteration. ``chunk_rows`` overrides
-    :data:`CHUNK_ROWS` (the numbers do not depend on it).
+    :data:`CHUNK_POINTS` // population rows per chunk (the numbers do not depend on it).
     """
     algo = make_algorithm(algorithm, params)
     validate_budget(population, iterations, runs, algo.local)
@@ -246,7 +251,8 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
     n_cases = len(seeds)
     x0_rows = _start_rows(problem, x0, ids, cases)
     rows = n_cases * len(ids)
-    size = 1 if not batch else (CHUNK_ROWS if chunk_rows is None else int(chunk_rows))
+    size = 1 if not batch else (max(1, CHUNK_POINTS // int(population)) if chunk_rows is None
+                                else int(chunk_rows))
     if size < 1:
         raise FkoptError(f"chunk_rows must be at least 1, got {chunk_rows}")
     need = batch_bytes(rows, size, int(population), int(iterations), problem.dim, len(snapshots), x_history)
