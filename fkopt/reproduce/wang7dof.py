@@ -38,10 +38,9 @@ NOTES = [
     "rand(0, 1)), quality 1/(1 + f) (the paper: 1/f); PSO constriction weights w = 0.7298, "
     "c1 = c2 = 1.49618, v_max = 0.2 x box width (the paper's eq. 10 has no inertia weight and gives no "
     "constants). One ABC iteration costs ~200 evaluations, one PSO iteration 300.",
-    "**Reduced for the time budget:** Tab. 3 uses 30 runs (paper 50) and Fig. 7 10 random reachable "
-    "poses with 1 run each (paper 100 poses): a single 7-DOF run of 500 iterations costs ~1 s of numpy "
-    "call overhead. `baselines` reruns the first 10 runs of Tab. 3 exactly (same seed) beside "
-    "Levenberg-Marquardt and ABC+LM.",
+    "**Budgets as in the paper:** Tab. 3 50 runs; Fig. 7 100 random reachable poses with 1 run each "
+    "(all poses of an algorithm in one batched solve). `baselines` reruns the first 10 runs of Tab. 3 "
+    "exactly (same seed) beside Levenberg-Marquardt and ABC+LM.",
     "\"Iterations to best\" is the first iteration at which a run's final best-so-far fitness was "
     "reached (`iterations_to_best` in runs.csv); swarms that still improve by tiny steps at the end "
     "get values near 500. \"Time to best\" (TIMING.md) is the time per run scaled by "
