@@ -18,6 +18,7 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
 4b. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
    600 iterations): wall time and ns per evaluation, beside a compiled loop's 72 ns; and the
    chunk size (rows per chunk) that :data:`fkopt.solve.CHUNK_POINTS` was chosen from.
+4c. ``assembly`` -- every assembly mode of Dietmaier's 6-SPS platform (:mod:`fkopt.assembly`).
 5. ``scaling`` -- GABC on the 3-RPS case with population 10..1000 (30 runs) and runs 1..1000
    (population 10): wall time and ns per evaluation; plotted into ``scaling.png``.
 
@@ -331,6 +332,22 @@ def bench_cases(rows: _Rows, quick: bool, rng) -> None:
         rows.add("cases", f"gabc 100 cases x 30 runs, {chunk} rows per chunk", ns, "ns/eval", "200 iterations")
 
 
+def bench_assembly(rows: _Rows, quick: bool) -> None:
+    """All assembly modes of Dietmaier's 6-SPS platform (40 real solutions): wall time."""
+    from . import mechanism
+    from .assembly import all_solutions
+    from .mechanisms.sps6 import DIETMAIER_LEGS
+    m = mechanism("6-sps")
+    reps = 1 if quick else 3
+    best, sols = np.inf, None
+    for _ in range(reps):
+        t = time.perf_counter()
+        sols = all_solutions(m, DIETMAIER_LEGS, seed=0)
+        best = min(best, time.perf_counter() - t)
+    rows.add("assembly", "dietmaier 6-sps all solutions", best, "s",
+             f"{len(sols)} solutions in the bounds (40 real ones exist), best of {reps}")
+
+
 # -- 5. scaling ------------------------------------------------------------------------------
 def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, float]]]:
     from .solve import solve
@@ -415,6 +432,7 @@ def run(quick: bool = False, peers: bool = False, out="bench") -> pd.DataFrame:
         bench_peers(rows, quick, per_run.get("gabc"), messages)
     bench_exact(rows, quick, rng)
     bench_cases(rows, quick, rng)
+    bench_assembly(rows, quick)
     curves = bench_scaling(rows, quick)
     plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
 

@@ -12,7 +12,7 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert list(csv.columns) == ["section", "item", "value", "unit", "note"]
     assert (tmp_path / "b" / "scaling.png").stat().st_size > 0
     assert len(csv) == len(df)
-    assert set(csv.section) == {"throughput", "mao2017", "exact", "cases", "scaling"}
+    assert set(csv.section) == {"throughput", "mao2017", "exact", "cases", "assembly", "scaling"}
     assert np.all(np.isfinite(csv.value)) and np.all(csv.value >= 0)
     # every registered mechanism has a throughput row
     for name in fkopt.MECHANISMS:
