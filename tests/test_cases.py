@@ -150,3 +150,12 @@ def test_experiment_batches_cases_with_the_task_seeds():
         assert rec.seed == seed and rec.result.seed == seed
         for name in ARRAYS:
             np.testing.assert_array_equal(getattr(rec.result, name), getattr(ref, name), err_msg=name)
+
+
+def test_experiment_too_large_for_memory_fails_validation():
+    from fkopt.experiment.config import ExperimentConfig
+    from fkopt.experiment.runner import validate_experiment
+    cfg = ExperimentConfig(name="huge", mechanism={"name": "3-rps"}, cases={"random": 2000, "seed": 1},
+                           algorithms=[{"name": "gabc"}], iterations=100_000, runs=100)
+    with pytest.raises(FkoptError, match=r"algorithms\[gabc\]: 2000 cases x 100 runs x 100000 iterations need"):
+        validate_experiment(cfg)

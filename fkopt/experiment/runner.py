@@ -20,7 +20,7 @@ from .. import registry
 from ..errors import FkoptError
 from ..problems import fk_problem
 from ..rotations import wrap_degrees
-from ..solve import Result, make_algorithm, solve
+from ..solve import CHUNK_POINTS, MEMORY_LIMIT, Result, batch_bytes, make_algorithm, solve
 from .config import AlgorithmSpec, ExperimentConfig, RandomCases
 
 
@@ -160,6 +160,16 @@ def validate_experiment(config: ExperimentConfig):
             x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
             _check_in_bounds(mech, x0, f"algorithms[{spec.key}].start")
     problems = [build_problem(config, mech, c) for c in cases]
+    keep_x = "variables" in config.figures or mech.kind == "serial"
+    for spec in config.algorithms:       # a batch that cannot fit in memory fails here, not midway
+        pop, its = spec.population or config.population, spec.iterations or config.iterations
+        rows = len(cases) * config.runs
+        need = batch_bytes(rows, max(1, CHUNK_POINTS // pop) if config.batch else 1, pop, its,
+                           len(mech.unknown_names), len(config.snapshots), keep_x)
+        if need > MEMORY_LIMIT:
+            raise FkoptError(f"algorithms[{spec.key}]: {len(cases)} cases x {config.runs} runs x {its} "
+                             f"iterations need about {need / 1e9:.1f} GB, more than the limit of "
+                             f"{MEMORY_LIMIT / 1e9:.1f} GB; lower runs, iterations or the number of cases")
     return mech, cases, problems
 
 
