@@ -8,8 +8,8 @@ own stream, ``run_seed_sequence(seed of its case, run id)`` (:mod:`fkopt.streams
 gives bit-identical numbers alone (solved with the seed recorded for it, ``result.seeds[c]``),
 inside a batch, in chunks, or one run at a time.
 
-Chunks. Rows are advanced in chunks of :data:`CHUNK_POINTS` // population rows (``chunk_rows``
-overrides it): about 10,000 points of the population per chunk, e.g. 1000 rows of a
+Chunks. Rows are advanced in chunks of at most :data:`CHUNK_POINTS` // population rows, as equal
+as possible (``chunk_rows`` overrides it): about 10,000 points of the population per chunk, e.g. 1000 rows of a
 population of 10 or 100 rows of 100. The results never depend on the chunk size (each row's
 numbers are its own); the speed does: at a few rows the per-iteration cost of numpy calls
 dominates, beyond ~10^4 points the working arrays leave the CPU caches. Measured on the 2-core
@@ -255,6 +255,8 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
                                 else int(chunk_rows))
     if size < 1:
         raise FkoptError(f"chunk_rows must be at least 1, got {chunk_rows}")
+    if chunk_rows is None and rows > size:     # equal chunks: 100 rows by 33 -> 4 x 25, not 33+33+33+1
+        size = -(-rows // -(-rows // size))
     need = batch_bytes(rows, size, int(population), int(iterations), problem.dim, len(snapshots), x_history)
     if need > MEMORY_LIMIT:
         raise FkoptError(f"a batch of {rows} runs ({n_cases} cases x {len(ids)} runs) of {iterations} "
