@@ -95,12 +95,21 @@ class PSO(Algorithm):
         p = self.params
         state.t += 1
         runs, population, dim = state.x.shape
-        r = streams.uniform(2, population, dim)
+        r = streams.uniform(2, population, dim)     # a fresh view: ours to overwrite
         g = state.best_x[:, None, :]
-        vel = (self.inertia_weight(state) * state.vel + p.c1 * r[:, 0] * (state.x - state.pos)
-               + p.c2 * r[:, 1] * (g - state.pos))
+        # w v + c1 r1 (p - x) + c2 r2 (g - x), the same operations in the same order, in place
+        cognitive, social = r[:, 0], r[:, 1]
+        cognitive *= p.c1
+        diff = np.subtract(state.x, state.pos)
+        cognitive *= diff
+        vel = np.multiply(state.vel, self.inertia_weight(state))
+        vel += cognitive
+        social *= p.c2
+        np.subtract(g, state.pos, out=diff)
+        social *= diff
+        vel += social
         limit = self.velocity_limit(problem.bounds)
-        vel = np.clip(vel, -limit, limit)
+        np.clip(vel, -limit, limit, out=vel)
         moved = state.pos + vel
         pos = clip(moved, problem.bounds)
         state.vel = np.where(pos != moved, 0.0, vel)
