@@ -8,6 +8,8 @@ Python API::
     problem = fkopt.fk_problem(m, joints)           # forward kinematics as a minimisation
     result = fkopt.solve(problem, "gabc", population=10, iterations=600, runs=30, seed=1)
     result.x[result.median_run], result.history     # per-run answers and best-so-far curves
+    many = fkopt.fk_problem(m, m.ik([[9, 13, 622], [0, 0, 500]]))    # joints (cases, 3)
+    fkopt.solve(many, "gabc", runs=30, seed=[1, 2]).case(1)          # pose 2 as if solved alone
 
     fk = fkopt.forward("6-sps-cmm", legs)           # exact solvers, batched over leading axes:
     ik = fkopt.inverse("7dof-arm", poses)           # .pose / .joints, .residual, .solved, .evaluations

@@ -45,8 +45,8 @@ after every round.
 
 Measured on Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``):
 all 40 real solutions, residuals ~1e-15, in the first round of 2000 starts for 10 seeds out
-of 10 (~0.2 s), and ~0.3-0.45 s of CPU for the whole search with its confirming round
-(4000 starts). The rarest basin is hit by ~0.3 % of the starts, so 2000 starts miss it with
+of 10, and the whole search stops after its confirming round (4000 starts); ``fkopt bench``
+(section ``assembly``) times it. The rarest basin is hit by ~0.3 % of the starts, so 2000 starts miss it with
 probability ~0.3 % and the confirming round makes an early stop with 39 unlikely (~1e-5).
 """
 from __future__ import annotations

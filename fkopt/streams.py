@@ -5,6 +5,11 @@ Every run k of an experiment with seed s draws from its own generator
 ``SeedSequence(s).spawn(n)`` -- so run k produces the same numbers whether it runs alone, in a
 batch of 30 or on another worker. Nothing in fkopt touches numpy's global RNG.
 
+Several targets (cases) solved in one batch: each case has its own integer seed (given per
+case, or derived from one seed by :func:`case_seed`), and run k of case c draws from
+``run_seed_sequence(seed_c, k)``. A row of a batch is therefore identified by (seed, run id)
+alone, and :class:`RunStreams` takes one seed per row.
+
 Algorithms only ever draw *uniforms* through :class:`RunStreams`; integers and other
 distributions are derived from them (``floor(u * n)``). Uniforms are drawn per run in large
 chunks and buffered: PCG64's ``random()`` consumes exactly one 64-bit output per double, so the
@@ -29,6 +34,10 @@ import numpy as np
 
 #: Uniforms buffered per run and refill (any value gives the same numbers; this one is fast).
 CHUNK = 8192
+#: Upper bound on the values buffered over all runs of a batch (8 MB): with many rows each run
+#: refills in smaller pieces (at least :data:`MIN_REFILL`). Again, the numbers do not depend on it.
+BUFFER_VALUES = 1 << 20
+MIN_REFILL = 256
 
 
 def run_seed_sequence(seed: int, run: int) -> np.random.SeedSequence:
@@ -36,15 +45,33 @@ def run_seed_sequence(seed: int, run: int) -> np.random.SeedSequence:
     return np.random.SeedSequence(seed, spawn_key=(run,))
 
 
-class RunStreams:
-    """One independent uniform stream per run, served as arrays shaped (runs, ...)."""
+def case_seed(seed: int, case: int) -> int:
+    """The integer seed of case ``case`` when a batch of cases is given one seed ``seed``:
+    the first 32-bit word of ``SeedSequence(seed, spawn_key=(case,))``'s state, i.e. of the
+    case-th child of ``SeedSequence(seed)``. Solving case c alone with this seed reproduces it."""
+    return int(np.random.SeedSequence(int(seed), spawn_key=(int(case),)).generate_state(1)[0])
 
-    def __init__(self, seed: int, run_ids: Sequence[int]):
-        self.seed = int(seed)
+
+class RunStreams:
+    """One independent uniform stream per run, served as arrays shaped (runs, ...).
+
+    ``seed`` is one integer for every row, or one per row (rows of several cases in a batch).
+    """
+
+    def __init__(self, seed: int | Sequence[int], run_ids: Sequence[int]):
         self.run_ids = [int(k) for k in run_ids]
-        self._generators = [np.random.Generator(np.random.PCG64(run_seed_sequence(self.seed, k)))
-                            for k in self.run_ids]
+        if np.ndim(seed) == 0:
+            self.seed = int(seed)
+            self.seeds = [self.seed] * len(self.run_ids)
+        else:
+            self.seeds = [int(s) for s in seed]
+            if len(self.seeds) != len(self.run_ids):
+                raise ValueError(f"{len(self.seeds)} seeds for {len(self.run_ids)} runs")
+            self.seed = self.seeds[0] if len(set(self.seeds)) == 1 else None
+        self._generators = [np.random.Generator(np.random.PCG64(run_seed_sequence(s, k)))
+                            for s, k in zip(self.seeds, self.run_ids)]
         self._runs = len(self.run_ids)
+        self._refill_size = max(MIN_REFILL, min(CHUNK, BUFFER_VALUES // max(self._runs, 1)))
         self._buffer = np.empty((self._runs, 0))
         self._pos = 0
         self._size = 0
@@ -56,7 +83,7 @@ class RunStreams:
     def _refill(self, n: int) -> None:
         """Keep the unread tail and append at least ``n`` fresh values per run."""
         tail = self._size - self._pos
-        fresh = max(n, CHUNK)
+        fresh = max(n, self._refill_size)
         buf = np.empty((self._runs, tail + fresh))
         buf[:, :tail] = self._buffer[:, self._pos:]
         for row, g in zip(buf, self._generators):

@@ -7,7 +7,7 @@ from scipy.optimize import least_squares
 
 import fkopt
 from fkopt.algorithms.aco import ACO
-from fkopt.algorithms.pso import PSO
+from fkopt.algorithms.pso import PSO, PSOState
 
 SWARMS = ["aco", "pso", "pabc", "abc+lm", "gabc+lm", "pso+lm"]
 ALL = SWARMS + ["nr", "lm"]
@@ -95,7 +95,7 @@ def test_rps_case_solved(rps, name):
 def test_batch_and_single_runs_identical(rps, name):
     # Same process, same numpy/LAPACK build: nr/lm solve each small system by its own LAPACK
     # call, so this holds on any machine; across builds or CPUs only tolerances hold (lm.py).
-    kw = dict(population=8, iterations=60, runs=3, seed=11)
+    kw = dict(population=8, iterations=60, runs=3, seed=11, x_history=True)
     a = fkopt.solve(rps, name, **kw)
     b = fkopt.solve(rps, name, batch=False, **kw)
     c = fkopt.solve(rps, name, **{**kw, "runs": 1}, run_ids=[2])
@@ -160,9 +160,10 @@ def test_aco_transfer_probability_reading():
 # -- PSO / P-ABC ---------------------------------------------------------------------------
 def test_pso_linear_inertia_schedule():
     algo = PSO(inertia="linear", w_max=0.5, w_min=0.1)
-    state = type("S", (), {"pso_t": 1, "pso_span": 500})()
+    x = np.zeros((1, 2, 1))
+    state = PSOState(x=x, f=np.zeros((1, 2)), pos=x, vel=x, t=1, span=500)
     assert algo.inertia_weight(state) == pytest.approx(0.5 - 0.4 / 500)
-    state.pso_t = 500
+    state.t = 500
     assert algo.inertia_weight(state) == pytest.approx(0.1)
     assert PSO(w=0.8).inertia_weight(state) == 0.8
 
@@ -210,7 +211,7 @@ def test_nr_quadratic_convergence_on_rps(rps):
 def test_nr_start_point_forms(rps):
     single = fkopt.solve(rps, "nr", x0=[5, 5, 600], iterations=10, runs=2)
     np.testing.assert_array_equal(single.history[0], single.history[1])
-    rows = fkopt.solve(rps, "nr", x0=[[5, 5, 600], [-5, 10, 650]], iterations=10, runs=2)
+    rows = fkopt.solve(rps, "nr", x0=[[5, 5, 600], [-5, 10, 650]], iterations=10, runs=2, x_history=True)
     np.testing.assert_array_equal(rows.history[0], single.history[0])
     np.testing.assert_array_equal(rows.x_history[1, 0], [-5, 10, 650])
     assert np.all(rows.fitness < 1e-20)

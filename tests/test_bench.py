@@ -15,7 +15,7 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100
     assert len(np.unique(img.reshape(-1, img.shape[-1]), axis=0)) > 10
     assert len(csv) == len(df)
-    assert set(csv.section) == {"throughput", "mao2017", "exact", "kinematics", "scaling"}
+    assert set(csv.section) == {"throughput", "mao2017", "exact", "kinematics", "cases", "scaling"}
     assert np.all(np.isfinite(csv.value)) and np.all(csv.value >= 0)
     # every registered mechanism has a throughput row
     for name in fkopt.MECHANISMS:
@@ -26,20 +26,16 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert v["gabc evaluations per run"] >= 2 * 10 * 600
     # the batched exact solve finds legs to 1e-9 for (nearly) every pose
     assert v["6-sps-cmm lm success"] >= 99.0
+    for n in (1, 10, 100):   # N cases x 30 runs together
+        assert v[f"gabc {n} cases x 30 runs per evaluation"] > 0
 
 
-def test_pose_batch_problem_index_is_inert():
+def test_batched_lm_solves_many_poses_as_cases():
     m = fkopt.mechanism("6-sps-cmm")
     rng = np.random.default_rng(3)
     poses = m.bounds[:, 0] + rng.random((5, 6)) * (m.bounds[:, 1] - m.bounds[:, 0])
-    p = bench.PoseBatchProblem(m, m.ik(poses))
-    x = np.concatenate([poses, np.arange(5.0)[:, None]], axis=1)
-    np.testing.assert_allclose(p.fitness(x), 0.0, atol=1e-20)
-    # flat, nested and shifted-index shapes select the right pose
-    assert p.residuals(x[None, :, None, :]).shape == (1, 5, 1, 6)
-    x2 = x.copy()
-    x2[:, -1] += 1e-3
-    np.testing.assert_array_equal(p.residuals(x2), p.residuals(x))
-    r = fkopt.solve(p, "lm", population=1, iterations=50, runs=5, x0=p.start())
-    np.testing.assert_array_equal(r.x[:, -1], np.arange(5.0))
-    assert np.abs(m.ik(r.x[:, :-1]) - m.ik(poses)).max() < 1e-9
+    p = fkopt.fk_problem(m, m.ik(poses))
+    np.testing.assert_allclose(p.fitness(poses[:, None, :])[:, 0], 0.0, atol=1e-20)
+    r = fkopt.solve(p, "lm", population=1, iterations=50, runs=1, x0=m.bounds.mean(axis=1))
+    assert r.x.shape == (5, 1, 6)
+    assert np.abs(m.ik(r.x[:, 0]) - m.ik(poses)).max() < 1e-9

@@ -47,7 +47,8 @@ def test_swarms_solve_3rps_case(case, name):
 
 
 def test_result_records(case):
-    res = fkopt.solve(case, "abc", population=10, iterations=50, runs=3, seed=0, target=1e-2)
+    res = fkopt.solve(case, "abc", population=10, iterations=50, runs=3, seed=0, target=1e-2,
+                      x_history=True)
     assert res.history.shape == (3, 51) and res.x_history.shape == (3, 51, 3)
     assert np.all(np.diff(res.history, axis=1) <= 0), "best-so-far must never increase"
     np.testing.assert_array_equal(res.history[:, -1], res.fitness)
@@ -63,7 +64,7 @@ def test_result_records(case):
 
 
 def test_bounds_respected(case):
-    res = fkopt.solve(case, "gabc", population=10, iterations=30, runs=5, seed=0)
+    res = fkopt.solve(case, "gabc", population=10, iterations=30, runs=5, seed=0, x_history=True)
     lo, hi = case.bounds[:, 0], case.bounds[:, 1]
     assert np.all((res.x_history >= lo) & (res.x_history <= hi))
 

@@ -51,7 +51,7 @@ IDS = ["abc", "gabc-mao2017", "gabc-zhu2010"]
 @pytest.mark.parametrize("name,params", CASES, ids=IDS)
 @pytest.mark.parametrize("stop", [False, True], ids=["full", "stop_at_target"])
 def test_batch_equals_one_run_at_a_time(problem, name, params, stop):
-    kw = dict(population=10, iterations=150, runs=6, seed=11, params=params,
+    kw = dict(population=10, iterations=150, runs=6, seed=11, params=params, x_history=True,
               target=1e-8 if stop else None, stop_at_target=stop)
     batch = fkopt.solve(problem, name, **kw)
     alone = fkopt.solve(problem, name, batch=False, **kw)
@@ -62,7 +62,7 @@ def test_batch_equals_one_run_at_a_time(problem, name, params, stop):
 
 @pytest.mark.parametrize("name,params", CASES, ids=IDS)
 def test_run_k_alone_equals_run_k_in_batch(printed, name, params):
-    kw = dict(population=10, iterations=120, seed=5, params=params)
+    kw = dict(population=10, iterations=120, seed=5, params=params, x_history=True)
     batch = fkopt.solve(printed, name, runs=8, **kw)
     for k in (0, 3, 7):
         alone = fkopt.solve(printed, name, runs=1, run_ids=[k], **kw)

@@ -56,7 +56,7 @@ def test_paper_pso_reaches_half_a_micrometre():
     pr = fk_problem(SixSPSCMM(), LEGS, objective="absolute")
     r = solve(pr, "pso", population=80, iterations=150, runs=3, seed=1, target=5e-7, stop_at_target=True,
               params=PSO_PAPER)
-    assert np.all(r.success(5e-7))
+    assert np.all(r.succeeded(5e-7))
     assert np.all(np.abs(r.x[:, :3] - EXACT[:3]) < 2e-6)
 
 

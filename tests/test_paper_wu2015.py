@@ -79,7 +79,7 @@ def test_newton_iterates_depend_only_on_the_start_theta():
     mech = mechanism_class("3-ppr")()
     prob = fk_problem(mech, mech.ik([20.0, 30.0, 15.0]))
     starts = np.array([s for s in NR_STARTS if s[2] == 10], dtype=float)
-    r = solve(prob, "nr", x0=starts, population=1, iterations=3, runs=len(starts))
+    r = solve(prob, "nr", x0=starts, population=1, iterations=3, runs=len(starts), x_history=True)
     np.testing.assert_allclose(r.x_history[:, 1], np.broadcast_to(r.x_history[0, 1], (len(starts), 3)), atol=1e-7)
     assert np.all(np.abs(r.x - [20, 30, 15]).max(axis=1) < 1e-3)
 

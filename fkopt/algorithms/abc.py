@@ -51,18 +51,18 @@ one draw per phase, index arithmetic on flattened (runs * SN) arrays instead of
 subclass that overrides only the whole-row :meth:`ABC.step` still works, on a slower path
 with identical numbers), the onlooker duplicates resolved by two ``np.minimum.at`` scatters
 (no sort), and the roulette as one broadcast comparison for small colonies or a vectorised
-binary search for large ones (the same integers either way). Measured with valgrind (a
-count of instructions, independent of machine load): a GABC iteration of the mao2017
-experiment went from 4.8 M to 2.3 M instructions, about half of it the two fitness calls.
+binary search for large ones (the same integers either way). ``fkopt bench`` measures what
+an evaluation costs.
 """
 from __future__ import annotations
 
 from typing import Literal
+from dataclasses import dataclass
 
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, row_offsets, uniform_in
+from .base import Algorithm, Params, State, row_offsets, rows_of, uniform_in
 
 
 class ABCParams(Params):
@@ -80,7 +80,7 @@ def quality(f: np.ndarray) -> np.ndarray:
     return np.where(f >= 0, 1.0 / (1.0 + f), 1.0 - f)
 
 
-#: Colonies up to this size use the dense (runs, SN, SN) roulette comparison; larger ones a
+#: Colonies up to this size use the dense roulette (SN comparisons per onlooker); larger ones a
 #: binary search (O(SN log SN)). Both give the same indices.
 DENSE_ROULETTE = 32
 
@@ -93,8 +93,13 @@ def roulette(cdf: np.ndarray, u: np.ndarray, dense: bool | None = None) -> np.nd
     runs, n = cdf.shape
     if dense is None:
         dense = n <= DENSE_ROULETTE
-    if dense:
-        return (cdf[:, None, :] > u[:, :, None]).argmax(axis=2)
+    if dense:   # count the entries <= u, one column at a time (a reduction over a short last
+        # axis, such as argmax over (runs, m, n), costs several times more)
+        count = (cdf[:, :1] <= u).astype(np.intp)
+        for i in range(1, n):
+            count += cdf[:, i:i + 1] <= u
+        count[count == n] = 0
+        return count
     # Binary search for the count of entries <= u (the first index with cdf > u).
     flat = cdf.ravel()
     base = (row_offsets(runs, n) - 1)[:, None]
@@ -131,10 +136,20 @@ class _Aux:
         self.none = np.full(runs * population, runs * population)
 
 
-def _aux(state: State, problem) -> _Aux:
-    aux = state.__dict__.get("_abc_aux")
+@dataclass(eq=False, kw_only=True)
+class ABCState(State):
+    """ABC's food sources ``x``/``f`` with their trial counters."""
+
+    trial: np.ndarray                   # (runs, population) failed attempts per source
+    limit: int                          # trials before a scout abandons the source
+    aux: _Aux | None = None             # index arrays for this shape, built on first use
+    pending: tuple | None = None        # scout sources placed but not yet evaluated
+
+
+def _aux(state: ABCState, problem) -> _Aux:
+    aux = state.aux
     if aux is None or aux.shape != state.x.shape:
-        aux = state._abc_aux = _Aux(state.x.shape, np.asarray(problem.bounds, dtype=float))
+        aux = state.aux = _Aux(state.x.shape, np.asarray(problem.bounds, dtype=float))
     return aux
 
 
@@ -144,13 +159,13 @@ class ABC(Algorithm):
     evaluations_per_iteration = "2*population (+1 per scout)"
 
     # -- phases ------------------------------------------------------------------------------
-    def initialize(self, problem, population, streams, x0):
+    def initialize(self, problem, population, streams, x0, iterations):
         x = uniform_in(problem.bounds, streams.uniform(population, problem.dim))
         f = np.fmin(problem.fitness(x), np.inf)
         runs = streams.runs
         limit = self.params.limit or population * problem.dim
-        return State(x=x, f=f, trial=np.zeros(f.shape, dtype=np.int64), limit=limit,
-                     evaluations=np.full(runs, population, dtype=np.int64))
+        return ABCState(x=x, f=f, trial=np.zeros(f.shape, dtype=np.int64), limit=limit,
+                        evaluations=np.full(runs, population, dtype=np.int64))
 
     #: Does the move read the best-so-far point (then it is refreshed between the phases)?
     uses_best = False
@@ -259,15 +274,19 @@ class ABC(Algorithm):
         aux = _aux(state, problem)
         population = state.f.shape[1]
         v, pos, m, old = self._propose(state, aux.sources, problem, streams)
-        pending = state.__dict__.pop("_abc_pending", None)
+        pending, state.pending = state.pending, None
         if pending is None:
             fv = np.fmin(problem.fitness(v), np.inf)
         else:   # fresh scout sources placed by scout_phase(evaluate=False): evaluate them too
             slots, fresh, count = pending
-            both = np.fmin(problem.fitness(np.concatenate([v.reshape(-1, v.shape[-1]), fresh])), np.inf)
-            fv = both[:v.shape[0] * population].reshape(state.f.shape)
             f = state.f.copy()
-            f.reshape(-1)[slots] = both[v.shape[0] * population:]
+            if getattr(problem, "cases", None) is None:   # one call for both
+                both = np.fmin(problem.fitness(np.concatenate([v.reshape(-1, v.shape[-1]), fresh])), np.inf)
+                fv = both[:v.shape[0] * population].reshape(state.f.shape)
+                f.reshape(-1)[slots] = both[v.shape[0] * population:]
+            else:   # a target per row: the scouts' rows (same numbers, a second call)
+                fv = np.fmin(problem.fitness(v), np.inf)
+                f.reshape(-1)[slots] = np.fmin(rows_of(problem, slots // population).fitness(fresh), np.inf)
             state.f = f
             state.evaluations = state.evaluations + count
         better = self.better(fv, state.f)
@@ -335,9 +354,9 @@ class ABC(Algorithm):
         state.trial = t.reshape(runs, population)
         f = state.f.reshape(-1).copy()
         if evaluate:
-            f[slots] = np.fmin(problem.fitness(fresh), np.inf)
+            f[slots] = np.fmin(rows_of(problem, rows).fitness(fresh), np.inf)
             state.evaluations = state.evaluations + scout
         else:
             f[slots] = np.inf
-            state._abc_pending = (slots, fresh, scout)
+            state.pending = (slots, fresh, scout)
         state.f = f.reshape(runs, population)

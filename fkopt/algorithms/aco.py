@@ -55,13 +55,13 @@ run and iteration (wu2015 Fig. 7).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from pydantic import Field
 
-from .base import Params, State, clip, uniform_in
-from .budget import BudgetAware
+from .base import Algorithm, Params, State, clip, uniform_in
 
 
 class ACOParams(Params):
@@ -83,21 +83,31 @@ class ACOParams(Params):
     contract: float = Field(0.9036, gt=0, le=1, description="adaptive: factor after a failed local move")
 
 
-class ACO(BudgetAware):
+@dataclass(eq=False, kw_only=True)
+class ACOState(State):
+    """The ants ``x``/``f``, their accumulated pheromone and local step sizes."""
+
+    tau: np.ndarray                    # (runs, population) pheromone (eq. 19)
+    step: np.ndarray                   # (runs, population) adaptive local half-widths
+    t: int = 0                         # iterations done
+    span: int = 1                      # iterations of the run (the schedule's length)
+
+
+class ACO(Algorithm):
     name = "aco"
     Params = ACOParams
     evaluations_per_iteration = "population"
 
-    def initialize(self, problem, population, streams, x0):
+    def initialize(self, problem, population, streams, x0, iterations):
         x = uniform_in(problem.bounds, streams.uniform(population, problem.dim))
         f = problem.fitness(x)
-        return State(x=x, f=f, tau=-f, aco_t=0, aco_span=self.budget(),
-                     step=np.full(f.shape, self.params.local_step),
-                     evaluations=np.full(streams.runs, population, dtype=np.int64))
+        return ACOState(x=x, f=f, tau=-f, span=int(iterations),
+                        step=np.full(f.shape, self.params.local_step),
+                        evaluations=np.full(streams.runs, population, dtype=np.int64))
 
     def local_half_width(self, state) -> float:
         p = self.params
-        frac = (state.aco_t - 1) / (state.aco_span - 1) if state.aco_span > 1 else 0.0
+        frac = (state.t - 1) / (state.span - 1) if state.span > 1 else 0.0
         return p.local_step * p.shrink ** min(frac, 1.0)
 
     @staticmethod
@@ -111,7 +121,7 @@ class ACO(BudgetAware):
 
     def iterate(self, state, problem, streams):
         p = self.params
-        state.aco_t += 1
+        state.t += 1
         runs, population, dim = state.x.shape
         local = self.transfer_probability(state.tau) < p.P0
         width = problem.bounds[:, 1] - problem.bounds[:, 0]

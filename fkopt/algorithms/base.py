@@ -1,9 +1,9 @@
 """The algorithm protocol and the shared iteration loop.
 
-An algorithm implements two methods on a :class:`State` holding arrays shaped
-(runs, population, dim):
+An algorithm implements two methods on its own typed :class:`State` (a dataclass) holding
+arrays shaped (runs, population, dim):
 
-* ``initialize(problem, population, streams, x0)`` sets ``state.x`` (the algorithm's memory:
+* ``initialize(problem, population, streams, x0, iterations)`` sets ``state.x`` (the algorithm's memory:
   ABC food sources, PSO personal bests, ant positions ...), ``state.f`` (their fitness) and
   ``state.evaluations`` (fitness evaluations so far, per run);
 * ``iterate(state, problem, streams)`` advances every run by one iteration of the method.
@@ -33,17 +33,21 @@ class Params(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+@dataclass(eq=False, kw_only=True)
 class State:
-    """Mutable per-batch state; algorithms attach whatever arrays they need."""
+    """What every algorithm's state holds; each algorithm subclasses it with its own fields
+    (:class:`fkopt.algorithms.abc.ABCState`, ``PSOState``, ...), evosax-style.
+
+    ``x``/``f`` are the algorithm's memory (runs, population, dim) / (runs, population) that
+    :meth:`Algorithm.update_best` reads, ``evaluations`` the count per run; ``best_x``/``best_f``
+    the best-so-far per run, kept by :meth:`Algorithm.minimize`.
+    """
 
     x: np.ndarray
     f: np.ndarray
-    evaluations: np.ndarray
-    best_x: np.ndarray
-    best_f: np.ndarray
-
-    def __init__(self, **arrays: Any):
-        self.__dict__.update(arrays)
+    evaluations: np.ndarray | None = None
+    best_x: np.ndarray | None = None
+    best_f: np.ndarray | None = None
 
 
 @dataclass
@@ -53,7 +57,7 @@ class RunRecord:
     best_x: np.ndarray                 # (runs, dim)
     best_f: np.ndarray                 # (runs,)
     history: np.ndarray                # (runs, iterations + 1) best-so-far fitness
-    x_history: np.ndarray              # (runs, iterations + 1, dim) best-so-far point
+    x_history: np.ndarray | None       # (runs, iterations + 1, dim) best-so-far point, if asked
     evaluation_history: np.ndarray     # (runs, iterations + 1) cumulative evaluations
     iterations_done: np.ndarray        # (runs,) iterations actually used (< iterations if stopped)
     extras: dict[str, np.ndarray] = field(default_factory=dict)       # name -> (runs, iterations + 1)
@@ -70,6 +74,13 @@ def row_offsets(runs: int, population: int) -> np.ndarray:
     out = np.arange(runs, dtype=np.intp) * population
     out.flags.writeable = False
     return out
+
+
+def rows_of(problem, rows: np.ndarray):
+    """The problem for points taken from batch rows ``rows`` (k, ..., dim), e.g. the active
+    points of a local method: ``problem.take(rows)`` when the problem's first axis is per row
+    (:func:`fkopt.solve` batching several targets), the problem itself otherwise."""
+    return problem if getattr(problem, "cases", None) is None else problem.take(rows)
 
 
 def clip(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:
@@ -107,7 +118,10 @@ class Algorithm:
         return f"{type(self).__name__}({args})"
 
     # -- to implement ------------------------------------------------------------------------
-    def initialize(self, problem, population: int, streams: RunStreams, x0: np.ndarray | None) -> State:
+    def initialize(self, problem, population: int, streams: RunStreams, x0: np.ndarray | None,
+                   iterations: int) -> State:
+        """The state after the initial population; ``iterations`` is the budget the run will get
+        (schedules such as PSO's linear inertia depend on it)."""
         raise NotImplementedError
 
     def iterate(self, state: State, problem, streams: RunStreams) -> None:
@@ -138,36 +152,45 @@ class Algorithm:
 
     def minimize(self, problem, *, population: int, iterations: int, streams: RunStreams,
                  target: float | None = None, stop_at_target: bool = False,
-                 x0: np.ndarray | None = None, snapshots=()) -> RunRecord:
+                 x0: np.ndarray | None = None, snapshots=(), x_history: bool = True) -> RunRecord:
+        """Run every row of ``streams`` for ``iterations`` iterations (see the module docstring).
+
+        ``x_history=False`` keeps only the final best point (``RunRecord.x_history`` is None):
+        (runs, iterations + 1, dim) floats are the largest record of a big batch.
+        """
         runs, dim = streams.runs, problem.dim
-        state = self.initialize(problem, population, streams, x0)
+        state = self.initialize(problem, population, streams, x0, iterations)
         state.best_f = np.full(runs, np.inf)
         state.best_x = np.full((runs, dim), np.nan)
         self.update_best(state)
 
         history = np.empty((runs, iterations + 1))
-        x_history = np.empty((runs, iterations + 1, dim))
+        xs = np.empty((runs, iterations + 1, dim)) if x_history else None
         evals = np.empty((runs, iterations + 1), dtype=np.int64)
         extra_hist: dict[str, np.ndarray] = {}
         snaps: dict[int, np.ndarray] = {}
         wanted = {int(s) for s in snapshots}
         done = np.zeros(runs, dtype=bool)
         done_at = np.full(runs, iterations)
+        final_x = state.best_x
 
         def record(t: int) -> None:
+            nonlocal final_x
             if t == 0 or not frozen:
                 history[:, t] = state.best_f
-                x_history[:, t] = state.best_x
+                final_x = state.best_x
                 evals[:, t] = state.evaluations
                 for key, value in self.extras(state).items():
                     extra_hist.setdefault(key, np.empty((runs, iterations + 1)))[:, t] = value
             else:   # runs that reached the target keep their values
                 history[:, t] = np.where(done, history[:, t - 1], state.best_f)
-                x_history[:, t] = np.where(done[:, None], x_history[:, t - 1], state.best_x)
+                final_x = np.where(done[:, None], final_x, state.best_x)
                 evals[:, t] = np.where(done, evals[:, t - 1], state.evaluations)
                 for key, value in self.extras(state).items():
                     arr = extra_hist[key]
                     arr[:, t] = np.where(done, arr[:, t - 1], value)
+            if xs is not None:
+                xs[:, t] = final_x
             if t in wanted:
                 snaps[t] = np.array(state.x, copy=True)
 
@@ -193,12 +216,13 @@ class Algorithm:
             done_at[newly] = last
         if last < iterations:   # every run stopped early: hold the final values to the end
             history[:, last + 1:] = history[:, [last]]
-            x_history[:, last + 1:] = x_history[:, [last]]
+            if xs is not None:
+                xs[:, last + 1:] = xs[:, [last]]
             evals[:, last + 1:] = evals[:, [last]]
             for arr in extra_hist.values():
                 arr[:, last + 1:] = arr[:, [last]]
         return RunRecord(
-            best_x=x_history[:, -1].copy(), best_f=history[:, -1].copy(), history=history,
-            x_history=x_history, evaluation_history=evals, iterations_done=done_at,
+            best_x=np.array(final_x, dtype=float, copy=True), best_f=history[:, -1].copy(), history=history,
+            x_history=xs, evaluation_history=evals, iterations_done=done_at,
             extras=extra_hist, snapshots=snaps,
         )

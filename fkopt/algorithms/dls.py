@@ -24,10 +24,12 @@ The function the iterations decrease is sum r^2; ``state.f`` is ``problem.fitnes
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, uniform_in
+from .base import Algorithm, Params, State, rows_of, uniform_in
 from .nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, start_points
 
 
@@ -42,6 +44,18 @@ class DLSParams(Params):
                             "fraction of each coordinate's box width")
 
 
+@dataclass(eq=False, kw_only=True)
+class DLSState(State):
+    """The points ``x``/``f`` (runs, n, dim) with their residuals, Jacobians and damping."""
+
+    r: np.ndarray                      # (runs, n, m) residuals
+    J: np.ndarray                      # (runs, n, m, dim) Jacobians
+    S: np.ndarray                      # (runs, n) sum of squared residuals
+    h: np.ndarray                      # (dim,) finite-difference steps (fallback only)
+    lam: np.ndarray                    # (runs, n) damping
+    age: np.ndarray                    # (runs, n) steps since the last (re)start
+
+
 class DLS(Algorithm):
     name = "dls"
     Params = DLSParams
@@ -52,14 +66,14 @@ class DLS(Algorithm):
         r = residuals_of(self, problem, x, square=False)
         return r, jacobian(problem, x, h), (r * r).sum(axis=-1)
 
-    def initialize(self, problem, population, streams, x0):
+    def initialize(self, problem, population, streams, x0, iterations):
         x = start_points(self, problem, population, streams, x0)
         h = jacobian_steps(problem.bounds, self.params.jac_step)
         r, J, S = self._eval(problem, x, h)
         n = x.shape[1]
-        return State(x=x, f=problem.fitness(x), r=r, J=J, S=S, h=h,
-                     lam=np.full(S.shape, self.params.damping), age=np.zeros(S.shape, dtype=np.int64),
-                     evaluations=np.full(streams.runs, n * (1 + jacobian_cost(problem)), dtype=np.int64))
+        return DLSState(x=x, f=problem.fitness(x), r=r, J=J, S=S, h=h,
+                        lam=np.full(S.shape, self.params.damping), age=np.zeros(S.shape, dtype=np.int64),
+                        evaluations=np.full(streams.runs, n * (1 + jacobian_cost(problem)), dtype=np.int64))
 
     def iterate(self, state, problem, streams):
         p = self.params
@@ -74,9 +88,10 @@ class DLS(Algorithm):
         if stuck.any():
             rows, cols = np.nonzero(stuck)
             xs = uniform_in(problem.bounds, u[rows, cols])
-            r, J, S = self._eval(problem, xs, state.h)
+            sub = rows_of(problem, rows)   # a target per batch row when solving several cases
+            r, J, S = self._eval(sub, xs, state.h)
             state.x[rows, cols], state.r[rows, cols], state.J[rows, cols], state.S[rows, cols] = xs, r, J, S
-            state.f[rows, cols] = problem.fitness(xs)
+            state.f[rows, cols] = sub.fitness(xs)
             state.lam[rows, cols], state.age[rows, cols] = p.damping, 0
             evals += np.bincount(rows, minlength=runs) * cost
         act = state.S > p.tol
@@ -101,12 +116,13 @@ class DLS(Algorithm):
                 fixed = np.where(out, (np.clip(xn, lo, hi) - x) / width, fixed)
                 free = np.where(out, 0.0, free)
             xn = np.clip(x + d * width, lo, hi)
-            rn, Jn, Sn = self._eval(problem, xn, state.h)
+            sub = rows_of(problem, rows)
+            rn, Jn, Sn = self._eval(sub, xn, state.h)
             ok = Sn < state.S[rows, cols]
             state.lam[rows, cols] = np.where(ok, np.maximum(lam * p.down, 1e-12), lam * p.up)
             state.age[rows, cols] += 1
             rk, ck = rows[ok], cols[ok]
             state.x[rk, ck], state.r[rk, ck], state.J[rk, ck], state.S[rk, ck] = xn[ok], rn[ok], Jn[ok], Sn[ok]
-            state.f[rk, ck] = problem.fitness(xn[ok])
+            state.f[rk, ck] = rows_of(problem, rk).fitness(xn[ok])
             evals += np.bincount(rows, minlength=runs) * cost
         state.evaluations = state.evaluations + evals

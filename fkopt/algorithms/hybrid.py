@@ -18,17 +18,44 @@ name; the registered classes only fix it.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 from pydantic import Field
 
 from .abc import ABCParams
-from .base import Params
-from .budget import BudgetAware, initialize_for
+from .base import Algorithm, Params, State
 from .gabc import GABCParams
-from .lm import LMCore, LMParams
+from .lm import LMCore, LMParams, LMState
 from .pso import PSOParams
+
+
+def _swarm_field(name: str) -> property:
+    def get(self):
+        return getattr(self.swarm, name)
+
+    def set(self, value):
+        setattr(self.swarm, name, value)
+    return property(get, set, doc=f"the swarm state's ``{name}``")
+
+
+@dataclass(eq=False, kw_only=True)
+class HybridState:
+    """The swarm's own state, then LM's; ``x``, ``f``, ``evaluations`` and the best-so-far are
+    the swarm state's (the LM point is written into its best memory slot)."""
+
+    swarm: State                       # the swarm algorithm's state
+    iteration: int = 0                 # iterations done
+    switch: int = 0                    # last swarm iteration
+    lm: LMState | None = None          # LM state, from the first LM iteration on
+    lm_slot: np.ndarray | None = None  # (runs,) memory slot holding the LM point
+
+    x = _swarm_field("x")
+    f = _swarm_field("f")
+    evaluations = _swarm_field("evaluations")
+    best_x = _swarm_field("best_x")
+    best_f = _swarm_field("best_f")
 
 
 class HybridParams(Params):
@@ -38,7 +65,7 @@ class HybridParams(Params):
                                          "before LM polishes; overrides swarm_fraction")
 
 
-class SwarmLM(BudgetAware):
+class SwarmLM(Algorithm):
     """Generic swarm-then-LM hybrid; subclasses set ``swarm`` (a registry name) and ``Params``."""
 
     swarm: ClassVar[str]
@@ -59,27 +86,24 @@ class SwarmLM(BudgetAware):
             return min(p.swarm_iterations, iterations)
         return int(round(p.swarm_fraction * iterations))
 
-    def initialize(self, problem, population, streams, x0):
-        S = self.swarm_phase(self.budget())
-        state = initialize_for(self.swarm_algorithm, problem, population, streams, x0, max(S, 1))
-        state.hybrid_t = 0
-        state.hybrid_switch = S
-        state.lm_state = None
-        return state
+    def initialize(self, problem, population, streams, x0, iterations):
+        S = self.swarm_phase(iterations)
+        swarm = self.swarm_algorithm.initialize(problem, population, streams, x0, max(S, 1))
+        return HybridState(swarm=swarm, switch=S)
 
     def iterate(self, state, problem, streams):
-        state.hybrid_t += 1
-        if state.hybrid_t <= state.hybrid_switch:
-            self.swarm_algorithm.iterate(state, problem, streams)
+        state.iteration += 1
+        if state.iteration <= state.switch:
+            self.swarm_algorithm.iterate(state.swarm, problem, streams)
             return
         runs = state.f.shape[0]
         rows = np.arange(runs)
-        if state.lm_state is None:
+        if state.lm is None:
             state.lm_slot = np.argmin(state.f, axis=1)
-            state.lm_state, evals = self.lm.start(problem, state.best_x[:, None, :].copy(),
-                                                  state.best_f[:, None].copy())
+            state.lm, evals = self.lm.start(problem, state.best_x[:, None, :].copy(),
+                                            state.best_f[:, None].copy())
             state.evaluations = state.evaluations + evals
-        st = state.lm_state
+        st = state.lm
         state.evaluations = state.evaluations + self.lm.step(st, problem)
         state.x[rows, state.lm_slot] = st.x[:, 0]
         state.f[rows, state.lm_slot] = st.f[:, 0]

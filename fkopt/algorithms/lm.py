@@ -34,10 +34,12 @@ Choices fkopt makes:
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip
+from .base import Algorithm, Params, State, clip, rows_of
 from .nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, scaled_step, start_points
 
 
@@ -53,6 +55,18 @@ class LMParams(Params):
                             "coordinate's box width")
 
 
+@dataclass(eq=False, kw_only=True)
+class LMState(State):
+    """LM's points ``x``/``f`` (runs, n, dim) with residuals, Jacobians and damping."""
+
+    r: np.ndarray                      # (runs, n, m) residuals
+    s: np.ndarray                      # (runs, n) sum of squared residuals
+    J: np.ndarray                      # (runs, n, m, dim) Jacobians
+    h: np.ndarray                      # (dim,) finite-difference steps
+    lam: np.ndarray                    # (runs, n) Marquardt damping
+    active: np.ndarray                 # (runs, n) still stepping
+
+
 def sum_squares(r: np.ndarray) -> np.ndarray:
     return (r * r).sum(axis=-1)
 
@@ -64,7 +78,7 @@ class LMCore:
         self.params = params
         self.algorithm = algorithm
 
-    def start(self, problem, x: np.ndarray, f: np.ndarray | None = None) -> tuple[State, np.ndarray]:
+    def start(self, problem, x: np.ndarray, f: np.ndarray | None = None) -> tuple[LMState, np.ndarray]:
         """LM state for points x (runs, n, dim); returns it and the evaluations used per run."""
         r = residuals_of(self.algorithm, problem, x, square=False)
         if f is None:
@@ -73,11 +87,11 @@ class LMCore:
         J = jacobian(problem, x, h)
         s = sum_squares(r)
         ok = np.isfinite(s) & np.all(np.isfinite(J), axis=(-2, -1))
-        st = State(x=np.array(x, dtype=float), f=np.array(f, dtype=float), r=r, s=s, J=J, h=h,
-                   lam=np.full(s.shape, self.params.damping), active=ok & (f > 0))
+        st = LMState(x=np.array(x, dtype=float), f=np.array(f, dtype=float), r=r, s=s, J=J, h=h,
+                     lam=np.full(s.shape, self.params.damping), active=ok & (f > 0))
         return st, np.full(x.shape[0], x.shape[1] * (1 + jacobian_cost(problem)), dtype=np.int64)
 
-    def step(self, st: State, problem) -> np.ndarray:
+    def step(self, st: LMState, problem) -> np.ndarray:
         """One trial step of every active point; returns evaluations used per run."""
         p = self.params
         act = st.active.copy()
@@ -93,12 +107,12 @@ class LMCore:
         M = A + (lam[:, None] * D)[..., None] * np.eye(A.shape[-1])
         d = -np.linalg.solve(M, g[..., None])[..., 0]
         x_try = clip(x + d, problem.bounds)
-        r_try = np.asarray(problem.residuals(x_try), dtype=float)
+        rows, cols = np.nonzero(act)
+        r_try = np.asarray(rows_of(problem, rows).residuals(x_try), dtype=float)
         s_try = sum_squares(r_try)
         accept = np.isfinite(s_try) & (s_try < st.s[act])
         lam = np.where(accept, np.maximum(lam * p.down, p.lambda_min), lam * p.up)
         small = accept & (scaled_step(x_try - x, problem.bounds) < p.tol)
-        rows, cols = np.nonzero(act)
         evals = np.bincount(rows, minlength=runs).astype(np.int64)
         if accept.any():
             rows, cols = rows[accept], cols[accept]
@@ -106,8 +120,9 @@ class LMCore:
             st.x[rows, cols] = xa
             st.r[rows, cols] = r_try[accept]
             st.s[rows, cols] = s_try[accept]
-            st.f[rows, cols] = problem.fitness(xa)
-            st.J[rows, cols] = jacobian(problem, xa, st.h)
+            sub = rows_of(problem, rows)
+            st.f[rows, cols] = sub.fitness(xa)
+            st.J[rows, cols] = jacobian(sub, xa, st.h)
             evals += np.bincount(rows, minlength=runs) * jacobian_cost(problem)
         st.lam[act] = lam
         finite_J = np.all(np.isfinite(st.J[act]), axis=(-2, -1))
@@ -125,7 +140,7 @@ class LM(Algorithm):
         super().__init__(**params)
         self.core = LMCore(self.params, self)
 
-    def initialize(self, problem, population, streams, x0):
+    def initialize(self, problem, population, streams, x0, iterations):
         x = start_points(self, problem, population, streams, x0)
         st, evals = self.core.start(problem, x)
         st.evaluations = evals

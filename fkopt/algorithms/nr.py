@@ -14,8 +14,9 @@ Choices fkopt makes (the paper prints none of them):
   of all points are evaluated in one ``residuals`` call, h_j = ``jac_step`` * (box width of
   coordinate j) (default 1e-6 of the width: central
   differences err by O(h^2), rounding by O(eps |r| / h), both far below what Newton needs).
-* Start points: ``x0`` given as one point (dim,) is used by every run; as (n, dim) row k is
-  the start of run k (rows are indexed by run id, so batch and one-run-at-a-time modes agree).
+* Start points: ``x0`` given as one point (dim,) is used by every run; as (runs, dim) row k is
+  the start of row k of the batch (:func:`fkopt.solve` maps run ids and cases to rows, so batch
+  and one-run-at-a-time modes agree).
   With ``x0`` the population is ignored (one point per run). Without ``x0`` every run starts
   from ``population`` points drawn uniformly in the box from its stream (a seeded multi-start;
   the run's answer is its best point). A start outside ``problem.bounds`` is an FkoptError.
@@ -37,11 +38,13 @@ Choices fkopt makes (the paper prints none of them):
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from pydantic import Field
 
 from ..errors import FkoptError
-from .base import Algorithm, Params, State, clip, uniform_in
+from .base import Algorithm, Params, State, clip, rows_of, uniform_in
 
 
 # -- helpers shared with lm.py and hybrid.py -------------------------------------------------
@@ -53,12 +56,11 @@ def start_points(algorithm: Algorithm, problem, population: int, streams, x0) ->
     x0 = np.asarray(x0, dtype=float)
     if x0.ndim == 1:
         x = np.broadcast_to(x0, (streams.runs, dim))
-    elif x0.ndim == 2:
-        ids = np.asarray(streams.run_ids)
-        if ids.size and ids.max() >= x0.shape[0]:
-            raise FkoptError(f"{algorithm.name}: x0 has {x0.shape[0]} start points (rows are indexed "
-                             f"by run id), run {int(ids.max())} has none")
-        x = x0[ids]
+    elif x0.ndim == 2:   # one start per row of the batch (fkopt.solve maps run ids/cases to rows)
+        if x0.shape[0] != streams.runs:
+            raise FkoptError(f"{algorithm.name}: x0 has {x0.shape[0]} start points for a batch of "
+                             f"{streams.runs} runs")
+        x = x0
     else:
         raise FkoptError(f"{algorithm.name}: x0 must be one point ({dim},) or one per run (runs, {dim}); "
                          f"got shape {x0.shape}")
@@ -128,6 +130,17 @@ def scaled_step(d: np.ndarray, bounds: np.ndarray) -> np.ndarray:
 
 
 # -- Newton-Raphson ------------------------------------------------------------------------
+@dataclass(eq=False, kw_only=True)
+class NRState(State):
+    """Newton's points ``x``/``f`` (runs, n, dim) with their residuals and Jacobians."""
+
+    r: np.ndarray                      # (runs, n, m) residuals
+    J: np.ndarray                      # (runs, n, m, dim) Jacobians
+    h: np.ndarray                      # (dim,) finite-difference steps
+    active: np.ndarray                 # (runs, n) still stepping
+    singular: np.ndarray               # (runs, n) frozen at a singular Jacobian
+
+
 class NRParams(Params):
     tol: float = Field(1e-12, ge=0, description="stop a point when max_j |step_j| / width_j < tol")
     jac_step: float = Field(1e-6, gt=0, description="finite-difference step as a fraction of each "
@@ -148,7 +161,7 @@ class NR(Algorithm):
         s = np.linalg.svd(np.where(ok[..., None, None], J, 0.0), compute_uv=False)
         return ~ok | ~(s[..., -1] > self.params.rcond * s[..., 0])
 
-    def initialize(self, problem, population, streams, x0):
+    def initialize(self, problem, population, streams, x0, iterations):
         x = start_points(self, problem, population, streams, x0)
         r = residuals_of(self, problem, x, square=True)
         f = problem.fitness(x)
@@ -163,8 +176,8 @@ class NR(Algorithm):
                              f"{streams.run_ids[k]}; choose another x0")
         active = (f > 0) & ~singular & np.isfinite(f)
         n = x.shape[1]
-        return State(x=x, f=f, r=r, J=J, h=h, active=active, singular=singular,
-                     evaluations=np.full(streams.runs, n * (1 + jacobian_cost(problem)), dtype=np.int64))
+        return NRState(x=x, f=f, r=r, J=J, h=h, active=active, singular=singular,
+                       evaluations=np.full(streams.runs, n * (1 + jacobian_cost(problem)), dtype=np.int64))
 
     def extras(self, state):
         return {"singular": state.singular.any(axis=1).astype(float)}
@@ -179,9 +192,10 @@ class NR(Algorithm):
         x_new = x_old + d
         if self.params.clip:
             x_new = clip(x_new, problem.bounds)
-        r_new = np.asarray(problem.residuals(x_new), dtype=float)
-        f_new = problem.fitness(x_new)
-        J_new = jacobian(problem, x_new, state.h)
+        sub = rows_of(problem, np.nonzero(act)[0])
+        r_new = np.asarray(sub.residuals(x_new), dtype=float)
+        f_new = sub.fitness(x_new)
+        J_new = jacobian(sub, x_new, state.h)
         ok = np.isfinite(f_new) & np.all(np.isfinite(r_new), axis=-1)
         singular = self._singular(J_new) & ok & (f_new > 0)
         small = scaled_step(x_new - x_old, problem.bounds) < self.params.tol

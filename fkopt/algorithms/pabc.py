@@ -16,12 +16,14 @@ scout) in the ABC phase; ``state.evaluations`` counts each phase exactly.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, fields
+
 import numpy as np
 from pydantic import Field
 
-from .abc import ABC, ABCParams
-from .budget import BudgetAware, initialize_for
-from .pso import PSO, PSOParams
+from .abc import ABC, ABCParams, ABCState
+from .base import Algorithm
+from .pso import PSO, PSOParams, PSOState
 
 
 class PABCParams(PSOParams, ABCParams):
@@ -29,7 +31,15 @@ class PABCParams(PSOParams, ABCParams):
                           "before switching to ABC (chang2024: 0.5)")
 
 
-class PABC(BudgetAware):
+@dataclass(eq=False, kw_only=True)
+class PABCState(PSOState, ABCState):
+    """Both a PSO and an ABC state: PSO advances it first, ABC (trial counters) after the switch."""
+
+    iteration: int = 0                 # iterations done
+    switch: int = 0                    # last PSO iteration
+
+
+class PABC(Algorithm):
     name = "pabc"
     Params = PABCParams
     reconstruction = ("chang2024's P-ABC equations were lost in extraction; PSO then ABC seeded "
@@ -45,18 +55,16 @@ class PABC(BudgetAware):
     def switch_iteration(self, iterations: int) -> int:
         return int(round(self.params.switch * iterations))
 
-    def initialize(self, problem, population, streams, x0):
-        p = self.switch_iteration(self.budget())
-        state = initialize_for(self.pso, problem, population, streams, x0, max(p, 1))
-        state.pabc_t = 0
-        state.pabc_switch = p
-        state.trial = np.zeros(state.f.shape, dtype=np.int64)
-        state.limit = self.abc.params.limit or population * problem.dim
-        return state
+    def initialize(self, problem, population, streams, x0, iterations):
+        p = self.switch_iteration(iterations)
+        pso = self.pso.initialize(problem, population, streams, x0, max(p, 1))
+        return PABCState(**{f.name: getattr(pso, f.name) for f in fields(pso)}, switch=p,
+                         trial=np.zeros(pso.f.shape, dtype=np.int64),
+                         limit=self.abc.params.limit or population * problem.dim)
 
     def iterate(self, state, problem, streams):
-        state.pabc_t += 1
-        if state.pabc_t <= state.pabc_switch:
+        state.iteration += 1
+        if state.iteration <= state.switch:
             self.pso.iterate(state, problem, streams)
         else:
             self.abc.iterate(state, problem, streams)

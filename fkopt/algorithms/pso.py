@@ -30,13 +30,13 @@ Choices fkopt makes where the papers are silent:
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from pydantic import Field
 
-from .base import Params, State, clip, uniform_in
-from .budget import BudgetAware
+from .base import Algorithm, Params, State, clip, uniform_in
 
 
 class PSOParams(Params):
@@ -53,7 +53,17 @@ class PSOParams(Params):
                                          "each coordinate's box width (used when v_max is None)")
 
 
-class PSO(BudgetAware):
+@dataclass(eq=False, kw_only=True)
+class PSOState(State):
+    """PSO's personal bests ``x``/``f``, current positions and velocities, iteration counter."""
+
+    pos: np.ndarray                    # (runs, population, dim) current positions
+    vel: np.ndarray                    # (runs, population, dim) velocities
+    t: int = 0                         # iterations done
+    span: int | None = None            # iterations of the linear inertia schedule
+
+
+class PSO(Algorithm):
     name = "pso"
     Params = PSOParams
     evaluations_per_iteration = "population"
@@ -68,29 +78,38 @@ class PSO(BudgetAware):
             return p.v_max_fraction * width
         return np.full(width.shape, np.inf)
 
-    def initialize(self, problem, population, streams, x0):
+    def initialize(self, problem, population, streams, x0, iterations):
         x = uniform_in(problem.bounds, streams.uniform(population, problem.dim))
         f = problem.fitness(x)
-        span = self.budget() if self.params.inertia == "linear" else None
-        return State(x=x, f=f, pos=x.copy(), vel=np.zeros_like(x), pso_t=0, pso_span=span,
-                     evaluations=np.full(streams.runs, population, dtype=np.int64))
+        span = int(iterations) if self.params.inertia == "linear" else None
+        return PSOState(x=x, f=f, pos=x.copy(), vel=np.zeros_like(x), span=span,
+                        evaluations=np.full(streams.runs, population, dtype=np.int64))
 
     def inertia_weight(self, state) -> float:
         p = self.params
         if p.inertia == "constant":
             return p.w
-        return p.w_max - (p.w_max - p.w_min) * min(state.pso_t, state.pso_span) / state.pso_span
+        return p.w_max - (p.w_max - p.w_min) * min(state.t, state.span) / state.span
 
     def iterate(self, state, problem, streams):
         p = self.params
-        state.pso_t += 1
+        state.t += 1
         runs, population, dim = state.x.shape
-        r = streams.uniform(2, population, dim)
+        r = streams.uniform(2, population, dim)     # a fresh view: ours to overwrite
         g = state.best_x[:, None, :]
-        vel = (self.inertia_weight(state) * state.vel + p.c1 * r[:, 0] * (state.x - state.pos)
-               + p.c2 * r[:, 1] * (g - state.pos))
+        # w v + c1 r1 (p - x) + c2 r2 (g - x), the same operations in the same order, in place
+        cognitive, social = r[:, 0], r[:, 1]
+        cognitive *= p.c1
+        diff = np.subtract(state.x, state.pos)
+        cognitive *= diff
+        vel = np.multiply(state.vel, self.inertia_weight(state))
+        vel += cognitive
+        social *= p.c2
+        np.subtract(g, state.pos, out=diff)
+        social *= diff
+        vel += social
         limit = self.velocity_limit(problem.bounds)
-        vel = np.clip(vel, -limit, limit)
+        np.clip(vel, -limit, limit, out=vel)
         moved = state.pos + vel
         pos = clip(moved, problem.bounds)
         state.vel = np.where(pos != moved, 0.0, vel)

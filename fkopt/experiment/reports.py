@@ -68,7 +68,7 @@ def summary_table(er: ExperimentResult) -> pd.DataFrame:
             "threshold": thr,
         }
         if thr is not None:
-            row["success_rate"] = float(np.mean(r.success(thr)))
+            row["success_rate"] = float(np.mean(r.succeeded(thr)))
             row["median_iterations_to_threshold"] = _nanmedian(r.iterations_to(thr))
             row["median_evaluations_to_threshold"] = _nanmedian(r.evaluations_to(thr))
         for k, v in spec.printed.items():

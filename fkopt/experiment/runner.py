@@ -3,7 +3,9 @@
 Seeds: the (case, algorithm) task with case index c and algorithm label L gets the integer
 seed ``SeedSequence([seed, c, crc32(L)]).generate_state(1)[0]`` and its run k the k-th child
 stream of that (see :mod:`fkopt.streams`). Reordering algorithms in a file or running one
-algorithm alone therefore reproduces the same numbers.
+algorithm alone therefore reproduces the same numbers -- and so does batching: each algorithm
+solves all cases of the experiment in one :func:`fkopt.solve` call (cases x runs rows), passing
+these per-case seeds, and the result is sliced back into one record per (case, algorithm).
 """
 from __future__ import annotations
 
@@ -18,7 +20,7 @@ from .. import registry
 from ..errors import FkoptError
 from ..problems import fk_problem
 from ..rotations import wrap_degrees
-from ..solve import Result, make_algorithm, solve
+from ..solve import CHUNK_POINTS, MEMORY_LIMIT, Result, batch_bytes, make_algorithm, solve
 from .config import AlgorithmSpec, ExperimentConfig, RandomCases
 from .timing import time_single_runs
 
@@ -161,34 +163,66 @@ def validate_experiment(config: ExperimentConfig):
             x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
             _check_in_bounds(mech, x0, f"algorithms[{spec.key}].start")
     problems = [build_problem(config, mech, c) for c in cases]
+    keep_x = "variables" in config.figures or mech.kind == "serial"
+    for spec in config.algorithms:       # a batch that cannot fit in memory fails here, not midway
+        pop, its = spec.population or config.population, spec.iterations or config.iterations
+        rows = len(cases) * config.runs
+        need = batch_bytes(rows, max(1, CHUNK_POINTS // pop) if config.batch else 1, pop, its,
+                           len(mech.unknown_names), len(config.snapshots), keep_x)
+        if need > MEMORY_LIMIT:
+            raise FkoptError(f"algorithms[{spec.key}]: {len(cases)} cases x {config.runs} runs x {its} "
+                             f"iterations need about {need / 1e9:.1f} GB, more than the limit of "
+                             f"{MEMORY_LIMIT / 1e9:.1f} GB; lower runs, iterations or the number of cases")
     return mech, cases, problems
+
+
+def batched_problem(config: ExperimentConfig, mech, cases: list[Case]):
+    """One problem with a case axis holding every case's inputs (see :mod:`fkopt.problems`)."""
+    inputs = np.stack([c.inputs for c in cases])
+    kwargs = {"objective": config.objective} if config.objective else {}
+    if mech.kind == "serial":
+        from ..problems import ik_problem
+        return ik_problem(mech, inputs, **kwargs)
+    return fk_problem(mech, inputs, **kwargs)
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
                    source: str | None = None) -> ExperimentResult:
-    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each."""
+    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each.
+
+    Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
+    each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
+    """
     mech, cases, problems = validate_experiment(config)
+    one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
+    batched = problems[0] if one else batched_problem(config, mech, cases)
+    keep_x = "variables" in config.figures or mech.kind == "serial"   # variables.png, position error
     records: list[TaskRecord] = []
     total = len(cases) * len(config.algorithms)
     start_all = time.perf_counter()
-    for case, problem in zip(cases, problems):
-        for spec in config.algorithms:
-            algo = make_algorithm(spec.name, spec.params)
-            seed = task_seed(config.seed, case.index, spec.key)
-            x0 = (mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
-                  if spec.start is not None else None)
-            start = time.perf_counter()
-            result = solve(problem, algo, population=spec.population or config.population,
-                           iterations=spec.iterations or config.iterations, runs=config.runs, seed=seed,
-                           target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
-                           batch=config.batch, snapshots=config.snapshots)
-            wall = time.perf_counter() - start
-            outputs = outputs_of(mech, result.x)
-            pos_hist = None
-            if hasattr(problem, "position_error"):
-                pos_hist = problem.position_error(result.x_history)
-            records.append(TaskRecord(case, spec, problem, result, seed, wall, outputs, pos_hist))
+    by_algorithm: list[list[TaskRecord]] = []
+    for spec in config.algorithms:
+        algo = make_algorithm(spec.name, spec.params)
+        seeds = [task_seed(config.seed, case.index, spec.key) for case in cases]
+        x0 = (mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
+              if spec.start is not None else None)
+        start = time.perf_counter()
+        result = solve(batched, algo, population=spec.population or config.population,
+                       iterations=spec.iterations or config.iterations, runs=config.runs,
+                       seed=seeds[0] if one else seeds,
+                       target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
+                       batch=config.batch, snapshots=config.snapshots, x_history=keep_x)
+        wall = (time.perf_counter() - start) / len(cases)     # amortised over the cases
+        recs = []
+        for i, (case, problem) in enumerate(zip(cases, problems)):
+            r = result if one else result.case(i)
+            pos_hist = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
+            recs.append(TaskRecord(case, spec, problem, r, seeds[i], wall, outputs_of(mech, r.x), pos_hist))
             if progress:
-                progress(f"{case.label} / {spec.key}", len(records), total)
+                progress(f"{case.label} / {spec.key}", len(records) + len(recs), total)
+        records += recs
+        by_algorithm.append(recs)
+    # case-major order, as the reports expect (every algorithm of case 1, then case 2, ...)
+    records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
     time_single_runs(config, records)
     return ExperimentResult(config, mech, cases, records, time.perf_counter() - start_all, source)

@@ -42,9 +42,9 @@ NOTES = [
     "v(t): no inertia weight (w = 1) and no constants. `pso_eq10` runs that form (w = 1, c1 = c2 = 2 as "
     "in Kennedy & Eberhart 1995, velocity clamp 0.2 x box width, without which w = 1 diverges) beside "
     "fkopt's constriction PSO.",
-    "**Budget:** runs and random poses of each experiment are in its header below (the paper: 50 runs, "
-    "100 poses); `baselines` reruns the first runs of Tab. 3 exactly (same seed) beside "
-    "Levenberg-Marquardt and ABC+LM.",
+    "**Budgets as in the paper:** Tab. 3 50 runs; Fig. 7 100 random reachable poses with 1 run each "
+    "(all poses of an algorithm in one batched solve). `baselines` reruns the first 10 runs of Tab. 3 "
+    "exactly (same seed) beside Levenberg-Marquardt and ABC+LM.",
     "\"Iterations to best\" is the first iteration at which a run's final best-so-far fitness was "
     "reached (`iterations_to_best` in runs.csv); swarms that still improve by tiny steps at the end "
     "get values near 500. \"Time to best\" (TIMING.md) is each timed single run's time scaled by "

@@ -25,7 +25,7 @@ import os
 import re
 import shutil
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Callable
@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import FkoptError
 from ..files import output_folder, write_atomically, write_json_atomically
 from ..experiment.runner import build_mechanism, task_seed
-from ..problems import fk_problem
+from ..problems import BoxedProblem, fk_problem
 from ..solve import make_algorithm, solve
 from .config import StudyAlgorithmSpec, StudyConfig
 from .poses import PoseSet, build_poses
@@ -153,27 +153,44 @@ def _empty(task: Task) -> dict:
 
 
 def _independent(config, mech, poses: PoseSet, spec, task: Task) -> dict:
+    """Every pose of the chunk in one solve (poses x runs rows), each pose with its own seed."""
     rec = _empty(task)
-    x0 = start_point(spec, mech)
-    budget = _budget(config, spec)
-    for i in range(task.start, task.stop):
-        problem = make_problem(config, mech, poses.inputs[i])
-        seed = task_seed(config.seed, i, spec.key)
-        t0 = time.perf_counter()
-        r = solve(problem, make_algorithm(spec.name, spec.params), runs=config.runs, seed=seed, x0=x0, **budget)
-        rec["seeds"].append(seed)
-        _collect(rec, r, config.threshold, time.perf_counter() - t0)
+    idx = range(task.start, task.stop)
+    seeds = [task_seed(config.seed, i, spec.key) for i in idx]
+    problem = make_problem(config, mech, poses.inputs[task.start:task.stop])
+    t0 = time.perf_counter()
+    r = solve(problem, make_algorithm(spec.name, spec.params), runs=config.runs, seed=seeds,
+              x0=start_point(spec, mech), **_budget(config, spec))
+    seconds = (time.perf_counter() - t0) / len(seeds)     # amortised over the poses
+    rec["seeds"] = seeds
+    for j in range(len(seeds)):
+        _collect(rec, r.case(j), config.threshold, seconds)
     return rec
 
 
-def _warm_box(mech, prev: np.ndarray, radius: float) -> np.ndarray:
+def _warm_boxes(mech, prev: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per run, the box of +-radius of the workspace around its previous solution, clipped."""
     lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
     half = radius * (hi - lo)
-    return np.column_stack([np.maximum(lo, prev - half), np.minimum(hi, prev + half)])
+    return np.maximum(lo, prev - half), np.minimum(hi, prev + half)
+
+
+def _runs_of(r, x: np.ndarray):
+    """A result of ``runs`` cases x 1 run read as one target with ``runs`` runs."""
+    one = lambda a: None if a is None else a[:, 0]   # noqa: E731
+    return replace(r, x=x, fitness=one(r.fitness), history=one(r.history), x_history=one(r.x_history),
+                   evaluation_history=one(r.evaluation_history), iterations_done=one(r.iterations_done),
+                   time_per_run=one(r.time_per_run), extras={}, snapshots={}, cases=None, seeds=None,
+                   run_ids=np.arange(len(x)))
 
 
 def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
-    """Solve the trajectory in order; each step warm-starts from the previous step's solution."""
+    """Solve the trajectory in order; each step warm-starts from the previous step's solution.
+
+    All runs of a step are one solve. A warm swarm searches a box around each run's previous
+    solution: the runs are then the cases of a :class:`fkopt.problems.BoxedProblem` (one box
+    each), run k drawing from case k's stream ``case_seed(step seed, k)``.
+    """
     rec = _empty(task)
     rec["start"] = []
     algo = make_algorithm(spec.name, spec.params)
@@ -189,42 +206,18 @@ def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
             start = prev if warm else x0
             r = solve(make_problem(config, mech, poses.inputs[t]), algo, runs=runs, seed=seed, x0=start, **budget)
             starts = (np.broadcast_to(start, (runs, dim)) if start is not None else np.full((runs, dim), np.nan))
-        else:   # a swarm searches a small box around each run's previous solution, run by run
-            parts = []
-            for k in range(runs):
-                box = _warm_box(mech, prev[k], config.tracking.radius)
-                problem = make_problem(config, mech, poses.inputs[t], bounds=box)
-                parts.append(solve(problem, algo, runs=1, run_ids=[k], seed=seed, x0=prev[k], **budget))
-            r = _stack(parts)
+        else:
+            lo, hi = _warm_boxes(mech, prev, config.tracking.radius)
+            target = make_problem(config, mech, np.repeat(poses.inputs[t][None], runs, axis=0))
+            boxed = BoxedProblem(target, lo, hi)
+            rb = solve(boxed, algo, runs=1, seed=seed, **budget)
+            r = _runs_of(rb, boxed.to_x(rb.x[:, 0]))
             starts = prev
         rec["seeds"].append(seed)
         rec["start"].append(np.asarray(starts, dtype=float).tolist())
         _collect(rec, r, config.threshold, time.perf_counter() - t0)
         prev = np.array(r.x, dtype=float)
     return rec
-
-
-@dataclass
-class _Stacked:
-    fitness: np.ndarray
-    evaluations: np.ndarray
-    iterations_done: np.ndarray
-    x: np.ndarray
-    to_it: np.ndarray
-    to_ev: np.ndarray
-
-    def iterations_to(self, thr):
-        return self.to_it
-
-    def evaluations_to(self, thr):
-        return self.to_ev
-
-
-def _stack(parts) -> _Stacked:
-    thr = parts[0].target
-    cat = lambda f: np.concatenate([f(p) for p in parts])  # noqa: E731
-    return _Stacked(cat(lambda p: p.fitness), cat(lambda p: p.evaluations), cat(lambda p: p.iterations_done),
-                    cat(lambda p: p.x), cat(lambda p: p.iterations_to(thr)), cat(lambda p: p.evaluations_to(thr)))
 
 
 # -- task files ----------------------------------------------------------------------------------
