@@ -15,7 +15,7 @@ M = fkopt.mechanism("3-rps")
 POSES = np.array([[9.0, 13.0, 622.0], [-17.0, 8.0, 436.0], [4.0, -7.0, 509.0], [-13.0, -19.0, 574.0]])
 JOINTS = M.ik(POSES)
 SEEDS = (11, 2017, 5, 99)
-ALGORITHMS = ("abc", "gabc", "pso", "aco", "pabc", "gabc+lm", "pso+lm", "nr", "lm")
+ALGORITHMS = ("abc", "gabc", "pso", "aco", "pabc", "gabc+lm", "pso+lm", "nr", "lm", "dls")
 BUDGET = dict(population=4, iterations=12, target=1e-3)
 ARRAYS = ("x", "fitness", "history", "evaluation_history", "iterations_done")
 
