@@ -260,8 +260,8 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
     need = batch_bytes(rows, size, int(population), int(iterations), problem.dim, len(snapshots), x_history)
     if need > MEMORY_LIMIT:
         raise FkoptError(f"a batch of {rows} runs ({n_cases} cases x {len(ids)} runs) of {iterations} "
-                         f"iterations needs about {need / 1e9:.1f} GB, more than fkopt's limit of "
-                         f"{MEMORY_LIMIT / 1e9:.1f} GB; solve fewer cases or runs at a time"
+                         f"iterations needs about {need / 2**30:.1f} GiB of memory, more than fkopt's per-solve "
+                         f"limit of {MEMORY_LIMIT / 2**30:.1f} GiB; solve fewer cases or runs at a time"
                          + (", or without x_history" if x_history else ""))
     case_of_row = np.repeat(np.arange(n_cases), len(ids))
     run_of_row = np.tile(ids, n_cases)

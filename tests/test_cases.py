@@ -108,7 +108,7 @@ def test_local_methods_take_a_start_per_case_or_per_case_and_run():
 
 def test_batch_too_large_for_memory_is_refused_before_allocating():
     problem = fkopt.fk_problem(M, np.repeat(JOINTS, 250, axis=0))       # 1000 cases
-    with pytest.raises(FkoptError, match=r"needs about .* GB, more than fkopt's limit"):
+    with pytest.raises(FkoptError, match=r"needs about .* GiB of memory, more than fkopt's per-solve limit"):
         fkopt.solve(problem, "gabc", population=10, iterations=100_000, runs=1000)
 
 

@@ -171,8 +171,8 @@ def validate_experiment(config: ExperimentConfig):
                            len(mech.unknown_names), len(config.snapshots), keep_x)
         if need > MEMORY_LIMIT:
             raise FkoptError(f"algorithms[{spec.key}]: {len(cases)} cases x {config.runs} runs x {its} "
-                             f"iterations need about {need / 1e9:.1f} GB, more than the limit of "
-                             f"{MEMORY_LIMIT / 1e9:.1f} GB; lower runs, iterations or the number of cases")
+                             f"iterations need about {need / 2**30:.1f} GiB of memory, more than fkopt's per-solve "
+                             f"limit of {MEMORY_LIMIT / 2**30:.1f} GiB; lower runs, iterations or the number of cases")
     return mech, cases, problems
 
 
