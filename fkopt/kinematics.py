@@ -25,7 +25,7 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
 
 * step d = J^T (J J^T + mu I)^{-1} (-r) (minimum-norm damped least squares for a redundant
   arm), mu = lambda * trace(J J^T) / 6 with lambda adapted per candidate as in
-  Levenberg-Marquardt (start ``damping`` = 0.3, x ``down`` = 0.1 after a step that decreases
+  Levenberg-Marquardt (start ``damping`` = 0.01, x ``down`` = 0.1 after a step that decreases
   |r|^2, x ``up`` = 10 otherwise); the joint step is capped at ``step_cap`` radians; the
   orientation rows use the angular velocity (the derivative of the rotation vector at zero
   error; ``exact_rotation=True`` applies the inverse left Jacobian of SO(3) -- measured: the
@@ -36,16 +36,25 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   removed, and the remaining joints re-solved for the residual left over (up to 3 passes) -- the
   redundancy absorbs the saturation instead of the step being clipped;
 * optional secondary objective in the null space of the task, ``rest`` > 0: pull every joint
-  towards mid-range, d += (I - J^+ J) z with z = rest (mid - q) / half-range^2 and J^+ the damped
-  pseudo-inverse above (off by default: it slows convergence to the task);
-* seeded random restarts: a candidate that has not converged after ``iterations`` (12) steps, or
-  stalls (lambda above 1e6), restarts from joints uniform inside the limits, drawn from
-  a counter-based hash of (seed, row index, draw number), at most ``restarts`` times. A batch
-  of N < ``fill`` rows starts with ``fill // N`` candidates per row (``start``, or mid-range,
-  and random ones: a single pose is solved from 32 starts side by side), and whenever fewer
-  than ``fill`` candidates remain, every unsolved row gets more at once. These restarts are
-  inverse's global stage (seeded random restarts of a local method with limits, rather than a
-  swarm). Same poses and seed give the same answer; a row's answer may differ between batches.
+  towards mid-range, d += (I - J^+ J) z with z = g rest (mid - q) / half-range^2, J^+ the
+  pseudo-inverse (damped by 1e-9 trace(J J^T) / 6) and g = min(1, |r|) fading the pull below
+  1 length unit of residual, so that a finite null-space step does not keep the task from
+  converging (off by default);
+* starts from a table: ``table`` (4096) joint configurations drawn uniformly inside the limits
+  by a fixed hash (not the seed), indexed by a k-d tree over their tool position and
+  reach / (3 sqrt 2) times their rotation matrix entries (1 rad weighs about a third of the
+  reach); a row's starts are ``start`` (when given), then the table's configurations nearest to
+  its target (``starts`` of them plus ``neighbours`` more for restarts), then seeded random draws
+  inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
+  1000 random reachable poses: about 80 % of nearest-configuration starts converge against
+  about 60 % of mid-range or random ones;
+* restarts: a candidate that has not converged after ``iterations`` (10) steps, or stalls
+  (lambda above 1e6), restarts in place from its row's next start, at most ``restarts`` times
+  per row; a solved row retires all its candidates at once. A batch of N < ``fill`` rows starts
+  with ``fill // N`` candidates per row side by side, and whenever fewer than ``fill``
+  candidates remain, every unsolved row gets more at once. These restarts are inverse's global
+  stage (restarts of a local method with limits, rather than a swarm). Same poses and seed give
+  the same answer; a row's answer may differ between batches.
 
 **Verdicts.** ``solved`` is true only when the closed form of the answer reproduces the input
 within ``tol`` and the answer is inside the bounds: forward, max |ik(pose) - joints| <= ``tol``
@@ -455,6 +464,7 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
 # inverse
 # ----------------------------------------------------------------------------------------------
 _D2R = np.pi / 180.0
+_I6 = np.arange(6)
 
 
 def _zyz_matrix(euler_deg: np.ndarray) -> np.ndarray:
@@ -495,10 +505,35 @@ def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.nd
     return (z >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
 
 
+_TABLES: dict = {}
+
+
+def _start_table(m, size: int):
+    """Joint configurations (size, n) in radians drawn uniformly inside the limits by a fixed
+    hash (independent of ``seed``), their tool features (position, w * rotation matrix
+    entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3) and a k-d tree
+    over them: ``inverse`` starts from the configurations nearest to each target. Cached per
+    arm (name, DH table, limits)."""
+    g = m.geometry
+    key = (m.name, size, repr(g), m.bounds.tobytes())
+    got = _TABLES.get(key)
+    if got is None:
+        from scipy.spatial import cKDTree
+        from .rotations import to_array
+        lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+        tq = lo + (hi - lo) * _uniform_hash(0x5EED, np.arange(size), np.zeros(size, dtype=np.int64), m.dof)
+        p, R = m.frame(np.degrees(tq))
+        wf = m.reach / (3.0 * np.sqrt(2.0))
+        feats = np.concatenate([np.stack(p, axis=-1), wf * to_array(R).reshape(size, 9)], axis=-1)
+        got = _TABLES[key] = (tq, cKDTree(feats), wf)
+    return got
+
+
 def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts: int = 200,
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
-            iterations: int = 12, damping: float = 0.3, step_cap: float = 2.0,
-            down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False) -> InverseResult:
+            iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
+            down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
+            table: int = 4096, neighbours: int = 8) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
@@ -545,25 +580,38 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = np.radians(q0)
     K = max(1, int(starts))
+    if N * K < fill:                                   # small batches: more candidates per row
+        K = max(K, fill // N)
     L = float(orientation_scale) if orientation_scale else reach
     pt, Rt = P[:, :3], _zyz_matrix(P[:, 3:])
-    eye6 = np.eye(6)
-    ev_r = np.zeros(N, dtype=np.int64)
-    ev_j = np.zeros(N, dtype=np.int64)
-    drawn = np.zeros(N, dtype=np.int64)            # random starts drawn per row
-    best_q = np.array(q0, dtype=float)
-    best_m = np.full(N, np.inf)
     to_deg = 180.0 / np.pi
+    budget = K + max(0, int(restarts))                 # starts per row, first ones included
+    # start j of row i: the given start (j = 0, when given or without table), then the
+    # table's configurations nearest to the target, then seeded random draws
+    own0 = 1 if (start is not None or not table) else 0
+    near = np.zeros((N, 0), dtype=np.intp)
+    if table:
+        tq, tree, wf = _start_table(m, int(table))
+        kn = min(int(table), K - own0 + int(neighbours))
+        if kn > 0:
+            _, near = tree.query(np.concatenate([pt, wf * Rt.reshape(N, 9)], axis=-1), k=kn)
+            near = np.asarray(near, dtype=np.intp).reshape(N, kn)
+    nn = near.shape[1]
 
-    # slots: K candidates per row (more when the batch is small), slot s works for row own[s]
-    if N * K < fill:
-        K = max(K, fill // N)
-    own = np.repeat(np.arange(N), K)
-    q = np.repeat(q0, K, axis=0)
-    if K > 1:
-        rnd = np.flatnonzero(np.arange(N * K) % K > 0)
-        q[rnd] = lo + (hi - lo) * _uniform_hash(seed, own[rnd], drawn[own[rnd]] + (np.arange(N * K)[rnd] % K) - 1, n)
-        drawn += K - 1
+    def starts_for(rows, j):
+        qs = np.empty((len(rows), n))
+        a = j < own0
+        if a.any():
+            qs[a] = q0[rows[a]]
+        b = (j >= own0) & (j < own0 + nn)
+        if b.any():
+            qs[b] = tq[near[rows[b], j[b] - own0]]
+        c = j >= own0 + nn
+        if c.any():
+            qs[c] = lo + (hi - lo) * _uniform_hash(seed, rows[c], j[c] - own0 - nn, n)
+        return qs
+
+    evaluated: list[np.ndarray] = []
 
     def evaluate(qa, rows):
         p, R, J = m.frame_jacobian(qa * to_deg)
@@ -578,115 +626,144 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         J[:, 3:] *= L
         return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
 
-    evaluated: list[np.ndarray] = []
+    best_q = np.array(q0, dtype=float)
+    best_m = np.full(N, np.inf)
+    done = np.zeros(N, dtype=bool)
+    used = np.full(N, K, dtype=np.int64)               # starts used per row
 
     def fold(sl):
         """Fold slots ``sl`` into the best answer of their rows (smallest merit wins)."""
         merit = np.maximum(pe[sl] / tp, re[sl] / tr)
-        order = np.lexsort((merit, own[sl]))
+        o = own[sl]
+        order = np.lexsort((merit, o))
         first = np.ones(len(sl), dtype=bool)
-        first[1:] = own[sl][order[1:]] != own[sl][order[:-1]]
+        first[1:] = o[order[1:]] != o[order[:-1]]
         top = order[first]
-        better = merit[top] < best_m[own[sl][top]]
-        rows = own[sl][top[better]]
-        best_q[rows], best_m[rows] = q[sl][top[better]], merit[top[better]]
+        better = merit[top] < best_m[o[top]]
+        rows = o[top[better]]
+        best_q[rows], best_m[rows] = q[sl[top[better]]], merit[top[better]]
 
+    def rank_in_row(rows):
+        """0, 1, ... for repeated entries of ``rows`` (in order of appearance)."""
+        order = np.argsort(rows, kind="stable")
+        srt = rows[order]
+        newgrp = np.ones(len(rows), dtype=bool)
+        newgrp[1:] = srt[1:] != srt[:-1]
+        first = np.maximum.accumulate(np.where(newgrp, np.arange(len(rows)), 0))
+        rank = np.empty(len(rows), dtype=np.int64)
+        rank[order] = np.arange(len(rows)) - first
+        return rank
+
+    # slots: candidates side by side, slot s works for row own[s]
+    own = np.repeat(np.arange(N), K)
+    q = starts_for(own, np.tile(np.arange(K), N))
     r, J, pe, re = evaluate(q, own)
-    lam = np.full(len(q), damping)
     S = _sumsq(r)
+    lam = np.full(len(q), damping)
     age = np.zeros(len(q), dtype=np.int64)
-    done = np.zeros(N, dtype=bool)
+    fresh = np.zeros(len(q), dtype=bool)               # restarted: q set, r and J not yet
     with np.errstate(all="ignore"):
-        while len(own):
-            # -- bookkeeping: best per row, finished rows, stuck slots ------------------------
-            conv = (pe <= tp) & (re <= tr)
+        while True:
+            # -- bookkeeping: solved rows retire, stuck slots restart in place ----------------
+            conv = (pe <= tp) & (re <= tr) & ~fresh
             if conv.any():
                 cs = np.flatnonzero(conv)
-                best_q[own[cs]], best_m[own[cs]] = q[cs], np.maximum(pe[cs] / tp, re[cs] / tr)
+                fold(cs)
                 done[own[cs]] = True
-            stuck = ~done[own] & ((age >= iterations) | (lam > 1e6))
-            if stuck.any():                            # seeded random restarts (budget per row)
-                sl = np.flatnonzero(stuck)
-                fold(sl)
-                rows = own[sl]
-                cnt = np.zeros(N, dtype=np.int64)
-                _, inv, counts = np.unique(rows, return_inverse=True, return_counts=True)
-                rank = np.empty(len(sl), dtype=np.int64)
-                order_sl = np.argsort(rows, kind="stable")
-                starts_of = np.concatenate([[0], np.cumsum(counts)[:-1]])
-                rank[order_sl] = np.arange(len(sl)) - np.repeat(starts_of, counts)
-                k = drawn[rows] + rank
-                ok = k < restarts + (K - 1)
-                sl, rows, k = sl[ok], rows[ok], k[ok]
-                np.add.at(cnt, rows, 1)
-                drawn += cnt
+            stuck = ((age >= iterations) | (lam > 1e6)) & ~fresh
+            if conv.any() or stuck.any():
+                live = ~done[own]
+                sl = np.flatnonzero(stuck & live)
                 if len(sl):
-                    q[sl] = lo + (hi - lo) * _uniform_hash(seed, rows, k, n)
-                    r[sl], J[sl], pe[sl], re[sl] = evaluate(q[sl], rows)
-                    S[sl] = _sumsq(r[sl])
-                    lam[sl], age[sl] = damping, 0
-            keep = ~done[own] & (age < iterations) & (lam <= 1e6)
-            if not keep.all():
-                fold(np.flatnonzero(~keep & ~done[own]))
-                own, q, r, J, pe, re, lam, S, age = (a[keep] for a in (own, q, r, J, pe, re, lam, S, age))
+                    fold(sl)
+                    rows = own[sl]
+                    j = used[rows] + rank_in_row(rows)
+                    ok = j < budget
+                    np.add.at(used, rows[ok], 1)
+                    live[sl[~ok]] = False
+                    sl, rows, j = sl[ok], rows[ok], j[ok]
+                    q[sl] = starts_for(rows, j)
+                    fresh[sl] = True
+                if not live.all():
+                    own, q, r, J, pe, re, lam, S, age, fresh = (
+                        a[live] for a in (own, q, r, J, pe, re, lam, S, age, fresh))
             if len(own) < fill:                        # few rows left: give each more candidates
-                rows_left = np.unique(own)
+                rows_left = np.flatnonzero(~done & (used < budget))
                 extra = (fill - len(own)) // max(len(rows_left), 1)
-                if extra > 0:
-                    give = np.minimum(extra, restarts + (K - 1) - drawn[rows_left])
-                    rows = np.repeat(rows_left, np.maximum(give, 0))
-                    if len(rows):
-                        k = drawn[rows] + (np.arange(len(rows)) - np.repeat(np.cumsum(np.maximum(give, 0)) - np.maximum(give, 0), np.maximum(give, 0)))
-                        drawn[rows_left] += np.maximum(give, 0)
-                        qa = lo + (hi - lo) * _uniform_hash(seed, rows, k, n)
-                        ra, Ja, pa, rea = evaluate(qa, rows)
-                        own = np.concatenate([own, rows])
-                        q, r, J = np.concatenate([q, qa]), np.concatenate([r, ra]), np.concatenate([J, Ja])
-                        pe, re = np.concatenate([pe, pa]), np.concatenate([re, rea])
-                        lam = np.concatenate([lam, np.full(len(rows), damping)])
-                        S = np.concatenate([S, _sumsq(ra)])
-                        age = np.concatenate([age, np.zeros(len(rows), dtype=np.int64)])
+                if extra > 0 and len(rows_left):
+                    give = np.minimum(extra, budget - used[rows_left])
+                    rows = np.repeat(rows_left, give)
+                    j = used[rows] + rank_in_row(rows)
+                    used[rows_left] += give
+                    k = len(rows)
+                    own = np.concatenate([own, rows])
+                    q = np.concatenate([q, starts_for(rows, j)])
+                    r, J = np.concatenate([r, np.empty((k, 6))]), np.concatenate([J, np.empty((k, 6, n))])
+                    pe, re = np.concatenate([pe, np.empty(k)]), np.concatenate([re, np.empty(k)])
+                    lam, S = np.concatenate([lam, np.empty(k)]), np.concatenate([S, np.empty(k)])
+                    age = np.concatenate([age, np.empty(k, dtype=np.int64)])
+                    fresh = np.concatenate([fresh, np.ones(k, dtype=bool)])
             if not len(own):
                 break
             # -- one damped least-squares step with saturation in the null space --------------
-            Jt_ = np.swapaxes(J, 1, 2)
-            mu = lam * (J * J).sum(axis=(1, 2)) / 6.0       # damping scaled to J
-            A = J @ Jt_
-            A[:, range(6), range(6)] += mu[:, None]
-            d = (Jt_ @ np.linalg.solve(A, -r[..., None]))[..., 0]
+            anyfresh = fresh.any()
+            st = np.flatnonzero(~fresh) if anyfresh else slice(None)
+            Js, rs, qs = J[st], r[st], q[st]
+            Jt_ = np.swapaxes(Js, 1, 2)
+            A = Js @ Jt_
+            tr6 = np.trace(A, axis1=1, axis2=2) * (1.0 / 6.0)
+            if rest > 0:                               # projector onto the null space of J
+                # fading as |r| drops below 1 length unit: at the end the task alone converges
+                z = (rest * np.minimum(1.0, np.sqrt(S[st])))[:, None] * (mid - qs) / (half * half)
+                A[:, _I6, _I6] += 1e-9 * tr6[:, None]
+                dz = z - (Jt_ @ np.linalg.solve(A, Js @ z[..., None]))[..., 0]
+                A[:, _I6, _I6] -= 1e-9 * tr6[:, None]
+            mu = lam[st] * tr6                         # damping scaled to J
+            A[:, _I6, _I6] += mu[:, None]
+            d = (Jt_ @ np.linalg.solve(A, -rs[..., None]))[..., 0]
             if rest > 0:
-                z = rest * (mid - q) / (half * half)
-                d += z - (Jt_ @ np.linalg.solve(A, J @ z[..., None]))[..., 0]
+                d += dz
             d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
-            qn = q + d
+            qn = qs + d
             out = (qn < lo) | (qn > hi)
-            if out.any():
-                free = (~out).astype(float)
-                fixed = np.where(out, np.clip(qn, lo, hi) - q, 0.0)
+            sat = np.flatnonzero(out.any(axis=-1))
+            if len(sat):                               # saturation in the null space, those rows only
+                Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
+                free = (~outv).astype(float)
+                fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
                 for _ in range(2):
-                    Jf = J * free[:, None, :]
-                    rr = r + (J @ fixed[..., None])[..., 0]
-                    A = Jf @ np.swapaxes(Jf, 1, 2)
-                    A[:, range(6), range(6)] += mu[:, None]
-                    d = (np.swapaxes(Jf, 1, 2) @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
-                    qn = q + d
-                    out = ((qn < lo) | (qn > hi)) & (free > 0)
-                    if not out.any():
+                    Jf = Jv * free[:, None, :]
+                    rr = rv + (Jv @ fixed[..., None])[..., 0]
+                    Jft = np.swapaxes(Jf, 1, 2)
+                    A = Jf @ Jft
+                    A[:, _I6, _I6] += muv[:, None]
+                    qv2 = qv + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
+                    outv = ((qv2 < lo) | (qv2 > hi)) & (free > 0)
+                    if not outv.any():
                         break
-                    fixed = np.where(out, np.clip(qn, lo, hi) - q, fixed)
-                    free = np.where(out, 0.0, free)
-                qn = np.clip(qn, lo, hi)
-            rt, Jn, pet, ret = evaluate(qn, own)
+                    fixed = np.where(outv, np.clip(qv2, lo, hi) - qv, fixed)
+                    free = np.where(outv, 0.0, free)
+                qn[sat] = np.clip(qv2, lo, hi)
+            # -- evaluate the trial points and the restarted slots in one call ----------------
+            if anyfresh:
+                qe = q.copy()
+                qe[st] = qn
+            else:
+                qe = qn
+            rt, Jn, pet, ret = evaluate(qe, own)
             St = _sumsq(rt)
-            ok = St < S
+            ok = (St < S) | fresh
             lam = np.where(ok, np.maximum(lam * down, 1e-12), lam * up)
-            q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qn[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
             age += 1
-    if len(own):
-        fold(np.arange(len(own)))
-    if evaluated:
-        ev_r += np.bincount(np.concatenate(evaluated), minlength=N)
-        ev_j[:] = ev_r
+            if anyfresh:
+                lam[fresh], age[fresh] = damping, 0
+                fresh[:] = False
+            if ok.all():
+                q, r, J, pe, re, S = qe, rt, Jn, pet, ret, St
+            else:
+                q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qe[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
+    ev_r = np.bincount(np.concatenate(evaluated), minlength=N).astype(np.int64)
+    ev_j = ev_r.copy()
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
     qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])
@@ -699,6 +776,6 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         mechanism=m.name, names=tuple(m.joint_names), joints=qd.reshape(shape + (n,)),
         position_error=perr.reshape(shape), rotation_error=rerr.reshape(shape),
         residual=np.maximum(perr / tp, rerr / tr).reshape(shape), solved=ok.reshape(shape),
-        restarts=np.maximum(drawn - (K - 1), 0).reshape(shape),
+        restarts=(used - K).reshape(shape),
         evaluations={"residual": ev_r.reshape(shape), "jacobian": ev_j.reshape(shape)},
         tol=(tp, tr))
