@@ -11,7 +11,9 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
    differences for a mechanism without one), from ``start`` or the centre of the bounds. A step
    that does not decrease |r|^2 is halved (up to 10 times); steps are capped at a quarter of the
    box width per coordinate. At most 30 iterations. A single row takes the same iteration with
-   scalar tests (its cost is numpy's per-call overhead).
+   scalar tests (its cost is numpy's per-call overhead), on Python floats throughout when the
+   mechanism has ``ik_jacobian1`` (6-SPS: the same formulas per leg) and a 6x6 Gaussian
+   elimination with partial pivoting.
 2. Rows not solved restart the same Newton from a few deterministic starts: the centre moved by
    +-1/4 of the box width along each coordinate (2 n starts), all rows at once.
 3. Rows still not solved go to a seeded global search, one row at a time: ``gabc+lm``
@@ -77,6 +79,7 @@ Jacobian counted as one) to ``residual``.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -362,6 +365,87 @@ def _newton1(res: _Residuals, x: np.ndarray, ftol: float, evals, iterations: int
     return x[None], np.array([rmax if np.isfinite(rmax) else np.inf])
 
 
+def _solve_small(A, b):
+    """x with A x = b for a small dense system on Python floats (Gaussian elimination with
+    partial pivoting; lists are not modified). None when singular or not finite."""
+    n = len(b)
+    M = [row[:] + [b[i]] for i, row in enumerate(A)]
+    for k in range(n):
+        piv, best = k, abs(M[k][k])
+        for i in range(k + 1, n):
+            a = abs(M[i][k])
+            if a > best:
+                piv, best = i, a
+        if not best > 1e-300:
+            return None
+        if piv != k:
+            M[k], M[piv] = M[piv], M[k]
+        Mk = M[k]
+        inv = 1.0 / Mk[k]
+        for i in range(k + 1, n):
+            Mi = M[i]
+            f = Mi[k] * inv
+            if f != 0.0:
+                for j in range(k + 1, n + 1):
+                    Mi[j] -= f * Mk[j]
+    x = [0.0] * n
+    for k in range(n - 1, -1, -1):
+        Mk = M[k]
+        acc = Mk[n]
+        for j in range(k + 1, n):
+            acc -= Mk[j] * x[j]
+        x[k] = acc / Mk[k]
+    if not all(map(math.isfinite, x)):
+        return None
+    return x
+
+
+def _newton_scalar(m, x, L, ftol, evals, iterations: int = 30, halvings: int = 10):
+    """:func:`_newton1` on Python floats with the mechanism's ``ik_jacobian1`` (one pose, no
+    angle joints): the same iteration (Newton step capped at a quarter of the box width,
+    halved until |r|^2 decreases, stop at max |r| <= ftol or when no halving decreases it).
+    Returns (x (1, n), max |r| (1,)), or None when a Jacobian is singular (the caller then
+    runs :func:`_newton1`)."""
+    rj = m.ik_jacobian1
+    cap = [4.0 / (hi - lo) for lo, hi in m.bounds.tolist()]
+    x = [float(v) for v in x]
+    L = [float(v) for v in L]
+    v, J = rj(x)
+    r = [a - b for a, b in zip(v, L)]
+    F = sum(a * a for a in r)
+    calls = 1
+    for _ in range(iterations):
+        rmax = max(map(abs, r))
+        if not rmax > ftol:
+            break
+        d = _solve_small(J, r)
+        if d is None:
+            evals[0][0] += calls
+            evals[1][0] += calls
+            return None
+        big = max(abs(a) * c for a, c in zip(d, cap))
+        if big > 1.0:
+            d = [a / big for a in d]
+        step, moved = 1.0, False
+        for _ in range(halvings + 1):
+            xt = [a - step * b for a, b in zip(x, d)]
+            vt, Jt = rj(xt)
+            calls += 1
+            rt = [a - b for a, b in zip(vt, L)]
+            Ft = sum(a * a for a in rt)
+            if Ft < F:
+                moved = True
+                break
+            step *= 0.5
+        if not moved:
+            break
+        x, r, J, F = xt, rt, Jt, Ft
+    evals[0][0] += calls
+    evals[1][0] += calls
+    rmax = max(map(abs, r))
+    return np.array([x]), np.array([rmax if math.isfinite(rmax) else np.inf])
+
+
 def _verify(mechanism, L, x, resid, tol):
     """Angle variables moved by multiples of 360 deg into the bounds (when possible), and the
     verdict: (x, max |ik(x) - L| with angle joints wrapped, solved). ``resid`` is the residual
@@ -417,7 +501,12 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
     ftol = 0.01 * tol
     all_rows = np.arange(N)
     with np.errstate(all="ignore"):
-        if N == 1:
+        got = None
+        if N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any():
+            got = _newton_scalar(m, x0[0], L[0], ftol, evals)
+        if got is not None:
+            x, rx = got
+        elif N == 1:
             x, rx = _newton1(res, np.array(x0[0], dtype=float), ftol, evals)
         else:
             x, rx = _newton(res, x0, all_rows, ftol, evals)
