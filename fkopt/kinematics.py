@@ -50,6 +50,10 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
   1000 random reachable poses: about 80 % of nearest-configuration starts converge against
   about 60 % of mid-range or random ones;
+* one pose (N = 1, ``rest`` = 0, no ``exact_rotation``) runs the same iteration on Python
+  floats (the arm's ``frame_jacobian1``, Cholesky solves of the 6x6 systems), its candidates
+  one after another in the order of its starts, stopping at the first that converges: numpy's
+  per-call overhead is most of the cost of the batched loop on a few rows;
 * restarts: a candidate that has not converged after ``iterations`` (10) steps, or stalls
   (lambda above 1e6), restarts in place from its row's next start, at most ``restarts`` times
   per row; a solved row retires all its candidates at once. A batch of N < ``fill`` rows starts
@@ -81,6 +85,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from operator import mul
 
 import numpy as np
 
@@ -400,6 +405,37 @@ def _solve_small(A, b):
     return x
 
 
+def _cholesky_solve(A, b):
+    """x with A x = b for a small symmetric positive definite A on Python floats (Cholesky;
+    lists are not modified). None when A is not positive definite or x not finite."""
+    n = len(b)
+    Lc = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        Li = Lc[i]
+        Ai = A[i]
+        for j in range(i + 1):
+            Lj = Lc[j]
+            acc = Ai[j] - sum(map(mul, Li[:j], Lj[:j]))
+            if i == j:
+                if not acc > 0.0:
+                    return None
+                Li[i] = math.sqrt(acc)
+            else:
+                Li[j] = acc / Lj[j]
+    y = [0.0] * n
+    for i in range(n):
+        y[i] = (b[i] - sum(map(mul, Lc[i][:i], y[:i]))) / Lc[i][i]
+    x = [0.0] * n
+    for i in range(n - 1, -1, -1):
+        acc = y[i]
+        for k in range(i + 1, n):
+            acc -= Lc[k][i] * x[k]
+        x[i] = acc / Lc[i][i]
+    if not all(map(math.isfinite, x)):
+        return None
+    return x
+
+
 def _newton_scalar(m, x, L, ftol, evals, iterations: int = 30, halvings: int = 10):
     """:func:`_newton1` on Python floats with the mechanism's ``ik_jacobian1`` (one pose, no
     angle joints): the same iteration (Newton step capped at a quarter of the box width,
@@ -594,6 +630,102 @@ def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.nd
     return (z >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
 
 
+def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping, down, up,
+                    step_cap, lo, hi):
+    """The damped least-squares iteration of :func:`inverse` for one pose on Python floats
+    (the arm's ``frame_jacobian1``, 6x6 eliminations), candidates one after another in the
+    order of ``start_of(j)``: the same step, damping update, saturation in the null space and
+    restart rule as the batched loop. For one pose numpy's per-call overhead is most of the
+    cost of the batched loop. Returns (best joints (n,) radians, starts used, evaluations)."""
+    n = m.dof
+    fj = m.frame_jacobian1
+    t0, t1, t2 = (float(v) for v in pt)
+    T = [[float(v) for v in row] for row in Rt]
+    lo, hi = lo.tolist(), hi.tolist()
+    evals = 0
+
+    def evaluate(q):
+        p, R, J = fj(q)
+        M = [[R[i][0] * T[j][0] + R[i][1] * T[j][1] + R[i][2] * T[j][2] for j in range(3)] for i in range(3)]
+        v0, v1, v2 = M[2][1] - M[1][2], M[0][2] - M[2][0], M[1][0] - M[0][1]
+        s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+        c = 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)
+        k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
+        e0, e1, e2 = v0 * k, v1 * k, v2 * k
+        d0, d1, d2 = p[0] - t0, p[1] - t1, p[2] - t2
+        r = [d0, d1, d2, L * e0, L * e1, L * e2]
+        for row in J[3:]:
+            for i in range(n):
+                row[i] *= L
+        return (r, J, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
+                d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
+
+    def dls(J, r, mu, fixed=None):
+        """d = Jf^T (Jf Jf^T + mu I)^{-1} (-r), Jf = J without the columns in ``fixed``."""
+        if fixed:
+            J = [[0.0 if i in fixed else v for i, v in enumerate(row)] for row in J]
+        A = [[0.0] * 6 for _ in range(6)]
+        for a in range(6):
+            Ja = J[a]
+            for b in range(a, 6):
+                A[a][b] = A[b][a] = sum(map(mul, Ja, J[b]))
+            A[a][a] += mu
+        y = _cholesky_solve(A, [-v for v in r])
+        if y is None:
+            return None
+        return [sum(map(mul, col, y)) for col in zip(*J)]
+
+    best_q, best_m = None, math.inf
+    allc = list(range(n))
+    for j in range(budget):
+        q = start_of(j)
+        r, J, pe, re, S = evaluate(q)
+        evals += 1
+        lam = damping
+        for _ in range(iterations):
+            if pe <= tp and re <= tr:
+                break
+            tr6 = sum(v * v for row in J for v in row) / 6.0
+            mu = lam * tr6
+            d = dls(J, r, mu)
+            if d is None:
+                break
+            big = max(map(abs, d))
+            if big > step_cap:
+                d = [v * (step_cap / big) for v in d]
+            qn = [a + b for a, b in zip(q, d)]
+            out = [i for i in allc if qn[i] < lo[i] or qn[i] > hi[i]]
+            if out:                                    # saturation in the null space
+                fixed = {}
+                for _ in range(2):
+                    for i in out:
+                        fixed[i] = min(max(qn[i], lo[i]), hi[i]) - q[i]
+                    rr = [r[a] + sum(J[a][i] * f for i, f in fixed.items()) for a in range(6)]
+                    ds = dls(J, rr, mu, fixed)
+                    if ds is None:
+                        break
+                    qn = [q[i] + (fixed[i] if i in fixed else ds[i]) for i in allc]
+                    out = [i for i in allc if i not in fixed and (qn[i] < lo[i] or qn[i] > hi[i])]
+                    if not out:
+                        break
+                qn = [min(max(v, a), b) for v, a, b in zip(qn, lo, hi)]
+            rn, Jn, pen, ren, Sn = evaluate(qn)
+            evals += 1
+            if Sn < S:
+                q, r, J, pe, re, S = qn, rn, Jn, pen, ren, Sn
+                lam = max(lam * down, 1e-12)
+            else:
+                lam *= up
+                if lam > 1e6:
+                    break
+        merit = max(pe / tp, re / tr)
+        if merit < best_m:
+            best_q, best_m = q, merit
+        if pe <= tp and re <= tr:
+            return np.array(best_q), j + 1, evals
+    return np.array(best_q), budget, evals
+
+
 _TABLES: dict = {}
 
 
@@ -715,144 +847,155 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         J[:, 3:] *= L
         return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
 
-    best_q = np.array(q0, dtype=float)
-    best_m = np.full(N, np.inf)
-    done = np.zeros(N, dtype=bool)
-    used = np.full(N, K, dtype=np.int64)               # starts used per row
+    if N == 1 and rest <= 0 and not exact_rotation and hasattr(m, "frame_jacobian1"):
+        def start_of(j):
+            return starts_for(np.zeros(1, dtype=np.intp), np.array([j]))[0].tolist()
 
-    def fold(sl):
-        """Fold slots ``sl`` into the best answer of their rows (smallest merit wins)."""
-        merit = np.maximum(pe[sl] / tp, re[sl] / tr)
-        o = own[sl]
-        order = np.lexsort((merit, o))
-        first = np.ones(len(sl), dtype=bool)
-        first[1:] = o[order[1:]] != o[order[:-1]]
-        top = order[first]
-        better = merit[top] < best_m[o[top]]
-        rows = o[top[better]]
-        best_q[rows], best_m[rows] = q[sl[top[better]]], merit[top[better]]
+        bq, nused, ne = _inverse_scalar(m, pt[0], Rt[0], L, start_of, budget, tp, tr, iterations,
+                                        damping, down, up, step_cap, lo, hi)
+        best_q, used = bq[None], np.array([nused], dtype=np.int64)
+        K = 1                                          # restarts: starts after the first
+        ev_r = np.array([ne], dtype=np.int64)
+        ev_j = ev_r.copy()
+    else:
+        best_q = np.array(q0, dtype=float)
+        best_m = np.full(N, np.inf)
+        done = np.zeros(N, dtype=bool)
+        used = np.full(N, K, dtype=np.int64)               # starts used per row
 
-    def rank_in_row(rows):
-        """0, 1, ... for repeated entries of ``rows`` (in order of appearance)."""
-        order = np.argsort(rows, kind="stable")
-        srt = rows[order]
-        newgrp = np.ones(len(rows), dtype=bool)
-        newgrp[1:] = srt[1:] != srt[:-1]
-        first = np.maximum.accumulate(np.where(newgrp, np.arange(len(rows)), 0))
-        rank = np.empty(len(rows), dtype=np.int64)
-        rank[order] = np.arange(len(rows)) - first
-        return rank
+        def fold(sl):
+            """Fold slots ``sl`` into the best answer of their rows (smallest merit wins)."""
+            merit = np.maximum(pe[sl] / tp, re[sl] / tr)
+            o = own[sl]
+            order = np.lexsort((merit, o))
+            first = np.ones(len(sl), dtype=bool)
+            first[1:] = o[order[1:]] != o[order[:-1]]
+            top = order[first]
+            better = merit[top] < best_m[o[top]]
+            rows = o[top[better]]
+            best_q[rows], best_m[rows] = q[sl[top[better]]], merit[top[better]]
 
-    # slots: candidates side by side, slot s works for row own[s]
-    own = np.repeat(np.arange(N), K)
-    q = starts_for(own, np.tile(np.arange(K), N))
-    r, J, pe, re = evaluate(q, own)
-    S = _sumsq(r)
-    lam = np.full(len(q), damping)
-    age = np.zeros(len(q), dtype=np.int64)
-    fresh = np.zeros(len(q), dtype=bool)               # restarted: q set, r and J not yet
-    with np.errstate(all="ignore"):
-        while True:
-            # -- bookkeeping: solved rows retire, stuck slots restart in place ----------------
-            conv = (pe <= tp) & (re <= tr) & ~fresh
-            if conv.any():
-                cs = np.flatnonzero(conv)
-                fold(cs)
-                done[own[cs]] = True
-            stuck = ((age >= iterations) | (lam > 1e6)) & ~fresh
-            if conv.any() or stuck.any():
-                live = ~done[own]
-                sl = np.flatnonzero(stuck & live)
-                if len(sl):
-                    fold(sl)
-                    rows = own[sl]
-                    j = used[rows] + rank_in_row(rows)
-                    ok = j < budget
-                    np.add.at(used, rows[ok], 1)
-                    live[sl[~ok]] = False
-                    sl, rows, j = sl[ok], rows[ok], j[ok]
-                    q[sl] = starts_for(rows, j)
-                    fresh[sl] = True
-                if not live.all():
-                    own, q, r, J, pe, re, lam, S, age, fresh = (
-                        a[live] for a in (own, q, r, J, pe, re, lam, S, age, fresh))
-            if len(own) < fill:                        # few rows left: give each more candidates
-                rows_left = np.flatnonzero(~done & (used < budget))
-                extra = (fill - len(own)) // max(len(rows_left), 1)
-                if extra > 0 and len(rows_left):
-                    give = np.minimum(extra, budget - used[rows_left])
-                    rows = np.repeat(rows_left, give)
-                    j = used[rows] + rank_in_row(rows)
-                    used[rows_left] += give
-                    k = len(rows)
-                    own = np.concatenate([own, rows])
-                    q = np.concatenate([q, starts_for(rows, j)])
-                    r, J = np.concatenate([r, np.empty((k, 6))]), np.concatenate([J, np.empty((k, 6, n))])
-                    pe, re = np.concatenate([pe, np.empty(k)]), np.concatenate([re, np.empty(k)])
-                    lam, S = np.concatenate([lam, np.empty(k)]), np.concatenate([S, np.empty(k)])
-                    age = np.concatenate([age, np.empty(k, dtype=np.int64)])
-                    fresh = np.concatenate([fresh, np.ones(k, dtype=bool)])
-            if not len(own):
-                break
-            # -- one damped least-squares step with saturation in the null space --------------
-            anyfresh = fresh.any()
-            st = np.flatnonzero(~fresh) if anyfresh else slice(None)
-            Js, rs, qs = J[st], r[st], q[st]
-            Jt_ = np.swapaxes(Js, 1, 2)
-            A = Js @ Jt_
-            tr6 = np.trace(A, axis1=1, axis2=2) * (1.0 / 6.0)
-            if rest > 0:                               # projector onto the null space of J
-                # fading as |r| drops below 1 length unit: at the end the task alone converges
-                z = (rest * np.minimum(1.0, np.sqrt(S[st])))[:, None] * (mid - qs) / (half * half)
-                A[:, _I6, _I6] += 1e-9 * tr6[:, None]
-                dz = z - (Jt_ @ np.linalg.solve(A, Js @ z[..., None]))[..., 0]
-                A[:, _I6, _I6] -= 1e-9 * tr6[:, None]
-            mu = lam[st] * tr6                         # damping scaled to J
-            A[:, _I6, _I6] += mu[:, None]
-            d = (Jt_ @ np.linalg.solve(A, -rs[..., None]))[..., 0]
-            if rest > 0:
-                d += dz
-            d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
-            qn = qs + d
-            out = (qn < lo) | (qn > hi)
-            sat = np.flatnonzero(out.any(axis=-1))
-            if len(sat):                               # saturation in the null space, those rows only
-                Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
-                free = (~outv).astype(float)
-                fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
-                for _ in range(2):
-                    Jf = Jv * free[:, None, :]
-                    rr = rv + (Jv @ fixed[..., None])[..., 0]
-                    Jft = np.swapaxes(Jf, 1, 2)
-                    A = Jf @ Jft
-                    A[:, _I6, _I6] += muv[:, None]
-                    qv2 = qv + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
-                    outv = ((qv2 < lo) | (qv2 > hi)) & (free > 0)
-                    if not outv.any():
-                        break
-                    fixed = np.where(outv, np.clip(qv2, lo, hi) - qv, fixed)
-                    free = np.where(outv, 0.0, free)
-                qn[sat] = np.clip(qv2, lo, hi)
-            # -- evaluate the trial points and the restarted slots in one call ----------------
-            if anyfresh:
-                qe = q.copy()
-                qe[st] = qn
-            else:
-                qe = qn
-            rt, Jn, pet, ret = evaluate(qe, own)
-            St = _sumsq(rt)
-            ok = (St < S) | fresh
-            lam = np.where(ok, np.maximum(lam * down, 1e-12), lam * up)
-            age += 1
-            if anyfresh:
-                lam[fresh], age[fresh] = damping, 0
-                fresh[:] = False
-            if ok.all():
-                q, r, J, pe, re, S = qe, rt, Jn, pet, ret, St
-            else:
-                q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qe[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
-    ev_r = np.bincount(np.concatenate(evaluated), minlength=N).astype(np.int64)
-    ev_j = ev_r.copy()
+        def rank_in_row(rows):
+            """0, 1, ... for repeated entries of ``rows`` (in order of appearance)."""
+            order = np.argsort(rows, kind="stable")
+            srt = rows[order]
+            newgrp = np.ones(len(rows), dtype=bool)
+            newgrp[1:] = srt[1:] != srt[:-1]
+            first = np.maximum.accumulate(np.where(newgrp, np.arange(len(rows)), 0))
+            rank = np.empty(len(rows), dtype=np.int64)
+            rank[order] = np.arange(len(rows)) - first
+            return rank
+
+        # slots: candidates side by side, slot s works for row own[s]
+        own = np.repeat(np.arange(N), K)
+        q = starts_for(own, np.tile(np.arange(K), N))
+        r, J, pe, re = evaluate(q, own)
+        S = _sumsq(r)
+        lam = np.full(len(q), damping)
+        age = np.zeros(len(q), dtype=np.int64)
+        fresh = np.zeros(len(q), dtype=bool)               # restarted: q set, r and J not yet
+        with np.errstate(all="ignore"):
+            while True:
+                # -- bookkeeping: solved rows retire, stuck slots restart in place ----------------
+                conv = (pe <= tp) & (re <= tr) & ~fresh
+                if conv.any():
+                    cs = np.flatnonzero(conv)
+                    fold(cs)
+                    done[own[cs]] = True
+                stuck = ((age >= iterations) | (lam > 1e6)) & ~fresh
+                if conv.any() or stuck.any():
+                    live = ~done[own]
+                    sl = np.flatnonzero(stuck & live)
+                    if len(sl):
+                        fold(sl)
+                        rows = own[sl]
+                        j = used[rows] + rank_in_row(rows)
+                        ok = j < budget
+                        np.add.at(used, rows[ok], 1)
+                        live[sl[~ok]] = False
+                        sl, rows, j = sl[ok], rows[ok], j[ok]
+                        q[sl] = starts_for(rows, j)
+                        fresh[sl] = True
+                    if not live.all():
+                        own, q, r, J, pe, re, lam, S, age, fresh = (
+                            a[live] for a in (own, q, r, J, pe, re, lam, S, age, fresh))
+                if len(own) < fill:                        # few rows left: give each more candidates
+                    rows_left = np.flatnonzero(~done & (used < budget))
+                    extra = (fill - len(own)) // max(len(rows_left), 1)
+                    if extra > 0 and len(rows_left):
+                        give = np.minimum(extra, budget - used[rows_left])
+                        rows = np.repeat(rows_left, give)
+                        j = used[rows] + rank_in_row(rows)
+                        used[rows_left] += give
+                        k = len(rows)
+                        own = np.concatenate([own, rows])
+                        q = np.concatenate([q, starts_for(rows, j)])
+                        r, J = np.concatenate([r, np.empty((k, 6))]), np.concatenate([J, np.empty((k, 6, n))])
+                        pe, re = np.concatenate([pe, np.empty(k)]), np.concatenate([re, np.empty(k)])
+                        lam, S = np.concatenate([lam, np.empty(k)]), np.concatenate([S, np.empty(k)])
+                        age = np.concatenate([age, np.empty(k, dtype=np.int64)])
+                        fresh = np.concatenate([fresh, np.ones(k, dtype=bool)])
+                if not len(own):
+                    break
+                # -- one damped least-squares step with saturation in the null space --------------
+                anyfresh = fresh.any()
+                st = np.flatnonzero(~fresh) if anyfresh else slice(None)
+                Js, rs, qs = J[st], r[st], q[st]
+                Jt_ = np.swapaxes(Js, 1, 2)
+                A = Js @ Jt_
+                tr6 = np.trace(A, axis1=1, axis2=2) * (1.0 / 6.0)
+                if rest > 0:                               # projector onto the null space of J
+                    # fading as |r| drops below 1 length unit: at the end the task alone converges
+                    z = (rest * np.minimum(1.0, np.sqrt(S[st])))[:, None] * (mid - qs) / (half * half)
+                    A[:, _I6, _I6] += 1e-9 * tr6[:, None]
+                    dz = z - (Jt_ @ np.linalg.solve(A, Js @ z[..., None]))[..., 0]
+                    A[:, _I6, _I6] -= 1e-9 * tr6[:, None]
+                mu = lam[st] * tr6                         # damping scaled to J
+                A[:, _I6, _I6] += mu[:, None]
+                d = (Jt_ @ np.linalg.solve(A, -rs[..., None]))[..., 0]
+                if rest > 0:
+                    d += dz
+                d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
+                qn = qs + d
+                out = (qn < lo) | (qn > hi)
+                sat = np.flatnonzero(out.any(axis=-1))
+                if len(sat):                               # saturation in the null space, those rows only
+                    Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
+                    free = (~outv).astype(float)
+                    fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
+                    for _ in range(2):
+                        Jf = Jv * free[:, None, :]
+                        rr = rv + (Jv @ fixed[..., None])[..., 0]
+                        Jft = np.swapaxes(Jf, 1, 2)
+                        A = Jf @ Jft
+                        A[:, _I6, _I6] += muv[:, None]
+                        qv2 = qv + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
+                        outv = ((qv2 < lo) | (qv2 > hi)) & (free > 0)
+                        if not outv.any():
+                            break
+                        fixed = np.where(outv, np.clip(qv2, lo, hi) - qv, fixed)
+                        free = np.where(outv, 0.0, free)
+                    qn[sat] = np.clip(qv2, lo, hi)
+                # -- evaluate the trial points and the restarted slots in one call ----------------
+                if anyfresh:
+                    qe = q.copy()
+                    qe[st] = qn
+                else:
+                    qe = qn
+                rt, Jn, pet, ret = evaluate(qe, own)
+                St = _sumsq(rt)
+                ok = (St < S) | fresh
+                lam = np.where(ok, np.maximum(lam * down, 1e-12), lam * up)
+                age += 1
+                if anyfresh:
+                    lam[fresh], age[fresh] = damping, 0
+                    fresh[:] = False
+                if ok.all():
+                    q, r, J, pe, re, S = qe, rt, Jn, pet, ret, St
+                else:
+                    q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qe[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
+        ev_r = np.bincount(np.concatenate(evaluated), minlength=N).astype(np.int64)
+        ev_j = ev_r.copy()
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
     qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])

@@ -175,3 +175,25 @@ def test_forward_one_pose_matches_the_batch():
         assert one.solved and one.residual <= 1e-9
         np.testing.assert_allclose(one.pose, batch.pose[k], atol=1e-8)
         assert one.evaluations["residual"] == one.evaluations["jacobian"] > 0
+
+
+def test_arm_scalar_frame_jacobian_matches_the_vectorised_one():
+    m = fkopt.mechanism("7dof-arm")
+    Q = random_poses(m, 20, seed=10)
+    p, R, J = m.frame_jacobian(Q)
+    for q, pp, RR, JJ in zip(Q, p, R, J):
+        p1, R1, J1 = m.frame_jacobian1(np.radians(q).tolist())
+        np.testing.assert_allclose(p1, pp, atol=1e-9)
+        np.testing.assert_allclose(R1, RR, atol=1e-12)
+        np.testing.assert_allclose(np.radians(J1), JJ, atol=1e-12)   # per radian -> per degree
+
+
+def test_inverse_one_pose_solves_within_limits_and_is_seeded():
+    m = fkopt.mechanism("7dof-arm")
+    P = m.fk(random_poses(m, 6, seed=11))
+    for k in range(6):
+        r = fkopt.inverse(m, P[k], seed=3)
+        assert r.solved and m.in_bounds(r.joints, tol=0.0)
+        assert r.position_error <= 1e-6 and r.rotation_error <= 1e-6
+        np.testing.assert_array_equal(fkopt.inverse(m, P[k], seed=3).joints, r.joints)
+        assert r.evaluations["residual"] == r.evaluations["jacobian"] > 0

@@ -20,6 +20,7 @@ Products are written elementwise (no matmul), so results are bit-identical for a
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -106,6 +107,7 @@ class DHArm(SerialMechanism):
         self._ca = tuple(float(np.cos(np.radians(v))) for v in g.alpha)
         self._sa = tuple(float(np.sin(np.radians(v))) for v in g.alpha)
         self._offset = tuple(float(v) for v in (g.theta_offset or [0.0] * n))
+        self._offset_rad = tuple(math.radians(v) for v in self._offset)
 
     @property
     def dof(self) -> int:
@@ -188,6 +190,36 @@ class DHArm(SerialMechanism):
         J[:, 3], J[:, 4], J[:, 5] = zx, zy, zz
         J *= np.pi / 180.0
         return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
+
+    def frame_jacobian1(self, t) -> tuple[list[float], list[list[float]], list[list[float]]]:
+        """:meth:`frame_jacobian` of one configuration on Python floats, joint angles ``t`` in
+        **radians** (n floats, offsets added here): position (3), rotation (3 rows of 3) and
+        the frame Jacobian per **radian** (6 rows of n), the recursion of
+        :meth:`_frame_jacobian_columns`. For one configuration numpy's per-call overhead is
+        most of the cost; ``fkopt.inverse`` on one pose uses this."""
+        x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+        p0 = p1 = p2 = 0.0
+        axes, origins = [], []
+        for ti, off, ca, sa, a, d in zip(t, self._offset_rad, self._ca, self._sa, self._a, self._d):
+            c, s_ = math.cos(ti + off), math.sin(ti + off)
+            axes.append((z0, z1, z2))
+            origins.append((p0, p1, p2))
+            u0, u1, u2 = x0 * c + y0 * s_, x1 * c + y1 * s_, x2 * c + y2 * s_
+            v0, v1, v2 = y0 * c - x0 * s_, y1 * c - x1 * s_, y2 * c - x2 * s_
+            p0, p1, p2 = p0 + (u0 * a + z0 * d), p1 + (u1 * a + z1 * d), p2 + (u2 * a + z2 * d)
+            x0, x1, x2 = u0, u1, u2
+            y0, y1, y2, z0, z1, z2 = (v0 * ca + z0 * sa, v1 * ca + z1 * sa, v2 * ca + z2 * sa,
+                                      z0 * ca - v0 * sa, z1 * ca - v1 * sa, z2 * ca - v2 * sa)
+        J = [[], [], [], [], [], []]
+        for (a0, a1, a2), (o0, o1, o2) in zip(axes, origins):
+            d0, d1, d2 = p0 - o0, p1 - o1, p2 - o2
+            J[0].append(a1 * d2 - a2 * d1)
+            J[1].append(a2 * d0 - a0 * d2)
+            J[2].append(a0 * d1 - a1 * d0)
+            J[3].append(a0)
+            J[4].append(a1)
+            J[5].append(a2)
+        return [p0, p1, p2], [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]], J
 
     def _dh_parts(self):
         """Constant (n, 4, 4) parts C0, C1, C2 with A_i = C0 + cos(theta) C1 + sin(theta) C2."""
