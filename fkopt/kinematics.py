@@ -56,9 +56,10 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   per-call overhead is most of the cost of the batched loop on a few rows;
 * restarts: a candidate that has not converged after ``iterations`` (10) steps, or stalls
   (lambda above 1e6), restarts in place from its row's next start, at most ``restarts`` times
-  per row; a solved row retires all its candidates at once. A batch of N < ``fill`` rows starts
-  with ``fill // N`` candidates per row side by side, and whenever fewer than ``fill``
-  candidates remain, every unsolved row gets more at once. These restarts are inverse's global
+  per row; a solved row retires all its candidates at once. A batch of N < ``fill`` (32) rows
+  starts with ``fill // N`` candidates per row side by side, and whenever fewer than ``tail``
+  (128) candidates remain, every unsolved row gets more at once (the last hard rows then try
+  many starts per iteration instead of a few per iteration for many iterations). These restarts are inverse's global
   stage (restarts of a local method with limits, rather than a swarm). Same poses and seed give
   the same answer; a row's answer may differ between batches.
 
@@ -754,7 +755,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
-            table: int = 4096, neighbours: int = 8) -> InverseResult:
+            table: int = 4096, neighbours: int = 8, tail: int = 128) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
@@ -919,9 +920,9 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     if not live.all():
                         own, q, r, J, pe, re, lam, S, age, fresh = (
                             a[live] for a in (own, q, r, J, pe, re, lam, S, age, fresh))
-                if len(own) < fill:                        # few rows left: give each more candidates
+                if len(own) < tail:                        # few rows left: give each more candidates
                     rows_left = np.flatnonzero(~done & (used < budget))
-                    extra = (fill - len(own)) // max(len(rows_left), 1)
+                    extra = (tail - len(own)) // max(len(rows_left), 1)
                     if extra > 0 and len(rows_left):
                         give = np.minimum(extra, budget - used[rows_left])
                         rows = np.repeat(rows_left, give)
