@@ -457,11 +457,22 @@ def bench_kinematics(rows: _Rows, quick: bool, rng, messages: list[str]) -> None
     ni = 200 if quick else 1000
     Q = _uniform(arm.bounds, (ni,), rng)
     P = arm.fk(Q)
+    kinematics._TABLES.clear()
     t = time.perf_counter()
-    inv = kinematics.inverse(arm, P, seed=0)
-    us = (time.perf_counter() - t) / ni * 1e6
+    kinematics.inverse(arm, P[:64], seed=0)              # warm-up: builds the start table
+    rows.add(sec, "7dof-arm inverse first call (64 poses)", (time.perf_counter() - t) * 1e3, "ms",
+             "includes building the 4096-configuration start table and its k-d tree, and importing "
+             "scipy.spatial (once per process; a single pose needs neither scipy nor the tree)")
+    reps = 1 if quick else 3
+    best = np.inf
+    for _ in range(reps):
+        t = time.perf_counter()
+        inv = kinematics.inverse(arm, P, seed=0)
+        best = min(best, time.perf_counter() - t)
+    us = best / ni * 1e6
     ok = (inv.position_error <= 0.1) & (inv.rotation_error <= 1e-3) & arm.in_bounds(inv.joints, tol=0.0)
-    rows.add(sec, f"7dof-arm inverse batch {ni}", us, "µs/pose", f"target <= 100 µs: {'met' if us <= 100 else 'NOT met'}")
+    rows.add(sec, f"7dof-arm inverse batch {ni}", us, "µs/pose",
+             f"best of {reps} calls; target <= 100 µs: {'met' if us <= 100 else 'NOT met'}")
     rows.add(sec, "7dof-arm inverse solved (0.1 mm, 1e-3 rad)", 100.0 * ok.mean(), "%",
              f"{ni} random reachable poses (fk of random in-limit joints), joints in limits; target >= 99.5 %")
     rows.add(sec, "7dof-arm inverse solved (default tol)", 100.0 * inv.solved.mean(), "%",
@@ -589,8 +600,15 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
-def run(quick: bool = False, peers: bool = False, out="bench") -> pd.DataFrame:
-    """Run the benchmark; print a table, write ``out/bench.csv`` and ``out/scaling.png``."""
+SECTIONS = ("throughput", "mao2017", "peers", "exact", "kinematics", "scaling")
+
+
+def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
+    """Run the benchmark; print a table, write ``out/bench.csv`` and ``out/scaling.png``.
+
+    ``sections``: names from :data:`SECTIONS` to run (default all; ``peers`` also needs
+    ``peers=True`` or its name here). ``scaling.png`` is written only with the scaling section."""
+    want = set(sections or SECTIONS)
     from rich.console import Console
     from rich.table import Table
 
@@ -604,15 +622,19 @@ def run(quick: bool = False, peers: bool = False, out="bench") -> pd.DataFrame:
     messages: list[str] = []
     start = time.perf_counter()
 
-    bench_throughput(rows, quick, rng)
-    per_run = bench_mao2017(rows, quick)
-    if peers:
+    if "throughput" in want:
+        bench_throughput(rows, quick, rng)
+    per_run = bench_mao2017(rows, quick) if ("mao2017" in want or "peers" in want) else {}
+    if peers and "peers" in want:
         bench_peers(rows, quick, per_run.get("gabc"), messages)
-    bench_exact(rows, quick, rng)
-    bench_kinematics(rows, quick, np.random.default_rng(12), messages)
-    bench_cli_process(rows, quick)
-    curves = bench_scaling(rows, quick)
-    plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
+    if "exact" in want:
+        bench_exact(rows, quick, rng)
+    if "kinematics" in want:
+        bench_kinematics(rows, quick, np.random.default_rng(12), messages)
+        bench_cli_process(rows, quick)
+    if "scaling" in want:
+        curves = bench_scaling(rows, quick)
+        plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
 
     df = pd.DataFrame(rows.rows, columns=["section", "item", "value", "unit", "note"])
     df.to_csv(out / "bench.csv", index=False)
@@ -627,5 +649,6 @@ def run(quick: bool = False, peers: bool = False, out="bench") -> pd.DataFrame:
     console.print(table)
     for msg in messages:
         console.print(msg)
-    console.print(f"total {time.perf_counter() - start:.1f} s; wrote {out / 'bench.csv'} and {out / 'scaling.png'}")
+    wrote = f"{out / 'bench.csv'}" + (f" and {out / 'scaling.png'}" if "scaling" in want else "")
+    console.print(f"total {time.perf_counter() - start:.1f} s; wrote {wrote}")
     return df

@@ -43,9 +43,9 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   1 length unit of residual, so that a finite null-space step does not keep the task from
   converging (off by default);
 * starts from a table: ``table`` (4096) joint configurations drawn uniformly inside the limits
-  by a fixed hash (not the seed), indexed by a k-d tree over their tool position and
-  reach / (3 sqrt 2) times their rotation matrix entries (1 rad weighs about a third of the
-  reach); a row's starts are ``start`` (when given), then the table's configurations nearest to
+  by a fixed hash (not the seed), compared by their tool position and reach / (3 sqrt 2) times
+  their rotation matrix entries (1 rad weighs about a third of the reach), nearest found
+  exactly (brute force below 32 rows, scipy's k-d tree from 32 rows on); a row's starts are ``start`` (when given), then the table's configurations nearest to
   its target (``starts`` of them plus ``neighbours`` more for restarts), then seeded random draws
   inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
   1000 random reachable poses: about 80 % of nearest-configuration starts converge against
@@ -732,23 +732,44 @@ _TABLES: dict = {}
 
 def _start_table(m, size: int):
     """Joint configurations (size, n) in radians drawn uniformly inside the limits by a fixed
-    hash (independent of ``seed``), their tool features (position, w * rotation matrix
-    entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3) and a k-d tree
-    over them: ``inverse`` starts from the configurations nearest to each target. Cached per
-    arm (name, DH table, limits)."""
-    g = m.geometry
-    key = (m.name, size, repr(g), m.bounds.tobytes())
+    hash (independent of ``seed``) and their tool features (position, w * rotation matrix
+    entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3): ``inverse``
+    starts from the configurations nearest to each target. Cached per arm (name, DH table,
+    limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`)."""
+    key = (m.name, size, repr(m.geometry), m.bounds.tobytes())
     got = _TABLES.get(key)
     if got is None:
-        from scipy.spatial import cKDTree
         from .rotations import to_array
         lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
         tq = lo + (hi - lo) * _uniform_hash(0x5EED, np.arange(size), np.zeros(size, dtype=np.int64), m.dof)
         p, R = m.frame(np.degrees(tq))
         wf = m.reach / (3.0 * np.sqrt(2.0))
         feats = np.concatenate([np.stack(p, axis=-1), wf * to_array(R).reshape(size, 9)], axis=-1)
-        got = _TABLES[key] = (tq, cKDTree(feats), wf)
+        got = _TABLES[key] = {"q": tq, "features": feats, "w": wf}
     return got
+
+
+#: Batches from this many rows query the start table through scipy's k-d tree (importing
+#: scipy.spatial costs ~0.4 s once per process); smaller ones by exact brute force.
+_TREE_MIN = 32
+
+
+def _nearest(table: dict, feats: np.ndarray, k: int) -> np.ndarray:
+    """Indices (N, k) of the table's k nearest configurations (Euclidean in the features),
+    nearest first."""
+    if len(feats) >= _TREE_MIN:
+        if "tree" not in table:
+            from scipy.spatial import cKDTree
+            table["tree"] = cKDTree(table["features"])
+        _, near = table["tree"].query(feats, k=k)
+        return np.asarray(near, dtype=np.intp).reshape(len(feats), k)
+    F = table["features"]
+    out = np.empty((len(feats), k), dtype=np.intp)
+    for i, f in enumerate(feats):
+        d2 = _sumsq(F - f)
+        part = np.argpartition(d2, k - 1)[:k] if k < len(d2) else np.arange(len(d2))
+        out[i] = part[np.argsort(d2[part], kind="stable")]
+    return out
 
 
 def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts: int = 200,
@@ -813,11 +834,11 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     own0 = 1 if (start is not None or not table) else 0
     near = np.zeros((N, 0), dtype=np.intp)
     if table:
-        tq, tree, wf = _start_table(m, int(table))
+        tab = _start_table(m, int(table))
+        tq = tab["q"]
         kn = min(int(table), K - own0 + int(neighbours))
         if kn > 0:
-            _, near = tree.query(np.concatenate([pt, wf * Rt.reshape(N, 9)], axis=-1), k=kn)
-            near = np.asarray(near, dtype=np.intp).reshape(N, kn)
+            near = _nearest(tab, np.concatenate([pt, tab["w"] * Rt.reshape(N, 9)], axis=-1), kn)
     nn = near.shape[1]
 
     def starts_for(rows, j):
