@@ -40,3 +40,18 @@ def test_pose_batch_problem_index_is_inert():
     r = fkopt.solve(p, "lm", population=1, iterations=50, runs=5, x0=p.start())
     np.testing.assert_array_equal(r.x[:, -1], np.arange(5.0))
     assert np.abs(m.ik(r.x[:, :-1]) - m.ik(poses)).max() < 1e-9
+
+
+def test_sections_select_what_runs(tmp_path):
+    df = bench.run(quick=True, out=tmp_path / "e", sections=["exact"])
+    assert set(df.section) == {"exact"}
+    assert not (tmp_path / "e" / "scaling.png").exists()
+
+
+def test_bench_cli_refuses_unknown_section(tmp_path):
+    import subprocess
+    import sys
+    p = subprocess.run([sys.executable, "-m", "fkopt.cli", "bench", "--section", "nope", "--out", str(tmp_path / "x")],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and "kinematics" in p.stderr and "Traceback" not in p.stderr
+    assert not (tmp_path / "x").exists()
