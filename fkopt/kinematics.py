@@ -838,7 +838,14 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         tq = tab["q"]
         kn = min(int(table), K - own0 + int(neighbours))
         if kn > 0:
-            near = _nearest(tab, np.concatenate([pt, tab["w"] * Rt.reshape(N, 9)], axis=-1), kn)
+            # the first K - own0 neighbours of every row now; the full lists only for rows
+            # that restart (most rows never need them)
+            feats = np.concatenate([pt, tab["w"] * Rt.reshape(N, 9)], axis=-1)
+            k0 = max(0, min(kn, K - own0))
+            near = np.full((N, kn), -1, dtype=np.intp)
+            if k0:
+                near[:, :k0] = _nearest(tab, feats, k0)
+            full = np.full(N, k0 == kn)
     nn = near.shape[1]
 
     def starts_for(rows, j):
@@ -848,6 +855,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             qs[a] = q0[rows[a]]
         b = (j >= own0) & (j < own0 + nn)
         if b.any():
+            need = np.unique(rows[b][~full[rows[b]]])
+            if len(need):
+                near[need] = _nearest(tab, feats[need], nn)
+                full[need] = True
             qs[b] = tq[near[rows[b], j[b] - own0]]
         c = j >= own0 + nn
         if c.any():
