@@ -71,7 +71,9 @@ the Newton loop evaluated at the answer with ``ik_jacobian`` (the same closed fo
 angles were moved into the bounds is evaluated again with ``ik``). Inverse, distance between
 fk(joints) and the target position <= ``tol[0]`` (length unit; default 1e-6) and geodesic angle
 <= ``tol[1]`` (radians; default 1e-6), every joint inside its limits, evaluated with the arm's
-elementwise :meth:`DHArm.frame` (the numbers of ``fk``), not with the solver's products.
+elementwise :meth:`DHArm.frame` (the numbers of ``fk``; for a single pose the same DH
+recursion on Python floats, :meth:`DHArm.frame_jacobian1`, equal to ~1e-13), not with the
+solver's products.
 
 **Evaluations** are counted per row and separately: ``evaluations["residual"]`` counts
 evaluations of the closed form (the inverse map for forward, the arm's forward map for inverse),
@@ -736,7 +738,10 @@ def _start_table(m, size: int):
     entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3): ``inverse``
     starts from the configurations nearest to each target. Cached per arm (name, DH table,
     limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`)."""
-    key = (m.name, size, repr(m.geometry), m.bounds.tobytes())
+    base = m.__dict__.get("_start_table_key")        # repr of the geometry costs ~50 us: once
+    if base is None:
+        base = m.__dict__["_start_table_key"] = (m.name, repr(m.geometry), m.bounds.tobytes())
+    key = base + (size,)
     got = _TABLES.get(key)
     if got is None:
         from .rotations import to_array
@@ -764,9 +769,11 @@ def _nearest(table: dict, feats: np.ndarray, k: int) -> np.ndarray:
         _, near = table["tree"].query(feats, k=k)
         return np.asarray(near, dtype=np.intp).reshape(len(feats), k)
     F = table["features"]
+    if "norms" not in table:
+        table["norms"] = _sumsq(F)
     out = np.empty((len(feats), k), dtype=np.intp)
     for i, f in enumerate(feats):
-        d2 = _sumsq(F - f)
+        d2 = table["norms"] - 2.0 * (F @ f)              # |F - f|^2 - |f|^2
         part = np.argpartition(d2, k - 1)[:k] if k < len(d2) else np.arange(len(d2))
         out[i] = part[np.argsort(d2[part], kind="stable")]
     return out
@@ -1032,8 +1039,12 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
     qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])
-    pf, Rf = m.frame(qd)
-    pf, Rf = np.stack(pf, axis=-1), to_array(Rf)
+    if N == 1 and hasattr(m, "frame_jacobian1"):    # one pose: the same recursion on floats
+        p1, R1, _ = m.frame_jacobian1(np.radians(qd[0]).tolist())
+        pf, Rf = np.array([p1]), np.array([R1])
+    else:
+        pf, Rf = m.frame(qd)
+        pf, Rf = np.stack(pf, axis=-1), to_array(Rf)
     perr = np.sqrt(_sumsq(pf - pt))
     rerr = np.sqrt(_sumsq(_rotation_error(Rf, Rt)))
     ok = (perr <= tp) & (rerr <= tr) & m.in_bounds(qd)
