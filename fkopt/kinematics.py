@@ -794,7 +794,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     ``restarts``: most random restarts per row. ``rest``: gain of the null-space pull towards
     mid-range (0: off). ``orientation_scale``: length units per radian weighing orientation
     against position in the least squares (default the arm's reach). ``iterations``: per
-    candidate before it restarts. See the module docstring.
+    candidate before it restarts. ``table``: size of the start table (0: no table, starts at
+    ``start`` or mid-range, then random); ``neighbours``: table configurations kept per row for
+    restarts beyond its first starts; ``fill`` / ``tail``: candidates side by side for small
+    batches / when few remain. See the module docstring.
     """
     m = _mechanism(arm, SerialMechanism, "inverse")
     if not hasattr(m, "frame_jacobian"):
