@@ -18,12 +18,14 @@ many inputs as pose variables:
    search); for other mechanisms on ``FKProblem.residuals`` with ``FKProblem.jacobian`` (central
    differences only for a mechanism without an analytic Jacobian).
    Steps are capped (6-SPS: 2 rad of rotation and one mechanism size of translation; others:
-   a quarter of the bounds width) and halved up to 8 times until the squared residual
-   decreases (backtracking line search: the full step's residual and Jacobian in one call,
-   the Jacobian kept when the step is taken; the halvings of the rows that need them in one
-   more call). A start stops when converged (then one more polishing step), diverged, stalled
-   or out of ``iterations`` (60: the rarest basins of Dietmaier's example are mostly reached
-   by slow, heavily damped starts). At most ``pool`` (512) starts of a round iterate at once;
+   a quarter of the bounds width). For other mechanisms they are halved up to 8 times until the
+   squared residual decreases (backtracking line search: the full step's residual and Jacobian
+   in one call, the Jacobian kept when the step is taken; the halvings of the rows that need
+   them in one more call). For 6-SPS every capped step is taken (plain Newton): measured on
+   Dietmaier's platform over 20 seeds, a seed then needs a median of ~1260 starts to see all 40
+   solutions against ~1700 with the line search (the backtracking shrinks the rarest basins),
+   and an iteration costs one evaluation. A start stops when converged (then one more
+   polishing step), diverged, stalled (line search) or out of ``iterations`` (60). At most ``pool`` (512) starts of a round iterate at once;
    a finished start is replaced by the round's next one, in order, and converged starts are
    deduplicated after every iteration, so the search stops mid-round as soon as ``maximum``
    solutions are known (the answer stays a function of the seed alone).
@@ -49,9 +51,8 @@ starts in one round. ``Solutions.history`` records (starts, seconds, solutions i
 after every round.
 
 On Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``) all 40 real
-solutions are found within the first round of 2000 starts for 10 seeds out of 10; the two
-rarest basins are each hit by ~0.15-0.25 % of the starts, so a seed needs between ~700 and
-2000 starts (times: ``fkopt bench``, section kinematics).
+solutions are found on 20 seeds out of 20, within the first round of 2000 starts for most (a
+median of ~1260 starts, at most ~3000); times: ``fkopt bench``, section kinematics.
 """
 from __future__ import annotations
 
@@ -431,7 +432,7 @@ def _sumsq(f):
 
 
 def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvings: int = 8,
-            pool: int | None = None, report=None):
+            pool: int | None = None, report=None, line_search: bool = True):
     """Damped Newton from every row of S. Returns (S, converged mask, rows started).
 
     Rows that finish (converged and polished, stalled, singular, diverged) are written back
@@ -439,7 +440,8 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     With ``pool``, at most that many rows run at once and finished ones are replaced by the
     next rows of S in order; ``report(rows, S_rows)`` receives the rows that finished converged
     after every iteration and returns True to stop the whole search (rows not started yet are
-    then never started). Both keep the answer a function of S alone.
+    then never started). Both keep the answer a function of S alone. ``line_search=False``
+    takes every (capped) Newton step whose residual is finite: plain Newton.
     """
     total = len(S)
     out = S.copy()
@@ -466,7 +468,7 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
         fc, Jc = model.residual_jacobian(cand)
         Fc = _sumsq(fc)
         # Polishing steps (already converged) are taken unconditionally.
-        accepted = ((Fc < F) | polish) & np.isfinite(Fc)
+        accepted = ((Fc < F) | polish | (not line_search)) & np.isfinite(Fc)
         S[accepted], F[accepted], f[accepted], J[accepted] = (
             cand[accepted], Fc[accepted], fc[accepted], Jc[accepted])
         stale = np.zeros(len(idx), dtype=bool)         # J not at S: taken at a halving
@@ -589,7 +591,8 @@ def pose_distance(mechanism: ParallelMechanism, a, b) -> np.ndarray:
 def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = None, seed: int = 0,
                   tol: float = 1e-9, dedup: float = 1e-6, round_size: int | None = None,
                   patience: int = 1, min_starts: int | None = None, max_starts: int = 200_000,
-                  iterations: int = 60, maximum: int | None = None, pool: int | None = 512) -> Solutions:
+                  iterations: int = 60, maximum: int | None = None, pool: int | None = 512,
+                  line_search: bool | None = None) -> Solutions:
     """Every distinct real forward solution of ``mechanism`` for ``joints`` inside its bounds.
 
     ``starts``: run exactly this many starts (one round); by default rounds of ``round_size``
@@ -598,7 +601,9 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     ``tol``: accepted residual, ``max_i |ik(pose)_i - joints_i| / max(1, |joints_i|)``.
     ``dedup``: duplicate tolerance in the normalised pose space (see the module docstring).
     ``seed``: the start stream (``RunStreams(seed, [0])``); same seed, same answer.
-    ``pool``: most starts iterated at once within a round (finished ones are replaced by the
+    ``line_search``: backtrack Newton steps until the squared residual decreases (default: yes,
+    except for 6-SPS, whose plain capped Newton steps reach the rarest basins more often; see
+    the module docstring). ``pool``: most starts iterated at once within a round (finished ones are replaced by the
     round's next starts, so the search can stop mid-round; None: the whole round at once).
     ``maximum``: the most assembly modes the mechanism can have; the search stops as soon as
     that many distinct real solutions (inside or outside the bounds) are found, since no more
@@ -627,6 +632,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         limit, need = int(max_starts), int(min_starts if min_starts is not None else 2 * size)
     streams = RunStreams(seed, [0])
     cap = maximum if maximum is not None else (40 if isinstance(model, _SixSPSModel) else None)
+    search = (not isinstance(model, _SixSPSModel)) if line_search is None else bool(line_search)
     jscale = np.maximum(1.0, np.abs(joints))
     ftol = 1e-3 * tol * float(jscale.min())           # Newton's own stop, well below the acceptance
 
@@ -668,7 +674,8 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         S0 = model.starts(streams.uniform(n, model.draws)[0])
         inside_before = sum(f is not None for f in found)
         with np.errstate(all="ignore"):                 # diverging starts may overflow
-            _, _, started = _newton(model, S0, ftol=ftol, iterations=iterations, pool=pool, report=report)
+            _, _, started = _newton(model, S0, ftol=ftol, iterations=iterations, pool=pool, report=report,
+                                    line_search=search)
         used += started
         inside = sum(f is not None for f in found)
         history.append((used, time.perf_counter() - t0, inside))
@@ -686,7 +693,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     out.time_s = time.perf_counter() - t0
     out.history = history
     out.settings = dict(seed=seed, tol=tol, dedup=dedup, round_size=size, patience=patience,
-                        iterations=iterations, maximum=cap)
+                        iterations=iterations, maximum=cap, pool=pool, line_search=search)
     return out
 
 
