@@ -640,6 +640,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     rep_keys: list[np.ndarray] = []                   # one key per distinct solution found
     hits: list[int] = []
     found: list[tuple[np.ndarray, float] | None] = []  # (pose in bounds, residual), None: outside
+    unchecked: list[np.ndarray] = []                  # states of new solutions not checked yet
     history: list[tuple[int, float, int]] = []
     used, quiet = 0, 0
     def add(S):
@@ -658,16 +659,21 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
             if not len(S):
                 return
         labels = _cluster(keys, dedup)
-        firsts = [int(np.flatnonzero(labels == lab)[0]) for lab in range(int(labels.max()) + 1)]
-        checked = _check_many(mechanism, problem, model.poses(S[firsts]), triple, jscale, tol)
-        for lab, first in enumerate(firsts):
-            rep_keys.append(keys[first])
-            hits.append(int((labels == lab).sum()))
-            found.append(checked[lab])
+        for lab in range(int(labels.max()) + 1):
+            members = np.flatnonzero(labels == lab)
+            rep_keys.append(keys[members[0]])
+            hits.append(len(members))
+            unchecked.append(S[members[0]])           # checked once per round (settle)
+
+    def settle():
+        """Check the round's new solutions (pose in the bounds, residual) in one call."""
+        if unchecked:
+            found.extend(_check_many(mechanism, problem, model.poses(np.array(unchecked)), triple, jscale, tol))
+            unchecked.clear()
 
     def report(rows, S):
         add(S)
-        return cap is not None and len(found) >= cap  # every assembly mode is found
+        return cap is not None and len(hits) >= cap   # every assembly mode is found
 
     while used < limit:
         n = min(size, limit - used)
@@ -677,6 +683,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
             _, _, started = _newton(model, S0, ftol=ftol, iterations=iterations, pool=pool, report=report,
                                     line_search=search)
         used += started
+        settle()
         inside = sum(f is not None for f in found)
         history.append((used, time.perf_counter() - t0, inside))
         quiet = quiet + 1 if inside == inside_before else 0
