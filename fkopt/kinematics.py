@@ -633,6 +633,16 @@ def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.nd
     return (z >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
 
 
+def _rotation_error1(R, T):
+    """:func:`_rotation_error` of one pair of rotations given as 3 rows of 3 floats."""
+    M = [[R[i][0] * T[j][0] + R[i][1] * T[j][1] + R[i][2] * T[j][2] for j in range(3)] for i in range(3)]
+    v0, v1, v2 = M[2][1] - M[1][2], M[0][2] - M[2][0], M[1][0] - M[0][1]
+    s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+    c = 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)
+    k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
+    return v0 * k, v1 * k, v2 * k
+
+
 def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping, down, up,
                     step_cap, lo, hi):
     """The damped least-squares iteration of :func:`inverse` for one pose on Python floats
@@ -649,12 +659,7 @@ def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping,
 
     def evaluate(q):
         p, R, J = fj(q)
-        M = [[R[i][0] * T[j][0] + R[i][1] * T[j][1] + R[i][2] * T[j][2] for j in range(3)] for i in range(3)]
-        v0, v1, v2 = M[2][1] - M[1][2], M[0][2] - M[2][0], M[1][0] - M[0][1]
-        s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-        c = 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)
-        k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
-        e0, e1, e2 = v0 * k, v1 * k, v2 * k
+        e0, e1, e2 = _rotation_error1(R, T)
         d0, d1, d2 = p[0] - t0, p[1] - t1, p[2] - t2
         r = [d0, d1, d2, L * e0, L * e1, L * e2]
         for row in J[3:]:
@@ -851,7 +856,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             # the first K - own0 neighbours of every row now; the full lists only for rows
             # that restart (most rows never need them)
             feats = np.concatenate([pt, tab["w"] * Rt.reshape(N, 9)], axis=-1)
-            k0 = max(0, min(kn, K - own0))
+            k0 = kn if N < _TREE_MIN else max(0, min(kn, K - own0))   # brute force: all at once
             near = np.full((N, kn), -1, dtype=np.intp)
             if k0:
                 near[:, :k0] = _nearest(tab, feats, k0)
@@ -1042,14 +1047,15 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
     qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])
-    if N == 1 and hasattr(m, "frame_jacobian1"):    # one pose: the same recursion on floats
+    if N == 1 and hasattr(m, "frame_jacobian1"):    # one pose: the same formulas on floats
         p1, R1, _ = m.frame_jacobian1(np.radians(qd[0]).tolist())
-        pf, Rf = np.array([p1]), np.array([R1])
+        perr = np.array([math.dist(p1, pt[0].tolist())])
+        rerr = np.array([math.hypot(*_rotation_error1(R1, Rt[0].tolist()))])
     else:
         pf, Rf = m.frame(qd)
         pf, Rf = np.stack(pf, axis=-1), to_array(Rf)
-    perr = np.sqrt(_sumsq(pf - pt))
-    rerr = np.sqrt(_sumsq(_rotation_error(Rf, Rt)))
+        perr = np.sqrt(_sumsq(pf - pt))
+        rerr = np.sqrt(_sumsq(_rotation_error(Rf, Rt)))
     ok = (perr <= tp) & (rerr <= tr) & m.in_bounds(qd)
     return InverseResult(
         mechanism=m.name, names=tuple(m.joint_names), joints=qd.reshape(shape + (n,)),
