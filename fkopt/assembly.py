@@ -18,10 +18,17 @@ many inputs as pose variables:
    search); for other mechanisms on ``FKProblem.residuals`` with ``FKProblem.jacobian`` (central
    differences only for a mechanism without an analytic Jacobian).
    Steps are capped (6-SPS: 2 rad of rotation and one mechanism size of translation; others:
-   a quarter of the bounds width) and halved up to 8 times until the squared residual
-   decreases (backtracking line search). A start stops when converged (then one more
-   polishing step), diverged, stalled or out of ``iterations`` (60: the rarest basins of
-   Dietmaier's example are mostly reached by slow, heavily damped starts).
+   a quarter of the bounds width). For other mechanisms they are halved up to 8 times until the
+   squared residual decreases (backtracking line search: the full step's residual and Jacobian
+   in one call, the Jacobian kept when the step is taken; the halvings of the rows that need
+   them in one more call). For 6-SPS every capped step is taken (plain Newton): measured on
+   Dietmaier's platform over 20 seeds, a seed then needs a median of ~1260 starts to see all 40
+   solutions against ~1700 with the line search (the backtracking shrinks the rarest basins),
+   and an iteration costs one evaluation. A start stops when converged (then one more
+   polishing step), diverged, stalled (line search) or out of ``iterations`` (60). At most ``pool`` (512) starts of a round iterate at once;
+   a finished start is replaced by the round's next one, in order, and converged starts are
+   deduplicated after every iteration, so the search stops mid-round as soon as ``maximum``
+   solutions are known (the answer stays a function of the seed alone).
 3. **Deduplication** with the stated tolerance ``dedup``: two converged starts are one
    solution when they differ by at most ``dedup`` in the normalised pose space -- length
    variables divided by their bounds width, angle variables in radians compared modulo 2 pi,
@@ -43,11 +50,9 @@ solutions are known (40 for a 6-SPS platform: no more can exist); ``starts=N`` i
 starts in one round. ``Solutions.history`` records (starts, seconds, solutions in the bounds)
 after every round.
 
-Measured on Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``):
-all 40 real solutions, residuals ~1e-15, in the first round of 2000 starts for 10 seeds out
-of 10, and the whole search stops after its confirming round (4000 starts); ``fkopt bench``
-(section ``assembly``) times it. The rarest basin is hit by ~0.3 % of the starts, so 2000 starts miss it with
-probability ~0.3 % and the confirming round makes an early stop with 39 unlikely (~1e-5).
+On Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``) all 40 real
+solutions are found on 20 seeds out of 20, within the first round of 2000 starts for most (a
+median of ~1260 starts, at most ~3000); times: ``fkopt bench``, section kinematics.
 """
 from __future__ import annotations
 
@@ -191,8 +196,8 @@ def _rotate(w, R):
     return out
 
 
-#: Batch size from which the 6-SPS model evaluates legs elementwise rather than by matmul.
-_SOA_MIN = 256
+#: Batch size from which the 6-SPS model evaluates legs elementwise rather than by one GEMM.
+_SOA_MIN = 1024
 
 
 class _SixSPSModel(_Model):
@@ -237,8 +242,8 @@ class _SixSPSModel(_Model):
         return np.concatenate([t, R.reshape(-1, 9)], axis=1)
 
     def _legs(self, S):
-        t, R = S[:, :3], S[:, 3:].reshape(-1, 3, 3)
-        w = R @ self.qT                                            # (n, 3, 6): R q_i
+        t = S[:, :3]
+        w = (np.ascontiguousarray(S[:, 3:]).reshape(-1, 3) @ self.qT).reshape(-1, 3, 6)   # R q_i, one GEMM
         v = w + (t[:, :, None] - self.bT)
         f = ((v * v).sum(1) - self.L2) * self.half_inv_L
         return f, v, w
@@ -426,22 +431,29 @@ def _sumsq(f):
     return out
 
 
-def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvings: int = 8):
-    """Damped Newton from every row of S. Returns (S, converged mask).
+def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvings: int = 8,
+            pool: int | None = None, report=None, line_search: bool = True):
+    """Damped Newton from every row of S. Returns (S, converged mask, rows started).
 
     Rows that finish (converged and polished, stalled, singular, diverged) are written back
     and dropped from the working arrays, so late iterations only cost what is still running.
+    With ``pool``, at most that many rows run at once and finished ones are replaced by the
+    next rows of S in order; ``report(rows, S_rows)`` receives the rows that finished converged
+    after every iteration and returns True to stop the whole search (rows not started yet are
+    then never started). Both keep the answer a function of S alone. ``line_search=False``
+    takes every (capped) Newton step whose residual is finite: plain Newton.
     """
+    total = len(S)
     out = S.copy()
-    conv = np.zeros(len(S), dtype=bool)
-    idx = np.arange(len(S))
-    S = S.copy()
+    conv = np.zeros(total, dtype=bool)
+    started = total if pool is None else min(total, int(pool))
+    idx = np.arange(started)
+    S = S[:started].copy()
+    it = np.zeros(started, dtype=np.int64)
     f, J = model.residual_jacobian(S)
     F = _sumsq(f)
     polish = np.zeros(len(S), dtype=bool)
-    for _ in range(iterations):
-        if not len(idx):
-            break
+    while len(idx):
         bad = ~(np.isfinite(J).all((1, 2)) & np.isfinite(f).all(-1))
         if bad.any():                                  # e.g. a pose outside the inverse map's domain
             J[bad], f[bad] = np.eye(J.shape[-1]), 0.0
@@ -449,38 +461,63 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
         ok = np.isfinite(dx).all(-1) & ~bad
         dx[~ok] = 0.0
         dx *= model.cap(dx)[:, None]
-        # Backtracking: full step for all, then half steps, then the remaining halvings
-        # (1/4 ... 1/2^halvings) evaluated together, taking the longest that decreases F.
-        accepted = np.zeros(len(idx), dtype=bool)
-        pending = np.arange(len(idx))
-        for lams in ([1.0], [0.5], [0.5 ** h for h in range(2, halvings + 1)]):
-            if not len(pending):
-                break
+        # Backtracking: the full step for all (residual and Jacobian at the trial point, the
+        # Jacobian kept when the step is taken), then all halvings 1/2 ... 1/2^halvings of the
+        # rows that need them evaluated together, taking the longest that decreases F.
+        cand = model.step(S, dx)
+        fc, Jc = model.residual_jacobian(cand)
+        Fc = _sumsq(fc)
+        # Polishing steps (already converged) are taken unconditionally.
+        accepted = ((Fc < F) | polish | (not line_search)) & np.isfinite(Fc)
+        S[accepted], F[accepted], f[accepted], J[accepted] = (
+            cand[accepted], Fc[accepted], fc[accepted], Jc[accepted])
+        stale = np.zeros(len(idx), dtype=bool)         # J not at S: taken at a halving
+        pending = np.flatnonzero(~accepted)
+        if len(pending) and halvings > 0:
+            lams = 0.5 ** np.arange(1, halvings + 1)
             k = len(lams)
             rows = np.repeat(pending, k)
             lam = np.tile(lams, len(pending))
             cand = model.step(S[rows], dx[rows] * lam[:, None])
             Fc = _sumsq(model.residual(cand))
-            # Polishing steps (already converged) are taken unconditionally.
-            good = (((Fc < F[rows]) | polish[rows]) & np.isfinite(Fc)).reshape(-1, k)
+            good = ((Fc < F[rows]) & np.isfinite(Fc)).reshape(-1, k)
             hit = good.any(-1)
             first = np.argmax(good, axis=-1)
             pick = np.flatnonzero(hit) * k + first[hit]
             sel = pending[hit]
             S[sel], F[sel] = cand[pick], Fc[pick]
             accepted[sel] = True
-            pending = pending[~hit]
+            stale[sel] = True
         newly = (F <= ftol * ftol) & ~polish & ok
-        finished = polish | ~accepted | ~ok | model.diverged(S)
+        it += 1
+        finished = polish | ~accepted | ~ok | model.diverged(S) | (it >= iterations)
         conv[idx[newly]] = True
         polish |= newly
         out[idx[finished]] = S[finished]
+        if report is not None:
+            fin = idx[finished]
+            good = fin[conv[fin]]
+            if len(good) and report(good, out[good]):
+                return out[:started], conv[:started], started
         keep = ~finished
-        idx, S, F, polish = idx[keep], S[keep], F[keep], polish[keep]
-        if len(idx):
-            f, J = model.residual_jacobian(S)
+        idx, S, F, f, J, polish, it, stale = (a[keep] for a in (idx, S, F, f, J, polish, it, stale))
+        k = min(total - started, int(finished.sum())) if pool is not None else 0
+        if k > 0:                                      # refill the pool with the next starts
+            new = np.arange(started, started + k)
+            started += k
+            idx, S = np.concatenate([idx, new]), np.concatenate([S, out[new]])
+            F = np.concatenate([F, np.zeros(k)])
+            f = np.concatenate([f, np.zeros((k,) + f.shape[1:])])
+            J = np.concatenate([J, np.zeros((k,) + J.shape[1:])])
+            polish = np.concatenate([polish, np.zeros(k, dtype=bool)])
+            it = np.concatenate([it, np.zeros(k, dtype=np.int64)])
+            stale = np.concatenate([stale, np.ones(k, dtype=bool)])
+        st = np.flatnonzero(stale)
+        if len(st):
+            f[st], J[st] = model.residual_jacobian(S[st])
+            F[st] = _sumsq(f[st])
     out[idx] = S
-    return out, conv
+    return out[:started], conv[:started], started
 
 
 def _cluster(keys: np.ndarray, tol: float) -> np.ndarray:
@@ -554,7 +591,8 @@ def pose_distance(mechanism: ParallelMechanism, a, b) -> np.ndarray:
 def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = None, seed: int = 0,
                   tol: float = 1e-9, dedup: float = 1e-6, round_size: int | None = None,
                   patience: int = 1, min_starts: int | None = None, max_starts: int = 200_000,
-                  iterations: int = 60, maximum: int | None = None) -> Solutions:
+                  iterations: int = 60, maximum: int | None = None, pool: int | None = 512,
+                  line_search: bool | None = None) -> Solutions:
     """Every distinct real forward solution of ``mechanism`` for ``joints`` inside its bounds.
 
     ``starts``: run exactly this many starts (one round); by default rounds of ``round_size``
@@ -563,6 +601,10 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     ``tol``: accepted residual, ``max_i |ik(pose)_i - joints_i| / max(1, |joints_i|)``.
     ``dedup``: duplicate tolerance in the normalised pose space (see the module docstring).
     ``seed``: the start stream (``RunStreams(seed, [0])``); same seed, same answer.
+    ``line_search``: backtrack Newton steps until the squared residual decreases (default: yes,
+    except for 6-SPS, whose plain capped Newton steps reach the rarest basins more often; see
+    the module docstring). ``pool``: most starts iterated at once within a round (finished ones are replaced by the
+    round's next starts, so the search can stop mid-round; None: the whole round at once).
     ``maximum``: the most assembly modes the mechanism can have; the search stops as soon as
     that many distinct real solutions (inside or outside the bounds) are found, since no more
     can exist. Default 40 for a 6-SPS platform (the number of complex solutions of the general
@@ -590,6 +632,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         limit, need = int(max_starts), int(min_starts if min_starts is not None else 2 * size)
     streams = RunStreams(seed, [0])
     cap = maximum if maximum is not None else (40 if isinstance(model, _SixSPSModel) else None)
+    search = (not isinstance(model, _SixSPSModel)) if line_search is None else bool(line_search)
     jscale = np.maximum(1.0, np.abs(joints))
     ftol = 1e-3 * tol * float(jscale.min())           # Newton's own stop, well below the acceptance
 
@@ -597,30 +640,50 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     rep_keys: list[np.ndarray] = []                   # one key per distinct solution found
     hits: list[int] = []
     found: list[tuple[np.ndarray, float] | None] = []  # (pose in bounds, residual), None: outside
+    unchecked: list[np.ndarray] = []                  # states of new solutions not checked yet
     history: list[tuple[int, float, int]] = []
     used, quiet = 0, 0
+    def add(S):
+        """Deduplicate converged states S against the solutions known so far and each other."""
+        good = (np.abs(model.residual(S)) / jscale <= tol).all(-1)
+        S = S[good]
+        if not len(S):
+            return
+        keys = model.keys(S)
+        if hits:                                      # known solutions (mutually > dedup apart)
+            dist = np.abs(keys[:, None, :] - np.array(rep_keys)[None]).max(-1)
+            near = dist.min(-1) <= dedup
+            for i in dist[near].argmin(-1).tolist():
+                hits[i] += 1
+            S, keys = S[~near], keys[~near]
+            if not len(S):
+                return
+        labels = _cluster(keys, dedup)
+        for lab in range(int(labels.max()) + 1):
+            members = np.flatnonzero(labels == lab)
+            rep_keys.append(keys[members[0]])
+            hits.append(len(members))
+            unchecked.append(S[members[0]])           # checked once per round (settle)
+
+    def settle():
+        """Check the round's new solutions (pose in the bounds, residual) in one call."""
+        if unchecked:
+            found.extend(_check_many(mechanism, problem, model.poses(np.array(unchecked)), triple, jscale, tol))
+            unchecked.clear()
+
+    def report(rows, S):
+        add(S)
+        return cap is not None and len(hits) >= cap   # every assembly mode is found
+
     while used < limit:
         n = min(size, limit - used)
         S0 = model.starts(streams.uniform(n, model.draws)[0])
-        with np.errstate(all="ignore"):                 # diverging starts may overflow
-            S, conv = _newton(model, S0, ftol=ftol, iterations=iterations)
-        used += n
-        good = conv & (np.abs(model.residual(S)) / jscale <= tol).all(-1)
-        S, keys = S[good], model.keys(S[good])
         inside_before = sum(f is not None for f in found)
-        if len(S):
-            old = len(hits)
-            labels = _cluster(np.concatenate([np.array(rep_keys), keys]) if old else keys, dedup)[old:]
-            # The old representatives, mutually farther apart than dedup, keep labels 0..old-1.
-            for lab in np.unique(labels):
-                members = np.flatnonzero(labels == lab)
-                if lab < old:
-                    hits[lab] += len(members)
-                    continue
-                first = members[0]
-                rep_keys.append(keys[first])
-                hits.append(len(members))
-                found.append(_check(mechanism, problem, model.poses(S[first:first + 1])[0], triple, jscale, tol))
+        with np.errstate(all="ignore"):                 # diverging starts may overflow
+            _, _, started = _newton(model, S0, ftol=ftol, iterations=iterations, pool=pool, report=report,
+                                    line_search=search)
+        used += started
+        settle()
         inside = sum(f is not None for f in found)
         history.append((used, time.perf_counter() - t0, inside))
         quiet = quiet + 1 if inside == inside_before else 0
@@ -637,7 +700,20 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     out.time_s = time.perf_counter() - t0
     out.history = history
     out.settings = dict(seed=seed, tol=tol, dedup=dedup, round_size=size, patience=patience,
-                        iterations=iterations, maximum=cap)
+                        iterations=iterations, maximum=cap, pool=pool, line_search=search)
+    return out
+
+
+def _check_many(mechanism, problem, X, triple, jscale, tol):
+    """:func:`_check` for rows X (k, dim), residuals in one call of the inverse map."""
+    moved = [_into_bounds(mechanism, x, triple) for x in X]
+    inb = [i for i, xb in enumerate(moved) if xb is not None]
+    out: list = [None] * len(X)
+    if inb:
+        r = np.abs(problem.residuals(np.array([moved[i] for i in inb])))
+        for i, ri in zip(inb, r):
+            if (ri / jscale <= tol).all():
+                out[i] = (moved[i], float(ri.max()))
     return out
 
 

@@ -356,12 +356,18 @@ def _emit(data: dict, as_json: bool, units) -> None:
 def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s)"),
           peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
-                                   "(the committed measurements are rewritten only with --out bench)")):
+                                   "(the committed measurements are rewritten only with --out bench)"),
+          section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
+                                            "throughput, mao2017, peers, exact, kinematics, scaling")):
     """Measure fkopt's speed (and peers') on this machine."""
-    from .bench import run as run_bench
+    from .bench import SECTIONS, run as run_bench
     from .files import output_folder
+    bad = [s for s in section if s not in SECTIONS]
+    if bad:
+        raise typer.BadParameter(f"unknown section {bad[0]!r}; allowed: {', '.join(SECTIONS)}",
+                                 param_hint="--section")
     output_folder(out)                 # a writable folder, not a file: before measuring anything
-    run_bench(quick=quick, peers=peers, out=out)
+    run_bench(quick=quick, peers=peers or "peers" in section, out=out, sections=section or None)
 
 
 @app.command()

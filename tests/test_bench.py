@@ -39,3 +39,18 @@ def test_batched_lm_solves_many_poses_as_cases():
     r = fkopt.solve(p, "lm", population=1, iterations=50, runs=1, x0=m.bounds.mean(axis=1))
     assert r.x.shape == (5, 1, 6)
     assert np.abs(m.ik(r.x[:, 0]) - m.ik(poses)).max() < 1e-9
+
+
+def test_sections_select_what_runs(tmp_path):
+    df = bench.run(quick=True, out=tmp_path / "e", sections=["exact"])
+    assert set(df.section) == {"exact"}
+    assert not (tmp_path / "e" / "scaling.png").exists()
+
+
+def test_bench_cli_refuses_unknown_section(tmp_path):
+    import subprocess
+    import sys
+    p = subprocess.run([sys.executable, "-m", "fkopt.cli", "bench", "--section", "nope", "--out", str(tmp_path / "x")],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 2 and "kinematics" in p.stderr and "Traceback" not in p.stderr
+    assert not (tmp_path / "x").exists()

@@ -105,7 +105,7 @@ def test_arm_frame_jacobian_elementwise_path_matches_products():
     m = fkopt.mechanism("7dof-arm")
     rng = np.random.default_rng(2)
     b = m.bounds
-    Q = b[:, 0] + rng.random((300, 7)) * (b[:, 1] - b[:, 0])   # >= the elementwise batch size
+    Q = b[:, 0] + rng.random((300, 7)) * (b[:, 1] - b[:, 0])   # >= the column path's batch size
     big = m.frame_jacobian(Q)
     small = m.frame_jacobian(Q[:50])                           # 4x4 products
     for a, c in zip(big, small):

@@ -142,3 +142,58 @@ def test_light_commands_import_no_heavy_layers(args):
     heavy = {m for m in imported if m.split(".")[0] in ("pandas", "matplotlib")
              or m.startswith(("fkopt.experiment", "fkopt.study", "fkopt.reproduce"))}
     assert not heavy, sorted(heavy)
+
+
+@pytest.mark.parametrize("name", ["6-sps", "6-sps-cmm"])
+def test_sps_scalar_jacobian_matches_the_vectorised_one(name):
+    m = fkopt.mechanism(name)
+    X = random_poses(m, 30, seed=8)
+    v, J = m.ik_jacobian(X)
+    for x, vv, JJ in zip(X, v, J):
+        v1, J1 = m.ik_jacobian1(x.tolist())
+        np.testing.assert_allclose(v1, vv, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(J1, JJ, rtol=0, atol=1e-12)
+
+
+def test_small_solve_matches_numpy_and_refuses_singular():
+    from fkopt.kinematics import _solve_small
+    rng = np.random.default_rng(3)
+    A, b = rng.normal(size=(6, 6)), rng.normal(size=6)
+    np.testing.assert_allclose(_solve_small(A.tolist(), b.tolist()), np.linalg.solve(A, b), rtol=1e-10)
+    A[3] = 2.0 * A[1]                            # rank 5
+    assert _solve_small(A.tolist(), b.tolist()) is None or not np.allclose(A @ _solve_small(A.tolist(), b.tolist()), b)
+    assert _solve_small(np.zeros((6, 6)).tolist(), b.tolist()) is None
+
+
+def test_forward_one_pose_matches_the_batch():
+    m = fkopt.mechanism("6-sps-cmm")
+    X = random_poses(m, 5, seed=9)
+    L = m.ik(X)
+    batch = fkopt.forward(m, L)
+    for k in range(5):
+        one = fkopt.forward(m, L[k])
+        assert one.solved and one.residual <= 1e-9
+        np.testing.assert_allclose(one.pose, batch.pose[k], atol=1e-8)
+        assert one.evaluations["residual"] == one.evaluations["jacobian"] > 0
+
+
+def test_arm_scalar_frame_jacobian_matches_the_vectorised_one():
+    m = fkopt.mechanism("7dof-arm")
+    Q = random_poses(m, 20, seed=10)
+    p, R, J = m.frame_jacobian(Q)
+    for q, pp, RR, JJ in zip(Q, p, R, J):
+        p1, R1, J1 = m.frame_jacobian1(np.radians(q).tolist())
+        np.testing.assert_allclose(p1, pp, atol=1e-9)
+        np.testing.assert_allclose(R1, RR, atol=1e-12)
+        np.testing.assert_allclose(np.radians(J1), JJ, atol=1e-12)   # per radian -> per degree
+
+
+def test_inverse_one_pose_solves_within_limits_and_is_seeded():
+    m = fkopt.mechanism("7dof-arm")
+    P = m.fk(random_poses(m, 6, seed=11))
+    for k in range(6):
+        r = fkopt.inverse(m, P[k], seed=3)
+        assert r.solved and m.in_bounds(r.joints, tol=0.0)
+        assert r.position_error <= 1e-6 and r.rotation_error <= 1e-6
+        np.testing.assert_array_equal(fkopt.inverse(m, P[k], seed=3).joints, r.joints)
+        assert r.evaluations["residual"] == r.evaluations["jacobian"] > 0

@@ -20,6 +20,7 @@ Products are written elementwise (no matmul), so results are bit-identical for a
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -29,8 +30,10 @@ from .. import rotations
 from ..errors import FkoptError, did_you_mean
 from .base import Geometry, SerialMechanism, describe_validation_error
 
-#: Batch size from which :meth:`DHArm.frame_jacobian` works elementwise rather than by 4x4 products.
-_SOA_MIN = 128
+#: Batch size from which :meth:`DHArm.frame_jacobian` works on the frame's columns rather than
+#: by batched 4x4 products (those cost about 1 µs per matrix, the columns a fixed ~20 array
+#: operations per joint).
+_COLUMNS_MIN = 64
 
 WANG7DOF = dict(
     a=[0.0, 200.0, 250.0, 300.0, 200.0, 200.0, 100.0],
@@ -104,6 +107,7 @@ class DHArm(SerialMechanism):
         self._ca = tuple(float(np.cos(np.radians(v))) for v in g.alpha)
         self._sa = tuple(float(np.sin(np.radians(v))) for v in g.alpha)
         self._offset = tuple(float(v) for v in (g.theta_offset or [0.0] * n))
+        self._offset_rad = tuple(math.radians(v) for v in self._offset)
 
     @property
     def dof(self) -> int:
@@ -148,7 +152,8 @@ class DHArm(SerialMechanism):
         joint i (standard DH: the frame before T_i). The Z-Y-Z Euler angles of the pose are
         singular at sin(beta) = 0, so the frame (angular velocity) is the well-defined derivative;
         :meth:`euler_rates` turns it into Euler-angle rates away from the singularity.
-        Batched 4x4 products over the leading axes (one matmul per joint, whatever the batch).
+        Batched 4x4 products (one matmul per joint) for small batches, elementwise on the
+        frame's columns from ``_COLUMNS_MIN`` rows on (see :meth:`_frame_jacobian_columns`).
         """
         q = np.asarray(joints, dtype=float)
         if q.shape[-1] != self.dof:
@@ -157,8 +162,8 @@ class DHArm(SerialMechanism):
         shape = q.shape[:-1]
         n = self.dof
         t = np.radians(q.reshape(-1, n) + self._offset)
-        if len(t) >= _SOA_MIN:
-            p, R, J = self._frame_jacobian_soa(t)
+        if len(t) >= _COLUMNS_MIN:
+            p, R, J = self._frame_jacobian_columns(t)
             return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
         # A_i = C0_i + cos(t_i) C1_i + sin(t_i) C2_i (constant 4x4 parts of the DH transform)
         C0, C1, C2 = self._dh_parts()
@@ -186,6 +191,36 @@ class DHArm(SerialMechanism):
         J *= np.pi / 180.0
         return p.reshape(shape + (3,)), R.reshape(shape + (3, 3)), J.reshape(shape + (6, n))
 
+    def frame_jacobian1(self, t) -> tuple[list[float], list[list[float]], list[list[float]]]:
+        """:meth:`frame_jacobian` of one configuration on Python floats, joint angles ``t`` in
+        **radians** (n floats, offsets added here): position (3), rotation (3 rows of 3) and
+        the frame Jacobian per **radian** (6 rows of n), the recursion of
+        :meth:`_frame_jacobian_columns`. For one configuration numpy's per-call overhead is
+        most of the cost; ``fkopt.inverse`` on one pose uses this."""
+        x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+        p0 = p1 = p2 = 0.0
+        axes, origins = [], []
+        for ti, off, ca, sa, a, d in zip(t, self._offset_rad, self._ca, self._sa, self._a, self._d):
+            c, s_ = math.cos(ti + off), math.sin(ti + off)
+            axes.append((z0, z1, z2))
+            origins.append((p0, p1, p2))
+            u0, u1, u2 = x0 * c + y0 * s_, x1 * c + y1 * s_, x2 * c + y2 * s_
+            v0, v1, v2 = y0 * c - x0 * s_, y1 * c - x1 * s_, y2 * c - x2 * s_
+            p0, p1, p2 = p0 + (u0 * a + z0 * d), p1 + (u1 * a + z1 * d), p2 + (u2 * a + z2 * d)
+            x0, x1, x2 = u0, u1, u2
+            y0, y1, y2, z0, z1, z2 = (v0 * ca + z0 * sa, v1 * ca + z1 * sa, v2 * ca + z2 * sa,
+                                      z0 * ca - v0 * sa, z1 * ca - v1 * sa, z2 * ca - v2 * sa)
+        J = [[], [], [], [], [], []]
+        for (a0, a1, a2), (o0, o1, o2) in zip(axes, origins):
+            d0, d1, d2 = p0 - o0, p1 - o1, p2 - o2
+            J[0].append(a1 * d2 - a2 * d1)
+            J[1].append(a2 * d0 - a0 * d2)
+            J[2].append(a0 * d1 - a1 * d0)
+            J[3].append(a0)
+            J[4].append(a1)
+            J[5].append(a2)
+        return [p0, p1, p2], [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]], J
+
     def _dh_parts(self):
         """Constant (n, 4, 4) parts C0, C1, C2 with A_i = C0 + cos(theta) C1 + sin(theta) C2."""
         if getattr(self, "_parts", None) is None:
@@ -199,43 +234,41 @@ class DHArm(SerialMechanism):
             self._parts = (C0, C1, C2)
         return self._parts
 
-    def _frame_jacobian_soa(self, t):
-        """:meth:`frame_jacobian` for many rows (k, n) of joint angles in radians, elementwise
-        (structure of arrays): faster than k small 4x4 products from a few hundred rows on."""
+    def _frame_jacobian_columns(self, t):
+        """:meth:`frame_jacobian` of rows (k, n) of joint angles in radians, elementwise on the
+        frame's columns as (3, k) arrays: with x, y, z the columns of R before joint i,
+        u = c x + s y, v = c y - s x, the frame after it has columns (u, ca v + sa z,
+        ca z - sa v) and origin p + a u + d z. About 20 array operations per joint whatever k
+        (4x4 products of tiny matrices cost about 1 µs each in numpy)."""
         k, n = t.shape
-        tt = np.ascontiguousarray(t.T)
-        ct, st = np.cos(tt), np.sin(tt)
-        J = np.empty((k, 6, n))
-        zs, os_ = [], []
-        R = p = None
+        tt = t.T
+        C, S = np.cos(tt), np.sin(tt)
+        Z = np.empty((3, n, k))                 # joint axes z_{i-1}
+        O = np.empty((3, n, k))                 # joint origins p_{i-1}
+        x = np.zeros((3, k))
+        y = np.zeros((3, k))
+        z = np.zeros((3, k))
+        x[0], y[1], z[2] = 1.0, 1.0, 1.0
+        p = np.zeros((3, k))
         for i in range(n):
-            c, s_ = ct[i], st[i]
+            c, s_ = C[i], S[i]
             ca, sa, a, d = self._ca[i], self._sa[i], self._a[i], self._d[i]
-            if R is None:
-                zs.append((0.0, 0.0, 1.0))
-                os_.append((0.0, 0.0, 0.0))
-                R = [[c, -s_ * ca, s_ * sa], [s_, c * ca, -c * sa], [np.zeros(k), np.full(k, sa), np.full(k, ca)]]
-                p = [a * c, a * s_, np.full(k, d)]
-                continue
-            zs.append((R[0][2], R[1][2], R[2][2]))
-            os_.append((p[0], p[1], p[2]))
-            p = [R[r][0] * (a * c) + R[r][1] * (a * s_) + (R[r][2] * d + p[r]) for r in range(3)]
-            R = [[R[r][0] * c + R[r][1] * s_,
-                  (R[r][1] * c - R[r][0] * s_) * ca + R[r][2] * sa,
-                  (R[r][0] * s_ - R[r][1] * c) * sa + R[r][2] * ca] for r in range(3)]
-        for i in range(n):
-            zx, zy, zz = zs[i]
-            dx, dy, dz = p[0] - os_[i][0], p[1] - os_[i][1], p[2] - os_[i][2]
-            J[:, 0, i] = zy * dz - zz * dy
-            J[:, 1, i] = zz * dx - zx * dz
-            J[:, 2, i] = zx * dy - zy * dx
-            J[:, 3, i], J[:, 4, i], J[:, 5, i] = zx, zy, zz
+            Z[:, i] = z
+            O[:, i] = p
+            u = x * c + y * s_
+            v = y * c - x * s_
+            p = p + (u * a + z * d)
+            x, y, z = u, v * ca + z * sa, z * ca - v * sa
+        D = p[:, None, :] - O
+        J = np.empty((6, n, k))
+        J[0] = Z[1] * D[2] - Z[2] * D[1]
+        J[1] = Z[2] * D[0] - Z[0] * D[2]
+        J[2] = Z[0] * D[1] - Z[1] * D[0]
+        J[3:] = Z
         J *= np.pi / 180.0
-        Rm = np.empty((k, 3, 3))
-        for r in range(3):
-            for c_ in range(3):
-                Rm[:, r, c_] = R[r][c_]
-        return np.stack(p, axis=-1), Rm, J
+        R = np.stack([x, y, z], axis=-1)        # (3 rows, k, 3 columns)
+        return (np.ascontiguousarray(p.T), np.ascontiguousarray(R.transpose(1, 0, 2)),
+                np.ascontiguousarray(J.transpose(2, 0, 1)))
 
     def jacobian(self, joints) -> np.ndarray:
         """The frame Jacobian (..., 6, n) of :meth:`frame_jacobian`."""

@@ -40,6 +40,8 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
+import math
+
 import numpy as np
 from pydantic import Field, model_validator
 
@@ -134,6 +136,7 @@ class SixSPS(ParallelMechanism):
         self._legs = legs
         self._q = q
         self._base = base
+        self._qb = tuple((tuple(map(float, q[i])), tuple(map(float, base[i]))) for i in range(6))
 
     # -- inverse map -----------------------------------------------------------------------
     def ik(self, poses) -> np.ndarray:
@@ -216,6 +219,31 @@ class SixSPS(ParallelMechanism):
         J[:, :, 5] = m2
         J[:, :, 3:] *= _D2R
         return lengths.reshape(shape + (6,)), J.reshape(shape + (6, 6))
+
+    def ik_jacobian1(self, pose) -> tuple[list[float], list[list[float]]]:
+        """:meth:`ik_jacobian` of one pose (6 floats) on Python floats: leg lengths (6) and the
+        Jacobian as 6 rows of 6, the same formulas. For a single pose numpy's per-call
+        overhead (~1 µs per operation on 6-element arrays) is most of the cost; these ~250
+        float operations take a fraction of it (:func:`fkopt.forward` on one pose uses it)."""
+        x, y, z, a, b, g = pose
+        a, b, g = a * _D2R, b * _D2R, g * _D2R
+        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+        r00, r01, r02 = cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa
+        r10, r11, r12 = sg * cb, sg * sb * sa + cg * ca, sg * sb * ca - cg * sa
+        r20, r21, r22 = -sb, cb * sa, cb * ca
+        lengths, J = [], []
+        for (q0, q1, q2), (b0, b1, b2) in self._qb:
+            w0 = r00 * q0 + r01 * q1 + r02 * q2
+            w1 = r10 * q0 + r11 * q1 + r12 * q2
+            w2 = r20 * q0 + r21 * q1 + r22 * q2
+            v0, v1, v2 = w0 + x - b0, w1 + y - b1, w2 + z - b2
+            L = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+            u0, u1, u2 = v0 / L, v1 / L, v2 / L
+            m0, m1, m2 = w1 * u2 - w2 * u1, w2 * u0 - w0 * u2, w0 * u1 - w1 * u0
+            lengths.append(L)
+            J.append([u0, u1, u2, (r00 * m0 + r10 * m1 + r20 * m2) * _D2R, (cg * m1 - sg * m0) * _D2R,
+                      m2 * _D2R])
+        return lengths, J
 
     def _ik_jacobian_soa(self, p):
         """:meth:`ik_jacobian` for many poses (n, 6), elementwise per leg (structure of arrays)."""
