@@ -197,12 +197,27 @@ def _print_summary(con, df, folder: Path, wall: float) -> None:
     if df["case"].nunique() > 8:   # many cases: one line per algorithm
         df = df.groupby("algorithm", sort=False).agg({c: "median" for c in cols[2:]}).reset_index()
         df.insert(0, "case", "median over cases")
+    rows = [[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]] for _, row in df.iterrows()]
     table = Table(title=f"{folder}  ({wall:.2f} s)")
-    for c in cols:
-        table.add_column(SHORT.get(c, c), justify="right", no_wrap=c in ("case", "algorithm"))
-    for _, row in df.iterrows():
-        table.add_row(*[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]])
-    con.print(table)
+    for j, c in enumerate(cols):
+        # values are never cut ("1.54e-…", "succe…"): each column is as wide as its widest value
+        # (headers may wrap); a terminal narrower than that wraps the lines, losing nothing
+        widest = max((len(r[j]) for r in rows), default=1)
+        table.add_column(SHORT.get(c, c), justify="right", no_wrap=True, min_width=widest)
+    for r in rows:
+        table.add_row(*r)
+    _print_wide(con, table)
+
+
+def _print_wide(con, renderable) -> None:
+    """Print ``renderable`` unclipped: in a pipe (no terminal, where rich assumes 80 columns)
+    or a narrow terminal the console is widened to what the table needs."""
+    from rich.console import Console
+    from rich.measure import Measurement
+    need = Measurement.get(con, con.options.update_width(10_000), renderable).maximum
+    if need > con.width:
+        con = Console(width=need, highlight=False, file=con.file, force_terminal=con.is_terminal)
+    con.print(renderable)
 
 
 @app.command()

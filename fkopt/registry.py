@@ -41,6 +41,7 @@ MECHANISMS: dict[str, str] = {
     "3-ppr": "fkopt.mechanisms.ppr3:ThreePPR",
     "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",
     "7dof-arm": "fkopt.mechanisms.dh_arm:SevenDofArm",
+    "urdf": "fkopt.mechanisms.urdf:URDFArm",
 }
 
 ALGORITHMS: dict[str, str] = {
@@ -178,6 +179,21 @@ def mechanism_class(name: str):
 
 def algorithm_class(name: str):
     return _load(ALGORITHMS, "algorithm", name)
+
+
+def resolve_files(cls, geometry: dict, folder) -> dict:
+    """``geometry`` with the file fields of mechanism ``cls`` (``cls.file_fields``, e.g. the URDF
+    ``file``) made relative to ``folder`` (the config file's folder) when they are relative."""
+    fields = getattr(cls, "file_fields", ())
+    if folder is None or not fields:
+        return dict(geometry)
+    from pathlib import Path
+    out = dict(geometry)
+    for key in fields:
+        value = out.get(key)
+        if isinstance(value, str) and value and not Path(value).is_absolute():
+            out[key] = str(Path(folder) / value)
+    return out
 
 
 def entries(kind: str) -> list[Entry]:

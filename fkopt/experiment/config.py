@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
 
@@ -121,6 +121,8 @@ class ExperimentConfig(Strict):
     #: Which regression check reruns it: "ci" (every CI run and `make check`) or "full"
     #: (`make check` only, for experiments too long for CI).
     check: Literal["ci", "full"] = "ci"
+    #: Folder of the config file: relative files of the mechanism (URDF) are resolved there.
+    _folder: Path | None = PrivateAttr(None)
 
     @field_validator("algorithms")
     @classmethod
@@ -161,6 +163,8 @@ def load_config(path: str | Path) -> ExperimentConfig:
     if not isinstance(data, dict):
         raise FkoptError(f"{path}: expected a mapping of experiment fields at the top level")
     try:
-        return ExperimentConfig(**data)
+        config = ExperimentConfig(**data)
     except ValidationError as err:
         raise FkoptError(f"{path}: {_one_line(err)}") from None
+    config._folder = path.parent
+    return config

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 import zlib
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -74,7 +75,8 @@ def task_seed(seed: int, case_index: int, label: str) -> int:
 
 def build_mechanism(config: ExperimentConfig):
     cls = registry.mechanism_class(config.mechanism.name)
-    return cls(bounds=dict(config.mechanism.bounds), **config.mechanism.geometry)
+    geometry = registry.resolve_files(cls, config.mechanism.geometry, getattr(config, "_folder", None))
+    return cls(bounds=dict(config.mechanism.bounds), **geometry)
 
 
 def _check_in_bounds(mech, pose: np.ndarray, where: str) -> None:
@@ -164,6 +166,8 @@ def validate_experiment(config: ExperimentConfig):
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
                    source: str | None = None) -> ExperimentResult:
     """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each."""
+    if source and getattr(config, "_folder", None) is None:   # rerun of stored results: files beside it
+        config._folder = Path(source).parent
     mech, cases, problems = validate_experiment(config)
     records: list[TaskRecord] = []
     total = len(cases) * len(config.algorithms)
