@@ -427,6 +427,8 @@ def write_tables(er: ExperimentResult, folder: Path) -> list[str]:
     csv("inputs.csv", inputs_table(er))
     csv("runs.csv", runs_table(er))
     csv("convergence.csv", convergence_table(er))
+    from .traces import write_trace   # each run's best-so-far improvements (fkopt export)
+    written.append(write_trace(er, folder))
     convergence_figure(er, folder / "convergence.png")
     written.append("convergence.png")
     figs = set(er.config.figures)
