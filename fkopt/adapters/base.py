@@ -18,7 +18,8 @@ For every library, fkopt -- not the library -- does the bookkeeping:
 * **Processes.** Runs are independent; ``workers`` (param; default 1 for libraries that
   evaluate whole populations at once, the CPU count for per-point libraries such as NiaPy)
   runs them in that many processes. The numbers do not depend on it.
-* **Target.** With ``stop_at_target`` a run stops at the first evaluation below the target.
+* **Target.** With ``stop_at_target`` a run stops after the call (a batch for vectorised
+  libraries) whose evaluations first went below the target; the whole batch is counted.
 
 Iteration axis. fkopt's records are indexed by iteration t = 0..iterations. For a library run
 the record t is the state after ``e_t = e_0 + round(t (B - e_0) / iterations)`` evaluations,
@@ -94,13 +95,10 @@ class Counter:
             self._evals.append(self.n + int(i) + 1)
             self._f.append(float(f[i]))
             self._x.append(X[i].copy())
-            if self.stop_below is not None and f[i] < self.stop_below:
-                take = int(i) + 1          # the run ends at this evaluation
-                break
-        self.best = float(running[take])
+        self.best = float(running[-1])
         self.n += take
-        if take < len(X):
-            raise _Stop
+        if take < len(X) or (self.stop_below is not None and self.best < self.stop_below):
+            raise _Stop     # a batch that reached the target still counts whole: it was evaluated
         return f
 
     def point(self, x) -> float:

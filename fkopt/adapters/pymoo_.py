@@ -38,15 +38,17 @@ def resolve(method: str):
 
 
 def _accepted(cls) -> set[str]:
+    """Keyword names of every ``__init__`` along the MRO (pymoo's base classes swallow unknown
+    keywords, so fkopt checks them itself); DE also forwards its ``Variant``'s (F, CR, ...)."""
     names = set()
     for klass in cls.__mro__:
         init = klass.__dict__.get("__init__")
-        if init is None:
-            continue
-        params = inspect.signature(init).parameters
-        names |= {p for p, v in params.items() if v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)}
-        if not any(v.kind == v.VAR_KEYWORD for v in params.values()):
-            break
+        if init is not None:
+            names |= {p for p, v in inspect.signature(init).parameters.items()
+                      if v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)}
+    if cls.__name__ == "DE":
+        from pymoo.algorithms.soo.nonconvex.de import Variant
+        names |= _accepted(Variant)
     return names - {"self"}
 
 
