@@ -43,7 +43,8 @@ FLOAT = "%.10g"
 LOG_FLOOR = 1e-32
 #: Beyond this many cases, convergence curves are pooled over all (case, run) pairs.
 MAX_CASE_CURVES = 6
-LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich")
+LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich", "pymoo", "niapy",
+             "yourdfpy")
 
 
 def _nanmedian(a) -> float:
