@@ -150,3 +150,19 @@ def test_broken_plugin_is_one_line_naming_it(installed_example, tmp_path):
     proc = run_cli(env, "fk", "3-rps", "--joints", "d1=600,d2=670,d3=630", "--algorithm", "de")
     assert_one_line_error(proc, "algorithm plug-in 'de'", "fkopt-example-plugin 0.1.0",
                           "ModuleNotFoundError", "no_such_dependency_xyz")
+
+
+def test_readme_minimal_plugin_example_works(tmp_path, monkeypatch):
+    """README's complete minimal example, named as package.module:Class, solves its FK."""
+    text = (ROOT / "README.md").read_text()
+    code = text.split("# mypkg/walk.py\n", 1)[1].split("```", 1)[0]
+    (tmp_path / "mypkg").mkdir()
+    (tmp_path / "mypkg" / "__init__.py").write_text("")
+    (tmp_path / "mypkg" / "walk.py").write_text(code)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    m = fkopt.mechanism("mypkg.walk:Slider")
+    problem = fkopt.fk_problem(m, m.ik([40.0, 60.0]))
+    r = fkopt.solve(problem, "mypkg.walk:Walk", population=10, iterations=300, runs=2, seed=1,
+                    params={"step": 0.05})
+    assert r.algorithm == "walk" and r.evaluations.tolist() == [3010, 3010]
+    assert abs(r.x[r.best_run] - [40.0, 60.0]).max() < 0.5
