@@ -166,3 +166,12 @@ def test_readme_minimal_plugin_example_works(tmp_path, monkeypatch):
                     params={"step": 0.05})
     assert r.algorithm == "walk" and r.evaluations.tolist() == [3010, 3010]
     assert abs(r.x[r.best_run] - [40.0, 60.0]).max() < 0.5
+
+
+def test_built_in_names_never_read_entry_points(monkeypatch):
+    def boom(kind):
+        raise AssertionError("entry points scanned")
+    monkeypatch.setattr(registry, "entry_points", boom)
+    assert registry.mechanism_class("3-rps").name == "3-rps"
+    assert registry.algorithm_class("gabc").name == "gabc"
+    assert registry.algorithm_class("scipy:dual_annealing").name == "scipy:dual_annealing"
