@@ -25,22 +25,7 @@ from functools import lru_cache
 
 from ..errors import FkoptError
 
-#: Names listed by ``fkopt list`` (niapy accepts any algorithm class of niapy.algorithms).
-ADAPTERS: dict[str, dict[str, str]] = {
-    "scipy": {"differential_evolution": "scipy.optimize:differential_evolution",
-              "dual_annealing": "scipy.optimize:dual_annealing"},
-    "pymoo": {"GA": "pymoo.algorithms.soo.nonconvex.ga:GA",
-              "DE": "pymoo.algorithms.soo.nonconvex.de:DE",
-              "PSO": "pymoo.algorithms.soo.nonconvex.pso:PSO",
-              "ES": "pymoo.algorithms.soo.nonconvex.es:ES",
-              "G3PCX": "pymoo.algorithms.soo.nonconvex.g3pcx:G3PCX",
-              "NelderMead": "pymoo.algorithms.soo.nonconvex.nelder:NelderMead",
-              "PatternSearch": "pymoo.algorithms.soo.nonconvex.pattern:PatternSearch"},
-    "niapy": {"<ClassName>": "niapy.algorithms.{basic,modified,other}:<ClassName>"},
-}
-
-#: pip distribution of each library (for versions and install hints).
-DISTRIBUTIONS = {"scipy": "scipy", "pymoo": "pymoo", "niapy": "niapy"}
+from .libraries import ADAPTERS, DISTRIBUTIONS  # noqa: F401  (re-exported)
 
 
 @lru_cache(maxsize=None)

@@ -145,7 +145,7 @@ def run_one(library: str, method: str, params: dict, problem, population: int, b
         raise
     except Exception as err:   # the library failed: one line naming it
         from importlib.metadata import version
-        from . import DISTRIBUTIONS
+        from .libraries import DISTRIBUTIONS
         msg = str(err).strip().splitlines()[0] if str(err).strip() else ""
         raise FkoptError(f"algorithm '{library}:{method}' ({library} {version(DISTRIBUTIONS[library])}) "
                          f"raised {type(err).__name__}: {msg}") from None
@@ -221,29 +221,6 @@ def record_from_traces(traces: list[Trace], population: int, iterations: int, bu
                 done[r] = below[0]
     return RunRecord(best_x=x_history[:, -1].copy(), best_f=history[:, -1].copy(), history=history,
                      x_history=x_history, evaluation_history=evals, iterations_done=done)
-
-
-def ceil_div(a: int, b: int) -> int:
-    return -(-int(a) // int(b))
-
-
-def library_version(library: str) -> str:
-    from importlib.metadata import PackageNotFoundError, version
-    from . import DISTRIBUTIONS
-    try:
-        return version(DISTRIBUTIONS[library])
-    except PackageNotFoundError:
-        return "not installed"
-
-
-def require(library: str, module: str):
-    """Import an optional library or fail with the install hint."""
-    from importlib import import_module
-    try:
-        return import_module(module)
-    except ImportError as err:
-        raise FkoptError(f"'{library}:' algorithms need {library} ({err.name or module} is not installed): "
-                         f'pip install "fkopt[peers]"') from None
 
 
 __all__ = ["Counter", "ExternalAlgorithm", "ExternalParams", "Trace", "checkpoints", "record_from_traces",

@@ -16,7 +16,7 @@ import inspect
 import numpy as np
 
 from ..errors import FkoptError
-from .base import require
+from .libraries import require
 
 MODULES = ("niapy.algorithms.basic", "niapy.algorithms.modified", "niapy.algorithms.other")
 RESERVED = {"seed", "callbacks", "individual_type", "initialization_function"}

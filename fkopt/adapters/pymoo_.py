@@ -15,13 +15,13 @@ import inspect
 import numpy as np
 
 from ..errors import FkoptError
-from .base import require
+from .libraries import require
 
 RESERVED = {"termination", "seed", "verbose", "save_history", "callback", "display", "output"}
 
 
 def _table() -> dict[str, str]:
-    from . import ADAPTERS
+    from .libraries import ADAPTERS
     return ADAPTERS["pymoo"]
 
 

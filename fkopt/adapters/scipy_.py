@@ -20,7 +20,7 @@ import inspect
 import numpy as np
 
 from ..errors import FkoptError
-from .base import ceil_div
+from .libraries import ceil_div
 
 METHODS = ("differential_evolution", "dual_annealing")
 RESERVED = {"func", "bounds", "rng", "seed", "workers", "callback", "vectorized", "maxfun", "args"}
