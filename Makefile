@@ -1,28 +1,42 @@
 # fkopt -- common tasks. `make install` once, then `make reproduce` / `make test`.
-PYTHON ?= python3
+# Every target runs the project's venv (.venv, made by `make install`) when it exists, so a bare
+# `fkopt` on the PATH is never needed; PYTHON=... picks another interpreter.
+PYTHON ?= $(if $(wildcard .venv/bin/python),.venv/bin/python,python3)
+FKOPT = $(PYTHON) -m fkopt.cli
 
-.PHONY: install test reproduce report check bench clean
+.PHONY: install install-peers test reproduce reproduce-peers report check bench clean
 
 install:
-	$(PYTHON) -m pip install -e ".[test]"
+	test -x .venv/bin/python || python3 -m venv .venv
+	.venv/bin/python -m pip install -e ".[test]"
+
+# The optional libraries of the peer configs (pymoo, NiaPy); scipy's adapters need nothing.
+install-peers:
+	$(PYTHON) -m pip install -e ".[peers]"
 
 test:
 	$(PYTHON) -m pytest
 
 # Rerun every experiment under configs/ and rewrite results/ (REPORT.md, TIMING.md, index.csv).
 reproduce:
-	fkopt reproduce --configs configs --out results
+	$(FKOPT) reproduce --configs configs --out results
+
+# The peer configs (peers/*.yaml: fkopt beside NiaPy, pymoo and scipy at equal evaluations).
+# Slow (NiaPy evaluates one point per call) and outside `make reproduce`; needs install-peers.
+reproduce-peers:
+	$(FKOPT) reproduce --configs peers --out results/peers
+	$(PYTHON) -m fkopt.peers results/peers
 
 # Regenerate the report from stored results without rerunning.
 report:
-	fkopt report results
+	$(FKOPT) report results
 
 # Rerun every stored experiment (CI reruns the `check: ci` subset through the tests).
 check:
-	fkopt check results --subset all
+	$(FKOPT) check results --subset all
 
 bench:
-	fkopt bench --out bench
+	$(FKOPT) bench --out bench
 
 clean:
-	rm -rf build dist *.egg-info .pytest_cache
+	rm -rf build dist *.egg-info .pytest_cache examples/plugin/build examples/plugin/*.egg-info

@@ -69,31 +69,86 @@ def _default_algorithm() -> str:
 
 # -- commands ------------------------------------------------------------------------------------
 @app.command("list")
-def list_cmd(as_json: bool = typer.Option(False, "--json", help="machine-readable output")):
-    """List the mechanisms and algorithms fkopt knows."""
+def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show its geometry, bounds, "
+                                                              "units, pose and joint names"),
+             as_json: bool = typer.Option(False, "--json", help="machine-readable output")):
+    """List the mechanisms and algorithms fkopt knows, and where each comes from."""
+    if mech is not None:
+        return _list_mechanism(mech, as_json)
+    mechs, algos = registry.entries("mechanism"), registry.entries("algorithm")
     if as_json:
-        typer.echo(json.dumps({"mechanisms": list(registry.MECHANISMS), "algorithms": list(registry.ALGORITHMS)}))
+        typer.echo(json.dumps({"mechanisms": [e.name for e in mechs], "algorithms": [e.name for e in algos],
+                               "origins": {"mechanisms": {e.name: e.origin for e in mechs},
+                                           "algorithms": {e.name: e.origin for e in algos}}}))
         return
+    from rich.markup import escape
     from rich.table import Table
-    table = Table(title="mechanisms")
-    for col in ("name", "kind", "pose", "joints", "paper"):
-        table.add_column(col)
-    for name in registry.MECHANISMS:
-        m = registry.mechanism_class(name)()
+    table = Table(title="mechanisms (fkopt list MECH for geometry and bounds)")
+    for col in ("name", "kind", "pose", "joints", "paper", "from"):
+        table.add_column(col, no_wrap=True)
+    for e in mechs:
+        try:   # class attributes only: listing builds no mechanism (the URDF one reads a file)
+            m = registry.mechanism_class(e.name)
+        except FkoptError as err:
+            table.add_row(e.name, "", "", "", "", escape(f"{e.origin}; error: {err}"))
+            continue
         mark = " (reconstruction)" if m.reconstruction else ""
-        table.add_row(name, m.kind, ", ".join(f"{n} [{u}]" for n, u in zip(m.pose_names, m.pose_units)),
-                      ", ".join(f"{n} [{u}]" for n, u in zip(m.joint_names, m.joint_units)),
-                      (m.paper or "") + mark)
+        table.add_row(e.name, m.kind, ", ".join(f"{n} \\[{u}]" for n, u in zip(m.pose_names, m.pose_units)),
+                      ", ".join(f"{n} \\[{u}]" for n, u in zip(m.joint_names, m.joint_units)),
+                      (m.paper or "") + mark, e.origin)
     con = _console()
-    con.print(table)
-    algos = Table(title="algorithms")
-    for col in ("name", "parameters (defaults)"):
-        algos.add_column(col)
-    for name in registry.ALGORITHMS:
-        cls = registry.algorithm_class(name)
+    _print_wide(con, table)     # one line per mechanism, even in a pipe
+    table = Table(title="algorithms")
+    for col in ("name", "parameters (defaults)", "from"):
+        table.add_column(col)
+    for e in algos:
+        if e.origin.startswith("adapter"):
+            table.add_row(e.name, "params: passed to the library; evaluations, workers", e.origin)
+            continue
+        try:
+            cls = registry.algorithm_class(e.name)
+        except FkoptError as err:
+            table.add_row(e.name, escape(f"error: {err}"), e.origin)
+            continue
         params = ", ".join(f"{k}={f.default!r}" for k, f in cls.Params.model_fields.items())
-        algos.add_row(name, params)
-    con.print(algos)
+        table.add_row(e.name, escape(params), e.origin)
+    con.print(table)
+    typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm (see README, Plug-ins).")
+
+
+def _list_mechanism(name: str, as_json: bool) -> None:
+    m = registry.mechanism_class(name)()
+    d = m.describe()
+    origin = next((e.origin for e in registry.entries("mechanism") if e.name == name), "direct reference")
+    units = dict(zip(m.unknown_names, m.unknown_units))
+    if as_json:
+        typer.echo(json.dumps({**d, "from": origin, "bounds_units": units}, default=str))
+        return
+    from rich.markup import escape
+    from rich.table import Table
+    con = _console()
+    title = f"{name}: {m.kind} mechanism" + (f", {m.paper}" if m.paper else "") + f" ({origin})"
+    con.print(f"[bold]{escape(title)}[/]")
+    if m.reconstruction:
+        con.print(escape(f"reconstruction: {m.reconstruction}"))
+    if "chain" in d:
+        con.print(escape("chain:  " + ", ".join(f"{k}={v}" for k, v in d["chain"].items())))
+    con.print("pose:   " + ", ".join(f"{n} \\[{u}]" for n, u in d["pose"].items()))
+    con.print("joints: " + ", ".join(f"{n} \\[{u}]" for n, u in d["joints"].items()))
+    bounds = Table(title=f"workspace bounds of the unknowns ({'pose' if m.kind == 'parallel' else 'joints'})")
+    for col in ("variable", "lower", "upper", "unit"):
+        bounds.add_column(col, justify="right" if col in ("lower", "upper") else "left")
+    for n, (lo, hi) in d["bounds"].items():
+        bounds.add_row(n, f"{lo:g}", f"{hi:g}", units.get(n, ""))
+    con.print(bounds)
+    geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)")
+    for col in ("key", "value", "description"):
+        geo.add_column(col)
+    fields = type(m.geometry).model_fields
+    for key, value in d["geometry"].items():
+        desc = fields[key].description or "" if key in fields else ""
+        geo.add_row(key, escape(json.dumps(value, default=str)), escape(desc))
+    con.print(geo)
 
 
 @app.command()
@@ -207,12 +262,27 @@ def _print_summary(con, df, folder: Path, wall: float) -> None:
     if df["case"].nunique() > 8:   # many cases: one line per algorithm
         df = df.groupby("algorithm", sort=False).agg({c: "median" for c in cols[2:]}).reset_index()
         df.insert(0, "case", "median over cases")
+    rows = [[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]] for _, row in df.iterrows()]
     table = Table(title=f"{folder}  ({wall:.2f} s)")
-    for c in cols:
-        table.add_column(SHORT.get(c, c), justify="right", no_wrap=c in ("case", "algorithm"))
-    for _, row in df.iterrows():
-        table.add_row(*[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]])
-    con.print(table)
+    for j, c in enumerate(cols):
+        # values are never cut ("1.54e-…", "succe…"): each column is as wide as its widest value
+        # (headers may wrap); a terminal narrower than that wraps the lines, losing nothing
+        widest = max((len(r[j]) for r in rows), default=1)
+        table.add_column(SHORT.get(c, c), justify="right", no_wrap=True, min_width=widest)
+    for r in rows:
+        table.add_row(*r)
+    _print_wide(con, table)
+
+
+def _print_wide(con, renderable) -> None:
+    """Print ``renderable`` unclipped: in a pipe (no terminal, where rich assumes 80 columns)
+    or a narrow terminal the console is widened to what the table needs."""
+    from rich.console import Console
+    from rich.measure import Measurement
+    need = Measurement.get(con, con.options.update_width(10_000), renderable).maximum
+    if need > con.width:
+        con = Console(width=need, highlight=False, file=con.file, force_terminal=con.is_terminal)
+    con.print(renderable)
 
 
 def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
@@ -350,6 +420,18 @@ def _emit(data: dict, as_json: bool, units) -> None:
             value = ", ".join(f"{k} {v}" for k, v in value.items())
         if name != key:
             typer.echo(f"{name:>8}: {value:.6g}" if isinstance(value, float) else f"{name:>8}: {value}")
+
+
+@app.command("export")
+def export_cmd(results: Path = typer.Argument(..., help="results folder: one experiment or a root of them"),
+               fmt: str = typer.Option("ioh", "--format", help="ioh: IOHprofiler data for IOHanalyzer"),
+               out: Path = typer.Option(..., "--out", help="folder to write (outside RESULTS)")):
+    """Export stored results for other tools (IOHanalyzer), without rerunning anything."""
+    from .export import FORMATS, ioh_export
+    if fmt not in FORMATS:
+        raise FkoptError(f"--format: unknown format '{fmt}'; allowed: {', '.join(FORMATS)}")
+    files = ioh_export(results, out)
+    typer.echo(f"wrote {len(files) - 1} IOHprofiler index files (.json) and their .dat files to {out}")
 
 
 @app.command()

@@ -75,9 +75,12 @@ class Mismatch:
 
 
 def deterministic_files(folder: Path) -> list[str]:
-    """Names of the files ``fkopt check`` compares: CSVs and meta.json, not timing files."""
+    """Names of the files ``fkopt check`` compares: CSVs (and gzip'ed CSVs: trace.csv.gz) and
+    meta.json, not timing files. A gzip'ed CSV is compared byte for byte on the same platform and
+    only through its recorded digest on another."""
     return sorted(p.name for p in Path(folder).iterdir()
-                  if p.is_file() and (p.suffix == ".csv" or p.name == "meta.json") and p.name not in TIMING_FILES)
+                  if p.is_file() and (p.name.endswith((".csv", ".csv.gz")) or p.name == "meta.json")
+                  and p.name not in TIMING_FILES)
 
 
 def sha256(path: Path) -> str:

@@ -20,7 +20,8 @@ from functools import lru_cache
 from importlib.metadata import PackageNotFoundError, version
 
 ENV_FILE = "env.json"
-LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich")
+LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich", "pymoo", "niapy",
+             "yourdfpy")
 
 
 def library_versions() -> dict[str, str]:

@@ -1,11 +1,35 @@
-"""Name -> implementation maps for mechanisms and algorithms.
+"""Name -> implementation maps for mechanisms and algorithms, built-in and plug-in.
 
-Adding a mechanism or an algorithm is one new module plus one line here. Entries are
-``"module:Class"`` strings imported on first use, so listing names costs nothing.
+A name resolves, in this order, to
+
+1. a **built-in** entry of :data:`MECHANISMS` / :data:`ALGORITHMS` (``"module:Class"`` strings
+   imported on first use, so listing names costs nothing). Adding one to fkopt is one module
+   plus one line here;
+2. an **adapter** of another library's optimiser (algorithms only): the reserved prefixes
+   ``scipy:``, ``pymoo:`` and ``niapy:`` (e.g. ``"pymoo:DE"``), see :mod:`fkopt.adapters`;
+3. an **entry point** of an installed package, in the groups ``fkopt.mechanisms`` and
+   ``fkopt.algorithms`` (``[project.entry-points."fkopt.algorithms"] de = "mypkg.de:DE"``).
+   Entry points are read only when a name is not built in (or when listing), so ``fkopt fk
+   3-rps`` never scans installed packages;
+4. a **direct reference** ``package.module:Class``.
+
+Whatever an entry point or a direct reference names is checked *before anything is called*:
+it must be a class and a subclass of fkopt's documented base
+(:class:`fkopt.mechanisms.base.Mechanism`, :class:`fkopt.algorithms.base.Algorithm`);
+anything else -- a function such as ``subprocess:run``, a module attribute that is not a
+class, a class of the wrong kind -- is refused with one line naming it. (Importing the named
+module runs its top level, as any ``import`` does; only installed or importable modules can be
+named, and nothing they define is *called* unless it passed the check.)
+
+Every failure is one :class:`~fkopt.errors.FkoptError` line naming the plug-in: an unknown
+name, an entry point or module that fails to import, a class missing a required method.
 """
 from __future__ import annotations
 
 import importlib
+import re
+from dataclasses import dataclass
+from functools import lru_cache
 
 from .errors import FkoptError, did_you_mean
 
@@ -17,6 +41,7 @@ MECHANISMS: dict[str, str] = {
     "3-ppr": "fkopt.mechanisms.ppr3:ThreePPR",
     "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",
     "7dof-arm": "fkopt.mechanisms.dh_arm:SevenDofArm",
+    "urdf": "fkopt.mechanisms.urdf:URDFArm",
 }
 
 ALGORITHMS: dict[str, str] = {
@@ -33,14 +58,120 @@ ALGORITHMS: dict[str, str] = {
     "pso+lm": "fkopt.algorithms.hybrid:PSOLM",
 }
 
+#: Prefixes reserved for the adapters of other libraries' optimisers (fkopt.adapters).
+ADAPTER_PREFIXES = ("scipy", "pymoo", "niapy")
+
+#: Entry-point groups third-party packages register in.
+GROUPS = {"mechanism": "fkopt.mechanisms", "algorithm": "fkopt.algorithms"}
+
+#: Methods a plug-in class must provide (checked on the class, before it is instantiated).
+REQUIRED = {"mechanism": {"parallel": ("ik",), "serial": ("fk",)},
+            "algorithm": ("minimize",)}
+
+_REFERENCE = re.compile(r"^[A-Za-z_][\w]*(\.[A-Za-z_]\w*)*:[A-Za-z_]\w*$")
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One name fkopt can resolve and where it comes from (for ``fkopt list``)."""
+
+    kind: str      # "mechanism" | "algorithm"
+    name: str
+    target: str    # "module:Class"
+    origin: str    # "built-in", "adapter", "entry point (distribution 1.0)"
+
+
+def _base(kind: str) -> type:
+    if kind == "mechanism":
+        from .mechanisms.base import Mechanism
+        return Mechanism
+    from .algorithms.base import Algorithm
+    return Algorithm
+
+
+def check_class(obj, kind: str, where: str):
+    """Refuse ``obj`` unless it is a class deriving from fkopt's base of ``kind`` and
+    overriding the required methods; nothing of ``obj`` is called."""
+    base = _base(kind)
+    if not isinstance(obj, type):
+        raise FkoptError(f"{kind} plug-in '{where}' is a {type(obj).__name__}, not a class; a plug-in must "
+                         f"be a subclass of {base.__module__}.{base.__qualname__}")
+    if not issubclass(obj, base):
+        raise FkoptError(f"{kind} plug-in '{where}' ({obj.__module__}.{obj.__qualname__}) does not subclass "
+                         f"{base.__module__}.{base.__qualname__}; refused")
+    if kind == "mechanism":
+        from .mechanisms.base import ParallelMechanism, SerialMechanism
+        family = ("parallel" if issubclass(obj, ParallelMechanism)
+                  else "serial" if issubclass(obj, SerialMechanism) else None)
+        if family is None:
+            raise FkoptError(f"mechanism plug-in '{where}' must subclass ParallelMechanism or SerialMechanism")
+        family_base = ParallelMechanism if family == "parallel" else SerialMechanism
+        missing = [] if hasattr(obj, "name") else ["name"]
+        missing += [m for m in REQUIRED["mechanism"][family] if getattr(obj, m) is getattr(family_base, m)]
+    else:
+        from .algorithms.base import Algorithm
+        missing = [] if hasattr(obj, "name") else ["name"]
+        # either the two-method protocol or a minimize of its own (adapters)
+        if obj.minimize is Algorithm.minimize:
+            missing += [m for m in ("initialize", "iterate") if getattr(obj, m) is getattr(Algorithm, m)]
+    if missing:
+        raise FkoptError(f"{kind} plug-in '{where}' ({obj.__module__}.{obj.__qualname__}) is missing "
+                         f"{', '.join(missing)}")
+    return obj
+
+
+def _import_target(target: str, kind: str, where: str):
+    module, _, attr = target.partition(":")
+    try:
+        mod = importlib.import_module(module)
+    except Exception as err:   # the plug-in's own import failed: name it, no traceback
+        raise FkoptError(f"{kind} plug-in '{where}': cannot import {module} "
+                         f"({type(err).__name__}: {err})") from None
+    try:
+        return getattr(mod, attr)
+    except AttributeError:
+        raise FkoptError(f"{kind} plug-in '{where}': module {module} has no attribute '{attr}'") from None
+
+
+@lru_cache(maxsize=None)
+def entry_points(kind: str) -> dict[str, tuple[str, str, object]]:
+    """Installed entry points of ``kind``: name -> (target, distribution, EntryPoint)."""
+    from importlib.metadata import entry_points as _eps
+    out = {}
+    for ep in _eps(group=GROUPS[kind]):
+        dist = getattr(ep, "dist", None)
+        origin = f"{dist.name} {dist.version}" if dist is not None else "unknown distribution"
+        out.setdefault(ep.name, (ep.value, origin, ep))
+    return out
+
 
 def _load(table: dict[str, str], kind: str, name: str):
-    try:
-        target = table[name]
-    except KeyError:
-        raise FkoptError(f"unknown {kind} '{name}'; allowed: {did_you_mean(name, table)}") from None
-    module, cls = target.split(":")
-    return getattr(importlib.import_module(module), cls)
+    if not isinstance(name, str) or not name:
+        raise FkoptError(f"{kind} name must be a non-empty string, got {name!r}")
+    if name in table:
+        module, cls = table[name].split(":")
+        return getattr(importlib.import_module(module), cls)
+    prefix, sep, rest = name.partition(":")
+    if sep and prefix in ADAPTER_PREFIXES:
+        if kind != "algorithm":
+            raise FkoptError(f"'{name}': the prefix '{prefix}:' is reserved for algorithm adapters")
+        from .adapters import adapter_class
+        return adapter_class(prefix, rest)
+    eps = entry_points(kind)
+    if name in eps:
+        target, origin, ep = eps[name]
+        try:
+            obj = ep.load()
+        except Exception as err:
+            raise FkoptError(f"{kind} plug-in '{name}' (entry point {target} from {origin}) failed to import: "
+                             f"{type(err).__name__}: {err}") from None
+        return check_class(obj, kind, name)
+    if sep and _REFERENCE.match(name):
+        return check_class(_import_target(name, kind, name), kind, name)
+    allowed = did_you_mean(name, [*table, *eps])
+    raise FkoptError(f"unknown {kind} '{name}'; allowed: {allowed}, "
+                     + ("scipy:NAME, pymoo:NAME, niapy:NAME, " if kind == "algorithm" else "")
+                     + "or package.module:Class of an installed plug-in")
 
 
 def mechanism_class(name: str):
@@ -49,3 +180,31 @@ def mechanism_class(name: str):
 
 def algorithm_class(name: str):
     return _load(ALGORITHMS, "algorithm", name)
+
+
+def resolve_files(cls, geometry: dict, folder) -> dict:
+    """``geometry`` with the file fields of mechanism ``cls`` (``cls.file_fields``, e.g. the URDF
+    ``file``) made relative to ``folder`` (the config file's folder) when they are relative."""
+    fields = getattr(cls, "file_fields", ())
+    if folder is None or not fields:
+        return dict(geometry)
+    from pathlib import Path
+    out = dict(geometry)
+    for key in fields:
+        value = out.get(key)
+        if isinstance(value, str) and value and not Path(value).is_absolute():
+            out[key] = str(Path(folder) / value)
+    return out
+
+
+def entries(kind: str) -> list[Entry]:
+    """Every name of ``kind`` fkopt knows without a direct reference, with its origin."""
+    table = MECHANISMS if kind == "mechanism" else ALGORITHMS
+    out = [Entry(kind, n, t, "built-in") for n, t in table.items()]
+    if kind == "algorithm":
+        from .adapters import ADAPTERS
+        out += [Entry(kind, f"{p}:{n}", t, f"adapter ({p}, {'optional' if p != 'scipy' else 'core'})")
+                for p, names in ADAPTERS.items() for n, t in names.items()]
+    out += [Entry(kind, n, t, f"entry point ({origin})")
+            for n, (t, origin, _) in entry_points(kind).items() if n not in table]
+    return out

@@ -1,4 +1,4 @@
-"""The verdict machinery: rank tests, equal-evaluation reads of trace.csv, timing verdicts, the
+"""The verdict machinery: rank tests, equal-evaluation reads of trace.csv.gz, timing verdicts, the
 selection parameter behind mao2017's Tab. 3 floor, and `fkopt check` failing on a changed verdict."""
 import shutil
 from pathlib import Path
@@ -43,7 +43,7 @@ def _fake_experiment(tmp_path) -> Experiment:
     # run 0 of "a": f = 8 at 0 evaluations, 4 at 100, 1 at 300; run 1 stops at iteration 2
     pd.DataFrame({"case": "c", "algorithm": "a", "run": [0, 0, 0, 1, 1],
                   "iteration": [0, 1, 3, 0, 2], "evaluations": [10, 100, 300, 10, 200],
-                  "best_fitness": [8.0, 4.0, 1.0, 9.0, 0.5]}).to_csv(folder / "trace.csv", index=False)
+                  "best_fitness": [8.0, 4.0, 1.0, 9.0, 0.5]}).to_csv(folder / "trace.csv.gz", index=False)
     pd.DataFrame({"case": "c", "algorithm": "a", "run": [0, 1], "final_fitness": [1.0, 0.5],
                   "evaluations": [400, 200], "iterations_done": [4, 2]}).to_csv(folder / "runs.csv", index=False)
     return Experiment(folder)

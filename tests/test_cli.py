@@ -95,7 +95,7 @@ def test_run_writes_all_files(tmp_path):
     meta = json.loads((folder / "meta.json").read_text())
     assert meta["seed"] == 1 and meta["config"]["runs"] == 4
     assert "libraries" not in meta and "platform" not in meta      # environment: env.json
-    assert set(meta["files"]) == {"summary.csv", "values.csv", "runs.csv", "trace.csv", "convergence.csv"}
+    assert set(meta["files"]) == {"summary.csv", "values.csv", "runs.csv", "trace.csv.gz", "convergence.csv"}
     env = json.loads((folder / "env.json").read_text())
     assert "numpy" in env["libraries"] and env["fkopt_version"] and env["fingerprint"]["machine"]
     assert not [p for p in (tmp_path / "res" / "test").iterdir() if p.name.startswith(".")]

@@ -32,7 +32,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
 from ..files import MAX_COMPONENT, check_component, error_line, load_mapping
@@ -147,6 +147,8 @@ class RunConfig(Strict):
     #: Which regression check reruns it: "ci" (every CI run and `make check`) or "full"
     #: (`make check` only, for experiments too long for CI).
     check: Literal["ci", "full"] = "ci"
+    #: Folder of the config file: relative files of the mechanism (URDF) are resolved there.
+    _folder: Path | None = PrivateAttr(None)
 
     @field_validator("algorithms")
     @classmethod
@@ -223,4 +225,6 @@ def experiment_from_dict(data: dict, where: str) -> ExperimentConfig:
 def load_config(path: str | Path) -> ExperimentConfig:
     """Read and validate an experiment file; errors name the file, line or field."""
     data = load_mapping(path, "experiment fields")
-    return experiment_from_dict(data, str(path))
+    config = experiment_from_dict(data, str(path))
+    config._folder = Path(path).parent   # relative files (e.g. a URDF) resolve beside the config
+    return config

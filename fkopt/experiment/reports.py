@@ -14,7 +14,7 @@ the figures drawn from timings, ``cases_time.png``):
 * ``inputs.csv``      (only when a case gives both joints and a pose) given vs computed inputs;
 * ``runs.csv``        one row per run (incl. ``iterations_to_best``: first iteration at which the
   run's final best-so-far fitness was reached);
-* ``trace.csv``       per-run best-so-far fitness where it changed, with evaluations (equal-evaluation
+* ``trace.csv.gz``    per-run best-so-far fitness where it changed, with evaluations (equal-evaluation
   comparisons of the claims);
 * ``convergence.csv`` best-so-far fitness per iteration: median and quartiles over runs, mean
   evaluations; ``convergence.png`` the same on a log scale (vs iterations and vs evaluations);
@@ -45,6 +45,7 @@ from ..files import output_folder, write_atomically, write_json
 from ..provenance import ENV_FILE, LIBRARIES, environment, library_versions  # noqa: F401 (re-exported)
 from . import plotting
 from .runner import ExperimentResult, pose_error
+from .traces import write_trace
 
 FLOAT = "%.10g"
 #: Fitness of exactly 0 cannot be drawn on a log axis; it is drawn at this floor (and said so).
@@ -180,31 +181,6 @@ def runs_table(er: ExperimentResult) -> pd.DataFrame:
         for key in r.extras:
             df[f"final_{key}"] = r.extras[key][:, -1]
         frames.append(df)
-    return pd.concat(frames, ignore_index=True)
-
-
-def trace_table(er: ExperimentResult) -> pd.DataFrame | None:
-    """Per-run best-so-far fitness where it changed (lossless step function), with evaluations.
-
-    Rows: iteration 0, every iteration whose best-so-far differs from the previous one, and the
-    run's last iteration. The best-so-far after ``E`` evaluations is the value of the last row
-    with ``evaluations <= E``: what equal-evaluation comparisons of the claims use. Written only
-    for experiments of at most ``MAX_CASE_CURVES`` cases and more than one run (size).
-    """
-    if len(er.cases) > MAX_CASE_CURVES or er.config.runs < 2:
-        return None
-    frames = []
-    for rec in er.records:
-        r = rec.result
-        h, ev = r.history, r.evaluation_history
-        keep = np.zeros(h.shape, dtype=bool)
-        keep[:, 0] = True
-        keep[:, 1:] = h[:, 1:] != h[:, :-1]
-        keep[np.arange(r.runs), r.iterations_done] = True
-        keep &= np.arange(h.shape[1]) <= r.iterations_done[:, None]
-        k, t = np.nonzero(keep)
-        frames.append(pd.DataFrame({"case": rec.case.label, "algorithm": rec.spec.key, "run": r.run_ids[k],
-                                    "iteration": t, "evaluations": ev[k, t], "best_fitness": h[k, t]}))
     return pd.concat(frames, ignore_index=True)
 
 
@@ -618,7 +594,7 @@ def write_tables(er: ExperimentResult, folder: Path, figures: bool = True) -> li
     csv("values.csv", values_table(er))
     csv("inputs.csv", inputs_table(er))
     csv("runs.csv", runs_table(er))
-    csv("trace.csv", trace_table(er))
+    written.append(write_trace(er, folder))   # each run's best-so-far improvements (claims, fkopt export)
     csv("convergence.csv", convergence_table(er))
     if figures:
         written += write_figures(er, folder, summary, timing)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 import zlib
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -79,7 +80,8 @@ def task_seed(seed: int, case_index: int, label: str) -> int:
 
 def build_mechanism(config: ExperimentConfig):
     cls = registry.mechanism_class(config.mechanism.name)
-    return cls(bounds=dict(config.mechanism.bounds), **config.mechanism.geometry)
+    geometry = registry.resolve_files(cls, config.mechanism.geometry, getattr(config, "_folder", None))
+    return cls(bounds=dict(config.mechanism.bounds), **geometry)
 
 
 def _check_in_bounds(mech, pose: np.ndarray, where: str) -> None:
@@ -193,6 +195,8 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
     each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
     """
+    if source and getattr(config, "_folder", None) is None:   # relative files resolve beside the config
+        config._folder = Path(source).parent
     mech, cases, problems = validate_experiment(config)
     one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
     batched = problems[0] if one else batched_problem(config, mech, cases)

@@ -256,8 +256,8 @@ def claims(store) -> list[Claim]:
         c.numbers["orders"] = float(gain)
         out.append(c)
         half = T // 2   # 150 of 300: P-ABC's switch from PSO to ABC
-    if t1 is not None and not t1.has("trace.csv"):
-        out.append(missing("Fig. 7 claims", "chang2024/tab1_fig7/trace.csv (per-run traces)"))
+    if t1 is not None and not t1.has("trace.csv.gz"):
+        out.append(missing("Fig. 7 claims", "chang2024/tab1_fig7/trace.csv.gz (per-run traces)"))
     elif t1 is not None:
         vs = {b: equal_budget(t1, "abc", b, NAMES, iteration=half) for b in ("pso", "pabc")}
         out.append(Claim(

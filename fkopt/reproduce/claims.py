@@ -10,7 +10,7 @@ Verdicts (:data:`RULES` is printed in the report's preamble):
 Claims comparing two algorithms are decided by a two-sided Mann-Whitney rank test over the runs
 (:func:`compare`, alpha = 0.05; identical samples are no difference), never by two medians
 alone, at equal iterations *and* at equal function evaluations (:func:`at_evaluations`, from
-``trace.csv``). The verdict follows the budget measure the paper used; the other is shown beside.
+``trace.csv.gz``). The verdict follows the budget measure the paper used; the other is shown beside.
 
 Every claim carries the numbers behind its verdict (:attr:`Claim.numbers`): the tests assert them,
 and ``claims.csv`` (one per paper, written by ``fkopt report``) stores the verdicts that
@@ -128,8 +128,8 @@ def compare(a: str, values_a, b: str, values_b) -> Comparison:
 
 
 def at_iteration(exp, algo: str, iteration: int | None = None, case: str | None = None) -> np.ndarray:
-    """Per-run best-so-far fitness after ``iteration`` (default: the end) from trace.csv/runs.csv."""
-    if iteration is None or not exp.has("trace.csv"):
+    """Per-run best-so-far fitness after ``iteration`` (default: the end) from trace.csv.gz/runs.csv."""
+    if iteration is None or not exp.has("trace.csv.gz"):
         r = exp.table("runs")
         r = r[r.algorithm == algo] if case is None else r[(r.algorithm == algo) & (r["case"] == case)]
         return r.sort_values("run").final_fitness.to_numpy(float)
@@ -137,7 +137,7 @@ def at_iteration(exp, algo: str, iteration: int | None = None, case: str | None 
 
 
 def at_evaluations(exp, algo: str, evaluations: float, case: str | None = None) -> np.ndarray:
-    """Per-run best-so-far fitness after ``evaluations`` function evaluations (trace.csv)."""
+    """Per-run best-so-far fitness after ``evaluations`` function evaluations (trace.csv.gz)."""
     return _from_trace(exp, algo, "evaluations", evaluations, case)
 
 
@@ -153,7 +153,7 @@ def _from_trace(exp, algo, column, budget, case) -> np.ndarray:
 
 def first_below(exp, algo: str, level: float, case: str | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per run: (iteration, evaluations) at which the best-so-far first went below ``level``
-    (inf where it never did), from trace.csv."""
+    (inf where it never did), from trace.csv.gz."""
     t = exp.table("trace")
     t = t[t.algorithm == algo] if case is None else t[(t.algorithm == algo) & (t["case"] == case)]
     its, evs = [], []
@@ -189,7 +189,7 @@ def equal_budget(exp, a: str, b: str, names: dict[str, str], case: str | None = 
     budget = min(evaluations_at(exp, x, iteration, case) for x in (a, b))
     it = compare(names.get(a, a), at_iteration(exp, a, iteration, case), names.get(b, b),
                  at_iteration(exp, b, iteration, case))
-    if not exp.has("trace.csv"):
+    if not exp.has("trace.csv.gz"):
         return it, None, budget
     evc = compare(names.get(a, a), at_evaluations(exp, a, budget, case), names.get(b, b),
                   at_evaluations(exp, b, budget, case))

@@ -91,8 +91,8 @@ def claims(store) -> list[Claim]:
             f"re-implemented ACO on the consistent inputs: equal iterations (600): {it.text()}; equal "
             f"evaluations ({budget:.0f}): {ev.text() if ev else 'n/a (no per-run trace)'}",
             {"p_iterations": it.p, "median_aco": it.median_a, "median_abc": it.median_b}))
-    if t3 is not None and not t3.has("trace.csv"):
-        out.append(missing("Fig. 2 claims", "mao2017/tab2_tab3_fig2/trace.csv (per-run traces)"))
+    if t3 is not None and not t3.has("trace.csv.gz"):
+        out.append(missing("Fig. 2 claims", "mao2017/tab2_tab3_fig2/trace.csv.gz (per-run traces)"))
     elif t3 is not None:
         runs = {a: first_below(t3, a, FLOOR) for a in ("abc", "gabc", "gabc_zhu2010")}
         med = {a: float(np.median(runs[a][0])) for a in runs}

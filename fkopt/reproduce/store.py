@@ -51,7 +51,9 @@ class Experiment:
 
     def table(self, name: str) -> pd.DataFrame:
         """A CSV of the experiment by stem (``summary``) or file name."""
-        file = name if name.endswith(".csv") else f"{name}.csv"
+        file = name if name.endswith((".csv", ".csv.gz")) else f"{name}.csv"
+        if not (self.folder / file).exists() and (self.folder / f"{file}.gz").exists():
+            file += ".gz"      # trace.csv.gz (fkopt.experiment.traces)
         return pd.read_csv(self.folder / file, keep_default_na=True)
 
     def figures(self) -> list[str]:

@@ -213,7 +213,7 @@ def _per_run(runs: pd.DataFrame, algo: str, column: str) -> np.ndarray:
 
 
 def _evaluations_to_best(exp, algo: str) -> np.ndarray:
-    """Per run: evaluations spent when its final best-so-far was first reached (trace.csv)."""
+    """Per run: evaluations spent when its final best-so-far was first reached (trace.csv.gz)."""
     t = exp.table("trace")
     t = t[t.algorithm == algo]
     last = t.sort_values(["run", "iteration"]).groupby("run").tail(1).set_index("run").best_fitness
@@ -242,7 +242,7 @@ def claims(store) -> list[Claim]:
         a, s = t.loc["abc"], t.loc["pso"]
         cb = compare("ABC", _per_run(runs, "abc", "iterations_to_best"), "PSO", _per_run(runs, "pso", "iterations_to_best"))
         ce = (compare("ABC", _evaluations_to_best(t3, "abc"), "PSO", _evaluations_to_best(t3, "pso"))
-              if t3.has("trace.csv") else None)
+              if t3.has("trace.csv.gz") else None)
         out.append(Claim(
             "Tab. 3: ABC reaches its best solution in fewer iterations than PSO (115 vs 311)",
             verdict(cb.lower == "ABC"),

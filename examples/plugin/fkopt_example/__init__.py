@@ -1,0 +1,1 @@
+"""Example fkopt plug-ins (see README.md beside pyproject.toml)."""

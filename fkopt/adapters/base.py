@@ -1,0 +1,227 @@
+"""The adapter of an external optimiser: a counting fitness wrapper and one RunRecord.
+
+For every library, fkopt -- not the library -- does the bookkeeping:
+
+* **Counting.** The library sees a wrapper of ``problem.fitness``. It counts each point it
+  evaluates (a batch of n points is n evaluations) and records best-so-far per evaluation: the
+  evaluation number, fitness and point of every improvement (:class:`Trace`).
+* **Budget.** A run gets ``evaluations`` fitness evaluations (param; default
+  ``population * (iterations + 1)``, what a generational method with that population uses
+  in ``iterations`` generations after its initial population). The library's own stopping
+  option is set to the budget where it has one, and the wrapper enforces it anyway: a batch
+  that would cross the budget is evaluated only up to it, and the next call raises a private
+  exception that ends the library's run. So no run ever uses more than the budget; a library
+  that stops by itself (converged) uses fewer, and the records say how many.
+* **Seeds.** Run k of a task gets the integer seed ``SeedSequence(seed, spawn_key=(k,))``
+  ``.generate_state(1)[0]`` (scipy gets a ``Generator`` on that SeedSequence), the stream
+  of :mod:`fkopt.streams` -- so run k gives the same numbers alone, in a batch or in a worker.
+* **Processes.** Runs are independent; ``workers`` (param; default 1 for libraries that
+  evaluate whole populations at once, the CPU count for per-point libraries such as NiaPy)
+  runs them in that many processes. The numbers do not depend on it.
+* **Target.** With ``stop_at_target`` a run stops after the call (a batch for vectorised
+  libraries) whose evaluations first went below the target; the whole batch is counted.
+
+Iteration axis. fkopt's records are indexed by iteration t = 0..iterations. For a library run
+the record t is the state after ``e_t = e_0 + round(t (B - e_0) / iterations)`` evaluations,
+with B the budget and e_0 = min(population, B): t = 0 is after the first population, t =
+iterations at the budget, evenly spaced between. With the default budget e_t = population (t +
+1), one iteration = one population's worth of evaluations. ``evaluation_history`` holds the
+evaluations actually used by then (``min(e_t, used)``), so evaluation-based comparisons
+(``mean_evaluations``, evaluations to threshold) are exact, while iteration-based ones compare
+checkpoints, not the library's generations. ``iterations_done`` is the first record below the
+target (with ``stop_at_target``), else ``iterations``.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+from pydantic import ConfigDict, Field
+
+from ..algorithms.base import Algorithm, Params, RunRecord
+from ..errors import FkoptError
+
+
+class _Stop(Exception):
+    """Raised by the wrapper to end a library's run (budget used up or target reached)."""
+
+
+class ExternalParams(Params):
+    """fkopt's own parameters of an adapter; every other key goes to the library."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+    evaluations: int | None = Field(None, ge=1, description="evaluation budget per run "
+                                    "(default population * (iterations + 1))")
+    workers: int | None = Field(None, ge=1, description="processes running the runs "
+                                "(default 1, or the CPU count for per-point libraries)")
+
+
+@dataclass
+class Trace:
+    """Best-so-far of one run, improvements only: ``evals[i]`` is the evaluation number at
+    which ``f[i]`` (point ``x[i]``) became the best; ``used`` the evaluations used."""
+
+    evals: np.ndarray
+    f: np.ndarray
+    x: np.ndarray
+    used: int
+
+
+class Counter:
+    """The fitness the library sees: counts, records improvements, enforces budget and target."""
+
+    def __init__(self, problem, budget: int, target: float | None = None, stop: bool = False):
+        self.problem = problem
+        self.budget = int(budget)
+        self.stop_below = target if (stop and target is not None) else None
+        self.n = 0
+        self.best = np.inf
+        self._evals: list[int] = []
+        self._f: list[float] = []
+        self._x: list[np.ndarray] = []
+
+    def batch(self, X) -> np.ndarray:
+        """Fitness of points ``X`` shaped (n, dim) -> (n,)."""
+        X = np.asarray(X, dtype=float)
+        if self.n >= self.budget or (self.stop_below is not None and self.best < self.stop_below):
+            raise _Stop
+        take = min(len(X), self.budget - self.n)
+        f = np.asarray(self.problem.fitness(X[:take]), dtype=float).reshape(take)
+        f = np.where(np.isnan(f), np.inf, f)
+        running = np.minimum.accumulate(np.concatenate([[self.best], f]))
+        for i in np.flatnonzero(running[1:] < running[:-1]):
+            self._evals.append(self.n + int(i) + 1)
+            self._f.append(float(f[i]))
+            self._x.append(X[i].copy())
+        self.best = float(running[-1])
+        self.n += take
+        if take < len(X) or (self.stop_below is not None and self.best < self.stop_below):
+            raise _Stop     # a batch that reached the target still counts whole: it was evaluated
+        return f
+
+    def point(self, x) -> float:
+        """Fitness of one point ``x`` shaped (dim,) (per-point libraries)."""
+        return float(self.batch(np.asarray(x, dtype=float)[None, :])[0])
+
+    def trace(self) -> Trace:
+        dim = self.problem.dim
+        return Trace(np.array(self._evals, dtype=np.int64), np.array(self._f, dtype=float),
+                     np.array(self._x, dtype=float).reshape(-1, dim), self.n)
+
+
+def checkpoints(population: int, iterations: int, budget: int) -> np.ndarray:
+    """Evaluation counts e_t (t = 0..iterations) at which the records are taken (module doc)."""
+    e0 = min(int(population), int(budget))
+    t = np.arange(int(iterations) + 1)
+    return e0 + np.rint(t * (budget - e0) / iterations).astype(np.int64)
+
+
+def run_seed(seed: int, run: int) -> np.random.SeedSequence:
+    """Run ``run``'s seed sequence (:func:`fkopt.streams.run_seed_sequence`)."""
+    return np.random.SeedSequence(int(seed), spawn_key=(int(run),))
+
+
+def _runner(library: str):
+    if library == "scipy":
+        from .scipy_ import run
+    elif library == "pymoo":
+        from .pymoo_ import run
+    else:
+        from .niapy_ import run
+    return run
+
+
+def run_one(library: str, method: str, params: dict, problem, population: int, budget: int,
+            seed_seq: np.random.SeedSequence, target, stop: bool, x0) -> Trace:
+    """One run of ``library:method`` (module level, so a worker process can run it)."""
+    counter = Counter(problem, budget, target, stop)
+    try:
+        _runner(library)(method, dict(params), counter, problem, int(population), int(budget), seed_seq, x0)
+    except _Stop:
+        pass
+    except FkoptError:
+        raise
+    except Exception as err:   # the library failed: one line naming it
+        from importlib.metadata import version
+        from .libraries import DISTRIBUTIONS
+        msg = str(err).strip().splitlines()[0] if str(err).strip() else ""
+        raise FkoptError(f"algorithm '{library}:{method}' ({library} {version(DISTRIBUTIONS[library])}) "
+                         f"raised {type(err).__name__}: {msg}") from None
+    if counter.n > budget:   # pragma: no cover - Counter never lets it happen
+        raise FkoptError(f"algorithm '{library}:{method}' used {counter.n} evaluations, budget {budget}")
+    return counter.trace()
+
+
+class ExternalAlgorithm(Algorithm):
+    """An optimiser of another library run by fkopt (see the module docstring)."""
+
+    Params = ExternalParams
+    library: ClassVar[str]
+    method: ClassVar[str]
+    target: ClassVar[Any]
+    #: Per-point libraries are slow per agent: their runs default to one process per CPU.
+    per_point: ClassVar[bool] = False   # set for niapy in fkopt.adapters.adapter_class
+    evaluations_per_iteration = "population (one record per population's worth of evaluations)"
+
+    def __init__(self, **params: Any):
+        super().__init__(**params)
+        self.library_params = dict(self.params.model_extra or {})
+        from importlib import import_module
+        import_module(f"{__package__}.{self.library}_").check_params(self.method, self.target,
+                                                                      self.library_params)
+
+    def budget_for(self, population: int, iterations: int) -> int:
+        return int(self.params.evaluations or population * (iterations + 1))
+
+    def minimize(self, problem, *, population: int, iterations: int, streams, target=None,
+                 stop_at_target: bool = False, x0=None, snapshots=(), **_ignored) -> RunRecord:
+        budget = self.budget_for(population, iterations)
+        runs = list(streams.run_ids)
+        seeds = [run_seed(streams.seed, k) for k in runs]
+        start = None if x0 is None else np.asarray(x0, dtype=float)
+        args = [(self.library, self.method, self.library_params, problem, population, budget, s,
+                 target, stop_at_target, None if start is None else (start if start.ndim == 1 else start[i]))
+                for i, s in enumerate(seeds)]
+        workers = self.params.workers or ((os.cpu_count() or 1) if self.per_point else 1)
+        workers = min(workers, len(runs))
+        if workers <= 1:
+            traces = [run_one(*a) for a in args]
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+            methods = multiprocessing.get_all_start_methods()
+            ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+                traces = list(pool.map(run_one, *zip(*args)))
+        self.last_traces = traces
+        return record_from_traces(traces, population, iterations, budget, problem.dim,
+                                  target if stop_at_target else None)
+
+
+def record_from_traces(traces: list[Trace], population: int, iterations: int, budget: int, dim: int,
+                       stop_target: float | None) -> RunRecord:
+    """Sample each run's improvement trace at the checkpoints e_t (module docstring)."""
+    e = checkpoints(population, iterations, budget)
+    runs = len(traces)
+    history = np.full((runs, iterations + 1), np.inf)
+    x_history = np.full((runs, iterations + 1, dim), np.nan)
+    evals = np.empty((runs, iterations + 1), dtype=np.int64)
+    done = np.full(runs, iterations)
+    for r, tr in enumerate(traces):
+        idx = np.searchsorted(tr.evals, e, side="right") - 1
+        ok = idx >= 0
+        history[r, ok] = tr.f[idx[ok]]
+        x_history[r, ok] = tr.x[idx[ok]]
+        evals[r] = np.minimum(e, tr.used)
+        if stop_target is not None:
+            below = np.flatnonzero(history[r] < stop_target)
+            if below.size:
+                done[r] = below[0]
+    return RunRecord(best_x=x_history[:, -1].copy(), best_f=history[:, -1].copy(), history=history,
+                     x_history=x_history, evaluation_history=evals, iterations_done=done)
+
+
+__all__ = ["Counter", "ExternalAlgorithm", "ExternalParams", "Trace", "checkpoints", "record_from_traces",
+           "run_one", "run_seed"]
