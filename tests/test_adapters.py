@@ -141,3 +141,14 @@ def test_pymoo_and_niapy_names_and_params():
     a = fkopt.algorithm("pymoo:DE", CR=0.5)
     r = fkopt.solve(Sphere(dim=2), a, population=10, iterations=5, runs=1)
     assert r.params["CR"] == 0.5 and r.evaluations[0] == 60
+
+
+def test_adapter_on_a_problem_with_cases_solves_each_case_as_alone():
+    """A batched problem (one target per case): each row's run gets its own case's target and seed."""
+    m = fkopt.mechanism("3-rps")
+    p = fkopt.fk_problem(m, m.ik([[9, 13, 622], [0, 0, 500]]))
+    both = fkopt.solve(p, "scipy:differential_evolution", population=10, iterations=20, runs=2, seed=[1, 2])
+    alone = fkopt.solve(p.case(1), "scipy:differential_evolution", population=10, iterations=20, runs=2, seed=2)
+    assert both.fitness.shape == (2, 2)
+    np.testing.assert_array_equal(both.case(1).fitness, alone.fitness)
+    np.testing.assert_array_equal(both.case(1).x, alone.x)

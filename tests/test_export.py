@@ -32,10 +32,11 @@ def stored(tmp_path_factory):
 def test_run_trace_keeps_improvements_and_the_final_count():
     hist = np.array([[5.0, 5.0, 3.0, 3.0, 1.0, 1.0]])
     evals = np.array([[10, 20, 30, 40, 50, 60]])
-    r, e, f = run_trace(hist, evals)
+    r, it, e, f = run_trace(hist, evals)
     assert e.tolist() == [10, 30, 50, 60] and f.tolist() == [5.0, 3.0, 1.0, 1.0]
-    r, e, f = run_trace(hist, evals, done=np.array([2]))    # stopped at iteration 2
-    assert e.tolist() == [10, 30]
+    assert it.tolist() == [0, 2, 4, 5]
+    r, it, e, f = run_trace(hist, evals, done=np.array([2]))    # stopped at iteration 2
+    assert e.tolist() == [10, 30] and it.tolist() == [0, 2]
 
 
 def test_trace_file_matches_the_runs(stored):

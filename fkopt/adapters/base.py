@@ -179,10 +179,14 @@ class ExternalAlgorithm(Algorithm):
                  stop_at_target: bool = False, x0=None, snapshots=(), **_ignored) -> RunRecord:
         budget = self.budget_for(population, iterations)
         runs = list(streams.run_ids)
-        seeds = [run_seed(streams.seed, k) for k in runs]
+        # one seed per batch row (rows of several cases carry their case's seed, fkopt.streams)
+        seeds = [run_seed(s, k) for s, k in zip(streams.seeds, runs)]
         start = None if x0 is None else np.asarray(x0, dtype=float)
-        args = [(self.library, self.method, self.library_params, problem, population, budget, s,
-                 target, stop_at_target, None if start is None else (start if start.ndim == 1 else start[i]))
+        # a problem with a case axis holds one target per row: each run solves its own row's
+        batched = getattr(problem, "cases", None) is not None
+        args = [(self.library, self.method, self.library_params, problem.case(i) if batched else problem,
+                 population, budget, s, target, stop_at_target,
+                 None if start is None else (start if start.ndim == 1 else start[i]))
                 for i, s in enumerate(seeds)]
         workers = self.params.workers or ((os.cpu_count() or 1) if self.per_point else 1)
         workers = min(workers, len(runs))
