@@ -97,7 +97,7 @@ def tables(config: AssemblyConfig, mech, sols, wall: float):
     }])
     timing = pd.DataFrame([{"case": "given joints", "algorithm": "all_solutions", "total_s": wall,
                             "solver_time_s": float(sols.time_s),
-                            **{f"printed_{k}": v for k, v in config.printed.items() if k.endswith("_s")}}])
+                            **{f"printed_{k}": v for k, v in sorted(config.printed.items()) if k.endswith("_s")}}])
     return summary, solutions, timing
 
 

@@ -213,7 +213,7 @@ def _experiment_run(config, out, *, source=None, progress=None, **_) -> Outcome:
 def _experiment_rerun(config, folder: Path, source: str | None) -> None:
     from .reports import write_tables
     from .runner import run_experiment
-    write_tables(run_experiment(config, source=source), folder, figures=False)
+    write_tables(run_experiment(config, source=source, timing=False), folder, figures=False)
 
 
 def _experiment_from_dict(data: dict, where: str):

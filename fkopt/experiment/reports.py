@@ -72,7 +72,7 @@ def summary_table(er: ExperimentResult) -> pd.DataFrame:
             row["success_rate"] = float(np.mean(r.succeeded(thr)))
             row["median_iterations_to_threshold"] = _nanmedian(r.iterations_to(thr))
             row["median_evaluations_to_threshold"] = _nanmedian(r.evaluations_to(thr))
-        for k, v in spec.printed.items():
+        for k, v in sorted(spec.printed.items()):   # sorted: a config reloaded from meta.json has sorted keys
             if not k.endswith("_ms"):
                 row[f"printed_{k}"] = v
         rows.append(row)
@@ -91,7 +91,7 @@ def timing_table(er: ExperimentResult) -> pd.DataFrame:
                "timed_runs": len(t), "mean_ms_per_run": float(np.mean(t)), "median_ms_per_run": float(med),
                "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
                "amortised_ms_per_run": float(np.mean(rec.result.time_per_run) * 1e3), "total_s": rec.wall_s}
-        for k, v in rec.spec.printed.items():
+        for k, v in sorted(rec.spec.printed.items()):
             if k.endswith("_ms"):
                 row[f"printed_{k}"] = v
         rows.append(row)

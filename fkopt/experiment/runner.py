@@ -189,8 +189,11 @@ def batched_problem(config: ExperimentConfig, mech, cases: list[Case]):
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
-                   source: str | None = None) -> ExperimentResult:
+                   source: str | None = None, timing: bool = True) -> ExperimentResult:
     """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each.
+
+    ``timing=False`` skips the single-run timing sample (:mod:`.timing`): what ``fkopt check``
+    reruns for, since timings are never compared.
 
     Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
     each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
@@ -228,5 +231,6 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
         by_algorithm.append(recs)
     # case-major order, as the reports expect (every algorithm of case 1, then case 2, ...)
     records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
-    time_single_runs(config, records)
+    if timing:
+        time_single_runs(config, records)
     return ExperimentResult(config, mech, cases, records, time.perf_counter() - start_all, source)
