@@ -25,7 +25,7 @@ from ..errors import FkoptError, did_you_mean
 class Geometry(BaseModel):
     """Base of every mechanism's geometry model (unknown keys are rejected)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)   # "1e400" from YAML is inf
 
 
 def describe_validation_error(err: ValidationError, where: str) -> str:
