@@ -132,11 +132,11 @@ def test_pymoo_and_niapy_names_and_params():
     pytest.importorskip("niapy")
     with pytest.raises(FkoptError, match="unknown pymoo adapter 'pymoo:XX'; allowed: pymoo:GA, pymoo:DE, pymoo:PSO"):
         fkopt.algorithm("pymoo:XX")
-    with pytest.raises(FkoptError, match="'pymoo:DE' 'nope' is not a parameter"):
+    with pytest.raises(FkoptError, match="'pymoo:DE' has no parameter 'nope'"):
         fkopt.algorithm("pymoo:DE", nope=1)
     with pytest.raises(FkoptError, match="unknown NiaPy algorithm 'niapy:Foo'; allowed: .*ArtificialBeeColonyAlgorithm"):
         fkopt.algorithm("niapy:Foo")
-    with pytest.raises(FkoptError, match="'niapy:ArtificialBeeColonyAlgorithm' 'limt' is not a parameter"):
+    with pytest.raises(FkoptError, match="'niapy:ArtificialBeeColonyAlgorithm' has no parameter 'limt'"):
         fkopt.algorithm("niapy:ArtificialBeeColonyAlgorithm", limt=5)
     a = fkopt.algorithm("pymoo:DE", CR=0.5)
     r = fkopt.solve(Sphere(dim=2), a, population=10, iterations=5, runs=1)

@@ -42,3 +42,14 @@ def require(library: str, module: str):
     except ImportError as err:
         raise FkoptError(f"'{library}:' algorithms need {library} ({err.name or module} is not installed): "
                          f'pip install "fkopt[peers]"') from None
+
+
+def refuse_unknown(name: str, params: dict, accepted, reserved) -> None:
+    """One line for a ``params:`` key that the library does not take, or that fkopt sets itself
+    (budget, seed, processes): the same check for every adapter."""
+    allowed = sorted(set(accepted) - set(reserved))
+    for key in params:
+        if key in reserved or key not in allowed:
+            what = (f"parameter '{key}' is set by fkopt (budget, seed, processes)" if key in reserved
+                    else f"has no parameter '{key}'")
+            raise FkoptError(f"algorithm '{name}' {what}; parameters: evaluations, workers, " + ", ".join(allowed))

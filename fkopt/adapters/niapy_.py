@@ -16,7 +16,7 @@ import inspect
 import numpy as np
 
 from ..errors import FkoptError
-from .libraries import require
+from .libraries import refuse_unknown, require
 
 MODULES = ("niapy.algorithms.basic", "niapy.algorithms.modified", "niapy.algorithms.other")
 RESERVED = {"seed", "callbacks", "individual_type", "initialization_function"}
@@ -45,12 +45,7 @@ def _accepted(cls) -> set[str]:
 
 
 def check_params(method: str, target, params: dict) -> None:
-    allowed = sorted(_accepted(target) - RESERVED)
-    for key in params:
-        if key in RESERVED or key not in allowed:
-            why = "is set by fkopt" if key in RESERVED else "is not a parameter"
-            raise FkoptError(f"algorithm 'niapy:{method}' '{key}' {why}; parameters: evaluations, workers, "
-                             + ", ".join(allowed))
+    refuse_unknown(f"niapy:{method}", params, _accepted(target), RESERVED)
 
 
 def run(method, params, counter, problem, population, budget, seed_seq, x0) -> None:

@@ -15,7 +15,7 @@ import inspect
 import numpy as np
 
 from ..errors import FkoptError
-from .libraries import require
+from .libraries import refuse_unknown, require
 
 RESERVED = {"termination", "seed", "verbose", "save_history", "callback", "display", "output"}
 
@@ -53,12 +53,7 @@ def _accepted(cls) -> set[str]:
 
 
 def check_params(method: str, target, params: dict) -> None:
-    allowed = sorted(_accepted(target) - RESERVED)
-    for key in params:
-        if key in RESERVED or key not in allowed:
-            why = "is set by fkopt" if key in RESERVED else "is not a parameter"
-            raise FkoptError(f"algorithm 'pymoo:{method}' '{key}' {why}; parameters: evaluations, workers, "
-                             + ", ".join(allowed))
+    refuse_unknown(f"pymoo:{method}", params, _accepted(target), RESERVED)
     try:
         target(**_with_pop(target, params, 10))
     except Exception as err:

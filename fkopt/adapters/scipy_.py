@@ -20,7 +20,7 @@ import inspect
 import numpy as np
 
 from ..errors import FkoptError
-from .libraries import ceil_div
+from .libraries import ceil_div, refuse_unknown
 
 METHODS = ("differential_evolution", "dual_annealing")
 RESERVED = {"func", "bounds", "rng", "seed", "workers", "callback", "vectorized", "maxfun", "args"}
@@ -35,14 +35,7 @@ def resolve(method: str):
 
 
 def check_params(method: str, target, params: dict) -> None:
-    allowed = [p for p in inspect.signature(target).parameters if p not in RESERVED]
-    for key in params:
-        if key in RESERVED:
-            raise FkoptError(f"algorithm 'scipy:{method}' parameter '{key}' is set by fkopt (budget, seed, "
-                             f"processes); parameters: evaluations, workers, {', '.join(allowed)}")
-        if key not in allowed:
-            raise FkoptError(f"algorithm 'scipy:{method}' has no parameter '{key}'; parameters: "
-                             f"evaluations, workers, {', '.join(allowed)}")
+    refuse_unknown(f"scipy:{method}", params, inspect.signature(target).parameters, RESERVED)
 
 
 def _rng_kwargs(fn, seed_seq) -> dict:
