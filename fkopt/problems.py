@@ -211,7 +211,7 @@ def _norm3(a, b, c):
 class IKProblem(Problem):
     """Inverse kinematics of a serial arm: find joints whose end-effector pose is ``pose``.
 
-    SPEC.md "wang7dof": fitness f = w_p * dP + w_r * dR, dP the distance between the tool
+    docs/models.md "wang7dof": fitness f = w_p * dP + w_r * dR, dP the distance between the tool
     point and the target position (mm), dR in radians, w_p = 1 and w_r = 180/pi by default (so
     f reads "mm + degrees"). ``objective`` chooses dR:
 

@@ -14,7 +14,7 @@ Matrix = tuple[tuple[np.ndarray, np.ndarray, np.ndarray], ...]
 def zyx(alpha, beta, gamma) -> Matrix:
     """R = Rz(gamma) Ry(beta) Rx(alpha) (Z-Y-X Euler, active, right-handed).
 
-    mao2017 eq. (2) and liu2008; SPEC.md "Rotation matrix used by mao2017 and liu2008".
+    mao2017 eq. (2) and liu2008; docs/models.md "Rotation matrix used by mao2017 and liu2008".
     """
     ca, sa = np.cos(alpha), np.sin(alpha)
     cb, sb = np.cos(beta), np.sin(beta)
@@ -46,7 +46,7 @@ def wrap_degrees(d):
 def zyz(alpha, beta, gamma) -> Matrix:
     """R = Rz(alpha) Ry(beta) Rz(gamma) (Z-Y-Z Euler, active, right-handed), angles in radians.
 
-    The orientation convention of wang7dof (SPEC.md "wang7dof"); :func:`zyz_angles` inverts it.
+    The orientation convention of wang7dof (docs/models.md "wang7dof"); :func:`zyz_angles` inverts it.
     """
     ca, sa = np.cos(alpha), np.sin(alpha)
     cb, sb = np.cos(beta), np.sin(beta)

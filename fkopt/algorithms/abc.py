@@ -1,6 +1,6 @@
 """Artificial bee colony (ABC) of Karaboga (2005), as used by mao2017 (Sec. 2.1) and wang7dof.
 
-SPEC.md "mao2017": fitness-to-quality map fit = 1/(1+f) for f >= 0 (1+|f| otherwise),
+docs/models.md "mao2017": fitness-to-quality map fit = 1/(1+f) for f >= 0 (1+|f| otherwise),
 onlooker roulette p_i = fit_i / sum(fit), greedy selection, and a scout that replaces a
 source whose trial counter exceeds ``limit``.
 

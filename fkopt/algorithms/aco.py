@@ -1,6 +1,6 @@
 """Improved continuous ant colony (ACO) of wu2015 (Sec. 4.2, eqs. 16-19); mao2017's "ACO".
 
-SPEC.md "wu2015". Ants are points in the box; one iteration ("sweep") moves every ant once:
+docs/models.md "wu2015". Ants are points in the box; one iteration ("sweep") moves every ant once:
 
 1. pheromone tau = -f (eq. 16), initially of the random start positions; the best pheromone
    tau_b is the largest (least negative) of the run, the mean tau_m = mean(tau) (eq. 17);

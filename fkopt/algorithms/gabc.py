@@ -1,6 +1,6 @@
 """Gbest-guided ABC (GABC): ABC whose neighbour move is also pulled by the best-so-far source.
 
-Two update rules, selected by the ``rule`` parameter (SPEC.md "mao2017"):
+Two update rules, selected by the ``rule`` parameter (docs/models.md "mao2017"):
 
 * ``"mao2017"`` (default) -- mao2017 eq. (19) as printed:
   v_ij = x_ij + phi_ij (x_ij - x_kj) + phi_ij (x_best,j - x_kj), phi_ij ~ U[-1, 1].

@@ -1,6 +1,6 @@
 """Levenberg-Marquardt on the residuals, batched over every (run, start) point.
 
-Not used by the five papers themselves; SPEC.md uses LM to check exact forward solutions
+Not used by the five papers themselves; docs/models.md uses LM to check exact forward solutions
 (mao2017's printed inputs, liu2008's case), and the ``*+lm`` hybrids polish a swarm's answer
 with it. Minimises S(x) = sum_i r_i(x)^2 (any number of residuals >= 1) with Marquardt's
 scaled damping, one trial step per point and iteration:

@@ -1,6 +1,6 @@
 """Newton-Raphson on the residuals, the classical numerical method wu2015 compares with (Tab. 2).
 
-SPEC.md "wu2015": Newton-Raphson from five start points for the 3-PPR case. Each iteration is
+docs/models.md "wu2015": Newton-Raphson from five start points for the 3-PPR case. Each iteration is
 one Newton step on the square system r(x) = 0 (``problem.residuals``, as many residuals as
 unknowns):
 

@@ -1,6 +1,6 @@
 """P-ABC of chang2024 (Sec. 3.2): PSO first, then ABC seeded with the particles' memories.
 
-The paper's equations (34)-(40) were lost in extraction; SPEC.md "chang2024" reconstructs the
+The paper's equations (34)-(40) were lost in extraction; docs/models.md "chang2024" reconstructs the
 method, and fkopt follows that reconstruction:
 
 * iterations 1 .. p run :class:`fkopt.algorithms.pso.PSO` (p = round(switch * iterations),
@@ -43,7 +43,7 @@ class PABC(Algorithm):
     name = "pabc"
     Params = PABCParams
     reconstruction = ("chang2024's P-ABC equations were lost in extraction; PSO then ABC seeded "
-                      "with the personal bests, as reconstructed in SPEC.md")
+                      "with the personal bests, as reconstructed in docs/models.md")
     evaluations_per_iteration = "population (PSO phase), 2*population (+1 per scout) (ABC phase)"
 
     def __init__(self, **params):

@@ -2,7 +2,7 @@
 
 Used by chang2024 (its PSO baseline and the first phase of P-ABC: w = 0.8, c1 = c2 = 2),
 liu2008 (Sec. 3, eqs. 7-8: inertia linear from w_max = 0.5 to w_min = 0.1 over the k_max
-iterations, c1 = c2 = 1.8, v_max = 1, 80 particles) and wang7dof (population 300). SPEC.md
+iterations, c1 = c2 = 1.8, v_max = 1, 80 particles) and wang7dof (population 300). docs/models.md
 "chang2024", "liu2008", "wang7dof". Per particle i and coordinate j, synchronously:
 
     v_ij <- w v_ij + c1 r1_ij (p_ij - x_ij) + c2 r2_ij (g_j - x_ij),  r1, r2 ~ U[0, 1)

@@ -3,7 +3,7 @@
 An experiment file describes one table/figure of a paper (or a study of one's own)::
 
     name: tab2_tab3_fig2            # folder name of the results
-    paper: mao2017                  # SPEC.md key (optional)
+    paper: mao2017                  # docs/models.md key (optional)
     title: "Tab. 2, Tab. 3 and Fig. 2: ACO vs ABC vs GABC"
     mechanism: {name: 3-rps, geometry: {ra: 274, rb: 158}, bounds: {z: [400, 700]}}
     objective: squared              # squared | absolute (parallel); paper | geodesic (serial)

@@ -41,9 +41,9 @@ class Mechanism:
 
     name: ClassVar[str]
     kind: ClassVar[str]
-    #: Paper key in SPEC.md this mechanism reproduces (``None`` for general ones).
+    #: Paper key in docs/models.md this mechanism reproduces (``None`` for general ones).
     paper: ClassVar[str | None] = None
-    #: Set when the model is a reconstruction (SPEC.md), with a one-sentence explanation.
+    #: Set when the model is a reconstruction (docs/models.md), with a one-sentence explanation.
     reconstruction: ClassVar[str | None] = None
     pose_names: ClassVar[tuple[str, ...]]
     pose_units: ClassVar[tuple[str, ...]]

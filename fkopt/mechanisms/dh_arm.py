@@ -1,6 +1,6 @@
 """Serial arms from a standard Denavit-Hartenberg table; the 7-DOF arm of wang7dof.
 
-SPEC.md "wang7dof" (7-DOF redundant arm, inverse kinematics by ABC vs PSO). Standard DH:
+docs/models.md "wang7dof" (7-DOF redundant arm, inverse kinematics by ABC vs PSO). Standard DH:
 T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), theta_i = q_i + theta_offset_i, and the
 end-effector frame T = T_1 T_2 ... T_n = [n o a p]. The pose is (x, y, z) = p in the length
 unit of the table (mm) and the Z-Y-Z Euler angles printed by wang7dof, in degrees:
@@ -307,7 +307,7 @@ class DHArm(SerialMechanism):
 
 
 class SevenDofArm(DHArm):
-    """The 7-DOF redundant arm of wang7dof (SPEC.md "wang7dof"); the table can still be overridden."""
+    """The 7-DOF redundant arm of wang7dof (docs/models.md "wang7dof"); the table can still be overridden."""
 
     name = "7dof-arm"
     paper = "wang7dof"

@@ -1,4 +1,4 @@
-"""Planar 3-PPR parallel mechanism of wu2015 (SPEC.md "wu2015 -- planar 3-PPR").
+"""Planar 3-PPR parallel mechanism of wu2015 (docs/models.md "wu2015 -- planar 3-PPR").
 
 Wu et al. (2015), forward kinematics of a planar 3-PPR parallel mechanism by an improved ant
 colony algorithm. The inverse map is printed:
@@ -7,7 +7,7 @@ colony algorithm. The inverse map is printed:
     d2 = F2x cos(theta) - F2y sin(theta) + x - D2x0,
     d3 = F3x sin(theta) + F3y cos(theta) + y,
 
-but the geometry (F_i, D_i0) is not. fkopt uses SPEC.md's reconstruction, which reproduces the
+but the geometry (F_i, D_i0) is not. fkopt uses docs/models.md's reconstruction, which reproduces the
 one printed case (x, y, theta) = (20 mm, 30 mm, 15 deg) -> d = (-14.8355, 65.3984, 70.1170) mm:
 F_i = r_F (cos phi_i, sin phi_i) with r_F = 41.5322 mm, phi = (210, 330, 90) deg,
 D1x0 = 5.4678 mm, D2x0 = -5.2814 mm. All of them can be overridden (``r_F``, ``phi1..3``,
@@ -40,7 +40,7 @@ class ThreePPRGeometry(Geometry):
 class ThreePPR(ParallelMechanism):
     name = "3-ppr"
     paper = "wu2015"
-    reconstruction = ("wu2015 prints the inverse map but not F_i or D_i0; SPEC.md's geometry "
+    reconstruction = ("wu2015 prints the inverse map but not F_i or D_i0; docs/models.md's geometry "
                       "(F_i on a circle r_F = 41.5322 mm at 210, 330, 90 deg, D1x0 = 5.4678 mm, "
                       "D2x0 = -5.2814 mm) reproduces the printed case")
     pose_names = ("x", "y", "theta")

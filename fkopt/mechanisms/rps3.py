@@ -1,4 +1,4 @@
-"""3-RPS parallel manipulator of mao2017 (SPEC.md "mao2017 -- 3-RPS").
+"""3-RPS parallel manipulator of mao2017 (docs/models.md "mao2017 -- 3-RPS").
 
 Mao, Xie, Wu, Yuan (2017), "Forward kinematics optimization of 3-RPS parallel manipulator
 based on global-best artificial bee colony algorithm", eqs. (1)-(10).

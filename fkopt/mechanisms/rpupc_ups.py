@@ -1,8 +1,8 @@
-"""3RPUPc-UPS parallel mechanism of chang2024 (SPEC.md "chang2024 -- 3RPUPc-UPS").
+"""3RPUPc-UPS parallel mechanism of chang2024 (docs/models.md "chang2024 -- 3RPUPc-UPS").
 
 Chang et al. (2024), forward kinematics of a 3RPUPc-UPS parallel mechanism solved by P-ABC.
 The paper's kinematic equations were lost in text extraction: the model below is the
-reconstruction of SPEC.md, which reproduces the paper's one printed case
+reconstruction of docs/models.md, which reproduces the paper's one printed case
 (alpha, beta, gamma, z) = (25 deg, 34 deg, 23 deg, 360 mm) -> (l1, l2, l3, delta) =
 (332.048, 390.904, 402.294 mm, -14.4389 deg) within the printed rounding.
 
@@ -18,7 +18,7 @@ rotations; the paper writes Rx(alpha) Ry(beta) Rz(gamma) in its own sign convent
 * Leg 4 (UPS): S joint C4 = Q + R_p (0, c, 0); input angle delta = atan2(dX, -dY) of C4 - B4 (deg).
 
 Default search bounds are not printed in the paper; fkopt uses angles in [-45, 45] deg and
-z in [300, 420] mm (SPEC.md's suggestion), which contains the printed case.
+z in [300, 420] mm (docs/models.md's suggestion), which contains the printed case.
 """
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ class RPUPcUPSGeometry(Geometry):
 class ThreeRPUPcUPS(ParallelMechanism):
     name = "3-rpupc-ups"
     paper = "chang2024"
-    reconstruction = ("chang2024's kinematic equations were lost in extraction; SPEC.md's model "
+    reconstruction = ("chang2024's kinematic equations were lost in extraction; docs/models.md's model "
                       "(annular-prismatic U joints kept in the legs' vertical planes, delta = "
                       "atan2(dX, -dY) of leg 4) reproduces the printed case within its rounding")
     pose_names = ("alpha", "beta", "gamma", "z")
@@ -44,7 +44,7 @@ class ThreeRPUPcUPS(ParallelMechanism):
     joint_names = ("l1", "l2", "l3", "delta")
     joint_units = ("mm", "mm", "mm", "deg")
     Geometry = RPUPcUPSGeometry
-    # Not printed in chang2024: SPEC.md suggests angles +-45 deg, z 300-420 mm.
+    # Not printed in chang2024: docs/models.md suggests angles +-45 deg, z 300-420 mm.
     default_bounds = {"alpha": (-45.0, 45.0), "beta": (-45.0, 45.0), "gamma": (-45.0, 45.0),
                       "z": (300.0, 420.0)}
 

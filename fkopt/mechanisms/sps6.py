@@ -4,7 +4,7 @@ Six legs of variable length join base point b_i (base frame) to platform point p
 frame) through spherical joints. The pose is the position (x, y, z) of a point fixed to the
 platform -- the platform origin moved by the probe offset s, i.e. the probe tip -- and Z-Y-X
 Euler angles (alpha, beta, gamma) in degrees, R = Rz(gamma) Ry(beta) Rx(alpha)
-(SPEC.md "Rotation matrix used by mao2017 and liu2008"). The inverse map is closed-form
+(docs/models.md "Rotation matrix used by mao2017 and liu2008"). The inverse map is closed-form
 (liu2008 eqs. (4)-(5)):
 
     l_i = R p_i + p_s - R s - b_i,    leg length |l_i|,    i = 1..6.
@@ -16,7 +16,7 @@ With s = 0 (the default) the position is that of the platform origin.
   (1, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071) admit 40 real assemblies
   (P. Dietmaier, "The Stewart-Gough platform of general geometry can have 40 real postures",
   Advances in Robot Kinematics, 1998), the maximum possible.
-* :class:`SixSPSCMM` (``"6-sps-cmm"``) is liu2008 (SPEC.md "liu2008 -- 6-SPS parallel CMM"):
+* :class:`SixSPSCMM` (``"6-sps-cmm"``) is liu2008 (docs/models.md "liu2008 -- 6-SPS parallel CMM"):
   Liu, Liu, Wei (2008), "Measurement modeling for 6-DOF parallel-link coordinate measuring
   machine based on particle swarm optimization", eqs. (1)-(5), Tab. 2: b_i and p_i on circles
   of radius R_b = 0.5 m, R_p = 0.225 m at the angles of eq. (2) with short-side central angles
