@@ -1,6 +1,6 @@
 """Summary of the peer experiments (``peers/*.yaml``, ``make reproduce-peers``) as markdown.
 
-:func:`peers_markdown` reads stored results only (``summary.csv``, ``runs.csv``, ``meta.json``
+:func:`peers_markdown` reads stored results only (``summary.csv``, ``runs.csv``, ``meta.json``, ``env.json``
 of every ``<paper>/peers/`` folder under a results root) and says, per paper, how each
 library's counterpart did beside fkopt's algorithm at the same evaluation budget. It is what
 ``results/peers/PEERS.md`` holds; ``fkopt.reproduce.report`` may include it as a section:
@@ -48,7 +48,10 @@ def paper_section(folder: Path) -> str:
     summary = pd.read_csv(folder / "summary.csv")
     config = meta["config"]
     thr = config.get("threshold")
-    libs = meta.get("libraries", {})
+    try:   # library versions are in env.json (fkopt.provenance), beside the timings
+        libs = json.loads((folder / "env.json").read_text()).get("libraries", {})
+    except (OSError, ValueError):
+        libs = {}
     lines = [f"## {config.get('paper')}: {config.get('title', '')}", ""]
     used = sorted({a["name"].split(":")[0] for a in config["algorithms"] if ":" in a["name"]})
     versions = ", ".join(f"{lib} {libs.get(lib, 'version not recorded')}" for lib in used)
