@@ -57,6 +57,8 @@ def check_out(out: Path, results: Path) -> Path:
         raise FkoptError(f"--out {out}: exists and is not a folder")
     if out.is_dir() and any(out.iterdir()) and not (out / MARKER).is_file():
         raise FkoptError(f"--out {out}: folder exists and was not written by fkopt export; choose a new folder")
+    from .files import output_folder   # the shared checks: a folder, writable, nothing below a file
+    output_folder(out)
     return out
 
 
