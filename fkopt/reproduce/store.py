@@ -97,12 +97,15 @@ class Store:
 
     def folders(self, paper: str | None = None) -> list[Experiment]:
         """Every results folder ``<paper>/<name>/`` holding a file, with or without meta.json
-        (hidden folders -- unfinished or temporary -- are not results)."""
+        (hidden folders -- unfinished or temporary -- are not results, and a nested results root
+        such as ``results/peers`` is a store of its own: ``fkopt check results/peers``)."""
         papers = [self.root / paper] if paper else sorted(p for p in self.root.iterdir() if p.is_dir())
         out = []
         for p in papers:
             if p.name.startswith(".") or not p.is_dir():
                 continue
+            if not paper and (p / "index.csv").exists():
+                continue   # a results root of its own (results/peers: make reproduce-peers), checked on its own
             for f in sorted(p.iterdir()):
                 if f.is_dir() and not f.name.startswith(".") and any(x.is_file() for x in f.iterdir()):
                     out.append(Experiment(f))
