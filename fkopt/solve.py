@@ -226,6 +226,25 @@ def batch_bytes(rows: int, chunk: int, population: int, iterations: int, dim: in
     return 2 * rows * per_row + working
 
 
+def chunk_size(cases: int, runs: int, population: int, iterations: int, dim: int, *, batch: bool = True,
+               chunk_rows: int | None = None, snapshots: int = 0, x_history: bool = False) -> int:
+    """Rows per chunk of a solve of ``cases`` x ``runs`` rows; an FkoptError, before anything is
+    allocated, when the batch's estimated memory (:func:`batch_bytes`) exceeds :data:`MEMORY_LIMIT`."""
+    rows = cases * runs
+    size = 1 if not batch else (max(1, CHUNK_POINTS // population) if chunk_rows is None else int(chunk_rows))
+    if size < 1:
+        raise FkoptError(f"chunk_rows must be at least 1, got {chunk_rows}")
+    if chunk_rows is None and rows > size:     # equal chunks: 100 rows by 33 -> 4 x 25, not 33+33+33+1
+        size = -(-rows // -(-rows // size))
+    need = batch_bytes(rows, size, population, iterations, dim, snapshots, x_history)
+    if need > MEMORY_LIMIT:
+        raise FkoptError(f"a batch of {rows} runs ({cases} cases x {runs} runs) of {iterations} "
+                         f"iterations needs about {need / 2**30:.1f} GiB of memory, more than fkopt's per-solve "
+                         f"limit of {MEMORY_LIMIT / 2**30:.1f} GiB; solve fewer cases or runs at a time"
+                         + (", or without x_history" if x_history else ""))
+    return size
+
+
 def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iterations: int = 100,
           runs: int = 1, seed: int | Sequence[int] = 0, target: float | None = None,
           stop_at_target: bool = False, x0=None, run_ids=None, batch: bool = True, snapshots=(),
@@ -251,18 +270,8 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
     n_cases = len(seeds)
     x0_rows = _start_rows(problem, x0, ids, cases)
     rows = n_cases * len(ids)
-    size = 1 if not batch else (max(1, CHUNK_POINTS // int(population)) if chunk_rows is None
-                                else int(chunk_rows))
-    if size < 1:
-        raise FkoptError(f"chunk_rows must be at least 1, got {chunk_rows}")
-    if chunk_rows is None and rows > size:     # equal chunks: 100 rows by 33 -> 4 x 25, not 33+33+33+1
-        size = -(-rows // -(-rows // size))
-    need = batch_bytes(rows, size, int(population), int(iterations), problem.dim, len(snapshots), x_history)
-    if need > MEMORY_LIMIT:
-        raise FkoptError(f"a batch of {rows} runs ({n_cases} cases x {len(ids)} runs) of {iterations} "
-                         f"iterations needs about {need / 2**30:.1f} GiB of memory, more than fkopt's per-solve "
-                         f"limit of {MEMORY_LIMIT / 2**30:.1f} GiB; solve fewer cases or runs at a time"
-                         + (", or without x_history" if x_history else ""))
+    size = chunk_size(n_cases, len(ids), int(population), int(iterations), problem.dim, batch=batch,
+                      chunk_rows=chunk_rows, snapshots=len(snapshots), x_history=x_history)
     case_of_row = np.repeat(np.arange(n_cases), len(ids))
     run_of_row = np.tile(ids, n_cases)
     seed_of_row = seeds[case_of_row]

@@ -189,18 +189,18 @@ def rerun_files(config, folder: Path, source: str | None = None) -> None:
 
 # -- experiments -----------------------------------------------------------------------------------
 def _experiment_validate(config) -> tuple[int, int]:
-    from .runner import validate_experiment
+    from ..solve import batch_bytes, chunk_size
+    from .runner import keeps_x_history, validate_experiment
     mech, cases, _ = validate_experiment(config)
-    dim = len(mech.unknown_names)
-    kept = work = 0
+    dim, keep_x = len(mech.unknown_names), keeps_x_history(config, mech)
+    need = 0   # every algorithm's records stay in memory until the folder is written: the solves' sum
     for spec in config.algorithms:
         pop = spec.population or config.population
         its = spec.iterations or config.iterations
-        # best-so-far, evaluations, position error and x histories of every run are kept per task
-        kept += len(cases) * config.runs * (its + 1) * (3 + dim) * 8
-        snaps = len(config.snapshots) * config.runs * pop * dim * 8
-        work = max(work, config.runs * pop * dim * 8 * 12 + snaps)
-    return len(config.algorithms) * len(cases), kept + work
+        size = chunk_size(len(cases), config.runs, pop, its, dim, batch=config.batch,
+                          snapshots=len(config.snapshots), x_history=keep_x)
+        need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
+    return len(config.algorithms) * len(cases), need
 
 
 def _experiment_run(config, out, *, source=None, progress=None, **_) -> Outcome:

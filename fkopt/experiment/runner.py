@@ -21,7 +21,7 @@ from .. import registry
 from ..errors import FkoptError
 from ..problems import fk_problem
 from ..rotations import wrap_degrees
-from ..solve import CHUNK_POINTS, MEMORY_LIMIT, Result, batch_bytes, make_algorithm, solve
+from ..solve import Result, chunk_size, make_algorithm, solve
 from .config import AlgorithmSpec, ExperimentConfig, RandomCases
 from .timing import time_single_runs
 
@@ -165,17 +165,20 @@ def validate_experiment(config: ExperimentConfig):
             x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
             _check_in_bounds(mech, x0, f"algorithms[{spec.key}].start")
     problems = [build_problem(config, mech, c) for c in cases]
-    keep_x = "variables" in config.figures or mech.kind == "serial"
     for spec in config.algorithms:       # a batch that cannot fit in memory fails here, not midway
-        pop, its = spec.population or config.population, spec.iterations or config.iterations
-        rows = len(cases) * config.runs
-        need = batch_bytes(rows, max(1, CHUNK_POINTS // pop) if config.batch else 1, pop, its,
-                           len(mech.unknown_names), len(config.snapshots), keep_x)
-        if need > MEMORY_LIMIT:
-            raise FkoptError(f"algorithms[{spec.key}]: {len(cases)} cases x {config.runs} runs x {its} "
-                             f"iterations need about {need / 2**30:.1f} GiB of memory, more than fkopt's per-solve "
-                             f"limit of {MEMORY_LIMIT / 2**30:.1f} GiB; lower runs, iterations or the number of cases")
+        try:
+            chunk_size(len(cases), config.runs, spec.population or config.population,
+                       spec.iterations or config.iterations, len(mech.unknown_names), batch=config.batch,
+                       snapshots=len(config.snapshots), x_history=keeps_x_history(config, mech))
+        except FkoptError as err:
+            raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
     return mech, cases, problems
+
+
+def keeps_x_history(config: ExperimentConfig, mech) -> bool:
+    """Does the experiment need each run's best-so-far point per iteration (variables.png, the
+    position error of a serial arm)? Otherwise only the final points are kept."""
+    return "variables" in config.figures or mech.kind == "serial"
 
 
 def batched_problem(config: ExperimentConfig, mech, cases: list[Case]):
@@ -203,7 +206,7 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     mech, cases, problems = validate_experiment(config)
     one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
     batched = problems[0] if one else batched_problem(config, mech, cases)
-    keep_x = "variables" in config.figures or mech.kind == "serial"   # variables.png, position error
+    keep_x = keeps_x_history(config, mech)
     records: list[TaskRecord] = []
     total = len(cases) * len(config.algorithms)
     start_all = time.perf_counter()
