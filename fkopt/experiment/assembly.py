@@ -19,22 +19,19 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
-from pydantic import Field, ValidationError, field_validator
+from pydantic import Field, ValidationError
 
 from ..errors import FkoptError
 from ..files import error_line
 from .kinds import Kind, Outcome
-from .config import MAX_ITERATIONS, MAX_POPULATION, MechanismSpec, Seed, Strict, safe_component
+from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
 
 KIND = "assembly"
 
 
-class AssemblyConfig(Strict):
+class AssemblyConfig(Located):
     kind: Literal["assembly"]
-    name: str
     paper: str = "assembly"
-    title: str = ""
-    description: str = ""
     mechanism: MechanismSpec
     joints: dict[str, float]
     seed: int = Seed()
@@ -49,15 +46,6 @@ class AssemblyConfig(Strict):
     expected: int | None = Field(None, ge=0)
     printed: dict[str, Any] = Field(default_factory=dict)
     check: Literal["ci", "full"] = "ci"
-
-    @field_validator("name", "paper")
-    @classmethod
-    def _component(cls, value, info):
-        return safe_component(value, info.field_name)
-
-    @property
-    def folder_parts(self) -> tuple[str, str]:
-        return (self.paper, self.name)
 
 
 def assembly_from_dict(data: dict, where: str) -> AssemblyConfig:

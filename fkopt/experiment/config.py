@@ -66,6 +66,25 @@ def safe_component(value, field: str):
         raise ValueError(str(err).split(": ", 1)[1]) from None
 
 
+class Located(Strict):
+    """A config that writes ``OUT/<paper>/<name>/``: both are single safe folder names."""
+
+    name: str
+    paper: str | None = None
+    title: str = ""
+    description: str = ""
+
+    @field_validator("name", "paper")
+    @classmethod
+    def _component(cls, value, info):
+        return safe_component(value, info.field_name)
+
+    @property
+    def folder_parts(self) -> tuple[str, str]:
+        """``(paper, name)``: the results folder is ``OUT/<paper>/<name>/``."""
+        return (self.paper or "experiments", self.name)
+
+
 class MechanismSpec(Strict):
     name: str
     geometry: dict[str, Any] = Field(default_factory=dict)
@@ -121,14 +140,10 @@ def unique_labels(algos):
     return algos
 
 
-class RunConfig(Strict):
+class RunConfig(Located):
     """What every config that runs algorithms x targets x runs shares (experiments, studies):
     names, mechanism, objective, algorithms, budget, seed, threshold, printed values."""
 
-    name: str
-    paper: str | None = None
-    title: str = ""
-    description: str = ""
     mechanism: MechanismSpec
     objective: str | None = None
     algorithms: list[AlgorithmSpec] = Field(min_length=1)
@@ -155,15 +170,6 @@ class RunConfig(Strict):
     def _unique_labels(cls, algos):
         return unique_labels(algos)
 
-    @field_validator("name", "paper")
-    @classmethod
-    def _component(cls, value, info):
-        return safe_component(value, info.field_name)
-
-    @property
-    def folder_parts(self) -> tuple[str, str]:
-        """``(paper, name)``: the results folder is ``OUT/<paper>/<name>/``."""
-        return (self.paper or "experiments", self.name)
 
     @model_validator(mode="after")
     def _stop_needs_threshold(self):
