@@ -33,12 +33,13 @@ A mismatch names the experiment, the file, the row, the column and both values.
 """
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
+
+from .outputs import CURVES, ENV_FILE, TIMING, deterministic_files, file_digests, files_with, sha256  # noqa: F401
 
 FITNESS_FLOOR = 1e-20
 LOG10_TOL = 0.5
@@ -53,10 +54,9 @@ COUNT_COLS = ("median_iterations_to_threshold", "median_evaluations_to_threshold
 EVALUATION_COLS = ("mean_evaluations",)
 KEY_COLS = ("case", "algorithm", "variable", "joint", "run", "iteration", "task_seed", "pose", "step")
 #: Files whose values are single runs or curves: compared in shape and keys only (tolerant mode).
-SHAPE_ONLY = ("runs.csv", "convergence.csv", "poses.csv", "ecdf.csv", "stats.csv", "tracking.csv",
-              "heatmap.csv", "solutions.csv")
+SHAPE_ONLY = files_with(CURVES)
 #: Never deterministic: wall-clock measurements and the environment.
-TIMING_FILES = ("timing.csv", "timing_runs.csv", "tracking_timing.csv", "env.json")
+TIMING_FILES = files_with(TIMING) + (ENV_FILE,)
 
 
 @dataclass
@@ -72,24 +72,6 @@ class Mismatch:
     def __str__(self) -> str:
         return (f"{self.experiment}: {self.file} [{self.row}] column '{self.column}': stored {self.stored!r}, "
                 f"rerun {self.rerun!r} ({self.rule})")
-
-
-def deterministic_files(folder: Path) -> list[str]:
-    """Names of the files ``fkopt check`` compares: CSVs (and gzip'ed CSVs: trace.csv.gz) and
-    meta.json, not timing files. A gzip'ed CSV is compared byte for byte on the same platform and
-    only through its recorded digest on another."""
-    return sorted(p.name for p in Path(folder).iterdir()
-                  if p.is_file() and (p.name.endswith((".csv", ".csv.gz")) or p.name == "meta.json")
-                  and p.name not in TIMING_FILES)
-
-
-def sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-def file_digests(folder: Path) -> dict[str, str]:
-    """SHA-256 of every deterministic CSV of a folder (recorded in its meta.json as ``files``)."""
-    return {name: sha256(Path(folder) / name) for name in deterministic_files(folder) if name != "meta.json"}
 
 
 def _close_fitness(a: float, b: float) -> bool:

@@ -14,6 +14,7 @@ solutions (``expected``; e.g. 40 for Dietmaier's 6-6 platform). The folder gets
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
@@ -23,6 +24,7 @@ from pydantic import Field, ValidationError
 
 from ..errors import FkoptError
 from ..files import error_line
+from ..outputs import write_outputs, write_result
 from .kinds import Kind, Outcome
 from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
 
@@ -55,63 +57,62 @@ def assembly_from_dict(data: dict, where: str) -> AssemblyConfig:
         raise FkoptError(f"{where}: {error_line(err, data=data)}") from None
 
 
-def run_assembly(config: AssemblyConfig):
-    """(mechanism, solutions, wall seconds)."""
+@dataclass
+class AssemblyResult:
+    config: AssemblyConfig
+    mechanism: object
+    solutions: Any                  # fkopt.assembly.Solutions
+    wall_s: float
+    source: str | None = None
+
+
+def run_assembly(config: AssemblyConfig, source: str | None = None) -> AssemblyResult:
     from ..assembly import all_solutions
     from .runner import build_mechanism
     mech = build_mechanism(config)
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
                          tol=config.tol, dedup=config.dedup, iterations=config.iterations)
-    return mech, sols, time.perf_counter() - start
+    return AssemblyResult(config, mech, sols, time.perf_counter() - start, source)
 
 
-def tables(config: AssemblyConfig, mech, sols, wall: float):
+# -- files (listed in fkopt.outputs.OUTPUTS["assembly"]) -------------------------------------------
+def solutions_table(ar: AssemblyResult) -> pd.DataFrame:
     rows = [{**{n: float(v) for n, v in s.pose.items()}, "residual": float(s.residual), "hits": int(s.hits)}
-            for s in sols]
-    solutions = pd.DataFrame(rows, columns=[*mech.pose_names, "residual", "hits"])
-    solutions = solutions.sort_values(list(mech.pose_names), kind="stable").reset_index(drop=True)
+            for s in ar.solutions]
+    solutions = pd.DataFrame(rows, columns=[*ar.mechanism.pose_names, "residual", "hits"])
+    solutions = solutions.sort_values(list(ar.mechanism.pose_names), kind="stable").reset_index(drop=True)
     solutions.insert(0, "solution", np.arange(1, len(solutions) + 1))
-    res = solutions["residual"].to_numpy() if len(solutions) else np.array([np.nan])
-    summary = pd.DataFrame([{
+    return solutions
+
+
+def summary_table(ar: AssemblyResult) -> pd.DataFrame:
+    config, sols = ar.config, ar.solutions
+    res = solutions_table(ar)["residual"].to_numpy()
+    res = res if len(res) else np.array([np.nan])
+    return pd.DataFrame([{
         "case": "given joints", "algorithm": "all_solutions", "method": "newton-multistart",
         "population": int(sols.settings["round_size"]),
         "iterations": config.iterations, "runs": 1,
-        "solutions_found": len(solutions), "expected": config.expected if config.expected is not None else np.nan,
+        "solutions_found": len(sols), "expected": config.expected if config.expected is not None else np.nan,
         "starts": int(sols.starts), "outside_bounds": int(getattr(sols, "outside", 0)),
         "median_fitness": float(np.median(res)), "mean_fitness": float(np.mean(res)),
         "best_fitness": float(np.min(res)), "worst_fitness": float(np.max(res)),
         "mean_evaluations": float(sols.starts),
     }])
-    timing = pd.DataFrame([{"case": "given joints", "algorithm": "all_solutions", "total_s": wall,
-                            "solver_time_s": float(sols.time_s),
-                            **{f"printed_{k}": v for k, v in sorted(config.printed.items()) if k.endswith("_s")}}])
-    return summary, solutions, timing
 
 
-def meta(config: AssemblyConfig, mech, source: str | None) -> dict:
+def timing_table(ar: AssemblyResult) -> pd.DataFrame:
+    return pd.DataFrame([{"case": "given joints", "algorithm": "all_solutions", "total_s": ar.wall_s,
+                          "solver_time_s": float(ar.solutions.time_s),
+                          **{f"printed_{k}": v for k, v in sorted(ar.config.printed.items()) if k.endswith("_s")}}])
+
+
+def meta(ar: AssemblyResult) -> dict:
+    config = ar.config
     return {"experiment": config.name, "paper": config.paper, "title": config.title, "kind": KIND,
-            "config_file": source, "config": config.model_dump(mode="json"), "seed": config.seed,
-            "mechanism": mech.describe(), "objective": "all real solutions (multi-start Newton)"}
-
-
-def write_files(config: AssemblyConfig, mech, sols, wall: float, folder: Path, source: str | None,
-                timing: bool = True) -> None:
-    """Every file of the folder (``timing=False``: only the deterministic ones, for ``fkopt check``)."""
-    from .reports import FLOAT, write_meta
-    summary, solutions, times = tables(config, mech, sols, wall)
-    summary.to_csv(folder / "summary.csv", index=False, float_format=FLOAT)
-    solutions.to_csv(folder / "solutions.csv", index=False, float_format="%.12g")
-    if timing:
-        times.to_csv(folder / "timing.csv", index=False, float_format=FLOAT)
-    write_meta(folder, meta(config, mech, source))
-
-
-def write_assembly(config: AssemblyConfig, mech, sols, wall: float, out: Path, source: str | None) -> Path:
-    """Write the folder aside and swap it into place (the previous result stays until then)."""
-    from ..files import output_folder, write_atomically
-    return write_atomically(output_folder(out, *config.folder_parts),
-                            lambda tmp: write_files(config, mech, sols, wall, tmp, source))
+            "config_file": ar.source, "config": config.model_dump(mode="json"), "seed": config.seed,
+            "mechanism": ar.mechanism.describe(), "objective": "all real solutions (multi-start Newton)"}
 
 
 # -- the pipeline kind (fkopt.experiment.kinds) ------------------------------------------------------
@@ -126,13 +127,12 @@ def _validate(config: AssemblyConfig) -> tuple[int, int]:
 
 
 def _run(config: AssemblyConfig, out, *, source=None, progress=None, **_):
-    mech, sols, wall = run_assembly(config)
-    return Outcome(write_assembly(config, mech, sols, wall, out, source), wall, sols)
+    ar = run_assembly(config, source)
+    return Outcome(write_result(KIND, ar, out), ar.wall_s, ar.solutions)
 
 
 def _rerun_files(config: AssemblyConfig, folder: Path, source: str | None) -> None:
-    mech, sols, wall = run_assembly(config)
-    write_files(config, mech, sols, wall, folder, source, timing=False)
+    write_outputs(KIND, run_assembly(config, source), folder, figures=False, timing=False)
 
 
 ASSEMBLY = Kind(KIND, assembly_from_dict, _validate, _run, _rerun_files)

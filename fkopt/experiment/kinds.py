@@ -37,6 +37,7 @@ from typing import Any, Callable
 
 from ..errors import FkoptError
 from ..files import load_mapping, output_folder
+from ..outputs import write_outputs, write_result
 
 #: kind -> "module:attribute" of its :class:`Kind`.
 KINDS: dict[str, str] = {
@@ -204,16 +205,15 @@ def _experiment_validate(config) -> tuple[int, int]:
 
 
 def _experiment_run(config, out, *, source=None, progress=None, **_) -> Outcome:
-    from .reports import write_experiment
     from .runner import run_experiment
     er = run_experiment(config, source=source, progress=progress)
-    return Outcome(write_experiment(er, out), er.wall_s, er)
+    return Outcome(write_result("experiment", er, out), er.wall_s, er)
 
 
 def _experiment_rerun(config, folder: Path, source: str | None) -> None:
-    from .reports import write_tables
     from .runner import run_experiment
-    write_tables(run_experiment(config, source=source, timing=False), folder, figures=False)
+    write_outputs("experiment", run_experiment(config, source=source, timing=False), folder,
+                  figures=False, timing=False)
 
 
 def _experiment_from_dict(data: dict, where: str):

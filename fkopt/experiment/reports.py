@@ -1,6 +1,8 @@
 """Reports: turn an :class:`ExperimentResult` into CSV tables, figures and ``meta.json``.
 
-Files of one experiment folder (all deterministic for a given seed except ``timing.csv``, ``timing_runs.csv`` and
+The makers below are listed, with each file's role (table, curves, timing, figure), in
+:data:`fkopt.outputs.OUTPUTS`, and :func:`fkopt.outputs.write_outputs` writes them. Files of one
+experiment folder (all deterministic for a given seed except ``timing.csv``, ``timing_runs.csv`` and
 the figures drawn from timings, ``cases_time.png``):
 
 * ``summary.csv``     final fitness statistics per case and algorithm over all runs (mean, std,
@@ -39,15 +41,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..compare import file_digests
 from ..files import nanmedian as _nanmedian
-from ..files import output_folder, write_atomically, write_json
-from ..provenance import ENV_FILE, LIBRARIES, environment, library_versions  # noqa: F401 (re-exported)
+from ..outputs import FLOAT, write_outputs, write_result
 from . import plotting
 from .runner import ExperimentResult, pose_error
-from .traces import write_trace
 
-FLOAT = "%.10g"
 #: Fitness of exactly 0 cannot be drawn on a log axis; it is drawn at this floor (and said so).
 LOG_FLOOR = 1e-32
 #: Beyond this many cases, convergence curves are pooled over all (case, run) pairs.
@@ -266,10 +264,11 @@ def _band(ax, xs, values, floor, name, color=None, end=None):
     return line
 
 
-def convergence_figure(er: ExperimentResult, path: Path) -> list[str]:
+def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far fitness vs iteration and vs function evaluations (median and quartiles of the
     runs, or the run itself). Runs that stop at the threshold end where (the median run) stopped
     (a bar); P-ABC's switch from PSO to ABC is marked with a triangle."""
+    path = folder / figure_file(er, "convergence")
     plt = _plt()
     curves = list(_curve_sets(er))
     floor = plotting.floor_of(*[c[2] for c in curves])
@@ -308,10 +307,13 @@ def convergence_figure(er: ExperimentResult, path: Path) -> list[str]:
     return names
 
 
-def variables_figure(er: ExperimentResult, path: Path) -> list[str]:
+def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far value of each unknown vs iteration for the median run (liu2008 Fig. 4a, wang7dof
     Fig. 4), with the true value dashed (for a redundant arm: the joints that defined the target,
     one of many solutions)."""
+    if "variables" not in er.config.figures:
+        return []
+    path = folder / figure_file(er, "variables")
     plt = _plt()
     recs = [r for r in er.records if r.case.index == 0]
     names = recs[0].result.variable_names
@@ -364,10 +366,12 @@ def _shading(problem, bounds, i, j, k, n=121, m=41):
     return gi, gj, np.log10(np.maximum(f, 1e-12))
 
 
-def snapshot_figures(er: ExperimentResult, folder: Path) -> list[str]:
+def snapshot_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
     """Population at the snapshot iterations, first case, run 0 (wu2015 Figs. 4-6): two projections
     shaded by log10 of the fitness (minimised over the third variable), the true pose and, where the
     mechanism has several exact forward solutions, the mirror solution(s)."""
+    if "snapshots" not in er.config.figures:
+        return []
     plt = _plt()
     written = []
     recs = [r for r in er.records if r.case.index == 0]
@@ -414,12 +418,13 @@ def snapshot_figures(er: ExperimentResult, folder: Path) -> list[str]:
     return written
 
 
-def extras_figure(er: ExperimentResult, path: Path) -> list[str]:
+def extras_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
     """Median over runs of each algorithm record vs iteration (wu2015 Fig. 7). Pheromone is
     tau = -f <= 0, so it is drawn as -tau on a log axis (the best pheromone's -tau is the best f)."""
     recs = [r for r in er.records if r.case.index == 0 and r.result.extras]
-    if not recs:
+    if "extras" not in er.config.figures or not recs:
         return []
+    path = folder / figure_file(er, "extras")
     plt = _plt()
     names = _spec_names(er)
     keys = sorted({k for r in recs for k in r.result.extras})
@@ -449,11 +454,12 @@ def extras_figure(er: ExperimentResult, path: Path) -> list[str]:
     return out
 
 
-def position_error_figure(er: ExperimentResult, path: Path) -> list[str]:
-    """Best-so-far position error (mm) vs iteration (wang7dof Figs. 5/6a)."""
-    curves = [c for c in _curve_sets(er) if c[4] is not None]
+def position_error_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+    """Best-so-far position error (mm) vs iteration (wang7dof Figs. 5/6a), serial arms."""
+    curves = [c for c in _curve_sets(er) if c[4] is not None] if er.mechanism.kind == "serial" else []
     if not curves:
         return []
+    path = folder / figure_file(er, "position_error")
     plt = _plt()
     fig, ax = plt.subplots(figsize=(5.5, 3.8))
     floor = plotting.floor_of(*[c[4] for c in curves])
@@ -478,9 +484,12 @@ def _case_axis(ax, n: int) -> None:
     ax.set_xlim(0.3, n + 0.7)
 
 
-def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, timing: pd.DataFrame) -> list[str]:
+def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
     """Per case (independent poses: markers, no lines): final fitness (deterministic), time per run
     (timed single runs) and, for serial arms, the final position error (wang7dof Fig. 7)."""
+    if "cases" not in er.config.figures:
+        return []
+    summary, timing = tables["summary.csv"], tables.get("timing.csv")
     plt = _plt()
     names = _spec_names(er)
     markers = "osD^v<>"
@@ -533,11 +542,12 @@ def cases_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, tim
     return written
 
 
-def time_figure(er: ExperimentResult, path: Path) -> list[str]:
+def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
     """Time of every timed single run per algorithm (wang7dof Fig. 6b): points and their median."""
     recs = [r for r in er.records if r.single_run_s is not None]
-    if not recs:
+    if "time" not in er.config.figures or not recs:
         return []
+    path = folder / figure_file(er, "time")
     plt = _plt()
     names = _spec_names(er)
     fig, ax = plt.subplots(figsize=(5, 3.4))
@@ -568,66 +578,11 @@ def meta(er: ExperimentResult) -> dict:
     }
 
 
-def write_meta(folder: Path, data: dict) -> None:
-    """``meta.json`` (with the digests of the CSVs already in ``folder``) and ``env.json``."""
-    write_json(folder / "meta.json", {**data, "files": file_digests(folder)})
-    write_json(folder / ENV_FILE, environment())
-
-
 def write_tables(er: ExperimentResult, folder: Path, figures: bool = True) -> list[str]:
-    """Write every file of the experiment into ``folder`` (which must exist); returns the names.
-
-    ``figures=False`` writes only the tables and meta.json (what ``fkopt check`` compares).
-    """
-    folder = Path(folder)
-    written = []
-
-    def csv(name, df):
-        if df is not None:
-            df.to_csv(folder / name, index=False, float_format=FLOAT)
-            written.append(name)
-
-    summary, timing = summary_table(er), timing_table(er)
-    csv("summary.csv", summary)
-    csv("timing.csv", timing)
-    csv("timing_runs.csv", timing_runs_table(er))
-    csv("values.csv", values_table(er))
-    csv("inputs.csv", inputs_table(er))
-    csv("runs.csv", runs_table(er))
-    written.append(write_trace(er, folder))   # each run's best-so-far improvements (claims, fkopt export)
-    csv("convergence.csv", convergence_table(er))
-    if figures:
-        written += write_figures(er, folder, summary, timing)
-    write_meta(folder, meta(er))
-    written += ["meta.json", ENV_FILE]
-    return written
-
-
-def write_figures(er: ExperimentResult, folder: Path, summary: pd.DataFrame, timing: pd.DataFrame) -> list[str]:
-    written = []
-    written += convergence_figure(er, folder / figure_file(er, "convergence"))
-    figs = set(er.config.figures)
-    if "variables" in figs:
-        written += variables_figure(er, folder / figure_file(er, "variables"))
-    if "snapshots" in figs:
-        written += snapshot_figures(er, folder)
-    if "extras" in figs:
-        written += extras_figure(er, folder / figure_file(er, "extras"))
-    if "cases" in figs:
-        written += cases_figures(er, folder, summary, timing)
-    if "time" in figs:
-        written += time_figure(er, folder / figure_file(er, "time"))
-    if er.mechanism.kind == "serial":
-        written += position_error_figure(er, folder / figure_file(er, "position_error"))
-    return written
-
-
-def experiment_folder(out: Path, er_or_config) -> Path:
-    """``OUT/<paper>/<name>``, checked (safe names, inside OUT, writable) before any computation."""
-    config = getattr(er_or_config, "config", er_or_config)
-    return output_folder(out, *config.folder_parts)
+    """Every file of the experiment (:data:`fkopt.outputs.OUTPUTS`) into ``folder`` (which must exist)."""
+    return write_outputs("experiment", er, folder, figures=figures)
 
 
 def write_experiment(er: ExperimentResult, out: Path) -> Path:
-    """Write the experiment's folder aside, then swap it into place (:func:`write_atomically`)."""
-    return write_atomically(experiment_folder(out, er), lambda tmp: write_tables(er, tmp))
+    """Write the experiment's folder aside, then swap it into place."""
+    return write_result("experiment", er, out)

@@ -18,8 +18,8 @@ evaluation count at the end of the iteration in which it happened (for the libra
 at the checkpoint of :mod:`fkopt.adapters.base`). Row 0 of a run is its initial population;
 its last row is always the evaluations used in all (the best value repeated if the last
 iteration did not improve), so a reader knows the run's budget. Runs that stopped at the
-threshold end at their stop. The file is gzip'ed with a fixed timestamp, so the same
-results give the same bytes.
+threshold end at their stop. :func:`fkopt.outputs.write_outputs` gzips it with a fixed
+timestamp, so the same results give the same bytes.
 """
 from __future__ import annotations
 
@@ -63,13 +63,6 @@ def trace_table(er) -> pd.DataFrame:
     if not frames:
         return pd.DataFrame(columns=list(COLUMNS))
     return pd.concat(frames, ignore_index=True)
-
-
-def write_trace(er, folder: Path) -> str:
-    """Write ``trace.csv.gz`` into ``folder``; returns its name."""
-    trace_table(er).to_csv(Path(folder) / FILE, index=False, float_format="%.10g",
-                           compression={"method": "gzip", "mtime": 0})
-    return FILE
 
 
 def read_trace(folder: Path) -> pd.DataFrame:

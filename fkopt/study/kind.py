@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..experiment.kinds import Kind, Outcome
+from ..outputs import write_outputs
 from .config import StudyConfig, study_from_dict
 
 
@@ -31,11 +32,10 @@ def _run(config: StudyConfig, out, *, source=None, progress=None, jobs: int = 1,
 
 
 def _rerun_files(config: StudyConfig, folder: Path, source: str | None) -> None:
-    from .reports import write_tables
     from .runner import rerun_in_memory
     result = rerun_in_memory(config)
     result.source = source
-    write_tables(result, folder, figures=False)
+    write_outputs("study", result, folder, figures=False, timing=False)
 
 
 STUDY = Kind("study", lambda data, where: study_from_dict(data, where), _validate, _run, _rerun_files)

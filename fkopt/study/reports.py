@@ -1,5 +1,9 @@
 """Files of a study folder ``OUT/<paper>/<name>/`` (conventions of :mod:`fkopt.experiment.reports`).
 
+The makers below are listed with their roles in :data:`fkopt.outputs.OUTPUTS` (``study``) and
+written by :func:`fkopt.outputs.write_outputs`; a maker returns None (a table) or ``[]`` (a
+figure) when its file does not apply (no grid, not tracking).
+
 Deterministic for a given config (whatever the executor, the number of jobs or a resume):
 
 * ``summary.csv``  one row per algorithm over all (pose, run) pairs (``case`` is ``all``, or
@@ -31,10 +35,8 @@ import numpy as np
 import pandas as pd
 
 from ..experiment import plotting
-from ..experiment.reports import FLOAT, _plt, _save, write_meta
+from ..experiment.reports import _plt, _save
 from ..files import nanmedian as _nanmedian
-from ..files import write_file_atomically
-from ..provenance import ENV_FILE
 from .statistics import ecdf_table, pairwise_tests
 
 # StudyResult (fkopt.study.runner) is only named in annotations: the runner imports this module.
@@ -196,7 +198,11 @@ def _axis(sr: StudyResult, var: str) -> str:
     return f"{var} ({units[var]})" if var in units else var
 
 
-def ecdf_figure(sr: StudyResult, ecdf: pd.DataFrame, path: Path) -> None:
+def ecdf_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+    """Fraction of (pose, run) pairs solved vs evaluations (log x), per algorithm."""
+    ecdf = tables.get("ecdf.csv")
+    if ecdf is None:
+        return []
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
     xmax = float(np.nanmax([np.nanmax(ar.evaluations) for ar in sr.algorithms] + [1.0]))
@@ -216,12 +222,16 @@ def ecdf_figure(sr: StudyResult, ecdf: pd.DataFrame, path: Path) -> None:
     ax.legend(fontsize=7, loc="lower right")
     ax.set_title(f"{sr.config.title or sr.config.name}: {len(sr.poses)} poses x {sr.config.runs} runs",
                  fontsize=9)
-    _save(fig, path)
+    names = _save(fig, folder / "ecdf.png")
     plt.close(fig)
+    return names
 
 
-def heatmap_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
+def heatmap_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     """Rows: log10 median final fitness, success rate, median evaluations to the threshold."""
+    table = tables.get("heatmap.csv")
+    if table is None:
+        return []
     plt = _plt()
     a1, a2 = sr.poses.grid_axes
     n = len(sr.algorithms)
@@ -267,11 +277,16 @@ def heatmap_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
     fig.suptitle(f"{sr.config.title or sr.config.name}" + (f"\n(fixed: {', '.join(f'{k}={v:g}' for k, v in fixed.items())};"
                                                          f" {sr.config.runs} runs per point)" if fixed else ""),
                  fontsize=10)
-    _save(fig, path)
+    names = _save(fig, folder / "heatmap.png")
     plt.close(fig)
+    return names
 
 
-def tracking_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
+def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+    """Per trajectory step: median final fitness and evaluations (warm-started vs cold)."""
+    table = tables.get("tracking.csv")
+    if table is None:
+        return []
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     for ar in sr.algorithms:
@@ -292,11 +307,16 @@ def tracking_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
     fig.suptitle(f"{sr.config.title or sr.config.name}\n(each step warm-started from the previous "
                  f"step's solution unless marked cold)", fontsize=10)
     fig.tight_layout()
-    _save(fig, path)
+    names = _save(fig, folder / "tracking.png")
     plt.close(fig)
+    return names
 
 
-def tracking_time_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> None:
+def tracking_time_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+    """Time per step and run (measured; TIMING.md)."""
+    table = tables.get("tracking_timing.csv")
+    if table is None:
+        return []
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 3.6))
     for ar in sr.algorithms:
@@ -308,8 +328,9 @@ def tracking_time_figure(sr: StudyResult, table: pd.DataFrame, path: Path) -> No
     ax.set_ylabel("time per step and run (ms)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
-    _save(fig, path)
+    names = _save(fig, folder / "tracking_time.png")
     plt.close(fig)
+    return names
 
 
 # -- folder --------------------------------------------------------------------------------------
@@ -328,54 +349,3 @@ def meta(sr: StudyResult) -> dict:
         "fingerprint": sr.config.fingerprint(), "poses": len(sr.poses),
         "mechanism": sr.mechanism.describe(), "objective": objective,
     }
-
-
-def _atomic(folder: Path, name: str, write) -> None:
-    write_file_atomically(folder / name, write)
-
-
-def write_tables(sr: StudyResult, folder: Path, figures: bool = True) -> list[str]:
-    """Write every file of the study into ``folder`` (each atomically; ``meta.json`` last)."""
-    folder = Path(folder)
-    written: list[str] = []
-
-    def csv(name, df):
-        if df is not None:
-            _atomic(folder, name, lambda p: df.to_csv(p, index=False, float_format=FLOAT))
-            written.append(name)
-
-    def fig(name, draw, *args):
-        # Drawn in place: the folder is a scratch copy swapped in whole, and a figure is two files
-        # (PNG and its PDF twin, fkopt.experiment.plotting.save).
-        if figures:
-            draw(sr, *args, folder / name)
-            written.extend([name, str(Path(name).with_suffix(".pdf"))])
-
-    csv("summary.csv", summary_table(sr))
-    csv("timing.csv", timing_table(sr))
-    csv("poses.csv", poses_table(sr))
-    csv("runs.csv", runs_table(sr))
-    ecdf = ecdf_of(sr)
-    csv("ecdf.csv", ecdf)
-    fig("ecdf.png", ecdf_figure, ecdf)
-    csv("stats.csv", stats_of(sr))
-    heat = heatmap_table(sr)
-    if heat is not None:
-        csv("heatmap.csv", heat)
-        fig("heatmap.png", heatmap_figure, heat)
-    track = tracking_table(sr)
-    if track is not None:
-        csv("tracking.csv", track)
-        fig("tracking.png", tracking_figure, track)
-        ttime = tracking_timing_table(sr)
-        csv("tracking_timing.csv", ttime)
-        fig("tracking_time.png", tracking_time_figure, ttime)
-    write_meta(folder, meta(sr))
-    written += ["meta.json", ENV_FILE]
-    return written
-
-
-def write_study(sr: StudyResult, folder: Path) -> list[str]:
-    """Write into ``folder`` in place (the runner writes aside and swaps instead)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    return write_tables(sr, folder)

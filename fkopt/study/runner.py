@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import FkoptError
 from ..files import output_folder, write_atomically, write_json_atomically
+from ..outputs import write_outputs
 from ..experiment.runner import build_mechanism, task_seed
 from ..problems import BoxedProblem, fk_problem
 from ..solve import make_algorithm, solve
@@ -400,10 +401,8 @@ def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1
     result = StudyResult(config, mech, poses, merge(config, mech, poses, records),
                          time.perf_counter() - t_start, source, computed, folder)
     if write:
-        from .reports import write_tables
-
         def fill(tmp: Path) -> None:
-            write_tables(result, tmp)
+            write_outputs("study", result, tmp)
             if keep_tasks:
                 os.replace(work / TASKS, tmp / TASKS)
 
