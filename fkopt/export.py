@@ -83,7 +83,7 @@ def _load(folder: Path):
 def ioh_export(results: Path, out: Path) -> list[Path]:
     """Write the IOHprofiler files of every experiment under ``results`` into ``out``."""
     from . import __version__
-    from .experiment.reports import write_atomically
+    from .files import write_atomically
     folders = experiment_folders(results)
     out = check_out(out, results)
     loaded = [(f, data) for f in folders if (data := _load(f)) is not None]

@@ -3,6 +3,7 @@ import filecmp
 import json
 import os
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -320,6 +321,61 @@ def test_tracking_warm_starts_from_previous_solution(tmp_path):
     timing = pd.read_csv(res.folder / "tracking_timing.csv")
     assert len(timing) == 3 * 8 and (timing.ms_per_run > 0).all()
     assert "ms_per_run" not in track.columns and "time" not in " ".join(track.columns)
+
+
+TWO_TRAJECTORIES = [
+    {"circle": {"centre": {"alpha": 0, "beta": 0, "z": 550}, "radius": [8, 4], "plane": ["alpha", "beta"]},
+     "points": 6},
+    {"waypoints": [{"alpha": -10, "beta": 0, "z": 500}, {"alpha": 10, "beta": 5, "z": 560}], "points": 4},
+]
+
+
+def test_tracking_batches_trajectories_each_as_if_alone():
+    """Step t of every trajectory is one solve; each trajectory's numbers equal those of a solve of
+    that trajectory alone (same pose indices, hence the same seeds), for local methods and warm swarms."""
+    from fkopt.study.runner import Task, _track
+    config = tracking_config(poses=TWO_TRAJECTORIES)
+    mech, poses = validate_study(config)
+    assert poses.segments == ((0, 6), (6, 10))
+    assert poses.step.tolist() == [0, 1, 2, 3, 4, 5, 0, 1, 2, 3]
+    for a, spec in enumerate(config.algorithms):
+        task = Task(a, spec.key, 0, 0, len(poses))
+        both = _track(config, mech, poses, spec, task)
+        for seg in poses.segments:
+            alone = _track(config, mech, replace(poses, segments=(seg,)), spec, task)
+            mine = [k for k, i in enumerate(both["poses"]) if seg[0] <= i < seg[1]]
+            assert [both["poses"][k] for k in mine] == alone["poses"] == list(range(*seg))
+            for key in ("seeds", "fitness", "evaluations", "x", "start", "iterations_done"):
+                np.testing.assert_array_equal(np.array([both[key][k] for k in mine], dtype=float),
+                                              np.array(alone[key], dtype=float), err_msg=f"{spec.key} {seg} {key}")
+
+
+def test_tracking_several_trajectories_report(tmp_path):
+    res = run_study(tracking_config(poses=TWO_TRAJECTORIES), tmp_path)
+    track = pd.read_csv(res.folder / "tracking.csv")
+    lm = track[track.algorithm == "lm"]
+    assert lm.trajectory.tolist() == [1] * 6 + [2] * 4
+    assert lm.step.tolist() == [0, 1, 2, 3, 4, 5, 0, 1, 2, 3]
+    assert lm.warm_start.tolist() == [False] + [True] * 5 + [False] + [True] * 3   # each starts cold
+    assert (res.folder / "tracking.png").exists()
+    runs = pd.read_csv(res.folder / "runs.csv")
+    first = runs[(runs.algorithm == "lm") & (runs.pose == 7)]     # trajectory 2, step 0: from the centre
+    centre = res.mechanism.bounds.mean(axis=1)
+    np.testing.assert_array_equal(first[["start_alpha", "start_beta", "start_z"]].to_numpy(),
+                                  np.broadcast_to(centre, (2, 3)))
+
+
+@pytest.mark.parametrize("poses, mode, fragment", [
+    (TWO_TRAJECTORIES, "independent", "a list of trajectories needs mode: tracking"),
+    ([{"uniform": 5}], "tracking", "poses[0]: a trajectory needs exactly one of waypoints, circle"),
+    ([TWO_TRAJECTORIES[0], {"waypoints": [{"alpha": 0, "beta": 0, "z": 500}], "points": 3}], "tracking",
+     "poses.1.waypoints"),
+    ([], "tracking", "poses: 1 to 1000 trajectories"),
+])
+def test_trajectory_list_errors(poses, mode, fragment):
+    with pytest.raises(FkoptError) as err:
+        small(poses=poses, mode=mode)
+    assert fragment in str(err.value) and "\n" not in str(err.value)
 
 
 # -- grid heat map, report, check ------------------------------------------------------------------

@@ -21,10 +21,13 @@ and adding a config kind is one module plus one line here. Everything else is sh
 * :func:`run_config` -- run and write (aside, then swapped into place);
 * :func:`rerun_files` -- rerun into a scratch folder, for ``fkopt check``.
 
-Not yet one pipeline (left for a later step, issue 11): a study still has its own runner and
-report tables rather than being "an experiment whose cases come from a pose set", and each kind
-still lists its own output files in its ``reports`` module (adding an output kind touches that
-kind's writer, and :data:`fkopt.compare.SHAPE_ONLY` when it holds single runs or curves).
+What the kinds share beyond this module: one solve path (:func:`fkopt.experiment.runner.solve_cases`
+-- an experiment's cases, a study's pose chunks and a tracking step's trajectories are all cases
+of one problem), one list of output files with their roles and one writer (:mod:`fkopt.outputs`),
+one checker (:mod:`fkopt.reproduce.check` through :func:`rerun_files`). What stays a study's own:
+its pose sets, its task files (the unit of ``--jobs``, Dask and ``--resume``) and its
+statistics; a study keeps per-(pose, run) records, not the per-iteration histories an
+experiment's figures need.
 """
 from __future__ import annotations
 

@@ -19,10 +19,10 @@ import numpy as np
 
 from .. import registry
 from ..errors import FkoptError
-from ..problems import fk_problem
+from ..problems import fk_problem, ik_problem
 from ..rotations import wrap_degrees
 from ..solve import Result, chunk_size, make_algorithm, solve
-from .config import AlgorithmSpec, ExperimentConfig, RandomCases
+from .config import AlgorithmSpec, ExperimentConfig, RandomCases, RunConfig
 from .timing import time_single_runs
 
 
@@ -132,15 +132,20 @@ def build_cases(config: ExperimentConfig, mech) -> list[Case]:
     return cases
 
 
-def build_problem(config: ExperimentConfig, mech, case: Case):
-    if mech.kind == "serial":
-        from .. import problems
-        if not hasattr(problems, "ik_problem"):
-            raise FkoptError(f"serial mechanism '{mech.name}' needs ik_problem, not available in this build")
-        kwargs = {"objective": config.objective} if config.objective else {}
-        return problems.ik_problem(mech, case.inputs, **kwargs)
+def make_problem(config: RunConfig, mech, inputs: np.ndarray, bounds=None):
+    """The problem of ``inputs`` -- one target ``(m,)`` or a case axis ``(cases, m)`` -- with the
+    config's objective: :func:`fkopt.fk_problem` for a parallel mechanism, :func:`fkopt.ik_problem`
+    for a serial arm. The one place experiments, studies and tracking steps get a problem from."""
     kwargs = {"objective": config.objective} if config.objective else {}
-    return fk_problem(mech, case.inputs, **kwargs)
+    if bounds is not None:
+        kwargs["bounds"] = bounds
+    if mech.kind == "serial":
+        return ik_problem(mech, inputs, **kwargs)
+    return fk_problem(mech, inputs, **kwargs)
+
+
+def build_problem(config: ExperimentConfig, mech, case: Case):
+    return make_problem(config, mech, case.inputs)
 
 
 def outputs_of(mech, x: np.ndarray) -> np.ndarray:
@@ -161,9 +166,7 @@ def validate_experiment(config: ExperimentConfig):
     cases = build_cases(config, mech)
     for spec in config.algorithms:
         make_algorithm(spec.name, spec.params)   # unknown names/parameters fail here
-        if spec.start is not None:
-            x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
-            _check_in_bounds(mech, x0, f"algorithms[{spec.key}].start")
+        start_point(spec, mech)
     problems = [build_problem(config, mech, c) for c in cases]
     for spec in config.algorithms:       # a batch that cannot fit in memory fails here, not midway
         try:
@@ -183,12 +186,35 @@ def keeps_x_history(config: ExperimentConfig, mech) -> bool:
 
 def batched_problem(config: ExperimentConfig, mech, cases: list[Case]):
     """One problem with a case axis holding every case's inputs (see :mod:`fkopt.problems`)."""
-    inputs = np.stack([c.inputs for c in cases])
-    kwargs = {"objective": config.objective} if config.objective else {}
-    if mech.kind == "serial":
-        from ..problems import ik_problem
-        return ik_problem(mech, inputs, **kwargs)
-    return fk_problem(mech, inputs, **kwargs)
+    return make_problem(config, mech, np.stack([c.inputs for c in cases]))
+
+
+def start_point(spec: AlgorithmSpec, mech) -> np.ndarray | None:
+    """An algorithm's ``start`` as a vector of the unknowns (checked inside the bounds): a pose
+    mapping, or (study files) ``"centre"`` -- the centre of the bounds; None: no start."""
+    if spec.start is None:
+        return None
+    if isinstance(spec.start, str):      # "centre" (the schema admits nothing else)
+        return mech.bounds.mean(axis=1)
+    x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
+    _check_in_bounds(mech, x0, f"algorithms[{spec.key}].start")
+    return x0
+
+
+def budget(config: RunConfig, spec: AlgorithmSpec) -> dict:
+    """The solve settings an algorithm gets from its spec and the config (spec first)."""
+    return dict(population=spec.population or config.population,
+                iterations=spec.iterations or config.iterations, runs=config.runs,
+                target=config.threshold, stop_at_target=config.stop_at_threshold)
+
+
+def solve_cases(config: RunConfig, spec: AlgorithmSpec, problem, seeds, *, x0=None, **options) -> Result:
+    """One algorithm on every case of ``problem`` for ``config.runs`` runs each, in one
+    :func:`fkopt.solve` call (cases x runs rows), case c seeded with ``seeds[c]`` (one int for a
+    single-target problem). The one solve path of experiments, study chunks and tracking steps;
+    ``options`` go to :func:`fkopt.solve` (``batch``, ``snapshots``, ``x_history``, ``runs``)."""
+    settings = {**budget(config, spec), **options}
+    return solve(problem, make_algorithm(spec.name, spec.params), seed=seeds, x0=x0, **settings)
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
@@ -212,16 +238,10 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     start_all = time.perf_counter()
     by_algorithm: list[list[TaskRecord]] = []
     for spec in config.algorithms:
-        algo = make_algorithm(spec.name, spec.params)
         seeds = [task_seed(config.seed, case.index, spec.key) for case in cases]
-        x0 = (mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
-              if spec.start is not None else None)
         start = time.perf_counter()
-        result = solve(batched, algo, population=spec.population or config.population,
-                       iterations=spec.iterations or config.iterations, runs=config.runs,
-                       seed=seeds[0] if one else seeds,
-                       target=config.threshold, stop_at_target=config.stop_at_threshold, x0=x0,
-                       batch=config.batch, snapshots=config.snapshots, x_history=keep_x)
+        result = solve_cases(config, spec, batched, seeds[0] if one else seeds, x0=start_point(spec, mech),
+                             batch=config.batch, snapshots=config.snapshots, x_history=keep_x)
         wall = (time.perf_counter() - start) / len(cases)     # amortised over the cases
         recs = []
         for i, (case, problem) in enumerate(zip(cases, problems)):

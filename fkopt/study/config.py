@@ -38,7 +38,9 @@ mechanism; the joints of a serial arm, whose targets are then ``fk(joints)`` (al
   box width), both ends included; a line is two waypoints;
 * ``{circle: {centre: {...}, radius: 0.05, plane: [x, y]}, points: 40}`` -- ``points`` poses on
   a closed circle (the first not repeated) in the plane of two variables around ``centre``;
-  ``radius`` may be ``[r1, r2]`` for an ellipse (e.g. mm and degrees).
+  ``radius`` may be ``[r1, r2]`` for an ellipse (e.g. mm and degrees);
+* (tracking only) a list of waypoint and circle sets: several independent trajectories, of any
+  lengths, numbered 1, 2, ... in ``tracking.csv``; their poses are indexed one after another.
 
 Modes:
 
@@ -46,14 +48,16 @@ Modes:
   seeded runs. A task is (pose chunk, algorithm); pose i of the task uses the seed
   ``task_seed(seed, i, label)`` of :mod:`fkopt.experiment.runner`, so the numbers do not
   depend on ``chunk``, on the executor, or on which tasks ran first.
-* ``tracking`` -- the poses are a trajectory solved in order, the way a controller does: each
-  step warm-starts from the previous step's solution of the same run (local methods ``nr``/``lm``:
-  ``x0`` = that solution; swarms and hybrids: their search box shrunk to
-  ``tracking.radius`` x the box width around it, one run at a time). The first step starts from
-  ``start`` (or the centre of the bounds) for local methods and from the full box for swarms.
-  ``warm_start: false`` on an algorithm solves every step cold instead (a baseline). A task is
-  (trajectory, algorithm); step t uses the seed ``task_seed(seed, t, label)``. Time per step
-  goes to ``tracking_timing.csv`` (never into the deterministic files).
+* ``tracking`` -- the poses are a trajectory (or several) solved in order, the way a controller
+  does: each step warm-starts from the previous step's solution of the same run (local methods
+  ``nr``/``lm``: ``x0`` = that solution; swarms and hybrids: their search box shrunk to
+  ``tracking.radius`` x the box width around it). The first step starts from ``start`` (or the
+  centre of the bounds) for local methods and from the full box for swarms. ``warm_start: false``
+  on an algorithm solves every step cold instead (a baseline). A task is (all trajectories,
+  algorithm): step t of every trajectory that has one is one solve (trajectories x runs rows),
+  the pose with index i in the pose set using the seed ``task_seed(seed, i, label)``, so a
+  trajectory's numbers do not depend on the others. Time per step (amortised over the
+  trajectories) goes to ``tracking_timing.csv`` (never into the deterministic files).
 """
 from __future__ import annotations
 
@@ -69,6 +73,8 @@ from ..experiment.config import MAX_CASES, MAX_RUNS, NOT_NUMERIC, AlgorithmSpec,
 from ..files import error_line, load_mapping
 
 KIND = "study"
+#: Trajectories of one tracking study (they are solved together, step by step).
+MAX_TRAJECTORIES = 1000
 
 
 class StudyAlgorithmSpec(AlgorithmSpec):
@@ -141,7 +147,8 @@ class StudyConfig(RunConfig):
 
     kind: Literal["study"]
     paper: str = "studies"
-    poses: PoseSet
+    #: A pose set; in tracking mode also a list of trajectories, solved together step by step.
+    poses: PoseSet | list[WaypointPoses | CirclePoses] = Field(union_mode="left_to_right")
     algorithms: list[StudyAlgorithmSpec] = Field(min_length=1)
     runs: int = Field(5, ge=1, le=MAX_RUNS)
     threshold: float = Field(1e-10, gt=0)
@@ -156,6 +163,13 @@ class StudyConfig(RunConfig):
         if self.mode == "tracking" and isinstance(self.poses, (UniformPoses, GridPoses)):
             raise ValueError("mode tracking needs a trajectory: poses.waypoints or poses.circle "
                              "(uniform and grid poses have no order)")
+        if isinstance(self.poses, list):
+            if self.mode != "tracking":
+                raise ValueError("poses: a list of trajectories needs mode: tracking (otherwise give one pose set)")
+            if not 1 <= len(self.poses) <= MAX_TRAJECTORIES:
+                raise ValueError(f"poses: 1 to {MAX_TRAJECTORIES} trajectories, got {len(self.poses)}")
+            if sum(p.points for p in self.poses) > MAX_CASES:
+                raise ValueError(f"poses: the trajectories have more than {MAX_CASES} points in all")
         return self
 
     def fingerprint(self) -> str:
@@ -169,6 +183,13 @@ class StudyConfig(RunConfig):
 def _pose_set_error(data: dict) -> str | None:
     """A clear message for a ``poses:`` mapping that names no (or several) pose set kinds."""
     poses = data.get("poses")
+    if isinstance(poses, list):       # tracking: trajectories
+        for j, item in enumerate(poses):
+            kinds = [k for k in ("waypoints", "circle") if isinstance(item, dict) and k in item]
+            if len(kinds) != 1:
+                return (f"poses[{j}]: a trajectory needs exactly one of waypoints, circle"
+                        + (f" (got {', '.join(kinds)})" if kinds else ""))
+        return None
     if not isinstance(poses, dict):
         return None
     kinds = [k for k in ("uniform", "grid", "waypoints", "circle") if k in poses]

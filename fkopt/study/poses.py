@@ -22,6 +22,22 @@ class PoseSet:
     inputs: np.ndarray              # (n, n_inputs) what each problem must reproduce
     targets: np.ndarray             # (n, n_pose) the true answer in the compared space (pose)
     grid_axes: tuple[str, str] | None = None   # the two varying variables of a 2-D grid
+    #: (start, stop) of each trajectory in ``points`` (tracking); one segment for any other set.
+    segments: tuple[tuple[int, int], ...] = ()
+
+    def __post_init__(self):
+        if not self.segments:
+            self.segments = ((0, len(self.points)),)
+
+    @property
+    def trajectory(self) -> np.ndarray:
+        """(n,) index of the trajectory each pose belongs to (all 0 but in multi-trajectory tracking)."""
+        return np.repeat(np.arange(len(self.segments)), [b - a for a, b in self.segments])
+
+    @property
+    def step(self) -> np.ndarray:
+        """(n,) position of each pose along its trajectory."""
+        return np.concatenate([np.arange(b - a) for a, b in self.segments])
 
     def __len__(self) -> int:
         return len(self.points)
@@ -98,19 +114,31 @@ def circle_points(mech, spec: CirclePoses) -> np.ndarray:
     return pts
 
 
-def build_poses(config: StudyConfig, mech) -> PoseSet:
-    spec = config.poses
-    axes = None
+def _points(mech, spec, where: str) -> tuple[np.ndarray, tuple[str, str] | None]:
     if isinstance(spec, UniformPoses):
-        pts = uniform_points(mech, spec)
-    elif isinstance(spec, GridPoses):
-        pts, axes = grid_points(mech, spec)
-    elif isinstance(spec, WaypointPoses):
-        pts = waypoint_points(mech, spec)
-    elif isinstance(spec, CirclePoses):
-        pts = circle_points(mech, spec)
-    else:  # pragma: no cover - the schema admits nothing else
-        raise FkoptError(f"poses: unsupported pose set {type(spec).__name__}")
+        return uniform_points(mech, spec), None
+    if isinstance(spec, GridPoses):
+        return grid_points(mech, spec)
+    if isinstance(spec, WaypointPoses):
+        return waypoint_points(mech, spec), None
+    if isinstance(spec, CirclePoses):
+        return circle_points(mech, spec), None
+    raise FkoptError(f"{where}: unsupported pose set {type(spec).__name__}")  # pragma: no cover
+
+
+def build_poses(config: StudyConfig, mech) -> PoseSet:
+    """The study's poses; a list of trajectories (tracking) is concatenated, with its segments."""
+    specs = config.poses if isinstance(config.poses, list) else [config.poses]
+    parts, axes, segments = [], None, []
+    for j, spec in enumerate(specs):
+        where = f"poses[{j}]" if isinstance(config.poses, list) else "poses"
+        try:
+            pts, axes = _points(mech, spec, where)
+        except FkoptError as err:     # the point builders name "poses"; a list names the item
+            raise FkoptError(str(err).replace("poses", where, 1)) from None
+        segments.append((sum(len(p) for p in parts), sum(len(p) for p in parts) + len(pts)))
+        parts.append(pts)
+    pts = np.concatenate(parts)
     _check_bounds(mech, pts, "poses")
     if mech.kind == "serial":
         targets = mech.fk(pts)
@@ -122,4 +150,5 @@ def build_poses(config: StudyConfig, mech) -> PoseSet:
         i = int(np.flatnonzero(~np.isfinite(inputs).all(axis=1))[0])
         raise FkoptError(f"poses: point {i + 1} ({', '.join(f'{n}={v:g}' for n, v in zip(mech.unknown_names, pts[i]))}) "
                          f"has no finite {'inverse' if mech.kind != 'serial' else 'forward'} map")
-    return PoseSet(tuple(mech.unknown_names), pts, np.asarray(inputs, float), np.asarray(targets, float), axes)
+    return PoseSet(tuple(mech.unknown_names), pts, np.asarray(inputs, float), np.asarray(targets, float), axes,
+                   tuple(segments))

@@ -158,13 +158,12 @@ def tracking_table(sr: StudyResult) -> pd.DataFrame | None:
     if sr.config.mode != "tracking":
         return None
     thr = sr.config.threshold
-    n = len(sr.poses)
+    step = sr.poses.step
     frames = []
     for ar in sr.algorithms:
-        warm = np.zeros(n, dtype=bool)
-        if ar.spec.warm_start:
-            warm[1:] = True
-        df = pd.DataFrame({"step": np.arange(n), "algorithm": ar.key, "warm_start": warm,
+        warm = (step > 0) & ar.spec.warm_start
+        df = pd.DataFrame({"trajectory": sr.poses.trajectory + 1, "step": step, "algorithm": ar.key,
+                           "warm_start": warm,
                            **{n_: sr.poses.points[:, j] for j, n_ in enumerate(sr.poses.names)},
                            "median_fitness": np.median(ar.fitness, axis=1),
                            "success_rate": np.mean(ar.fitness < thr, axis=1),
@@ -179,9 +178,9 @@ def tracking_timing_table(sr: StudyResult) -> pd.DataFrame | None:
     if sr.config.mode != "tracking":
         return None
     runs = sr.config.runs
-    return pd.concat([pd.DataFrame({"step": np.arange(len(sr.poses)), "algorithm": ar.key,
-                                    "ms_per_run": ar.time_s / runs * 1e3}) for ar in sr.algorithms],
-                     ignore_index=True)
+    return pd.concat([pd.DataFrame({"trajectory": sr.poses.trajectory + 1, "step": sr.poses.step,
+                                    "algorithm": ar.key, "ms_per_run": ar.time_s / runs * 1e3})
+                      for ar in sr.algorithms], ignore_index=True)
 
 
 # -- figures -------------------------------------------------------------------------------------
@@ -191,6 +190,10 @@ def _name(ar) -> str:
     if ar.spec.label and ar.spec.label != ar.spec.name and "cold" in ar.spec.label:
         name += " (cold)"
     return name
+
+
+#: Line styles of the trajectories of a multi-trajectory tracking study (colour: the algorithm).
+_STYLES = ("-", "--", ":", "-.")
 
 
 def _axis(sr: StudyResult, var: str) -> str:
@@ -289,12 +292,18 @@ def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
         return []
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    floor = plotting.floor_of(table.median_fitness.to_numpy(dtype=float))
+    several = table.trajectory.nunique() > 1
     for ar in sr.algorithms:
-        d = table[table.algorithm == ar.key]
         name = _name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)")
-        floor = plotting.floor_of(table.median_fitness.to_numpy(dtype=float))
-        axes[0].plot(d.step, np.maximum(d.median_fitness, floor), marker=".", lw=1, label=name)
-        axes[1].plot(d.step, d.median_evaluations, marker=".", lw=1, label=name)
+        color = None
+        for traj, d in table[table.algorithm == ar.key].groupby("trajectory"):
+            label = (f"{name}, trajectory {traj}" if several else name) if color is None or several else None
+            line, = axes[0].plot(d.step, np.maximum(d.median_fitness, floor), marker=".", lw=1, label=label,
+                                 color=color, ls=_STYLES[(traj - 1) % len(_STYLES)])
+            color = line.get_color()
+            axes[1].plot(d.step, d.median_evaluations, marker=".", lw=1, color=color,
+                         ls=_STYLES[(traj - 1) % len(_STYLES)])
     axes[0].axhline(sr.config.threshold, color="k", lw=0.8, ls="--")
     axes[0].set_yscale("log")
     axes[0].set_ylabel("final fitness (median over runs)")
@@ -320,9 +329,12 @@ def tracking_time_figure(sr: StudyResult, folder: Path, tables: dict) -> list[st
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 3.6))
     for ar in sr.algorithms:
-        d = table[table.algorithm == ar.key]
-        ax.plot(d.step, d.ms_per_run, marker=".", lw=1,
-                label=_name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)"))
+        color = None
+        for traj, d in table[table.algorithm == ar.key].groupby("trajectory"):
+            line, = ax.plot(d.step, d.ms_per_run, marker=".", lw=1, color=color, ls=_STYLES[(traj - 1) % len(_STYLES)],
+                            label=None if color is not None else
+                            _name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)"))
+            color = line.get_color()
     ax.set_yscale("log")
     ax.set_xlabel("trajectory step")
     ax.set_ylabel("time per step and run (ms)")

@@ -1,7 +1,9 @@
 """Run a study: plan tasks, run the missing ones on an executor, keep one file per task, merge.
 
-* A task is (pose chunk, algorithm) in ``independent`` mode and (trajectory, algorithm) in
-  ``tracking`` mode. :func:`run_task` computes one from a JSON-able payload (so it runs in
+* A task is (pose chunk, algorithm) in ``independent`` mode and (all trajectories, algorithm)
+  in ``tracking`` mode. A chunk's poses are the cases of one solve through the experiment's
+  solve path (:func:`fkopt.experiment.runner.solve_cases`): a study is an experiment whose
+  cases come from a pose set. :func:`run_task` computes one from a JSON-able payload (so it runs in
   another process or on a Dask worker) and returns plain lists; the seeds come from
   :func:`fkopt.experiment.runner.task_seed` per pose (or step), so a task's numbers do not
   depend on where, when or next to what it ran.
@@ -35,9 +37,10 @@ import numpy as np
 from ..errors import FkoptError
 from ..files import output_folder, write_atomically, write_json_atomically
 from ..outputs import write_outputs
-from ..experiment.runner import build_mechanism, task_seed
-from ..problems import BoxedProblem, fk_problem
-from ..solve import make_algorithm, solve
+from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
+from ..problems import BoxedProblem
+from ..solve import make_algorithm
+from ..streams import case_seed
 from .config import StudyAlgorithmSpec, StudyConfig
 from .poses import PoseSet, build_poses
 
@@ -69,30 +72,6 @@ def plan_tasks(config: StudyConfig, n_poses: int) -> list[Task]:
         stop = min(start + config.chunk, n_poses)
         out += [Task(a, spec.key, c, start, stop) for a, spec in enumerate(config.algorithms)]
     return out
-
-
-def make_problem(config: StudyConfig, mech, inputs: np.ndarray, bounds=None):
-    kwargs = {"objective": config.objective} if config.objective else {}
-    if bounds is not None:
-        kwargs["bounds"] = bounds
-    if mech.kind == "serial":
-        from ..problems import ik_problem
-        return ik_problem(mech, inputs, **kwargs)
-    return fk_problem(mech, inputs, **kwargs)
-
-
-def start_point(spec: StudyAlgorithmSpec, mech) -> np.ndarray | None:
-    if spec.start is None:
-        return None
-    if spec.start == "centre":
-        return mech.bounds.mean(axis=1)
-    x0 = mech.vector(spec.start, mech.unknown_names, f"algorithms[{spec.key}].start")
-    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
-    for name, v, a, b in zip(mech.unknown_names, x0, lo, hi):
-        if not a - 1e-9 <= v <= b + 1e-9:
-            raise FkoptError(f"algorithms[{spec.key}].start: {name}={v:g} is outside the workspace "
-                             f"bounds [{a:g}, {b:g}]")
-    return x0
 
 
 def validate_study(config: StudyConfig):
@@ -132,12 +111,6 @@ def run_task(payload: dict) -> dict:
     return rec
 
 
-def _budget(config: StudyConfig, spec: StudyAlgorithmSpec) -> dict:
-    return dict(population=spec.population or config.population,
-                iterations=spec.iterations or config.iterations,
-                target=config.threshold, stop_at_target=config.stop_at_threshold)
-
-
 def _collect(rec: dict, r, thr: float, seconds: float) -> None:
     rec["fitness"].append(r.fitness.tolist())
     rec["evaluations"].append(r.evaluations.tolist())
@@ -154,14 +127,13 @@ def _empty(task: Task) -> dict:
 
 
 def _independent(config, mech, poses: PoseSet, spec, task: Task) -> dict:
-    """Every pose of the chunk in one solve (poses x runs rows), each pose with its own seed."""
+    """The chunk's poses are the cases of one experiment solve (poses x runs rows,
+    :func:`fkopt.experiment.runner.solve_cases`), each pose with its own seed."""
     rec = _empty(task)
-    idx = range(task.start, task.stop)
-    seeds = [task_seed(config.seed, i, spec.key) for i in idx]
+    seeds = [task_seed(config.seed, i, spec.key) for i in range(task.start, task.stop)]
     problem = make_problem(config, mech, poses.inputs[task.start:task.stop])
     t0 = time.perf_counter()
-    r = solve(problem, make_algorithm(spec.name, spec.params), runs=config.runs, seed=seeds,
-              x0=start_point(spec, mech), **_budget(config, spec))
+    r = solve_cases(config, spec, problem, seeds, x0=start_point(spec, mech))
     seconds = (time.perf_counter() - t0) / len(seeds)     # amortised over the poses
     rec["seeds"] = seeds
     for j in range(len(seeds)):
@@ -170,55 +142,68 @@ def _independent(config, mech, poses: PoseSet, spec, task: Task) -> dict:
 
 
 def _warm_boxes(mech, prev: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per run, the box of +-radius of the workspace around its previous solution, clipped."""
+    """Per row, the box of +-radius of the workspace around its previous solution, clipped."""
     lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
     half = radius * (hi - lo)
     return np.maximum(lo, prev - half), np.minimum(hi, prev + half)
 
 
-def _runs_of(r, x: np.ndarray):
-    """A result of ``runs`` cases x 1 run read as one target with ``runs`` runs."""
-    one = lambda a: None if a is None else a[:, 0]   # noqa: E731
+def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
+    """Solve every trajectory in order; each step warm-starts from the previous step's solution.
+
+    Step t of all trajectories that have one is a single solve, trajectory j being case j with
+    the seed ``task_seed(seed, i, label)`` of its pose's index i in the pose set. A cold step
+    (the first; every step without ``warm_start``) and a local method are one solve of those
+    cases x runs rows (local methods start at the previous solution of their run). A warm swarm
+    searches a box around each run's previous solution: every (trajectory, run) is then a case
+    of a :class:`fkopt.problems.BoxedProblem` (one box each), run k of trajectory j drawing from
+    ``case_seed(seed of j's step, k)`` -- so a trajectory gives the same numbers alone or
+    batched with others.
+    """
+    rec = _empty(task)
+    rec["poses"], rec["start"] = [], []
+    algo = make_algorithm(spec.name, spec.params)
+    runs, dim = config.runs, len(mech.unknown_names)
+    x0 = start_point(spec, mech)
+    segments = poses.segments
+    prev = np.full((len(segments), runs, dim), np.nan)
+    for t in range(max(stop - start for start, stop in segments)):
+        active = [j for j, (start, stop) in enumerate(segments) if start + t < stop]
+        idx = [segments[j][0] + t for j in active]
+        seeds = [task_seed(config.seed, i, spec.key) for i in idx]
+        warm = spec.warm_start and t > 0
+        t0 = time.perf_counter()
+        if algo.local or not warm:
+            starts = prev[active] if warm else (np.broadcast_to(x0, (len(active), runs, dim)) if x0 is not None
+                                                else np.full((len(active), runs, dim), np.nan))
+            r = solve_cases(config, spec, make_problem(config, mech, poses.inputs[idx]), seeds,
+                            x0=prev[active] if warm else x0)
+            results = [r.case(c) for c in range(len(active))]
+        else:
+            starts = prev[active]
+            lo, hi = _warm_boxes(mech, starts.reshape(-1, dim), config.tracking.radius)
+            target = make_problem(config, mech, np.repeat(poses.inputs[idx], runs, axis=0))
+            boxed = BoxedProblem(target, lo, hi)
+            rb = solve_cases(config, spec, boxed, [case_seed(s, k) for s in seeds for k in range(runs)], runs=1)
+            x = boxed.to_x(rb.x[:, 0]).reshape(len(active), runs, dim)
+            results = [_runs_of(rb, x[c], slice(c * runs, (c + 1) * runs)) for c in range(len(active))]
+        seconds = (time.perf_counter() - t0) / len(active)    # amortised over the trajectories
+        for c, (j, i, r) in enumerate(zip(active, idx, results)):
+            rec["poses"].append(i)
+            rec["seeds"].append(seeds[c])
+            rec["start"].append(np.asarray(starts[c], dtype=float).tolist())
+            _collect(rec, r, config.threshold, seconds)
+            prev[j] = np.array(r.x, dtype=float)
+    return rec
+
+
+def _runs_of(r, x: np.ndarray, rows: slice):
+    """Rows ``rows`` of a result of (trajectory, run) cases x 1 run, read as one target's runs."""
+    one = lambda a: None if a is None else a[rows, 0]   # noqa: E731
     return replace(r, x=x, fitness=one(r.fitness), history=one(r.history), x_history=one(r.x_history),
                    evaluation_history=one(r.evaluation_history), iterations_done=one(r.iterations_done),
                    time_per_run=one(r.time_per_run), extras={}, snapshots={}, cases=None, seeds=None,
                    run_ids=np.arange(len(x)))
-
-
-def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
-    """Solve the trajectory in order; each step warm-starts from the previous step's solution.
-
-    All runs of a step are one solve. A warm swarm searches a box around each run's previous
-    solution: the runs are then the cases of a :class:`fkopt.problems.BoxedProblem` (one box
-    each), run k drawing from case k's stream ``case_seed(step seed, k)``.
-    """
-    rec = _empty(task)
-    rec["start"] = []
-    algo = make_algorithm(spec.name, spec.params)
-    budget = _budget(config, spec)
-    runs, dim = config.runs, len(mech.unknown_names)
-    x0 = start_point(spec, mech)
-    prev = None
-    for t in range(task.start, task.stop):
-        seed = task_seed(config.seed, t, spec.key)
-        warm = spec.warm_start and prev is not None
-        t0 = time.perf_counter()
-        if algo.local or not warm:
-            start = prev if warm else x0
-            r = solve(make_problem(config, mech, poses.inputs[t]), algo, runs=runs, seed=seed, x0=start, **budget)
-            starts = (np.broadcast_to(start, (runs, dim)) if start is not None else np.full((runs, dim), np.nan))
-        else:
-            lo, hi = _warm_boxes(mech, prev, config.tracking.radius)
-            target = make_problem(config, mech, np.repeat(poses.inputs[t][None], runs, axis=0))
-            boxed = BoxedProblem(target, lo, hi)
-            rb = solve(boxed, algo, runs=1, seed=seed, **budget)
-            r = _runs_of(rb, boxed.to_x(rb.x[:, 0]))
-            starts = prev
-        rec["seeds"].append(seed)
-        rec["start"].append(np.asarray(starts, dtype=float).tolist())
-        _collect(rec, r, config.threshold, time.perf_counter() - t0)
-        prev = np.array(r.x, dtype=float)
-    return rec
 
 
 # -- task files ----------------------------------------------------------------------------------
