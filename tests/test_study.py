@@ -388,10 +388,9 @@ def test_stored_configs_run_small_and_feed_report_check_claims(tmp_path):
     smaller = {"3rps_workspace.yaml": {"poses": {"uniform": 4, "seed": 1}, "runs": 2, "iterations": 150},
                "3rps_slice.yaml": {"poses": {"grid": {"alpha": [-20, 20, 3], "beta": [-20, 20, 3]},
                                              "fixed": {"z": 550}}, "runs": 2},
-               "6sps_tracking.yaml": {"poses": {"circle": {"centre": {"x": 0, "y": 0, "z": 0.95, "alpha": 0,
-                                                                      "beta": 0, "gamma": 0},
-                                                           "radius": 0.05, "plane": ["x", "y"]}, "points": 4},
-                                      "runs": 2}}
+               "6sps_tracking.yaml": {"runs": 2}}
+    tracking = yaml.safe_load((ROOT / "configs" / "studies" / "6sps_tracking.yaml").read_text())["poses"]
+    smaller["6sps_tracking.yaml"]["poses"] = [{**t, "points": 4} for t in tracking]     # both, 4 steps each
     for name, over in smaller.items():
         data = yaml.safe_load((ROOT / "configs" / "studies" / name).read_text())
         data.update(over)

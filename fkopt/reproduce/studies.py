@@ -31,7 +31,7 @@ NOTES = [
     "ignores that pairing (conservative). ECDFs follow COCO: fraction of (pose, run) pairs "
     "solved vs evaluations, log axis.",
     "Reduced sizes to keep `make reproduce` short: 50 uniform poses x 5 runs (the issue's example "
-    "was 200 x 30), a 9 x 9 grid x 3 runs, a 40-step circle x 3 runs. Larger studies: "
+    "was 200 x 30), a 9 x 9 grid x 3 runs, two 40-step trajectories (a circle, a tilting line) x 3 runs, solved together step by step. Larger studies: "
     "`fkopt study CONFIG --jobs N` or `--executor dask --scheduler ADDRESS`; results are identical "
     "whatever the executor.",
     "LM/NR 'from the centre' start at the centre of the search box, the same point for every pose "
@@ -123,7 +123,7 @@ def claims(store) -> list[Claim]:
     else:
         s = _summary(tr)
         out.append(Claim(
-            "Expectation: warm-started LM tracks every step of the circle to fitness < 1e-14 m^2",
+            "Expectation: warm-started LM tracks every step of both trajectories to fitness < 1e-14 m^2",
             verdict(s.loc["lm", "success_rate"] == 1.0),
             f"success {g(100 * s.loc['lm', 'success_rate'])} % of the (step, run) pairs; PSO+LM "
             f"{g(100 * s.loc['pso+lm', 'success_rate'])} %, cold LM {g(100 * s.loc['lm-cold', 'success_rate'])} %"))
@@ -168,5 +168,5 @@ def extra_tables(exp) -> list[tuple[str, pd.DataFrame]]:
             median_evaluations_per_step=("median_evaluations", "median"),
             **{f"max_{c.removeprefix('max_abs_error_')}_error": (c, "max") for c in errs}).reset_index()
         out.append(("Tracking per algorithm (`tracking.csv`): steps warm-started from the previous "
-                    "solution, success rate, evaluations per step, largest error along the circle:", agg))
+                    "solution, success rate, evaluations per step, largest error along the trajectories:", agg))
     return out
