@@ -1,3 +1,5 @@
+import sys
+
 import numpy as np
 import pytest
 
@@ -26,3 +28,20 @@ class Sphere:
 @pytest.fixture
 def sphere():
     return Sphere()
+
+
+@pytest.fixture
+def cli(monkeypatch, capsys):
+    """Run ``fkopt ARGS`` in this process (as the console script does); (status, stdout, stderr)."""
+    from fkopt.cli import main
+
+    def run(*args):
+        monkeypatch.setattr(sys, "argv", ["fkopt", *map(str, args)])
+        try:
+            main()
+            code = 0
+        except SystemExit as exc:
+            code = exc.code or 0
+        out = capsys.readouterr()
+        return code, out.out, out.err
+    return run

@@ -17,7 +17,6 @@ from pathlib import Path
 import pytest
 import yaml
 
-from fkopt.cli import main
 
 BASE = {
     "name": "fresh", "paper": "test", "title": "hostile base",
@@ -195,17 +194,6 @@ def snapshot(root: Path) -> dict:
             for p in sorted(root.rglob("*")) if p.is_file() and not p.is_symlink()}
 
 
-def run_cli(monkeypatch, capsys, argv):
-    monkeypatch.setattr(sys, "argv", ["fkopt", *argv])
-    try:
-        main()
-        code = 0
-    except SystemExit as exc:
-        code = exc.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
-
-
 @pytest.fixture(scope="module")
 def sandbox(tmp_path_factory):
     """A sandbox with previous results (an experiment and a study), a decoy ``configs/`` and
@@ -241,7 +229,7 @@ def sandbox(tmp_path_factory):
 
 
 @pytest.mark.parametrize("case", CORPUS, ids=[c[0] for c in CORPUS])
-def test_hostile_input(case, sandbox, monkeypatch, capsys):
+def test_hostile_input(case, sandbox, cli, monkeypatch):
     ident, content, argv, fragments = case
     root, out = sandbox, sandbox / "out"
     f = root / "inputs" / f"{ident}.yaml"
@@ -249,7 +237,7 @@ def test_hostile_input(case, sandbox, monkeypatch, capsys):
         (f.write_bytes if isinstance(content, bytes) else f.write_text)(content)
     before = snapshot(root)
     monkeypatch.chdir(root)          # a relative path written by mistake would land in the sandbox
-    code, stdout, err = run_cli(monkeypatch, capsys, [a.format(f=f, out=out, root=root) for a in argv])
+    code, stdout, err = cli(*[a.format(f=f, out=out, root=root) for a in argv])
     lines = err.strip().splitlines()
     assert code == 2, (code, err)
     assert len(lines) == 1, err
@@ -265,19 +253,19 @@ def test_corpus_is_large_enough():
     assert len(CORPUS) >= 60
 
 
-def test_check_with_corrupt_meta_fails_with_status_1(sandbox, monkeypatch, capsys):
-    code, _, err = run_cli(monkeypatch, capsys, ["check", str(sandbox / "corrupt"), "-q"])
+def test_check_with_corrupt_meta_fails_with_status_1(sandbox, cli):
+    code, _, err = cli("check", str(sandbox / "corrupt"), "-q")
     assert code == 1
     assert "meta.json" in err and "Traceback" not in err
     assert err.strip().splitlines()[-1].startswith("fkopt: check failed:")
 
 
-def test_check_with_missing_meta_is_a_failure(sandbox, tmp_path, monkeypatch, capsys):
+def test_check_with_missing_meta_is_a_failure(sandbox, tmp_path, cli):
     import shutil
     results = tmp_path / "results"
     shutil.copytree(sandbox / "out" / "test" / "small", results / "test" / "small")
     (results / "test" / "small" / "meta.json").unlink()
-    code, _, err = run_cli(monkeypatch, capsys, ["check", str(results), "-q"])
+    code, _, err = cli("check", str(results), "-q")
     assert code == 1 and "test/small: meta.json" in err and "missing" in err
 
 
@@ -324,29 +312,29 @@ def test_interrupted_study_rerun_keeps_previous_result(tmp_path, how):
     _interrupt(tmp_path, {**STUDY, "name": "small"}, SLOW_STUDY, "study", how)
 
 
-def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, monkeypatch, capsys):
+def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, cli):
     cfg = tmp_path / "c.yaml"
     out = tmp_path / "out"
     cfg.write_text(yaml_of({**BASE, "name": "small"}))
-    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])[0] == 0
+    assert cli("run", str(cfg), "--out", str(out), "-q")[0] == 0
     # title/printed/check changes are not result-changing: replaced without --force
     cfg.write_text(yaml_of({**BASE, "name": "small", "title": "renamed", "check": "full"}))
-    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])[0] == 0
+    assert cli("run", str(cfg), "--out", str(out), "-q")[0] == 0
     cfg.write_text(yaml_of({**BASE, "name": "small", "seed": 2}))
-    code, _, err = run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])
+    code, _, err = cli("run", str(cfg), "--out", str(out), "-q")
     assert code == 2 and "--force" in err
-    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q", "--force"])[0] == 0
+    assert cli("run", str(cfg), "--out", str(out), "-q", "--force")[0] == 0
     assert json.loads((out / "test" / "small" / "meta.json").read_text())["seed"] == 2
 
 
-def test_hidden_scratch_folders_are_not_results(tmp_path, monkeypatch, capsys):
+def test_hidden_scratch_folders_are_not_results(tmp_path, cli):
     """A writer killed before its swap leaves a complete hidden copy: report and check skip it."""
     import shutil
     from fkopt.reproduce.store import Store
     cfg = tmp_path / "c.yaml"
     cfg.write_text(yaml_of({**BASE, "name": "small"}))
     out = tmp_path / "out"
-    assert run_cli(monkeypatch, capsys, ["run", str(cfg), "--out", str(out), "-q"])[0] == 0
+    assert cli("run", str(cfg), "--out", str(out), "-q")[0] == 0
     shutil.copytree(out / "test" / "small", out / "test" / ".small.new-x1y2")
     assert [e.name for e in Store(out).experiments()] == ["small"]
     assert [e.name for e in Store(out).folders()] == ["small"]

@@ -2,7 +2,6 @@
 import filecmp
 import json
 import os
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -50,23 +49,6 @@ def tracking_config(**over):
     }
     cfg.update(over)
     return study_from_dict(cfg)
-
-
-@pytest.fixture
-def cli(monkeypatch, capsys):
-    """Run ``fkopt ARGS`` in this process (as the console script does); (status, stdout, stderr)."""
-    from fkopt.cli import main
-
-    def run(*args):
-        monkeypatch.setattr(sys, "argv", ["fkopt", *map(str, args)])
-        try:
-            main()
-            code = 0
-        except SystemExit as exc:
-            code = exc.code or 0
-        out = capsys.readouterr()
-        return code, out.out, out.err
-    return run
 
 
 def same_files(a: Path, b: Path, names=DETERMINISTIC):
