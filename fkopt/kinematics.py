@@ -743,9 +743,9 @@ def _start_table(m, size: int):
     entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3): ``inverse``
     starts from the configurations nearest to each target. Cached per arm (name, DH table,
     limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`)."""
-    base = m.__dict__.get("_start_table_key")        # repr of the geometry costs ~50 us: once
-    if base is None:
-        base = m.__dict__["_start_table_key"] = (m.name, repr(m.geometry), m.bounds.tobytes())
+    base = m.__dict__.get("_start_table_key")
+    if base is None:                                 # the DH table's numbers (no pydantic model needed)
+        base = m.__dict__["_start_table_key"] = (m.name, m._a, m._d, m._ca, m._sa, m._offset, m.bounds.tobytes())
     key = base + (size,)
     got = _TABLES.get(key)
     if got is None:
