@@ -1011,18 +1011,25 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
                     free = (~outv).astype(float)
                     fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
+                    qv2 = np.empty_like(qv)
+                    act = slice(None)                      # rows re-solved: all, then those with new violations
                     for _ in range(2):
-                        Jf = Jv * free[:, None, :]
-                        rr = rv + (Jv @ fixed[..., None])[..., 0]
+                        Ja, fa = Jv[act], free[act]
+                        Jf = Ja * fa[:, None, :]
+                        rr = rv[act] + (Ja @ fixed[act][..., None])[..., 0]
                         Jft = np.swapaxes(Jf, 1, 2)
                         A = Jf @ Jft
-                        A[:, _I6, _I6] += muv[:, None]
-                        qv2 = qv + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
-                        outv = ((qv2 < lo) | (qv2 > hi)) & (free > 0)
-                        if not outv.any():
+                        A[:, _I6, _I6] += muv[act][:, None]
+                        qa = qv[act] + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed[act]
+                        qv2[act] = qa
+                        outa = ((qa < lo) | (qa > hi)) & (fa > 0)
+                        more = np.flatnonzero(outa.any(axis=-1))
+                        if not len(more):
                             break
-                        fixed = np.where(outv, np.clip(qv2, lo, hi) - qv, fixed)
-                        free = np.where(outv, 0.0, free)
+                        act = more if isinstance(act, slice) else act[more]
+                        outa = outa[more]
+                        fixed[act] = np.where(outa, np.clip(qa[more], lo, hi) - qv[act], fixed[act])
+                        free[act] = np.where(outa, 0.0, free[act])
                     qn[sat] = np.clip(qv2, lo, hi)
                 # -- evaluate the trial points and the restarted slots in one call ----------------
                 if anyfresh:
