@@ -848,6 +848,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     # table's configurations nearest to the target, then seeded random draws
     own0 = 1 if (start is not None or not table) else 0
     near = np.zeros((N, 0), dtype=np.intp)
+    k0 = 0                                             # neighbours known for every row
     if table:
         tab = _start_table(m, int(table))
         tq = tab["q"]
@@ -870,7 +871,8 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             qs[a] = q0[rows[a]]
         b = (j >= own0) & (j < own0 + nn)
         if b.any():
-            need = np.unique(rows[b][~full[rows[b]]])
+            late = b & (j - own0 >= k0)                # beyond the neighbours every row has
+            need = np.unique(rows[late][~full[rows[late]]])
             if len(need):
                 near[need] = _nearest(tab, feats[need], nn)
                 full[need] = True
