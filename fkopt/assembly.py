@@ -470,9 +470,9 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     next rows of S in order; ``report(rows, S_rows)`` receives the rows that finished converged
     after every iteration and returns True to stop the whole search (rows not started yet are
     then never started). Both keep the answer a function of S alone. ``line_search=False``
-    takes every (capped) Newton step whose residual is finite: plain Newton. ``capture(S_rows,
-    F_rows)`` sees the rows still iterating (not converged) after every iteration and returns a
-    mask of those to stop now (counted by the caller as hits of solutions it knows) or None.
+    takes every (capped) Newton step whose residual is finite: plain Newton. ``capture(S, F,
+    open)`` sees the rows still iterating (``open``: not converged) after every iteration and returns
+    the indices of those to stop now (counted by the caller as hits of solutions it knows) or None.
     """
     total = len(S)
     out = S.copy()
@@ -500,8 +500,11 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
         Fc = _sumsq(fc)
         # Polishing steps (already converged) are taken unconditionally.
         accepted = ((Fc < F) | polish | (not line_search)) & np.isfinite(Fc)
-        S[accepted], F[accepted], f[accepted], J[accepted] = (
-            cand[accepted], Fc[accepted], fc[accepted], Jc[accepted])
+        if accepted.all():
+            S, F, f, J = cand, Fc, fc, Jc
+        else:
+            S[accepted], F[accepted], f[accepted], J[accepted] = (
+                cand[accepted], Fc[accepted], fc[accepted], Jc[accepted])
         stale = np.zeros(len(idx), dtype=bool)         # J not at S: taken at a halving
         pending = np.flatnonzero(~accepted)
         if len(pending) and halvings > 0:
@@ -523,11 +526,9 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
         it += 1
         finished = polish | ~accepted | ~ok | model.diverged(S) | (it >= iterations)
         if capture is not None:
-            open_ = np.flatnonzero(~finished & ~polish & ~newly)
-            if len(open_):
-                got = capture(S[open_], F[open_])
-                if got is not None:
-                    finished[open_[got]] = True
+            got = capture(S, F, ~finished & ~polish & ~newly)
+            if got is not None:
+                finished[got] = True
         conv[idx[newly]] = True
         polish |= newly
         out[idx[finished]] = S[finished]
@@ -736,19 +737,19 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
 
     cap_f2 = (capture[0] * float(jscale.min())) ** 2 if capture else 0.0
 
-    def captured(S, F):
-        """Rows near convergence (residual <= capture[0]) within capture[1] of a known solution."""
-        cand = np.flatnonzero(F <= cap_f2)
-        if not len(cand) or not hits:
+    def captured(S, F, open_):
+        """Open rows near convergence (residual <= capture[0]) within capture[1] of a known solution."""
+        if not hits:
+            return None
+        cand = np.flatnonzero((F <= cap_f2) & open_)
+        if not len(cand):
             return None
         dist = np.abs(model.keys(S[cand])[:, None, :] - known_keys()[None]).max(-1)
         j = dist.argmin(-1)
         near = dist[np.arange(len(cand)), j] <= capture[1]
         for i in j[near].tolist():
             hits[i] += 1
-        out = np.zeros(len(S), dtype=bool)
-        out[cand[near]] = True
-        return out
+        return cand[near]
 
     shift = None
     while used < limit:
