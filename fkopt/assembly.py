@@ -744,9 +744,11 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         cand = np.flatnonzero((F <= cap_f2) & open_)
         if not len(cand):
             return None
-        dist = np.abs(model.keys(S[cand])[:, None, :] - known_keys()[None]).max(-1)
-        j = dist.argmin(-1)
-        near = dist[np.arange(len(cand)), j] <= capture[1]
+        keys, known_ = model.keys(S[cand]), known_keys()
+        # the known solution nearest in the first three key coordinates (position for 6-SPS),
+        # then the full distance to that one only (a row it misses just runs to convergence)
+        j = np.abs(keys[:, None, :3] - known_[None, :, :3]).max(-1).argmin(-1)
+        near = np.abs(keys - known_[j]).max(-1) <= capture[1]
         for i in j[near].tolist():
             hits[i] += 1
         return cand[near]
