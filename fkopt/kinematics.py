@@ -46,10 +46,11 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   by a fixed hash (not the seed), compared by their tool position and reach / (3 sqrt 2) times
   their rotation matrix entries (1 rad weighs about a third of the reach), nearest found
   exactly (brute force below 32 rows, scipy's k-d tree from 32 rows on); a row's starts are ``start`` (when given), then the table's configurations nearest to
-  its target (``starts`` of them plus ``neighbours`` more for restarts), then seeded random draws
+  its target (``starts`` of them plus ``neighbours`` (32) more for restarts), then seeded random draws
   inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
   1000 random reachable poses: about 80 % of nearest-configuration starts converge against
-  about 60 % of mid-range or random ones;
+  about 60 % of mid-range or random ones, and the few hardest rows of a batch need about half
+  as many candidates with 32 table neighbours before the random draws as with 8;
 * one pose (N = 1, ``rest`` = 0, no ``exact_rotation``) runs the same iteration on Python
   floats (the arm's ``frame_jacobian1``, Cholesky solves of the 6x6 systems), its candidates
   one after another in the order of its starts, stopping at the first that converges: numpy's
@@ -58,8 +59,9 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   (lambda above 1e6), restarts in place from its row's next start, at most ``restarts`` times
   per row; a solved row retires all its candidates at once. A batch of N < ``fill`` (32) rows
   starts with ``fill // N`` candidates per row side by side, and whenever fewer than ``tail``
-  (128) candidates remain, every unsolved row gets more at once (the last hard rows then try
-  many starts per iteration instead of a few per iteration for many iterations). These restarts are inverse's global
+  (256) candidates remain, every unsolved row gets more at once (the last hard rows then try
+  many starts per iteration instead of a few per iteration for many iterations: in a batch
+  the time of the last iterations is numpy's per-call overhead, whatever their few rows). These restarts are inverse's global
   stage (restarts of a local method with limits, rather than a swarm). Same poses and seed give
   the same answer; a row's answer may differ between batches.
 
@@ -788,7 +790,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
-            table: int = 4096, neighbours: int = 8, tail: int = 128) -> InverseResult:
+            table: int = 4096, neighbours: int = 32, tail: int = 256) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
