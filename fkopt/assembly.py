@@ -485,7 +485,7 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     F = _sumsq(f)
     polish = np.zeros(len(S), dtype=bool)
     while len(idx):
-        bad = ~(np.isfinite(J).all((1, 2)) & np.isfinite(f).all(-1))
+        bad = ~np.isfinite(F + J.sum(axis=(1, 2)))     # F = |f|^2: one test for f and J
         if bad.any():                                  # e.g. a pose outside the inverse map's domain
             J[bad], f[bad] = np.eye(J.shape[-1]), 0.0
         dx = _solve(J, f)
@@ -584,21 +584,28 @@ def _cluster(keys: np.ndarray, tol: float) -> np.ndarray:
 
 
 def _into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> np.ndarray | None:
-    """Move angle variables into the bounds by multiples of 360 deg (and the Euler equivalence)."""
-    lo, hi = mechanism.bounds[:, 0], mechanism.bounds[:, 1]
-    angle = mechanism.angle_mask(mechanism.pose_units)
+    """Move angle variables into the bounds by multiples of 360 deg (and the Euler equivalence).
+
+    On Python floats (the same floor-modulo arithmetic as numpy's): called once per solution."""
+    lo, hi = mechanism.bounds[:, 0].tolist(), mechanism.bounds[:, 1].tolist()
+    angle = np.flatnonzero(mechanism.angle_mask(mechanism.pose_units)).tolist()
+    x = [float(v) for v in x]
     candidates = [x]
     if triple is not None:
         a, b, g = triple
-        alt = x.copy()
+        alt = list(x)
         alt[a] += 180.0
         alt[b] = 180.0 - alt[b]
         alt[g] += 180.0
         candidates.append(alt)
+
+    def inside(c):                                   # mechanism.in_bounds (tolerance 1e-9)
+        return all(lo[i] - 1e-9 <= v <= hi[i] + 1e-9 for i, v in enumerate(c))
+
     for c in candidates:
-        c = c.copy()
+        c = list(c)
         ok = True
-        for i in np.flatnonzero(angle):
+        for i in angle:
             v = lo[i] + (c[i] - lo[i]) % 360.0           # smallest representative >= lo
             if v > hi[i] + 1e-9 and v - 360.0 >= lo[i] - 1e-9:
                 v -= 360.0                                 # round-off just below lo
@@ -606,11 +613,12 @@ def _into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> np.ndarray | No
                 ok = False
                 break
             c[i] = v
-        if ok and mechanism.in_bounds(c):
+        if ok and inside(c):
             # Prefer the plain wrap to [-180, 180) when that is inside the bounds too.
-            w = c.copy()
-            w[angle] = _wrap(w[angle])
-            return w if mechanism.in_bounds(w) else c
+            w = list(c)
+            for i in angle:
+                w[i] = (w[i] + 180.0) % 360.0 - 180.0
+            return np.array(w if inside(w) else c)
     return None
 
 
