@@ -16,18 +16,53 @@ Python API::
 """
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version as _version
+import sys
+import types
 
 from .errors import FkoptError
-from .kinematics import ForwardResult, InverseResult, forward, inverse
-from .problems import FKProblem, IKProblem, fk_problem, ik_problem
 from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
-from .solve import Result, solve
 
-try:
-    __version__ = _version("fkopt")
-except PackageNotFoundError:  # running from a source tree
-    __version__ = "0.0.0+unknown"
+#: Public names loaded on first use (PEP 562), so that ``import fkopt`` -- and ``fkopt fk`` --
+#: pay only for what they touch: the optimiser layer imports pydantic, the version
+#: importlib.metadata.
+_LAZY = {"ForwardResult": "kinematics", "InverseResult": "kinematics", "forward": "kinematics",
+         "inverse": "kinematics", "FKProblem": "problems", "IKProblem": "problems",
+         "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+        try:
+            value = version("fkopt")
+        except PackageNotFoundError:  # running from a source tree
+            value = "0.0.0+unknown"
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY) | {"__version__"})
+
+
+class _Package(types.ModuleType):
+    """Importing the submodule ``fkopt.solve`` binds it as the package attribute ``solve``
+    (the import system does so after running it); the public ``fkopt.solve`` is the function,
+    as when it was imported eagerly."""
+
+    def __setattr__(self, name, value):
+        if name == "solve" and isinstance(value, types.ModuleType):
+            value = value.solve
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 def mechanism(name: str, **geometry):

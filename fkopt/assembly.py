@@ -5,7 +5,12 @@ usually has several (a general 6-SPS platform up to 40, Dietmaier 1998). :func:`
 finds them all, numerically, for any :class:`~fkopt.mechanisms.base.ParallelMechanism` with as
 many inputs as pose variables:
 
-1. **Starts** come in rounds drawn from one seeded stream (:class:`fkopt.streams.RunStreams`).
+1. **Starts** come in rounds, points of one randomly shifted Kronecker sequence
+   frac(u0 + k alpha) in the unit cube (Roberts 2018; ``qmc=False``: independent uniforms),
+   u0 drawn from the seeded stream (:class:`fkopt.streams.RunStreams`), mapped to the unknowns.
+   A low-discrepancy sequence reaches every region of the start space at a steady rate, so the
+   rarest basins (a few hits per thousand starts) are found after a less variable number of
+   starts than with independent draws (README, Performance).
    For a 6-SPS platform a start is a rotation -- uniform on SO(3) (Shoemake's quaternions) when
    the angle bounds cover a full turn, else uniform Euler angles inside the bounds -- and the
    position that best satisfies, in least squares, the five *linear* equations obtained by
@@ -25,7 +30,12 @@ many inputs as pose variables:
    Dietmaier's platform over 20 seeds, a seed then needs a median of ~1260 starts to see all 40
    solutions against ~1700 with the line search (the backtracking shrinks the rarest basins),
    and an iteration costs one evaluation. A start stops when converged (then one more
-   polishing step), diverged, stalled (line search) or out of ``iterations`` (60). At most ``pool`` (512) starts of a round iterate at once;
+   polishing step), diverged, stalled (line search) or out of ``iterations`` (60), or is
+   *captured*: its residual is at most ``capture[0]`` (1e-4, relative as ``tol``) and its
+   state within ``capture[1]`` (1e-3, in the dedup coordinates) of a solution already known
+   -- well inside that solution's quadratic convergence region, where the remaining steps would
+   only confirm it; it counts as a hit of that solution (``capture=None``: every start runs to
+   convergence). At most ``pool`` (512) starts of a round iterate at once;
    a finished start is replaced by the round's next one, in order, and converged starts are
    deduplicated after every iteration, so the search stops mid-round as soon as ``maximum``
    solutions are known (the answer stays a function of the seed alone).
@@ -51,8 +61,8 @@ starts in one round. ``Solutions.history`` records (starts, seconds, solutions i
 after every round.
 
 On Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``) all 40 real
-solutions are found on 20 seeds out of 20, within the first round of 2000 starts for most (a
-median of ~1260 starts, at most ~3000); times: ``fkopt bench``, section kinematics.
+solutions are found on every seed tried, almost always within the first round of 2000 starts
+(counts and times: README, Performance, and ``fkopt bench``, section kinematics).
 """
 from __future__ import annotations
 
@@ -196,6 +206,21 @@ def _rotate(w, R):
     return out
 
 
+def _solve3_sym(M, y):
+    """x with M x = y for symmetric (n, 3, 3) M, by the adjugate (elementwise; LAPACK's per-matrix
+    overhead dominates for 3x3); rows with det(M) = 0 get a non-finite x (their start diverges)."""
+    a, b, c = M[:, 0, 0], M[:, 0, 1], M[:, 0, 2]
+    d, e, f = M[:, 1, 1], M[:, 1, 2], M[:, 2, 2]
+    A00, A01, A02 = d * f - e * e, c * e - b * f, b * e - c * d
+    A11, A12, A22 = a * f - c * c, b * c - a * e, a * d - b * b
+    det = a * A00 + b * A01 + c * A02
+    y0, y1, y2 = y[:, 0], y[:, 1], y[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / det
+        return np.stack([(A00 * y0 + A01 * y1 + A02 * y2) * inv, (A01 * y0 + A11 * y1 + A12 * y2) * inv,
+                         (A02 * y0 + A12 * y1 + A22 * y2) * inv], axis=-1)
+
+
 #: Batch size from which the 6-SPS model evaluates legs elementwise rather than by one GEMM.
 _SOA_MIN = 1024
 
@@ -233,12 +258,14 @@ class _SixSPSModel(_Model):
             e = lo + (hi - lo) * u
             R = _zyx_matrix(e[:, 0], e[:, 1], e[:, 2])
         # Position from the five linear equations (leg i minus leg 1), least squares.
-        w = np.einsum("nkj,ij->nik", R, self.q) - self.base        # R q_i - b_i
+        w = np.swapaxes(R @ self.qT, 1, 2) - self.base             # R q_i - b_i, (n, 6, 3)
         c = self.L2 - (w * w).sum(-1)                              # |t|^2 + 2 t.w_i = c_i
         A = 2.0 * (w[:, 1:] - w[:, :1])
         d = c[:, 1:] - c[:, :1]
-        AtA = np.einsum("nij,nik->njk", A, A) + 1e-12 * np.eye(3)
-        t = np.linalg.solve(AtA, np.einsum("nij,ni->nj", A, d)[..., None])[..., 0]
+        M = np.swapaxes(A, 1, 2) @ A                               # normal equations, 3x3 symmetric
+        M[:, (0, 1, 2), (0, 1, 2)] += 1e-12
+        y = (np.swapaxes(A, 1, 2) @ d[..., None])[..., 0]
+        t = _solve3_sym(M, y)
         return np.concatenate([t, R.reshape(-1, 9)], axis=1)
 
     def _legs(self, S):
@@ -432,7 +459,7 @@ def _sumsq(f):
 
 
 def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvings: int = 8,
-            pool: int | None = None, report=None, line_search: bool = True):
+            pool: int | None = None, report=None, line_search: bool = True, capture=None):
     """Damped Newton from every row of S. Returns (S, converged mask, rows started).
 
     Rows that finish (converged and polished, stalled, singular, diverged) are written back
@@ -441,7 +468,9 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     next rows of S in order; ``report(rows, S_rows)`` receives the rows that finished converged
     after every iteration and returns True to stop the whole search (rows not started yet are
     then never started). Both keep the answer a function of S alone. ``line_search=False``
-    takes every (capped) Newton step whose residual is finite: plain Newton.
+    takes every (capped) Newton step whose residual is finite: plain Newton. ``capture(S, F,
+    open)`` sees the rows still iterating (``open``: not converged) after every iteration and returns
+    the indices of those to stop now (counted by the caller as hits of solutions it knows) or None.
     """
     total = len(S)
     out = S.copy()
@@ -454,7 +483,7 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     F = _sumsq(f)
     polish = np.zeros(len(S), dtype=bool)
     while len(idx):
-        bad = ~(np.isfinite(J).all((1, 2)) & np.isfinite(f).all(-1))
+        bad = ~np.isfinite(F + J.sum(axis=(1, 2)))     # F = |f|^2: one test for f and J
         if bad.any():                                  # e.g. a pose outside the inverse map's domain
             J[bad], f[bad] = np.eye(J.shape[-1]), 0.0
         dx = _solve(J, f)
@@ -469,8 +498,11 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
         Fc = _sumsq(fc)
         # Polishing steps (already converged) are taken unconditionally.
         accepted = ((Fc < F) | polish | (not line_search)) & np.isfinite(Fc)
-        S[accepted], F[accepted], f[accepted], J[accepted] = (
-            cand[accepted], Fc[accepted], fc[accepted], Jc[accepted])
+        if accepted.all():
+            S, F, f, J = cand, Fc, fc, Jc
+        else:
+            S[accepted], F[accepted], f[accepted], J[accepted] = (
+                cand[accepted], Fc[accepted], fc[accepted], Jc[accepted])
         stale = np.zeros(len(idx), dtype=bool)         # J not at S: taken at a halving
         pending = np.flatnonzero(~accepted)
         if len(pending) and halvings > 0:
@@ -491,6 +523,10 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
         newly = (F <= ftol * ftol) & ~polish & ok
         it += 1
         finished = polish | ~accepted | ~ok | model.diverged(S) | (it >= iterations)
+        if capture is not None:
+            got = capture(S, F, ~finished & ~polish & ~newly)
+            if got is not None:
+                finished[got] = True
         conv[idx[newly]] = True
         polish |= newly
         out[idx[finished]] = S[finished]
@@ -520,6 +556,18 @@ def _newton(model: _Model, S: np.ndarray, *, ftol: float, iterations: int, halvi
     return out[:started], conv[:started], started
 
 
+def _kronecker(shift, start: int, n: int, d: int) -> np.ndarray:
+    """Points start .. start + n - 1 (n, d) of the randomly shifted Kronecker sequence
+    frac(shift + k alpha), alpha_j = phi_d^-(j+1), phi_d the root > 1 of x^(d+1) = x + 1
+    (M. Roberts 2018, "The unreasonable effectiveness of quasirandom sequences")."""
+    phi = 2.0
+    for _ in range(60):
+        phi = (1.0 + phi) ** (1.0 / (d + 1))
+    alpha = phi ** -np.arange(1, d + 1)
+    k = np.arange(start, start + n, dtype=float)[:, None]
+    return (np.asarray(shift)[None, :] + k * alpha[None, :]) % 1.0
+
+
 def _cluster(keys: np.ndarray, tol: float) -> np.ndarray:
     """Label rows whose keys are within ``tol`` (max norm) of a representative: greedy, vectorised."""
     labels = np.full(len(keys), -1)
@@ -534,21 +582,28 @@ def _cluster(keys: np.ndarray, tol: float) -> np.ndarray:
 
 
 def _into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> np.ndarray | None:
-    """Move angle variables into the bounds by multiples of 360 deg (and the Euler equivalence)."""
-    lo, hi = mechanism.bounds[:, 0], mechanism.bounds[:, 1]
-    angle = mechanism.angle_mask(mechanism.pose_units)
+    """Move angle variables into the bounds by multiples of 360 deg (and the Euler equivalence).
+
+    On Python floats (the same floor-modulo arithmetic as numpy's): called once per solution."""
+    lo, hi = mechanism.bounds[:, 0].tolist(), mechanism.bounds[:, 1].tolist()
+    angle = np.flatnonzero(mechanism.angle_mask(mechanism.pose_units)).tolist()
+    x = [float(v) for v in x]
     candidates = [x]
     if triple is not None:
         a, b, g = triple
-        alt = x.copy()
+        alt = list(x)
         alt[a] += 180.0
         alt[b] = 180.0 - alt[b]
         alt[g] += 180.0
         candidates.append(alt)
+
+    def inside(c):                                   # mechanism.in_bounds (tolerance 1e-9)
+        return all(lo[i] - 1e-9 <= v <= hi[i] + 1e-9 for i, v in enumerate(c))
+
     for c in candidates:
-        c = c.copy()
+        c = list(c)
         ok = True
-        for i in np.flatnonzero(angle):
+        for i in angle:
             v = lo[i] + (c[i] - lo[i]) % 360.0           # smallest representative >= lo
             if v > hi[i] + 1e-9 and v - 360.0 >= lo[i] - 1e-9:
                 v -= 360.0                                 # round-off just below lo
@@ -556,11 +611,12 @@ def _into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> np.ndarray | No
                 ok = False
                 break
             c[i] = v
-        if ok and mechanism.in_bounds(c):
+        if ok and inside(c):
             # Prefer the plain wrap to [-180, 180) when that is inside the bounds too.
-            w = c.copy()
-            w[angle] = _wrap(w[angle])
-            return w if mechanism.in_bounds(w) else c
+            w = list(c)
+            for i in angle:
+                w[i] = (w[i] + 180.0) % 360.0 - 180.0
+            return np.array(w if inside(w) else c)
     return None
 
 
@@ -592,7 +648,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
                   tol: float = 1e-9, dedup: float = 1e-6, round_size: int | None = None,
                   patience: int = 1, min_starts: int | None = None, max_starts: int = 200_000,
                   iterations: int = 60, maximum: int | None = None, pool: int | None = 512,
-                  line_search: bool | None = None) -> Solutions:
+                  line_search: bool | None = None, capture: tuple[float, float] | None = (1e-4, 1e-3), qmc: bool = True) -> Solutions:
     """Every distinct real forward solution of ``mechanism`` for ``joints`` inside its bounds.
 
     ``starts``: run exactly this many starts (one round); by default rounds of ``round_size``
@@ -605,6 +661,9 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     except for 6-SPS, whose plain capped Newton steps reach the rarest basins more often; see
     the module docstring). ``pool``: most starts iterated at once within a round (finished ones are replaced by the
     round's next starts, so the search can stop mid-round; None: the whole round at once).
+    ``capture``: (residual, distance) under which a start is counted as a hit of a known
+    solution and stopped (module docstring). ``qmc``: starts from a randomly shifted Kronecker
+    sequence (default) rather than independent uniforms.
     ``maximum``: the most assembly modes the mechanism can have; the search stops as soon as
     that many distinct real solutions (inside or outside the bounds) are found, since no more
     can exist. Default 40 for a 6-SPS platform (the number of complex solutions of the general
@@ -643,6 +702,13 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     unchecked: list[np.ndarray] = []                  # states of new solutions not checked yet
     history: list[tuple[int, float, int]] = []
     used, quiet = 0, 0
+    known = [np.empty((0, 0))]                        # rep_keys as one array, rebuilt when it grows
+
+    def known_keys():
+        if len(known[0]) != len(rep_keys):
+            known[0] = np.array(rep_keys)
+        return known[0]
+
     def add(S):
         """Deduplicate converged states S against the solutions known so far and each other."""
         good = (np.abs(model.residual(S)) / jscale <= tol).all(-1)
@@ -651,7 +717,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
             return
         keys = model.keys(S)
         if hits:                                      # known solutions (mutually > dedup apart)
-            dist = np.abs(keys[:, None, :] - np.array(rep_keys)[None]).max(-1)
+            dist = np.abs(keys[:, None, :] - known_keys()[None]).max(-1)
             near = dist.min(-1) <= dedup
             for i in dist[near].argmin(-1).tolist():
                 hits[i] += 1
@@ -675,13 +741,37 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         add(S)
         return cap is not None and len(hits) >= cap   # every assembly mode is found
 
+    cap_f2 = (capture[0] * float(jscale.min())) ** 2 if capture else 0.0
+
+    def captured(S, F, open_):
+        """Open rows near convergence (residual <= capture[0]) within capture[1] of a known solution."""
+        if not hits:
+            return None
+        cand = np.flatnonzero((F <= cap_f2) & open_)
+        if not len(cand):
+            return None
+        keys, known_ = model.keys(S[cand]), known_keys()
+        # the known solution nearest in the first three key coordinates (position for 6-SPS),
+        # then the full distance to that one only (a row it misses just runs to convergence)
+        j = np.abs(keys[:, None, :3] - known_[None, :, :3]).max(-1).argmin(-1)
+        near = np.abs(keys - known_[j]).max(-1) <= capture[1]
+        for i in j[near].tolist():
+            hits[i] += 1
+        return cand[near]
+
+    shift = None
     while used < limit:
         n = min(size, limit - used)
-        S0 = model.starts(streams.uniform(n, model.draws)[0])
+        if qmc:
+            if shift is None:
+                shift = streams.uniform(1, model.draws)[0][0]
+            S0 = model.starts(_kronecker(shift, used, n, model.draws))
+        else:
+            S0 = model.starts(streams.uniform(n, model.draws)[0])
         inside_before = sum(f is not None for f in found)
         with np.errstate(all="ignore"):                 # diverging starts may overflow
             _, _, started = _newton(model, S0, ftol=ftol, iterations=iterations, pool=pool, report=report,
-                                    line_search=search)
+                                    line_search=search, capture=captured if capture else None)
         used += started
         settle()
         inside = sum(f is not None for f in found)

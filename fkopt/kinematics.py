@@ -46,10 +46,11 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   by a fixed hash (not the seed), compared by their tool position and reach / (3 sqrt 2) times
   their rotation matrix entries (1 rad weighs about a third of the reach), nearest found
   exactly (brute force below 32 rows, scipy's k-d tree from 32 rows on); a row's starts are ``start`` (when given), then the table's configurations nearest to
-  its target (``starts`` of them plus ``neighbours`` more for restarts), then seeded random draws
+  its target (``starts`` of them plus ``neighbours`` (32) more for restarts), then seeded random draws
   inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
   1000 random reachable poses: about 80 % of nearest-configuration starts converge against
-  about 60 % of mid-range or random ones;
+  about 60 % of mid-range or random ones, which is why the hardest rows of a batch try 32 table
+  neighbours before the random draws (README, Performance);
 * one pose (N = 1, ``rest`` = 0, no ``exact_rotation``) runs the same iteration on Python
   floats (the arm's ``frame_jacobian1``, Cholesky solves of the 6x6 systems), its candidates
   one after another in the order of its starts, stopping at the first that converges: numpy's
@@ -58,8 +59,9 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   (lambda above 1e6), restarts in place from its row's next start, at most ``restarts`` times
   per row; a solved row retires all its candidates at once. A batch of N < ``fill`` (32) rows
   starts with ``fill // N`` candidates per row side by side, and whenever fewer than ``tail``
-  (128) candidates remain, every unsolved row gets more at once (the last hard rows then try
-  many starts per iteration instead of a few per iteration for many iterations). These restarts are inverse's global
+  (256) candidates remain, every unsolved row gets more at once (the last hard rows then try
+  many starts per iteration instead of a few per iteration for many iterations: in a batch
+  the time of the last iterations is numpy's per-call overhead, whatever their few rows). These restarts are inverse's global
   stage (restarts of a local method with limits, rather than a swarm). Same poses and seed give
   the same answer; a row's answer may differ between batches.
 
@@ -743,9 +745,9 @@ def _start_table(m, size: int):
     entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3): ``inverse``
     starts from the configurations nearest to each target. Cached per arm (name, DH table,
     limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`)."""
-    base = m.__dict__.get("_start_table_key")        # repr of the geometry costs ~50 us: once
-    if base is None:
-        base = m.__dict__["_start_table_key"] = (m.name, repr(m.geometry), m.bounds.tobytes())
+    base = m.__dict__.get("_start_table_key")
+    if base is None:                                 # the DH table's numbers (no pydantic model needed)
+        base = m.__dict__["_start_table_key"] = (m.name, m._a, m._d, m._ca, m._sa, m._offset, m.bounds.tobytes())
     key = base + (size,)
     got = _TABLES.get(key)
     if got is None:
@@ -788,7 +790,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
-            table: int = 4096, neighbours: int = 8, tail: int = 128) -> InverseResult:
+            table: int = 4096, neighbours: int = 32, tail: int = 256) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
@@ -848,6 +850,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     # table's configurations nearest to the target, then seeded random draws
     own0 = 1 if (start is not None or not table) else 0
     near = np.zeros((N, 0), dtype=np.intp)
+    k0 = 0                                             # neighbours known for every row
     if table:
         tab = _start_table(m, int(table))
         tq = tab["q"]
@@ -870,7 +873,8 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
             qs[a] = q0[rows[a]]
         b = (j >= own0) & (j < own0 + nn)
         if b.any():
-            need = np.unique(rows[b][~full[rows[b]]])
+            late = b & (j - own0 >= k0)                # beyond the neighbours every row has
+            need = np.unique(rows[late][~full[rows[late]]])
             if len(need):
                 near[need] = _nearest(tab, feats[need], nn)
                 full[need] = True
@@ -1011,18 +1015,25 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
                     free = (~outv).astype(float)
                     fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
+                    qv2 = np.empty_like(qv)
+                    act = slice(None)                      # rows re-solved: all, then those with new violations
                     for _ in range(2):
-                        Jf = Jv * free[:, None, :]
-                        rr = rv + (Jv @ fixed[..., None])[..., 0]
+                        Ja, fa = Jv[act], free[act]
+                        Jf = Ja * fa[:, None, :]
+                        rr = rv[act] + (Ja @ fixed[act][..., None])[..., 0]
                         Jft = np.swapaxes(Jf, 1, 2)
                         A = Jf @ Jft
-                        A[:, _I6, _I6] += muv[:, None]
-                        qv2 = qv + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed
-                        outv = ((qv2 < lo) | (qv2 > hi)) & (free > 0)
-                        if not outv.any():
+                        A[:, _I6, _I6] += muv[act][:, None]
+                        qa = qv[act] + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed[act]
+                        qv2[act] = qa
+                        outa = ((qa < lo) | (qa > hi)) & (fa > 0)
+                        more = np.flatnonzero(outa.any(axis=-1))
+                        if not len(more):
                             break
-                        fixed = np.where(outv, np.clip(qv2, lo, hi) - qv, fixed)
-                        free = np.where(outv, 0.0, free)
+                        act = more if isinstance(act, slice) else act[more]
+                        outa = outa[more]
+                        fixed[act] = np.where(outa, np.clip(qa[more], lo, hi) - qv[act], fixed[act])
+                        free[act] = np.where(outa, 0.0, free[act])
                     qn[sat] = np.clip(qv2, lo, hi)
                 # -- evaluate the trial points and the restarted slots in one call ----------------
                 if anyfresh:

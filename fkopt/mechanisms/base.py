@@ -11,24 +11,73 @@ bounds of the unknowns, and its closed-form map, vectorised over any leading bat
 Angles are in degrees at every public interface; lengths in the unit of the source paper
 (mm, or m for liu2008). Geometry is a pydantic model per mechanism, so overrides from Python or
 YAML are validated with clear messages.
+
+pydantic is imported only when a geometry is validated or inspected: a mechanism built without
+overrides keeps no model until ``mechanism.geometry`` is first read (then the model of the
+defaults is built, as before), and a mechanism whose own code needs only the default values
+reads them from its pydantic-free ``geometry_defaults`` (:meth:`Mechanism.geometry_values`).
+``fkopt fk`` / ``fkopt ik`` on a preset thus never import pydantic (its import is a large part
+of such a process: ``fkopt bench --section kinematics``).
+A mechanism module can build its model class on first use with :class:`lazy_model`; the
+``Geometry`` base class itself is built on first import of the name.
 """
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from types import SimpleNamespace
+from typing import Any, Callable, ClassVar
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..errors import FkoptError, did_you_mean
 
 
-class Geometry(BaseModel):
-    """Base of every mechanism's geometry model (unknown keys are rejected)."""
+def _geometry_base():
+    from pydantic import BaseModel, ConfigDict
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)   # "1e400" from YAML is inf
+    class Geometry(BaseModel):
+        """Base of every mechanism's geometry model (unknown keys are rejected)."""
+
+        model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)   # "1e400" from YAML is inf
+
+    Geometry.__module__ = __name__
+    return Geometry
 
 
-def describe_validation_error(err: ValidationError, where: str) -> str:
+def __getattr__(name: str):
+    # ``Geometry`` (the pydantic base of every geometry model) is built on first import.
+    if name == "Geometry":
+        cls = globals()["Geometry"] = _geometry_base()
+        return cls
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class lazy_model:
+    """Class attribute holding a geometry model class built by ``build()`` on first access
+    (so that importing the mechanism's module does not import pydantic)."""
+
+    def __init__(self, build: Callable[[], type]):
+        self.build = build
+        self.cls: type | None = None
+
+    def __get__(self, obj, owner=None) -> type:
+        if self.cls is None:
+            self.cls = self.build()
+        return self.cls
+
+
+def validate_geometry(model: type, geometry: dict[str, Any], where: str, clean=lambda m: m):
+    """``model(**geometry)``, or a one-line :class:`FkoptError` naming ``where``, the field and
+    the allowed keys (``clean`` edits the message, e.g. drops pydantic's "Value error, ")."""
+    from pydantic import ValidationError
+    try:
+        return model(**geometry)
+    except ValidationError as err:
+        allowed = did_you_mean("", model.model_fields)
+        raise FkoptError(clean(describe_validation_error(err, f"{where} geometry"))
+                         + f" (geometry keys: {allowed})") from None
+
+
+def describe_validation_error(err, where: str) -> str:
     """Collapse a pydantic error into one line: ``where.field: message``."""
     first = err.errors()[0]
     loc = ".".join(str(p) for p in first["loc"])
@@ -49,18 +98,32 @@ class Mechanism:
     pose_units: ClassVar[tuple[str, ...]]
     joint_names: ClassVar[tuple[str, ...]]
     joint_units: ClassVar[tuple[str, ...]]
-    Geometry: ClassVar[type[Geometry]] = Geometry
+    Geometry: ClassVar[type] = lazy_model(lambda: __getattr__("Geometry"))
+    #: The default geometry's values without pydantic (``None``: the mechanism reads
+    #: ``self.geometry``, which builds the model); must equal ``Geometry().model_dump()``.
+    geometry_defaults: ClassVar[dict[str, Any] | None] = None
     #: Default search bounds of the unknowns, name -> (lower, upper).
     default_bounds: ClassVar[dict[str, tuple[float, float]]]
 
     def __init__(self, bounds: dict[str, Any] | None = None, **geometry: Any):
-        try:
-            self.geometry = self.Geometry(**geometry)
-        except ValidationError as err:
-            allowed = did_you_mean("", self.Geometry.model_fields)
-            raise FkoptError(describe_validation_error(err, f"{self.name} geometry")
-                             + f" (geometry keys: {allowed})") from None
+        if geometry or self.geometry_defaults is None:
+            self.geometry = validate_geometry(self.Geometry, geometry, self.name)
+        # else: the model of the defaults is built on first access of ``geometry`` (__getattr__)
         self.bounds = self._make_bounds(bounds or {})
+
+    def __getattr__(self, name: str):
+        if name == "geometry":                       # defaults, built on first use
+            g = self.__dict__["geometry"] = self.Geometry()
+            return g
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def geometry_values(self):
+        """The geometry's values by attribute: the model when one was built or given, else
+        :attr:`geometry_defaults` (no pydantic)."""
+        g = self.__dict__.get("geometry")
+        if g is None and self.geometry_defaults is not None:
+            return SimpleNamespace(**self.geometry_defaults)
+        return self.geometry
 
     # -- variables ---------------------------------------------------------------------------
     @property

@@ -24,11 +24,10 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import Field, ValidationError, model_validator
 
 from .. import rotations
-from ..errors import FkoptError, did_you_mean
-from .base import Geometry, SerialMechanism, describe_validation_error
+from ..errors import FkoptError
+from .base import SerialMechanism, lazy_model, validate_geometry
 
 #: Batch size from which :meth:`DHArm.frame_jacobian` works on the frame's columns rather than
 #: by batched 4x4 products (those cost about 1 µs per matrix, the columns a fixed ~20 array
@@ -44,35 +43,48 @@ WANG7DOF = dict(
 )
 
 
-class DHGeometry(Geometry):
-    a: list[float] = Field(default_factory=lambda: list(WANG7DOF["a"]),
-                           description="link lengths a_i (mm)")
-    alpha: list[float] = Field(default_factory=lambda: list(WANG7DOF["alpha"]),
-                               description="link twists alpha_i (deg)")
-    d: list[float] = Field(default_factory=lambda: list(WANG7DOF["d"]), description="link offsets d_i (mm)")
-    theta_offset: list[float] | None = Field(None, description="joint angle offsets (deg), default 0")
-    limits: list[tuple[float, float]] = Field(default_factory=lambda: list(WANG7DOF["limits"]),
-                                              description="joint limits [lower, upper] per joint (deg)")
+def _dh_geometry():
+    from pydantic import Field, model_validator
+    from .base import Geometry
 
-    @model_validator(mode="after")
-    def _consistent(self):
-        n = len(self.a)
-        if n < 1:
-            raise ValueError("the DH table needs at least 1 joint (a is empty)")
-        lengths = {"a": n, "alpha": len(self.alpha), "d": len(self.d), "limits": len(self.limits)}
-        if self.theta_offset is not None:
-            lengths["theta_offset"] = len(self.theta_offset)
-        if len(set(lengths.values())) > 1:
-            raise ValueError("DH table columns must have equal lengths, got "
-                             + ", ".join(f"{k}={v}" for k, v in lengths.items()))
-        for i, (lo, hi) in enumerate(self.limits):
-            if not lo < hi:
-                raise ValueError(f"limits[{i}] (joint q{i + 1}): lower {lo:g} must be below upper {hi:g}")
-        values = [*self.a, *self.alpha, *self.d, *(self.theta_offset or []),
-                  *(v for pair in self.limits for v in pair)]
-        if not np.all(np.isfinite(values)):
-            raise ValueError("DH table values must be finite")
-        return self
+    class DHGeometry(Geometry):
+        a: list[float] = Field(default_factory=lambda: list(WANG7DOF["a"]),
+                               description="link lengths a_i (mm)")
+        alpha: list[float] = Field(default_factory=lambda: list(WANG7DOF["alpha"]),
+                                   description="link twists alpha_i (deg)")
+        d: list[float] = Field(default_factory=lambda: list(WANG7DOF["d"]), description="link offsets d_i (mm)")
+        theta_offset: list[float] | None = Field(None, description="joint angle offsets (deg), default 0")
+        limits: list[tuple[float, float]] = Field(default_factory=lambda: list(WANG7DOF["limits"]),
+                                                  description="joint limits [lower, upper] per joint (deg)")
+
+        @model_validator(mode="after")
+        def _consistent(self):
+            n = len(self.a)
+            if n < 1:
+                raise ValueError("the DH table needs at least 1 joint (a is empty)")
+            lengths = {"a": n, "alpha": len(self.alpha), "d": len(self.d), "limits": len(self.limits)}
+            if self.theta_offset is not None:
+                lengths["theta_offset"] = len(self.theta_offset)
+            if len(set(lengths.values())) > 1:
+                raise ValueError("DH table columns must have equal lengths, got "
+                                 + ", ".join(f"{k}={v}" for k, v in lengths.items()))
+            for i, (lo, hi) in enumerate(self.limits):
+                if not lo < hi:
+                    raise ValueError(f"limits[{i}] (joint q{i + 1}): lower {lo:g} must be below upper {hi:g}")
+            values = [*self.a, *self.alpha, *self.d, *(self.theta_offset or []),
+                      *(v for pair in self.limits for v in pair)]
+            if not np.all(np.isfinite(values)):
+                raise ValueError("DH table values must be finite")
+            return self
+
+    DHGeometry.__module__ = __name__
+    return DHGeometry
+
+
+def __getattr__(name: str):
+    if name == "DHGeometry":                           # built on first use (pydantic)
+        return DHArm.Geometry
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class DHArm(SerialMechanism):
@@ -81,7 +93,9 @@ class DHArm(SerialMechanism):
     name = "dh-arm"
     pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
     pose_units = ("mm", "mm", "mm", "deg", "deg", "deg")
-    Geometry = DHGeometry
+    Geometry = lazy_model(_dh_geometry)                # pydantic model, built on first use
+    geometry_defaults = {"a": list(WANG7DOF["a"]), "alpha": list(WANG7DOF["alpha"]), "d": list(WANG7DOF["d"]),
+                         "theta_offset": None, "limits": list(WANG7DOF["limits"])}
     # Class-level values describe the default (wang7dof) table; each instance sets its own.
     joint_names = tuple(f"q{i + 1}" for i in range(len(WANG7DOF["a"])))
     joint_units = ("deg",) * len(WANG7DOF["a"])
@@ -90,18 +104,16 @@ class DHArm(SerialMechanism):
     def __init__(self, bounds: dict[str, Any] | None = None, **geometry: Any):
         # The joint names and default bounds depend on the table: validate it first, then set
         # them on the instance before the base class builds the bounds from joint_names.
-        try:
-            table = self.Geometry(**geometry)
-        except ValidationError as err:
-            allowed = did_you_mean("", self.Geometry.model_fields)
-            raise FkoptError(describe_validation_error(err, f"{self.name} geometry").replace("Value error, ", "")
-                             + f" (geometry keys: {allowed})") from None
+        if geometry:
+            table = validate_geometry(self.Geometry, geometry, self.name, lambda m: m.replace("Value error, ", ""))
+        else:                                          # the default table: valid, no pydantic needed
+            table = self.geometry_values()
         n = len(table.a)
         self.joint_names = tuple(f"q{i + 1}" for i in range(n))
         self.joint_units = ("deg",) * n
         self.default_bounds = {f"q{i + 1}": tuple(lim) for i, lim in enumerate(table.limits)}
         super().__init__(bounds, **geometry)
-        g = self.geometry
+        g = self.geometry_values()
         self._a = tuple(float(v) for v in g.a)
         self._d = tuple(float(v) for v in g.d)
         self._ca = tuple(float(np.cos(np.radians(v))) for v in g.alpha)

@@ -43,10 +43,9 @@ from typing import Any, ClassVar
 import math
 
 import numpy as np
-from pydantic import Field, model_validator
 
 from .. import rotations
-from .base import Geometry, ParallelMechanism
+from .base import ParallelMechanism, lazy_model
 
 Vec3 = tuple[float, float, float]
 Points6 = tuple[Vec3, Vec3, Vec3, Vec3, Vec3, Vec3]
@@ -80,12 +79,19 @@ def general_bounds(base, platform, probe) -> dict[str, tuple[float, float]]:
     return out
 
 
-class SixSPSGeometry(Geometry):
-    base: Points6 = Field(DIETMAIER_BASE, description="six base joints b_i [x, y, z] (base frame)")
-    platform: Points6 = Field(DIETMAIER_PLATFORM,
-                              description="six platform joints p_i [x, y, z] (platform frame)")
-    probe: Vec3 = Field((0.0, 0.0, 0.0),
-                        description="probe offset s in the platform frame; the pose locates p_s = origin + R s")
+def _six_sps_geometry():
+    from pydantic import Field
+    from .base import Geometry
+
+    class SixSPSGeometry(Geometry):
+        base: Points6 = Field(DIETMAIER_BASE, description="six base joints b_i [x, y, z] (base frame)")
+        platform: Points6 = Field(DIETMAIER_PLATFORM,
+                                  description="six platform joints p_i [x, y, z] (platform frame)")
+        probe: Vec3 = Field((0.0, 0.0, 0.0),
+                            description="probe offset s in the platform frame; the pose locates p_s = origin + R s")
+
+    SixSPSGeometry.__module__ = __name__
+    return SixSPSGeometry
 
 
 class SixSPS(ParallelMechanism):
@@ -96,13 +102,15 @@ class SixSPS(ParallelMechanism):
     pose_units = ("m", "m", "m", "deg", "deg", "deg")
     joint_names = ("l1", "l2", "l3", "l4", "l5", "l6")
     joint_units = ("m", "m", "m", "m", "m", "m")
-    Geometry = SixSPSGeometry
+    Geometry = lazy_model(_six_sps_geometry)           # pydantic model, built on first use
+    geometry_defaults: ClassVar[dict[str, Any]] = {"base": DIETMAIER_BASE, "platform": DIETMAIER_PLATFORM,
+                                                   "probe": (0.0, 0.0, 0.0)}
     default_bounds: ClassVar[dict[str, tuple[float, float]]]  # set below from the default geometry
 
     # -- geometry --------------------------------------------------------------------------
     def points(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(base (6, 3), platform (6, 3), probe (3,)) as arrays."""
-        g = self.geometry
+        g = self.geometry_values()
         return (np.array(g.base, dtype=float), np.array(g.platform, dtype=float),
                 np.array(g.probe, dtype=float))
 
@@ -288,23 +296,39 @@ class SixSPS(ParallelMechanism):
 SixSPS.default_bounds = general_bounds(np.array(DIETMAIER_BASE), np.array(DIETMAIER_PLATFORM), np.zeros(3))
 
 
-class SixSPSCMMGeometry(Geometry):
-    Rb: float = Field(0.5, gt=0, description="base joint circle radius R_b (m)")
-    Rp: float = Field(0.225, gt=0, description="platform joint circle radius R_p (m)")
-    tb: float = Field(30.0, gt=0, lt=120, description="base short-side central angle theta_b (deg)")
-    tp: float = Field(30.0, gt=0, lt=120, description="platform short-side central angle theta_p (deg)")
-    ls: float = Field(0.180, description="probe offset l_s along the platform z axis (m)")
-    base: Points6 | None = Field(None, description="explicit base joints (replace Rb, tb)")
-    platform: Points6 | None = Field(None, description="explicit platform joints (replace Rp, tp)")
+def _six_sps_cmm_geometry():
+    from pydantic import Field, model_validator
+    from .base import Geometry
 
-    @model_validator(mode="after")
-    def _not_both(self):
-        fields = self.model_fields_set
-        if self.base is not None and fields & {"Rb", "tb"}:
-            raise ValueError("give either base or (Rb, tb), not both")
-        if self.platform is not None and fields & {"Rp", "tp"}:
-            raise ValueError("give either platform or (Rp, tp), not both")
-        return self
+    class SixSPSCMMGeometry(Geometry):
+        Rb: float = Field(0.5, gt=0, description="base joint circle radius R_b (m)")
+        Rp: float = Field(0.225, gt=0, description="platform joint circle radius R_p (m)")
+        tb: float = Field(30.0, gt=0, lt=120, description="base short-side central angle theta_b (deg)")
+        tp: float = Field(30.0, gt=0, lt=120, description="platform short-side central angle theta_p (deg)")
+        ls: float = Field(0.180, description="probe offset l_s along the platform z axis (m)")
+        base: Points6 | None = Field(None, description="explicit base joints (replace Rb, tb)")
+        platform: Points6 | None = Field(None, description="explicit platform joints (replace Rp, tp)")
+
+        @model_validator(mode="after")
+        def _not_both(self):
+            fields = self.model_fields_set
+            if self.base is not None and fields & {"Rb", "tb"}:
+                raise ValueError("give either base or (Rb, tb), not both")
+            if self.platform is not None and fields & {"Rp", "tp"}:
+                raise ValueError("give either platform or (Rp, tp), not both")
+            return self
+
+    SixSPSCMMGeometry.__module__ = __name__
+    return SixSPSCMMGeometry
+
+
+def __getattr__(name: str):
+    # The geometry models are built on first use (importing pydantic costs more than fk itself).
+    if name == "SixSPSGeometry":
+        return SixSPS.Geometry
+    if name == "SixSPSCMMGeometry":
+        return SixSPSCMM.Geometry
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class SixSPSCMM(SixSPS):
@@ -312,7 +336,9 @@ class SixSPSCMM(SixSPS):
 
     name = "6-sps-cmm"
     paper = "liu2008"
-    Geometry = SixSPSCMMGeometry
+    Geometry = lazy_model(_six_sps_cmm_geometry)
+    geometry_defaults: ClassVar[dict[str, Any]] = {"Rb": 0.5, "Rp": 0.225, "tb": 30.0, "tp": 30.0, "ls": 0.180,
+                                                   "base": None, "platform": None}
     # Workspace around the home pose (not printed in liu2008; our choice, contains Tab. 3).
     default_bounds = {"x": (-0.2, 0.2), "y": (-0.2, 0.2), "z": (0.7, 1.1),
                       "alpha": (-30.0, 30.0), "beta": (-30.0, 30.0), "gamma": (-30.0, 30.0)}
@@ -325,7 +351,7 @@ class SixSPSCMM(SixSPS):
         return theta_b, theta_p
 
     def points(self):
-        g = self.geometry
+        g = self.geometry_values()
         theta_b, theta_p = np.radians(self.joint_angles(g.tb, g.tp))
         zero = np.zeros(6)
         base = (np.array(g.base, dtype=float) if g.base is not None else
