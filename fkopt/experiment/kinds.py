@@ -9,7 +9,9 @@ Kinds (the file's ``kind:`` key; an experiment file has none):
 
 Each kind is a :class:`Kind`, named in :data:`KINDS` by a ``"module:attribute"`` string imported
 on first use (like :mod:`fkopt.registry`), so this floor never imports the study floor above it,
-and adding a config kind is one module plus one line here. Everything else is shared:
+and adding a config kind is one module plus one line here and its list of files in
+:data:`fkopt.outputs.OUTPUTS` (which must stay on the floor of :mod:`fkopt.compare`, which reads
+the roles). Everything else is shared:
 
 * :func:`load_any` -- the one loader (:func:`fkopt.files.load_mapping`: size, UTF-8, no aliases,
   no duplicate keys) and the one validator entry point (pydantic, one-line errors);
