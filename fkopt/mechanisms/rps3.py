@@ -16,6 +16,8 @@ B_i = r_b (cos phi_i, sin phi_i, 0), phi_i = 2 pi (i - 1) / 3 (eq. 3).
 """
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from pydantic import Field
 
@@ -25,6 +27,17 @@ from .base import Geometry, ParallelMechanism
 
 _HALF_DEG = np.pi / 360.0          # degrees -> half-angle in radians
 _S3 = 0.5 * np.sqrt(3.0)           # sin(120 deg)
+#: Poses per block of :meth:`ThreeRPS.ik_columns` (its scratch array: 21 x BLOCK floats per thread).
+BLOCK = 16384
+_scratch = threading.local()
+
+
+def _workspace() -> np.ndarray:
+    """This thread's scratch array for :meth:`ThreeRPS._legs` (21, BLOCK), made on first use."""
+    ws = getattr(_scratch, "ws", None)
+    if ws is None:
+        ws = _scratch.ws = np.empty((21, BLOCK))
+    return ws
 
 
 class ThreeRPSGeometry(Geometry):
@@ -78,39 +91,95 @@ class ThreeRPS(ParallelMechanism):
         """
         poses = np.asarray(poses, dtype=float)
         shape = poses.shape[:-1]
+        out = np.empty(shape + (3,))
+        self.ik_columns(poses, out=out.reshape(-1, 3).T)
+        return out
+
+    def ik_columns(self, poses, out=None) -> np.ndarray:
+        """The leg lengths of the flattened poses as rows: ``ik(poses).reshape(-1, 3).T``, (3, n)
+        and C-contiguous (``out``, if given, receives them), the same numbers as :meth:`ik`.
+
+        :class:`fkopt.problems.FKProblem` computes its fitness on these rows (three contiguous
+        arrays instead of an interleaved (n, 3) one). The operations run in blocks of at most
+        :data:`BLOCK` poses on a reused per-thread scratch array (``out=`` everywhere), so an
+        evaluation allocates nothing but its result; the arithmetic is elementwise, so the
+        numbers do not depend on the blocks.
+        """
+        poses = np.asarray(poses, dtype=float)
         p = poses.reshape(-1, 3).T                          # (3, n) view
+        n = p.shape[1]
+        if out is None:
+            out = np.empty((3, n))
+        ws = _workspace()
+        for s in range(0, n, BLOCK):
+            e = min(s + BLOCK, n)
+            self._legs(p[:, s:e], out[:, s:e], ws[:, :e - s])
+        return out
+
+    def _legs(self, p, out, ws) -> None:
+        """:meth:`ik_columns` of one block: poses ``p`` (3, b) into ``out`` (3, b), scratch ``ws``."""
         ra, rb = self.geometry.ra, self.geometry.rb
-        t = np.tan(np.multiply(p[:2], _HALF_DEG, order="C"))
-        t2 = t * t
-        r = 1.0 / (1.0 + t2)
-        s = (t + t) * r
-        c = (1.0 - t2) * r
-        sa, sb = s
-        ca, cb = c
+        mul, add, sub, div = np.multiply, np.add, np.subtract, np.divide
+        T, T2, R, S, C = ws[0:2], ws[2:4], ws[4:6], ws[6:8], ws[8:10]
+        mul(p[:2], _HALF_DEG, out=T2)
+        np.tan(T2, out=T)                                   # t
+        mul(T, T, out=T2)                                   # t2
+        add(1.0, T2, out=R)
+        div(1.0, R, out=R)                                  # r = 1 / (1 + t2)
+        add(T, T, out=S)
+        mul(S, R, out=S)                                    # s = (t + t) r
+        sub(1.0, T2, out=C)
+        mul(C, R, out=C)                                    # c = (1 - t2) r
+        sa, sb = S
+        ca, cb = C
         z = p[2]
-        tg = sa * sb / (ca + cb)
-        cg = 1.0 / np.sqrt(1.0 + tg * tg)
-        sg = tg * cg
-        sbsa = sb * sa
-        R00 = cg * cb
-        R10 = sg * cb
-        R11 = sg * sbsa + cg * ca
-        R01 = cg * sbsa - sg * ca
-        out = np.empty((z.shape[0], 3))
-        e = (1.5 * rb) * R00 - (0.5 * rb) * R11 - ra
-        f = z - rb * sb
-        np.sqrt(e * e + f * f, out=out[:, 0])
-        ax = 0.5 * ra - (0.5 * rb) * R11
-        bx = (_S3 * rb) * R01
-        ay = (-1.5 * rb) * R10
-        by = (-2.0 * _S3) * ax
-        az = z + (0.5 * rb) * sb
-        bz = (_S3 * rb) * (cb * sa)
-        u, v, w = ax + bx, ay + by, az + bz
-        np.sqrt(u * u + v * v + w * w, out=out[:, 1])
-        u, v, w = ax - bx, ay - by, az - bz
-        np.sqrt(u * u + v * v + w * w, out=out[:, 2])
-        return out.reshape(shape + (3,))
+        sbsa, tg, cg, sg, R00, R10, R11, R01, h, a, b = ws[10:21]
+        mul(sb, sa, out=sbsa)                               # = sa * sb
+        add(ca, cb, out=tg)
+        div(sbsa, tg, out=tg)                               # tg = sa sb / (ca + cb)
+        mul(tg, tg, out=cg)
+        add(1.0, cg, out=cg)
+        np.sqrt(cg, out=cg)
+        div(1.0, cg, out=cg)                                # cg = 1 / sqrt(1 + tg^2)
+        mul(tg, cg, out=sg)
+        mul(cg, cb, out=R00)
+        mul(sg, cb, out=R10)
+        mul(sg, sbsa, out=R11)
+        mul(cg, ca, out=a)
+        add(R11, a, out=R11)                                # R11 = sg sbsa + cg ca
+        mul(cg, sbsa, out=R01)
+        mul(sg, ca, out=a)
+        sub(R01, a, out=R01)                                # R01 = cg sbsa - sg ca
+        mul(0.5 * rb, R11, out=h)                           # (0.5 rb) R11, used twice
+        mul(1.5 * rb, R00, out=a)
+        sub(a, h, out=a)
+        sub(a, ra, out=a)                                   # e
+        mul(rb, sb, out=b)
+        sub(z, b, out=b)                                    # f = z - rb sb
+        mul(a, a, out=a)
+        mul(b, b, out=b)
+        add(a, b, out=a)
+        np.sqrt(a, out=out[0])                              # d1
+        ax, bx, ay, by, az, bz = tg, sg, R00, R11, sbsa, cg  # reuse rows no longer needed
+        sub(0.5 * ra, h, out=ax)
+        mul(_S3 * rb, R01, out=bx)
+        mul(-1.5 * rb, R10, out=ay)
+        mul(-2.0 * _S3, ax, out=by)
+        mul(0.5 * rb, sb, out=az)
+        add(z, az, out=az)
+        mul(cb, sa, out=bz)
+        mul(_S3 * rb, bz, out=bz)
+        u, v, w = R10, R01, h
+        for sign, d in ((add, out[1]), (sub, out[2])):
+            sign(ax, bx, out=u)
+            sign(ay, by, out=v)
+            sign(az, bz, out=w)
+            mul(u, u, out=u)
+            mul(v, v, out=v)
+            mul(w, w, out=w)
+            add(u, v, out=u)
+            add(u, w, out=u)
+            np.sqrt(u, out=d)
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
