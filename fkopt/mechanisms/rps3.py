@@ -27,16 +27,17 @@ from .base import Geometry, ParallelMechanism
 
 _HALF_DEG = np.pi / 360.0          # degrees -> half-angle in radians
 _S3 = 0.5 * np.sqrt(3.0)           # sin(120 deg)
-#: Poses per block of :meth:`ThreeRPS.ik_columns` (its scratch array: 21 x BLOCK floats per thread).
+#: Poses per block of :meth:`ThreeRPS.ik_columns` (its scratch array: 28 x BLOCK floats per thread).
 BLOCK = 16384
+_PLUS_MINUS = np.array([[1.0], [-1.0]])
 _scratch = threading.local()
 
 
 def _workspace() -> np.ndarray:
-    """This thread's scratch array for :meth:`ThreeRPS._legs` (21, BLOCK), made on first use."""
+    """This thread's scratch array for :meth:`ThreeRPS._legs` (28, BLOCK), made on first use."""
     ws = getattr(_scratch, "ws", None)
     if ws is None:
-        ws = _scratch.ws = np.empty((21, BLOCK))
+        ws = _scratch.ws = np.empty((28, BLOCK))
     return ws
 
 
@@ -117,7 +118,11 @@ class ThreeRPS(ParallelMechanism):
         return out
 
     def _legs(self, p, out, ws) -> None:
-        """:meth:`ik_columns` of one block: poses ``p`` (3, b) into ``out`` (3, b), scratch ``ws``."""
+        """:meth:`ik_columns` of one block: poses ``p`` (3, b) into ``out`` (3, b), scratch ``ws``.
+
+        Pairs of rows go through one call where the formulas allow it (alpha and beta; cg and
+        sg; legs 2 and 3 as a_* + (+-b_*), IEEE's a - b being exactly a + (-b)), so a small
+        batch costs few numpy calls."""
         ra, rb = self.geometry.ra, self.geometry.rb
         mul, add, sub, div = np.multiply, np.add, np.subtract, np.divide
         T, T2, R, S, C = ws[0:2], ws[2:4], ws[4:6], ws[6:8], ws[8:10]
@@ -133,7 +138,9 @@ class ThreeRPS(ParallelMechanism):
         sa, sb = S
         ca, cb = C
         z = p[2]
-        sbsa, tg, cg, sg, R00, R10, R11, R01, h, a, b = ws[10:21]
+        sbsa, tg = ws[10], ws[11]
+        CS, RR, A, B, EF = ws[12:14], ws[14:16], ws[16:18], ws[18:20], ws[20:22]
+        cg, sg = CS
         mul(sb, sa, out=sbsa)                               # = sa * sb
         add(ca, cb, out=tg)
         div(sbsa, tg, out=tg)                               # tg = sa sb / (ca + cb)
@@ -142,44 +149,42 @@ class ThreeRPS(ParallelMechanism):
         np.sqrt(cg, out=cg)
         div(1.0, cg, out=cg)                                # cg = 1 / sqrt(1 + tg^2)
         mul(tg, cg, out=sg)
-        mul(cg, cb, out=R00)
-        mul(sg, cb, out=R10)
-        mul(sg, sbsa, out=R11)
-        mul(cg, ca, out=a)
-        add(R11, a, out=R11)                                # R11 = sg sbsa + cg ca
-        mul(cg, sbsa, out=R01)
-        mul(sg, ca, out=a)
-        sub(R01, a, out=R01)                                # R01 = cg sbsa - sg ca
+        mul(CS, cb, out=RR)                                 # R00 = cg cb, R10 = sg cb
+        R00, R10 = RR
+        mul(CS, sbsa, out=A)                                # cg sbsa, sg sbsa
+        mul(CS, ca, out=B)                                  # cg ca, sg ca
+        R11, R01 = B[0], A[0]
+        add(A[1], B[0], out=R11)                            # R11 = sg sbsa + cg ca
+        sub(A[0], B[1], out=R01)                            # R01 = cg sbsa - sg ca
+        h, ax, ay, az, bz = A[1], tg, sbsa, B[1], cg        # rows no longer needed
         mul(0.5 * rb, R11, out=h)                           # (0.5 rb) R11, used twice
-        mul(1.5 * rb, R00, out=a)
-        sub(a, h, out=a)
-        sub(a, ra, out=a)                                   # e
-        mul(rb, sb, out=b)
-        sub(z, b, out=b)                                    # f = z - rb sb
-        mul(a, a, out=a)
-        mul(b, b, out=b)
-        add(a, b, out=a)
-        np.sqrt(a, out=out[0])                              # d1
-        ax, bx, ay, by, az, bz = tg, sg, R00, R11, sbsa, cg  # reuse rows no longer needed
+        e, f = EF
+        mul(1.5 * rb, R00, out=e)
+        sub(e, h, out=e)
+        sub(e, ra, out=e)                                   # e
+        mul(rb, sb, out=f)
+        sub(z, f, out=f)                                    # f = z - rb sb
+        mul(EF, EF, out=EF)
+        add(e, f, out=e)
+        np.sqrt(e, out=out[0])                              # d1
         sub(0.5 * ra, h, out=ax)
-        mul(_S3 * rb, R01, out=bx)
+        BX, BY, BZ = ws[22:24], ws[24:26], ws[26:28]        # (+b, -b) of x, y, z
+        mul(_S3 * rb * _PLUS_MINUS, R01, out=BX)
         mul(-1.5 * rb, R10, out=ay)
-        mul(-2.0 * _S3, ax, out=by)
+        mul(-2.0 * _S3 * _PLUS_MINUS, ax, out=BY)
         mul(0.5 * rb, sb, out=az)
         add(z, az, out=az)
         mul(cb, sa, out=bz)
-        mul(_S3 * rb, bz, out=bz)
-        u, v, w = R10, R01, h
-        for sign, d in ((add, out[1]), (sub, out[2])):
-            sign(ax, bx, out=u)
-            sign(ay, by, out=v)
-            sign(az, bz, out=w)
-            mul(u, u, out=u)
-            mul(v, v, out=v)
-            mul(w, w, out=w)
-            add(u, v, out=u)
-            add(u, w, out=u)
-            np.sqrt(u, out=d)
+        mul(_S3 * rb * _PLUS_MINUS, bz, out=BZ)
+        add(ax, BX, out=BX)                                 # u = ax +- bx (legs 2, 3)
+        add(ay, BY, out=BY)
+        add(az, BZ, out=BZ)
+        mul(BX, BX, out=BX)
+        mul(BY, BY, out=BY)
+        mul(BZ, BZ, out=BZ)
+        add(BX, BY, out=BX)
+        add(BX, BZ, out=BX)
+        np.sqrt(BX, out=out[1:3])                           # d2, d3
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
