@@ -33,12 +33,36 @@ _PLUS_MINUS = np.array([[1.0], [-1.0]])
 _scratch = threading.local()
 
 
-def _workspace() -> np.ndarray:
-    """This thread's scratch array for :meth:`ThreeRPS._legs` (28, BLOCK), made on first use."""
-    ws = getattr(_scratch, "ws", None)
-    if ws is None:
-        ws = _scratch.ws = np.empty((28, BLOCK))
-    return ws
+class _Rows:
+    """Named row views of a (28, b) scratch array for :meth:`ThreeRPS._legs` (pairs as (2, b))."""
+
+    def __init__(self, ws: np.ndarray):
+        self.T, self.T2, self.R, self.S, self.C = ws[0:2], ws[2:4], ws[4:6], ws[6:8], ws[8:10]
+        self.sa, self.sb = self.S
+        self.ca, self.cb = self.C
+        self.sbsa, self.tg = ws[10], ws[11]
+        self.CS, self.RR, self.A, self.B, self.EF = ws[12:14], ws[14:16], ws[16:18], ws[18:20], ws[20:22]
+        self.cg, self.sg = self.CS
+        self.R00, self.R10 = self.RR
+        self.R11, self.R01 = self.B[0], self.A[0]
+        self.h, self.ax, self.ay, self.az, self.bz = self.A[1], self.tg, self.sbsa, self.B[1], self.cg
+        self.e, self.f = self.EF
+        self.BX, self.BY, self.BZ = ws[22:24], ws[24:26], ws[26:28]
+
+
+def _scratch_rows(b: int) -> _Rows:
+    """This thread's scratch rows for a block of ``b`` poses: views of a C-contiguous (28, b)
+    prefix of one buffer of 28 * BLOCK floats (made on first use), cached for a few widths."""
+    cache = getattr(_scratch, "rows", None)
+    if cache is None:
+        cache = _scratch.rows = {}
+        _scratch.buffer = np.empty(28 * BLOCK)
+    rows = cache.get(b)
+    if rows is None:
+        if len(cache) >= 8:
+            cache.clear()
+        rows = cache[b] = _Rows(_scratch.buffer[:28 * b].reshape(28, b))
+    return rows
 
 
 class ThreeRPSGeometry(Geometry):
@@ -111,80 +135,80 @@ class ThreeRPS(ParallelMechanism):
         n = p.shape[1]
         if out is None:
             out = np.empty((3, n))
-        ws = _workspace()
         for s in range(0, n, BLOCK):
             e = min(s + BLOCK, n)
-            self._legs(p[:, s:e], out[:, s:e], ws[:, :e - s])
+            self._legs(p[:, s:e], out[:, s:e], _scratch_rows(e - s))
         return out
 
-    def _legs(self, p, out, ws) -> None:
-        """:meth:`ik_columns` of one block: poses ``p`` (3, b) into ``out`` (3, b), scratch ``ws``.
+    def _legs(self, p, out, w: _Rows) -> None:
+        """:meth:`ik_columns` of one block: poses ``p`` (3, b) into ``out`` (3, b), scratch rows ``w``.
 
         Pairs of rows go through one call where the formulas allow it (alpha and beta; cg and
-        sg; legs 2 and 3 as a_* + (+-b_*), IEEE's a - b being exactly a + (-b)), so a small
-        batch costs few numpy calls."""
+        sg; legs 2 and 3 as a_* + (+-b_*), IEEE's a - b being exactly a + (-b)), and the
+        scratch rows are contiguous, so a small batch costs few and cheap numpy calls. (The
+        output of every call is its third positional argument.)"""
         ra, rb = self.geometry.ra, self.geometry.rb
+        consts = self.__dict__.get("_pm")
+        if consts is None:   # (+c, -c) pairs of legs 2 and 3
+            consts = self._pm = (_S3 * rb * _PLUS_MINUS, -2.0 * _S3 * _PLUS_MINUS)
+        pm_rb, pm_2 = consts
         mul, add, sub, div = np.multiply, np.add, np.subtract, np.divide
-        T, T2, R, S, C = ws[0:2], ws[2:4], ws[4:6], ws[6:8], ws[8:10]
-        mul(p[:2], _HALF_DEG, out=T2)
-        np.tan(T2, out=T)                                   # t
-        mul(T, T, out=T2)                                   # t2
-        add(1.0, T2, out=R)
-        div(1.0, R, out=R)                                  # r = 1 / (1 + t2)
-        add(T, T, out=S)
-        mul(S, R, out=S)                                    # s = (t + t) r
-        sub(1.0, T2, out=C)
-        mul(C, R, out=C)                                    # c = (1 - t2) r
-        sa, sb = S
-        ca, cb = C
+        T, T2, R, S, C = w.T, w.T2, w.R, w.S, w.C
+        mul(p[:2], _HALF_DEG, T2)
+        np.tan(T2, T)                                       # t
+        mul(T, T, T2)                                       # t2
+        add(1.0, T2, R)
+        div(1.0, R, R)                                      # r = 1 / (1 + t2)
+        add(T, T, S)
+        mul(S, R, S)                                        # s = (t + t) r
+        sub(1.0, T2, C)
+        mul(C, R, C)                                        # c = (1 - t2) r
+        sa, sb, ca, cb = w.sa, w.sb, w.ca, w.cb
         z = p[2]
-        sbsa, tg = ws[10], ws[11]
-        CS, RR, A, B, EF = ws[12:14], ws[14:16], ws[16:18], ws[18:20], ws[20:22]
-        cg, sg = CS
-        mul(sb, sa, out=sbsa)                               # = sa * sb
-        add(ca, cb, out=tg)
-        div(sbsa, tg, out=tg)                               # tg = sa sb / (ca + cb)
-        mul(tg, tg, out=cg)
-        add(1.0, cg, out=cg)
-        np.sqrt(cg, out=cg)
-        div(1.0, cg, out=cg)                                # cg = 1 / sqrt(1 + tg^2)
-        mul(tg, cg, out=sg)
-        mul(CS, cb, out=RR)                                 # R00 = cg cb, R10 = sg cb
-        R00, R10 = RR
-        mul(CS, sbsa, out=A)                                # cg sbsa, sg sbsa
-        mul(CS, ca, out=B)                                  # cg ca, sg ca
-        R11, R01 = B[0], A[0]
-        add(A[1], B[0], out=R11)                            # R11 = sg sbsa + cg ca
-        sub(A[0], B[1], out=R01)                            # R01 = cg sbsa - sg ca
-        h, ax, ay, az, bz = A[1], tg, sbsa, B[1], cg        # rows no longer needed
-        mul(0.5 * rb, R11, out=h)                           # (0.5 rb) R11, used twice
-        e, f = EF
-        mul(1.5 * rb, R00, out=e)
-        sub(e, h, out=e)
-        sub(e, ra, out=e)                                   # e
-        mul(rb, sb, out=f)
-        sub(z, f, out=f)                                    # f = z - rb sb
-        mul(EF, EF, out=EF)
-        add(e, f, out=e)
-        np.sqrt(e, out=out[0])                              # d1
-        sub(0.5 * ra, h, out=ax)
-        BX, BY, BZ = ws[22:24], ws[24:26], ws[26:28]        # (+b, -b) of x, y, z
-        mul(_S3 * rb * _PLUS_MINUS, R01, out=BX)
-        mul(-1.5 * rb, R10, out=ay)
-        mul(-2.0 * _S3 * _PLUS_MINUS, ax, out=BY)
-        mul(0.5 * rb, sb, out=az)
-        add(z, az, out=az)
-        mul(cb, sa, out=bz)
-        mul(_S3 * rb * _PLUS_MINUS, bz, out=BZ)
-        add(ax, BX, out=BX)                                 # u = ax +- bx (legs 2, 3)
-        add(ay, BY, out=BY)
-        add(az, BZ, out=BZ)
-        mul(BX, BX, out=BX)
-        mul(BY, BY, out=BY)
-        mul(BZ, BZ, out=BZ)
-        add(BX, BY, out=BX)
-        add(BX, BZ, out=BX)
-        np.sqrt(BX, out=out[1:3])                           # d2, d3
+        sbsa, tg, cg, sg, CS = w.sbsa, w.tg, w.cg, w.sg, w.CS
+        mul(sb, sa, sbsa)                                   # = sa * sb
+        add(ca, cb, tg)
+        div(sbsa, tg, tg)                                   # tg = sa sb / (ca + cb)
+        mul(tg, tg, cg)
+        add(1.0, cg, cg)
+        np.sqrt(cg, cg)
+        div(1.0, cg, cg)                                    # cg = 1 / sqrt(1 + tg^2)
+        mul(tg, cg, sg)
+        mul(CS, cb, w.RR)                                   # R00 = cg cb, R10 = sg cb
+        A, B = w.A, w.B
+        mul(CS, sbsa, A)                                    # cg sbsa, sg sbsa
+        mul(CS, ca, B)                                      # cg ca, sg ca
+        R11, R01 = w.R11, w.R01
+        add(A[1], B[0], R11)                                # R11 = sg sbsa + cg ca
+        sub(A[0], B[1], R01)                                # R01 = cg sbsa - sg ca
+        h, e, f = w.h, w.e, w.f                             # h, ax, ay, az, bz reuse free rows
+        mul(0.5 * rb, R11, h)                               # (0.5 rb) R11, used twice
+        mul(1.5 * rb, w.R00, e)
+        sub(e, h, e)
+        sub(e, ra, e)                                       # e
+        mul(rb, sb, f)
+        sub(z, f, f)                                        # f = z - rb sb
+        mul(w.EF, w.EF, w.EF)
+        add(e, f, e)
+        np.sqrt(e, out[0])                                  # d1
+        ax, ay, az, bz, BX, BY, BZ = w.ax, w.ay, w.az, w.bz, w.BX, w.BY, w.BZ
+        sub(0.5 * ra, h, ax)
+        mul(pm_rb, R01, BX)                                 # (+bx, -bx)
+        mul(-1.5 * rb, w.R10, ay)
+        mul(pm_2, ax, BY)                                   # (+by, -by)
+        mul(0.5 * rb, sb, az)
+        add(z, az, az)
+        mul(cb, sa, bz)
+        mul(pm_rb, bz, BZ)                                  # (+bz, -bz)
+        add(ax, BX, BX)                                     # u = ax +- bx (legs 2, 3)
+        add(ay, BY, BY)
+        add(az, BZ, BZ)
+        mul(BX, BX, BX)
+        mul(BY, BY, BY)
+        mul(BZ, BZ, BZ)
+        add(BX, BY, BX)
+        add(BX, BZ, BX)
+        np.sqrt(BX, out[1:3])                               # d2, d3
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
