@@ -45,14 +45,18 @@ iteration and run, in this order:
 3. onlooker phase: SN uniforms for the roulette, then the same block as 2. for the moves.
 
 Speed. At the sizes of the papers (30 runs x 10 bees x 3 variables) the cost of an iteration is
-the number of numpy calls, not arithmetic; the phases are written to keep that number small:
-one draw per phase, index arithmetic on flattened (runs * SN) arrays instead of
-``take_along_axis``, only the moved coordinate computed and clipped (:meth:`ABC.move`; a
-subclass that overrides only the whole-row :meth:`ABC.step` still works, on a slower path
-with identical numbers), the onlooker duplicates resolved by two ``np.minimum.at`` scatters
-(no sort), and the roulette as one broadcast comparison for small colonies or a vectorised
-binary search for large ones (the same integers either way). ``fkopt bench`` measures what
-an evaluation costs.
+the number of numpy calls; at thousands of rows (cases x runs, :func:`fkopt.solve`) it is the
+number of passes over (runs, SN) arrays and whether they are contiguous. The phases are written
+for both: one draw per phase, de-interleaved once into contiguous j, k', phi arrays; flat
+index arithmetic with per-bee tables built once per state (:class:`_Aux`; the neighbour
+k' + (k' >= i) is a table lookup); only the moved coordinate computed and clipped
+(:meth:`ABC.move`; a subclass that overrides only the whole-row :meth:`ABC.step` still works,
+on the slower general path with identical numbers); ``x``, ``f`` and ``trial`` updated in place
+only where a candidate won (an ``np.where`` on a random mask costs a branch misprediction per
+element); the onlooker duplicates resolved by two ``np.minimum.at`` scatters (no sort) and a
+winner written back as its one moved coordinate; the roulette as a dense count on bee-major
+(SN, runs) arrays for small colonies or a vectorised binary search for large ones (the same
+integers either way). ``fkopt bench`` measures what an evaluation costs.
 """
 from __future__ import annotations
 

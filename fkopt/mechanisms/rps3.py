@@ -101,7 +101,7 @@ class ThreeRPS(ParallelMechanism):
     def ik(self, poses) -> np.ndarray:
         """Leg lengths (..., 3) of poses (..., 3): eq. (10) with eq. (6) substituted.
 
-        Lean form (about 45 array operations, no sin/cos/arctan): with the half-angle tangents
+        Lean form (no sin/cos/arctan; :meth:`ik_columns` does the work): with the half-angle tangents
         t = tan(angle / 2), sin = 2t / (1 + t^2), cos = (1 - t^2) / (1 + t^2); the parasitic
         rotation tan(gamma) = sa sb / (ca + cb) gives cos(gamma) = 1 / sqrt(1 + tan^2) and
         sin(gamma) = tan(gamma) cos(gamma) (|gamma| < 90 deg). Substituting x_e = (r_b/2)(R00 - R11)
