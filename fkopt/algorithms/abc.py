@@ -87,6 +87,9 @@ def quality(f: np.ndarray) -> np.ndarray:
 #: Colonies up to this size use the dense roulette (SN comparisons per onlooker); larger ones a
 #: binary search (O(SN log SN)). Both give the same indices.
 DENSE_ROULETTE = 32
+#: Up to this many comparisons (runs * SN * SN) the onlookers' dense count is one broadcast
+#: comparison (few numpy calls); above it a loop over the SN columns (few passes).
+SMALL_ROULETTE = 8192
 
 
 def roulette(cdf: np.ndarray, u: np.ndarray, dense: bool | None = None) -> np.ndarray:
@@ -159,6 +162,7 @@ class _Aux:
             self.count = np.empty((population, runs), dtype=np.uint8)
             self.hit = np.empty((population, runs), dtype=np.uint8)
         self.sources_out = np.empty((runs, population), dtype=np.intp)
+        self.arrays = None                                          # x, f, trial as checked by _aux
 
 
 @dataclass(eq=False, kw_only=True)
@@ -184,9 +188,13 @@ def _own(a: np.ndarray, dtype) -> np.ndarray:
 
 def _aux(state: ABCState, problem) -> _Aux:
     aux = state.aux
+    if aux is not None and aux.arrays is not None and (
+            aux.arrays[0] is state.x and aux.arrays[1] is state.f and aux.arrays[2] is state.trial):
+        return aux                                      # the arrays checked last time
     if aux is None or aux.shape != state.x.shape:
         aux = state.aux = _Aux(state.x.shape, np.asarray(problem.bounds, dtype=float))
     state.x, state.f, state.trial = _own(state.x, float), _own(state.f, float), _own(state.trial, np.int64)
+    aux.arrays = (state.x, state.f, state.trial)
     return aux
 
 
@@ -381,7 +389,7 @@ class ABC(Algorithm):
         fv = self._evaluate_candidates(state, problem, v)
         better = self.better(fv, state.f)
         # Greedy selection, only where a candidate won (x is v with the old value elsewhere).
-        won = np.flatnonzero(better)
+        won = better.reshape(-1).nonzero()[0]
         state.f.reshape(-1)[won] = fv.reshape(-1)[won]
         trial = state.trial.reshape(-1)
         trial += 1
@@ -407,10 +415,15 @@ class ABC(Algorithm):
         bee-major (SN, runs) arrays, where every comparison is one contiguous pass."""
         f = state.f
         runs, population = f.shape
-        if not aux.dense:
-            cdf = quality(f).cumsum(axis=1)
+        if not aux.dense or runs * population * population <= SMALL_ROULETTE:
+            q = np.divide(1.0, np.add(1.0, f)) if f.min() >= 0 else quality(f)
+            cdf = q.cumsum(axis=1)
             u = streams.uniform(population) * cdf[:, -1:]
-            return roulette(cdf, u, dense=False)
+            if not aux.dense:
+                return roulette(cdf, u, dense=False)
+            count = (cdf[:, None, :] <= u[:, :, None]).sum(axis=2)     # few rows: one comparison
+            count[count == population] = 0
+            return count
         q, cdf = aux.q, aux.cdf
         if f.min() >= 0:                                # quality 1 / (1 + f) (f < 0: quality())
             np.add(f.T, 1.0, out=q)
@@ -448,11 +461,11 @@ class ABC(Algorithm):
         # fitness, and the first onlooker reaching it.
         best = aux.inf.copy()
         np.minimum.at(best, flat, fv)
-        hit = np.flatnonzero(fv == best.take(flat))
+        hit = (fv == best.take(flat)).nonzero()[0]
         first = aux.none.copy()
         np.minimum.at(first, flat.take(hit), hit)
         f = state.f.reshape(-1)
-        won = np.flatnonzero(self.better(best, f))      # sources replaced by an onlooker's candidate
+        won = self.better(best, f).nonzero()[0]         # sources replaced by an onlooker's candidate
         winner = first.take(won)
         state.x.reshape(-1)[pos.reshape(-1).take(winner)] = m.reshape(-1).take(winner)
         f[won] = best.take(won)
@@ -498,7 +511,7 @@ class ABC(Algorithm):
         # Drawn for every run so each run's stream advances the same way whatever the others do.
         u = streams.uniform(problem.dim)
         trial = state.trial
-        over = np.flatnonzero(trial.reshape(-1) > state.limit)
+        over = (trial.reshape(-1) > state.limit).nonzero()[0]
         if over.size == 0:
             return
         rows = over // population                       # runs with a source over the limit
