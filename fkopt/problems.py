@@ -206,6 +206,10 @@ class FKProblem(Problem):
         key = ("rows", lead)
         rows = self._shapes.get(key)
         if rows is None:
+            stale = [k for k in self._shapes if k[0] == "rows"]
+            if len(stale) >= 4:                          # a few shapes at a time (memory stays bounded)
+                for k in stale:
+                    del self._shapes[k]
             per_case = int(np.prod(lead[1:], dtype=np.int64))
             rows = self._shapes[key] = np.repeat(self.joints.T, per_case, axis=1)
         return rows
