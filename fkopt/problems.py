@@ -173,8 +173,46 @@ class FKProblem(Problem):
         return self.mechanism.jacobian(x)
 
     def fitness(self, x) -> np.ndarray:
-        r = self.residuals(x)
-        return _row_sum(np.abs(r) if self.objective == "absolute" else r * r)
+        columns = getattr(self.mechanism, "ik_columns", None)
+        m = len(self._angle)
+        if columns is None or m >= 8:
+            r = self.residuals(x)
+            return _row_sum(np.abs(r) if self.objective == "absolute" else r * r)
+        # The same operations on the residuals as rows (m, n): contiguous arrays, fewer passes.
+        x = np.asarray(x, dtype=float)
+        if self.cases is not None:
+            self._check_cases(x)
+        lead = x.shape[:-1]
+        r = columns(x)
+        np.subtract(r, self._joint_rows(lead), out=r)
+        if self._angle.any():
+            r[self._angle_idx] = wrap_degrees(r[self._angle_idx])
+        if self.objective == "absolute":
+            np.abs(r, out=r)
+        else:
+            np.multiply(r, r, out=r)
+        if m == 1:
+            return r[0].reshape(lead)
+        out = np.add(r[0], r[1])
+        for k in range(2, m):
+            out += r[k]
+        return out.reshape(lead)
+
+    def _joint_rows(self, lead: tuple[int, ...]) -> np.ndarray:
+        """The target joints against the residual rows of points shaped ``lead``: (m, 1) for one
+        target; (m, n) for a case axis, each case's joints repeated over its points (cached)."""
+        if self.cases is None:
+            return self.joints[:, None]
+        key = ("rows", lead)
+        rows = self._shapes.get(key)
+        if rows is None:
+            stale = [k for k in self._shapes if k[0] == "rows"]
+            if len(stale) >= 4:                          # a few shapes at a time (memory stays bounded)
+                for k in stale:
+                    del self._shapes[k]
+            per_case = int(np.prod(lead[1:], dtype=np.int64))
+            rows = self._shapes[key] = np.repeat(self.joints.T, per_case, axis=1)
+        return rows
 
 
 def fk_problem(mechanism: Mechanism, joints, **kwargs) -> FKProblem:

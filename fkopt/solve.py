@@ -12,13 +12,11 @@ Chunks. Rows are advanced in chunks of at most :data:`CHUNK_POINTS` // populatio
 as possible (``chunk_rows`` overrides it): about 10,000 points of the population per chunk, e.g. 1000 rows of a
 population of 10 or 100 rows of 100. The results never depend on the chunk size (each row's
 numbers are its own); the speed does: at a few rows the per-iteration cost of numpy calls
-dominates, beyond ~10^4 points the working arrays leave the CPU caches. Measured on the 2-core
-development machine (busy, so ratios rather than absolute times): GABC on 3-RPS, population 10,
-3000 rows: 621 / 471 / 522 / 562 ns per evaluation at 300 / 600 / 1000 / 1500 rows per chunk
-(10,000 rows at once were 1.3-2.3x slower than 10 x 1000); ABC on the 7-DOF arm, population 100,
-100 rows: 2391 / 2058 / 1886 / 1644 ns at 10 / 25 / 50 / 100 rows per chunk; P-ABC's ABC on
-3RPUPc-UPS, population 100: 100 rows per chunk 1.5x faster than 500. ``fkopt bench`` (section
-``cases``) keeps measuring it. With ``batch=False`` every row is solved on its own, one after
+dominates, beyond ~10^4 points the working arrays leave the CPU caches. The size was chosen by
+measuring GABC on 3-RPS (population 10, 3000 rows), ABC on the 7-DOF arm (population 100) and
+P-ABC's ABC on 3RPUPc-UPS at several chunk sizes; ``fkopt bench`` (section ``cases``) keeps
+measuring 300 / 1000 / 3000 rows per chunk, and the README's Performance section gives the
+numbers. With ``batch=False`` every row is solved on its own, one after
 the other -- the reference mode that proves batching never changes the numbers.
 
 Memory. The records kept for every row (best-so-far fitness and evaluations per iteration,

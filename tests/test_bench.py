@@ -54,3 +54,23 @@ def test_bench_cli_refuses_unknown_section(tmp_path):
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and "kinematics" in p.stderr and "Traceback" not in p.stderr
     assert not (tmp_path / "x").exists()
+
+
+def test_compiled_reference_solves_the_same_problem(tmp_path):
+    """The C loop the cases section times is GABC on the 3-RPS fitness: same budget in
+    evaluations, and it solves the poses as fkopt does (a broken loop would not)."""
+    import shutil
+    import pytest
+    built = bench.compile_reference(tmp_path)
+    if isinstance(built, str):
+        assert shutil.which("gcc") is None and shutil.which("cc") is None and shutil.which("clang") is None, built
+        pytest.skip(built)
+    m = fkopt.mechanism("3-rps")
+    poses = m.bounds[:, 0] + np.random.default_rng(3).random((4, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    out = bench.run_reference(built[0], m.ik(poses), 200, 10, 5)
+    r = fkopt.solve(fkopt.fk_problem(m, m.ik(poses)), "gabc", population=10, iterations=200, runs=5, seed=1)
+    per_run = out["evaluations"] / 20
+    assert 2 * 10 * 200 + 10 <= per_run <= 2 * 10 * 200 + 10 + 200        # + at most one scout per iteration
+    assert abs(per_run - r.evaluations.mean()) < 50
+    assert out["median"] < 1e-12 and np.median(r.fitness) < 1e-12
+    assert out["seconds"] > 0

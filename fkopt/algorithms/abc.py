@@ -45,14 +45,18 @@ iteration and run, in this order:
 3. onlooker phase: SN uniforms for the roulette, then the same block as 2. for the moves.
 
 Speed. At the sizes of the papers (30 runs x 10 bees x 3 variables) the cost of an iteration is
-the number of numpy calls, not arithmetic; the phases are written to keep that number small:
-one draw per phase, index arithmetic on flattened (runs * SN) arrays instead of
-``take_along_axis``, only the moved coordinate computed and clipped (:meth:`ABC.move`; a
-subclass that overrides only the whole-row :meth:`ABC.step` still works, on a slower path
-with identical numbers), the onlooker duplicates resolved by two ``np.minimum.at`` scatters
-(no sort), and the roulette as one broadcast comparison for small colonies or a vectorised
-binary search for large ones (the same integers either way). ``fkopt bench`` measures what
-an evaluation costs.
+the number of numpy calls; at thousands of rows (cases x runs, :func:`fkopt.solve`) it is the
+number of passes over (runs, SN) arrays and whether they are contiguous. The phases are written
+for both: one draw per phase, de-interleaved once into contiguous j, k', phi arrays; flat
+index arithmetic with per-bee tables built once per state (:class:`_Aux`; the neighbour
+k' + (k' >= i) is a table lookup); only the moved coordinate computed and clipped
+(:meth:`ABC.move`; a subclass that overrides only the whole-row :meth:`ABC.step` still works,
+on the slower general path with identical numbers); ``x``, ``f`` and ``trial`` updated in place
+only where a candidate won (an ``np.where`` on a random mask costs a branch misprediction per
+element); the onlooker duplicates resolved by two ``np.minimum.at`` scatters (no sort) and a
+winner written back as its one moved coordinate; the roulette as a dense count on bee-major
+(SN, runs) arrays for small colonies or a vectorised binary search for large ones (the same
+integers either way). ``fkopt bench`` measures what an evaluation costs.
 """
 from __future__ import annotations
 
@@ -83,6 +87,9 @@ def quality(f: np.ndarray) -> np.ndarray:
 #: Colonies up to this size use the dense roulette (SN comparisons per onlooker); larger ones a
 #: binary search (O(SN log SN)). Both give the same indices.
 DENSE_ROULETTE = 32
+#: Up to this many comparisons (runs * SN * SN) the onlookers' dense count is one broadcast
+#: comparison (few numpy calls); above it a loop over the SN columns (few passes).
+SMALL_ROULETTE = 8192
 
 
 def roulette(cdf: np.ndarray, u: np.ndarray, dense: bool | None = None) -> np.ndarray:
@@ -118,27 +125,53 @@ def roulette(cdf: np.ndarray, u: np.ndarray, dense: bool | None = None) -> np.nd
 
 
 class _Aux:
-    """Index arrays an ABC needs for a given (runs, population, dim), built once per state."""
-
-    __slots__ = ("shape", "sources", "offsets", "scale", "cand", "lo", "hi", "width", "ids", "inf", "none")
+    """Index tables and scratch arrays an ABC needs for a given (runs, population, dim), built
+    once per state, so that the phases work on contiguous (runs, population) arrays."""
 
     def __init__(self, shape, bounds):
         runs, population, dim = shape
+        n = runs * population
         self.shape = shape
         self.sources = np.broadcast_to(np.arange(population), (runs, population))
         self.offsets = row_offsets(runs, population)[:, None]       # (runs, 1)
         self.scale = np.array([[dim], [population - 1], [2.0]])     # u -> j, k, 2u
-        self.cand = (np.arange(runs * population) * dim).reshape(runs, population)
+        self.cand = (np.arange(n) * dim).reshape(runs, population)  # flat index of x[r, i, 0]
         self.lo, self.hi = bounds[:, 0].copy(), bounds[:, 1].copy()
         self.width = self.hi - self.lo
-        self.ids = np.arange(runs * population)
-        self.inf = np.full(runs * population, np.inf)
-        self.none = np.full(runs * population, runs * population)
+        self.ids = np.arange(n)
+        self.inf = np.full(n, np.inf)
+        self.none = np.full(n, n)
+        # -- the contiguous fast path (see ABC.employed_phase) --
+        per_bee = lambda a: np.repeat(a, population).reshape(runs, population)   # noqa: E731
+        self.scale3 = np.array([dim, population - 1, 2.0])[:, None, None]
+        self.row_p = per_bee(np.arange(runs) * population)          # flat index of x[r, 0] / dim
+        self.row_pd = self.row_p * dim                              # flat index of x[r, 0, 0]
+        self.row_d = per_bee(np.arange(runs) * dim)                 # flat index of best_x[r, 0]
+        i, k = np.arange(population), np.arange(population - 1)
+        # neighbour k' in [0, SN - 1) of bee i is k' + (k' >= i): as a table, times dim
+        self.neighbour = ((k + (k >= i[:, None])) * dim).ravel()
+        self.neighbour_row = np.tile(i * (population - 1), runs).reshape(runs, population)
+        self.w = np.empty((3, runs, population))                     # scaled draws
+        self.jk = np.empty((2, runs, population), dtype=np.intp)    # j, k'
+        self.v = np.empty((n + runs, dim))                          # candidates (+ fresh scouts)
+        self.dense = population <= DENSE_ROULETTE
+        if self.dense:
+            self.q = np.empty((population, runs))                   # qualities, bee-major
+            self.cdf = np.empty((population, runs))
+            self.u = np.empty((population, runs))
+            self.count = np.empty((population, runs), dtype=np.uint8)
+            self.hit = np.empty((population, runs), dtype=np.uint8)
+        self.sources_out = np.empty((runs, population), dtype=np.intp)
+        self.arrays = None                                          # x, f, trial as checked by _aux
 
 
 @dataclass(eq=False, kw_only=True)
 class ABCState(State):
-    """ABC's food sources ``x``/``f`` with their trial counters."""
+    """ABC's food sources ``x``/``f`` with their trial counters.
+
+    The phases update ``x``, ``f`` and ``trial`` in place (C-contiguous arrays of the state's
+    own; :func:`_aux` replaces any other by a contiguous copy first).
+    """
 
     trial: np.ndarray                   # (runs, population) failed attempts per source
     limit: int                          # trials before a scout abandons the source
@@ -146,10 +179,22 @@ class ABCState(State):
     pending: tuple | None = None        # scout sources placed but not yet evaluated
 
 
+def _own(a: np.ndarray, dtype) -> np.ndarray:
+    """``a`` itself when it is a C-contiguous writable array that owns its data, else a copy."""
+    if a.dtype == dtype and a.flags.c_contiguous and a.flags.writeable and a.base is None:
+        return a
+    return np.array(a, dtype=dtype, order="C")
+
+
 def _aux(state: ABCState, problem) -> _Aux:
     aux = state.aux
+    if aux is not None and aux.arrays is not None and (
+            aux.arrays[0] is state.x and aux.arrays[1] is state.f and aux.arrays[2] is state.trial):
+        return aux                                      # the arrays checked last time
     if aux is None or aux.shape != state.x.shape:
         aux = state.aux = _Aux(state.x.shape, np.asarray(problem.bounds, dtype=float))
+    state.x, state.f, state.trial = _own(state.x, float), _own(state.f, float), _own(state.trial, np.int64)
+    aux.arrays = (state.x, state.f, state.trial)
     return aux
 
 
@@ -193,9 +238,11 @@ class ABC(Algorithm):
         """New value of the chosen coordinate j, before clipping: ``xs + step``.
 
         ``xs``, ``xk``, ``j``, ``phi``: (runs, n) -- coordinate j of the source and of the
-        neighbour, the coordinate index and phi.
+        neighbour, the coordinate index and phi. Returns a new array (the inputs are not changed).
         """
-        return xs + phi * (xs - xk)
+        out = np.subtract(xs, xk)
+        out *= phi
+        return np.add(xs, out, out=out)             # xs + phi * (xs - xk)
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -214,7 +261,10 @@ class ABC(Algorithm):
 
     def _propose(self, state, sources, problem, streams):
         """``(v, pos, new, old)``: the candidates and, on the fast path, the flat positions of
-        their moved coordinate in ``v`` with its new (clipped) and old values (else Nones)."""
+        their moved coordinate in ``v`` with its new (clipped) and old values (else Nones).
+
+        The general form of the phases' candidate step (any ``sources``, whole-row steps);
+        the phases use :meth:`_moves` on their contiguous arrays (the same numbers)."""
         aux = _aux(state, problem)
         x = state.x
         runs, population, dim = x.shape
@@ -253,6 +303,40 @@ class ABC(Algorithm):
         v.reshape(-1)[pos] = m
         return v, pos, m, old
 
+    def _moves(self, state, aux, streams, sources=None):
+        """The phases' candidate step on contiguous (runs, population) arrays: draws one block
+        of 3 * population uniforms per run (j, k', phi as in :meth:`_propose`) and returns
+        ``(pos, m, j)``: the flat index in ``x`` of the moved coordinate of each candidate's
+        source, its new (clipped) value and the coordinate index j. ``sources``: the onlookers' chosen sources (None:
+        the employed bees, source i for bee i)."""
+        x = state.x
+        xf = x.reshape(-1)
+        runs, population, dim = x.shape
+        u = streams.uniform(3, population)                          # (runs, 3, SN) view
+        w = aux.w
+        np.multiply(u.transpose(1, 0, 2), aux.scale3, out=w)         # u*dim, u*(SN-1), 2u
+        jk = aux.jk
+        np.copyto(jk, w[:2], casting="unsafe")                      # floor (u >= 0)
+        j, k = jk
+        phi = w[2]
+        phi -= 1.0
+        if sources is None:
+            k += aux.neighbour_row
+            pos = aux.cand + j
+        else:
+            nb = np.multiply(sources, population - 1)
+            k += nb
+            pos = np.add(sources, aux.row_p, out=nb)
+            pos *= dim
+            pos += j
+        kpos = aux.neighbour.take(k)                                # dim * (k' + (k' >= i))
+        kpos += aux.row_pd
+        kpos += j
+        m = self.move(state, xf.take(pos), xf.take(kpos), j, phi, streams)
+        np.maximum(m, aux.lo.take(j), out=m)
+        np.minimum(m, aux.hi.take(j), out=m)
+        return pos, m, j
+
     def better(self, new: np.ndarray, old: np.ndarray) -> np.ndarray:
         """Greedy selection: does ``new`` replace ``old``? (``selection`` parameter)."""
         if self.params.selection == "karaboga":
@@ -270,45 +354,134 @@ class ABC(Algorithm):
         state.best_f = np.where(better, fb, state.best_f)
         state.best_x = np.where(better[:, None], state.x.reshape(runs * population, -1)[flat], state.best_x)
 
-    def employed_phase(self, state, problem, streams):
-        aux = _aux(state, problem)
-        population = state.f.shape[1]
-        v, pos, m, old = self._propose(state, aux.sources, problem, streams)
+    def _evaluate_candidates(self, state, problem, v) -> np.ndarray:
+        """Fitness of the candidates ``v`` (runs * SN, dim), and of the scouts' fresh sources
+        placed by :meth:`scout_phase` (``evaluate=False``), which it writes into ``state.f``."""
+        runs, population, dim = state.x.shape
+        n = runs * population
         pending, state.pending = state.pending, None
         if pending is None:
-            fv = np.fmin(problem.fitness(v), np.inf)
-        else:   # fresh scout sources placed by scout_phase(evaluate=False): evaluate them too
-            slots, fresh, count = pending
-            f = state.f.copy()
-            if getattr(problem, "cases", None) is None:   # one call for both
-                both = np.fmin(problem.fitness(np.concatenate([v.reshape(-1, v.shape[-1]), fresh])), np.inf)
-                fv = both[:v.shape[0] * population].reshape(state.f.shape)
-                f.reshape(-1)[slots] = both[v.shape[0] * population:]
-            else:   # a target per row: the scouts' rows (same numbers, a second call)
-                fv = np.fmin(problem.fitness(v), np.inf)
-                f.reshape(-1)[slots] = np.fmin(rows_of(problem, slots // population).fitness(fresh), np.inf)
-            state.f = f
-            state.evaluations = state.evaluations + count
+            return np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf)
+        slots, fresh, count = pending
+        f = state.f.reshape(-1)
+        if getattr(problem, "cases", None) is None:     # one call for both
+            both = state.aux.v[:n + len(fresh)]
+            both[n:] = fresh
+            both = np.fmin(problem.fitness(both), np.inf)
+            fv = both[:n].reshape(state.f.shape)
+            f[slots] = both[n:]
+        else:   # a target per row: the scouts' rows (same numbers, a second call)
+            fv = np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf)
+            f[slots] = np.fmin(rows_of(problem, slots // population).fitness(fresh), np.inf)
+        state.evaluations = state.evaluations + count
+        return fv
+
+    def employed_phase(self, state, problem, streams):
+        aux = _aux(state, problem)
+        if self._row_step:
+            return self._employed_rows(state, problem, streams, aux)
+        runs, population, dim = state.x.shape
+        n = runs * population
+        pos, m, _ = self._moves(state, aux, streams)
+        v = aux.v[:n]
+        np.copyto(v, state.x.reshape(n, dim))
+        v.reshape(-1)[pos] = m
+        fv = self._evaluate_candidates(state, problem, v)
         better = self.better(fv, state.f)
-        if pos is None:
-            state.x = np.where(better[..., None], v, state.x)
-        else:   # v is x with one coordinate moved: put the old value back where it failed
-            v.reshape(-1)[pos] = np.where(better, m, old)
-            state.x = v
+        # Greedy selection, only where a candidate won (x is v with the old value elsewhere).
+        won = better.reshape(-1).nonzero()[0]
+        state.f.reshape(-1)[won] = fv.reshape(-1)[won]
+        trial = state.trial.reshape(-1)
+        trial += 1
+        trial[won] = 0
+        state.x.reshape(-1)[pos.reshape(-1)[won]] = m.reshape(-1)[won]
+        state.evaluations = state.evaluations + population
+
+    def _employed_rows(self, state, problem, streams, aux):
+        """:meth:`employed_phase` for a subclass that customises only the whole-row :meth:`step`."""
+        runs, population, dim = state.x.shape
+        v, _, _, _ = self._propose(state, aux.sources, problem, streams)
+        np.copyto(aux.v[:runs * population], v.reshape(-1, dim))
+        fv = self._evaluate_candidates(state, problem, aux.v[:runs * population])
+        better = self.better(fv, state.f)
+        state.x = np.where(better[..., None], v, state.x)
         state.f = np.where(better, fv, state.f)
         state.trial = np.where(better, 0, state.trial + 1)
         state.evaluations = state.evaluations + population
 
+    def _choose_sources(self, state, aux, streams) -> np.ndarray:
+        """The onlookers' roulette (module docstring): draws SN uniforms per run, returns the
+        chosen sources (runs, SN). Small colonies: the dense count of :func:`roulette` on
+        bee-major (SN, runs) arrays, where every comparison is one contiguous pass."""
+        f = state.f
+        runs, population = f.shape
+        if not aux.dense or runs * population * population <= SMALL_ROULETTE:
+            q = np.divide(1.0, np.add(1.0, f)) if f.min() >= 0 else quality(f)
+            cdf = q.cumsum(axis=1)
+            u = streams.uniform(population) * cdf[:, -1:]
+            if not aux.dense:
+                return roulette(cdf, u, dense=False)
+            count = (cdf[:, None, :] <= u[:, :, None]).sum(axis=2)     # few rows: one comparison
+            count[count == population] = 0
+            return count
+        q, cdf = aux.q, aux.cdf
+        if f.min() >= 0:                                # quality 1 / (1 + f) (f < 0: quality())
+            np.add(f.T, 1.0, out=q)
+            np.divide(1.0, q, out=q)
+        else:
+            np.copyto(q, quality(f).T)
+        np.cumsum(q, axis=0, out=cdf)                   # the same sequential sums as along axis 1
+        u = aux.u
+        np.multiply(streams.uniform(population).T, cdf[-1], out=u)
+        count, hit = aux.count, aux.hit
+        np.less_equal(cdf[0], u, out=count.view(np.bool_))
+        for i in range(1, population):
+            np.less_equal(cdf[i], u, out=hit.view(np.bool_))
+            count += hit
+        if count.max() == population:                   # no cumulative quality above u: source 0
+            count[count == population] = 0
+        out = aux.sources_out
+        np.copyto(out, count.T)
+        return out
+
     def onlooker_phase(self, state, problem, streams):
         aux = _aux(state, problem)
+        if self._row_step:
+            return self._onlooker_rows(state, problem, streams, aux)
+        runs, population, dim = state.x.shape
+        n = runs * population
+        sources = self._choose_sources(state, aux, streams)
+        flat = np.add(sources, aux.row_p).reshape(-1)   # flat index of each onlooker's source
+        pos, m, j = self._moves(state, aux, streams, sources)
+        v = aux.v[:n]
+        state.x.reshape(n, dim).take(flat, axis=0, out=v)
+        v.reshape(-1)[aux.cand + j] = m
+        fv = np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf).reshape(-1)
+        # Resolve onlookers that chose the same source: per source, the lowest candidate
+        # fitness, and the first onlooker reaching it.
+        best = aux.inf.copy()
+        np.minimum.at(best, flat, fv)
+        hit = (fv == best.take(flat)).nonzero()[0]
+        first = aux.none.copy()
+        np.minimum.at(first, flat.take(hit), hit)
+        f = state.f.reshape(-1)
+        won = self.better(best, f).nonzero()[0]         # sources replaced by an onlooker's candidate
+        winner = first.take(won)
+        state.x.reshape(-1)[pos.reshape(-1).take(winner)] = m.reshape(-1).take(winner)
+        f[won] = best.take(won)
+        trial = state.trial.reshape(-1)
+        trial += np.bincount(flat, minlength=n)
+        trial[won] = 0
+        state.evaluations = state.evaluations + population
+
+    def _onlooker_rows(self, state, problem, streams, aux):
+        """:meth:`onlooker_phase` for a subclass that customises only the whole-row :meth:`step`."""
         runs, population = state.f.shape
         cdf = quality(state.f).cumsum(axis=1)
         u = streams.uniform(population) * cdf[:, -1:]
         sources = roulette(cdf, u)
         v = self.candidates(state, sources, problem, streams)
         fv = np.fmin(problem.fitness(v), np.inf).ravel()
-        # Resolve onlookers that chose the same source: per source, the lowest candidate
-        # fitness, and the first onlooker reaching it.
         size = runs * population
         flat = (sources + aux.offsets).ravel()
         best = aux.inf.copy()
@@ -338,25 +511,22 @@ class ABC(Algorithm):
         # Drawn for every run so each run's stream advances the same way whatever the others do.
         u = streams.uniform(problem.dim)
         trial = state.trial
-        if trial.max() <= state.limit:
+        over = (trial.reshape(-1) > state.limit).nonzero()[0]
+        if over.size == 0:
             return
-        worst = trial.argmax(axis=1)
-        worst += aux.offsets[:, 0]
-        scout = trial.reshape(-1)[worst] > state.limit
-        rows = np.flatnonzero(scout)
-        slots = worst[rows]
+        rows = over // population                       # runs with a source over the limit
+        rows = rows[np.concatenate(([True], rows[1:] != rows[:-1]))]
+        slots = trial[rows].argmax(axis=1)
+        slots += rows * population
+        scout = np.zeros(runs, dtype=bool)
+        scout[rows] = True
         fresh = aux.lo + u[rows] * aux.width
-        x = state.x.reshape(runs * population, -1).copy()
-        x[slots] = fresh
-        state.x = x.reshape(state.x.shape)
-        t = trial.reshape(-1).copy()
-        t[slots] = 0
-        state.trial = t.reshape(runs, population)
-        f = state.f.reshape(-1).copy()
+        state.x.reshape(runs * population, -1)[slots] = fresh
+        trial.reshape(-1)[slots] = 0
+        f = state.f.reshape(-1)
         if evaluate:
             f[slots] = np.fmin(rows_of(problem, rows).fitness(fresh), np.inf)
             state.evaluations = state.evaluations + scout
         else:
             f[slots] = np.inf
             state.pending = (slots, fresh, scout)
-        state.f = f.reshape(runs, population)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from typing import Literal
 
+import numpy as np
 from pydantic import Field
 
 from .abc import ABC, ABCParams
@@ -40,8 +41,17 @@ class GABC(ABC):
 
     def move(self, state, xs, xk, j, phi, streams):
         """:meth:`step` on the chosen coordinate only (same numbers, same draws)."""
-        best = state.best_x.reshape(-1)[j + row_offsets(*state.best_x.shape)[:, None]]
+        bx = state.best_x
+        aux = getattr(state, "aux", None)
+        rows = aux.row_d if aux is not None and aux.row_d.shape == j.shape else row_offsets(*bx.shape)[:, None]
+        best = bx.reshape(-1).take(j + rows)
+        out = np.subtract(xs, xk)
+        out *= phi                                           # phi (xs - xk)
         if self.params.rule == "mao2017":
-            return xs + (phi * (xs - xk) + phi * (best - xk))
-        psi = self.params.C * streams.uniform(xs.shape[1])
-        return xs + (phi * (xs - xk) + psi * (best - xs))
+            best -= xk
+            best *= phi                                      # phi (best - xk)
+        else:
+            best -= xs
+            best *= self.params.C * streams.uniform(xs.shape[1])   # psi (best - xs)
+        out += best
+        return np.add(xs, out, out=out)

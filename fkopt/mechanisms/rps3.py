@@ -16,6 +16,8 @@ B_i = r_b (cos phi_i, sin phi_i, 0), phi_i = 2 pi (i - 1) / 3 (eq. 3).
 """
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 from pydantic import Field
 
@@ -25,6 +27,42 @@ from .base import Geometry, ParallelMechanism
 
 _HALF_DEG = np.pi / 360.0          # degrees -> half-angle in radians
 _S3 = 0.5 * np.sqrt(3.0)           # sin(120 deg)
+#: Poses per block of :meth:`ThreeRPS.ik_columns` (its scratch array: 28 x BLOCK floats per thread).
+BLOCK = 16384
+_PLUS_MINUS = np.array([[1.0], [-1.0]])
+_scratch = threading.local()
+
+
+class _Rows:
+    """Named row views of a (28, b) scratch array for :meth:`ThreeRPS._legs` (pairs as (2, b))."""
+
+    def __init__(self, ws: np.ndarray):
+        self.T, self.T2, self.R, self.S, self.C = ws[0:2], ws[2:4], ws[4:6], ws[6:8], ws[8:10]
+        self.sa, self.sb = self.S
+        self.ca, self.cb = self.C
+        self.sbsa, self.tg = ws[10], ws[11]
+        self.CS, self.RR, self.A, self.B, self.EF = ws[12:14], ws[14:16], ws[16:18], ws[18:20], ws[20:22]
+        self.cg, self.sg = self.CS
+        self.R00, self.R10 = self.RR
+        self.R11, self.R01 = self.B[0], self.A[0]
+        self.h, self.ax, self.ay, self.az, self.bz = self.A[1], self.tg, self.sbsa, self.B[1], self.cg
+        self.e, self.f = self.EF
+        self.BX, self.BY, self.BZ = ws[22:24], ws[24:26], ws[26:28]
+
+
+def _scratch_rows(b: int) -> _Rows:
+    """This thread's scratch rows for a block of ``b`` poses: views of a C-contiguous (28, b)
+    prefix of one buffer of 28 * BLOCK floats (made on first use), cached for a few widths."""
+    cache = getattr(_scratch, "rows", None)
+    if cache is None:
+        cache = _scratch.rows = {}
+        _scratch.buffer = np.empty(28 * BLOCK)
+    rows = cache.get(b)
+    if rows is None:
+        if len(cache) >= 8:
+            cache.clear()
+        rows = cache[b] = _Rows(_scratch.buffer[:28 * b].reshape(28, b))
+    return rows
 
 
 class ThreeRPSGeometry(Geometry):
@@ -63,7 +101,7 @@ class ThreeRPS(ParallelMechanism):
     def ik(self, poses) -> np.ndarray:
         """Leg lengths (..., 3) of poses (..., 3): eq. (10) with eq. (6) substituted.
 
-        Lean form (about 45 array operations, no sin/cos/arctan): with the half-angle tangents
+        Lean form (no sin/cos/arctan; :meth:`ik_columns` does the work): with the half-angle tangents
         t = tan(angle / 2), sin = 2t / (1 + t^2), cos = (1 - t^2) / (1 + t^2); the parasitic
         rotation tan(gamma) = sa sb / (ca + cb) gives cos(gamma) = 1 / sqrt(1 + tan^2) and
         sin(gamma) = tan(gamma) cos(gamma) (|gamma| < 90 deg). Substituting x_e = (r_b/2)(R00 - R11)
@@ -78,39 +116,99 @@ class ThreeRPS(ParallelMechanism):
         """
         poses = np.asarray(poses, dtype=float)
         shape = poses.shape[:-1]
+        out = np.empty(shape + (3,))
+        self.ik_columns(poses, out=out.reshape(-1, 3).T)
+        return out
+
+    def ik_columns(self, poses, out=None) -> np.ndarray:
+        """The leg lengths of the flattened poses as rows: ``ik(poses).reshape(-1, 3).T``, (3, n)
+        and C-contiguous (``out``, if given, receives them), the same numbers as :meth:`ik`.
+
+        :class:`fkopt.problems.FKProblem` computes its fitness on these rows (three contiguous
+        arrays instead of an interleaved (n, 3) one). The operations run in blocks of at most
+        :data:`BLOCK` poses on a reused per-thread scratch array (``out=`` everywhere), so an
+        evaluation allocates nothing but its result; the arithmetic is elementwise, so the
+        numbers do not depend on the blocks.
+        """
+        poses = np.asarray(poses, dtype=float)
         p = poses.reshape(-1, 3).T                          # (3, n) view
+        n = p.shape[1]
+        if out is None:
+            out = np.empty((3, n))
+        for s in range(0, n, BLOCK):
+            e = min(s + BLOCK, n)
+            self._legs(p[:, s:e], out[:, s:e], _scratch_rows(e - s))
+        return out
+
+    def _legs(self, p, out, w: _Rows) -> None:
+        """:meth:`ik_columns` of one block: poses ``p`` (3, b) into ``out`` (3, b), scratch rows ``w``.
+
+        Pairs of rows go through one call where the formulas allow it (alpha and beta; cg and
+        sg; legs 2 and 3 as a_* + (+-b_*), IEEE's a - b being exactly a + (-b)), and the
+        scratch rows are contiguous, so a small batch costs few and cheap numpy calls. (The
+        output of every call is its third positional argument.)"""
         ra, rb = self.geometry.ra, self.geometry.rb
-        t = np.tan(np.multiply(p[:2], _HALF_DEG, order="C"))
-        t2 = t * t
-        r = 1.0 / (1.0 + t2)
-        s = (t + t) * r
-        c = (1.0 - t2) * r
-        sa, sb = s
-        ca, cb = c
+        consts = self.__dict__.get("_pm")
+        if consts is None:   # (+c, -c) pairs of legs 2 and 3
+            consts = self._pm = (_S3 * rb * _PLUS_MINUS, -2.0 * _S3 * _PLUS_MINUS)
+        pm_rb, pm_2 = consts
+        mul, add, sub, div = np.multiply, np.add, np.subtract, np.divide
+        T, T2, R, S, C = w.T, w.T2, w.R, w.S, w.C
+        mul(p[:2], _HALF_DEG, T2)
+        np.tan(T2, T)                                       # t
+        mul(T, T, T2)                                       # t2
+        add(1.0, T2, R)
+        div(1.0, R, R)                                      # r = 1 / (1 + t2)
+        add(T, T, S)
+        mul(S, R, S)                                        # s = (t + t) r
+        sub(1.0, T2, C)
+        mul(C, R, C)                                        # c = (1 - t2) r
+        sa, sb, ca, cb = w.sa, w.sb, w.ca, w.cb
         z = p[2]
-        tg = sa * sb / (ca + cb)
-        cg = 1.0 / np.sqrt(1.0 + tg * tg)
-        sg = tg * cg
-        sbsa = sb * sa
-        R00 = cg * cb
-        R10 = sg * cb
-        R11 = sg * sbsa + cg * ca
-        R01 = cg * sbsa - sg * ca
-        out = np.empty((z.shape[0], 3))
-        e = (1.5 * rb) * R00 - (0.5 * rb) * R11 - ra
-        f = z - rb * sb
-        np.sqrt(e * e + f * f, out=out[:, 0])
-        ax = 0.5 * ra - (0.5 * rb) * R11
-        bx = (_S3 * rb) * R01
-        ay = (-1.5 * rb) * R10
-        by = (-2.0 * _S3) * ax
-        az = z + (0.5 * rb) * sb
-        bz = (_S3 * rb) * (cb * sa)
-        u, v, w = ax + bx, ay + by, az + bz
-        np.sqrt(u * u + v * v + w * w, out=out[:, 1])
-        u, v, w = ax - bx, ay - by, az - bz
-        np.sqrt(u * u + v * v + w * w, out=out[:, 2])
-        return out.reshape(shape + (3,))
+        sbsa, tg, cg, sg, CS = w.sbsa, w.tg, w.cg, w.sg, w.CS
+        mul(sb, sa, sbsa)                                   # = sa * sb
+        add(ca, cb, tg)
+        div(sbsa, tg, tg)                                   # tg = sa sb / (ca + cb)
+        mul(tg, tg, cg)
+        add(1.0, cg, cg)
+        np.sqrt(cg, cg)
+        div(1.0, cg, cg)                                    # cg = 1 / sqrt(1 + tg^2)
+        mul(tg, cg, sg)
+        mul(CS, cb, w.RR)                                   # R00 = cg cb, R10 = sg cb
+        A, B = w.A, w.B
+        mul(CS, sbsa, A)                                    # cg sbsa, sg sbsa
+        mul(CS, ca, B)                                      # cg ca, sg ca
+        R11, R01 = w.R11, w.R01
+        add(A[1], B[0], R11)                                # R11 = sg sbsa + cg ca
+        sub(A[0], B[1], R01)                                # R01 = cg sbsa - sg ca
+        h, e, f = w.h, w.e, w.f                             # h, ax, ay, az, bz reuse free rows
+        mul(0.5 * rb, R11, h)                               # (0.5 rb) R11, used twice
+        mul(1.5 * rb, w.R00, e)
+        sub(e, h, e)
+        sub(e, ra, e)                                       # e
+        mul(rb, sb, f)
+        sub(z, f, f)                                        # f = z - rb sb
+        mul(w.EF, w.EF, w.EF)
+        add(e, f, e)
+        np.sqrt(e, out[0])                                  # d1
+        ax, ay, az, bz, BX, BY, BZ = w.ax, w.ay, w.az, w.bz, w.BX, w.BY, w.BZ
+        sub(0.5 * ra, h, ax)
+        mul(pm_rb, R01, BX)                                 # (+bx, -bx)
+        mul(-1.5 * rb, w.R10, ay)
+        mul(pm_2, ax, BY)                                   # (+by, -by)
+        mul(0.5 * rb, sb, az)
+        add(z, az, az)
+        mul(cb, sa, bz)
+        mul(pm_rb, bz, BZ)                                  # (+bz, -bz)
+        add(ax, BX, BX)                                     # u = ax +- bx (legs 2, 3)
+        add(ay, BY, BY)
+        add(az, BZ, BZ)
+        mul(BX, BX, BX)
+        mul(BY, BY, BY)
+        mul(BZ, BZ, BZ)
+        add(BX, BY, BX)
+        add(BX, BZ, BX)
+        np.sqrt(BX, out[1:3])                               # d2, d3
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
