@@ -455,14 +455,20 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
 @app.command()
 def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="folder of experiment files"),
               out: Path = typer.Option(Path("results"), "--out", help="results root"),
+              jobs: Optional[int] = typer.Option(None, "--jobs", "-j", help="worker processes for the "
+                                                 "experiments' solves (default: the CPUs available; "
+                                                 "1: all in this process); timings are measured "
+                                                 "afterwards, one at a time"),
               quiet: bool = typer.Option(False, "--quiet", "-q")):
     """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
     from .reproduce.report import write_report
-    from .reproduce.run import plan, run_all
+    from .reproduce.run import default_jobs, plan, run_all
 
+    if jobs is not None and jobs < 1:
+        raise FkoptError(f"--jobs: must be at least 1, got {jobs}")
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
     con = _console()
     start = time.perf_counter()
@@ -479,7 +485,15 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
         def finished(d):
             bar.remove_task(current.pop("task"))
             bar.advance(overall)
-        done = run_all(planned, out, started=started, finished=finished)
+
+        def solving(n, total):
+            if "solving" not in current:
+                current["solving"] = bar.add_task("", total=total, name="  solving experiments in parallel")
+            bar.update(current["solving"], completed=n)
+            if n == total:
+                bar.remove_task(current.pop("solving"))
+        done = run_all(planned, out, started=started, finished=finished,
+                       jobs=default_jobs() if jobs is None else jobs, solving=solving)
     paths = write_report(out)
     total = time.perf_counter() - start
     if not quiet:

@@ -158,3 +158,36 @@ def test_check_accepts_a_paper_folder(tmp_path):
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     assert "ok   mao2017/tab6" in proc.stdout and "1 experiments match" in proc.stdout
+
+
+def test_reproduce_in_worker_processes_gives_the_serial_files(tmp_path, cli):
+    """--jobs 2 solves the experiments in two spawned worker processes, then times and writes them
+    here: every deterministic file and the report equal those of --jobs 1."""
+    import filecmp
+
+    import yaml
+
+    from fkopt.outputs import deterministic_files
+    configs = tmp_path / "configs" / "mini"
+    configs.mkdir(parents=True)
+    base = {"paper": "mini", "mechanism": {"name": "3-rps"}, "iterations": 30, "runs": 3, "seed": 4}
+    (configs / "a.yaml").write_text(yaml.safe_dump({**base, "name": "a", "cases": {"random": 3, "seed": 1},
+                                                    "algorithms": [{"name": "gabc"}, {"name": "pso"}]}))
+    (configs / "b.yaml").write_text(yaml.safe_dump({**base, "name": "b",
+                                                    "cases": [{"pose": {"alpha": 5, "beta": 3, "z": 600}}],
+                                                    "algorithms": [{"name": "abc"}, {"name": "lm", "population": 1}]}))
+    outs = {}
+    for jobs in (1, 2):
+        outs[jobs] = tmp_path / f"out{jobs}"
+        code, _, err = cli("reproduce", "--configs", tmp_path / "configs", "--out", outs[jobs], "--jobs", jobs, "-q")
+        assert code == 0, err
+    for name in ("a", "b"):
+        one, two = outs[1] / "mini" / name, outs[2] / "mini" / name
+        files = deterministic_files(one)
+        assert "summary.csv" in files and files == deterministic_files(two)
+        assert (two / "timing_runs.csv").exists()          # timed here, after the workers
+        for f in files:
+            assert filecmp.cmp(one / f, two / f, shallow=False), f"{name}/{f}"
+    assert (outs[1] / "REPORT.md").read_text() == (outs[2] / "REPORT.md").read_text()
+    code, _, err = cli("reproduce", "--configs", tmp_path / "configs", "--out", outs[1], "--jobs", 0)
+    assert code == 2 and "--jobs: must be at least 1" in err

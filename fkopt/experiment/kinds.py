@@ -209,9 +209,9 @@ def _experiment_validate(config) -> tuple[int, int]:
     return len(config.algorithms) * len(cases), need
 
 
-def _experiment_run(config, out, *, source=None, progress=None, **_) -> Outcome:
+def _experiment_run(config, out, *, source=None, progress=None, solved=None, **_) -> Outcome:
     from .runner import run_experiment
-    er = run_experiment(config, source=source, progress=progress)
+    er = run_experiment(config, source=source, progress=progress, solved=solved)
     return Outcome(write_result("experiment", er, out), er.wall_s, er)
 
 

@@ -217,37 +217,71 @@ def solve_cases(config: RunConfig, spec: AlgorithmSpec, problem, seeds, *, x0=No
     return solve(problem, make_algorithm(spec.name, spec.params), seed=seeds, x0=x0, **settings)
 
 
-def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
-                   source: str | None = None, timing: bool = True) -> ExperimentResult:
-    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each.
+@dataclass
+class Solved:
+    """What solving one algorithm on every case produced: the batched result and the wall time
+    of the solve per case (amortised). Picklable, so another process can compute it
+    (``fkopt reproduce --jobs N``); it holds no mechanism or problem."""
 
-    ``timing=False`` skips the single-run timing sample (:mod:`.timing`): what ``fkopt check``
-    reruns for, since timings are never compared.
+    result: Result
+    wall_s: float
 
-    Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
-    each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
-    """
+
+def _prepare(config: ExperimentConfig, source: str | None):
     if source and getattr(config, "_folder", None) is None:   # relative files resolve beside the config
         config._folder = Path(source).parent
     mech, cases, problems = validate_experiment(config)
     one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
     batched = problems[0] if one else batched_problem(config, mech, cases)
-    keep_x = keeps_x_history(config, mech)
+    return mech, cases, problems, batched
+
+
+def _seeds(config: ExperimentConfig, cases: list[Case], spec: AlgorithmSpec):
+    seeds = [task_seed(config.seed, case.index, spec.key) for case in cases]
+    return seeds[0] if len(cases) == 1 else seeds
+
+
+def _solve_one(config: ExperimentConfig, mech, cases, batched, spec: AlgorithmSpec) -> Solved:
+    start = time.perf_counter()
+    result = solve_cases(config, spec, batched, _seeds(config, cases, spec), x0=start_point(spec, mech),
+                         batch=config.batch, snapshots=config.snapshots, x_history=keeps_x_history(config, mech))
+    return Solved(result, (time.perf_counter() - start) / len(cases))    # amortised over the cases
+
+
+def solve_experiment(config: ExperimentConfig, source: str | None = None) -> list[Solved]:
+    """Only the solves of an experiment, one :class:`Solved` per algorithm (for a worker process;
+    :func:`run_experiment` builds the records from them with ``solved=``)."""
+    mech, cases, _, batched = _prepare(config, source)
+    return [_solve_one(config, mech, cases, batched, spec) for spec in config.algorithms]
+
+
+def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
+                   source: str | None = None, timing: bool = True,
+                   solved: list[Solved] | None = None) -> ExperimentResult:
+    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each.
+
+    ``timing=False`` skips the single-run timing sample (:mod:`.timing`): what ``fkopt check``
+    reruns for, since timings are never compared. ``solved``: the algorithms' solves computed
+    elsewhere (:func:`solve_experiment`, e.g. in a worker process); the records, and the timing
+    sample, are then made here.
+
+    Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
+    each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
+    """
+    start_all = time.perf_counter()
+    mech, cases, problems, batched = _prepare(config, source)
     records: list[TaskRecord] = []
     total = len(cases) * len(config.algorithms)
-    start_all = time.perf_counter()
     by_algorithm: list[list[TaskRecord]] = []
-    for spec in config.algorithms:
-        seeds = [task_seed(config.seed, case.index, spec.key) for case in cases]
-        start = time.perf_counter()
-        result = solve_cases(config, spec, batched, seeds[0] if one else seeds, x0=start_point(spec, mech),
-                             batch=config.batch, snapshots=config.snapshots, x_history=keep_x)
-        wall = (time.perf_counter() - start) / len(cases)     # amortised over the cases
+    for a, spec in enumerate(config.algorithms):
+        done = _solve_one(config, mech, cases, batched, spec) if solved is None else solved[a]
+        seeds = _seeds(config, cases, spec)
+        seeds = seeds if isinstance(seeds, list) else [seeds]
         recs = []
         for i, (case, problem) in enumerate(zip(cases, problems)):
-            r = result if one else result.case(i)
+            r = done.result if len(cases) == 1 else done.result.case(i)
             pos_hist = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
-            recs.append(TaskRecord(case, spec, problem, r, seeds[i], wall, outputs_of(mech, r.x), pos_hist))
+            recs.append(TaskRecord(case, spec, problem, r, seeds[i], done.wall_s, outputs_of(mech, r.x), pos_hist))
             if progress:
                 progress(f"{case.label} / {spec.key}", len(records) + len(recs), total)
         records += recs
@@ -256,4 +290,7 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
     if timing:
         time_single_runs(config, records)
-    return ExperimentResult(config, mech, cases, records, time.perf_counter() - start_all, source)
+    wall = time.perf_counter() - start_all
+    if solved is not None:      # the solves' own time, measured where they ran
+        wall += sum(d.wall_s * len(cases) for d in solved)
+    return ExperimentResult(config, mech, cases, records, wall, source)
