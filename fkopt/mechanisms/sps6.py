@@ -254,14 +254,18 @@ class SixSPS(ParallelMechanism):
         return lengths, J
 
     def _ik_jacobian_soa(self, p):
-        """:meth:`ik_jacobian` for many poses (n, 6), elementwise per leg (structure of arrays)."""
+        """:meth:`ik_jacobian` for many poses (n, 6), elementwise per leg (structure of arrays).
+
+        The Jacobian is filled as (leg, variable, pose) rows, each written contiguously, and
+        returned as a (pose, leg, variable) view: strided writes of single columns of an
+        (n, 6, 6) array cost more than the arithmetic."""
         n = len(p)
         pt = np.ascontiguousarray(p.T)
         ang = pt[3:6] * _D2R
         R = rotations.zyx(ang[0], ang[1], ang[2])
         sg, cg = np.sin(ang[2]), np.cos(ang[2])
-        lengths = np.empty((n, 6))
-        J = np.empty((n, 6, 6))
+        lengths = np.empty((6, n))
+        J = np.empty((6, 6, n))
         for i in range(6):
             q, b = self._q[i], self._base[i]
             w = []
@@ -272,18 +276,17 @@ class SixSPS(ParallelMechanism):
                         wk = R[k][j] * q[j] if wk is None else wk + R[k][j] * q[j]
                 w.append(np.zeros(n) if wk is None else wk)
             v = [w[k] + (pt[k] - b[k]) for k in range(3)]
-            L = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-            lengths[:, i] = L
+            L = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2], out=lengths[i])
             inv = 1.0 / L
-            u = [v[k] * inv for k in range(3)]
+            Ji = J[i]
+            u = [np.multiply(v[k], inv, out=Ji[k]) for k in range(3)]
             m0 = w[1] * u[2] - w[2] * u[1]
             m1 = w[2] * u[0] - w[0] * u[2]
             m2 = w[0] * u[1] - w[1] * u[0]
-            J[:, i, 0], J[:, i, 1], J[:, i, 2] = u
-            J[:, i, 3] = (R[0][0] * m0 + R[1][0] * m1 + R[2][0] * m2) * _D2R
-            J[:, i, 4] = (cg * m1 - sg * m0) * _D2R
-            J[:, i, 5] = m2 * _D2R
-        return lengths, J
+            np.multiply(R[0][0] * m0 + R[1][0] * m1 + R[2][0] * m2, _D2R, out=Ji[3])
+            np.multiply(cg * m1 - sg * m0, _D2R, out=Ji[4])
+            np.multiply(m2, _D2R, out=Ji[5])
+        return lengths.T, J.transpose(2, 0, 1)
 
     def ik_vectors(self, poses) -> np.ndarray:
         """Leg vectors l_i (..., 6, 3) in the base frame (reference implementation, uses arrays)."""
