@@ -132,13 +132,11 @@ def build_cases(config: ExperimentConfig, mech) -> list[Case]:
     return cases
 
 
-def make_problem(config: RunConfig, mech, inputs: np.ndarray, bounds=None):
+def make_problem(config: RunConfig, mech, inputs: np.ndarray):
     """The problem of ``inputs`` -- one target ``(m,)`` or a case axis ``(cases, m)`` -- with the
     config's objective: :func:`fkopt.fk_problem` for a parallel mechanism, :func:`fkopt.ik_problem`
     for a serial arm. The one place experiments, studies and tracking steps get a problem from."""
     kwargs = {"objective": config.objective} if config.objective else {}
-    if bounds is not None:
-        kwargs["bounds"] = bounds
     if mech.kind == "serial":
         return ik_problem(mech, inputs, **kwargs)
     return fk_problem(mech, inputs, **kwargs)
@@ -236,14 +234,13 @@ def _prepare(config: ExperimentConfig, source: str | None):
     return mech, cases, problems, batched
 
 
-def _seeds(config: ExperimentConfig, cases: list[Case], spec: AlgorithmSpec):
-    seeds = [task_seed(config.seed, case.index, spec.key) for case in cases]
-    return seeds[0] if len(cases) == 1 else seeds
+def _seeds(config: ExperimentConfig, cases: list[Case], spec: AlgorithmSpec) -> list[int]:
+    return [task_seed(config.seed, case.index, spec.key) for case in cases]
 
 
-def _solve_one(config: ExperimentConfig, mech, cases, batched, spec: AlgorithmSpec) -> Solved:
+def _solve_one(config: ExperimentConfig, mech, cases, batched, spec: AlgorithmSpec, seeds: list[int]) -> Solved:
     start = time.perf_counter()
-    result = solve_cases(config, spec, batched, _seeds(config, cases, spec), x0=start_point(spec, mech),
+    result = solve_cases(config, spec, batched, seeds[0] if len(cases) == 1 else seeds, x0=start_point(spec, mech),
                          batch=config.batch, snapshots=config.snapshots, x_history=keeps_x_history(config, mech))
     return Solved(result, (time.perf_counter() - start) / len(cases))    # amortised over the cases
 
@@ -252,7 +249,7 @@ def solve_experiment(config: ExperimentConfig, source: str | None = None) -> lis
     """Only the solves of an experiment, one :class:`Solved` per algorithm (for a worker process;
     :func:`run_experiment` builds the records from them with ``solved=``)."""
     mech, cases, _, batched = _prepare(config, source)
-    return [_solve_one(config, mech, cases, batched, spec) for spec in config.algorithms]
+    return [_solve_one(config, mech, cases, batched, spec, _seeds(config, cases, spec)) for spec in config.algorithms]
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
@@ -274,9 +271,8 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     total = len(cases) * len(config.algorithms)
     by_algorithm: list[list[TaskRecord]] = []
     for a, spec in enumerate(config.algorithms):
-        done = _solve_one(config, mech, cases, batched, spec) if solved is None else solved[a]
         seeds = _seeds(config, cases, spec)
-        seeds = seeds if isinstance(seeds, list) else [seeds]
+        done = _solve_one(config, mech, cases, batched, spec, seeds) if solved is None else solved[a]
         recs = []
         for i, (case, problem) in enumerate(zip(cases, problems)):
             r = done.result if len(cases) == 1 else done.result.case(i)

@@ -28,6 +28,7 @@ from typing import Any, Callable, ClassVar
 
 import numpy as np
 
+from .. import rotations
 from ..errors import FkoptError, did_you_mean
 
 
@@ -238,3 +239,27 @@ class SerialMechanism(Mechanism):
     def fk(self, joints) -> np.ndarray:
         """End-effector pose for joints shaped (..., len(joint_names)) -> (..., len(pose_names))."""
         raise NotImplementedError
+
+
+class FrameArm(SerialMechanism):
+    """A serial arm whose closed form is its tip frame: :meth:`frame` gives (p, R), the
+    position and rotation as nested tuples of arrays shaped like the batch; the pose is the
+    position and the Z-Y-Z Euler angles in degrees (wang7dof's convention). DH tables and URDF
+    chains are both such arms."""
+
+    pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
+
+    def frame(self, joints):
+        raise NotImplementedError
+
+    def fk(self, joints) -> np.ndarray:
+        p, R = self.frame(joints)
+        alpha, beta, gamma = rotations.zyz_angles(R)
+        return np.stack([p[0], p[1], p[2], np.degrees(alpha), np.degrees(beta), np.degrees(gamma)], axis=-1)
+
+    def fk_matrix(self, joints) -> np.ndarray:
+        """Homogeneous tip transforms shaped (..., 4, 4)."""
+        p, R = self.frame(joints)
+        upper = np.concatenate([rotations.to_array(R), np.stack(p, axis=-1)[..., None]], axis=-1)
+        last = np.broadcast_to(np.array([0.0, 0.0, 0.0, 1.0]), upper.shape[:-2] + (1, 4))
+        return np.concatenate([upper, last], axis=-2)

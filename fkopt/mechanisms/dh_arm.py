@@ -25,9 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import rotations
 from ..errors import FkoptError
-from .base import SerialMechanism, lazy_model, validate_geometry
+from .base import FrameArm, lazy_model, validate_geometry
 
 #: Batch size from which :meth:`DHArm.frame_jacobian` works on the frame's columns rather than
 #: by batched 4x4 products (those cost about 1 µs per matrix, the columns a fixed ~20 array
@@ -87,11 +86,10 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-class DHArm(SerialMechanism):
+class DHArm(FrameArm):
     """Serial arm with revolute joints q1..qn (deg) described by a standard DH table."""
 
     name = "dh-arm"
-    pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
     pose_units = ("mm", "mm", "mm", "deg", "deg", "deg")
     Geometry = lazy_model(_dh_geometry)                # pydantic model, built on first use
     geometry_defaults = {"a": list(WANG7DOF["a"]), "alpha": list(WANG7DOF["alpha"]), "d": list(WANG7DOF["d"]),
@@ -302,20 +300,6 @@ class DHArm(SerialMechanism):
             gd = (np.cos(al) * wx + np.sin(al) * wy) / sb
         bd = -np.sin(al) * wx + np.cos(al) * wy
         return np.stack([wz - cb * gd, bd, gd], axis=-2)
-
-    def fk(self, joints) -> np.ndarray:
-        p, R = self.frame(joints)
-        alpha, beta, gamma = rotations.zyz_angles(R)
-        return np.stack([p[0], p[1], p[2], np.degrees(alpha), np.degrees(beta), np.degrees(gamma)], axis=-1)
-
-    def fk_matrix(self, joints) -> np.ndarray:
-        """Homogeneous end-effector transforms shaped (..., 4, 4)."""
-        p, R = self.frame(joints)
-        top = rotations.to_array(R)
-        pos = np.stack(p, axis=-1)[..., None]
-        upper = np.concatenate([top, pos], axis=-1)
-        last = np.broadcast_to(np.array([0.0, 0.0, 0.0, 1.0]), upper.shape[:-2] + (1, 4))
-        return np.concatenate([upper, last], axis=-2)
 
 
 class SevenDofArm(DHArm):

@@ -29,9 +29,8 @@ from typing import Any
 import numpy as np
 from pydantic import Field, ValidationError
 
-from .. import rotations
 from ..errors import FkoptError, did_you_mean
-from .base import Geometry, SerialMechanism, describe_validation_error
+from .base import FrameArm, Geometry, describe_validation_error
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.urdf"
 #: Bounds of continuous joints unless the config gives them (deg).
@@ -108,11 +107,10 @@ def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
     return chain
 
 
-class URDFArm(SerialMechanism):
+class URDFArm(FrameArm):
     """Serial arm from a URDF chain (module docstring). Lengths in m, angles in deg."""
 
     name = "urdf"
-    pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
     pose_units = ("m", "m", "m", "deg", "deg", "deg")
     Geometry = URDFGeometry
     #: Geometry keys holding file paths (relative ones are resolved against the config's folder).
@@ -212,18 +210,6 @@ class URDFArm(SerialMechanism):
             R = tuple(tuple(R[r][0] * M[0][cc] + R[r][1] * M[1][cc] + R[r][2] * M[2][cc] for cc in range(3))
                       for r in range(3))
         return p, R
-
-    def fk(self, joints) -> np.ndarray:
-        p, R = self.frame(joints)
-        alpha, beta, gamma = rotations.zyz_angles(R)
-        return np.stack([p[0], p[1], p[2], np.degrees(alpha), np.degrees(beta), np.degrees(gamma)], axis=-1)
-
-    def fk_matrix(self, joints) -> np.ndarray:
-        """Homogeneous tip transforms shaped (..., 4, 4)."""
-        p, R = self.frame(joints)
-        upper = np.concatenate([rotations.to_array(R), np.stack(p, axis=-1)[..., None]], axis=-1)
-        last = np.broadcast_to(np.array([0.0, 0.0, 0.0, 1.0]), upper.shape[:-2] + (1, 4))
-        return np.concatenate([upper, last], axis=-2)
 
     def describe(self) -> dict[str, Any]:
         out = super().describe()

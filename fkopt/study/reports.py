@@ -298,7 +298,7 @@ def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
         name = _name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)")
         color = None
         for traj, d in table[table.algorithm == ar.key].groupby("trajectory"):
-            label = (f"{name}, trajectory {traj}" if several else name) if color is None or several else None
+            label = f"{name}, trajectory {traj}" if several else name
             line, = axes[0].plot(d.step, np.maximum(d.median_fitness, floor), marker=".", lw=1, label=label,
                                  color=color, ls=_STYLES[(traj - 1) % len(_STYLES)])
             color = line.get_color()

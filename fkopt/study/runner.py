@@ -173,14 +173,13 @@ def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
         seeds = [task_seed(config.seed, i, spec.key) for i in idx]
         warm = spec.warm_start and t > 0
         t0 = time.perf_counter()
+        # where each (trajectory, run) starts: its previous solution, or the cold start (NaN: none)
+        starts = prev[active] if warm else np.broadcast_to(np.nan if x0 is None else x0, (len(active), runs, dim))
         if algo.local or not warm:
-            starts = prev[active] if warm else (np.broadcast_to(x0, (len(active), runs, dim)) if x0 is not None
-                                                else np.full((len(active), runs, dim), np.nan))
             r = solve_cases(config, spec, make_problem(config, mech, poses.inputs[idx]), seeds,
-                            x0=prev[active] if warm else x0)
+                            x0=starts if warm else x0)
             results = [r.case(c) for c in range(len(active))]
         else:
-            starts = prev[active]
             lo, hi = _warm_boxes(mech, starts.reshape(-1, dim), config.tracking.radius)
             target = make_problem(config, mech, np.repeat(poses.inputs[idx], runs, axis=0))
             boxed = BoxedProblem(target, lo, hi)
