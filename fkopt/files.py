@@ -17,6 +17,11 @@ Every config file, geometry file and results folder of fkopt goes through this m
   file, before any computation starts. Every command that writes (run, study, reproduce, assembly
   searches, bench, export) calls it first: ``output_folder(out)`` checks the folder itself,
   ``output_folder(out, "a", "b")`` a folder below it.
+* :func:`inside` -- the one output-path guard: a file or folder fkopt writes, reads back to
+  merge, or swaps is refused with one line unless it resolves (symbolic links included) inside
+  the root it belongs to. Every writer calls it on every path, not only on the folder: a link
+  planted inside ``--out`` (``.partial/tasks``, ``REPORT.md``, ``bench.csv``) cannot redirect
+  a write outside.
 * :func:`write_atomically` -- write a folder aside (a hidden temporary sibling), then swap it into
   place with one ``renameat2(RENAME_EXCHANGE)`` system call (two renames with signals blocked
   where that call does not exist). The previous result stays complete until the new one is.
@@ -195,6 +200,21 @@ def check_component(value: Any, field: str) -> str:
     return value
 
 
+def inside(root: str | Path, path: str | Path, option: str = "--out") -> Path:
+    """``path`` unchanged, after checking that it resolves (every symbolic link on the way,
+    including ``path`` itself) to ``root`` or below it; else one line naming both."""
+    path = Path(path)
+    try:
+        base = Path(root).resolve()
+        resolved = path.resolve()
+    except (OSError, RuntimeError) as err:   # a loop of links
+        raise FkoptError(f"{option}: {path}: cannot resolve ({getattr(err, 'strerror', None) or err})") from None
+    if resolved != base and base not in resolved.parents:
+        link = " (through a symbolic link)" if resolved != path.absolute() else ""
+        raise FkoptError(f"{option}: {path} resolves to {resolved}{link}, outside {root}; refusing to write there")
+    return path
+
+
 def output_folder(out: str | Path, *parts: str, option: str = "--out") -> Path:
     """``OUT/parts...`` checked before any computation; returns the path (unresolved, for messages).
 
@@ -209,10 +229,7 @@ def output_folder(out: str | Path, *parts: str, option: str = "--out") -> Path:
     target = out.joinpath(*parts)
     if out.exists() and not out.is_dir():
         raise FkoptError(f"{option}: {out} is a file, not a folder")
-    base = out.resolve()
-    resolved = target.resolve()
-    if resolved != base and base not in resolved.parents:
-        raise FkoptError(f"{option}: {target} resolves to {resolved}, outside {out}; refusing to write there")
+    inside(out, target, option)
     if target.exists() and not target.is_dir():
         raise FkoptError(f"{option}: {target} exists and is a file, not a results folder")
     parent = target.parent if parts else target
@@ -324,6 +341,15 @@ def write_json_atomically(path: str | Path, data: Any, **dump) -> None:
 def write_json(path: str | Path, data: Any) -> None:
     """The one JSON layout of results files (sorted keys, indent 2, newline at the end)."""
     Path(path).write_text(json.dumps(data, indent=2, sort_keys=True, default=float) + "\n")
+
+
+# -- resources -------------------------------------------------------------------------------------
+def available_cpus() -> int:
+    """CPUs this process may run on (its affinity mask, else the CPU count)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
 
 
 # -- numbers ---------------------------------------------------------------------------------------

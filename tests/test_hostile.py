@@ -269,6 +269,198 @@ def test_check_with_missing_meta_is_a_failure(sandbox, tmp_path, cli):
     assert code == 1 and "test/small: meta.json" in err and "missing" in err
 
 
+# == issue 19: hostile inputs, second round ========================================================
+# Each section reproduces a reported failure; every test failed before its fix.
+
+def one_line_error(result, *fragments) -> str:
+    """``result`` of ``cli(...)`` is exit 2 with exactly one ``fkopt: error:`` line holding ``fragments``."""
+    code, out, err = result
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and lines[0].startswith("fkopt: error: "), (code, err[-2000:])
+    assert "Traceback" not in out + err
+    for frag in fragments:
+        assert frag in lines[0], lines[0]
+    return lines[0]
+
+
+@pytest.fixture
+def finished_study(tmp_path, cli):
+    """A finished study ``OUT/studies/small`` (2 poses, 1 task), its config, and an outside folder."""
+    cfg = tmp_path / "s.yaml"
+    cfg.write_text(yaml_of({**STUDY, "name": "small"}))
+    out = tmp_path / "out"
+    assert cli("study", cfg, "--out", out, "-q")[0] == 0
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "keep.txt").write_text("outside --out\n")
+    return cfg, out, out / "studies" / "small", outside
+
+
+def _partial_with_a_task(out: Path, final: Path) -> Path:
+    """An unfinished run's .partial holding the finished study's task files (as if interrupted)."""
+    import shutil
+    work = final.parent / f".{final.name}.partial"
+    shutil.copytree(final / "tasks", work / "tasks")
+    return work
+
+
+# -- class 1: no write through a symbolic link inside --out ---------------------------------------
+@pytest.mark.parametrize("link", ["partial", "tasks"])
+def test_study_resume_refuses_partial_links_outside(finished_study, cli, link):
+    cfg, out, final, outside = finished_study
+    work = final.parent / f".{final.name}.partial"
+    if link == "partial":
+        work.symlink_to(outside, target_is_directory=True)
+    else:
+        work.mkdir()
+        (work / "tasks").symlink_to(outside, target_is_directory=True)
+    before, outside_before = snapshot(final), snapshot(outside)
+    one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), "outside")
+    assert snapshot(outside) == outside_before and sorted(p.name for p in outside.iterdir()) == ["keep.txt"]
+    assert snapshot(final) == before and not (final / "tasks").is_symlink()
+
+
+def test_study_resume_refuses_a_task_file_linked_outside(finished_study, cli):
+    cfg, out, final, outside = finished_study
+    task = next((final / "tasks").glob("a*.json"))
+    (outside / task.name).write_bytes(task.read_bytes())
+    task.unlink()
+    task.symlink_to(outside / task.name)
+    one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), "outside")
+
+
+@pytest.mark.parametrize("target", ["REPORT.md", "index.csv", "studies/claims.csv"])
+def test_report_refuses_files_linked_outside(finished_study, cli, target):
+    _, out, _, outside = finished_study
+    victim = outside / "keep.txt"
+    (out / target).unlink(missing_ok=True)
+    (out / target).symlink_to(victim)
+    one_line_error(cli("report", out), "outside")
+    assert victim.read_text() == "outside --out\n"
+
+
+def test_bench_refuses_bench_csv_linked_outside(tmp_path, cli):
+    bench = tmp_path / "b"
+    bench.mkdir()
+    victim = tmp_path / "victim.csv"
+    victim.write_text("keep\n")
+    (bench / "bench.csv").symlink_to(victim)
+    one_line_error(cli("bench", "--quick", "--section", "exact", "--out", bench), "outside")
+    assert victim.read_text() == "keep\n"
+
+
+def test_inside_guard_resolves_every_link(tmp_path):
+    from fkopt.errors import FkoptError
+    from fkopt.files import inside
+    (tmp_path / "out" / "a").mkdir(parents=True)
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "out" / "a" / "ok").symlink_to(tmp_path / "out")          # a link that stays inside
+    (tmp_path / "out" / "a" / "away").symlink_to(tmp_path / "elsewhere")
+    (tmp_path / "out" / "loop").symlink_to(tmp_path / "out" / "loop")
+    assert inside(tmp_path / "out", tmp_path / "out" / "a" / "ok" / "x.csv")
+    for bad in ("a/away/x.csv", "a/../../elsewhere", "loop/x"):
+        with pytest.raises(FkoptError):
+            inside(tmp_path / "out", tmp_path / "out" / bad)
+
+
+# -- class 2 and 6: resumed task files are verified, corrupt ones are one line ------------------------
+def test_resume_refuses_an_edited_task_file(finished_study, cli):
+    cfg, out, final, _ = finished_study
+    task = next((final / "tasks").glob("a*.json"))
+    rec = json.loads(task.read_text())
+    rec["fitness"][0][0] = 0.0                     # a better-looking result, written by hand
+    task.write_text(json.dumps(rec))
+    before = snapshot(final)
+    one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), task.name, "changed since")
+    assert snapshot(final) == before
+
+
+@pytest.mark.parametrize("content", ["[]", '{"fingerprint": "x"}', '"text"', '{"id": 5}', "{not json"],
+                         ids=["list", "no-id", "string", "id-number", "garbage"])
+def test_resume_refuses_corrupt_task_files(finished_study, cli, content):
+    cfg, out, final, _ = finished_study
+    work = _partial_with_a_task(out, final)
+    task = next((work / "tasks").glob("a*.json"))
+    task.write_text(content)
+    one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), task.name)
+    assert task.read_text() == content            # nothing wiped: the user decides
+
+
+@pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task"])
+def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli, edit):
+    """Someone who also rewrote study.json's digests still cannot slip a malformed record in."""
+    import hashlib
+    cfg, out, final, _ = finished_study
+    work = _partial_with_a_task(out, final)
+    task = next((work / "tasks").glob("a*.json"))
+    rec = json.loads(task.read_text())
+    if edit == "list":
+        rec = []
+    elif edit == "no-id":
+        del rec["id"]
+    elif edit == "shape":
+        rec["fitness"] = rec["fitness"][:1]
+    elif edit == "strings":
+        rec["x"] = "abc"
+    else:
+        rec["task"]["stop"] = 1
+    task.write_text(json.dumps(rec))
+    manifest = json.loads((work / "tasks" / "study.json").read_text())
+    manifest["tasks"][task.stem] = hashlib.sha256(task.read_bytes()).hexdigest()
+    (work / "tasks" / "study.json").write_text(json.dumps(manifest))
+    one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), task.name)
+
+
+def test_resume_reuses_verified_tasks(finished_study, cli):
+    cfg, out, final, _ = finished_study
+    before = snapshot(final)
+    code, stdout, err = cli("study", cfg, "--out", out, "--resume")
+    assert code == 0, err
+    assert "reused" in stdout
+    assert {k: v for k, v in snapshot(final).items() if k.endswith(".csv") and "timing" not in k} == \
+        {k: v for k, v in before.items() if k.endswith(".csv") and "timing" not in k}
+
+
+# -- class 4 and 5: workers, Dask addresses -------------------------------------------------------
+@pytest.mark.parametrize("address", ["not an address", "tcp://host:99999", "tcp://:80", "http://x:1/",
+                                     "tcp://127.0.0.1:1"],
+                         ids=["words", "port-range", "no-host", "http", "unreachable"])
+def test_bad_scheduler_is_one_line_and_keeps_partial(finished_study, cli, address):
+    pytest.importorskip("dask.distributed")
+    cfg, out, final, _ = finished_study
+    work = _partial_with_a_task(out, final)
+    before = snapshot(work)
+    one_line_error(cli("study", cfg, "--out", out, "-q", "--executor", "dask", "--scheduler", address,
+                       "--resume"), "--scheduler")
+    assert snapshot(work) == before
+
+
+def test_workers_never_exceed_cpus_or_tasks():
+    from fkopt.files import available_cpus
+    from fkopt.study.executors import worker_count
+    assert worker_count(10_000, 10_000) == available_cpus()
+    assert worker_count(12, 2) == min(2, available_cpus())
+    assert worker_count(1, 5) == 1
+
+
+def test_jobs_10000_starts_no_more_processes_than_cpus(tmp_path, monkeypatch):
+    """--jobs 10000 on this machine asks the pool for at most the CPUs (and the tasks)."""
+    import concurrent.futures
+    from fkopt.files import available_cpus
+    from fkopt.study import executors
+    asked = []
+
+    class Pool(concurrent.futures.ThreadPoolExecutor):
+        def __init__(self, max_workers, mp_context=None):
+            asked.append(max_workers)
+            super().__init__(max_workers)
+    monkeypatch.setattr(executors, "ProcessPoolExecutor", Pool)
+    got = []
+    executors.execute(abs, list(range(-6, 0)), jobs=10_000, on_result=got.append)
+    assert sorted(got) == [1, 2, 3, 4, 5, 6]
+    assert asked in ([], [min(6, available_cpus())]) and (asked or available_cpus() == 1)
+
+
 # -- interrupted reruns keep the previous result ----------------------------------------------------
 SLOW = {**BASE, "name": "small", "population": 40, "iterations": 3000, "runs": 60,
         "algorithms": [{"name": "abc"}, {"name": "gabc"}, {"name": "pso"}]}

@@ -189,7 +189,8 @@ class ExternalAlgorithm(Algorithm):
                  None if start is None else (start if start.ndim == 1 else start[i]))
                 for i, s in enumerate(seeds)]
         workers = self.params.workers or ((os.cpu_count() or 1) if self.per_point else 1)
-        workers = min(workers, len(runs))
+        from ..files import available_cpus
+        workers = min(workers, len(runs), available_cpus())
         if workers <= 1:
             traces = [run_one(*a) for a in args]
         else:

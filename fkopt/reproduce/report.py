@@ -206,14 +206,27 @@ def draw_paper_figures(root: str | Path) -> list[Path]:
 
 
 def write_report(root: str | Path) -> list[Path]:
+    """Write REPORT.md, TIMING.md, index.csv and every paper's claims.csv under ``root``.
+
+    Every file is checked before anything is computed or written: it must resolve (symbolic
+    links included) inside ``root`` (:func:`fkopt.files.inside`), so a link planted in a
+    results root cannot make ``fkopt report`` overwrite a file elsewhere."""
+    from ..files import inside
     root = Path(root)
+    paths = [root / "REPORT.md", root / "TIMING.md", root / "index.csv"]
+    claims = [root / paper / CLAIMS_FILE for paper in Store(root).papers() if paper_module(paper) is not None]
+    for path in paths + claims:
+        inside(root, path, "report")
+    for exp in Store(root).experiments():     # folders a paper's figures are drawn into
+        if getattr(paper_module(exp.paper), "figures", None):
+            for path in [exp.folder, *exp.folder.iterdir()]:
+                inside(root, path, "report")
     figures = draw_paper_figures(root)
     report, timing, index = build_report(root)
-    paths = [root / "REPORT.md", root / "TIMING.md", root / "index.csv"]
     paths[0].write_text(report)
     paths[1].write_text(timing)
     index.to_csv(paths[2], index=False, float_format="%.10g")
     for path, df in claims_files(root).items():
-        df.to_csv(path, index=False)
+        df.to_csv(inside(root, path, "report"), index=False)
         paths.append(path)
     return paths + figures

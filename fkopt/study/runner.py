@@ -35,7 +35,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import FkoptError
-from ..files import output_folder, write_atomically, write_json_atomically
+from ..files import inside, output_folder, write_atomically, write_json_atomically
 from ..outputs import write_outputs
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
@@ -211,19 +211,89 @@ def write_json_atomic(path: Path, data: dict) -> None:
     write_json_atomically(path, data, separators=(",", ":"))
 
 
-def read_task_files(folder: Path, fingerprint: str) -> dict[str, dict]:
-    """Finished tasks in ``folder/tasks`` (unreadable files are ignored: they are redone)."""
+def _digest(path: Path) -> str:
+    import hashlib
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _record_problem(rec, path: Path, planned: dict[str, Task], config: StudyConfig, dim: int) -> str | None:
+    """Why ``rec`` (read from ``path``) is not a finished task of this study; None when it is."""
+    if not isinstance(rec, dict):
+        return f"holds a JSON {type(rec).__name__}, not a task record"
+    if rec.get("id") != path.stem:
+        return f"its id {str(rec.get('id'))[:40]!r} is not its file name {path.stem!r}"
+    task = planned.get(path.stem)
+    if task is None:
+        return "no task of this study has that id"
+    if rec.get("task") != task.__dict__:
+        return "its task (algorithm, poses) is not the one its id names"
+    n = task.stop - task.start if config.mode == "independent" else None
+    try:
+        poses = np.asarray(rec["poses"])
+        if poses.ndim != 1 or (n is not None and len(poses) != n) or not np.issubdtype(poses.dtype, np.integer):
+            return "poses: not the task's pose indices"
+        if poses.size and (poses.min() < task.start or poses.max() >= task.stop):
+            return "poses: outside the task's poses"
+        rows = len(poses)
+        shapes = {k: (rows, config.runs) for k in ("fitness", "evaluations", "iterations_done",
+                                                     "iterations_to", "evaluations_to")}
+        shapes["x"] = (rows, config.runs, dim)
+        shapes["time_s"] = (rows,)
+        shapes["seeds"] = (rows,)
+        if config.mode == "tracking":
+            shapes["start"] = (rows, config.runs, dim)
+        for key, shape in shapes.items():
+            value = np.asarray(rec[key], dtype=float)
+            if value.shape != shape:
+                return f"{key}: shape {value.shape}, expected {shape}"
+        float(rec["wall_s"])
+    except KeyError as err:
+        return f"field {err.args[0]!r} is missing"
+    except (TypeError, ValueError):
+        return f"{key}: not numbers" if "key" in locals() else "poses: not numbers"
+    return None
+
+
+def read_task_files(folder: Path, config: StudyConfig, dim: int, digests: dict[str, str] | None) -> dict[str, dict]:
+    """Finished tasks in ``folder/tasks``, each checked before it is reused.
+
+    ``digests`` (task id -> SHA-256, recorded in ``study.json`` as each file was written): a file
+    whose bytes changed since, or that no record names, is refused with one line; without
+    digests (a study written by an older fkopt) no file is trusted and every task is redone.
+    A file that is not a task record of this study (``[]``, no ``id``, wrong shapes, another
+    config) is refused with one line naming it -- nothing is reused blindly.
+    """
+    if digests is None:
+        return {}
+    fingerprint = config.fingerprint()
     out = {}
+    root = folder.parent
     for path in sorted((folder / TASKS).glob("a*.json")):
+        inside(root, path, "--resume")
+        redo = "delete it to recompute that task, or rerun without --resume to start over"
+        if digests.get(path.stem) != _digest(path):
+            raise FkoptError(f"{path}: changed since fkopt wrote it (its SHA-256 is not the one recorded in "
+                             f"{STUDY_FILE}); {redo}")
         try:
-            rec = json.loads(path.read_text())
-        except (OSError, ValueError):
-            continue
-        if rec.get("fingerprint") != fingerprint:
+            rec = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as err:
+            raise FkoptError(f"{path}: unreadable task file ({type(err).__name__}); {redo}") from None
+        if isinstance(rec, dict) and rec.get("fingerprint") != fingerprint:
             raise FkoptError(f"{path}: belongs to another version of the study (its config changed); "
                              "rerun without --resume to start over")
-        out[rec["id"]] = rec
+        out[path.stem] = rec
     return out
+
+
+def check_records(records: dict[str, dict], folder: Path, config: StudyConfig, n_poses: int, dim: int) -> None:
+    """Every reused record is a finished task of this study (see :func:`read_task_files`)."""
+    planned = {t.id: t for t in plan_tasks(config, n_poses)}
+    for ident, rec in records.items():
+        path = folder / TASKS / f"{ident}.json"
+        problem = _record_problem(rec, path, planned, config, dim)
+        if problem:
+            raise FkoptError(f"{path}: not a finished task of this study ({problem}); delete it to recompute "
+                             "that task, or rerun without --resume to start over")
 
 
 # -- merged result -------------------------------------------------------------------------------
@@ -318,26 +388,51 @@ def work_folder(out: str | Path, config: StudyConfig) -> Path:
     return Path(out) / config.paper / f".{config.name}.partial"
 
 
-def _prepare(final: Path, work: Path, config: StudyConfig, resume: bool) -> None:
+def _guard(out: str | Path, *paths: Path) -> None:
+    """Every path a study writes, reads back or swaps lies inside ``--out`` (links resolved)."""
+    for path in paths:
+        inside(out, path)
+
+
+def _manifest(study_file: Path) -> dict | None:
+    try:
+        data = json.loads(study_file.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _prepare(out, final: Path, work: Path, config: StudyConfig, resume: bool) -> dict[str, str] | None:
+    """Make ``work`` ready; returns the task digests of the files that may be reused (or None)."""
     study_file = work / TASKS / STUDY_FILE
+    _guard(out, work, work / TASKS, study_file, final, final / TASKS)
     if not resume:
+        if work.is_symlink():
+            work.unlink()
         shutil.rmtree(work, ignore_errors=True)
     elif not work.exists() and (final / TASKS).is_dir():
         # resume a finished study: start from a copy of its task files (the folder stays as it is)
+        sources = sorted((final / TASKS).glob("*.json"))
+        _guard(out, *sources)
         (work / TASKS).mkdir(parents=True)
-        for path in (final / TASKS).glob("*.json"):
-            shutil.copy2(path, work / TASKS / path.name)
+        for path in sources:
+            shutil.copyfile(path, work / TASKS / path.name)
+    digests = None
     if resume and study_file.exists():
-        try:
-            stored = json.loads(study_file.read_text()).get("fingerprint")
-        except (OSError, ValueError):
-            stored = None
-        if stored not in (None, config.fingerprint()):
+        stored = _manifest(study_file) or {}
+        if stored.get("fingerprint") not in (None, config.fingerprint()):
             raise FkoptError(f"--resume: {final} holds tasks of another version of study '{config.name}' "
                              "(its config changed); rerun without --resume to start over")
+        if isinstance(stored.get("tasks"), dict):
+            digests = {str(k): str(v) for k, v in stored["tasks"].items()}
     (work / TASKS).mkdir(parents=True, exist_ok=True)
+    _guard(out, work, work / TASKS)
+    return digests
+
+
+def _write_manifest(study_file: Path, config: StudyConfig, digests: dict[str, str]) -> None:
     write_json_atomic(study_file, {"name": config.name, "fingerprint": config.fingerprint(),
-                                   "config": config.model_dump(mode="json")})
+                                   "config": config.model_dump(mode="json"), "tasks": dict(sorted(digests.items()))})
 
 
 def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
@@ -351,22 +446,33 @@ def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1
     study; every task finished so far stays in :func:`work_folder` for ``resume=True``, and a
     previous result stays complete. ``keep_tasks=False`` drops the task files once the study
     is written (``fkopt reproduce``).
+
+    Every task file is recorded with its SHA-256 in ``tasks/study.json`` as it is written;
+    ``resume`` reuses only files that still have it and hold a task of this study.
     """
-    from .executors import execute, validate_executor
+    from .executors import check_scheduler, execute, validate_executor
     validate_executor(executor, jobs, scheduler)
     mech, poses = validate_study(config)
     folder = output_folder(out, *config.folder_parts)   # safe, inside OUT, writable: before any work
     work = work_folder(out, config)
-    t_start = time.perf_counter()
-    _prepare(folder, work, config, resume)
-    fp = config.fingerprint()
-    records = read_task_files(work, fp) if resume else {}
     tasks = plan_tasks(config, len(poses))
+    check_scheduler(executor, scheduler)    # reachable before anything (a .partial) is touched
+    t_start = time.perf_counter()
+    digests = _prepare(out, folder, work, config, resume)
+    dim = len(mech.unknown_names)
+    records = read_task_files(work, config, dim, digests) if resume else {}
+    check_records(records, work, config, len(poses), dim)
+    kept = {k: v for k, v in (digests or {}).items() if k in records}
+    study_file = work / TASKS / STUDY_FILE
+    _write_manifest(study_file, config, kept)
     pending = [t for t in tasks if t.id not in records]
     computed: list[str] = []
 
     def finished(rec: dict) -> None:
-        write_json_atomic(work / TASKS / f"{rec['id']}.json", rec)
+        path = inside(out, work / TASKS / f"{rec['id']}.json")
+        write_json_atomic(path, rec)
+        kept[rec["id"]] = _digest(path)
+        _write_manifest(study_file, config, kept)
         records[rec["id"]] = rec
         computed.append(rec["id"])
         if progress:
@@ -388,6 +494,7 @@ def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1
         def fill(tmp: Path) -> None:
             write_outputs("study", result, tmp)
             if keep_tasks:
+                _guard(out, work / TASKS)
                 os.replace(work / TASKS, tmp / TASKS)
 
         write_atomically(folder, fill)
