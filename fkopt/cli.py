@@ -522,6 +522,9 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
           subset: str = typer.Option("all", "--subset", help="all | ci"),
           experiment: Optional[list[str]] = typer.Option(None, "--experiment", "-e",
                                                          help="PAPER/NAME to check (repeatable)"),
+          allow_plugins: bool = typer.Option(False, "--allow-plugins", help="import plug-ins the stored "
+                                             "configs name as package.module:Class (only for results you "
+                                             "trust; registered entry points need no flag)"),
           quiet: bool = typer.Option(False, "--quiet", "-q")):
     """Rerun stored results from their recorded config; exit 1 if anything drifted.
 
@@ -546,7 +549,7 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
         raise FkoptError(f"{results}: no stored results (folders with meta.json) to check")
     failures = []
     for e in exps:
-        bad = check_experiment(e)
+        bad = check_experiment(e, allow_plugins=allow_plugins)
         failures += bad
         if not quiet:
             typer.echo(f"{'ok  ' if not bad else 'FAIL'} {e.paper}/{e.name}")

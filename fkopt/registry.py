@@ -23,11 +23,24 @@ named, and nothing they define is *called* unless it passed the check.)
 
 Every failure is one :class:`~fkopt.errors.FkoptError` line naming the plug-in: an unknown
 name, an entry point or module that fails to import, a class missing a required method.
+
+The named attribute is read from the module's namespace itself (``module.__dict__``), never
+through ``getattr``: a module-level ``__getattr__`` of the plug-in's module is not called
+before the subclass check.
+
+Where fkopt reads names out of files it did not write -- ``fkopt check`` of someone else's
+results folder, whose ``meta.json`` names the mechanism and algorithms -- resolution runs
+inside :func:`registered_only`: built-in names, adapters and *registered* entry points
+resolve, a direct reference ``package.module:Class`` (which would import any installed
+module) is refused with one line unless the user asked for it (``fkopt check
+--allow-plugins``).
 """
 from __future__ import annotations
 
 import importlib
 import re
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -67,6 +80,9 @@ GROUPS = {"mechanism": "fkopt.mechanisms", "algorithm": "fkopt.algorithms"}
 #: Methods a plug-in class must provide (checked on the class, before it is instantiated).
 REQUIRED = {"mechanism": {"parallel": ("ik",), "serial": ("fk",)},
             "algorithm": ("minimize",)}
+
+#: True inside :func:`registered_only`: direct references are refused.
+_REGISTERED_ONLY: ContextVar[bool] = ContextVar("fkopt_registered_only", default=False)
 
 _REFERENCE = re.compile(r"^[A-Za-z_][\w]*(\.[A-Za-z_]\w*)*:[A-Za-z_]\w*$")
 
@@ -120,17 +136,37 @@ def check_class(obj, kind: str, where: str):
     return obj
 
 
+@contextmanager
+def registered_only(active: bool = True):
+    """Within the block, resolve only built-in names, adapters and registered entry points;
+    a direct reference ``package.module:Class`` is refused before anything is imported."""
+    token = _REGISTERED_ONLY.set(bool(active))
+    try:
+        yield
+    finally:
+        _REGISTERED_ONLY.reset(token)
+
+
 def _import_target(target: str, kind: str, where: str):
+    """The object ``module:attr`` names, read from the module's own namespace (a module-level
+    ``__getattr__`` is never called); ``attr`` may be dotted (``Outer.Inner``)."""
     module, _, attr = target.partition(":")
     try:
         mod = importlib.import_module(module)
-    except Exception as err:   # the plug-in's own import failed: name it, no traceback
+    except BaseException as err:   # the plug-in's own import failed (even SystemExit): name it
+        if isinstance(err, (KeyboardInterrupt, GeneratorExit)):
+            raise
         raise FkoptError(f"{kind} plug-in '{where}': cannot import {module} "
                          f"({type(err).__name__}: {err})") from None
-    try:
-        return getattr(mod, attr)
-    except AttributeError:
-        raise FkoptError(f"{kind} plug-in '{where}': module {module} has no attribute '{attr}'") from None
+    obj = mod
+    for part in attr.split("[")[0].strip().split("."):     # "mod:Class [extra]" of an entry point
+        space = getattr(obj, "__dict__", {})     # the namespace itself, no __getattr__
+        if not isinstance(space, dict) and not hasattr(space, "get"):
+            space = {}
+        if part not in space:
+            raise FkoptError(f"{kind} plug-in '{where}': module {module} has no attribute '{attr}'")
+        obj = space[part]
+    return obj
 
 
 @lru_cache(maxsize=None)
@@ -161,12 +197,16 @@ def _load(table: dict[str, str], kind: str, name: str):
     if name in eps:
         target, origin, ep = eps[name]
         try:
-            obj = ep.load()
-        except Exception as err:
+            obj = _import_target(target, kind, name)
+        except FkoptError as err:
             raise FkoptError(f"{kind} plug-in '{name}' (entry point {target} from {origin}) failed to import: "
-                             f"{type(err).__name__}: {err}") from None
+                             f"{str(err).split(': ', 1)[-1]}") from None
         return check_class(obj, kind, name)
     if sep and _REFERENCE.match(name):
+        if _REGISTERED_ONLY.get():
+            raise FkoptError(f"{kind} '{name}' is a direct reference to an installed module; checking stored "
+                             "results imports only built-in names and registered entry points (fkopt check "
+                             "--allow-plugins imports it, if you trust the results folder)")
         return check_class(_import_target(name, kind, name), kind, name)
     allowed = did_you_mean(name, [*table, *eps])
     raise FkoptError(f"unknown {kind} '{name}'; allowed: {allowed}, "

@@ -159,7 +159,9 @@ def make_algorithm(algorithm: str | Algorithm, params: dict[str, Any] | None = N
         if params:
             raise FkoptError("pass parameters either to the algorithm object or to solve(), not both")
         return algorithm
-    return algorithm_class(algorithm)(**(params or {}))
+    cls = algorithm_class(algorithm)
+    who = f"algorithm plug-in '{algorithm}' ({plugin_of(cls)})" if plugin_of(cls) else None
+    return contained(who, lambda: cls(**(params or {})))
 
 
 def validate_budget(population: int, iterations: int, runs: int, local: bool = False) -> None:
@@ -270,6 +272,7 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
     rows = n_cases * len(ids)
     size = chunk_size(n_cases, len(ids), int(population), int(iterations), problem.dim, batch=batch,
                       chunk_rows=chunk_rows, snapshots=len(snapshots), x_history=x_history)
+    who = _plugins(algo, problem)         # plug-ins are contained and their records checked
     case_of_row = np.repeat(np.arange(n_cases), len(ids))
     run_of_row = np.tile(ids, n_cases)
     seed_of_row = seeds[case_of_row]
@@ -282,8 +285,11 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
         sub = problem if cases is None else problem.take(case_of_row[s:e])
         x0_part = x0_rows if x0_rows is None or x0_rows.ndim == 1 else x0_rows[s:e]
         start = time.perf_counter()
-        parts.append(algo.minimize(sub, streams=RunStreams(seed_of_row[s:e], run_of_row[s:e]),
-                                   x0=x0_part, **kwargs))
+        part = contained(who, lambda: algo.minimize(sub, streams=RunStreams(seed_of_row[s:e], run_of_row[s:e]),
+                                                    x0=x0_part, **kwargs))
+        if who is not None:
+            check_record(part, who, e - s, int(iterations), problem.bounds)
+        parts.append(part)
         times[s:e] = (time.perf_counter() - start) / (e - s)
     record = parts[0] if len(parts) == 1 else _concatenate(parts)
     shape = (len(ids),) if cases is None else (n_cases, len(ids))
@@ -298,6 +304,86 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
         snapshots={k: lead(v) for k, v in record.snapshots.items()},
         cases=cases, seeds=None if cases is None else seeds,
     )
+
+
+# -- plug-in containment ---------------------------------------------------------------------------
+def plugin_of(obj) -> str | None:
+    """``"module.Class"`` when ``obj``'s class is not fkopt's own (a plug-in), else None."""
+    cls = obj if isinstance(obj, type) else type(obj)
+    module = getattr(cls, "__module__", "") or ""
+    return None if module == "fkopt" or module.startswith("fkopt.") else f"{module}.{cls.__qualname__}"
+
+
+def _plugins(algo, problem) -> str | None:
+    """What to name when a plug-in in this solve fails: the algorithm's and/or the mechanism's."""
+    names = []
+    if plugin_of(algo):
+        names.append(f"algorithm plug-in '{algo.name}' ({plugin_of(algo)})")
+    mech = getattr(problem, "mechanism", None)
+    if mech is not None and plugin_of(mech):
+        names.append(f"mechanism plug-in '{getattr(mech, 'name', '?')}' ({plugin_of(mech)})")
+    return " / ".join(names) or None
+
+
+def contained(who: str | None, call):
+    """``call()``; when ``who`` names a plug-in, anything it raises -- an exception, even
+    ``SystemExit(0)`` from inside ``iterate`` -- becomes one :class:`FkoptError` line naming it
+    (Ctrl-C stays Ctrl-C). fkopt's own code is not wrapped: its failures are bugs to see."""
+    if who is None:
+        return call()
+    try:
+        return call()
+    except FkoptError as err:
+        raise FkoptError(f"{who}: {err}") from None
+    except (KeyboardInterrupt, GeneratorExit, MemoryError):
+        raise
+    except BaseException as err:
+        text = (str(err).strip().splitlines() or [""])[0][:300]
+        raise FkoptError(f"{who} raised {type(err).__name__}" + (f": {text}" if text else "")
+                         + "; the plug-in failed, not fkopt") from None
+
+
+def check_record(record, who: str, rows: int, iterations: int, bounds) -> None:
+    """A plug-in's :class:`RunRecord` must be one fkopt can store: the right shapes, no NaN
+    fitness, evaluation counts that are whole, non-negative and never decrease, iterations used
+    within the budget, final points inside the bounds. Else one line naming the plug-in."""
+    def bad(msg):
+        raise FkoptError(f"{who} returned an invalid result: {msg}")
+    if not isinstance(record, RunRecord):
+        bad(f"a {type(record).__name__}, not a RunRecord")
+    bounds = np.asarray(bounds, dtype=float)
+    dim, T = len(bounds), iterations + 1
+    want = {"best_x": (rows, dim), "best_f": (rows,), "history": (rows, T), "evaluation_history": (rows, T),
+            "iterations_done": (rows,)}
+    if record.x_history is not None:
+        want["x_history"] = (rows, T, dim)
+    arrays = {}
+    for key, shape in want.items():
+        try:
+            arrays[key] = a = np.asarray(getattr(record, key), dtype=float)
+        except (TypeError, ValueError):
+            bad(f"{key} is not numbers")
+        if a.shape != shape:
+            bad(f"{key} has shape {a.shape}, expected {shape}")
+    for key in ("best_f", "history"):
+        if np.isnan(arrays[key]).any():
+            bad(f"{key} holds NaN fitness values")
+    ev = arrays["evaluation_history"]
+    if not np.isfinite(ev).all() or (ev < 0).any() or (ev != np.round(ev)).any() or (np.diff(ev, axis=1) < 0).any():
+        bad("evaluation counts must be whole numbers >= 0 that never decrease")
+    done = arrays["iterations_done"]
+    if not np.isfinite(done).all() or (done < 0).any() or (done > iterations).any() or (done != np.round(done)).any():
+        bad(f"iterations_done must be whole numbers in 0..{iterations}")
+    x = arrays["best_x"]
+    found = np.isfinite(arrays["best_f"])
+    if np.isnan(x[found]).any():
+        bad("best_x holds NaN for a run with a finite fitness")
+    tol = 1e-9 * (bounds[:, 1] - bounds[:, 0])
+    outside = found[:, None] & ((x < bounds[:, 0] - tol) | (x > bounds[:, 1] + tol))
+    if outside.any():
+        r, j = map(int, np.argwhere(outside)[0])
+        bad(f"run {r}'s point has variable {j + 1} = {x[r, j]:g} outside the bounds "
+            f"[{bounds[j, 0]:g}, {bounds[j, 1]:g}]")
 
 
 def _concatenate(parts: list[RunRecord]) -> RunRecord:

@@ -175,6 +175,23 @@ class ExternalAlgorithm(Algorithm):
     def budget_for(self, population: int, iterations: int) -> int:
         return int(self.params.evaluations or population * (iterations + 1))
 
+    def resources(self, population: int, iterations: int, dim: int) -> int:
+        """The library's own population (``popsize`` x dim, ``pop_size``, ``population_size``):
+        refused when it exceeds the evaluation budget (its first generation could never be
+        evaluated); else its estimated bytes (about 64 arrays of its points, per worker
+        process), which the job's memory estimate adds to fkopt's own."""
+        from importlib import import_module
+        module = import_module(f"{__package__}.{self.library}_")
+        points = module.library_population(self.method, self.library_params, int(population), int(dim))
+        budget = self.budget_for(population, iterations)
+        if points > budget:
+            raise FkoptError(f"algorithm '{self.library}:{self.method}': its population of {points} points per "
+                             f"generation exceeds the run's budget of {budget} evaluations (population x "
+                             "(iterations + 1), or params.evaluations); lower the library's population")
+        from ..files import available_cpus
+        workers = max(1, min(self.params.workers or 1, available_cpus()))
+        return 64 * 8 * points * max(int(dim), 1) * workers
+
     def minimize(self, problem, *, population: int, iterations: int, streams, target=None,
                  stop_at_target: bool = False, x0=None, snapshots=(), **_ignored) -> RunRecord:
         budget = self.budget_for(population, iterations)

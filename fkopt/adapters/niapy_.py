@@ -48,6 +48,12 @@ def check_params(method: str, target, params: dict) -> None:
     refuse_unknown(f"niapy:{method}", params, _accepted(target), RESERVED)
 
 
+def library_population(method: str, params: dict, population: int, dim: int) -> int:
+    """Points the method holds (``population_size``, default fkopt's population)."""
+    value = params.get("population_size", population)
+    return int(value) if isinstance(value, int) and not isinstance(value, bool) else population
+
+
 def run(method, params, counter, problem, population, budget, seed_seq, x0) -> None:
     cls = resolve(method)
     from niapy.problems import Problem

@@ -54,10 +54,21 @@ def _accepted(cls) -> set[str]:
 
 def check_params(method: str, target, params: dict) -> None:
     refuse_unknown(f"pymoo:{method}", params, _accepted(target), RESERVED)
+    size = params.get("pop_size")
+    if size is not None and (not isinstance(size, int) or isinstance(size, bool) or size < 1):
+        raise FkoptError(f"algorithm 'pymoo:{method}' parameter 'pop_size': {size!r} is not allowed; a whole "
+                         "number >= 1")
+    small = {**params, "pop_size": min(size, 10)} if size is not None else params
     try:
-        target(**_with_pop(target, params, 10))
+        target(**_with_pop(target, small, 10))
     except Exception as err:
         raise FkoptError(f"algorithm 'pymoo:{method}' rejected params {params}: {type(err).__name__}: {err}") from None
+
+
+def library_population(method: str, params: dict, population: int, dim: int) -> int:
+    """Points the method holds and evaluates per generation (``pop_size``, default fkopt's)."""
+    value = params.get("pop_size", population)
+    return int(value) if isinstance(value, int) and not isinstance(value, bool) else population
 
 
 def _with_pop(cls, params: dict, population: int) -> dict:

@@ -34,8 +34,75 @@ def resolve(method: str):
     return getattr(scipy.optimize, method)
 
 
+#: Documented ranges of scipy's numeric options, checked before any run (scipy checks some of
+#: them only once a run has started, others never: dual_annealing with ``maxiter: -1`` runs
+#: forever). name -> (lower, upper, lower open, upper open, whole number); None: unbounded.
+RANGES = {
+    "differential_evolution": {"maxiter": (1, None, False, False, True), "popsize": (1, None, False, False, True),
+                               "recombination": (0, 1, False, False, False), "tol": (0, None, False, False, False),
+                               "atol": (0, None, False, False, False)},
+    "dual_annealing": {"maxiter": (1, None, False, False, True), "initial_temp": (0.01, 5e4, True, False, False),
+                       "restart_temp_ratio": (0, 1, True, True, False), "visit": (1, 3, True, False, False),
+                       "accept": (-1e4, -5, False, False, False)},
+}
+
+
+def _check_range(name: str, key: str, value, rule) -> None:
+    lo, hi, lo_open, hi_open, whole = rule
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and value == value
+    if ok and whole:
+        ok = float(value).is_integer()
+    if ok and lo is not None:
+        ok = value > lo if lo_open else value >= lo
+    if ok and hi is not None:
+        ok = value < hi if hi_open else value <= hi
+    if not ok:
+        span = f"{'(' if lo_open else '['}{lo if lo is not None else '-inf'}, {hi if hi is not None else 'inf'}" \
+               f"{')' if hi_open or hi is None else ']'}"
+        raise FkoptError(f"algorithm '{name}' parameter '{key}': {value!r} is not allowed; "
+                         f"{'a whole number ' if whole else 'a number '}in {span}")
+
+
 def check_params(method: str, target, params: dict) -> None:
-    refuse_unknown(f"scipy:{method}", params, inspect.signature(target).parameters, RESERVED)
+    name = f"scipy:{method}"
+    refuse_unknown(name, params, inspect.signature(target).parameters, RESERVED)
+    for key, rule in RANGES.get(method, {}).items():
+        if key in params:
+            _check_range(name, key, params[key], rule)
+    if method == "differential_evolution":
+        _probe(method, params)
+
+
+def _probe(method: str, params: dict) -> None:
+    """Let scipy check the other options: a run on a 2-D box stopped at its first evaluation."""
+    from .base import Counter, _Stop
+
+    class Box:
+        dim = 2
+        bounds = np.array([[0.0, 1.0], [0.0, 1.0]])
+
+        @staticmethod
+        def fitness(x):
+            return np.zeros(len(x))
+    small = dict(params)
+    if "popsize" in small:
+        small["popsize"] = min(int(small["popsize"]), 5)
+    try:
+        run(method, small, Counter(Box(), 0), Box(), 4, 0, np.random.SeedSequence(0), None)
+    except _Stop:
+        pass
+    except Exception as err:
+        msg = (str(err).strip().splitlines() or [type(err).__name__])[0]
+        from .libraries import library_version
+        raise FkoptError(f"algorithm 'scipy:{method}' (scipy {library_version('scipy')}) rejected params {params}: "
+                         f"{type(err).__name__}: {msg}") from None
+
+
+def library_population(method: str, params: dict, population: int, dim: int) -> int:
+    """Points the method holds and evaluates per generation."""
+    if method == "differential_evolution":
+        return int(params.get("popsize", max(1, ceil_div(population, dim)))) * dim
+    return 1
 
 
 def _rng_kwargs(fn, seed_seq) -> dict:

@@ -131,6 +131,12 @@ class Algorithm:
         """Extra per-run scalars to record each iteration (e.g. ACO pheromone)."""
         return {}
 
+    def resources(self, population: int, iterations: int, dim: int) -> int:
+        """Bytes this algorithm needs beyond fkopt's own arrays of a solve (counted by
+        :func:`fkopt.solve.batch_bytes`), or a one-line error when the settings cannot run;
+        checked for every algorithm of a config before the first starts. 0 for fkopt's own."""
+        return 0
+
     # -- shared --------------------------------------------------------------------------------
     @staticmethod
     def update_best(state: State) -> None:
@@ -160,6 +166,9 @@ class Algorithm:
         """
         runs, dim = streams.runs, problem.dim
         state = self.initialize(problem, population, streams, x0, iterations)
+        if not all(hasattr(state, k) for k in ("x", "f", "evaluations")):
+            raise FkoptError(f"algorithm '{self.name}': initialize returned a {type(state).__name__}, not a State "
+                             "with x, f and evaluations")
         state.best_f = np.full(runs, np.inf)
         state.best_x = np.full((runs, dim), np.nan)
         self.update_best(state)

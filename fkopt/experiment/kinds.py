@@ -206,7 +206,19 @@ def _experiment_validate(config) -> tuple[int, int]:
         size = chunk_size(len(cases), config.runs, pop, its, dim, batch=config.batch,
                           snapshots=len(config.snapshots), x_history=keep_x)
         need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
+        need += algorithm_resources(spec, pop, its, dim)
     return len(config.algorithms) * len(cases), need
+
+
+def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int:
+    """An algorithm's own memory beyond fkopt's arrays (an adapter's library population), or a
+    one-line error naming it when its settings cannot run -- for every algorithm of a config,
+    before the first one starts (:meth:`fkopt.algorithms.base.Algorithm.resources`)."""
+    from ..solve import make_algorithm
+    try:
+        return int(make_algorithm(spec.name, spec.params).resources(population, iterations, dim))
+    except FkoptError as err:
+        raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
 
 
 def _experiment_run(config, out, *, source=None, progress=None, solved=None, **_) -> Outcome:

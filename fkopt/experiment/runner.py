@@ -79,9 +79,32 @@ def task_seed(seed: int, case_index: int, label: str) -> int:
 
 
 def build_mechanism(config: ExperimentConfig):
+    """The config's mechanism, checked before any work: its bounds finite with a finite width
+    (:func:`fkopt.mechanisms.base.check_bounds`), and its closed form giving finite values of
+    the right shape at the centre of the bounds. A plug-in mechanism that raises or returns
+    something else is one line naming it."""
+    from ..mechanisms.base import check_bounds
+    from ..solve import contained, plugin_of
     cls = registry.mechanism_class(config.mechanism.name)
+    who = f"mechanism plug-in '{config.mechanism.name}' ({plugin_of(cls)})" if plugin_of(cls) else None
     geometry = registry.resolve_files(cls, config.mechanism.geometry, getattr(config, "_folder", None))
-    return cls(bounds=dict(config.mechanism.bounds), **geometry)
+    mech = contained(who, lambda: cls(bounds=dict(config.mechanism.bounds), **geometry))
+    name = who or config.mechanism.name
+    names = contained(who, lambda: tuple(mech.unknown_names))
+    check_bounds(name, names, contained(who, lambda: mech.bounds))
+    centre = mech.bounds.mean(axis=1)
+    closed, out_names = (mech.fk, mech.pose_names) if mech.kind == "serial" else (mech.ik, mech.joint_names)
+    try:
+        value = np.asarray(contained(who, lambda: closed(centre)), dtype=float)
+    except (TypeError, ValueError):
+        raise FkoptError(f"{name}: its closed form returned something that is not numbers") from None
+    if value.shape != (len(out_names),):
+        raise FkoptError(f"{name}: its closed form returned shape {value.shape} at the centre of the bounds, "
+                         f"expected ({len(out_names)},) ({', '.join(out_names)})")
+    if np.isnan(value).all():
+        raise FkoptError(f"{name}: its closed form gives only NaN at the centre of the bounds "
+                         f"{centre.round(6).tolist()}; check the geometry")
+    return mech
 
 
 def _check_in_bounds(mech, pose: np.ndarray, where: str) -> None:

@@ -82,8 +82,31 @@ def describe_validation_error(err, where: str) -> str:
     """Collapse a pydantic error into one line: ``where.field: message``."""
     first = err.errors()[0]
     loc = ".".join(str(p) for p in first["loc"])
-    msg = first["msg"]
+    msg = first["msg"].removeprefix("Value error, ")
     return f"{where}.{loc}: {msg}" if loc else f"{where}: {msg}"
+
+
+def check_bounds(name: str, names, bounds) -> np.ndarray:
+    """Search bounds every solver and figure can use: shape (len(names), 2), finite, lower below
+    upper, and a finite width (``[-1e308, 1e308]`` overflows to an infinite width); else one line
+    naming the variable. The one check of bounds -- presets, overrides, URDF limits, plug-ins."""
+    try:
+        b = np.asarray(bounds, dtype=float)
+    except (TypeError, ValueError):
+        raise FkoptError(f"{name} bounds: expected numbers [lower, upper] per variable") from None
+    if b.shape != (len(names), 2):
+        raise FkoptError(f"{name} bounds: expected shape ({len(names)}, 2) for {', '.join(names)}, got {b.shape}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        width = b[:, 1] - b[:, 0]
+    for n, (lo, hi), w in zip(names, b, width):
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise FkoptError(f"{name} bounds.{n}: [{lo:g}, {hi:g}] must be finite numbers")
+        if not lo < hi:
+            raise FkoptError(f"{name} bounds.{n}: lower {lo:g} must be below upper {hi:g}")
+        if not np.isfinite(w) or w > 1e150:
+            raise FkoptError(f"{name} bounds.{n}: [{lo:g}, {hi:g}] is too wide (width {w:g}); "
+                             "bounds must span at most 1e150")
+    return b
 
 
 class Mechanism:
@@ -149,9 +172,7 @@ class Mechanism:
                 raise FkoptError(f"{self.name} bounds.{key}: expected [lower, upper], got {value!r}") from None
             bounds[key] = (lo, hi)
         out = np.array([bounds[n] for n in names], dtype=float)
-        for n, (lo, hi) in zip(names, out):
-            if not lo < hi:
-                raise FkoptError(f"{self.name} bounds.{n}: lower {lo:g} must be below upper {hi:g}")
+        check_bounds(self.name, names, out)
         return out
 
     def in_bounds(self, x, tol: float = 1e-9) -> np.ndarray:

@@ -79,8 +79,23 @@ def general_bounds(base, platform, probe) -> dict[str, tuple[float, float]]:
     return out
 
 
+def degenerate(points, what: str) -> str | None:
+    """Why six joint points cannot make a 6-SPS (two coincide, or all lie on one line), else None."""
+    pts = np.asarray(points, dtype=float)
+    d = np.linalg.norm(pts[:, None, :] - pts[None, :, :], axis=-1)
+    scale = max(float(d.max()), 1e-300)
+    i, j = np.triu_indices(6, 1)
+    close = d[i, j] <= 1e-9 * scale
+    if close.any() or scale <= 1e-300:
+        k = int(np.argmax(close)) if close.any() else 0
+        return f"{what} joints {i[k] + 1} and {j[k] + 1} coincide ({pts[i[k]].tolist()})"
+    if np.linalg.matrix_rank(pts - pts.mean(axis=0), tol=1e-9 * scale) < 2:
+        return f"all six {what} joints lie on one line"
+    return None
+
+
 def _six_sps_geometry():
-    from pydantic import Field
+    from pydantic import Field, model_validator
     from .base import Geometry
 
     class SixSPSGeometry(Geometry):
@@ -89,6 +104,14 @@ def _six_sps_geometry():
                                   description="six platform joints p_i [x, y, z] (platform frame)")
         probe: Vec3 = Field((0.0, 0.0, 0.0),
                             description="probe offset s in the platform frame; the pose locates p_s = origin + R s")
+
+        @model_validator(mode="after")
+        def _not_degenerate(self):
+            why = degenerate(self.base, "base") or degenerate(self.platform, "platform")
+            if why:
+                raise ValueError(f"degenerate geometry: {why}; six distinct joints not on one line "
+                                 "are needed on the base and on the platform")
+            return self
 
     SixSPSGeometry.__module__ = __name__
     return SixSPSGeometry
@@ -246,7 +269,10 @@ class SixSPS(ParallelMechanism):
             w2 = r20 * q0 + r21 * q1 + r22 * q2
             v0, v1, v2 = w0 + x - b0, w1 + y - b1, w2 + z - b2
             L = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-            u0, u1, u2 = v0 / L, v1 / L, v2 / L
+            if L == 0.0:      # a leg of length 0 (joints coincide): no direction, a zero row
+                u0 = u1 = u2 = 0.0
+            else:
+                u0, u1, u2 = v0 / L, v1 / L, v2 / L
             m0, m1, m2 = w1 * u2 - w2 * u1, w2 * u0 - w0 * u2, w0 * u1 - w1 * u0
             lengths.append(L)
             J.append([u0, u1, u2, (r00 * m0 + r10 * m1 + r20 * m2) * _D2R, (cg * m1 - sg * m0) * _D2R,

@@ -44,10 +44,19 @@ class URDFGeometry(Geometry):
     tip: str | None = Field(None, description="last link of the chain (default: the only leaf link)")
 
 
+#: Largest URDF file read (bytes): a robot description with meshes referenced, not inlined, is
+#: kilobytes; a parsed tree takes ~35 times its file size in memory.
+MAX_URDF_BYTES = 4 << 20
+
+
 def _load(path: Path):
     """Parse with yourdfpy; every failure is one line naming the file."""
     if not path.is_file():
         raise FkoptError(f"urdf geometry.file: {path} does not exist")
+    size = path.stat().st_size
+    if size > MAX_URDF_BYTES:
+        raise FkoptError(f"urdf {path}: {size} bytes, larger than the {MAX_URDF_BYTES} bytes accepted for "
+                         "a URDF file")
     try:
         import yourdfpy
     except ImportError:
@@ -134,6 +143,10 @@ class URDFArm(FrameArm):
         for j in chain:
             origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
             axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
+            for what, value in (("origin", origin), ("axis", axis)):
+                if not np.all(np.isfinite(value)):
+                    raise FkoptError(f"urdf {path}: joint '{j.name}' {what} holds a value that is not a finite "
+                                     "number (NaN or inf)")
             if j.type in MOVING:
                 norm = float(np.linalg.norm(axis))
                 if not norm > 0:
@@ -149,6 +162,10 @@ class URDFArm(FrameArm):
                     limits[j.name] = CONTINUOUS_BOUNDS
                 else:
                     lo, hi = float(lim.lower), float(lim.upper)
+                    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+                        raise FkoptError(f"urdf {path}: joint '{j.name}' <limit lower=\"{lim.lower}\" "
+                                         f"upper=\"{lim.upper}\">: finite numbers, lower below upper, are "
+                                         "needed (a joint without limits is type=\"continuous\")")
                     limits[j.name] = (lo, hi) if prismatic else (round(float(np.degrees(lo)), 9),
                                                                  round(float(np.degrees(hi)), 9))
             steps.append((j.type, origin[:3, :3].copy(), origin[:3, 3].copy(), axis))

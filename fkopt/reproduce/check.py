@@ -71,12 +71,22 @@ def same_platform(exp: Experiment) -> bool:
     return stored == fingerprint()
 
 
-def check_experiment(exp: Experiment, config=None, exact: bool | None = None) -> list[Mismatch]:
+def check_experiment(exp: Experiment, config=None, exact: bool | None = None,
+                     allow_plugins: bool = False) -> list[Mismatch]:
     """Mismatches of one stored result (any kind) against a rerun; ``[]`` when it matches.
 
     ``exact`` forces the byte-for-byte (True) or the tolerant (False) comparison; by default it
-    is chosen by the platform fingerprint.
+    is chosen by the platform fingerprint. The stored config names its mechanism and algorithms:
+    only built-in names and registered entry points are resolved (a direct reference
+    ``package.module:Class`` in someone else's meta.json is refused, not imported) unless
+    ``allow_plugins`` (:func:`fkopt.registry.registered_only`).
     """
+    from ..registry import registered_only
+    with registered_only(not allow_plugins):
+        return _check_experiment(exp, config, exact)
+
+
+def _check_experiment(exp: Experiment, config, exact: bool | None) -> list[Mismatch]:
     label = _label(exp)
     problem = exp.meta_error()
     if problem:

@@ -9,6 +9,7 @@ from .config import StudyConfig, study_from_dict
 
 
 def _validate(config: StudyConfig) -> tuple[int, int]:
+    from ..experiment.kinds import algorithm_resources
     from ..solve import batch_bytes, chunk_size
     from .runner import plan_tasks, validate_study
     mech, poses = validate_study(config)
@@ -20,7 +21,8 @@ def _validate(config: StudyConfig) -> tuple[int, int]:
         pop = spec.population or config.population
         its = spec.iterations or config.iterations
         size = chunk_size(cases, config.runs, pop, its, dim)      # refuses a solve over the per-solve limit
-        work = max(work, batch_bytes(cases * config.runs, size, pop, its, dim))
+        work = max(work, batch_bytes(cases * config.runs, size, pop, its, dim)
+                   + algorithm_resources(spec, pop, its, dim))
         # kept for every (pose, run): fitness, counts, solution, as JSON task records (~10x)
         kept += n * config.runs * (dim + 6) * 8 * 10
     return len(plan_tasks(config, n)), work + kept
