@@ -461,6 +461,270 @@ def test_jobs_10000_starts_no_more_processes_than_cpus(tmp_path, monkeypatch):
     assert asked in ([], [min(6, available_cpus())]) and (asked or available_cpus() == 1)
 
 
+# -- class 3: geometry, bounds and limits validated before computing --------------------------------
+URDF_ARM = """<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base"/><link name="l1"/><link name="tip"/>
+  <joint name="q1" type="revolute"><parent link="base"/><child link="l1"/>
+    <origin xyz="{origin}" rpy="0 0 0"/><axis xyz="{axis}"/><limit lower="{lower}" upper="1.5" effort="1" velocity="1"/></joint>
+  <joint name="q2" type="revolute"><parent link="l1"/><child link="tip"/>
+    <origin xyz="0.3 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-1.5" upper="1.5" effort="1" velocity="1"/></joint>
+</robot>
+"""
+DEGENERATE_6SPS = {"base": [[0, 0, 0] for _ in range(6)], "platform": [[0.1 * i, 0, 0] for i in range(6)]}
+EARLY = [   # (id, config, fragments of the one line)
+    ("bounds-overflow", {**BASE, "mechanism": {"name": "3-rps", "bounds": {"z": [-1e308, 1e308]}}},
+     ["bounds.z", "too wide"]),
+    ("bounds-huge-angles", {**BASE, "mechanism": {"name": "3-rps", "bounds": {"alpha": [-1e200, 1e200]}}},
+     ["bounds.alpha"]),
+    ("urdf-inf-limit", {**BASE, "mechanism": {"name": "urdf", "geometry": {"file": "{urdf_inf}"}},
+                        "cases": {"random": 1, "seed": 1}}, ["q1", "limit", "finite"]),
+    ("urdf-nan-origin", {**BASE, "mechanism": {"name": "urdf", "geometry": {"file": "{urdf_nan}"}},
+                         "cases": {"random": 1, "seed": 1}}, ["q1", "origin", "finite"]),
+    ("urdf-inf-axis", {**BASE, "mechanism": {"name": "urdf", "geometry": {"file": "{urdf_axis}"}},
+                       "cases": {"random": 1, "seed": 1}}, ["q1", "axis", "finite"]),
+    ("urdf-too-large", {**BASE, "mechanism": {"name": "urdf", "geometry": {"file": "{urdf_big}"}},
+                        "cases": {"random": 1, "seed": 1}}, ["larger than"]),
+    ("6sps-degenerate", {**BASE, "mechanism": {"name": "6-sps", "geometry": DEGENERATE_6SPS},
+                         "cases": {"random": 1, "seed": 1}}, ["degenerate", "coincide"]),
+    ("plugin-mech-inf-bounds", {**BASE, "mechanism": {"name": "hostile_plugins:InfiniteBounds"},
+                                "cases": {"random": 1, "seed": 1}}, ["InfiniteBounds", "finite"]),
+    ("plugin-mech-raises", {**BASE, "mechanism": {"name": "hostile_plugins:RaisingMech"},
+                            "cases": {"random": 1, "seed": 1}}, ["RaisingMech", "ZeroDivisionError"]),
+    ("plugin-mech-shape", {**BASE, "mechanism": {"name": "hostile_plugins:WrongShapeMech"},
+                           "cases": {"random": 1, "seed": 1}}, ["WrongShapeMech", "shape"]),
+    # -- class 4 and 5: adapters' parameters and populations, every algorithm before the first ----------
+    ("scipy-de-popsize", {**BASE, "algorithms": [{"name": "scipy:differential_evolution",
+                                                   "params": {"popsize": 3_000_000}}]},
+     ["scipy:differential_evolution", "exceeds the run's budget"]),
+    ("scipy-da-maxiter", {**BASE, "algorithms": [{"name": "scipy:dual_annealing", "params": {"maxiter": -1}}]},
+     ["maxiter", "whole number"]),
+    ("scipy-da-visit", {**BASE, "algorithms": [{"name": "scipy:dual_annealing", "params": {"visit": 100}}]},
+     ["visit"]),
+    ("scipy-de-strategy-second", {**BASE, "algorithms": [{"name": "hostile_plugins:Marks"},
+                                                         {"name": "scipy:differential_evolution",
+                                                          "params": {"strategy": "nope"}}]},
+     ["scipy:differential_evolution", "strategy"]),
+    ("scipy-de-popsize-memory", {**BASE, "algorithms": [{"name": "scipy:differential_evolution",
+                                                         "params": {"popsize": 300_000_000, "evaluations": 10**12}}]},
+     ["GiB of memory"]),
+    ("pymoo-pop-size", {**BASE, "algorithms": [{"name": "pymoo:DE", "params": {"pop_size": 2_000_000}}]},
+     ["pymoo:DE", "exceeds the run's budget"]),
+    # -- class 7: plug-in algorithms contained -------------------------------------------------------------
+    ("plugin-raises", {**BASE, "algorithms": [{"name": "hostile_plugins:Raises"}]}, ["Raises", "RuntimeError", "boom"]),
+    ("plugin-returns-none", {**BASE, "algorithms": [{"name": "hostile_plugins:ReturnsNone"}]},
+     ["ReturnsNone", "NoneType"]),
+    ("plugin-bad-state", {**BASE, "algorithms": [{"name": "hostile_plugins:BadState"}]}, ["BadState", "shape"]),
+    ("plugin-nan-fitness", {**BASE, "algorithms": [{"name": "hostile_plugins:NaNFitness"}]}, ["NaNFitness", "NaN"]),
+    ("plugin-out-of-bounds", {**BASE, "algorithms": [{"name": "hostile_plugins:OutOfBounds"}]},
+     ["OutOfBounds", "outside the bounds"]),
+    ("plugin-negative-evals", {**BASE, "algorithms": [{"name": "hostile_plugins:NegativeEvals"}]},
+     ["NegativeEvals", "evaluations"]),
+    ("plugin-system-exit", {**BASE, "algorithms": [{"name": "hostile_plugins:Exits"}]}, ["Exits", "SystemExit"]),
+    ("plugin-wrong-record", {**BASE, "algorithms": [{"name": "hostile_plugins:WrongRecord"}]},
+     ["WrongRecord", "shape"]),
+    ("plugin-init-raises", {**BASE, "algorithms": [{"name": "hostile_plugins:InitRaises"}]},
+     ["InitRaises", "KeyError"]),
+    ("plugin-module-getattr", {**BASE, "algorithms": [{"name": "hostile_lazy:Anything"}]}, ["no attribute"]),
+]
+
+PLUGINS = r"""
+import numpy as np
+from fkopt.algorithms.base import Algorithm, RunRecord, State
+from fkopt.mechanisms.base import ParallelMechanism
+from fkopt.mechanisms.rps3 import ThreeRPS
+
+
+class Good(Algorithm):
+    name = "good"
+
+    def initialize(self, problem, population, streams, x0, iterations):
+        x = np.broadcast_to(problem.bounds.mean(axis=1), (streams.runs, population, problem.dim)).copy()
+        return State(x=x, f=problem.fitness(x), evaluations=np.full(streams.runs, population))
+
+    def iterate(self, state, problem, streams):
+        state.evaluations = state.evaluations + state.x.shape[1]
+
+
+class Marks(Good):
+    # leaves a mark when it starts: a config refused up front never gets here
+
+    def initialize(self, *args):
+        import pathlib
+        pathlib.Path(__file__).with_name("started").write_text("yes")
+        return super().initialize(*args)
+
+
+class Raises(Good):
+    def iterate(self, state, problem, streams):
+        raise RuntimeError("boom")
+
+
+class InitRaises(Good):
+    def __init__(self, **params):
+        raise KeyError("config")
+
+
+class ReturnsNone(Good):
+    def initialize(self, *args):
+        return None
+
+
+class BadState(Good):
+    def iterate(self, state, problem, streams):
+        state.x = state.x[:, :, :1]
+
+
+class NaNFitness(Good):
+    def iterate(self, state, problem, streams):
+        state.f = np.full_like(state.f, np.nan)
+
+
+class OutOfBounds(Good):
+    def iterate(self, state, problem, streams):
+        state.x = state.x + 1e6
+
+
+class NegativeEvals(Good):
+    def iterate(self, state, problem, streams):
+        state.evaluations = state.evaluations * 0 - 5
+
+
+class Exits(Good):
+    def iterate(self, state, problem, streams):
+        raise SystemExit(0)
+
+
+class WrongRecord(Good):
+    def minimize(self, problem, *, population, iterations, streams, **kw):
+        n = streams.runs
+        return RunRecord(best_x=np.zeros((n, 1)), best_f=np.zeros(n), history=np.zeros((n, iterations + 1)),
+                         x_history=None, evaluation_history=np.zeros((n, iterations + 1), dtype=int),
+                         iterations_done=np.full(n, iterations))
+
+
+class InfiniteBounds(ThreeRPS):
+    name = "infinite"
+    default_bounds = {**ThreeRPS.default_bounds, "z": (-np.inf, np.inf)}
+
+
+class RaisingMech(ThreeRPS):
+    name = "raising"
+
+    def ik(self, poses):
+        return 1 / 0
+
+
+class WrongShapeMech(ThreeRPS):
+    name = "wrong-shape"
+
+    def ik(self, poses):
+        return np.zeros(2)
+"""
+
+LAZY = r"""
+import pathlib
+MARK = pathlib.Path(__file__).with_name("getattr-called")
+
+
+def __getattr__(name):
+    MARK.write_text(name)
+    raise AttributeError(name)
+"""
+
+
+@pytest.fixture
+def plugin_dir(tmp_path, monkeypatch):
+    """Importable plug-in modules (hostile_plugins, hostile_lazy) for this test only."""
+    import importlib
+    folder = tmp_path / "plugins"
+    folder.mkdir()
+    (folder / "hostile_plugins.py").write_text(PLUGINS)
+    (folder / "hostile_lazy.py").write_text(LAZY)
+    monkeypatch.syspath_prepend(str(folder))
+    for name in ("hostile_plugins", "hostile_lazy"):
+        sys.modules.pop(name, None)
+    importlib.invalidate_caches()
+    yield folder
+    for name in ("hostile_plugins", "hostile_lazy", "hostile_marker"):
+        sys.modules.pop(name, None)
+
+
+@pytest.mark.parametrize("case", EARLY, ids=[c[0] for c in EARLY])
+def test_bad_input_fails_before_any_work(case, tmp_path, plugin_dir, cli):
+    ident, config, fragments = case
+    files = {"urdf_inf": URDF_ARM.format(origin="0 0 0.1", axis="0 0 1", lower="-inf"),
+             "urdf_nan": URDF_ARM.format(origin="nan 0 0.1", axis="0 0 1", lower="-1.5"),
+             "urdf_axis": URDF_ARM.format(origin="0 0 0.1", axis="0 inf 1", lower="-1.5"),
+             "urdf_big": URDF_ARM.format(origin="0 0 0.1", axis="0 0 1", lower="-1.5")
+             + "<!-- " + "x" * (5 << 20) + " -->\n"}
+    for key, text in files.items():
+        (tmp_path / f"{key}.urdf").write_text(text)
+    text = yaml_of(config)
+    for key in files:
+        text = text.replace("{" + key + "}", str(tmp_path / f"{key}.urdf"))
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(text)
+    out = tmp_path / "out"
+    one_line_error(cli("run", cfg, "--out", out, "-q"), *fragments)
+    assert not out.exists() or not any(p.is_file() for p in out.rglob("*")), "a refused config wrote a file"
+    assert not (plugin_dir / "getattr-called").exists(), "a module-level __getattr__ was called"
+    assert not (plugin_dir / "started").exists(), "an algorithm started before every one was validated"
+
+
+def test_degenerate_6sps_is_one_line_in_fk(tmp_path, cli):
+    geo = tmp_path / "g.yaml"
+    geo.write_text(yaml_of(DEGENERATE_6SPS))
+    one_line_error(cli("fk", "6-sps", "--joints", "l1=1,l2=1,l3=1,l4=1,l5=1,l6=1", "--geometry", geo),
+                   "degenerate")
+
+
+def test_a_leg_of_length_zero_does_not_divide_by_zero():
+    """Dietmaier's first base and platform joints coincide at the zero pose (leg 1 of length 0)."""
+    from fkopt.mechanisms.sps6 import SixSPS
+    lengths, J = SixSPS().ik_jacobian1([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    assert lengths[0] == 0.0 and J[0][:3] == [0.0, 0.0, 0.0]
+
+
+def test_good_plugin_still_runs(tmp_path, plugin_dir, cli):
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml_of({**BASE, "algorithms": [{"name": "hostile_plugins:Good"}]}))
+    code, _, err = cli("run", cfg, "--out", tmp_path / "out", "-q")
+    assert code == 0, err
+
+
+def test_plugin_failure_in_a_study_worker_is_one_line(tmp_path, plugin_dir, cli):
+    """SystemExit(0) inside iterate, in a study: not exit 0 with nothing written."""
+    cfg = tmp_path / "s.yaml"
+    cfg.write_text(yaml_of({**STUDY, "algorithms": [{"name": "hostile_plugins:Exits"}]}))
+    one_line_error(cli("study", cfg, "--out", tmp_path / "out", "-q"), "Exits", "SystemExit")
+
+
+# -- class 7: fkopt check imports only registered names -------------------------------------------
+def test_check_does_not_import_modules_named_in_stored_results(finished_study, plugin_dir, cli):
+    _, out, final, _ = finished_study
+    (plugin_dir / "hostile_marker.py").write_text(
+        "import pathlib\npathlib.Path(__file__).with_name('imported').write_text('yes')\n")
+    meta = json.loads((final / "meta.json").read_text())
+    meta["config"]["algorithms"][0]["name"] = "hostile_marker:Anything"
+    (final / "meta.json").write_text(json.dumps(meta))
+    code, _, err = cli("check", out, "-q")
+    assert code in (1, 2) and "Traceback" not in err and "--allow-plugins" in err, err
+    assert not (plugin_dir / "imported").exists(), "fkopt check imported a module named by meta.json"
+    code, _, err = cli("check", out, "-q", "--allow-plugins")
+    assert code != 0 and (plugin_dir / "imported").exists()       # asked for: imported (then refused)
+
+
+def test_registered_only_refuses_references_but_not_built_ins():
+    from fkopt import registry
+    from fkopt.errors import FkoptError
+    with registry.registered_only():
+        assert registry.algorithm_class("gabc").__name__ == "GABC"
+        with pytest.raises(FkoptError, match="allow-plugins"):
+            registry.algorithm_class("fkopt.algorithms.gabc:GABC")
+    assert registry.algorithm_class("fkopt.algorithms.gabc:GABC").__name__ == "GABC"
+
+
 # -- interrupted reruns keep the previous result ----------------------------------------------------
 SLOW = {**BASE, "name": "small", "population": 40, "iterations": 3000, "runs": 60,
         "algorithms": [{"name": "abc"}, {"name": "gabc"}, {"name": "pso"}]}

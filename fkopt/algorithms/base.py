@@ -137,6 +137,31 @@ class Algorithm:
         checked for every algorithm of a config before the first starts. 0 for fkopt's own."""
         return 0
 
+    def check_state(self, state, problem, runs: int, step: str) -> None:
+        """A plug-in's state after ``step`` (initialize/iterate), checked before fkopt uses it:
+        x (runs, population, dim) of finite points inside the bounds, f (runs, population)
+        without NaN, evaluations (runs,) of whole numbers >= 0. One line naming the plug-in."""
+        where = f"algorithm '{self.name}' ({type(self).__module__}.{type(self).__qualname__}): {step}"
+        if state is None or not all(hasattr(state, k) for k in ("x", "f", "evaluations")):
+            raise FkoptError(f"{where} returned {type(state).__name__}, not a State with x, f and evaluations")
+        try:
+            x, f = np.asarray(state.x, dtype=float), np.asarray(state.f, dtype=float)
+            ev = np.asarray(state.evaluations, dtype=float)
+        except (TypeError, ValueError):
+            raise FkoptError(f"{where}: state.x, state.f and state.evaluations must be numbers") from None
+        dim = problem.dim
+        if x.ndim != 3 or x.shape[0] != runs or x.shape[2] != dim or f.shape != x.shape[:2]:
+            raise FkoptError(f"{where}: state.x has shape {x.shape} and state.f {f.shape}; expected "
+                             f"(runs={runs}, population, dim={dim}) and (runs, population)")
+        if ev.shape != (runs,) or not np.isfinite(ev).all() or (ev < 0).any() or (ev != np.round(ev)).any():
+            raise FkoptError(f"{where}: state.evaluations must be {runs} whole numbers >= 0, got shape {ev.shape}")
+        if np.isnan(f).any():
+            raise FkoptError(f"{where}: state.f holds NaN fitness values")
+        b = np.asarray(problem.bounds, dtype=float)
+        tol = 1e-9 * (b[:, 1] - b[:, 0])
+        if not np.isfinite(x).all() or ((x < b[:, 0] - tol) | (x > b[:, 1] + tol)).any():
+            raise FkoptError(f"{where}: state.x holds points outside the bounds (or not finite)")
+
     # -- shared --------------------------------------------------------------------------------
     @staticmethod
     def update_best(state: State) -> None:
@@ -166,9 +191,9 @@ class Algorithm:
         """
         runs, dim = streams.runs, problem.dim
         state = self.initialize(problem, population, streams, x0, iterations)
-        if not all(hasattr(state, k) for k in ("x", "f", "evaluations")):
-            raise FkoptError(f"algorithm '{self.name}': initialize returned a {type(state).__name__}, not a State "
-                             "with x, f and evaluations")
+        plugin = not type(self).__module__.startswith("fkopt.")
+        if plugin:
+            self.check_state(state, problem, runs, "initialize")
         state.best_f = np.full(runs, np.inf)
         state.best_x = np.full((runs, dim), np.nan)
         self.update_best(state)
@@ -218,6 +243,8 @@ class Algorithm:
                         last = t - 1
                         break
             self.iterate(state, problem, streams)
+            if plugin:
+                self.check_state(state, problem, runs, "iterate")
             self.update_best(state)
             record(t)
         if stop_at_target and target is not None:
