@@ -299,8 +299,13 @@ def _umask() -> int:
     return mask
 
 
-def write_atomically(final: str | Path, write: Callable[[Path], Any]) -> Path:
+def write_atomically(final: str | Path, write: Callable[[Path], Any],
+                     check: Callable[[Path], Any] | None = None) -> Path:
     """Call ``write(tmp)`` on a hidden temporary sibling of ``final``, then swap it into place.
+
+    ``check(final)``, when given, runs just before the swap (after the computation and the
+    writing): a publish-time check, e.g. that no other run put a different result at ``final``
+    meanwhile; raising from it leaves ``final`` as it is.
 
     A failed or interrupted write (exception, Ctrl-C, kill -9) leaves ``final`` as it was (the
     previous result or nothing); a killed process may leave a hidden ``.<name>.new-*`` folder.
@@ -311,6 +316,8 @@ def write_atomically(final: str | Path, write: Callable[[Path], Any]) -> Path:
     try:
         os.chmod(tmp, 0o777 & ~_umask())      # mkdtemp makes it private; a results folder is not
         write(tmp)
+        if check is not None:
+            check(final)
         swap_into_place(tmp, final)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -160,10 +160,10 @@ def write_outputs(kind: str, result: Any, folder: str | Path, *, figures: bool =
     return written + [META_FILE, ENV_FILE]
 
 
-def write_result(kind: str, result: Any, out: str | Path) -> Path:
+def write_result(kind: str, result: Any, out: str | Path, check=None) -> Path:
     """Write ``result``'s folder ``OUT/<paper>/<name>/`` aside and swap it into place
     (:func:`fkopt.files.write_atomically`: a failed or interrupted write never leaves a
     half-written folder and never loses the previous one)."""
     from .files import output_folder, write_atomically
     folder = output_folder(out, *result.config.folder_parts)
-    return write_atomically(folder, lambda tmp: write_outputs(kind, result, tmp))
+    return write_atomically(folder, lambda tmp: write_outputs(kind, result, tmp), check)

@@ -725,6 +725,30 @@ def test_registered_only_refuses_references_but_not_built_ins():
     assert registry.algorithm_class("fkopt.algorithms.gabc:GABC").__name__ == "GABC"
 
 
+# -- class 8: two runs into one paper/name at once ------------------------------------------------
+def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli, monkeypatch):
+    """Run A (seed 1) computes; meanwhile run B (seed 99) publishes into the same paper/name. A
+    must not replace B's result without --force: it is refused at publish time, one line."""
+    from fkopt.experiment import runner
+    from fkopt.experiment.kinds import from_dict, run_config
+    out = tmp_path / "out"
+    cfg = tmp_path / "a.yaml"
+    cfg.write_text(yaml_of({**BASE, "name": "same"}))
+    real = runner.run_experiment
+
+    def meanwhile(config, **kw):
+        result = real(config, **kw)
+        if config.seed == 1:              # the other run finishes while this one computes
+            run_config(from_dict({**BASE, "name": "same", "seed": 99}, "other"), out)
+        return result
+    monkeypatch.setattr(runner, "run_experiment", meanwhile)
+    one_line_error(cli("run", cfg, "--out", out, "-q"), "--force", "another fkopt run")
+    assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 99
+    monkeypatch.setattr(runner, "run_experiment", real)
+    assert cli("run", cfg, "--out", out, "-q", "--force")[0] == 0      # asked for: replaced
+    assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 1
+
+
 # -- interrupted reruns keep the previous result ----------------------------------------------------
 SLOW = {**BASE, "name": "small", "population": 40, "iterations": 3000, "runs": 60,
         "algorithms": [{"name": "abc"}, {"name": "gabc"}, {"name": "pso"}]}

@@ -126,9 +126,9 @@ def _validate(config: AssemblyConfig) -> tuple[int, int]:
     return 1, starts * len(mech.unknown_names) ** 2 * 8 * 40
 
 
-def _run(config: AssemblyConfig, out, *, source=None, progress=None, **_):
+def _run(config: AssemblyConfig, out, *, source=None, progress=None, publish_check=None, **_):
     ar = run_assembly(config, source)
-    return Outcome(write_result(KIND, ar, out), ar.wall_s, ar.solutions)
+    return Outcome(write_result(KIND, ar, out, publish_check), ar.wall_s, ar.solutions)
 
 
 def _rerun_files(config: AssemblyConfig, folder: Path, source: str | None) -> None:

@@ -185,6 +185,16 @@ def run_config(config, out: str | Path, *, source: str | None = None, progress=N
     if not checked:
         validate_any(config, source)
         prepare_output(config, out, force)
+
+    def publish_check(folder: Path) -> None:
+        # checked again at publish time: another fkopt run may have written a result of a
+        # different config there while this one computed (two runs at once into one paper/name)
+        try:
+            check_overwrite(folder, config, force)
+        except FkoptError as err:
+            raise FkoptError(f"{err} (it was written by another fkopt run while this one computed; "
+                             "nothing of this run was published)") from None
+    options.setdefault("publish_check", publish_check)
     return kind.run(config, out, source=source, progress=progress, **options)
 
 
@@ -221,10 +231,10 @@ def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int
         raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
 
 
-def _experiment_run(config, out, *, source=None, progress=None, solved=None, **_) -> Outcome:
+def _experiment_run(config, out, *, source=None, progress=None, solved=None, publish_check=None, **_) -> Outcome:
     from .runner import run_experiment
     er = run_experiment(config, source=source, progress=progress, solved=solved)
-    return Outcome(write_result("experiment", er, out), er.wall_s, er)
+    return Outcome(write_result("experiment", er, out, publish_check), er.wall_s, er)
 
 
 def _experiment_rerun(config, folder: Path, source: str | None) -> None:

@@ -29,10 +29,11 @@ def _validate(config: StudyConfig) -> tuple[int, int]:
 
 
 def _run(config: StudyConfig, out, *, source=None, progress=None, jobs: int = 1, executor: str = "local",
-         scheduler: str | None = None, resume: bool = False, keep_tasks: bool = True, **_) -> Outcome:
+         scheduler: str | None = None, resume: bool = False, keep_tasks: bool = True, publish_check=None,
+         **_) -> Outcome:
     from .runner import run_study
     result = run_study(config, out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,
-                       progress=progress, source=source, keep_tasks=keep_tasks)
+                       progress=progress, source=source, keep_tasks=keep_tasks, publish_check=publish_check)
     return Outcome(result.folder, result.wall_s, result)
 
 

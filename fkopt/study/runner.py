@@ -438,14 +438,15 @@ def _write_manifest(study_file: Path, config: StudyConfig, digests: dict[str, st
 def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
               scheduler: str | None = None, resume: bool = False,
               progress: Callable[[str, int, int], None] | None = None, source: str | None = None,
-              write: bool = True, keep_tasks: bool = True) -> StudyResult:
+              write: bool = True, keep_tasks: bool = True, publish_check=None) -> StudyResult:
     """Run (or resume) a study into ``OUT/<paper>/<name>/`` and write its report files.
 
     ``progress(label, done, total)`` is called after each finished task (``done`` counts the
     tasks already on disk too). An exception raised by it (e.g. KeyboardInterrupt) stops the
     study; every task finished so far stays in :func:`work_folder` for ``resume=True``, and a
     previous result stays complete. ``keep_tasks=False`` drops the task files once the study
-    is written (``fkopt reproduce``).
+    is written (``fkopt reproduce``). ``publish_check(folder)`` runs just before the result is
+    swapped into place (:func:`fkopt.files.write_atomically`).
 
     Every task file is recorded with its SHA-256 in ``tasks/study.json`` as it is written;
     ``resume`` reuses only files that still have it and hold a task of this study.
@@ -497,7 +498,7 @@ def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1
                 _guard(out, work / TASKS)
                 os.replace(work / TASKS, tmp / TASKS)
 
-        write_atomically(folder, fill)
+        write_atomically(folder, fill, publish_check)
         shutil.rmtree(work, ignore_errors=True)
     return result
 
