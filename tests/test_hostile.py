@@ -421,6 +421,16 @@ def test_resume_reuses_verified_tasks(finished_study, cli):
         {k: v for k, v in before.items() if k.endswith(".csv") and "timing" not in k}
 
 
+@pytest.mark.parametrize("content", [b"claim,verdict\n\xff\xfe caf\xe9,holds\n", b"\x00\x01\x02garbage",
+                                     b"a,b\n1,2\n"], ids=["latin1", "binary", "columns"])
+def test_check_with_a_corrupt_claims_csv_is_one_failure_line(finished_study, cli, content):
+    _, out, final, _ = finished_study
+    (final.parent / "claims.csv").write_bytes(content)
+    code, _, err = cli("check", out, "-q")
+    assert code == 1 and "Traceback" not in err, err
+    assert "claims.csv" in err.strip().splitlines()[-1]
+
+
 # -- class 4 and 5: workers, Dask addresses -------------------------------------------------------
 @pytest.mark.parametrize("address", ["not an address", "tcp://host:99999", "tcp://:80", "http://x:1/",
                                      "tcp://127.0.0.1:1"],

@@ -238,6 +238,26 @@ def claims_frame(claims: list[Claim]) -> pd.DataFrame:
     return pd.DataFrame([{"claim": c.text, "verdict": c.verdict} for c in claims], columns=["claim", "verdict"])
 
 
+#: Largest claims.csv read (bytes).
+MAX_CLAIMS_BYTES = 4 << 20
+
+
+def read_claims(file: str | Path) -> dict[str, str]:
+    """A stored ``claims.csv`` as {claim: verdict}; a file that is not UTF-8, too large, not a
+    CSV or without the ``claim`` and ``verdict`` columns is one line naming it."""
+    import io
+    from ..errors import FkoptError
+    from ..files import read_text
+    text = read_text(file, MAX_CLAIMS_BYTES)
+    try:
+        df = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
+    except (ValueError, pd.errors.ParserError) as err:
+        raise FkoptError(f"{file}: not a CSV table ({(str(err).splitlines() or [''])[0][:200]})") from None
+    if list(df.columns[:2]) != ["claim", "verdict"]:
+        raise FkoptError(f"{file}: expected the columns claim, verdict; got {', '.join(map(str, df.columns[:4]))}")
+    return dict(zip(df.claim, df.verdict))
+
+
 def verdict_changes(root: str | Path) -> list[tuple[str, str, str, str]]:
     """(paper, claim, stored verdict, recomputed verdict) for every claim whose verdict computed
     from the results under ``root`` differs from the stored ``<paper>/claims.csv`` (``(absent)``
@@ -252,8 +272,7 @@ def verdict_changes(root: str | Path) -> list[tuple[str, str, str, str]]:
         file = root / paper / CLAIMS_FILE
         if mod is None or not file.exists():
             continue
-        stored = pd.read_csv(file)
-        stored = dict(zip(stored.claim, stored.verdict))
+        stored = read_claims(file)
         now = {c.text: c.verdict for c in mod.claims(store)}
         for text in sorted(set(stored) | set(now)):
             a, b = stored.get(text, "(absent)"), now.get(text, "(absent)")
@@ -268,8 +287,14 @@ def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
     import shutil
     import tempfile
     from ..compare import Mismatch
+    from ..errors import FkoptError
     if not (exp.folder.parent / CLAIMS_FILE).exists():
         return []
+    try:
+        read_claims(exp.folder.parent / CLAIMS_FILE)
+    except FkoptError as err:
+        return [Mismatch(f"{exp.paper}/{exp.name}", CLAIMS_FILE, "-", "file", str(err),
+                         "a UTF-8 CSV with claim, verdict", "readable")]
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-claims-"))
     try:
         shutil.copytree(exp.folder.parent, tmp / exp.paper)
