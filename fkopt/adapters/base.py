@@ -169,8 +169,36 @@ class ExternalAlgorithm(Algorithm):
         super().__init__(**params)
         self.library_params = dict(self.params.model_extra or {})
         from importlib import import_module
-        import_module(f"{__package__}.{self.library}_").check_params(self.method, self.target,
-                                                                      self.library_params)
+        module = import_module(f"{__package__}.{self.library}_")
+        module.check_params(self.method, self.target, self.library_params)
+        small = getattr(module, "probe_params", lambda *_: None)(self.method, self.library_params)
+        if small is not None:
+            self.probe(small)
+
+    def probe(self, params: dict) -> None:
+        """Let the library check its options: one run on a 2-D box, stopped at its first
+        evaluation (budget 0), before any real run starts; a rejection is one line."""
+        class Box:
+            dim = 2
+            bounds = np.array([[0.0, 1.0], [0.0, 1.0]])
+            variable_names = ("u", "v")
+
+            @staticmethod
+            def fitness(x):
+                return np.zeros(len(x))
+        try:
+            _runner(self.library)(self.method, dict(params), Counter(Box(), 0), Box(), 4, 0,
+                                  np.random.SeedSequence(0), None)
+        except _Stop:
+            pass
+        except FkoptError:
+            raise
+        except Exception as err:
+            from .libraries import library_version
+            msg = (str(err).strip().splitlines() or [type(err).__name__])[0]
+            raise FkoptError(f"algorithm '{self.library}:{self.method}' ({self.library} "
+                             f"{library_version(self.library)}) rejected params {self.library_params}: "
+                             f"{type(err).__name__}: {msg}") from None
 
     def budget_for(self, population: int, iterations: int) -> int:
         return int(self.params.evaluations or population * (iterations + 1))

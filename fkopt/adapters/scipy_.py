@@ -69,33 +69,18 @@ def check_params(method: str, target, params: dict) -> None:
     for key, rule in RANGES.get(method, {}).items():
         if key in params:
             _check_range(name, key, params[key], rule)
-    if method == "differential_evolution":
-        _probe(method, params)
 
 
-def _probe(method: str, params: dict) -> None:
-    """Let scipy check the other options: a run on a 2-D box stopped at its first evaluation."""
-    from .base import Counter, _Stop
-
-    class Box:
-        dim = 2
-        bounds = np.array([[0.0, 1.0], [0.0, 1.0]])
-
-        @staticmethod
-        def fitness(x):
-            return np.zeros(len(x))
+def probe_params(method: str, params: dict) -> dict | None:
+    """Parameters for a probe run that lets scipy check the options fkopt does not know
+    (:meth:`fkopt.adapters.base.ExternalAlgorithm.probe`); None: no probe (dual_annealing
+    checks nothing before it evaluates)."""
+    if method != "differential_evolution":
+        return None
     small = dict(params)
     if "popsize" in small:
         small["popsize"] = min(int(small["popsize"]), 5)
-    try:
-        run(method, small, Counter(Box(), 0), Box(), 4, 0, np.random.SeedSequence(0), None)
-    except _Stop:
-        pass
-    except Exception as err:
-        msg = (str(err).strip().splitlines() or [type(err).__name__])[0]
-        from .libraries import library_version
-        raise FkoptError(f"algorithm 'scipy:{method}' (scipy {library_version('scipy')}) rejected params {params}: "
-                         f"{type(err).__name__}: {msg}") from None
+    return small
 
 
 def library_population(method: str, params: dict, population: int, dim: int) -> int:
