@@ -298,3 +298,15 @@ def test_rank_rules_see_a_real_shift_and_forgive_noise():
     other.loc[: n // 2, "x_a"] = -1.0                      # half the runs on another solution
     bad = compare_runs("e", "runs.csv", base.astype(str), other.astype(str), rules)
     assert [m.column for m in bad] == ["solutions"]
+
+
+def test_a_study_run_moved_is_caught_by_its_recomputed_fitness(tmp_path):
+    from fkopt.reproduce.check import recomputed_fitness
+    from fkopt.experiment.kinds import from_dict
+    folder = _copy(tmp_path, "studies", "3rps_slice")
+    exp = Store(folder.parents[1]).get("studies", "3rps_slice")
+    config = from_dict(dict(exp.config), "studies/3rps_slice")
+    assert recomputed_fitness(exp, config) == []
+    _edit_csv(folder, "runs.csv", 7, "x_z", lambda v: v + 0.5)
+    bad = recomputed_fitness(Store(folder.parents[1]).get("studies", "3rps_slice"), config)
+    assert [(m.file, m.column) for m in bad] == [("runs.csv", "final_fitness")] and "pose" in bad[0].row

@@ -110,7 +110,7 @@ def rules_for(exp: Experiment, tier: str) -> Rules:
 
 
 def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
-    """The fitness of every stored run of an experiment recomputed from its stored ``x``, against
+    """The fitness of every stored run of an experiment or study recomputed from its stored ``x``, against
     the stored ``final_fitness`` (on every platform).
 
     ``runs.csv`` keeps 10 significant digits, so x is known to within d_i = 5e-10 |x_i|. The
@@ -119,24 +119,33 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     residual and 2 for safety), plus the stored fitness' own rounding (5e-10 relative).
     """
     from ..experiment.kinds import config_kind
-    if config_kind(config).name != "experiment" or not (exp.folder / "runs.csv").is_file():
+    kind = config_kind(config).name
+    if kind not in ("experiment", "study") or not (exp.folder / "runs.csv").is_file():
         return []
-    from ..experiment.runner import build_cases, build_mechanism, build_problem
+    from ..experiment.runner import build_cases, build_mechanism, build_problem, make_problem
     label = _label(exp)
     try:
         runs = pd.read_csv(exp.folder / "runs.csv")
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
         return [Mismatch(label, "runs.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
     mech = build_mechanism(config)
+    if kind == "experiment":
+        groups = [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
+                  for case in build_cases(config, mech)]
+    else:                               # a study: one problem per pose of its pose set (runs.csv: pose = i + 1)
+        from ..study.poses import build_poses
+        poses = build_poses(config, mech)
+        groups = [(f"pose {i + 1}", runs["pose"] == i + 1, lambda i=i: make_problem(config, mech, poses.inputs[i]))
+                  for i in range(len(poses))]
     out = []
-    for case in build_cases(config, mech):
-        rows = runs[runs["case"].astype(str) == case.label]
+    for where, sel, make in groups:
+        rows = runs[sel]
         if rows.empty:
             continue
-        problem = build_problem(config, mech, case)
+        problem = make()
         xs = [c for c in runs.columns if c.startswith("x_")]
         if len(xs) != problem.dim:
-            return [Mismatch(label, "runs.csv", case.label, "x", f"{len(xs)} x columns", f"{problem.dim} variables",
+            return [Mismatch(label, "runs.csv", where, "x", f"{len(xs)} x columns", f"{problem.dim} variables",
                              "one x column per variable")]
         x = rows[xs].to_numpy(float)
         stored = rows["final_fitness"].to_numpy(float)
@@ -151,7 +160,7 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
         bad = ~(np.abs(f0 - stored) <= tol)
         for i in np.flatnonzero(bad)[:3]:
             row = rows.iloc[i]
-            out.append(Mismatch(label, "runs.csv", f"{case.label} / {row['algorithm']} / {row['run']}",
+            out.append(Mismatch(label, "runs.csv", f"{where} / {row['algorithm']} / {row['run']}",
                                 "final_fitness", float(stored[i]), float(f0[i]),
                                 f"fitness(x) of the stored x, within {tol[i]:.2g} (10 digits of x; every platform)"))
     return out
