@@ -310,3 +310,12 @@ def test_a_study_run_moved_is_caught_by_its_recomputed_fitness(tmp_path):
     _edit_csv(folder, "runs.csv", 7, "x_z", lambda v: v + 0.5)
     bad = recomputed_fitness(Store(folder.parents[1]).get("studies", "3rps_slice"), config)
     assert [(m.file, m.column) for m in bad] == [("runs.csv", "final_fitness")] and "pose" in bad[0].row
+
+
+def test_check_cli_tolerant_forces_the_cross_platform_rules(tmp_path, cli):
+    folder = _copy(tmp_path)
+    code, out, err = cli("check", folder, "--tolerant")
+    assert code == 0, err
+    assert "ok   mao2017/tab6 (blas rules)" in out
+    code, _, err = cli("check", folder, "--tier", "fuzzy")
+    assert code == 2 and "--tier: 'fuzzy' unknown; allowed: auto, exact, blas, any" in err
