@@ -94,9 +94,10 @@ def rules_for(exp: Experiment, tier: str) -> Rules:
     cfg = exp.config if isinstance(exp.config, dict) else {}
     mech = cfg.get("mechanism") or {}
     try:
-        mech_ok = bool(getattr(mechanism_class(mech.get("name")), "blas_free_fitness", False))
+        mech_cls = mechanism_class(mech.get("name"))
+        mech_ok, isolated = bool(getattr(mech_cls, "blas_free_fitness", False)), mech_cls.kind == "parallel"
     except Exception:   # an unknown or unloadable mechanism: assume BLAS on its path
-        mech_ok = False
+        mech_ok, isolated = False, False
     free = set()
     for a in cfg.get("algorithms") or []:
         try:
@@ -106,7 +107,7 @@ def rules_for(exp: Experiment, tier: str) -> Rules:
             pass
     threshold = cfg.get("threshold")
     reach = float(threshold) if isinstance(threshold, (int, float)) and threshold > 0 else Rules.reach
-    return Rules(tier, lambda label: label not in free, reach)
+    return Rules(tier, lambda label: label not in free, reach, isolated)
 
 
 def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
