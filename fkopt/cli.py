@@ -464,12 +464,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
+    from .reproduce.changes import snapshot, write_changes
     from .reproduce.report import write_report
     from .reproduce.run import default_jobs, plan, run_all
 
     if jobs is not None and jobs < 1:
         raise FkoptError(f"--jobs: must be at least 1, got {jobs}")
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
+    before = snapshot(out)              # what the tree held, for CHANGES.md
     con = _console()
     start = time.perf_counter()
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
@@ -494,7 +496,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
                        jobs=default_jobs() if jobs is None else jobs, solving=solving)
-    paths = write_report(out)
+    paths = write_report(out) + [write_changes(out, before)]
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")

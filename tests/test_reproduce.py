@@ -319,3 +319,18 @@ def test_check_cli_tolerant_forces_the_cross_platform_rules(tmp_path, cli):
     assert "ok   mao2017/tab6 (blas rules)" in out
     code, _, err = cli("check", folder, "--tier", "fuzzy")
     assert code == 2 and "--tier: 'fuzzy' unknown; allowed: auto, exact, blas, any" in err
+
+
+def test_changes_say_what_a_regeneration_moved(tmp_path):
+    from fkopt.reproduce.changes import describe, snapshot
+    folder = _copy(tmp_path)
+    shutil.copy(RESULTS / "mao2017" / "claims.csv", folder.parent / "claims.csv")
+    before = snapshot(tmp_path / "results")
+    assert "Unchanged (every deterministic file byte-identical): mao2017/tab6." in describe(before, tmp_path / "results")
+    _edit_csv(folder, "summary.csv", 0, "mean_evaluations", lambda v: v + 20)
+    claims = (folder.parent / "claims.csv").read_text().splitlines()
+    claims[1] = claims[1].rsplit(",", 1)[0] + ",not held" if claims[1].endswith(",held") else claims[1].rsplit(",", 1)[0] + ",held"
+    (folder.parent / "claims.csv").write_text("\n".join(claims) + "\n")
+    text = describe(before, tmp_path / "results")
+    assert "## mao2017/tab6" in text and "`summary.csv`" in text and "mean_evaluations" in text and "→" in text
+    assert "## Verdicts that changed" in text and "mao2017:" in text
