@@ -431,7 +431,7 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
     if fmt not in FORMATS:
         raise FkoptError(f"--format: unknown format '{fmt}'; allowed: {', '.join(FORMATS)}")
     files = ioh_export(results, out)
-    typer.echo(f"wrote {len(files) - 1} IOHprofiler index files (.json) and their .dat files to {out}")
+    typer.echo(f"wrote {len(files)} IOHprofiler index files (.json) and their .dat files to {out}")
 
 
 @app.command()
