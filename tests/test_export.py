@@ -3,6 +3,7 @@ against the IOHprofiler project's own artefacts: the files ``ioh.logger.Analyzer
 ``iohinspector``'s reader."""
 import gzip
 import json
+import warnings
 import zlib
 
 import numpy as np
@@ -159,7 +160,8 @@ def test_ioh_export_has_the_analyzer_layout_and_loads_in_iohinspector(stored, tm
         assert dat.startswith(" ".join(ATTRIBUTES) + "\n1 ")
     assert (ref_file.parent / ref["scenarios"][0]["path"]).read_text().startswith(" ".join(ATTRIBUTES) + "\n1 ")
 
-    with _no_warnings():
+    with warnings.catch_warnings():     # iohinspector warns (and skips) on a file it cannot read
+        warnings.simplefilter("error")
         dm = iohinspector.DataManager()
         dm.add_folder(str(out))
     overview = dm.overview.to_pandas()
@@ -185,19 +187,6 @@ def test_ioh_export_has_the_analyzer_layout_and_loads_in_iohinspector(stored, tm
             assert run.evals == t.evaluations.iloc[-1] and run.best.y == pytest.approx(t.best_fitness.iloc[-1], rel=1e-9)
             checked += 1
     assert checked == 30
-
-
-class _no_warnings:
-    """iohinspector warns (and skips) instead of raising on a file it cannot read."""
-
-    def __enter__(self):
-        import warnings
-        self._cm = warnings.catch_warnings()
-        self._cm.__enter__()
-        warnings.simplefilter("error")
-
-    def __exit__(self, *exc):
-        self._cm.__exit__(*exc)
 
 
 def test_export_refuses_what_it_must_not_touch(stored, tmp_path):
