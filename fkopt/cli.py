@@ -667,6 +667,8 @@ def main() -> None:
         kind = type(err).__name__
         if kind == "Exit":
             sys.exit(getattr(err, "exit_code", 0))
+        if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
+            fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
         if kind == "Abort":
             print("fkopt: interrupted", file=sys.stderr)
             sys.exit(130)

@@ -284,3 +284,21 @@ def test_bomb_is_measured_not_unpacked_into_memory(tmp_path):
     assert len(read_trace(tmp_path, limit=4 << 20)) > 100_000
     with gzip.open(tmp_path / "trace.csv.gz", "rb") as fh:
         assert fh.read(8) == b"case,alg"
+
+
+def test_an_eof_anywhere_is_an_error_not_an_interruption(monkeypatch, capsys, tmp_path):
+    """click turns an EOFError into Abort ("interrupted", 130); fkopt says what it is instead."""
+    import sys
+
+    import fkopt.export
+    from fkopt.cli import main
+
+    def truncated(*args, **kwargs):
+        raise EOFError("Compressed file ended before the end-of-stream marker was reached")
+    monkeypatch.setattr(fkopt.export, "ioh_export", truncated)
+    monkeypatch.setattr(sys, "argv", ["fkopt", "export", str(tmp_path), "--out", str(tmp_path / "o")])
+    with pytest.raises(SystemExit) as exc:
+        main()
+    err = capsys.readouterr().err.strip()
+    assert exc.value.code == 2 and len(err.splitlines()) == 1
+    assert err.startswith("fkopt: error: unexpected end of a file") and "end-of-stream" in err
