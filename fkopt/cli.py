@@ -431,7 +431,7 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
     if fmt not in FORMATS:
         raise FkoptError(f"--format: unknown format '{fmt}'; allowed: {', '.join(FORMATS)}")
     files = ioh_export(results, out)
-    typer.echo(f"wrote {len(files) - 1} IOHprofiler index files (.json) and their .dat files to {out}")
+    typer.echo(f"wrote {len(files)} IOHprofiler index files (.json) and their .dat files to {out}")
 
 
 @app.command()
@@ -680,6 +680,8 @@ def main() -> None:
         kind = type(err).__name__
         if kind == "Exit":
             sys.exit(getattr(err, "exit_code", 0))
+        if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
+            fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
         if kind == "Abort":
             print("fkopt: interrupted", file=sys.stderr)
             sys.exit(130)

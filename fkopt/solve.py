@@ -77,6 +77,9 @@ class Result:
     #: Number of cases (None: a single-target problem) and the integer seed of each case.
     cases: int | None = None
     seeds: np.ndarray | None = None
+    #: Every improvement of each run's best-so-far at its exact evaluation number, as (row,
+    #: evaluation, fitness) arrays; row = case * runs + run (:class:`~fkopt.algorithms.base.RunRecord`).
+    events: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def runs(self) -> int:
@@ -95,7 +98,15 @@ class Result:
         return first
 
     def evaluations_to(self, threshold: float) -> np.ndarray:
-        """Evaluations used when each run first went below ``threshold`` (NaN: never)."""
+        """The evaluation at which each run first went below ``threshold`` (NaN: never): exact
+        from :attr:`events`; without them, the count at the end of that iteration."""
+        if self.events is not None:
+            r, e, f = self.events
+            out = np.full(self.fitness.size, np.nan)
+            below = f < threshold
+            rows, first = np.unique(r[below], return_index=True)   # events are sorted by row, evaluation
+            out[rows] = e[below][first]
+            return out.reshape(self.fitness.shape)
         it = self.iterations_to(threshold)
         ok = ~np.isnan(it)
         at = np.where(ok, it, 0).astype(np.intp)[..., None]
@@ -146,7 +157,8 @@ class Result:
             history=pick(self.history), x_history=pick(self.x_history),
             evaluation_history=pick(self.evaluation_history), iterations_done=pick(self.iterations_done),
             time_per_run=pick(self.time_per_run), extras={k: pick(v) for k, v in self.extras.items()},
-            snapshots={k: pick(v) for k, v in self.snapshots.items()}, cases=None, seeds=None)
+            snapshots={k: pick(v) for k, v in self.snapshots.items()}, cases=None, seeds=None,
+            events=pick_events(self.events, np.arange(i * self.runs, (i + 1) * self.runs)))
 
     def __repr__(self) -> str:
         where = "" if self.cases is None else f"cases={self.cases}, "
@@ -296,7 +308,7 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
         evaluation_history=lead(record.evaluation_history), iterations_done=lead(record.iterations_done),
         time_per_run=lead(times), target=target, extras={k: lead(v) for k, v in record.extras.items()},
         snapshots={k: lead(v) for k, v in record.snapshots.items()},
-        cases=cases, seeds=None if cases is None else seeds,
+        cases=cases, seeds=None if cases is None else seeds, events=record.events,
     )
 
 
@@ -308,4 +320,20 @@ def _concatenate(parts: list[RunRecord]) -> RunRecord:
         evaluation_history=cat("evaluation_history"), iterations_done=cat("iterations_done"),
         extras={k: np.concatenate([p.extras[k] for p in parts]) for k in parts[0].extras},
         snapshots={k: np.concatenate([p.snapshots[k] for p in parts]) for k in parts[0].snapshots},
+        events=None if any(p.events is None for p in parts) else tuple(
+            np.concatenate(a) for a in zip(*((p.events[0] + off, p.events[1], p.events[2]) for p, off in
+                                             zip(parts, np.cumsum([0] + [len(p.best_f) for p in parts[:-1]]))))),
     )
+
+
+def pick_events(events, rows: np.ndarray):
+    """The events of rows ``rows`` (old row numbers, in their new order), renumbered 0, 1, ..."""
+    if events is None:
+        return None
+    r, e, f = events
+    new = np.full(int(max(r.max(initial=-1), np.max(rows, initial=-1))) + 1, -1)
+    new[np.asarray(rows)] = np.arange(len(rows))
+    keep = new[r] >= 0
+    nr = new[r[keep]]
+    order = np.lexsort((e[keep], nr))
+    return nr[order], e[keep][order], f[keep][order]
