@@ -113,7 +113,7 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
         params = ", ".join(f"{k}={f.default!r}" for k, f in cls.Params.model_fields.items())
         table.add_row(e.name, escape(params), e.origin)
     con.print(table)
-    typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm (see README, Plug-ins).")
+    typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm (see docs/plugins.md).")
 
 
 def _list_mechanism(name: str, as_json: bool) -> None:
