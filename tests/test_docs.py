@@ -26,3 +26,11 @@ def test_every_relative_link_resolves():
             if not path.exists() and str(path.relative_to(ROOT)) not in WRITTEN_ELSEWHERE:
                 broken.append(f"{page.relative_to(ROOT)} -> {target}")
     assert not broken, broken
+
+
+def test_readme_python_api_block_runs():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    code = text.split("## Python API")[1].split("```python\n")[1].split("```")[0]
+    names: dict = {}
+    exec(compile(code, "README.md (Python API)", "exec"), names)
+    assert bool(names["fk"].solved) and bool(names["inv"].solved) and names["result"].success.all()
