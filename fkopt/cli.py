@@ -677,6 +677,19 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
         typer.echo(f"{len(exps)} experiments match their stored results")
 
 
+def _reflowed_help() -> None:
+    """typer's rich help keeps the line breaks of a docstring's later paragraphs, so a paragraph
+    wrapped at 100 source columns broke mid-sentence in an 80-column terminal: each command's help
+    is its docstring with every paragraph on one line, for the terminal to wrap."""
+    import inspect
+    for info in app.registered_commands:
+        if info.help is None and info.callback is not None and info.callback.__doc__:
+            paragraphs = inspect.cleandoc(info.callback.__doc__).split("\n\n")
+            info.help = "\n\n".join(" ".join(p.split()) for p in paragraphs)
+
+
+_reflowed_help()
+
 #: Commands that may skip typer's parsing (see :func:`_direct`).
 DIRECT = {"fk": "fk", "ik": "ik", "list": "list_cmd"}
 _NUMBER = {"int": r"[0-9]+", "float": r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?"}

@@ -117,3 +117,8 @@ def test_schema_command_prints_the_committed_schemas():
     bad = fkopt("schema", "nope")
     assert bad.returncode == 2 and bad.stderr.strip() == \
         "fkopt: error: schema: unknown kind 'nope'; allowed: experiment, study, assembly"
+
+
+def test_help_paragraphs_are_wrapped_by_the_terminal_not_the_source():
+    text = fkopt("fk", "--help", columns=200).stdout
+    assert "reproduces the joints within --tolerance (the best residual is reported)" in text
