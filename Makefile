@@ -4,11 +4,18 @@
 PYTHON ?= $(if $(wildcard .venv/bin/python),.venv/bin/python,python3)
 FKOPT = $(PYTHON) -m fkopt.cli
 
-.PHONY: install install-peers test reproduce reproduce-peers report check bench clean
+.PHONY: install install-peers test reproduce reproduce-peers report check bench clean constraints
 
+# constraints.txt pins every dependency at the version the stored results were made with.
 install:
 	test -x .venv/bin/python || python3 -m venv .venv
-	.venv/bin/python -m pip install -e ".[test]"
+	.venv/bin/python -m pip install -e ".[test]" -c constraints.txt
+
+# Move the pins on purpose: upgrade .venv (e.g. pip install -U -e ".[test]"), regenerate results/
+# (make reproduce) with it, then record what it holds here, all in one commit.
+constraints:
+	{ echo "# Every library in the venv that made results/ (make constraints); pip install -c constraints.txt"; \
+	  $(PYTHON) -m pip freeze --exclude-editable | grep -v -i '^fkopt'; } > constraints.txt
 
 # The optional libraries of the peer configs (pymoo, NiaPy); scipy's adapters need nothing.
 install-peers:

@@ -569,12 +569,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
+    from .reproduce.changes import snapshot, write_changes
     from .reproduce.report import write_report
     from .reproduce.run import default_jobs, plan, run_all
 
     if jobs is not None and jobs < 1:
         raise FkoptError(f"--jobs: must be at least 1, got {jobs}")
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
+    before = snapshot(out)              # what the tree held, for CHANGES.md
     con = _console()
     start = time.perf_counter()
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
@@ -599,7 +601,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
                        jobs=default_jobs() if jobs is None else jobs, solving=solving)
-    paths = write_report(out)
+    paths = write_report(out) + [write_changes(out, before)]
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")
@@ -638,14 +640,24 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
           subset: str = typer.Option("all", "--subset", help="all | ci"),
           experiment: Optional[list[str]] = typer.Option(None, "--experiment", "-e",
                                                          help="PAPER/NAME to check (repeatable)"),
+          tolerant: bool = typer.Option(False, "--tolerant",
+                                        help="use the cross-platform rules even where the fingerprint "
+                                             "matches (same as --tier blas)"),
+          tier: str = typer.Option("auto", "--tier", help="auto (from each stored env.json) | exact | blas | any"),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="print only drift and errors, not one "
                                      "line per experiment")):
     """Rerun stored results from their recorded config; exit 1 if anything drifted.
 
-    Exact when the platform fingerprint in env.json matches this machine, by documented
-    tolerances otherwise (fkopt.compare); a missing or unreadable meta.json is a failure.
+    Byte for byte where the platform fingerprint in env.json matches this machine; elsewhere
+    rows no BLAS call touched stay exact and the rest follow the cross-platform rules of
+    fkopt.compare (docs/regression.md). A missing or unreadable meta.json is a failure.
     """
-    from .reproduce.check import check_experiment, select
+    from .reproduce.check import check_experiment, select, stored_tier
+    if tier not in ("auto", "exact", "blas", "any"):
+        raise FkoptError(f"--tier: '{tier}' unknown; allowed: auto, exact, blas, any")
+    if tolerant and tier not in ("auto", "blas"):
+        raise FkoptError(f"--tolerant is --tier blas; it cannot be combined with --tier {tier}")
+    forced = "blas" if tolerant else (None if tier == "auto" else tier)
     from .reproduce.store import locate
     if subset not in ("all", "ci"):
         raise FkoptError(f"--subset: '{subset}' unknown; allowed: all, ci")
@@ -663,10 +675,11 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
         raise FkoptError(f"{results}: no stored results (folders with meta.json) to check")
     failures = []
     for e in exps:
-        bad = check_experiment(e)
+        used = forced or stored_tier(e)
+        bad = check_experiment(e, tier=used)
         failures += bad
         if not quiet:
-            typer.echo(f"{'ok  ' if not bad else 'FAIL'} {e.paper}/{e.name}")
+            typer.echo(f"{'ok  ' if not bad else 'FAIL'} {e.paper}/{e.name} ({used} rules)")
     if failures:
         for m in failures[:20]:
             typer.echo(f"drift: {m}", err=True)

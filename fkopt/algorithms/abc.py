@@ -200,6 +200,7 @@ def _aux(state: ABCState, problem) -> _Aux:
 
 class ABC(Algorithm):
     name = "abc"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = ABCParams
     evaluations_per_iteration = "2*population (+1 per scout)"
 

@@ -95,6 +95,7 @@ class ACOState(State):
 
 class ACO(Algorithm):
     name = "aco"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = ACOParams
     evaluations_per_iteration = "population"
 

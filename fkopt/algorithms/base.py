@@ -100,6 +100,10 @@ class Algorithm:
     Params: ClassVar[type[Params]] = Params
     #: Deterministic local methods (Newton, LM) start from ``x0`` and ignore the population.
     local: ClassVar[bool] = False
+    #: True when no BLAS/LAPACK call lies on the algorithm's own path (elementwise numpy only), so
+    #: its results do not depend on which BLAS kernel runs (:mod:`fkopt.compare`). False by default:
+    #: code fkopt has not read (adapters, plug-ins) is assumed to call BLAS somewhere.
+    blas_free: ClassVar[bool] = False
     #: Rough evaluations per iteration as a function of population, for documentation.
     evaluations_per_iteration: ClassVar[str] = "population"
 

@@ -65,6 +65,7 @@ class PSOState(State):
 
 class PSO(Algorithm):
     name = "pso"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = PSOParams
     evaluations_per_iteration = "population"
 

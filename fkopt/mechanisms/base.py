@@ -95,6 +95,9 @@ class Mechanism:
     paper: ClassVar[str | None] = None
     #: Set when the model is a reconstruction (docs/models.md), with a one-sentence explanation.
     reconstruction: ClassVar[str | None] = None
+    #: True when the fitness path (forward/inverse map, no Jacobian) is elementwise numpy, with no
+    #: BLAS call (:mod:`fkopt.compare`); False for mechanisms fkopt has not read (plug-ins).
+    blas_free_fitness: ClassVar[bool] = False
     pose_names: ClassVar[tuple[str, ...]]
     pose_units: ClassVar[tuple[str, ...]]
     joint_names: ClassVar[tuple[str, ...]]

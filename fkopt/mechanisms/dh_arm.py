@@ -90,6 +90,7 @@ class DHArm(FrameArm):
     """Serial arm with revolute joints q1..qn (deg) described by a standard DH table."""
 
     name = "dh-arm"
+    blas_free_fitness = True   # elementwise map (module docstring): no BLAS on the fitness path
     pose_units = ("mm", "mm", "mm", "deg", "deg", "deg")
     Geometry = lazy_model(_dh_geometry)                # pydantic model, built on first use
     geometry_defaults = {"a": list(WANG7DOF["a"]), "alpha": list(WANG7DOF["alpha"]), "d": list(WANG7DOF["d"]),
