@@ -652,24 +652,30 @@ def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, 
     return curves
 
 
-def plot_scaling(curves, path: Path, iterations: int) -> None:
+def plot_scaling(curves, path: Path, iterations: int):
+    """Two panels (growing population, growing runs), each with two y-axes told apart by marker,
+    line style and label as well as colour: cost per evaluation (left, circles, solid) and wall
+    time (right, squares, dashed). Returns the figure."""
     from matplotlib.figure import Figure
-    fig = Figure(figsize=(10, 4))
-    for ax, key, xlabel in zip(fig.subplots(1, 2), ("population", "runs"),
-                               ("population (30 runs)", "runs (population 10)")):
+    fig = Figure(figsize=(10, 4.2))
+    for ax, key, xlabel, title in zip(fig.subplots(1, 2), ("population", "runs"),
+                                      ("population (30 runs)", "runs (population 10)"),
+                                      ("growing the population", "growing the number of runs")):
         pts = np.array(curves[key], dtype=float)
         if not len(pts):
             continue
-        ax.loglog(pts[:, 0], pts[:, 2], "o-", color="C0", label="ns per evaluation")
+        cost, = ax.loglog(pts[:, 0], pts[:, 2], "o-", color="C0", label="ns per evaluation (left axis)")
         ax.set_xlabel(xlabel)
-        ax.set_ylabel("ns per evaluation", color="C0")
+        ax.set_ylabel("ns per evaluation  (● solid)", color="C0")
         ax2 = ax.twinx()
-        ax2.loglog(pts[:, 0], pts[:, 1], "s--", color="C1", label="wall time")
-        ax2.set_ylabel("wall time (s)", color="C1")
-        ax.set_title(f"gabc on 3-RPS, {iterations} iterations")
+        wall, = ax2.loglog(pts[:, 0], pts[:, 1], "s--", color="C1", label="wall time, s (right axis)")
+        ax2.set_ylabel("wall time, s  (■ dashed)", color="C1")
+        ax.set_title(f"{title}: gabc on 3-RPS, {iterations} iterations", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
+        ax.legend(handles=[cost, wall], loc="upper center", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
+    return fig
 
 
 # -- entry point -----------------------------------------------------------------------------

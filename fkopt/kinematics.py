@@ -50,7 +50,7 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
   1000 random reachable poses: about 80 % of nearest-configuration starts converge against
   about 60 % of mid-range or random ones, which is why the hardest rows of a batch try 32 table
-  neighbours before the random draws (README, Performance);
+  neighbours before the random draws (measured in the commit that chose it; docs/performance.md);
 * one pose (N = 1, ``rest`` = 0, no ``exact_rotation``) runs the same iteration on Python
   floats (the arm's ``frame_jacobian1``, Cholesky solves of the 6x6 systems), its candidates
   one after another in the order of its starts, stopping at the first that converges: numpy's

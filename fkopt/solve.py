@@ -15,7 +15,7 @@ numbers are its own); the speed does: at a few rows the per-iteration cost of nu
 dominates, beyond ~10^4 points the working arrays leave the CPU caches. The size was chosen by
 measuring GABC on 3-RPS (population 10, 3000 rows), ABC on the 7-DOF arm (population 100) and
 P-ABC's ABC on 3RPUPc-UPS at several chunk sizes; ``fkopt bench`` (section ``cases``) keeps
-measuring 300 / 1000 / 3000 rows per chunk, and the README's Performance section gives the
+measuring 300 / 1000 / 3000 rows per chunk, and ``bench/bench.csv`` keeps the
 numbers. With ``batch=False`` every row is solved on its own, one after
 the other -- the reference mode that proves batching never changes the numbers.
 

@@ -291,11 +291,15 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
     runs = curves[0][2].shape[0]
     what = "best-so-far " + plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))
     axes[0].set_ylabel(what)
+    threshold = er.config.threshold
     for ax, xl in zip(axes, ("iteration", "function evaluations (mean over runs)")):
         ax.set_yscale("log")
         ax.set_xlabel(xl)
         if zero:
             plotting.mark_zero(ax, floor)
+        if threshold is not None:     # what success rates and iterations to the threshold count
+            ax.axhline(threshold, color="0.35", lw=0.9, ls=":", zorder=1,
+                       label=f"threshold {threshold:g}" if ax is axes[0] else None)
     axes[0].legend(loc="best")
     note = "one run" if single else f"median of {runs} runs, band: quartiles"
     if er.config.stop_at_threshold:
@@ -328,7 +332,7 @@ def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         xh = r.x_history[r.median_run]
         end = int(r.iterations_done[r.median_run]) + 1
         for j, ax in enumerate(flat[:len(names)]):
-            ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key])
+            ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key], lw=1.1)
     case = recs[0].case
     if er.mechanism.kind == "parallel":
         truth, what = ((case.target, "true value") if case.target is not None
@@ -337,17 +341,23 @@ def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         truth, what = case.given_joints, "joints defining the target"
     for j, ax in enumerate(flat[:len(names)]):
         ax.set_title(f"{names[j]} ({units[j]})")
-        ax.set_xlabel("iteration")
+        # most of the movement is in the first few per cent of the iterations: a logarithmic
+        # axis (linear below 1, so iteration 0 is shown) spreads it out
+        ax.set_xscale("symlog", linthresh=1, linscale=0.3)
+        ax.set_xlabel("iteration (log scale)")
         if truth is not None:
-            ax.axhline(truth[j], color="k", lw=0.8, ls="--", label=what)
+            ax.axhline(truth[j], color="k", lw=0.8, ls="--", label=what, zorder=1)
     for ax in flat[len(names):]:
         ax.set_visible(False)
-    flat[0].legend(fontsize=7)
+    # one legend for all panels, below them: never on a curve or on the truth line
+    handles, labels = flat[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 4), fontsize=7)
     runs = recs[0].result.runs
     fig.suptitle(f"{er.config.title or er.config.name}\nbest-so-far variables of the median run "
                  f"(of {runs}), case {case.label}" if runs > 1 else
                  f"{er.config.title or er.config.name}\nbest-so-far variables, case {case.label}", fontsize=9)
-    fig.tight_layout()
+    legend_rows = int(np.ceil(len(labels) / 4))
+    fig.tight_layout(rect=(0, 0.08 * legend_rows / rows + 0.01, 1, 1))
     out = _save(fig, path)
     plt.close(fig)
     return out
