@@ -127,8 +127,10 @@ def values_table(er: ExperimentResult) -> pd.DataFrame:
                     pose_error(mech, rec.outputs[med], case.reference)[j])
             if name in printed:
                 row["printed_value"] = printed[name]
-                if target is not None:
-                    row["printed_abs_error"] = _abs_diff(unit, printed[name], float(target[j]))
+                if f"{name}_error" in printed:   # the paper's error column, transcribed, never recomputed
+                    row["printed_abs_error"] = printed[f"{name}_error"]
+                if target is not None:   # |printed value - target| from the rounded printed value
+                    row["printed_value_minus_target"] = _abs_diff(unit, printed[name], float(target[j]))
             rows.append(row)
     return pd.DataFrame(rows)
 

@@ -12,6 +12,7 @@ import pandas as pd
 
 from . import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
 from .claims import CLAIMS_FILE, RULES, Claim, claims_frame
+from .engine import info, judge_paper
 from ..experiment.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
 from .store import Experiment, Store
 
@@ -92,8 +93,12 @@ def experiment_section(exp: Experiment, root: Path) -> str:
 
 
 def claims_table(claims: list[Claim]) -> str:
-    df = pd.DataFrame([{"claim": c.text, "verdict": f"**{c.verdict}**", "fkopt's evidence": c.evidence}
-                       for c in claims])
+    df = pd.DataFrame([{"id": c.id, "claim": c.text, "verdict": f"**{c.verdict}**", "condition": c.condition,
+                        "fkopt's evidence": c.evidence} for c in claims])
+    if claims and not any(c.id for c in claims):
+        df = df.drop(columns=["id"])
+    if claims and not any(c.condition for c in claims):
+        df = df.drop(columns=["condition"])
     return df.to_markdown(index=False) if claims else "_(none)_"
 
 
@@ -123,7 +128,8 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
               f"n = max(1, ceil({TIMING_RUNS} / cases)), on the first {TIMING_RUNS} cases; a task stops "
               f"adding runs after {TIMING_BUDGET_S:g} s of timed runs but times at least {TIMING_MIN_RUNS}) "
               "is solved again alone with the same seed stream and timed around that call (after an "
-              "untimed warm-up). Tables give the median and quartiles of those runs; `amortised_ms_per_run` "
+              "untimed warm-up), the algorithms of a case interleaved (run 0 of each, then run 1 of each: "
+              "A B A B ...) in one process, so that a slow period of the machine hits all alike. Tables give the median and quartiles of those runs; `amortised_ms_per_run` "
               "(the batch's wall time / runs) is shown for information and never judged. Two "
               "algorithms' times differ only if a two-sided Mann-Whitney test over the timed runs "
               "rejects equality at alpha = 0.05, otherwise the verdict is *within noise*. Measured on "
@@ -133,21 +139,27 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
     out.append("")
     index_rows = []
     for paper in papers:
-        mod = paper_module(paper)
+        about = info(paper)
+        judged = judge_paper(paper, store)
         exps = store.experiments(paper)
-        order = getattr(mod, "EXPERIMENTS", [])
+        order = about["experiments"]
         exps.sort(key=lambda e: (order.index(e.name) if e.name in order else len(order), e.name))
-        title = getattr(mod, "TITLE", paper)
-        out += [f"## {paper}", "", f"**{title}**", ""]
-        for note in getattr(mod, "NOTES", []):
+        out += [f"## {paper}", "", f"**{about['title']}**", ""]
+        for note in about["notes"]:
             out.append(f"- {note}")
         out.append("")
-        if mod is not None:
-            cl = mod.claims(store)
-            n_timing = len(mod.timing_claims(store)) if hasattr(mod, "timing_claims") else 0
+        if about["inconsistencies"]:
+            out += ["### The paper's internal inconsistencies", ""]
+            out += [f"- {x}" for x in about["inconsistencies"]] + [""]
+        if judged is not None:
+            cl, tc = judged
             out += ["### Claims", "", claims_table(cl), ""]
-            if n_timing:
-                out += [f"The paper's {n_timing} claim(s) about time are judged in "
+            disagree = [c.id or c.text[:40] for c in cl if c.numbers.get("bases_disagree")]
+            if disagree:
+                out += ["Budget bases disagree (equal iterations vs equal evaluations) for: "
+                        + ", ".join(f"`{x}`" for x in disagree) + "; the verdict uses the paper's basis.", ""]
+            if tc:
+                out += [f"The paper's {len(tc)} claim(s) about time are judged in "
                         f"[TIMING.md](TIMING.md#{paper}) only.", ""]
 
         timing += [f"## {paper}", ""]
@@ -161,8 +173,8 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
                 if fig.endswith("_time.png") and fig != "cases_time.png":
                     timing.append(f"![{exp.name} {fig}]({exp.folder.relative_to(root)}/{fig})\n")
             index_rows += index_rows_of(exp)
-        if mod is not None and hasattr(mod, "timing_claims"):
-            timing += ["### Timing claims", "", claims_table(mod.timing_claims(store)), ""]
+        if judged is not None and judged[1]:
+            timing += ["### Timing claims", "", claims_table(judged[1]), ""]
     return "\n".join(out).rstrip() + "\n", "\n".join(timing).rstrip() + "\n", pd.DataFrame(index_rows)
 
 
@@ -189,9 +201,9 @@ def claims_files(root: str | Path) -> dict[Path, pd.DataFrame]:
     store = Store(root)
     out = {}
     for paper in store.papers():
-        mod = paper_module(paper)
-        if mod is not None:
-            out[root / paper / CLAIMS_FILE] = claims_frame(mod.claims(store))
+        judged = judge_paper(paper, store)
+        if judged is not None:
+            out[root / paper / CLAIMS_FILE] = claims_frame(judged[0])
     return out
 
 
