@@ -184,15 +184,15 @@ def within_of_final(exp, algo: str, fraction: float = 0.01) -> tuple[np.ndarray,
 
 
 def evaluations_at(exp, algo: str, iteration: int | None = None, case: str | None = None) -> float:
-    """Evaluations spent after ``iteration``: mean over runs (convergence.csv); at the end (default)
-    the median over runs (runs.csv)."""
+    """Evaluations spent after ``iteration`` (or the last recorded one before it): mean over runs
+    (convergence.csv); at the end (default) the median over runs (runs.csv)."""
     if iteration is None:
         return float(_select(exp.table("runs"), algo, case).evaluations.median())
     c = exp.table("convergence")
-    c = c[(c.algorithm == algo) & (c.iteration == iteration)]
+    c = c[(c.algorithm == algo) & (c.iteration <= iteration)]   # a shorter run: its end
     if case is not None:
         c = c[c["case"] == case]
-    return float(c.mean_evaluations.iloc[0])
+    return float(c.sort_values("iteration").mean_evaluations.iloc[-1])
 
 
 def equal_budget(exp, a: str, b: str, names: dict[str, str], case: str | None = None,

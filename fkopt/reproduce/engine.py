@@ -222,18 +222,18 @@ def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str]
     mapping per algorithm, e.g. the printed mean of each)."""
     spec = {k: (v.get(algo) if isinstance(v, dict) and k in ("order", "order_at_most", "below", "above", "at_least")
                 else v) for k, v in spec.items()}
-    if "order" in spec:
+    if spec.get("order") is not None:
         d = float(spec.get("decades", 0.5))
         off = np.log10(max(value, 1e-300)) - np.log10(spec["order"])
         return abs(off) <= d, f"{off:+.2f} decades from {g(spec['order'])} (held within +-{d:g})"
-    if "order_at_most" in spec:
+    if spec.get("order_at_most") is not None:
         cap = 10.0 ** (np.floor(np.log10(spec["order_at_most"])) + 1)
         return value < cap, f"of the order of {g(spec['order_at_most'])} or below (< {g(cap)})"
-    if "below" in spec:
+    if spec.get("below") is not None:
         return value < spec["below"], f"below {g(spec['below'])}"
-    if "above" in spec:
+    if spec.get("above") is not None:
         return value > spec["above"], f"above {g(spec['above'])}"
-    if "at_least" in spec:
+    if spec.get("at_least") is not None:
         return value >= spec["at_least"], f"at least {g(spec['at_least'])}"
     raise ValueError(f"no rule in {spec}")
 
