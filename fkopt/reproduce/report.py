@@ -114,8 +114,14 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
            "judged in [TIMING.md](TIMING.md) only (one source of truth), because they change on every "
            "run while everything here is fixed by the seeds. Statistics are over all runs, never a "
            "single lucky run.", "", "**Verdicts.**", ""] + [f"- {r}" for r in RULES] + [
-           "- The verdicts of this file are stored in `results/<paper>/claims.csv`; `fkopt check` "
-           "fails when a recomputed verdict differs.", "",
+           "- The verdicts of this file are stored in `results/<paper>/claims.csv` (columns id, claim, "
+           "verdict, condition); `fkopt check` fails when a recomputed verdict differs. The claims are "
+           "data (`configs/<paper>/claims.yaml`) judged by one engine: rules in "
+           "[docs/claims.md](../docs/claims.md).",
+           "- **ABC population convention:** an ABC's population is its number of food sources (= employed "
+           "= onlooker bees), so one ABC iteration costs about 2 x population evaluations, a PSO iteration "
+           "population; at the papers' equal iterations ABC gets more evaluations, hence every comparison "
+           "at equal evaluations too ([docs/models.md](../docs/models.md)).", "",
            "**Figures** are named after the paper figure they mirror (`fig2.png`, with a PDF twin) and use "
            "the papers' algorithm names and units. A fitness of exactly 0 cannot sit on a log axis: it is "
            "drawn on a grey band labelled \"0 (exact, drawn at floor)\" a decade below the smallest "
