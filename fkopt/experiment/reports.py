@@ -229,7 +229,11 @@ def figure_file(er: ExperimentResult, kind: str) -> str:
 
 
 def _spec_names(er: ExperimentResult) -> dict[str, str]:
-    return {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+    """Legend names; algorithms that share a paper name (wu2015's five Newton starts) add their label."""
+    names = {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+    counts = pd.Series(list(names.values())).value_counts()
+    return {spec.key: f"{names[spec.key]} · {spec.label}" if counts[names[spec.key]] > 1 and spec.label
+            else names[spec.key] for spec in er.config.algorithms}
 
 
 def _curve_sets(er: ExperimentResult):
@@ -298,6 +302,12 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
         ax.set_xlabel(xl)
         if zero:
             plotting.mark_zero(ax, floor)
+    if er.config.threshold:   # the precision the paper stops at or reads its curves against (liu2008 Fig. 4b)
+        for ax in axes:
+            ax.axhline(er.config.threshold, color="0.4", lw=0.8, ls="--",
+                       label=f"threshold {er.config.threshold:g}" if ax is axes[0] else None)
+    from matplotlib.ticker import MaxNLocator
+    axes[0].xaxis.set_major_locator(MaxNLocator(integer=True))   # iterations are whole numbers
     axes[0].legend(loc="best")
     note = "one run" if single else f"median of {runs} runs, band: quartiles"
     if er.config.stop_at_threshold:
@@ -515,9 +525,12 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
             ax.set_yscale("log")
             if (table[col] <= 0).any():
                 plotting.mark_zero(ax, floor)
-        _case_axis(ax, len(er.cases))
+        shown = int(table["case"].map(order).max())   # timings cover only the first timed cases
+        _case_axis(ax, shown)
         ax.set_ylabel(ylabel)
-        ax.set_title(er.config.title or er.config.name, fontsize=9)
+        ax.set_title((er.config.title or er.config.name)
+                     + (f"\ntimed poses only: the first {shown} of {len(er.cases)}" if shown < len(er.cases) else ""),
+                     fontsize=9)
         ax.legend()
         written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
