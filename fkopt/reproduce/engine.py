@@ -27,6 +27,7 @@ shown). Adding a claim touches the claims file only.
 """
 from __future__ import annotations
 
+import os
 from functools import lru_cache
 from pathlib import Path
 
@@ -39,7 +40,8 @@ from .claims import (ALPHA, CONDITIONAL, NOT_CHECKABLE, Claim, compare, equal_bu
                      missing, p_text, verdict, within_of_final)
 
 CLAIMS_YAML = "claims.yaml"
-CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+#: Where the claims files live: the repository's configs/ (``FKOPT_CONFIGS`` points elsewhere).
+CONFIGS = Path(os.environ.get("FKOPT_CONFIGS", Path(__file__).resolve().parents[2] / "configs"))
 KINDS = ("comparison", "magnitude", "iterations_to_target", "timing", "value")
 
 
