@@ -262,6 +262,9 @@ def faster_claim(text: str, faster: str, cmp: Comparison | None, printed: tuple 
 
 # -- claims.csv and drift --------------------------------------------------------------------------
 CLAIMS_FILE = "claims.csv"
+#: Timing verdicts, stored apart: they change with the machine (``fkopt check`` compares them only
+#: where the platform fingerprint matches; :func:`verdict_changes` with ``timing=True``).
+TIMING_CLAIMS_FILE = "timing_claims.csv"
 COLUMNS = ["id", "claim", "verdict", "condition"]
 
 
@@ -277,22 +280,23 @@ def _key(df: pd.DataFrame) -> pd.Series:
     return df["claim"].astype(str)
 
 
-def verdict_changes(root: str | Path) -> list[tuple[str, str, str, str]]:
+def verdict_changes(root: str | Path, timing: bool = False) -> list[tuple[str, str, str, str]]:
     """(paper, claim, stored verdict, recomputed verdict) for every non-timing claim whose verdict
     computed from the results under ``root`` differs from the stored ``<paper>/claims.csv``
-    (``(absent)`` when a claim appeared or disappeared). Timing verdicts are not in claims.csv."""
+    (``(absent)`` when a claim appeared or disappeared). ``timing=True``: the timing claims against
+    ``<paper>/timing_claims.csv`` instead (meaningful only on the platform that measured them)."""
     from .engine import judge_paper
     from .store import Store
     root = Path(root)
     store = Store(root)
     out = []
     for paper in store.papers():
-        file = root / paper / CLAIMS_FILE
+        file = root / paper / (TIMING_CLAIMS_FILE if timing else CLAIMS_FILE)
         judged = judge_paper(paper, store)
         if judged is None or not file.exists():
             continue
         stored = pd.read_csv(file, keep_default_na=False)
-        now = claims_frame(judged[0])
+        now = claims_frame(judged[1] if timing else judged[0])
         by_id = "id" in stored and (stored["id"] != "").all()
         s = dict(zip(_key(stored), zip(stored.claim, stored.verdict)))
         n = dict(zip(now["id"] if by_id else now["claim"], zip(now.claim, now.verdict)))

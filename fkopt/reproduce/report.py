@@ -11,7 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
-from .claims import CLAIMS_FILE, RULES, Claim, claims_frame
+from .claims import CLAIMS_FILE, RULES, TIMING_CLAIMS_FILE, Claim, claims_frame
 from .engine import info, judge_paper
 from ..experiment.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
 from .store import Experiment, Store
@@ -202,7 +202,8 @@ def index_rows_of(exp: Experiment) -> list[dict]:
 
 
 def claims_files(root: str | Path) -> dict[Path, pd.DataFrame]:
-    """``<paper>/claims.csv`` of every paper with claims: the verdicts ``fkopt check`` guards."""
+    """``<paper>/claims.csv`` of every paper with claims (the verdicts ``fkopt check`` guards) and
+    ``<paper>/timing_claims.csv`` (the timing verdicts, which change with the machine)."""
     root = Path(root)
     store = Store(root)
     out = {}
@@ -210,6 +211,8 @@ def claims_files(root: str | Path) -> dict[Path, pd.DataFrame]:
         judged = judge_paper(paper, store)
         if judged is not None:
             out[root / paper / CLAIMS_FILE] = claims_frame(judged[0])
+            if judged[1]:
+                out[root / paper / TIMING_CLAIMS_FILE] = claims_frame(judged[1])
     return out
 
 
