@@ -192,3 +192,21 @@ def test_reproduce_never_runs_a_claims_file(tmp_path):
     shutil.copy(ROOT / "configs" / "mao2017" / "claims.yaml", tmp_path / "p" / "claims.yaml")
     shutil.copy(ROOT / "configs" / "mao2017" / "tab3_floor.yaml", tmp_path / "p" / "tab3_floor.yaml")
     assert [p.path.name for p in plan(tmp_path, tmp_path / "out")] == ["tab3_floor.yaml"]
+
+
+def test_timed_runs_are_interleaved(monkeypatch):
+    """Run k of every algorithm of a case before run k + 1 of any (A B A B ...), warm-ups first."""
+    from types import SimpleNamespace as NS
+
+    from fkopt.experiment import timing
+    calls = []
+    monkeypatch.setattr(timing, "solve", lambda problem, name, iterations, run_ids, **kw: calls.append(
+        (name, iterations, run_ids[0])))
+    config = NS(runs=3, population=5, iterations=7, threshold=None, stop_at_threshold=False)
+    recs = [NS(case=NS(index=0), spec=NS(name=n, population=None, iterations=None, start=None, params={}),
+               problem=None, seed=1) for n in ("a", "b")]
+    timing.time_single_runs(config, recs)
+    timed = [(n, k) for n, it, k in calls if it == 7]
+    assert [c[0] for c in calls[:2]] == ["a", "b"] and all(it == 2 for _, it, _ in calls[:2])   # warm-ups
+    assert timed == [("a", 0), ("b", 0), ("a", 1), ("b", 1), ("a", 2), ("b", 2)]
+    assert all(len(r.single_run_s) == 3 for r in recs)

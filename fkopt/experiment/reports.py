@@ -573,8 +573,8 @@ def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
         ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
     ax.set_xticks(range(len(er.config.algorithms)), [names[s.key] for s in er.config.algorithms])
     ax.set_ylabel("time per run, one run at a time (ms)")
-    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} timed runs per algorithm (bar: median)",
-                 fontsize=9)
+    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} of the {er.config.runs} runs per algorithm "
+                 "timed one at a time (fkopt's timing sample, TIMING.md; bar: median)", fontsize=9)
     out = _save(fig, path)
     plt.close(fig)
     return out
