@@ -237,9 +237,11 @@ def resolution(cmp: Comparison) -> float:
 def faster_claim(text: str, faster: str, cmp: Comparison | None, printed: tuple | None = None) -> Claim:
     """'``faster`` takes less time': held / not held / within noise.
 
-    Rank test on the interleaved single-run times at ALPHA; *within noise* when the test finds no
-    difference, or when the paper's own printed difference (``printed`` = (ms of ``faster``, ms of
-    the other)) is smaller than the spread of fkopt's timed runs, which no run count here resolves.
+    Rank test on the interleaved single-run times at ALPHA: held when ``faster`` is significantly
+    faster, *within noise* when the test finds no difference. When fkopt finds the opposite, the
+    verdict is *not held*, unless the paper's own printed difference (``printed`` = (ms of
+    ``faster``, ms of the other)) is smaller than the spread of the timed runs: a difference the
+    paper could not resolve is not refuted by one fkopt resolves the other way (*within noise*).
     """
     if cmp is None:
         return Claim(text, NOT_CHECKABLE, "no single-run timings stored (timing_runs.csv)")
@@ -247,7 +249,7 @@ def faster_claim(text: str, faster: str, cmp: Comparison | None, printed: tuple 
     lower = cmp.lower
     v = WITHIN_NOISE if lower is None else verdict(lower == faster)
     note = ""
-    if printed is not None:
+    if printed is not None and v == NOT_HELD:
         rel = abs(printed[1] - printed[0]) / max(abs(printed[0]), abs(printed[1]))
         if rel < res:
             v = WITHIN_NOISE
