@@ -127,8 +127,10 @@ def values_table(er: ExperimentResult) -> pd.DataFrame:
                     pose_error(mech, rec.outputs[med], case.reference)[j])
             if name in printed:
                 row["printed_value"] = printed[name]
-                if target is not None:
-                    row["printed_abs_error"] = _abs_diff(unit, printed[name], float(target[j]))
+                if f"{name}_error" in printed:   # the paper's error column, transcribed, never recomputed
+                    row["printed_abs_error"] = printed[f"{name}_error"]
+                if target is not None:   # |printed value - target| from the rounded printed value
+                    row["printed_value_minus_target"] = _abs_diff(unit, printed[name], float(target[j]))
             rows.append(row)
     return pd.DataFrame(rows)
 
@@ -227,7 +229,11 @@ def figure_file(er: ExperimentResult, kind: str) -> str:
 
 
 def _spec_names(er: ExperimentResult) -> dict[str, str]:
-    return {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+    """Legend names; algorithms that share a paper name (wu2015's five Newton starts) add their label."""
+    names = {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+    counts = pd.Series(list(names.values())).value_counts()
+    return {spec.key: f"{names[spec.key]} · {spec.label}" if counts[names[spec.key]] > 1 and spec.label
+            else names[spec.key] for spec in er.config.algorithms}
 
 
 def _curve_sets(er: ExperimentResult):
@@ -300,6 +306,8 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
         if threshold is not None:     # what success rates and iterations to the threshold count
             ax.axhline(threshold, color="0.35", lw=0.9, ls=":", zorder=1,
                        label=f"threshold {threshold:g}" if ax is axes[0] else None)
+    from matplotlib.ticker import MaxNLocator
+    axes[0].xaxis.set_major_locator(MaxNLocator(integer=True))   # iterations are whole numbers
     axes[0].legend(loc="best")
     note = "one run" if single else f"median of {runs} runs, band: quartiles"
     if er.config.stop_at_threshold:
@@ -523,9 +531,12 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
             ax.set_yscale("log")
             if (table[col] <= 0).any():
                 plotting.mark_zero(ax, floor)
-        _case_axis(ax, len(er.cases))
+        shown = int(table["case"].map(order).max())   # timings cover only the first timed cases
+        _case_axis(ax, shown)
         ax.set_ylabel(ylabel)
-        ax.set_title(er.config.title or er.config.name, fontsize=9)
+        ax.set_title((er.config.title or er.config.name)
+                     + (f"\ntimed poses only: the first {shown} of {len(er.cases)}" if shown < len(er.cases) else ""),
+                     fontsize=9)
         ax.legend()
         written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
@@ -568,8 +579,8 @@ def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
         ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
     ax.set_xticks(range(len(er.config.algorithms)), [names[s.key] for s in er.config.algorithms])
     ax.set_ylabel("time per run, one run at a time (ms)")
-    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} timed runs per algorithm (bar: median)",
-                 fontsize=9)
+    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} of the {er.config.runs} runs per algorithm "
+                 "timed one at a time (fkopt's timing sample, TIMING.md; bar: median)", fontsize=9)
     out = _save(fig, path)
     plt.close(fig)
     return out

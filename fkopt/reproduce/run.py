@@ -38,7 +38,8 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     configs = Path(configs)
     if not configs.is_dir():
         raise FkoptError(f"--configs: {configs} is not a folder")
-    files = sorted(configs.rglob("*.yaml"))
+    from .engine import is_claims_file
+    files = sorted(f for f in configs.rglob("*.yaml") if not is_claims_file(f))   # claims are no experiment
     if not files:
         raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
     planned = []
