@@ -192,6 +192,7 @@ def check_experiment(exp: Experiment, config=None, exact: bool | None = None, ti
     out += summary_consistency(label, exp.folder)
     out += recomputed_fitness(exp, config)
     out += missing_claims(exp)
+    out += timing_verdicts(exp)
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-check-"))
     try:
         rerun_files(config, tmp, exp.meta.get("config_file"))
@@ -214,11 +215,39 @@ def missing_claims(exp: Experiment) -> list[Mismatch]:
     from .claims import CLAIMS_FILE
     if not (exp.folder.parents[1] / "REPORT.md").is_file():
         return []
+    from .engine import load
     module = paper_module(exp.paper)
-    if module is None or not hasattr(module, "claims") or (exp.folder.parent / CLAIMS_FILE).is_file():
+    has_claims = load(exp.paper) is not None or hasattr(module, "claims")
+    if not has_claims or (exp.folder.parent / CLAIMS_FILE).is_file():
         return []
     return [Mismatch(exp.paper, CLAIMS_FILE, "-", "file", "missing", "present",
                      f"{exp.paper} has claims: its {CLAIMS_FILE} is part of the stored result")]
+
+
+def timing_verdicts(exp: Experiment) -> list[Mismatch]:
+    """The stored timing verdicts of ``exp``'s paper (``timing_claims.csv``) must be those its stored
+    timed runs give. Check's rerun measures no time, so this compares the stored verdicts with the
+    stored measurements: on every platform, and it catches an edited timing verdict."""
+    from .claims import TIMING_CLAIMS_FILE, claims_frame
+    from .engine import judge_paper
+    file = exp.folder.parent / TIMING_CLAIMS_FILE
+    if not file.is_file():
+        return []
+    try:
+        stored = pd.read_csv(file, keep_default_na=False)
+        judged = judge_paper(exp.paper, Store(exp.folder.parents[1]))
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, "-", "file", f"unreadable ({err})", "readable",
+                         "readable CSV")]
+    if judged is None:
+        return []
+    now = claims_frame(judged[1])
+    key = "id" if "id" in stored.columns and "id" in now.columns else "claim"
+    a = dict(zip(stored[key].astype(str), stored["verdict"].astype(str)))
+    b = dict(zip(now[key].astype(str), now["verdict"].astype(str)))
+    return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, k[:90], "verdict", a.get(k, "(absent)"), b.get(k, "(absent)"),
+                     "the verdict of the stored timed runs (every platform)")
+            for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
 
 
 def select(store: Store, subset: str = "all", paper: str | None = None, name: str | None = None) -> list[Experiment]:
