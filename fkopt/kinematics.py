@@ -618,6 +618,18 @@ def _rotation_error(R: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     return v * k[:, None]
 
 
+def _internal(m, q):
+    """Public joint values (deg, length unit) -> inverse's internal units (rad, length unit)."""
+    a = m.angle_mask(m.joint_units)
+    return np.where(a, np.radians(q), q) if not a.all() else np.radians(q)
+
+
+def _public(m, u):
+    """Inverse's internal units (rad, length unit) -> public joint values (deg, length unit)."""
+    a = m.angle_mask(m.joint_units)
+    return np.where(a, np.degrees(u), u) if not a.all() else np.degrees(u)
+
+
 _M64 = np.uint64(0xFFFFFFFFFFFFFFFF)
 
 
@@ -744,21 +756,30 @@ def _start_table(m, size: int):
     hash (independent of ``seed``) and their tool features (position, w * rotation matrix
     entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3): ``inverse``
     starts from the configurations nearest to each target. Cached per arm (name, DH table,
-    limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`)."""
-    base = m.__dict__.get("_start_table_key")
-    if base is None:                                 # the DH table's numbers (no pydantic model needed)
-        base = m.__dict__["_start_table_key"] = (m.name, m._a, m._d, m._ca, m._sa, m._offset, m.bounds.tobytes())
-    key = base + (size,)
+    limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`). The arm's
+    own forward map (``frame``) makes it, so it serves DH and URDF arms alike."""
+    key = m.kinematic_key() + (m.bounds.tobytes(), size)
     got = _TABLES.get(key)
     if got is None:
         from .rotations import to_array
-        lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+        lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
         tq = lo + (hi - lo) * _uniform_hash(0x5EED, np.arange(size), np.zeros(size, dtype=np.int64), m.dof)
-        p, R = m.frame(np.degrees(tq))
+        p, R = m.frame(_public(m, tq))
         wf = m.reach / (3.0 * np.sqrt(2.0))
         feats = np.concatenate([np.stack(p, axis=-1), wf * to_array(R).reshape(size, 9)], axis=-1)
         got = _TABLES[key] = {"q": tq, "features": feats, "w": wf}
     return got
+
+
+def _masked_table(tab: dict, W: np.ndarray) -> dict:
+    """The start table compared on the selected task components: masked position features,
+    and the rotation features only when all three rotation components count (a rotation
+    matrix entry is not one rotation-vector axis). Cached beside the table."""
+    fmask = np.concatenate([W[:3], np.full(9, float(W[3:].all()))])
+    key = ("masked", fmask.tobytes())
+    if key not in tab:
+        tab[key] = {"q": tab["q"], "features": tab["features"] * fmask, "w": tab["w"], "mask": fmask}
+    return tab[key]
 
 
 #: Batches from this many rows query the start table through scipy's k-d tree (importing
@@ -786,7 +807,28 @@ def _nearest(table: dict, feats: np.ndarray, k: int) -> np.ndarray:
     return out
 
 
-def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts: int = 200,
+#: Names of the six task components ``mask`` selects, in order.
+TASK = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def _task_mask(mask) -> np.ndarray | None:
+    """``mask`` as a (6,) array of 0/1 over (x, y, z, rx, ry, rz), or None for the full pose."""
+    if mask is None:
+        return None
+    if isinstance(mask, str):
+        mask = [name in {t.strip() for t in mask.split(",")} for name in TASK] \
+            if all(t.strip() in TASK for t in mask.split(",")) else mask
+    try:
+        W = np.asarray(mask, dtype=float)
+    except (TypeError, ValueError):
+        W = None
+    if W is None or W.shape != (6,) or not np.isin(W, (0.0, 1.0)).all() or not W.any():
+        raise FkoptError(f"inverse mask: expected 6 flags 0/1 over ({', '.join(TASK)}) with at least one "
+                         f"set, or names like 'x,y,z'; got {mask!r}")
+    return None if W.all() else W
+
+
+def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0, restarts: int = 200,
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
@@ -796,7 +838,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
     ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles (deg), as ``arm.fk``
     returns them. ``start``: start joints (n,) or (..., n) inside the limits (default mid-range).
-    ``tol``: (position, orientation in radians). ``seed``: the restarts' stream. ``starts``:
+    ``tol``: (position, orientation in radians). ``mask``: the task components that count, 6
+    flags over (x, y, z, rx, ry, rz) -- position and rotation-vector error in the base frame,
+    as roboticstoolbox's ``we`` -- or their names (``"x,y,z"``: position only, for arms with
+    fewer than 6 joints); the errors reported are those of the selected components. ``seed``: the restarts' stream. ``starts``:
     candidates solved side by side per row (the start and ``starts - 1`` random ones);
     ``restarts``: most random restarts per row. ``rest``: gain of the null-space pull towards
     mid-range (0: off). ``orientation_scale``: length units per radian weighing orientation
@@ -828,8 +873,12 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         unit = m.pose_units[0]
         raise FkoptError(f"{m.name} target ({P[k, 0]:g}, {P[k, 1]:g}, {P[k, 2]:g}) unreachable "
                          f"(distance {dist[k]:.1f} {unit} > reach {reach:.1f} {unit})")
-    lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+    lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    # saturation bounds: none for periodic (continuous) joints, wrapped at the end
+    periodic = m.periodic_mask()
+    slo, shi = (np.where(periodic, -np.inf, lo), np.where(periodic, np.inf, hi)) if periodic.any() else (lo, hi)
+    W = _task_mask(mask)
     if start is None:
         q0 = np.broadcast_to(mid, (N, n))
     else:
@@ -838,13 +887,13 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         if not m.in_bounds(q0).all():
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
-        q0 = np.radians(q0)
+        q0 = _internal(m, q0)
     K = max(1, int(starts))
     if N * K < fill:                                   # small batches: more candidates per row
         K = max(K, fill // N)
     L = float(orientation_scale) if orientation_scale else reach
     pt, Rt = P[:, :3], _zyz_matrix(P[:, 3:])
-    to_deg = 180.0 / np.pi
+    to_deg = 180.0 / np.pi if m.angle_mask(m.joint_units).all() else _public(m, np.ones(n))
     budget = K + max(0, int(restarts))                 # starts per row, first ones included
     # start j of row i: the given start (j = 0, when given or without table), then the
     # table's configurations nearest to the target, then seeded random draws
@@ -853,12 +902,16 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     k0 = 0                                             # neighbours known for every row
     if table:
         tab = _start_table(m, int(table))
+        if W is not None:                              # nearest in the selected components only
+            tab = _masked_table(tab, W)
         tq = tab["q"]
         kn = min(int(table), K - own0 + int(neighbours))
         if kn > 0:
             # the first K - own0 neighbours of every row now; the full lists only for rows
             # that restart (most rows never need them)
             feats = np.concatenate([pt, tab["w"] * Rt.reshape(N, 9)], axis=-1)
+            if W is not None:
+                feats = feats * tab["mask"]
             k0 = kn if N < _TREE_MIN else max(0, min(kn, K - own0))   # brute force: all at once
             near = np.full((N, kn), -1, dtype=np.intp)
             if k0:
@@ -891,20 +944,23 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         evaluated.append(rows)                        # counted per row at the end
         e = _rotation_error(R, Rt[rows])
         dp = p - pt[rows]
+        J *= to_deg                                    # per radian (per length unit) of joint motion
+        if W is not None:                              # masked task: those rows do not count
+            dp, e = dp * W[:3], e * W[3:]
+            J *= W[:, None]
         r = np.concatenate([dp, L * e], axis=-1)
-        J *= to_deg                                    # per radian of joint motion
         # d e = J_l^{-1}(e) omega (left Jacobian of SO(3): e = log(R R_t^T), dR = [omega]x R)
         if exact_rotation:
             J[:, 3:] = so3_right_jacobian_inverse(-e) @ J[:, 3:]
         J[:, 3:] *= L
         return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
 
-    if N == 1 and rest <= 0 and not exact_rotation and hasattr(m, "frame_jacobian1"):
+    if N == 1 and rest <= 0 and not exact_rotation and W is None:
         def start_of(j):
             return starts_for(np.zeros(1, dtype=np.intp), np.array([j]))[0].tolist()
 
         bq, nused, ne = _inverse_scalar(m, pt[0], Rt[0], L, start_of, budget, tp, tr, iterations,
-                                        damping, down, up, step_cap, lo, hi)
+                                        damping, down, up, step_cap, slo, shi)
         best_q, used = bq[None], np.array([nused], dtype=np.int64)
         K = 1                                          # restarts: starts after the first
         ev_r = np.array([ne], dtype=np.int64)
@@ -1009,12 +1065,12 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     d += dz
                 d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
                 qn = qs + d
-                out = (qn < lo) | (qn > hi)
+                out = (qn < slo) | (qn > shi)
                 sat = np.flatnonzero(out.any(axis=-1))
                 if len(sat):                               # saturation in the null space, those rows only
                     Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
                     free = (~outv).astype(float)
-                    fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
+                    fixed = np.where(outv, np.clip(qn[sat], slo, shi) - qv, 0.0)
                     qv2 = np.empty_like(qv)
                     act = slice(None)                      # rows re-solved: all, then those with new violations
                     for _ in range(2):
@@ -1026,15 +1082,15 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                         A[:, _I6, _I6] += muv[act][:, None]
                         qa = qv[act] + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed[act]
                         qv2[act] = qa
-                        outa = ((qa < lo) | (qa > hi)) & (fa > 0)
+                        outa = ((qa < slo) | (qa > shi)) & (fa > 0)
                         more = np.flatnonzero(outa.any(axis=-1))
                         if not len(more):
                             break
                         act = more if isinstance(act, slice) else act[more]
                         outa = outa[more]
-                        fixed[act] = np.where(outa, np.clip(qa[more], lo, hi) - qv[act], fixed[act])
+                        fixed[act] = np.where(outa, np.clip(qa[more], slo, shi) - qv[act], fixed[act])
                         free[act] = np.where(outa, 0.0, free[act])
-                    qn[sat] = np.clip(qv2, lo, hi)
+                    qn[sat] = np.clip(qv2, slo, shi)
                 # -- evaluate the trial points and the restarted slots in one call ----------------
                 if anyfresh:
                     qe = q.copy()
@@ -1057,16 +1113,22 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         ev_j = ev_r.copy()
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
-    qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])
-    if N == 1 and hasattr(m, "frame_jacobian1"):    # one pose: the same formulas on floats
-        p1, R1, _ = m.frame_jacobian1(np.radians(qd[0]).tolist())
+    qd = _public(m, best_q)
+    if periodic.any():                                 # continuous joints: into [-180, 180)
+        qd = np.where(periodic, (qd + 180.0) % 360.0 - 180.0, qd)
+    qd = np.clip(qd, m.bounds[:, 0], m.bounds[:, 1])
+    if N == 1 and W is None:                           # one pose: the same formulas on floats
+        p1, R1, _ = m.frame_jacobian1(_internal(m, qd[0]).tolist())
         perr = np.array([math.dist(p1, pt[0].tolist())])
         rerr = np.array([math.hypot(*_rotation_error1(R1, Rt[0].tolist()))])
     else:
         pf, Rf = m.frame(qd)
         pf, Rf = np.stack(pf, axis=-1), to_array(Rf)
-        perr = np.sqrt(_sumsq(pf - pt))
-        rerr = np.sqrt(_sumsq(_rotation_error(Rf, Rt)))
+        dpf, ef = pf - pt, _rotation_error(Rf, Rt)
+        if W is not None:
+            dpf, ef = dpf * W[:3], ef * W[3:]
+        perr = np.sqrt(_sumsq(dpf))
+        rerr = np.sqrt(_sumsq(ef))
     ok = (perr <= tp) & (rerr <= tr) & m.in_bounds(qd)
     return InverseResult(
         mechanism=m.name, names=tuple(m.joint_names), joints=qd.reshape(shape + (n,)),

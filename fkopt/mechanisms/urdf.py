@@ -10,19 +10,28 @@ in the base frame plus the Z-Y-Z Euler angles (degrees) of :class:`fkopt.mechani
 so :class:`fkopt.problems.IKProblem` treats both alike.
 
 Bounds: revolute and prismatic joints take ``<limit lower upper>`` from the file; continuous
-joints (no limits) default to [-180, 180] deg, and any joint's bounds can be overridden by the
-config's ``mechanism.bounds`` as for every mechanism. In an experiment file, a relative
+joints (no limits) get [-180, 180] deg and are *periodic* (``arm.periodic``): solvers may move
+them through any angle and ``fkopt.inverse`` wraps the answer into [-180, 180). Any joint's
+bounds can be overridden by the config's ``mechanism.bounds`` as for every mechanism (a
+continuous joint given bounds is no longer periodic). In an experiment file, a relative
 ``geometry.file`` is relative to the config file's folder (see
 :func:`fkopt.experiment.runner.build_mechanism`); from Python, to the working directory.
 Without ``file`` the mechanism is wang7dof's arm written as URDF (``mechanisms/data/wang7dof.urdf``),
 which gives the same poses as ``7dof-arm`` with lengths in metres instead of millimetres.
 
-Parsing uses yourdfpy (meshes are not loaded); FK is vectorised over any batch shape and
-written elementwise like the DH arm, so batching never changes the numbers. No analytic
-Jacobian here: solvers that need one use their finite-difference fallback.
+Mimic joints (``<mimic joint multiplier offset>``) are not unknowns: q = multiplier * q_master
++ offset (SI units, as URDF defines it), through chains of mimics; their limits narrow the
+master's bounds, so every answer inside the bounds keeps them. A mimic whose master is not on
+the chain is refused with one line. ``geometry.tool`` adds a tool (TCP) frame on the tip link.
+
+Parsing uses yourdfpy (meshes are not loaded). FK and the analytic geometric frame Jacobian
+(:meth:`URDFArm.frame_jacobian`) share one recursion (:meth:`URDFArm._walk`), elementwise over
+the batch (no matmul), so batching never changes the numbers; ``frame_jacobian1`` is the same
+recursion on Python floats for a single configuration.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +51,9 @@ class URDFGeometry(Geometry):
     file: str = Field(str(DEFAULT_FILE), description="URDF file (relative: to the config's folder)")
     base: str | None = Field(None, description="first link of the chain (default: the root link)")
     tip: str | None = Field(None, description="last link of the chain (default: the only leaf link)")
+    tool: list[float] | None = Field(None, min_length=6, max_length=6,
+                                     description="tool (TCP) frame on the tip link: x, y, z (m), roll, pitch, "
+                                                 "yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll) as URDF origins)")
 
 
 def _load(path: Path):
@@ -107,6 +119,75 @@ def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
     return chain
 
 
+#: Entries of the constant rotations within this of 0 or +-1 are snapped to it: URDF files
+#: write quarter turns as rpy="0 0 1.5707963267948966", whose cosine is 6e-17, not 0; snapping
+#: moves the frame by ~1e-16 and turns most constant products into copies (fewer array ops).
+_SNAP = 1e-15
+
+
+def _rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll) (radians)."""
+    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
+                              math.cos(yaw), math.sin(yaw))
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _align(axis: np.ndarray) -> np.ndarray:
+    """A rotation A whose third column is the unit ``axis``, so that Rot(axis, t) = A Rz(t) A^T:
+    a signed permutation for a coordinate axis (the common case), else completed by
+    Gram-Schmidt."""
+    for k in range(3):
+        for sign in (1.0, -1.0):
+            if np.array_equal(axis, sign * np.eye(3)[k]):
+                i, j = (k + 1) % 3, (k + 2) % 3            # e_i x e_j = e_k
+                cols = (np.eye(3)[i], sign * np.eye(3)[j], sign * np.eye(3)[k])
+                return np.stack(cols, axis=1)
+    h = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    x = h - (h @ axis) * axis
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(axis, x), axis], axis=1)
+
+
+def _snap(a: np.ndarray) -> np.ndarray:
+    a = np.where(np.abs(a) < _SNAP, 0.0, a)
+    return np.where(np.abs(np.abs(a) - 1.0) < _SNAP, np.sign(a), a)
+
+
+def _terms(C: np.ndarray) -> tuple:
+    """The non-zero entries of a constant 3x3 rotation by output column: ((row, value), ...) per
+    column, for products ``F C`` written as sums of scaled columns of F."""
+    return tuple(tuple((m, float(C[m, c])) for m in range(3) if C[m, c] != 0.0) for c in range(3))
+
+
+def _combine(cols, terms):
+    """Columns of F C (see :func:`_terms`): a copy-free column for a +1 entry, else sums."""
+    out = []
+    for tc in terms:
+        acc = None
+        for m, v in tc:
+            t = cols[m] if v == 1.0 else (-cols[m] if v == -1.0 else cols[m] * v)
+            acc = t if acc is None else acc + t
+        out.append(acc)
+    return out
+
+
+def _offset(cols, v):
+    """F v for a constant vector v (its non-zero entries only); None when v = 0."""
+    acc = None
+    for m in range(3):
+        if v[m] != 0.0:
+            t = cols[m] * v[m]
+            acc = t if acc is None else acc + t
+    return acc
+
+
+def _combine1(cols, terms):
+    """:func:`_combine` on columns given as 3-tuples of floats."""
+    return [tuple(sum(cols[m][r] * v for m, v in tc) for r in range(3)) for tc in terms]
+
+
 class URDFArm(FrameArm):
     """Serial arm from a URDF chain (module docstring). Lengths in m, angles in deg."""
 
@@ -130,88 +211,265 @@ class URDFArm(FrameArm):
         path = Path(g.file)
         robot = _load(path)
         chain = _chain(robot, path, g.base, g.tip)
-        names, units, limits, steps = [], [], {}, []
-        for j in chain:
-            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
-            axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
-            if j.type in MOVING:
-                norm = float(np.linalg.norm(axis))
-                if not norm > 0:
-                    raise FkoptError(f"urdf {path}: joint '{j.name}' has a zero axis")
-                axis = axis / norm
+        moving = [j for j in chain if j.type in MOVING]
+        on_chain = {j.name: j for j in moving}
+        names, units, limits, kinds = [], [], {}, {}
+        for j in moving:
+            if j.mimic is None:
                 names.append(j.name)
-                prismatic = j.type == "prismatic"
-                units.append("m" if prismatic else "deg")
-                lim = j.limit
-                if j.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
-                    if j.type != "continuous":
-                        raise FkoptError(f"urdf {path}: joint '{j.name}' ({j.type}) needs <limit lower upper>")
-                    limits[j.name] = CONTINUOUS_BOUNDS
-                else:
-                    lo, hi = float(lim.lower), float(lim.upper)
-                    limits[j.name] = (lo, hi) if prismatic else (round(float(np.degrees(lo)), 9),
-                                                                 round(float(np.degrees(hi)), 9))
-            steps.append((j.type, origin[:3, :3].copy(), origin[:3, 3].copy(), axis))
-        if len(set(names)) != len(names):
-            raise FkoptError(f"urdf {path}: joint names repeat along the chain")
+                units.append("m" if j.type == "prismatic" else "deg")
+        index = {n: i for i, n in enumerate(names)}
+        to_si = [math.pi / 180.0 if u == "deg" else 1.0 for u in units]
+
+        def source(j, seen=()):
+            """(unknown index, multiplier, offset) of joint j in SI units: q_j = m q_src + o."""
+            if j.mimic is None:
+                return index[j.name], 1.0, 0.0
+            master = on_chain.get(j.mimic.joint)
+            if master is None or j.name in seen:
+                why = "is not on the chain" if master is None else "mimics in a loop"
+                raise FkoptError(f"urdf {path}: joint '{j.name}' mimics '{j.mimic.joint}', which {why} "
+                                 f"between '{chain[0].parent}' and '{chain[-1].child}'")
+            var, mult, off = source(master, seen + (j.name,))
+            a = 1.0 if j.mimic.multiplier is None else float(j.mimic.multiplier)
+            b = 0.0 if j.mimic.offset is None else float(j.mimic.offset)
+            return var, a * mult, a * off + b
+
+        for j in moving:
+            lim = j.limit
+            has = lim is not None and lim.lower is not None and lim.upper is not None and j.type != "continuous"
+            if j.type != "continuous" and not has:
+                raise FkoptError(f"urdf {path}: joint '{j.name}' ({j.type}) needs <limit lower upper>")
+            var, mult, off = source(j)
+            kinds[var] = kinds.get(var, set()) | {j.type}
+            if not has:
+                lo_si, hi_si = -math.inf, math.inf
+            else:
+                lo_si, hi_si = float(lim.lower), float(lim.upper)
+            if mult == 0.0:
+                if not lo_si <= off <= hi_si:
+                    raise FkoptError(f"urdf {path}: joint '{j.name}' mimics with multiplier 0 at offset "
+                                     f"{off:g}, outside its limits [{lo_si:g}, {hi_si:g}]")
+                continue
+            # limits of the joint as limits of its unknown: q_src in [(lo - o)/m, (hi - o)/m]
+            a, b = sorted(((lo_si - off) / mult, (hi_si - off) / mult))
+            a, b = a / to_si[var], b / to_si[var]
+            if units[var] == "deg":
+                a, b = (round(v, 9) if math.isfinite(v) else v for v in (a, b))
+            lo, hi = limits.get(names[var], (-math.inf, math.inf))
+            limits[names[var]] = (max(lo, a), min(hi, b))
+        periodic = []
+        for i, n in enumerate(names):
+            lo, hi = limits[n]
+            periodic.append(not (math.isfinite(lo) and math.isfinite(hi)))
+            if periodic[-1]:                           # continuous: documented range, wrapped
+                lo, hi = (max(lo, CONTINUOUS_BOUNDS[0]) if math.isfinite(lo) else CONTINUOUS_BOUNDS[0],
+                          min(hi, CONTINUOUS_BOUNDS[1]) if math.isfinite(hi) else CONTINUOUS_BOUNDS[1])
+                periodic[-1] = (lo, hi) == CONTINUOUS_BOUNDS
+            if not lo < hi:
+                raise FkoptError(f"urdf {path}: the limits of joint '{n}' and the joints mimicking it "
+                                 "leave no motion")
+            limits[n] = (lo, hi)
         self.joint_names = tuple(names)
         self.joint_units = tuple(units)
         self.default_bounds = limits
         super().__init__(bounds, **geometry)
+        # a continuous joint is periodic unless the config bounds it
+        self.periodic = np.array([p and tuple(b) == CONTINUOUS_BOUNDS
+                                  for p, b in zip(periodic, self.bounds.tolist())])
         self.path = path
         self.base_link = chain[0].parent
         self.tip_link = chain[-1].child
-        self._steps = steps
-        strokes = [max(abs(lo), abs(hi)) for unit, (lo, hi) in zip(self.joint_units, self.bounds) if unit == "m"]
-        self._reach = float(sum(np.linalg.norm(p) for _, _, p, _ in steps) + sum(strokes))
+        self._to_si = np.array(to_si)
+        self._build(chain, source, g.tool)
+        #: The chain's moving joints as URDF gives them (limits in rad or m; None: continuous),
+        #: with the unknown each follows (itself unless it mimics another).
+        self.chain_joints = []
+        for j in moving:
+            var, mult, off = source(j)
+            lim = j.limit
+            self.chain_joints.append({
+                "name": j.name, "type": j.type,
+                "limits": None if j.type == "continuous" or lim is None else [lim.lower, lim.upper],
+                "unit": "rad" if j.type != "prismatic" else "m",
+                "unknown": names[var], "multiplier": mult, "offset": off})
 
-    @property
-    def dof(self) -> int:
-        return len(self.joint_names)
+    def _build(self, chain, source, tool) -> None:
+        """Constant parts of the recursion (module docstring of :meth:`frame`): per moving joint
+        C_i = A_{i-1}^T T_R A_i and v_i = A_{i-1}^T T_p, with T the product of the fixed origins
+        since the previous moving joint (its own origin included) and A_i turning z onto its axis;
+        the tail (fixed joints after the last, then the tool) the same way."""
+        acc = np.eye(4)
+        A_prev = np.eye(3)
+        joints, reach = [], 0.0
+        for j in chain:
+            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+            reach += float(np.linalg.norm(origin[:3, 3]))
+            acc = acc @ origin
+            if j.type == "fixed":
+                continue
+            axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
+            norm = float(np.linalg.norm(axis))
+            if not norm > 0:
+                raise FkoptError(f"urdf {self.path}: joint '{j.name}' has a zero axis")
+            A = _align(axis / norm)
+            var, mult, off = source(j)
+            joints.append((j.type == "prismatic", _terms(_snap(A_prev.T @ acc[:3, :3] @ A)),
+                           tuple(float(v) for v in A_prev.T @ acc[:3, 3]), var, mult, off))
+            if j.type == "prismatic":
+                lo, hi = self.bounds[var] * self._to_si[var]
+                reach += max(abs(mult * lo + off), abs(mult * hi + off))
+            acc, A_prev = np.eye(4), A
+        if tool is not None:
+            T = np.eye(4)
+            T[:3, :3] = _rpy(*np.radians(tool[3:]))
+            T[:3, 3] = tool[:3]
+            reach += float(np.linalg.norm(tool[:3]))
+            acc = acc @ T
+        self._joints = tuple(joints)
+        self._tail = (_terms(_snap(A_prev.T @ acc[:3, :3])), tuple(float(v) for v in A_prev.T @ acc[:3, 3]))
+        self._reach = reach
+        self._plain = all(m == 1.0 and o == 0.0 and v == i for i, (_, _, _, v, m, o) in enumerate(joints))
+        self._key = (self.name, self._joints, self._tail)
 
     @property
     def reach(self) -> float:
         """Upper bound of the tip's distance from the base origin (sum of origin offsets + strokes)."""
         return self._reach
 
-    def frame(self, joints):
-        """Tip frame as (p, R) -- p = (px, py, pz) in m, R a :data:`rotations.Matrix` -- computed
-        elementwise over the batch shape of ``joints`` (..., dof)."""
+    def kinematic_key(self) -> tuple:
+        return self._key
+
+    def _chain_values(self, q: np.ndarray) -> list:
+        """Values (SI: rad, m) of the chain's moving joints for rows q (k, dof) in public units."""
+        cols = [np.radians(q[:, i]) if u == "deg" else q[:, i] for i, u in enumerate(self.joint_units)]
+        if self._plain:
+            return cols
+        return [cols[v] * m + o if (m, o) != (1.0, 0.0) else cols[v] for _, _, _, v, m, o in self._joints]
+
+    def _walk(self, q: np.ndarray, jacobian: bool):
+        """Tip frame of rows q (k, dof): position (3, k), columns x, y, z (3, k) of R and, when
+        ``jacobian``, the axes and origins (3, k) of the moving joints. The carried frame
+        F_i = W_i A_i has joint i's axis as its z column: F_i = F_{i-1} C_i Rz(t_i), origin
+        p_i = p_{i-1} + F_{i-1} v_i (+ t_i z for a prismatic joint); the columns' update is
+        u = c x + s y, v = c y - s x (a fixed number of array operations per joint)."""
+        k = len(q)
+        t = self._chain_values(q)
+        cols = list(np.eye(3)[:, :, None] * np.ones(k))          # x, y, z of the base frame (3, k)
+        p = np.zeros((3, k))
+        axes, origins = [], []
+        for ti, (prismatic, terms, v, _, _, _) in zip(t, self._joints):
+            dp = _offset(cols, v)
+            if dp is not None:
+                p = p + dp
+            cols = _combine(cols, terms)
+            if jacobian:
+                axes.append(cols[2])
+                origins.append(p)
+            if prismatic:
+                p = p + cols[2] * ti
+            else:
+                c, s = np.cos(ti), np.sin(ti)
+                x, y = cols[0], cols[1]
+                cols = [x * c + y * s, y * c - x * s, cols[2]]
+        terms, v = self._tail
+        dp = _offset(cols, v)
+        if dp is not None:
+            p = p + dp
+        cols = _combine(cols, terms)
+        return p, cols, axes, origins
+
+    def _check(self, joints) -> np.ndarray:
         joints = np.asarray(joints, dtype=float)
         if joints.shape[-1:] != (self.dof,):
             raise FkoptError(f"{self.name} joints: expected {self.dof} values "
                              f"({', '.join(self.joint_names)}), got shape {joints.shape}")
+        return joints
+
+    def frame(self, joints):
+        """Tip frame as (p, R) -- p = (px, py, pz) in m, R a :data:`rotations.Matrix` -- computed
+        elementwise over the batch shape of ``joints`` (..., dof) (:meth:`_walk`)."""
+        joints = self._check(joints)
         shape = joints.shape[:-1]
-        zero = np.zeros(shape)
-        R = tuple(tuple(zero + (1.0 if r == c else 0.0) for c in range(3)) for r in range(3))
-        p = (zero.copy(), zero.copy(), zero.copy())
-        k = 0
-        for kind, Ro, po, axis in self._steps:
-            # fixed origin: p += R po, R = R Ro
-            p = tuple(p[r] + R[r][0] * po[0] + R[r][1] * po[1] + R[r][2] * po[2] for r in range(3))
-            R = tuple(tuple(R[r][0] * Ro[0][c] + R[r][1] * Ro[1][c] + R[r][2] * Ro[2][c] for c in range(3))
-                      for r in range(3))
-            if kind == "fixed":
-                continue
-            q = joints[..., k]
-            k += 1
-            if kind == "prismatic":
-                d = (axis[0] * q, axis[1] * q, axis[2] * q)
-                p = tuple(p[r] + R[r][0] * d[0] + R[r][1] * d[1] + R[r][2] * d[2] for r in range(3))
-                continue
-            t = np.radians(q)
-            c, s = np.cos(t), np.sin(t)
-            v = 1.0 - c
-            x, y, z = axis
-            # Rodrigues: Rot(axis, t) = c I + s [axis]x + (1 - c) axis axis^T
-            M = ((c + x * x * v, x * y * v - z * s, x * z * v + y * s),
-                 (y * x * v + z * s, c + y * y * v, y * z * v - x * s),
-                 (z * x * v - y * s, z * y * v + x * s, c + z * z * v))
-            R = tuple(tuple(R[r][0] * M[0][cc] + R[r][1] * M[1][cc] + R[r][2] * M[2][cc] for cc in range(3))
-                      for r in range(3))
-        return p, R
+        p, cols, _, _ = self._walk(joints.reshape(-1, self.dof), False)
+        return (tuple(p[r].reshape(shape) for r in range(3)),
+                tuple(tuple(cols[c][r].reshape(shape) for c in range(3)) for r in range(3)))
+
+    def frame_jacobian(self, joints) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Tip position (..., 3), rotation (..., 3, 3) and geometric frame Jacobian (..., 6, n)
+        per public joint unit (rows 0-2 d(position)/dq, rows 3-5 the angular velocity in the base
+        frame): a revolute joint with world axis z through o contributes (z x (p - o), z), a
+        prismatic one (z, 0) (Siciliano et al., Robotics, 2009, eq. 3.30); a mimicking joint adds
+        its column times its multiplier to the column of the joint it follows."""
+        joints = self._check(joints)
+        shape = joints.shape[:-1]
+        q = joints.reshape(-1, self.dof)
+        k, n = len(q), self.dof
+        p, cols, axes, origins = self._walk(q, True)
+        Z, O = np.stack(axes, axis=1), np.stack(origins, axis=1)        # (3, m, k)
+        D = p[:, None, :] - O
+        Jc = np.empty((6, len(axes), k))
+        Jc[0] = Z[1] * D[2] - Z[2] * D[1]
+        Jc[1] = Z[2] * D[0] - Z[0] * D[2]
+        Jc[2] = Z[0] * D[1] - Z[1] * D[0]
+        Jc[3:] = Z
+        pri = [i for i, j in enumerate(self._joints) if j[0]]
+        if pri:
+            Jc[:3, pri], Jc[3:, pri] = Z[:, pri], 0.0
+        if self._plain:
+            J = Jc * self._to_si[None, :, None]
+        else:
+            J = np.zeros((6, n, k))
+            for i, (_, _, _, v, m, _) in enumerate(self._joints):
+                J[:, v] += Jc[:, i] * (m * self._to_si[v])
+        R = np.stack(cols, axis=-1)                                       # (3 rows, k, 3 columns)
+        return (np.ascontiguousarray(p.T).reshape(shape + (3,)),
+                np.ascontiguousarray(R.transpose(1, 0, 2)).reshape(shape + (3, 3)),
+                np.ascontiguousarray(J.transpose(2, 0, 1)).reshape(shape + (6, n)))
+
+    def frame_jacobian1(self, t) -> tuple[list[float], list[list[float]], list[list[float]]]:
+        """:meth:`frame_jacobian` of one configuration on Python floats, in internal units (``t``
+        in rad for angles, m for lengths; the Jacobian per rad / per m): the recursion of
+        :meth:`_walk`. For one configuration numpy's per-call overhead is most of the cost."""
+        cols = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+        p0 = p1 = p2 = 0.0
+        axes, origins = [], []
+        for prismatic, terms, v, var, m, o in self._joints:
+            ti = t[var] * m + o
+            if v != (0.0, 0.0, 0.0):
+                p0 += cols[0][0] * v[0] + cols[1][0] * v[1] + cols[2][0] * v[2]
+                p1 += cols[0][1] * v[0] + cols[1][1] * v[1] + cols[2][1] * v[2]
+                p2 += cols[0][2] * v[0] + cols[1][2] * v[1] + cols[2][2] * v[2]
+            cols = _combine1(cols, terms)
+            z = cols[2]
+            axes.append(z)
+            origins.append((p0, p1, p2))
+            if prismatic:
+                p0, p1, p2 = p0 + z[0] * ti, p1 + z[1] * ti, p2 + z[2] * ti
+            else:
+                c, s = math.cos(ti), math.sin(ti)
+                x, y = cols[0], cols[1]
+                cols = [(x[0] * c + y[0] * s, x[1] * c + y[1] * s, x[2] * c + y[2] * s),
+                        (y[0] * c - x[0] * s, y[1] * c - x[1] * s, y[2] * c - x[2] * s), z]
+        terms, v = self._tail
+        p0 += cols[0][0] * v[0] + cols[1][0] * v[1] + cols[2][0] * v[2]
+        p1 += cols[0][1] * v[0] + cols[1][1] * v[1] + cols[2][1] * v[2]
+        p2 += cols[0][2] * v[0] + cols[1][2] * v[1] + cols[2][2] * v[2]
+        cols = _combine1(cols, terms)
+        J = [[0.0] * self.dof for _ in range(6)]
+        for (prismatic, _, _, var, m, _), (a0, a1, a2), (o0, o1, o2) in zip(self._joints, axes, origins):
+            if prismatic:
+                col = (a0, a1, a2, 0.0, 0.0, 0.0)
+            else:
+                d0, d1, d2 = p0 - o0, p1 - o1, p2 - o2
+                col = (a1 * d2 - a2 * d1, a2 * d0 - a0 * d2, a0 * d1 - a1 * d0, a0, a1, a2)
+            for r in range(6):
+                J[r][var] += col[r] * m
+        R = [[cols[0][r], cols[1][r], cols[2][r]] for r in range(3)]
+        return [p0, p1, p2], R, J
 
     def describe(self) -> dict[str, Any]:
         out = super().describe()
         out["chain"] = {"file": str(self.path), "base": self.base_link, "tip": self.tip_link}
+        out["chain_joints"] = self.chain_joints
         return out
