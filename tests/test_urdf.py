@@ -9,7 +9,7 @@ import fkopt
 from fkopt.errors import FkoptError
 from fkopt.experiment.config import load_config
 from fkopt.experiment.runner import run_experiment
-from fkopt.mechanisms.urdf import DEFAULT_FILE
+from fkopt.mechanisms.urdf import DEFAULT_FILE, example_robot, example_robots_folder
 from fkopt.rotations import wrap_degrees
 
 TWO_JOINTS = """<?xml version="1.0"?>
@@ -100,33 +100,14 @@ def test_yaml_file_path_is_relative_to_the_config_folder(tmp_path, monkeypatch):
 
 
 # -- real robots (example-robot-data) --------------------------------------------------------------
-def _robots_folder():
-    """The robots/ folder the PyPI package example-robot-data installs (a cmeel prefix, no
-    Python module), or None."""
-    from importlib import metadata
-    try:
-        files = metadata.files("example-robot-data") or []
-    except metadata.PackageNotFoundError:
-        return None
-    for f in files:
-        if str(f).endswith("robots/panda_description/urdf/panda.urdf"):
-            return f.locate().parents[2]
-    return None
-
-
-ROBOTS = {   # file under robots/, base link, tip link (the chains ikpy follows from the base)
-    "panda": ("panda_description/urdf/panda.urdf", "panda_link0", "panda_hand_tcp"),
-    "ur5": ("ur_description/urdf/ur5_robot.urdf", "base_link", "ee_link"),
-    "kinova": ("kinova_description/robots/kinova.urdf", "base", "j2s6s200_end_effector"),
-}
+ROBOTS = {   # name -> tip link for the FK comparison: the chains ikpy follows from the base
+    "panda": "panda_hand_tcp", "ur5": "ee_link", "kinova": "j2s6s200_end_effector"}
 
 
 def robot(name, **extra):
-    folder = _robots_folder()
-    if folder is None:
+    if example_robots_folder() is None:
         pytest.skip("example-robot-data is not installed (pip install fkopt[test])")
-    rel, base, tip = ROBOTS[name]
-    return fkopt.mechanism("urdf", file=str(folder / rel), base=base, tip=tip, **extra)
+    return example_robot(name, **{"tip": ROBOTS[name], **extra})
 
 
 def random_joints(m, n, seed):
@@ -276,22 +257,18 @@ def test_masked_inverse_position_only():
         fkopt.inverse(m, poses[0], mask=[0] * 6)
 
 
-PR2 = ("pr2_description/urdf/pr2.urdf", "torso_lift_link", "l_gripper_l_finger_tip_link")
-
-
 def test_mimic_joints_follow_their_master_as_yourdfpy_does():
     """PR2's left gripper chain: the finger tip joint mimics the finger joint; it is not an
     unknown, and the FK agrees with yourdfpy's (which applies mimics itself)."""
-    folder = _robots_folder()
-    if folder is None:
+    if example_robots_folder() is None:
         pytest.skip("example-robot-data is not installed")
     import yourdfpy
-    rel, base, tip = PR2
-    m = fkopt.mechanism("urdf", file=str(folder / rel), base=base, tip=tip)
+    m = example_robot("pr2-left-gripper")
+    base, tip = m.base_link, m.tip_link
     assert len(m.joint_names) == 8 and "l_gripper_l_finger_tip_joint" not in m.joint_names
     tipj = next(j for j in m.chain_joints if j["name"] == "l_gripper_l_finger_tip_joint")
     assert tipj["unknown"] == "l_gripper_l_finger_joint" and tipj["multiplier"] == 1.0
-    robot_ = yourdfpy.URDF.load(str(folder / rel), load_meshes=False, build_collision_scene_graph=False)
+    robot_ = yourdfpy.URDF.load(str(m.path), load_meshes=False, build_collision_scene_graph=False)
     q = random_joints(m, 20, 2)
     T = m.fk_matrix(q)
     for k in range(len(q)):

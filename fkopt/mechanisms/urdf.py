@@ -183,9 +183,72 @@ def _offset(cols, v):
     return acc
 
 
-def _combine1(cols, terms):
-    """:func:`_combine` on columns given as 3-tuples of floats."""
-    return [tuple(sum(cols[m][r] * v for m, v in tc) for r in range(3)) for tc in terms]
+def _lin(terms) -> str:
+    """Source of a sum ``c1 * n1 + c2 * n2 ...`` of named floats (coefficients +-1 written as signs)."""
+    out = ""
+    for name, v in terms:
+        if v == 0.0:
+            continue
+        t = name if abs(v) == 1.0 else f"{name} * {abs(v)!r}"
+        out += (" - " if v < 0 else " + ") + t if out else ("-" if v < 0 else "") + t
+    return out or "0.0"
+
+
+def _compile1(joints, tail, dof):
+    """A function t -> (p, R, J) on Python floats: :meth:`URDFArm._walk` and the Jacobian of
+    :meth:`URDFArm.frame_jacobian` unrolled for one arm's constants (zero terms dropped, +-1
+    factors as signs, the columns' names permuted instead of copied), like ``namedtuple``
+    builds its class from source. Frame columns are x0..x2, y0..y2, z0..z2, position p0..p2."""
+    src = ["def fj1(t):", "    x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0",
+           "    p0 = p1 = p2 = 0.0"]
+    names = ("x", "y", "z")
+
+    def offset(v):
+        for r in range(3):
+            e = _lin([(f"{names[m]}{r}", v[m]) for m in range(3)])
+            if e != "0.0":
+                src.append(f"    p{r} = p{r} + ({e})")
+
+    def combine(terms):
+        new = [_lin([(f"{names[m]}{r}", v) for m, v in terms[c]]) for c in range(3) for r in range(3)]
+        src.append("    x0, x1, x2, y0, y1, y2, z0, z1, z2 = " + ", ".join(new))
+
+    cols = {}
+    for i, (prismatic, terms, v, var, mult, off) in enumerate(joints):
+        src.append(f"    q = t[{var}]" + (f" * {mult!r} + {off!r}" if (mult, off) != (1.0, 0.0) else ""))
+        offset(v)
+        combine(terms)
+        src.append(f"    a{i}0, a{i}1, a{i}2, o{i}0, o{i}1, o{i}2 = z0, z1, z2, p0, p1, p2")
+        if prismatic:
+            src.append("    p0, p1, p2 = p0 + z0 * q, p1 + z1 * q, p2 + z2 * q")
+        else:
+            src.append("    c, s = cos(q), sin(q)")
+            src.append("    x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, "
+                       "y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)")
+        cols.setdefault(var, []).append((i, prismatic, mult))
+    offset(tail[1])
+    combine(tail[0])
+    rows = [[] for _ in range(6)]
+    for var in range(dof):
+        parts = [[] for _ in range(6)]
+        for i, prismatic, mult in cols.get(var, []):
+            k = "" if mult == 1.0 else f" * {mult!r}"
+            if prismatic:
+                col = (f"a{i}0", f"a{i}1", f"a{i}2", None, None, None)
+            else:
+                d = (f"(p0 - o{i}0)", f"(p1 - o{i}1)", f"(p2 - o{i}2)")
+                col = (f"(a{i}1 * {d[2]} - a{i}2 * {d[1]})", f"(a{i}2 * {d[0]} - a{i}0 * {d[2]})",
+                       f"(a{i}0 * {d[1]} - a{i}1 * {d[0]})", f"a{i}0", f"a{i}1", f"a{i}2")
+            for r in range(6):
+                if col[r] is not None:
+                    parts[r].append(col[r] + k)
+        for r in range(6):
+            rows[r].append(" + ".join(parts[r]) or "0.0")
+    src.append("    return [p0, p1, p2], [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]], ["
+               + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]")
+    scope = {"cos": math.cos, "sin": math.sin}
+    exec(compile("\n".join(src), "<fkopt.urdf frame_jacobian1>", "exec"), scope)
+    return scope["fj1"]
 
 
 class URDFArm(FrameArm):
@@ -430,46 +493,54 @@ class URDFArm(FrameArm):
     def frame_jacobian1(self, t) -> tuple[list[float], list[list[float]], list[list[float]]]:
         """:meth:`frame_jacobian` of one configuration on Python floats, in internal units (``t``
         in rad for angles, m for lengths; the Jacobian per rad / per m): the recursion of
-        :meth:`_walk`. For one configuration numpy's per-call overhead is most of the cost."""
-        cols = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
-        p0 = p1 = p2 = 0.0
-        axes, origins = [], []
-        for prismatic, terms, v, var, m, o in self._joints:
-            ti = t[var] * m + o
-            if v != (0.0, 0.0, 0.0):
-                p0 += cols[0][0] * v[0] + cols[1][0] * v[1] + cols[2][0] * v[2]
-                p1 += cols[0][1] * v[0] + cols[1][1] * v[1] + cols[2][1] * v[2]
-                p2 += cols[0][2] * v[0] + cols[1][2] * v[1] + cols[2][2] * v[2]
-            cols = _combine1(cols, terms)
-            z = cols[2]
-            axes.append(z)
-            origins.append((p0, p1, p2))
-            if prismatic:
-                p0, p1, p2 = p0 + z[0] * ti, p1 + z[1] * ti, p2 + z[2] * ti
-            else:
-                c, s = math.cos(ti), math.sin(ti)
-                x, y = cols[0], cols[1]
-                cols = [(x[0] * c + y[0] * s, x[1] * c + y[1] * s, x[2] * c + y[2] * s),
-                        (y[0] * c - x[0] * s, y[1] * c - x[1] * s, y[2] * c - x[2] * s), z]
-        terms, v = self._tail
-        p0 += cols[0][0] * v[0] + cols[1][0] * v[1] + cols[2][0] * v[2]
-        p1 += cols[0][1] * v[0] + cols[1][1] * v[1] + cols[2][1] * v[2]
-        p2 += cols[0][2] * v[0] + cols[1][2] * v[1] + cols[2][2] * v[2]
-        cols = _combine1(cols, terms)
-        J = [[0.0] * self.dof for _ in range(6)]
-        for (prismatic, _, _, var, m, _), (a0, a1, a2), (o0, o1, o2) in zip(self._joints, axes, origins):
-            if prismatic:
-                col = (a0, a1, a2, 0.0, 0.0, 0.0)
-            else:
-                d0, d1, d2 = p0 - o0, p1 - o1, p2 - o2
-                col = (a1 * d2 - a2 * d1, a2 * d0 - a0 * d2, a0 * d1 - a1 * d0, a0, a1, a2)
-            for r in range(6):
-                J[r][var] += col[r] * m
-        R = [[cols[0][r], cols[1][r], cols[2][r]] for r in range(3)]
-        return [p0, p1, p2], R, J
+        :meth:`_walk` written out for this arm's constants (:func:`_compile1`, once per arm),
+        since for one configuration the interpreter's per-operation cost is all there is."""
+        f = self.__dict__.get("_fj1")
+        if f is None:
+            f = self.__dict__["_fj1"] = _compile1(self._joints, self._tail, self.dof)
+        return f(t)
 
     def describe(self) -> dict[str, Any]:
         out = super().describe()
         out["chain"] = {"file": str(self.path), "base": self.base_link, "tip": self.tip_link}
         out["chain_joints"] = self.chain_joints
         return out
+
+
+#: Serial chains of the PyPI package ``example-robot-data`` (version 6) that fkopt was tried on:
+#: name -> (file under its robots/ folder, base link, tip link). Tests and ``fkopt bench
+#: --section robots`` use them; docs/robots.md lists the results.
+EXAMPLE_ROBOTS = {
+    "panda": ("panda_description/urdf/panda.urdf", "panda_link0", "panda_hand_tcp"),
+    "ur5": ("ur_description/urdf/ur5_robot.urdf", "base_link", "tool0"),
+    "kinova": ("kinova_description/robots/kinova.urdf", "base", "j2s6s200_end_effector"),
+    "xarm7": ("xarm_description/urdf/xarm7.urdf", "link_base", "link_eef"),
+    "z1": ("z1_description/urdf/z1.urdf", "link00", "gripperStator"),
+    "baxter-left": ("baxter_description/urdf/baxter.urdf", "torso", "left_gripper"),
+    "pr2-left-gripper": ("pr2_description/urdf/pr2.urdf", "torso_lift_link", "l_gripper_l_finger_tip_link"),
+}
+
+
+def example_robots_folder() -> Path | None:
+    """The robots/ folder installed by the PyPI package example-robot-data (a cmeel prefix
+    with no Python module, found through the package's file list), or None."""
+    from importlib import metadata
+    try:
+        files = metadata.files("example-robot-data") or []
+    except metadata.PackageNotFoundError:
+        return None
+    for f in files:
+        if str(f).endswith("robots/panda_description/urdf/panda.urdf"):
+            return Path(f.locate()).parents[2]
+    return None
+
+
+def example_robot(name: str, **geometry: Any) -> "URDFArm":
+    """``URDFArm`` of chain ``name`` of :data:`EXAMPLE_ROBOTS` (example-robot-data must be installed)."""
+    if name not in EXAMPLE_ROBOTS:
+        raise FkoptError(f"unknown example robot '{name}'; allowed: {', '.join(EXAMPLE_ROBOTS)}")
+    folder = example_robots_folder()
+    if folder is None:
+        raise FkoptError("example-robot-data is not installed: pip install example-robot-data")
+    rel, base, tip = EXAMPLE_ROBOTS[name]
+    return URDFArm(file=str(folder / rel), **{"base": base, "tip": tip, **geometry})
