@@ -657,6 +657,53 @@ def _rotation_error1(R, T):
     return v0 * k, v1 * k, v2 * k
 
 
+_DLS: dict = {}
+
+
+def _dls_function(n: int):
+    """``dls(J, r, mu) -> d`` for a 6 x n Jacobian on Python floats: d = J^T (J J^T + mu I)^{-1} (-r)
+    by Cholesky, or None when J J^T + mu I is not positive definite or d not finite; and
+    ``trace6(J)`` = sum of J's squared entries / 6. Written out once per n (straight-line source,
+    as ``namedtuple`` builds its class) with the additions in the order of the loops of
+    :func:`_cholesky_solve` and ``sum(map(mul, ...))``, so the numbers are the loops' numbers; a
+    one-pose inverse spends most of its time here and in the arm's ``frame_jacobian1``."""
+    got = _DLS.get(n)
+    if got is not None:
+        return got
+    R = range(6)
+    src = ["def dls(J, r, mu):", "    " + ", ".join(f"J{a}" for a in R) + " = J",
+           *(f"    " + ", ".join(f"J{a}_{i}" for i in range(n)) + f", = J{a}" for a in R),
+           "    " + ", ".join(f"b{a}" for a in R) + " = " + ", ".join(f"-r[{a}]" for a in R)]
+    dot = lambda a, b: " + ".join(f"J{a}_{i} * J{b}_{i}" for i in range(n))   # noqa: E731
+    for a in R:
+        for b in range(a, 6):
+            src.append(f"    A{a}{b} = {dot(a, b)}" + (" + mu" if a == b else ""))
+    for i in R:                                        # Cholesky, row by row (as _cholesky_solve)
+        for j in range(i + 1):
+            prev = " + ".join(f"L{i}{k} * L{j}{k}" for k in range(j))
+            acc = f"A{j}{i} - ({prev})" if prev else f"A{j}{i} - 0"
+            if i == j:
+                src += [f"    acc = {acc}", "    if not acc > 0.0:", "        return None",
+                        f"    L{i}{i} = sqrt(acc)"]
+            else:
+                src.append(f"    L{i}{j} = ({acc}) / L{j}{j}")
+    for i in R:
+        prev = " + ".join(f"L{i}{k} * y{k}" for k in range(i))
+        src.append(f"    y{i} = (b{i} - ({prev or 0})) / L{i}{i}")
+    for i in reversed(R):
+        acc = f"y{i}" + "".join(f" - L{k}{i} * x{k}" for k in range(i + 1, 6))
+        src.append(f"    x{i} = ({acc}) / L{i}{i}")
+    src.append("    if not (" + " and ".join(f"isfinite(x{a})" for a in R) + "):")
+    src.append("        return None")
+    src.append("    return [" + ", ".join(" + ".join(f"J{a}_{i} * x{a}" for a in R) for i in range(n)) + "]")
+    src.append("def trace6(J):")
+    src.append("    return (" + " + ".join(f"J[{a}][{i}] * J[{a}][{i}]" for a in R for i in range(n)) + ") / 6.0")
+    scope = {"sqrt": math.sqrt, "isfinite": math.isfinite}
+    exec(compile("\n".join(src), f"<fkopt.kinematics dls n={n}>", "exec"), scope)
+    got = _DLS[n] = (scope["dls"], scope["trace6"])
+    return got
+
+
 def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping, down, up,
                     step_cap, lo, hi):
     """The damped least-squares iteration of :func:`inverse` for one pose on Python floats
@@ -676,26 +723,19 @@ def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping,
         e0, e1, e2 = _rotation_error1(R, T)
         d0, d1, d2 = p[0] - t0, p[1] - t1, p[2] - t2
         r = [d0, d1, d2, L * e0, L * e1, L * e2]
-        for row in J[3:]:
-            for i in range(n):
-                row[i] *= L
+        J[3] = [v * L for v in J[3]]
+        J[4] = [v * L for v in J[4]]
+        J[5] = [v * L for v in J[5]]
         return (r, J, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
                 d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
+
+    dls0, trace6 = _dls_function(n)
 
     def dls(J, r, mu, fixed=None):
         """d = Jf^T (Jf Jf^T + mu I)^{-1} (-r), Jf = J without the columns in ``fixed``."""
         if fixed:
             J = [[0.0 if i in fixed else v for i, v in enumerate(row)] for row in J]
-        A = [[0.0] * 6 for _ in range(6)]
-        for a in range(6):
-            Ja = J[a]
-            for b in range(a, 6):
-                A[a][b] = A[b][a] = sum(map(mul, Ja, J[b]))
-            A[a][a] += mu
-        y = _cholesky_solve(A, [-v for v in r])
-        if y is None:
-            return None
-        return [sum(map(mul, col, y)) for col in zip(*J)]
+        return dls0(J, r, mu)
 
     best_q, best_m = None, math.inf
     allc = list(range(n))
@@ -707,7 +747,7 @@ def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping,
         for _ in range(iterations):
             if pe <= tp and re <= tr:
                 break
-            tr6 = sum(v * v for row in J for v in row) / 6.0
+            tr6 = trace6(J)
             mu = lam * tr6
             d = dls(J, r, mu)
             if d is None:
@@ -828,6 +868,87 @@ def _task_mask(mask) -> np.ndarray | None:
     return None if W.all() else W
 
 
+def _arm_constants(m) -> dict:
+    """Per-arm values of a one-pose :func:`inverse` as Python floats, cached on the arm (keyed by
+    its bounds, which a user may change): internal-unit limits, saturation limits (none for
+    periodic joints), the periodic mask and the unit factors."""
+    key = m.bounds.tobytes()
+    got = m.__dict__.get("_inverse_constants")
+    if got is None or got["key"] != key:
+        lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
+        per = m.periodic_mask()
+        got = m.__dict__["_inverse_constants"] = {
+            "key": key, "lo": lo, "hi": hi, "slo": np.where(per, -np.inf, lo), "shi": np.where(per, np.inf, hi),
+            "periodic": per, "blo": m.bounds[:, 0].tolist(), "bhi": m.bounds[:, 1].tolist(),
+            "angle": m.angle_mask(m.joint_units).tolist()}
+    return got
+
+
+def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
+                 down, up, step_cap) -> InverseResult:
+    """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
+    Python floats (:func:`_inverse_scalar`), the same starts in the same order (``start``, then
+    the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
+    first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
+    batch's bookkeeping costs more than the iteration itself for a single pose."""
+    tp, tr = tol
+    n = m.dof
+    c = _arm_constants(m)
+    x, y, z = (float(v) for v in pose[:3])
+    reach = m.reach
+    dist = math.sqrt(x * x + y * y + z * z)
+    if dist > reach * (1.0 + 1e-12):
+        unit = m.pose_units[0]
+        raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
+                         f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
+    lo, hi = c["lo"], c["hi"]
+    own0 = 1 if (start is not None or not table) else 0
+    if start is None:
+        q0 = (0.5 * (lo + hi)).tolist()
+    else:
+        s = _values(m, start, m.joint_names, "start")
+        if s.ndim != 1 or not m.in_bounds(s):
+            box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
+            raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})"
+                             if s.ndim == 1 else f"{m.name} start: one pose takes one start (n,), got {s.shape}")
+        q0 = _internal(m, s).tolist()
+    L = float(orientation_scale) if orientation_scale else reach
+    Rt = _zyz_matrix(np.asarray(pose[3:], dtype=float)[None])[0]
+    near: list[int] = []
+    nn = min(table, kn) if table else 0
+
+    def start_of(j):
+        if j < own0:
+            return q0
+        if j < own0 + nn:
+            if not near:
+                tab = _start_table(m, table)
+                f = np.concatenate([pose[:3], tab["w"] * Rt.reshape(9)])
+                near.extend(_nearest(tab, f[None], nn)[0].tolist())
+                near.append(tab)
+            return near[-1]["q"][near[j - own0]].tolist()
+        return (lo + (hi - lo) * _uniform_hash(seed, np.zeros(1, dtype=np.intp),
+                                               np.array([j - own0 - nn]), n)[0]).tolist()
+
+    bq, used, ne = _inverse_scalar(m, pose[:3], Rt, L, start_of, budget, tp, tr, iterations,
+                                   damping, down, up, step_cap, c["slo"], c["shi"])
+    qd = _public(m, bq)
+    per = c["periodic"]
+    if per.any():                                       # continuous joints: into [-180, 180)
+        qd = np.where(per, (qd + 180.0) % 360.0 - 180.0, qd)
+    qd = np.clip(qd, m.bounds[:, 0], m.bounds[:, 1])
+    p1, R1, _ = m.frame_jacobian1(_internal(m, qd).tolist())
+    perr = math.dist(p1, (x, y, z))
+    rerr = math.hypot(*_rotation_error1(R1, Rt.tolist()))
+    inside = all(a <= v <= b for v, a, b in zip(qd.tolist(), c["blo"], c["bhi"]))
+    ev = np.array(ne, dtype=np.int64)
+    return InverseResult(
+        mechanism=m.name, names=tuple(m.joint_names), joints=qd, position_error=np.array(perr),
+        rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+        solved=np.array(perr <= tp and rerr <= tr and inside), restarts=np.array(used - 1, dtype=np.int64),
+        evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
+
+
 def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0, restarts: int = 200,
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
@@ -862,6 +983,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
         raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
     P0 = _values(m, poses, m.pose_names, "target pose")
+    if P0.ndim == 1 and rest <= 0 and not exact_rotation and mask is None:
+        return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
+                            int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
+                            + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap)
     shape = P0.shape[:-1]
     P = P0.reshape(-1, 6)
     N, n = len(P), m.dof
