@@ -45,11 +45,12 @@ def _rtb_ets(path: Path, base: str, tip: str):
         return None, f"roboticstoolbox-python not importable ({type(err).__name__}: {err}); " \
                      "pip install roboticstoolbox-python: the rtb rows are skipped"
     import tempfile
-    from lxml import etree
-    tree = etree.parse(str(path))
-    for tag in ("visual", "collision", "transmission", "gazebo"):
-        for e in list(tree.getroot().iter(tag)):
-            e.getparent().remove(e)
+    import xml.etree.ElementTree as ET
+    tree = ET.parse(str(path))
+    for parent in list(tree.getroot().iter()):
+        for e in list(parent):
+            if e.tag in ("visual", "collision", "transmission", "gazebo"):
+                parent.remove(e)
     with tempfile.TemporaryDirectory() as tmp:
         copy = Path(tmp) / path.name
         tree.write(str(copy))
@@ -87,7 +88,7 @@ def bench_robots(rows, quick: bool, messages: list[str]) -> None:
             m = urdf.example_robot(name)
             rows.add(sec, f"{name} load", (time.perf_counter() - t) * 1e3, "ms",
                      f"parse {Path(m.path).name} ({m.base_link} -> {m.tip_link}, {m.dof} joints)"
-                     + ("; includes importing yourdfpy" if not arms else ""))
+                     + ("; the process's first URDF" if not arms else ""))
             arms.append((name, m, m.path, m.base_link, m.tip_link, TOL_M, 1.0, m.periodic_mask()))
     # the DH arm (mm); rtb reads it as URDF, whose q1 is continuous (rtb's answers wrapped)
     arms.append(("wang7dof", mechanism("7dof-arm"), urdf.DEFAULT_FILE, "link0", "tool", TOL_MM, 1000.0,

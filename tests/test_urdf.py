@@ -262,7 +262,7 @@ def test_mimic_joints_follow_their_master_as_yourdfpy_does():
     unknown, and the FK agrees with yourdfpy's (which applies mimics itself)."""
     if example_robots_folder() is None:
         pytest.skip("example-robot-data is not installed")
-    import yourdfpy
+    yourdfpy = pytest.importorskip("yourdfpy")
     m = example_robot("pr2-left-gripper")
     base, tip = m.base_link, m.tip_link
     assert len(m.joint_names) == 8 and "l_gripper_l_finger_tip_joint" not in m.joint_names

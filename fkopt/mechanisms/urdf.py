@@ -24,7 +24,7 @@ Mimic joints (``<mimic joint multiplier offset>``) are not unknowns: q = multipl
 master's bounds, so every answer inside the bounds keeps them. A mimic whose master is not on
 the chain is refused with one line. ``geometry.tool`` adds a tool (TCP) frame on the tip link.
 
-Parsing uses yourdfpy (meshes are not loaded). FK and the analytic geometric frame Jacobian
+Parsing uses the standard library's XML parser (links and joints only). FK and the analytic geometric frame Jacobian
 (:meth:`URDFArm.frame_jacobian`) share one recursion (:meth:`URDFArm._walk`), elementwise over
 the batch (no matmul), so batching never changes the numbers; ``frame_jacobian1`` is the same
 recursion on Python floats for a single configuration.
@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -56,28 +57,66 @@ class URDFGeometry(Geometry):
                                                  "yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll) as URDF origins)")
 
 
-def _load(path: Path):
-    """Parse with yourdfpy; every failure is one line naming the file."""
+def _floats(text, count: int, default, what: str, path: Path) -> tuple:
+    if text is None:
+        return default
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        values = ()
+    if len(values) != count or not all(map(math.isfinite, values)):
+        raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{text}')")
+    return values
+
+
+def _load(path: Path) -> SimpleNamespace:
+    """The links and joints of a URDF file (what a kinematic chain needs: no meshes, inertias
+    or transmissions), read with the standard library's XML parser -- importing a URDF library
+    cost 1.3-2.0 s per process. Every failure is one line naming the file."""
+    import xml.etree.ElementTree as ET
     if not path.is_file():
         raise FkoptError(f"urdf geometry.file: {path} does not exist")
     try:
-        import yourdfpy
-    except ImportError:
-        raise FkoptError("the 'urdf' mechanism needs yourdfpy: pip install yourdfpy") from None
-    from lxml import etree   # a dependency of yourdfpy
-    try:   # strict XML first: yourdfpy would log the error and retry with a recovering parser
-        etree.parse(str(path), etree.XMLParser(remove_blank_text=True))
-    except etree.XMLSyntaxError as err:
+        root = ET.parse(str(path)).getroot()
+    except ET.ParseError as err:
         raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
-    try:
-        robot = yourdfpy.URDF.load(str(path), build_scene_graph=False, build_collision_scene_graph=False,
-                                   load_meshes=False, load_collision_meshes=False)
-    except Exception as err:
-        msg = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise FkoptError(f"urdf {path}: malformed URDF ({msg})") from None
-    if robot is None or not getattr(robot, "robot", None) or not robot.link_map:
-        raise FkoptError(f"urdf {path}: malformed URDF (no <robot> with links)")
-    return robot
+    links = {e.get("name"): e for e in root.findall("link")}
+    if root.tag != "robot" or not links or None in links:
+        raise FkoptError(f"urdf {path}: malformed URDF (no <robot> with named links)")
+    joints = {}
+    for e in root.findall("joint"):
+        name, kind = e.get("name"), e.get("type")
+        parent, child = e.find("parent"), e.find("child")
+        if not name or not kind or parent is None or child is None or not parent.get("link") \
+                or not child.get("link"):
+            raise FkoptError(f"urdf {path}: malformed URDF (joint '{name}' needs name, type, "
+                             "<parent link> and <child link>)")
+        if name in joints:
+            raise FkoptError(f"urdf {path}: malformed URDF (joint '{name}' is defined twice)")
+        origin = np.eye(4)
+        o = e.find("origin")
+        if o is not None:
+            origin[:3, 3] = _floats(o.get("xyz"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin xyz", path)
+            origin[:3, :3] = _rpy(*_floats(o.get("rpy"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin rpy", path))
+        ax = e.find("axis")
+        axis = _floats(None if ax is None else ax.get("xyz"), 3, (1.0, 0.0, 0.0), f"joint '{name}' axis", path)
+        lim = e.find("limit")
+        limit = None
+        if lim is not None and lim.get("lower") is not None and lim.get("upper") is not None:
+            limit = SimpleNamespace(lower=_floats(lim.get("lower"), 1, None, f"joint '{name}' limit lower", path)[0],
+                                    upper=_floats(lim.get("upper"), 1, None, f"joint '{name}' limit upper", path)[0])
+        mi = e.find("mimic")
+        mimic = None
+        if mi is not None:
+            if not mi.get("joint"):
+                raise FkoptError(f"urdf {path}: malformed URDF (joint '{name}': <mimic> needs joint)")
+            mimic = SimpleNamespace(
+                joint=mi.get("joint"),
+                multiplier=_floats(mi.get("multiplier"), 1, (1.0,), f"joint '{name}' mimic multiplier", path)[0],
+                offset=_floats(mi.get("offset"), 1, (0.0,), f"joint '{name}' mimic offset", path)[0])
+        joints[name] = SimpleNamespace(name=name, type=kind, parent=parent.get("link"), child=child.get("link"),
+                                       origin=origin, axis=np.array(axis), limit=limit, mimic=mimic)
+    return SimpleNamespace(link_map=links, joint_map=joints)
 
 
 def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
