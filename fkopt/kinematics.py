@@ -705,12 +705,13 @@ def _dls_function(n: int):
 
 
 def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping, down, up,
-                    step_cap, lo, hi):
+                    step_cap, lo, hi, W=None):
     """The damped least-squares iteration of :func:`inverse` for one pose on Python floats
     (the arm's ``frame_jacobian1``, 6x6 eliminations), candidates one after another in the
     order of ``start_of(j)``: the same step, damping update, saturation in the null space and
     restart rule as the batched loop. For one pose numpy's per-call overhead is most of the
-    cost of the batched loop. Returns (best joints (n,) radians, starts used, evaluations)."""
+    cost of the batched loop. ``W``: the task mask of :func:`inverse` (6 floats 0/1) or None.
+    Returns (best joints (n,) radians, starts used, evaluations)."""
     n = m.dof
     fj = m.frame_jacobian1
     t0, t1, t2 = (float(v) for v in pt)
@@ -722,6 +723,9 @@ def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping,
         p, R, J = fj(q)
         e0, e1, e2 = _rotation_error1(R, T)
         d0, d1, d2 = p[0] - t0, p[1] - t1, p[2] - t2
+        if W is not None:                              # masked task: those rows do not count
+            d0, d1, d2, e0, e1, e2 = d0 * W[0], d1 * W[1], d2 * W[2], e0 * W[3], e1 * W[4], e2 * W[5]
+            J = [[v * w for v in row] for row, w in zip(J, W)]
         r = [d0, d1, d2, L * e0, L * e1, L * e2]
         J[3] = [v * L for v in J[3]]
         J[4] = [v * L for v in J[4]]
@@ -885,7 +889,7 @@ def _arm_constants(m) -> dict:
 
 
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
-                 down, up, step_cap) -> InverseResult:
+                 down, up, step_cap, W=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
     Python floats (:func:`_inverse_scalar`), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
@@ -924,6 +928,9 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
             if not near:
                 tab = _start_table(m, table)
                 f = np.concatenate([pose[:3], tab["w"] * Rt.reshape(9)])
+                if W is not None:                      # nearest in the selected components only
+                    tab = _masked_table(tab, W)
+                    f = f * tab["mask"]
                 near.extend(_nearest(tab, f[None], nn)[0].tolist())
                 near.append(tab)
             return near[-1]["q"][near[j - own0]].tolist()
@@ -931,15 +938,19 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
                                                np.array([j - own0 - nn]), n)[0]).tolist()
 
     bq, used, ne = _inverse_scalar(m, pose[:3], Rt, L, start_of, budget, tp, tr, iterations,
-                                   damping, down, up, step_cap, c["slo"], c["shi"])
+                                   damping, down, up, step_cap, c["slo"], c["shi"],
+                                   None if W is None else W.tolist())
     qd = _public(m, bq)
     per = c["periodic"]
     if per.any():                                       # continuous joints: into [-180, 180)
         qd = np.where(per, (qd + 180.0) % 360.0 - 180.0, qd)
     qd = np.clip(qd, m.bounds[:, 0], m.bounds[:, 1])
     p1, R1, _ = m.frame_jacobian1(_internal(m, qd).tolist())
-    perr = math.dist(p1, (x, y, z))
-    rerr = math.hypot(*_rotation_error1(R1, Rt.tolist()))
+    dp = [a - b for a, b in zip(p1, (x, y, z))]
+    e = _rotation_error1(R1, Rt.tolist())
+    if W is not None:
+        dp, e = [v * w for v, w in zip(dp, W[:3])], [v * w for v, w in zip(e, W[3:])]
+    perr, rerr = math.hypot(*dp), math.hypot(*e)
     inside = all(a <= v <= b for v, a, b in zip(qd.tolist(), c["blo"], c["bhi"]))
     ev = np.array(ne, dtype=np.int64)
     return InverseResult(
@@ -983,10 +994,11 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
         raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
     P0 = _values(m, poses, m.pose_names, "target pose")
-    if P0.ndim == 1 and rest <= 0 and not exact_rotation and mask is None:
+    if P0.ndim == 1 and rest <= 0 and not exact_rotation:
         return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
                             int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
-                            + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap)
+                            + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap,
+                            _task_mask(mask))
     shape = P0.shape[:-1]
     P = P0.reshape(-1, 6)
     N, n = len(P), m.dof
