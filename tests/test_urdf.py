@@ -1,4 +1,6 @@
 """Serial arms from URDF: wang7dof as URDF gives 7dof-arm's poses, limits, errors, YAML paths."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 import yaml
@@ -345,3 +347,16 @@ def test_cli_list_and_ik_on_a_urdf_arm(tmp_path):
     assert masked["solved"] and masked["rotation_error_rad"] == 0.0
     bad = _cli("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose, "--mask", "x,y,w")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "inverse mask" in bad.stderr
+
+
+def test_fkopt_run_resolves_the_urdf_beside_the_config(tmp_path, monkeypatch):
+    """``fkopt run`` loads configs through ``load_any``: the URDF path is relative to the config
+    (it was resolved against the working directory, so examples/urdf failed from elsewhere)."""
+    from fkopt.experiment.kinds import load_any
+    from fkopt.experiment.runner import build_mechanism
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(tmp_path)
+    config = load_any(root / "examples" / "urdf" / "ur5_ik.yaml")
+    m = build_mechanism(config)
+    assert m.dof == 6 and m.path == root / "examples" / "urdf" / "ur5.urdf"
+    assert m.periodic_mask().sum() == 0                       # UR5 joints are revolute, +-360 deg
