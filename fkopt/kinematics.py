@@ -607,6 +607,15 @@ def _zyz_matrix(euler_deg: np.ndarray) -> np.ndarray:
     return R
 
 
+def _zyz_matrix1(a: float, b: float, g: float) -> list[list[float]]:
+    """:func:`_zyz_matrix` of one triple of Euler angles (deg) on Python floats (the same formulas)."""
+    a, b, g = math.radians(a), math.radians(b), math.radians(g)
+    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+    return [[ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb],
+            [sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb],
+            [-sb * cg, sb * sg, cb]]
+
+
 def _rotation_error(R: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     """Rotation vector (k, 3) of R Rt^T (base frame), angle in [0, pi] radians."""
     M = R @ np.swapaxes(Rt, -1, -2)
@@ -883,8 +892,8 @@ def _arm_constants(m) -> dict:
         per = m.periodic_mask()
         got = m.__dict__["_inverse_constants"] = {
             "key": key, "lo": lo, "hi": hi, "slo": np.where(per, -np.inf, lo), "shi": np.where(per, np.inf, hi),
-            "periodic": per, "blo": m.bounds[:, 0].tolist(), "bhi": m.bounds[:, 1].tolist(),
-            "angle": m.angle_mask(m.joint_units).tolist()}
+            "periodic": per.tolist(), "blo": m.bounds[:, 0].tolist(), "bhi": m.bounds[:, 1].tolist(),
+            "angle": m.angle_mask(m.joint_units).tolist(), "mid": (0.5 * (lo + hi)).tolist()}
     return got
 
 
@@ -906,18 +915,20 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
                          f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
     lo, hi = c["lo"], c["hi"]
+    blo, bhi, angle = c["blo"], c["bhi"], c["angle"]
     own0 = 1 if (start is not None or not table) else 0
     if start is None:
-        q0 = (0.5 * (lo + hi)).tolist()
+        q0 = c["mid"]
     else:
         s = _values(m, start, m.joint_names, "start")
-        if s.ndim != 1 or not m.in_bounds(s):
+        sl = s.tolist()
+        if s.ndim != 1 or not all(a - 1e-9 <= v <= b + 1e-9 for v, a, b in zip(sl, blo, bhi)):
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})"
                              if s.ndim == 1 else f"{m.name} start: one pose takes one start (n,), got {s.shape}")
-        q0 = _internal(m, s).tolist()
+        q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
     L = float(orientation_scale) if orientation_scale else reach
-    Rt = _zyz_matrix(np.asarray(pose[3:], dtype=float)[None])[0]
+    Rt = _zyz_matrix1(*pose[3:].tolist())
     near: list[int] = []
     nn = min(table, kn) if table else 0
 
@@ -927,7 +938,7 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         if j < own0 + nn:
             if not near:
                 tab = _start_table(m, table)
-                f = np.concatenate([pose[:3], tab["w"] * Rt.reshape(9)])
+                f = np.concatenate([pose[:3], tab["w"] * np.array(Rt).reshape(9)])
                 if W is not None:                      # nearest in the selected components only
                     tab = _masked_table(tab, W)
                     f = f * tab["mask"]
@@ -940,21 +951,20 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
     bq, used, ne = _inverse_scalar(m, pose[:3], Rt, L, start_of, budget, tp, tr, iterations,
                                    damping, down, up, step_cap, c["slo"], c["shi"],
                                    None if W is None else W.tolist())
-    qd = _public(m, bq)
-    per = c["periodic"]
-    if per.any():                                       # continuous joints: into [-180, 180)
-        qd = np.where(per, (qd + 180.0) % 360.0 - 180.0, qd)
-    qd = np.clip(qd, m.bounds[:, 0], m.bounds[:, 1])
-    p1, R1, _ = m.frame_jacobian1(_internal(m, qd).tolist())
+    # public units; continuous joints wrapped into [-180, 180); clipped into the limits
+    qd = [math.degrees(v) if a else v for v, a in zip(bq.tolist(), angle)]
+    qd = [(v + 180.0) % 360.0 - 180.0 if p else v for v, p in zip(qd, c["periodic"])]
+    qd = [min(max(v, a), b) for v, a, b in zip(qd, blo, bhi)]
+    p1, R1, _ = m.frame_jacobian1([math.radians(v) if a else v for v, a in zip(qd, angle)])
     dp = [a - b for a, b in zip(p1, (x, y, z))]
-    e = _rotation_error1(R1, Rt.tolist())
+    e = _rotation_error1(R1, Rt)
     if W is not None:
         dp, e = [v * w for v, w in zip(dp, W[:3])], [v * w for v, w in zip(e, W[3:])]
     perr, rerr = math.hypot(*dp), math.hypot(*e)
-    inside = all(a <= v <= b for v, a, b in zip(qd.tolist(), c["blo"], c["bhi"]))
+    inside = all(a <= v <= b for v, a, b in zip(qd, blo, bhi))
     ev = np.array(ne, dtype=np.int64)
     return InverseResult(
-        mechanism=m.name, names=tuple(m.joint_names), joints=qd, position_error=np.array(perr),
+        mechanism=m.name, names=tuple(m.joint_names), joints=np.array(qd), position_error=np.array(perr),
         rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
         solved=np.array(perr <= tp and rerr <= tr and inside), restarts=np.array(used - 1, dtype=np.int64),
         evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
