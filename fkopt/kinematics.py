@@ -21,7 +21,11 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
 
 **inverse(arm, poses[..., 6])** -- joints whose end-effector pose is ``poses`` (x, y, z in the
 arm's length unit, Z-Y-Z Euler angles in degrees as :meth:`DHArm.fk` prints them), every joint
-inside its limits. A bounded damped least-squares method on the 6 residuals
+inside its limits, for any frame arm (DH tables and URDF chains alike: the solver uses the arm's
+frame, frame Jacobian and periodic joints only). Internally angles are in radians and lengths
+(prismatic joints) in the arm's unit; continuous (periodic) joints are not saturated and the
+answer is wrapped into [-180, 180). ``mask`` selects task components (position only, ...);
+``start`` as the current joints gives the locally nearest solution (see :func:`inverse`). A bounded damped least-squares method on the 6 residuals
 (position error, L * rotation vector of R R_t^T with L = ``orientation_scale`` length units per
 radian, default the arm's reach; the geodesic orientation error, no Euler differences):
 
@@ -607,6 +611,15 @@ def _zyz_matrix(euler_deg: np.ndarray) -> np.ndarray:
     return R
 
 
+def _solved1(p, R, pt, Rt, W, tol) -> bool:
+    """Whether frame (p, R) on floats is within tol of target (pt, Rt), task mask W (or None)."""
+    dp = [a - b for a, b in zip(p, pt)]
+    e = _rotation_error1(R, Rt)
+    if W is not None:
+        dp, e = [v * w for v, w in zip(dp, W[:3])], [v * w for v, w in zip(e, W[3:])]
+    return math.hypot(*dp) <= tol[0] and math.hypot(*e) <= tol[1]
+
+
 def _zyz_matrix1(a: float, b: float, g: float) -> list[list[float]]:
     """:func:`_zyz_matrix` of one triple of Euler angles (deg) on Python floats (the same formulas)."""
     a, b, g = math.radians(a), math.radians(b), math.radians(g)
@@ -881,6 +894,67 @@ def _task_mask(mask) -> np.ndarray | None:
     return None if W.all() else W
 
 
+def _toward_start(m, q, q0, pt, Rt, L, W, tol, slo, shi, periodic, rounds: int = 30):
+    """Rows q (k, n) of solved joints (internal units) moved along the arm's self-motion towards
+    the starts q0 (k, n), staying solved: each round a null-space step dz = (I - J^+ J)(q0 - q)
+    (J^+ = J^T (J J^T + eps I)^{-1}, the task rows of ``W`` only) clipped into the limits, then up
+    to 3 damped least-squares corrections of the task; a row takes the round only if it is still
+    within ``tol`` and nearer to its start (Euclidean in rad and length units; periodic joints by
+    their angle difference wrapped into [-pi, pi)). A redundant arm (or a masked task) thus
+    returns the solution locally nearest to the current joints; a 6-joint arm with a full pose has
+    no self-motion and keeps its answer. Returns (q, Jacobian evaluations per row)."""
+    k, n = q.shape
+    to_pub = _public(m, np.ones(n))
+    Wr = np.ones(6) if W is None else np.asarray(W, dtype=float)
+    evals = np.zeros(k, dtype=np.int64)
+
+    def gap(a):
+        g = q0 - a
+        if periodic.any():
+            g[:, periodic] = (g[:, periodic] + np.pi) % (2 * np.pi) - np.pi
+        return g
+
+    def task(a):
+        p, R, J = m.frame_jacobian(a * to_pub)
+        e = _rotation_error(R, Rt)
+        J = J * to_pub * Wr[:, None]
+        J[:, 3:] *= L
+        dp, e = (p - pt) * Wr[:3], e * Wr[3:]
+        return np.concatenate([dp, L * e], axis=-1), J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
+
+    act = np.arange(k)
+    dist = np.sqrt(_sumsq(gap(q)))
+    for _ in range(rounds):
+        if not len(act):
+            break
+        qa = q[act]
+        r, J, _, _ = task(qa)
+        evals[act] += 1
+        Jt = np.swapaxes(J, 1, 2)
+        A = J @ Jt
+        A[:, _I6, _I6] += 1e-9 * np.trace(A, axis1=1, axis2=2)[:, None] + 1e-300
+        g = gap(qa)
+        dz = g - (Jt @ np.linalg.solve(A, (J @ g[..., None])))[..., 0]
+        qn = np.clip(qa + dz, slo, shi)
+        for _ in range(3):                             # back onto the task
+            r, J, pe, re = task(qn)
+            evals[act] += 1
+            if ((pe <= tol[0]) & (re <= tol[1])).all():
+                break
+            Jt = np.swapaxes(J, 1, 2)
+            A = J @ Jt
+            A[:, _I6, _I6] += 1e-9 * np.trace(A, axis1=1, axis2=2)[:, None] + 1e-300
+            qn = np.clip(qn - (Jt @ np.linalg.solve(A, r[..., None]))[..., 0], slo, shi)
+        else:
+            r, J, pe, re = task(qn)
+            evals[act] += 1
+        dn = np.sqrt(_sumsq(gap(qn)))
+        ok = (pe <= tol[0]) & (re <= tol[1]) & (dn < dist[act] - 1e-12)
+        q[act[ok]], dist[act[ok]] = qn[ok], dn[ok]
+        act = act[ok & (dn < dist[act] * (1 - 1e-6))] if ok.any() else act[:0]
+    return q, evals
+
+
 def _arm_constants(m) -> dict:
     """Per-arm values of a one-pose :func:`inverse` as Python floats, cached on the arm (keyed by
     its bounds, which a user may change): internal-unit limits, saturation limits (none for
@@ -951,6 +1025,12 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
     bq, used, ne = _inverse_scalar(m, pose[:3], Rt, L, start_of, budget, tp, tr, iterations,
                                    damping, down, up, step_cap, c["slo"], c["shi"],
                                    None if W is None else W.tolist())
+    if start is not None and (n > 6 or W is not None):   # self-motion towards the start
+        p1, R1, _ = m.frame_jacobian1(bq.tolist())
+        if _solved1(p1, R1, (x, y, z), Rt, W, tol):
+            q1, extra = _toward_start(m, bq[None].copy(), np.array([q0]), np.array([[x, y, z]]), np.array([Rt]),
+                                      L, W, tol, c["slo"], c["shi"], np.array(c["periodic"]))
+            bq, ne = q1[0], ne + int(extra[0])
     # public units; continuous joints wrapped into [-180, 180); clipped into the limits
     qd = [math.degrees(v) if a else v for v, a in zip(bq.tolist(), angle)]
     qd = [(v + 180.0) % 360.0 - 180.0 if p else v for v, p in zip(qd, c["periodic"])]
@@ -977,9 +1057,15 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             table: int = 4096, neighbours: int = 32, tail: int = 256) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
-    ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
-    ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles (deg), as ``arm.fk``
-    returns them. ``start``: start joints (n,) or (..., n) inside the limits (default mid-range).
+    ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
+    URDF arms, through ``frame``, ``frame_jacobian``, ``frame_jacobian1``, ``kinematic_key`` and
+    ``periodic_mask`` only). ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles
+    (deg), as ``arm.fk`` returns them. ``start``: the current joints (n,) or (..., n) inside the
+    limits (default mid-range): the first candidate begins there; when it is solved and the arm
+    has self-motion (more than 6 joints, or a ``mask``), the answer is then moved along the
+    self-motion to the solution locally nearest to ``start`` (Euclidean distance in rad and
+    length units, continuous joints by their wrapped difference; :func:`_toward_start`). Nearest
+    is local: another branch of solutions may hold a nearer one.
     ``tol``: (position, orientation in radians). ``mask``: the task components that count, 6
     flags over (x, y, z, rx, ry, rz) -- position and rotation-vector error in the base frame,
     as roboticstoolbox's ``we`` -- or their names (``"x,y,z"``: position only, for arms with
@@ -1258,6 +1344,14 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
                     q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qe[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
         ev_r = np.bincount(np.concatenate(evaluated), minlength=N).astype(np.int64)
         ev_j = ev_r.copy()
+        if start is not None and (n > 6 or W is not None):   # self-motion towards the starts
+            good = np.flatnonzero(best_m <= 1.0)
+            if len(good):
+                qg, extra = _toward_start(m, best_q[good].copy(), q0[good], pt[good], Rt[good], L, W,
+                                          (tp, tr), slo, shi, periodic)
+                best_q[good] = qg
+                ev_r[good] += extra
+                ev_j[good] += extra
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
     qd = _public(m, best_q)

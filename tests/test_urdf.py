@@ -360,3 +360,25 @@ def test_fkopt_run_resolves_the_urdf_beside_the_config(tmp_path, monkeypatch):
     m = build_mechanism(config)
     assert m.dof == 6 and m.path == root / "examples" / "urdf" / "ur5.urdf"
     assert m.periodic_mask().sum() == 0                       # UR5 joints are revolute, +-360 deg
+
+
+def test_start_returns_the_solution_nearest_to_the_current_joints():
+    """A redundant arm (Panda) started at joints near a known solution: the answer is moved along
+    the self-motion towards the start, so it is at least as near as that solution (median), and
+    the same start as one pose agrees with the batch."""
+    m = robot("panda")
+    rng = np.random.default_rng(3)
+    q = random_joints(m, 100, 12)
+    start = np.clip(q + rng.normal(0.0, 2.0, q.shape), m.bounds[:, 0], m.bounds[:, 1])
+    r = fkopt.inverse(m, m.fk(q), start=start, tol=(1e-4, 1e-3))
+    assert r.solved.all()
+    d, dq = np.linalg.norm(r.joints - start, axis=1), np.linalg.norm(q - start, axis=1)
+    assert np.median(d) <= np.median(dq)
+    one = fkopt.inverse(m, m.fk(q[0]), start=start[0], tol=(1e-4, 1e-3))
+    assert one.solved and np.linalg.norm(one.joints - start[0]) <= dq[0] + 1e-9
+    # a 6-joint arm started at a solution keeps it
+    ur5 = robot("ur5")
+    q6 = random_joints(ur5, 1, 4)[0]
+    same = fkopt.inverse(ur5, ur5.fk(q6), start=q6, tol=(1e-4, 1e-3))
+    assert same.solved and same.restarts == 0
+    np.testing.assert_allclose(same.joints, q6, atol=1e-9)
