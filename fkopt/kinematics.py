@@ -671,10 +671,15 @@ def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.nd
 
 def _rotation_error1(R, T):
     """:func:`_rotation_error` of one pair of rotations given as 3 rows of 3 floats."""
-    M = [[R[i][0] * T[j][0] + R[i][1] * T[j][1] + R[i][2] * T[j][2] for j in range(3)] for i in range(3)]
-    v0, v1, v2 = M[2][1] - M[1][2], M[0][2] - M[2][0], M[1][0] - M[0][1]
+    # M = R T^T entry by entry (written out: this runs once per iteration of a one-pose inverse)
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
+    (t00, t01, t02), (t10, t11, t12), (t20, t21, t22) = T
+    v0 = (r20 * t10 + r21 * t11 + r22 * t12) - (r10 * t20 + r11 * t21 + r12 * t22)
+    v1 = (r00 * t20 + r01 * t21 + r02 * t22) - (r20 * t00 + r21 * t01 + r22 * t02)
+    v2 = (r10 * t00 + r11 * t01 + r12 * t02) - (r00 * t10 + r01 * t11 + r02 * t12)
     s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-    c = 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)
+    c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
+               + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
     k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
     return v0 * k, v1 * k, v2 * k
 
