@@ -94,7 +94,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from operator import mul
 
 import numpy as np
 
@@ -414,37 +413,6 @@ def _solve_small(A, b):
     return x
 
 
-def _cholesky_solve(A, b):
-    """x with A x = b for a small symmetric positive definite A on Python floats (Cholesky;
-    lists are not modified). None when A is not positive definite or x not finite."""
-    n = len(b)
-    Lc = [[0.0] * n for _ in range(n)]
-    for i in range(n):
-        Li = Lc[i]
-        Ai = A[i]
-        for j in range(i + 1):
-            Lj = Lc[j]
-            acc = Ai[j] - sum(map(mul, Li[:j], Lj[:j]))
-            if i == j:
-                if not acc > 0.0:
-                    return None
-                Li[i] = math.sqrt(acc)
-            else:
-                Li[j] = acc / Lj[j]
-    y = [0.0] * n
-    for i in range(n):
-        y[i] = (b[i] - sum(map(mul, Lc[i][:i], y[:i]))) / Lc[i][i]
-    x = [0.0] * n
-    for i in range(n - 1, -1, -1):
-        acc = y[i]
-        for k in range(i + 1, n):
-            acc -= Lc[k][i] * x[k]
-        x[i] = acc / Lc[i][i]
-    if not all(map(math.isfinite, x)):
-        return None
-    return x
-
-
 def _newton_scalar(m, x, L, ftol, evals, iterations: int = 30, halvings: int = 10):
     """:func:`_newton1` on Python floats with the mechanism's ``ik_jacobian1`` (one pose, no
     angle joints): the same iteration (Newton step capped at a quarter of the box width,
@@ -691,9 +659,10 @@ def _dls_function(n: int):
     """``dls(J, r, mu) -> d`` for a 6 x n Jacobian on Python floats: d = J^T (J J^T + mu I)^{-1} (-r)
     by Cholesky, or None when J J^T + mu I is not positive definite or d not finite; and
     ``trace6(J)`` = sum of J's squared entries / 6. Written out once per n (straight-line source,
-    as ``namedtuple`` builds its class) with the additions in the order of the loops of
-    :func:`_cholesky_solve` and ``sum(map(mul, ...))``, so the numbers are the loops' numbers; a
-    one-pose inverse spends most of its time here and in the arm's ``frame_jacobian1``."""
+    as ``namedtuple`` builds its class) with the additions in the order of the loops it replaced
+    (dot products summed left to right from 0; Cholesky L row by row, then forward and back
+    substitution), so the answers are those loops' to the bit; a one-pose inverse spends most of
+    its time here and in the arm's ``frame_jacobian1``."""
     got = _DLS.get(n)
     if got is not None:
         return got
@@ -705,7 +674,7 @@ def _dls_function(n: int):
     for a in R:
         for b in range(a, 6):
             src.append(f"    A{a}{b} = {dot(a, b)}" + (" + mu" if a == b else ""))
-    for i in R:                                        # Cholesky, row by row (as _cholesky_solve)
+    for i in R:                                        # Cholesky, row by row
         for j in range(i + 1):
             prev = " + ".join(f"L{i}{k} * L{j}{k}" for k in range(j))
             acc = f"A{j}{i} - ({prev})" if prev else f"A{j}{i} - 0"
@@ -1000,11 +969,12 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         q0 = c["mid"]
     else:
         s = _values(m, start, m.joint_names, "start")
-        sl = s.tolist()
-        if s.ndim != 1 or not all(a - 1e-9 <= v <= b + 1e-9 for v, a, b in zip(sl, blo, bhi)):
+        if s.size != n:
+            raise FkoptError(f"{m.name} start: one pose takes one start ({n},), got shape {s.shape}")
+        sl = s.reshape(n).tolist()
+        if not all(a - 1e-9 <= v <= b + 1e-9 for v, a, b in zip(sl, blo, bhi)):
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
-            raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})"
-                             if s.ndim == 1 else f"{m.name} start: one pose takes one start (n,), got {s.shape}")
+            raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
     L = float(orientation_scale) if orientation_scale else reach
     Rt = _zyz_matrix1(*pose[3:].tolist())
