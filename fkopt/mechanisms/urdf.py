@@ -315,7 +315,7 @@ class URDFArm(FrameArm):
         chain = _chain(robot, path, g.base, g.tip)
         moving = [j for j in chain if j.type in MOVING]
         on_chain = {j.name: j for j in moving}
-        names, units, limits, kinds = [], [], {}, {}
+        names, units, limits = [], [], {}
         for j in moving:
             if j.mimic is None:
                 names.append(j.name)
@@ -343,7 +343,6 @@ class URDFArm(FrameArm):
             if j.type != "continuous" and not has:
                 raise FkoptError(f"urdf {path}: joint '{j.name}' ({j.type}) needs <limit lower upper>")
             var, mult, off = source(j)
-            kinds[var] = kinds.get(var, set()) | {j.type}
             if not has:
                 lo_si, hi_si = -math.inf, math.inf
             else:
