@@ -209,13 +209,14 @@ def test_real_robot_inverse_on_random_reachable_poses(name):
     assert all(o.solved for o in one)
 
 
-@pytest.mark.parametrize("solver", ["lm", "dls"])
-def test_swarm_api_solvers_use_the_urdf_jacobian(solver):
+@pytest.mark.parametrize("solver, population", [("lm", 1), ("dls", 1), ("gabc+lm", 10)])
+def test_swarm_api_solvers_use_the_urdf_jacobian(solver, population):
     m = robot("panda")
     pose = m.fk(random_joints(m, 1, 3)[0])
     problem = fkopt.ik_problem(m, pose, objective="geodesic", w_p=1000.0)
     assert problem.has_jacobian
-    r = fkopt.solve(problem, solver, population=1, iterations=300, runs=4, seed=2)
+    np.testing.assert_array_equal(problem.jacobian(random_joints(m, 2, 1)).shape, (2, 6, 7))
+    r = fkopt.solve(problem, solver, population=population, iterations=300, runs=4, seed=2)
     assert r.fitness.min() < 1e-6
 
 
