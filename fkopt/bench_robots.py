@@ -144,9 +144,10 @@ def bench_robots(rows, quick: bool, messages: list[str]) -> None:
         ok = _check(m, inv.joints, Tt, tol, scale)
         us = best_f / n * 1e6
         lie = int((inv.solved & ~ok).sum())
+        r_us = best_r / n * 1e6
         rows.add(sec, f"{name} inverse batch {n}", us, "µs/pose",
-                 f"best of {reps}; " + (f"rtb {best_r / n * 1e6:.0f} µs/pose, ratio fkopt/rtb {us / (best_r / n * 1e6):.2f} "
-                                       f"(target <= 1)" if ets is not None else "no rtb"))
+                 f"best of {reps}; " + (f"rtb {r_us:.0f} µs/pose, ratio fkopt/rtb {us / r_us:.2f} (target <= 1)"
+                                        if ets is not None else "no rtb"))
         rows.add(sec, f"{name} inverse solved", 100.0 * ok.mean(), "%",
                  f"{n} random reachable poses, 0.1 mm and 1e-3 rad, verified; target >= 99.5 %; "
                  f"reported solved but not: {lie}; Jacobians per pose {inv.evaluations['jacobian'].mean():.1f}")

@@ -319,7 +319,8 @@ def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
 @app.command()
 def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
-       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
+                                               "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered swarm/local solver for "
                                                "a serial arm instead of fkopt.inverse"),
        seed: int = typer.Option(0, "--seed", min=0),
@@ -380,7 +381,8 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
 @app.command()
 def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        joints: str = typer.Option(..., "--joints", help="e.g. d1=598.85,d2=671.92,d3=629.16"),
-       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
+                                               "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered solver (e.g. gabc+lm) "
                                                "instead of fkopt.forward"),
        seed: int = typer.Option(0, "--seed", min=0),

@@ -25,9 +25,10 @@ inside its limits, for any frame arm (DH tables and URDF chains alike: the solve
 frame, frame Jacobian and periodic joints only). Internally angles are in radians and lengths
 (prismatic joints) in the arm's unit; continuous (periodic) joints are not saturated and the
 answer is wrapped into [-180, 180). ``mask`` selects task components (position only, ...);
-``start`` as the current joints gives the locally nearest solution (see :func:`inverse`). A bounded damped least-squares method on the 6 residuals
-(position error, L * rotation vector of R R_t^T with L = ``orientation_scale`` length units per
-radian, default the arm's reach; the geodesic orientation error, no Euler differences):
+``start`` as the current joints gives the locally nearest solution (see :func:`inverse`).
+A bounded damped least-squares method on the 6 residuals (position error, L * rotation vector
+of R R_t^T with L = ``orientation_scale`` length units per radian, default the arm's reach; the
+geodesic orientation error, no Euler differences):
 
 * step d = J^T (J J^T + mu I)^{-1} (-r) (minimum-norm damped least squares for a redundant
   arm), mu = lambda * trace(J J^T) / 6 with lambda adapted per candidate as in
@@ -1044,7 +1045,8 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     ``tol``: (position, orientation in radians). ``mask``: the task components that count, 6
     flags over (x, y, z, rx, ry, rz) -- position and rotation-vector error in the base frame,
     as roboticstoolbox's ``we`` -- or their names (``"x,y,z"``: position only, for arms with
-    fewer than 6 joints); the errors reported are those of the selected components. ``seed``: the restarts' stream. ``starts``:
+    fewer than 6 joints); the errors reported are those of the selected components. ``seed``:
+    the restarts' stream. ``starts``:
     candidates solved side by side per row (the start and ``starts - 1`` random ones);
     ``restarts``: most random restarts per row. ``rest``: gain of the null-space pull towards
     mid-range (0: off). ``orientation_scale``: length units per radian weighing orientation
