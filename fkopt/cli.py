@@ -64,7 +64,13 @@ def _mechanism(name: str, geometry: Optional[Path]):
     from . import mechanism
     from .registry import mechanism_class, resolve_files
     if geometry is not None and geometry.suffix.lower() == ".urdf":
-        return mechanism(name, file=str(geometry))
+        try:
+            return mechanism(name, file=str(geometry))
+        except FkoptError as err:
+            if "name geometry." not in str(err):
+                raise
+            raise FkoptError(f"{err}: with a branching tree give --geometry a YAML file with "
+                             f"'file: {geometry.name}', 'base:' and 'tip:'") from None
     values = load_geometry(geometry)
     if geometry is not None:
         values = resolve_files(mechanism_class(name), values, geometry.parent)
