@@ -21,7 +21,10 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    1000 reachable poses batched and one at a time, beside roboticstoolbox-python's ``ik_LM``
    (run in the Python named by ``FKOPT_RTB_PYTHON``, or /work/venv-rtb, when installed); the
    whole ``fkopt fk`` process beside ``python -c "import numpy"``.
-4c. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
+4c. ``robots`` -- ``fkopt.inverse`` on the Panda, UR5 and Kinova of example-robot-data and the
+   wang7dof arm beside roboticstoolbox's ETS ``ik_LM`` on the same poses, timed alternately
+   (:mod:`fkopt.bench_robots`).
+4d. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
    600 iterations): wall time and ns per evaluation, beside the same GABC as a plain C loop
    (``fkopt/bench_ref/gabc_3rps.c``, compiled with the system's C compiler into a temporary
    folder and run on the same 100 cases; the row is skipped with a message when there is no
@@ -700,7 +703,7 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
-SECTIONS = ("throughput", "mao2017", "peers", "exact", "kinematics", "cases", "scaling")
+SECTIONS = ("throughput", "mao2017", "peers", "exact", "kinematics", "robots", "cases", "scaling")
 
 
 def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
@@ -732,6 +735,9 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     if "kinematics" in want:
         bench_kinematics(rows, quick, np.random.default_rng(12), messages)
         bench_cli_process(rows, quick)
+    if "robots" in want:
+        from .bench_robots import bench_robots
+        bench_robots(rows, quick, messages)
     if "cases" in want:
         bench_cases(rows, quick, rng, messages)
     if "scaling" in want:

@@ -98,8 +98,22 @@ def load_geometry(path: Optional[Path]) -> dict:
 
 
 def _mechanism(name: str, geometry: Optional[Path]):
+    """Mechanism ``name`` with the overrides of a --geometry YAML file (its relative file paths,
+    e.g. a URDF's, taken from the YAML's folder), or, for ``urdf``, a .urdf file itself."""
     from . import mechanism
-    return mechanism(name, **load_geometry(geometry))
+    from .registry import mechanism_class, resolve_files
+    if geometry is not None and geometry.suffix.lower() == ".urdf":
+        try:
+            return mechanism(name, file=str(geometry))
+        except FkoptError as err:
+            if "name geometry." not in str(err):
+                raise
+            raise FkoptError(f"{err}: with a branching tree give --geometry a YAML file with "
+                             f"'file: {geometry.name}', 'base:' and 'tip:'") from None
+    values = load_geometry(geometry)
+    if geometry is not None:
+        values = resolve_files(mechanism_class(name), values, geometry.parent)
+    return mechanism(name, **values)
 
 
 def _default_algorithm() -> str:
@@ -110,12 +124,16 @@ def _default_algorithm() -> str:
 @app.command("list")
 def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show its geometry, bounds, "
                                                               "units, pose and joint names"),
+             geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry "
+                                                     "overrides (for urdf also the .urdf file itself)"),
              as_json: bool = typer.Option(False, "--json", help="print one JSON object instead of "
                                           "tables: {mechanisms, algorithms, origins}, or with MECH its "
                                           "geometry, bounds, units and names")):
     """List the mechanisms and algorithms fkopt knows, and where each comes from."""
     if mech is not None:
-        return _list_mechanism(mech, as_json)
+        return _list_mechanism(mech, as_json, geometry)
+    if geometry is not None:
+        raise FkoptError("--geometry: name the mechanism it is for (fkopt list MECH --geometry FILE)")
     mechs, algos = registry.entries("mechanism"), registry.entries("algorithm")
     if as_json:
         typer.echo(json.dumps({"mechanisms": [e.name for e in mechs], "algorithms": [e.name for e in algos],
@@ -184,8 +202,8 @@ def unit_groups(names, units) -> str:
     return "\n".join(parts)
 
 
-def _list_mechanism(name: str, as_json: bool) -> None:
-    m = registry.mechanism_class(name)()
+def _list_mechanism(name: str, as_json: bool, geometry: Optional[Path] = None) -> None:
+    m = _mechanism(name, geometry)
     d = m.describe()
     origin = next((e.origin for e in registry.entries("mechanism") if e.name == name), "direct reference")
     units = dict(zip(m.unknown_names, m.unknown_units))
@@ -209,6 +227,16 @@ def _list_mechanism(name: str, as_json: bool) -> None:
     for n, (lo, hi) in d["bounds"].items():
         bounds.add_row(n, f"{lo:g}", f"{hi:g}", units.get(n, ""))
     con.print(bounds)
+    if d.get("chain_joints"):                          # URDF: every moving joint as the file has it
+        chain = Table(title="chain joints (URDF units; a mimic joint follows its unknown: "
+                            "q = multiplier * unknown + offset)")
+        for col in ("joint", "type", "lower", "upper", "unit", "unknown", "multiplier", "offset"):
+            chain.add_column(col, justify="right" if col in ("lower", "upper", "multiplier", "offset") else "left")
+        for j in d["chain_joints"]:
+            lim = j["limits"] or ("-", "-")
+            chain.add_row(escape(j["name"]), j["type"], *(f"{v:g}" if v != "-" else v for v in lim), j["unit"],
+                          escape(j["unknown"]), f"{j['multiplier']:g}", f"{j['offset']:g}")
+        con.print(chain)
     geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)")
     for col in ("key", "value", "description"):
         geo.add_column(col)
@@ -375,10 +403,15 @@ def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
 @app.command()
 def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
-       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
+                                               "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered swarm/local solver for "
                                                "a serial arm instead of fkopt.inverse"),
        seed: int = typer.Option(0, "--seed", min=0, help="seed of the random starts (swarm, restarts)"),
+       start: Optional[str] = typer.Option(None, "--start", help="current joints of a serial arm, e.g. "
+                                           "q1=10,q2=0,...: the search begins there (fkopt.inverse)"),
+       mask: Optional[str] = typer.Option(None, "--mask", help="task components that count, names from "
+                                          "x,y,z,rx,ry,rz (e.g. x,y,z: position only; fkopt.inverse)"),
        position_tol: float = typer.Option(1e-6, "--position-tol", help="largest accepted position error "
                                           "(the arm's length unit)"),
        orientation_tol: float = typer.Option(1e-6, "--orientation-tol", help="largest accepted geodesic "
@@ -405,6 +438,8 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     for name, value in (("--position-tol", position_tol), ("--orientation-tol", orientation_tol)):
         if not (np.isfinite(value) and value > 0):
             raise FkoptError(f"{name}: must be a positive number, got {value}")
+    if algorithm and (start or mask):
+        raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
     if algorithm:
         from . import problems, solve
         problem = problems.ik_problem(m, values, objective="geodesic")
@@ -417,7 +452,8 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
                "solved": bool(perr <= position_tol and rerr <= orientation_tol), "algorithm": algorithm}
     else:
         from .kinematics import inverse
-        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed)
+        q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
+        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed, start=q0, mask=mask)
         out = r.as_dict()
         out["algorithm"] = "inverse"
         perr, rerr = out["position_error"], out["rotation_error_rad"]
@@ -434,7 +470,8 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
 @app.command()
 def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        joints: str = typer.Option(..., "--joints", help="e.g. d1=598.85,d2=671.92,d3=629.16"),
-       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
+                                               "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered solver (e.g. gabc+lm) "
                                                "instead of fkopt.forward"),
        seed: int = typer.Option(0, "--seed", min=0, help="seed of the random starts (swarm, restarts)"),

@@ -75,7 +75,7 @@ def test_direct_parsing_matches_the_signature():
     assert kw == {"mech": "6-sps-cmm", "joints": "a=1", "geometry": None, "algorithm": None, "seed": 0,
                   "tolerance": 1e-6, "all_solutions": True, "as_json": False}
     func, kw = cli._direct(["list"])
-    assert func is cli.list_cmd and kw == {"mech": None, "as_json": False}
+    assert func is cli.list_cmd and kw == {"mech": None, "geometry": None, "as_json": False}
 
 
 def test_lazy_package_attributes():

@@ -98,8 +98,12 @@ def from_dict(data: dict, where: str):
 
 
 def load_any(path: str | Path):
-    """An experiment, study or assembly config, by the file's ``kind``."""
-    return from_dict(load_mapping(path, "config fields"), str(path))
+    """An experiment, study or assembly config, by the file's ``kind``; a config with file fields
+    (a URDF's ``geometry.file``) resolves its relative paths beside the file, as ``load_config``."""
+    config = from_dict(load_mapping(path, "config fields"), str(path))
+    if "_folder" in getattr(type(config), "__private_attributes__", {}):
+        config._folder = Path(path).parent
+    return config
 
 
 def available_memory() -> int:
