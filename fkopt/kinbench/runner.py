@@ -1,0 +1,179 @@
+"""Run a suite on the experiment layer's one solve path.
+
+One task is one (problem, solver): every pose of every selected set of the problem is a case of
+one batched problem (:func:`fkopt.experiment.runner.make_problem`), solved by
+:func:`fkopt.experiment.runner.solve_cases` for ``runs`` runs in one call. Case seeds:
+:func:`fkopt.experiment.runner.task_seed` of (suite seed, pose index within its set,
+``"<problem>/<set>/<solver label>"``); run k of a case is its k-th child stream
+(:mod:`fkopt.streams`), so a task's numbers do not depend on which other problems, sets,
+solvers or workers there are. Tasks run in this process, in local worker processes or on Dask
+(:func:`fkopt.study.executors.execute`).
+
+Budget: a run of a problem of dimension n may spend ``B = budget_per_dim * n`` fitness
+evaluations (an analytic Jacobian counts as one, as everywhere in fkopt). The solver gets
+``ceil(B / population)`` iterations and stops once below the smallest target; every measure is
+read from the run's cumulative evaluation counts at the last iteration within ``B``.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import FkoptError
+from ..experiment.config import RunConfig
+from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
+from ..solve import chunk_size, make_algorithm
+from .config import SuiteConfig, suite_from_dict
+from .posesets import load_pose_sets, targets_of
+
+
+def target_column(t: float) -> str:
+    return f"evals_to_{t:.0e}"
+
+
+def budget_of(config: SuiteConfig, dim: int) -> int:
+    return int(config.budget_per_dim) * int(dim)
+
+
+def run_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
+    """The experiment layer's settings of one (problem, solver) task."""
+    budget = budget_of(config, dim)
+    pop = solver.population or config.population
+    cfg = RunConfig(name=problem.name, mechanism=problem.mechanism, objective=problem.objective,
+                    algorithms=[solver.model_dump(exclude={"track"})], population=config.population,
+                    iterations=solver.iterations or max(1, math.ceil(budget / pop)), runs=config.runs,
+                    seed=config.seed, threshold=min(config.targets), stop_at_threshold=True)
+    cfg._folder = config._folder
+    return cfg
+
+
+@dataclass
+class SuiteResult:
+    config: SuiteConfig
+    runs: pd.DataFrame                   # one row per (problem, set, pose, solver, run)
+    timing: pd.DataFrame                 # one row per (problem, solver): wall time per solve
+    manifest: dict
+    wall_s: float
+    source: str | None = None
+    extra_runs: list[pd.DataFrame] = field(default_factory=list)   # imported outside results
+
+
+def _cases(config: SuiteConfig, sets: dict, problem):
+    """(set name, pose index, point) of every case of ``problem``, in set then pose order."""
+    return [(name, i, p) for name in config.sets for i, p in enumerate(sets[(problem.name, name)])]
+
+
+def validate_suite(config: SuiteConfig) -> tuple[int, int]:
+    """Everything a suite needs, built without solving; (tasks, estimated bytes)."""
+    sets, _ = load_pose_sets(config)
+    need = 0
+    for problem in config.problems:
+        cfg0 = run_config(config, problem, config.solvers[0], 1)
+        mech = build_mechanism(cfg0)
+        cases = _cases(config, sets, problem)
+        if not cases:
+            raise FkoptError(f"problems[{problem.name}]: no poses in sets {', '.join(config.sets)}")
+        dim = len(mech.unknown_names)
+        for p in (c[2] for c in cases):
+            if not np.all(mech.in_bounds(p[None])):
+                raise FkoptError(f"problems[{problem.name}]: a frozen pose lies outside mechanism.bounds")
+        for solver in config.solvers:
+            where = f"solvers[{solver.key}]"
+            try:
+                make_algorithm(solver.name, solver.params)
+                start_point(solver, mech)
+                cfg = run_config(config, problem, solver, dim)
+                pop = solver.population or config.population
+                chunk_size(len(cases), config.runs, pop, cfg.iterations, dim)
+            except FkoptError as err:
+                raise FkoptError(f"{where}: {err}") from None
+            T = cfg.iterations + 1
+            need = max(need, len(cases) * config.runs * 8 * (3 * T + 2 * dim) * 2)
+    return len(config.problems) * len(config.solvers), need
+
+
+def solve_task(payload: dict) -> dict:
+    """Worker: one (problem, solver) task; returns its run rows and wall time (picklable)."""
+    config = suite_from_dict(payload["config"], "suite task")
+    config._folder = Path(payload["folder"]) if payload["folder"] else None
+    problem = config.problems[payload["problem"]]
+    solver = config.solvers[payload["solver"]]
+    sets, _ = load_pose_sets(config)
+    cases = _cases(config, sets, problem)
+    mech = build_mechanism(run_config(config, problem, solver, 1))
+    dim = len(mech.unknown_names)
+    cfg = run_config(config, problem, solver, dim)
+    points = np.stack([c[2] for c in cases])
+    batched = make_problem(cfg, mech, targets_of(mech, points))
+    seeds = [task_seed(config.seed, i, f"{problem.name}/{name}/{solver.key}") for name, i, _ in cases]
+    spec = cfg.algorithms[0]
+    start = time.perf_counter()
+    result = solve_cases(cfg, spec, batched, seeds, x0=start_point(spec, mech))
+    wall = time.perf_counter() - start
+    return {"problem": payload["problem"], "solver": payload["solver"], "dim": dim,
+            "rows": run_rows(config, problem, solver, cases, result, dim),
+            "wall_s": wall, "solves": len(cases) * config.runs}
+
+
+def at_budget(history: np.ndarray, evals: np.ndarray, budget: int, targets) -> dict:
+    """Measures of runs from their best-so-far fitness and cumulative evaluations per iteration
+    (``(..., T + 1)`` each), cut at ``budget`` evaluations: evaluations used, final fitness and,
+    per target, the evaluations when the target was first reached (NaN: not within the budget)."""
+    within = evals <= budget
+    last = np.where(within.any(axis=-1), within.shape[-1] - 1 - np.argmax(within[..., ::-1], axis=-1), -1)
+    ok = last >= 0
+    li = np.maximum(last, 0)[..., None]
+    used = np.where(ok, np.take_along_axis(evals, li, axis=-1)[..., 0], 0).astype(float)
+    final = np.where(ok, np.take_along_axis(history, li, axis=-1)[..., 0], np.inf)
+    out = {"evaluations": used, "fitness": final}
+    for t in targets:
+        hit = (history < t) & within
+        first = np.argmax(hit, axis=-1)[..., None]
+        ev = np.take_along_axis(evals, first, axis=-1)[..., 0].astype(float)
+        out[target_column(t)] = np.where(hit.any(axis=-1), ev, np.nan)
+    return out
+
+
+def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> pd.DataFrame:
+    budget = budget_of(config, dim)
+    m = at_budget(result.history, result.evaluation_history, budget, config.targets)
+    n, runs = len(cases), config.runs
+    cols = {"problem": problem.name, "class": problem.problem_class,
+            "set": np.repeat([c[0] for c in cases], runs), "pose": np.repeat([c[1] for c in cases], runs),
+            "solver": solver.key, "track": solver.track, "run": np.tile(np.arange(runs), n),
+            "dim": dim, "budget": budget}
+    cols.update({k: np.asarray(v).reshape(n * runs) for k, v in m.items()})
+    return pd.DataFrame(cols)
+
+
+def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
+              executor: str = "local", scheduler: str | None = None, timing: bool = True) -> SuiteResult:
+    from ..study.executors import execute
+    start = time.perf_counter()
+    if source and config._folder is None:
+        config._folder = Path(source).parent
+    _, manifest = load_pose_sets(config)
+    data = config.model_dump(mode="json", by_alias=True)
+    folder = str(config._folder) if config._folder is not None else ""
+    payloads = [{"config": data, "folder": folder, "problem": p, "solver": s}
+                for p in range(len(config.problems)) for s in range(len(config.solvers))]
+    done: list[dict] = []
+
+    def collect(rec: dict) -> None:
+        done.append(rec)
+        if progress:
+            progress(f"{config.problems[rec['problem']].name} / {config.solvers[rec['solver']].key}",
+                     len(done), len(payloads))
+
+    execute(solve_task, payloads, executor=executor, jobs=jobs, scheduler=scheduler, on_result=collect)
+    done.sort(key=lambda r: (r["problem"], r["solver"]))
+    runs = pd.concat([r["rows"] for r in done], ignore_index=True)
+    tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
+                         "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
+                        for r in done])
+    return SuiteResult(config, runs, tim, manifest, time.perf_counter() - start, source)
