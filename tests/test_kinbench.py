@@ -1,0 +1,215 @@
+"""kinbench: suite configs, frozen pose sets, COCO measures, leaderboard files, plug-ins."""
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from fkopt.errors import FkoptError
+from fkopt.experiment.kinds import from_dict, load_any, run_config
+from fkopt.kinbench import measures as M
+from fkopt.kinbench.config import load_suite
+from fkopt.kinbench.posesets import (BOUNDARY_SHARE, condition_numbers, generate, load_pose_sets,
+                                     problem_mechanism)
+from fkopt.kinbench.runner import at_budget, target_column
+
+ROOT = Path(__file__).resolve().parents[1]
+SUITES = ROOT / "configs" / "suites"
+SUITE = SUITES / "kinbench.yaml"
+PY = sys.executable
+
+
+def tiny(tmp_path, **over) -> Path:
+    """A small suite beside a copy of the frozen pose sets (the folder the YAML names)."""
+    shutil.copytree(SUITES / "kinbench-v1", tmp_path / "kinbench-v1")
+    data = yaml.safe_load(SUITE.read_text())
+    data.update(name="tiny", problems=[p for p in data["problems"] if p["name"] in ("mao2017-3rps", "wu2015-3ppr")],
+                solvers=[{"name": "pso"}, {"name": "lm"}], poses=2, runs=2, budget_per_dim=100, bootstrap=200,
+                quick=None)
+    data.update(over)
+    path = tmp_path / "tiny.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def cli(*args, cwd=None):
+    return subprocess.run([PY, "-m", "fkopt.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+
+
+# -- config -------------------------------------------------------------------------------------
+def test_the_suite_file_and_its_quick_tier_validate():
+    cfg = load_suite(SUITE)
+    q = cfg.quick_tier()
+    assert q.name == "kinbench-quick" and q.quick is None and q.check == "ci"
+    assert {p.name for p in q.problems} < {p.name for p in cfg.problems}
+    assert [s.track for s in cfg.solvers if s.name == "lm"] == ["jacobian"]
+    # what meta.json stores reloads as the same config (fkopt check reruns from it)
+    again = from_dict(q.model_dump(mode="json", by_alias=True), "meta")
+    assert again.model_dump() == q.model_dump()
+
+
+@pytest.mark.parametrize("change, fragment", [
+    ({"solvers": [{"name": "some.module:Solver"}]}, "needs 'track' (allowed: black-box, jacobian, exact)"),
+    ({"solvers": [{"name": "gabc", "track": "grey-box"}]}, "track"),
+    ({"sets": ["uniform", "weird"]}, "sets"),
+    ({"targets": [1e-4, 1e-2]}, "decreasing order"),
+    ({"quick": {"solvers": ["nope"]}}, "quick.solvers: 'nope' is not one of"),
+    ({"budget_per_dim": 0}, "budget_per_dim"),
+])
+def test_bad_suite_fields_are_one_line_errors(tmp_path, change, fragment):
+    path = tiny(tmp_path, **change)
+    with pytest.raises(FkoptError) as err:
+        load_any(path)
+    assert fragment in str(err.value) and str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+# -- pose sets ----------------------------------------------------------------------------------
+def test_frozen_pose_sets_are_regenerated_bit_for_bit_from_their_seed():
+    cfg = load_suite(SUITE)
+    manifest = json.loads((SUITES / "kinbench-v1" / "manifest.json").read_text())
+    from fkopt.kinbench.posesets import POSES, csv_bytes
+    for problem in cfg.problems[:2]:
+        sets, _ = generate(problem, manifest["seed"], POSES, cfg._folder)
+        mech, _ = problem_mechanism(problem)
+        for name, pts in sets.items():
+            digest = hashlib.sha256(csv_bytes(mech.unknown_names, pts)).hexdigest()
+            assert digest == manifest["problems"][problem.name]["sets"][name]["sha256"], (problem.name, name)
+
+
+def test_pose_sets_measure_what_they_claim():
+    cfg = load_suite(SUITE)
+    sets, manifest = load_pose_sets(cfg)
+    for problem in cfg.problems:
+        mech, _ = problem_mechanism(problem)
+        lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+        info = manifest["problems"][problem.name]["sets"]
+        kappa = condition_numbers(problem, None, sets[(problem.name, "near-singular")])
+        assert np.all(kappa > info["near-singular"]["bound"] * (1 - 1e-5)), problem.name
+        uni = condition_numbers(problem, None, sets[(problem.name, "uniform")])
+        assert np.median(kappa) > np.median(uni), problem.name
+        b = sets[(problem.name, "boundary")]
+        gap = np.minimum(b - lo, hi - b) / (hi - lo)
+        assert np.all(gap.min(axis=1) <= BOUNDARY_SHARE + 1e-12) and np.all(gap >= -1e-12), problem.name
+        assert len(sets[(problem.name, "printed")]) >= 1
+
+
+def test_a_changed_pose_file_is_refused_by_its_checksum(tmp_path):
+    path = tiny(tmp_path)
+    f = tmp_path / "kinbench-v1" / "mao2017-3rps" / "uniform.csv"
+    f.write_text(f.read_text().replace("1", "2", 1))
+    out = tmp_path / "out"
+    r = cli("suite", path, "--out", out, "-q")
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.count("\n") == 1 and "uniform.csv: SHA-256" in r.stderr and "Traceback" not in r.stderr
+    assert not (out / "kinbench").exists()
+
+
+def test_a_mechanism_other_than_the_pose_sets_one_is_refused(tmp_path):
+    data = yaml.safe_load(SUITE.read_text())
+    probs = data["problems"][:1]
+    probs[0]["mechanism"]["geometry"]["ra"] = 275
+    with pytest.raises(FkoptError, match=r"problems\[mao2017-3rps\].mechanism: differs"):
+        from fkopt.experiment.kinds import validate_any
+        validate_any(load_any(tiny(tmp_path, problems=probs)))
+
+
+# -- measures -----------------------------------------------------------------------------------
+def test_at_budget_cuts_every_measure_at_the_budget():
+    hist = np.array([[1.0, 1e-3, 1e-5, 1e-11], [1.0, 0.5, 0.5, 0.5]])
+    ev = np.array([[10, 20, 30, 40], [10, 20, 30, 40]])
+    m = at_budget(hist, ev, 35, [1e-2, 1e-4, 1e-10])
+    assert m["evaluations"].tolist() == [30, 30] and m["fitness"].tolist() == [1e-5, 0.5]
+    assert m[target_column(1e-2)].tolist()[0] == 20 and np.isnan(m[target_column(1e-2)][1])
+    assert np.isnan(m[target_column(1e-10)][0])        # reached at 40 > budget 35
+
+
+def _runs(rows):
+    cols = ["problem", "class", "set", "pose", "solver", "track", "run", "dim", "budget", "evaluations", "fitness",
+            target_column(1e-2), target_column(1e-6)]
+    return pd.DataFrame(rows, columns=cols)
+
+
+def test_ert_and_success_rate_follow_coco():
+    nan = np.nan
+    runs = _runs([["p", "c", "u", 0, "a", "black-box", 0, 2, 100, 40, 1e-7, 10, 40],
+                  ["p", "c", "u", 0, "a", "black-box", 1, 2, 100, 100, 1e-3, 30, nan],
+                  ["p", "c", "u", 0, "a", "black-box", 2, 2, 100, 100, 1.0, nan, nan]])
+    t = M.measures_table(runs, [1e-2, 1e-6]).set_index("target")
+    assert t.loc[1e-2, "success_rate"] == pytest.approx(2 / 3)
+    assert t.loc[1e-2, "ert"] == pytest.approx((10 + 30 + 100) / 2)
+    assert t.loc[1e-6, "ert"] == pytest.approx((40 + 100 + 100) / 1) and t.loc[1e-6, "ert_per_dim"] == 120
+    e = M.ecdf_table(runs, [1e-2, 1e-6], 50)
+    e = e[e.scope == "all"]
+    assert e["fraction"].is_monotonic_increasing and e["fraction"].iloc[-1] == pytest.approx(3 / 6)
+    first = e[e.fraction > 0].iloc[0]          # 10 evaluations / dimension 2: reached from b = 5 on
+    assert first["fraction"] == pytest.approx(1 / 6) and first["evals_per_dim"] >= 5
+    assert e[e.evals_per_dim < 5]["fraction"].max() == 0
+
+
+def test_ranking_finds_a_real_difference_and_no_fake_one():
+    rng = np.random.default_rng(0)
+    base = rng.random(40)
+    scores = pd.DataFrame({"good": base + 0.2, "bad": base, "twin": base + rng.normal(0, 1e-3, 40)})
+    r = M.rank_scope(scores, 1000, 0.05, 1, "s").set_index("solver")
+    assert r.loc["good", "rank"] == 1 and set(r.loc["good", "better_than"].split(";")) == {"bad", "twin"}
+    assert r.loc["twin", "better_than"] == "" and r.loc["bad", "better_than"] == ""
+    assert r.loc["good", "ci_low"] < r.loc["good", "score"] < r.loc["good", "ci_high"]
+
+
+# -- end to end ---------------------------------------------------------------------------------
+def test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it(tmp_path):
+    path = tiny(tmp_path)
+    out = tmp_path / "out"
+    r = cli("suite", path, "--out", out, "-q")
+    assert r.returncode == 0, r.stderr
+    folder = out / "kinbench" / "tiny"
+    for name in ("leaderboard.csv", "leaderboard.md", "measures.csv", "ecdf.csv", "runs.csv", "timing.csv",
+                 "index.html", "ecdf_all.png", "ecdf_all.pdf", "ecdf_parallel-fk-3dof.png", "meta.json"):
+        assert (folder / name).is_file(), name
+    lb = pd.read_csv(folder / "leaderboard.csv")
+    assert set(lb.loc[lb.scope == "overall", "solver"]) == {"pso", "lm"}
+    assert {"overall", "track:black-box", "track:jacobian"} <= set(lb.scope)
+    runs = pd.read_csv(folder / "runs.csv")
+    assert len(runs) == 2 * 2 * (4 * 2) * 2     # problems x solvers x (4 sets x 2 poses) x runs
+    assert (runs["evaluations"] <= runs["budget"]).all()
+    page = (folder / "index.html").read_text()
+    assert "data:image/png;base64," in page and "http://" not in page and "https://" not in page
+    assert "<script src" not in page and "<link" not in page
+    assert "## Per track" in (folder / "leaderboard.md").read_text()
+    chk = cli("check", folder)
+    assert chk.returncode == 0, chk.stdout + chk.stderr
+
+
+def test_fkopt_run_accepts_a_suite_and_numbers_do_not_depend_on_other_solvers(tmp_path):
+    path = tiny(tmp_path)
+    one = load_any(tiny(tmp_path / "b", solvers=[{"name": "lm"}]))
+    both = load_any(path)
+    a = run_config(both, tmp_path / "o1", source=str(path)).result.runs
+    b = run_config(one, tmp_path / "o2", source=str(tmp_path / "b" / "tiny.yaml")).result.runs
+    pd.testing.assert_frame_equal(a[a.solver == "lm"].reset_index(drop=True), b.reset_index(drop=True))
+
+
+def test_a_plugin_algorithm_from_examples_gets_a_leaderboard_row(tmp_path, monkeypatch):
+    """examples/plugin's DE, named by direct reference: nothing in fkopt knows it."""
+    monkeypatch.syspath_prepend(str(ROOT / "examples" / "plugin"))
+    path = tiny(tmp_path, solvers=[{"name": "fkopt_example.de:DE", "label": "de", "track": "black-box"},
+                                   {"name": "pso"}])
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    lb = pd.read_csv(res.folder / "leaderboard.csv")
+    row = lb[(lb.scope == "track:black-box") & (lb.solver == "de")]
+    assert len(row) == 1 and row["track"].item() == "black-box" and 0 <= row["score"].item() <= 1
+
+
+def test_reproduce_does_not_pick_up_suites(tmp_path):
+    from fkopt.reproduce.run import plan
+    shutil.copytree(SUITES, tmp_path / "configs" / "suites")
+    shutil.copy(ROOT / "configs" / "wu2015" / "tab2_nr.yaml", tmp_path / "configs" / "one.yaml")
+    planned = plan(tmp_path / "configs", tmp_path / "out")
+    assert [p.path.name for p in planned] == ["one.yaml"]
