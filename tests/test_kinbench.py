@@ -213,3 +213,48 @@ def test_reproduce_does_not_pick_up_suites(tmp_path):
     shutil.copy(ROOT / "configs" / "wu2015" / "tab2_nr.yaml", tmp_path / "configs" / "one.yaml")
     planned = plan(tmp_path / "configs", tmp_path / "out")
     assert [p.path.name for p in planned] == ["one.yaml"]
+
+
+def _outside_csv(path, rows_of):
+    """An outside solver's log: for every instance and 2 runs, rows_of(problem, set, pose, run) rows."""
+    cfg = load_suite(path)
+    sets, _ = load_pose_sets(cfg)
+    rows = []
+    for (problem, name), pts in sets.items():
+        for i in range(len(pts)):
+            for run in range(2):
+                rows += [dict(problem=problem, set=name, pose=i, run=run, evaluations=e, best_so_far=f)
+                         for e, f in rows_of(problem, name, i, run)]
+    return pd.DataFrame(rows)
+
+
+def test_outside_results_are_ranked_beside_fkopts(tmp_path):
+    path = tiny(tmp_path)
+    # a perfect outside solver: every target at 2 x dim evaluations; and one that never gets close
+    _outside_csv(path, lambda *a: [(1, 5.0), (6, 1e-12), (1000, 1e-13)]).to_csv(tmp_path / "fast.csv", index=False)
+    _outside_csv(path, lambda *a: [(1, 5.0), (300, 1.0)]).to_csv(tmp_path / "slow.csv", index=False)
+    path = tiny(tmp_path / "s", outside=[{"solver": "ext-fast", "track": "black-box", "file": "../fast.csv"},
+                                         {"solver": "ext-slow", "track": "black-box", "file": "../slow.csv"}])
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    lb = pd.read_csv(res.folder / "leaderboard.csv")
+    bb = lb[lb.scope == "track:black-box"].set_index("solver")
+    assert bb.loc["ext-fast", "rank"] == 1 and bb.loc["ext-slow", "score"] == 0
+    assert set(bb.index) == {"ext-fast", "ext-slow", "pso"}
+    assert bb.loc["ext-fast", "success_1e-10"] == 1
+    expected = np.log(100 / 2) / np.log(100)    # all 5 targets at 6 evaluations / dim 3 = 2 per dim
+    assert bb.loc["ext-fast", "score"] == pytest.approx(expected)
+    meta = json.loads((res.folder / "meta.json").read_text())
+    assert set(meta["outside"]) == {"ext-fast", "ext-slow"}
+
+
+def test_an_outside_file_missing_an_instance_is_refused_before_solving(tmp_path):
+    path = tiny(tmp_path)
+    df = _outside_csv(path, lambda *a: [(1, 5.0)])
+    df[~((df.problem == "wu2015-3ppr") & (df.set == "boundary") & (df.pose == 1))].to_csv(tmp_path / "x.csv",
+                                                                                          index=False)
+    path = tiny(tmp_path / "s", outside=[{"solver": "ext", "track": "exact", "file": "../x.csv"}])
+    out = tmp_path / "out"
+    r = cli("suite", path, "--out", out, "-q")
+    assert r.returncode == 2 and "no run of problem wu2015-3ppr, set boundary, pose 1" in r.stderr
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+    assert not out.exists() or not any(p.is_file() for p in out.rglob("*"))

@@ -73,6 +73,15 @@ class SuiteSolver(AlgorithmSpec):
         return self
 
 
+class OutsideSolver(Strict):
+    """Results of a solver run outside fkopt (:mod:`fkopt.kinbench.outside`)."""
+
+    solver: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+:-]{0,63}$")
+    track: Literal["black-box", "jacobian", "exact"]
+    file: str = Field(min_length=1)
+    description: str = ""
+
+
 class SuiteProblem(Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
     problem_class: str = Field(alias="class", min_length=1, max_length=64)
@@ -110,6 +119,8 @@ class SuiteConfig(Located):
     #: of the Holm-corrected pairwise tests.
     bootstrap: int = Field(1000, ge=100, le=100_000)
     alpha: float = Field(0.05, gt=0, lt=0.5)
+    #: Solvers run elsewhere, imported from CSV files of evaluations and best-so-far per run.
+    outside: list[OutsideSolver] = Field(default_factory=list)
     quick: QuickTier | None = None
     check: Literal["ci", "full"] = "full"
     _folder: Path | None = PrivateAttr(None)
@@ -131,6 +142,14 @@ class SuiteConfig(Located):
         if dup:
             raise ValueError(f"problem names must be unique, '{dup[0]}' repeats")
         return problems
+
+    @model_validator(mode="after")
+    def _outside_names(self):
+        names = [s.key for s in self.solvers] + [o.solver for o in self.outside]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"solver labels must be unique over solvers and outside, '{dup[0]}' repeats")
+        return self
 
     @field_validator("targets")
     @classmethod

@@ -128,10 +128,16 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
     return write_page(sr, folder, tables)
 
 
+def _outside_digest(config, entry) -> str:
+    from .outside import digest
+    return digest(config, entry)
+
+
 def meta(sr) -> dict:
     c = sr.config
     manifest = sr.manifest or {}
     digest = hashlib.sha256(repr(sorted((k, str(v)) for k, v in manifest.items())).encode()).hexdigest()
     return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json", by_alias=True),
             "config_file": sr.source, "pose_sets": {"version": manifest.get("version"), "manifest_sha256": digest},
+            "outside": {o.solver: _outside_digest(c, o) for o in c.outside},
             "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)"}

@@ -72,13 +72,14 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
     """Everything a suite needs, built without solving; (tasks, estimated bytes)."""
     sets, _ = load_pose_sets(config)
     need = 0
+    dims: dict[str, int] = {}
     for problem in config.problems:
         cfg0 = run_config(config, problem, config.solvers[0], 1)
         mech = build_mechanism(cfg0)
         cases = _cases(config, sets, problem)
         if not cases:
             raise FkoptError(f"problems[{problem.name}]: no poses in sets {', '.join(config.sets)}")
-        dim = len(mech.unknown_names)
+        dim = dims[problem.name] = len(mech.unknown_names)
         for p in (c[2] for c in cases):
             if not np.all(mech.in_bounds(p[None])):
                 raise FkoptError(f"problems[{problem.name}]: a frozen pose lies outside mechanism.bounds")
@@ -94,6 +95,12 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
                 raise FkoptError(f"{where}: {err}") from None
             T = cfg.iterations + 1
             need = max(need, len(cases) * config.runs * 8 * (3 * T + 2 * dim) * 2)
+    if config.outside:            # read and checked now, so a bad file fails before any solve
+        from .outside import read_outside
+        instances = {(p.name, s, i) for p in config.problems for s in config.sets
+                     for i in range(len(sets[(p.name, s)]))}
+        for k in range(len(config.outside)):
+            read_outside(config, k, dims, instances)
     return len(config.problems) * len(config.solvers), need
 
 
@@ -172,7 +179,15 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
 
     execute(solve_task, payloads, executor=executor, jobs=jobs, scheduler=scheduler, on_result=collect)
     done.sort(key=lambda r: (r["problem"], r["solver"]))
-    runs = pd.concat([r["rows"] for r in done], ignore_index=True)
+    frames = [r["rows"] for r in done]
+    if config.outside:
+        from .outside import read_outside
+        dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
+        sets, _ = load_pose_sets(config)
+        instances = {(p.name, s, i) for p in config.problems for s in config.sets
+                     for i in range(len(sets[(p.name, s)]))}
+        frames += [read_outside(config, k, dims, instances) for k in range(len(config.outside))]
+    runs = pd.concat(frames, ignore_index=True)
     tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
                          "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
                         for r in done])
