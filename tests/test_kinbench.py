@@ -258,3 +258,11 @@ def test_an_outside_file_missing_an_instance_is_refused_before_solving(tmp_path)
     assert r.returncode == 2 and "no run of problem wu2015-3ppr, set boundary, pose 1" in r.stderr
     assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
     assert not out.exists() or not any(p.is_file() for p in out.rglob("*"))
+
+
+def test_worker_processes_write_the_same_bytes(tmp_path):
+    path = tiny(tmp_path, solvers=[{"name": "lm"}, {"name": "pso"}])
+    a = run_config(load_any(path), tmp_path / "one", source=str(path)).folder
+    b = run_config(load_any(path), tmp_path / "two", source=str(path), jobs=2).folder
+    for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
