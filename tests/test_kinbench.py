@@ -17,7 +17,7 @@ from fkopt.kinbench import measures as M
 from fkopt.kinbench.config import load_suite
 from fkopt.kinbench.posesets import (BOUNDARY_SHARE, condition_numbers, generate, load_pose_sets,
                                      problem_mechanism)
-from fkopt.kinbench.runner import at_budget, target_column
+from fkopt.kinbench.budget import at_budget, target_column
 
 ROOT = Path(__file__).resolve().parents[1]
 SUITES = ROOT / "configs" / "suites"
@@ -48,7 +48,7 @@ def test_the_suite_file_and_its_quick_tier_validate():
     cfg = load_suite(SUITE)
     q = cfg.quick_tier()
     assert q.name == "kinbench-quick" and q.quick is None and q.check == "ci"
-    assert {p.name for p in q.problems} < {p.name for p in cfg.problems}
+    assert {s.key for s in q.solvers} < {s.key for s in cfg.solvers} and q.poses < cfg.poses and q.runs < cfg.runs
     assert [s.track for s in cfg.solvers if s.name == "lm"] == ["jacobian"]
     # what meta.json stores reloads as the same config (fkopt check reruns from it)
     again = from_dict(q.model_dump(mode="json", by_alias=True), "meta")

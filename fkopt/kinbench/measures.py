@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from ..study.statistics import holm
-from .runner import target_column
+from .budget import target_column
 
 ECDF_POINTS_PER_DECADE = 10
 INSTANCE = ["problem", "set", "pose"]

@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import FkoptError
+from .budget import at_budget, budget_of
 
 COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
 
@@ -46,7 +47,6 @@ def digest(config, entry) -> str:
 
 def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]]) -> pd.DataFrame:
     """The run rows (as :func:`fkopt.kinbench.runner.run_rows` makes them) of ``config.outside[k]``."""
-    from .runner import at_budget, budget_of
     entry = config.outside[k]
     path = outside_path(config, entry)
     where = f"outside[{k}].file: {path}"

@@ -28,16 +28,10 @@ from ..errors import FkoptError
 from ..experiment.config import RunConfig
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..solve import chunk_size, make_algorithm
+from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
+from .outside import read_outside
 from .posesets import load_pose_sets, targets_of
-
-
-def target_column(t: float) -> str:
-    return f"evals_to_{t:.0e}"
-
-
-def budget_of(config: SuiteConfig, dim: int) -> int:
-    return int(config.budget_per_dim) * int(dim)
 
 
 def run_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
@@ -96,7 +90,6 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
             T = cfg.iterations + 1
             need = max(need, len(cases) * config.runs * 8 * (3 * T + 2 * dim) * 2)
     if config.outside:            # read and checked now, so a bad file fails before any solve
-        from .outside import read_outside
         instances = {(p.name, s, i) for p in config.problems for s in config.sets
                      for i in range(len(sets[(p.name, s)]))}
         for k in range(len(config.outside)):
@@ -125,25 +118,6 @@ def solve_task(payload: dict) -> dict:
     return {"problem": payload["problem"], "solver": payload["solver"], "dim": dim,
             "rows": run_rows(config, problem, solver, cases, result, dim),
             "wall_s": wall, "solves": len(cases) * config.runs}
-
-
-def at_budget(history: np.ndarray, evals: np.ndarray, budget: int, targets) -> dict:
-    """Measures of runs from their best-so-far fitness and cumulative evaluations per iteration
-    (``(..., T + 1)`` each), cut at ``budget`` evaluations: evaluations used, final fitness and,
-    per target, the evaluations when the target was first reached (NaN: not within the budget)."""
-    within = evals <= budget
-    last = np.where(within.any(axis=-1), within.shape[-1] - 1 - np.argmax(within[..., ::-1], axis=-1), -1)
-    ok = last >= 0
-    li = np.maximum(last, 0)[..., None]
-    used = np.where(ok, np.take_along_axis(evals, li, axis=-1)[..., 0], 0).astype(float)
-    final = np.where(ok, np.take_along_axis(history, li, axis=-1)[..., 0], np.inf)
-    out = {"evaluations": used, "fitness": final}
-    for t in targets:
-        hit = (history < t) & within
-        first = np.argmax(hit, axis=-1)[..., None]
-        ev = np.take_along_axis(evals, first, axis=-1)[..., 0].astype(float)
-        out[target_column(t)] = np.where(hit.any(axis=-1), ev, np.nan)
-    return out
 
 
 def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> pd.DataFrame:
@@ -181,7 +155,6 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     done.sort(key=lambda r: (r["problem"], r["solver"]))
     frames = [r["rows"] for r in done]
     if config.outside:
-        from .outside import read_outside
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
         sets, _ = load_pose_sets(config)
         instances = {(p.name, s, i) for p in config.problems for s in config.sets
