@@ -111,6 +111,15 @@ def test_a_changed_pose_file_is_refused_by_its_checksum(tmp_path):
     assert not (out / "kinbench").exists()
 
 
+def test_a_solver_that_cannot_take_a_problem_is_refused_before_solving(tmp_path):
+    data = yaml.safe_load(SUITE.read_text())
+    arm = [p for p in data["problems"] if p["name"] == "wang2020-7dof"]
+    path = tiny(tmp_path, problems=arm, solvers=[{"name": "pso"}, {"name": "nr"}])
+    r = cli("suite", path, "--out", tmp_path / "out", "-q")
+    assert r.returncode == 2 and r.stderr.startswith(f"fkopt: error: {path}: solvers[nr] on problems[wang2020-7dof]: nr needs")
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
 def test_a_mechanism_other_than_the_pose_sets_one_is_refused(tmp_path):
     data = yaml.safe_load(SUITE.read_text())
     probs = data["problems"][:1]

@@ -85,8 +85,14 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
                 cfg = run_config(config, problem, solver, dim)
                 pop = solver.population or config.population
                 chunk_size(len(cases), config.runs, pop, cfg.iterations, dim)
+                # a one-iteration probe on one pose: a solver that cannot take this problem (nr on
+                # a redundant arm, ...) fails here, before any real work
+                probe = cfg.model_copy(update={"runs": 1, "iterations": 1, "stop_at_threshold": False})
+                spec = cfg.algorithms[0]
+                solve_cases(probe, spec, make_problem(probe, mech, targets_of(mech, cases[0][2][None])), [0],
+                            x0=start_point(spec, mech))
             except FkoptError as err:
-                raise FkoptError(f"{where}: {err}") from None
+                raise FkoptError(f"{where} on problems[{problem.name}]: {err}") from None
             T = cfg.iterations + 1
             need = max(need, len(cases) * config.runs * 8 * (3 * T + 2 * dim) * 2)
     if config.outside:            # read and checked now, so a bad file fails before any solve
