@@ -10,8 +10,8 @@ A *trial* is one run on one (problem, set, pose) *instance*; a *triple* is (inst
   or the evaluations used within the budget when it was not -- divided by the number of
   successes (inf when there are none); also given per dimension;
 * **ECDF** (empirical runtime distribution): the share of (triple, run) pairs reached within
-  b x dimension evaluations, on a log grid of b (:data:`ECDF_POINTS_PER_DECADE` per decade,
-  from 1 to the budget per dimension), per solver over all problems and per problem class;
+  b x dimension evaluations, as a step function of b (one row per step), per solver over all
+  problems and per problem class;
 * **score** of a solver on an instance: the area under that instance's ECDF on the log axis of
   evaluations/dimension from 1 to the budget per dimension, normalised to [0, 1] -- the mean
   over its runs and targets of ``log(Bd / max(e/d, 1)) / log(Bd)`` for a target reached with e
@@ -33,10 +33,10 @@ from itertools import combinations
 import numpy as np
 import pandas as pd
 
+from ..study.statistics import ecdf_table as ecdf_steps
 from ..study.statistics import holm
 from .budget import target_column
 
-ECDF_POINTS_PER_DECADE = 10
 INSTANCE = ["problem", "set", "pose"]
 
 
@@ -63,27 +63,21 @@ def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def ecdf_grid(budget_per_dim: float) -> np.ndarray:
-    decades = max(np.log10(budget_per_dim), 0.0)
-    n = max(int(np.ceil(decades * ECDF_POINTS_PER_DECADE)), 1)
-    return np.unique(np.concatenate([np.logspace(0, decades, n + 1), [budget_per_dim]]))
-
-
 def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFrame:
     """Share of (problem, set, pose, target, run) reached within b x dim evaluations, per scope
-    (``all`` and ``class:<c>``) and solver, on :func:`ecdf_grid`."""
-    grid = ecdf_grid(budget_per_dim)
-    rows = []
+    (``all`` and ``class:<c>``) and solver: the steps of the runtime distribution
+    (:func:`fkopt.study.statistics.ecdf_table`, in evaluations / dimension)."""
+    frames = []
     scopes = [("all", runs)] + [(f"class:{c}", g) for c, g in runs.groupby("class", sort=True)]
     for scope, sub in scopes:
-        for (solver, track), g in sub.groupby(["solver", "track"], sort=False):
-            per_dim = hits(g, targets) / g["dim"].to_numpy(dtype=float)[:, None]
-            flat = np.sort(per_dim[~np.isnan(per_dim)])
-            counts = np.searchsorted(flat, grid, side="right")
-            for b, c in zip(grid, counts):
-                rows.append({"scope": scope, "solver": solver, "track": track, "evals_per_dim": b,
-                             "reached": int(c), "pairs": per_dim.size, "fraction": c / per_dim.size})
-    return pd.DataFrame(rows)
+        per_dim = hits(sub, targets) / sub["dim"].to_numpy(dtype=float)[:, None]
+        solvers = list(dict.fromkeys(sub["solver"]))
+        df = ecdf_steps({s: per_dim[(sub["solver"] == s).to_numpy()] for s in solvers})
+        df = df.rename(columns={"algorithm": "solver", "evaluations": "evals_per_dim", "solved": "reached"})
+        df.insert(0, "scope", scope)
+        df.insert(2, "track", df["solver"].map(dict(zip(sub["solver"], sub["track"]))))
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
 
 
 def trial_scores(runs: pd.DataFrame, targets, budget_per_dim: float) -> np.ndarray:

@@ -7,6 +7,7 @@ runs.csv, measures.csv (per problem), ecdf.csv, leaderboard.csv, timing.csv, the
 from __future__ import annotations
 
 import hashlib
+import json
 import re
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from . import measures as M
+from .outside import digest
 
 
 def runs_table(sr) -> pd.DataFrame:
@@ -56,8 +58,12 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     targets = ", ".join(f"{t:.0e}" for t in sr.config.targets)
     for scope, g in df.groupby("scope", sort=False):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
-        for k, ((solver, track), s) in enumerate(g.groupby(["solver", "track"], sort=False)):
-            x, y = np.log10(s["evals_per_dim"].to_numpy()), s["fraction"].to_numpy()
+        top = float(sr.config.budget_per_dim)
+        for (solver, track), s in g.groupby(["solver", "track"], sort=False):
+            s = s.dropna(subset=["evals_per_dim"])      # a solver that reached nothing: flat at 0
+            b = np.concatenate([[1.0], np.maximum(s["evals_per_dim"].to_numpy(), 1.0), [top]])
+            f = np.concatenate([[0.0], s["fraction"].to_numpy(), [s["fraction"].max() if len(s) else 0.0]])
+            x, y = np.log10(b), f
             line, = ax.step(x, y, where="post", linestyle=styles.get(track, "-"), label=f"{solver} ({track})")
             ax.annotate(solver, (x[-1], y[-1]), xytext=(3, 0), textcoords="offset points", fontsize=7,
                         color=line.get_color(), va="center")
@@ -128,16 +134,12 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
     return write_page(sr, folder, tables)
 
 
-def _outside_digest(config, entry) -> str:
-    from .outside import digest
-    return digest(config, entry)
-
-
 def meta(sr) -> dict:
     c = sr.config
     manifest = sr.manifest or {}
-    digest = hashlib.sha256(repr(sorted((k, str(v)) for k, v in manifest.items())).encode()).hexdigest()
+    canonical = hashlib.sha256(json.dumps(manifest, sort_keys=True).encode()).hexdigest()
     return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json", by_alias=True),
-            "config_file": sr.source, "pose_sets": {"version": manifest.get("version"), "manifest_sha256": digest},
-            "outside": {o.solver: _outside_digest(c, o) for o in c.outside},
+            "config_file": sr.source,
+            "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
+            "outside": {o.solver: digest(c, o) for o in c.outside},
             "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)"}

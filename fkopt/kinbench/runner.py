@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -26,12 +26,12 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..experiment.config import RunConfig
-from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
+from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..solve import chunk_size, make_algorithm
 from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
 from .outside import read_outside
-from .posesets import load_pose_sets, targets_of
+from .posesets import load_pose_sets, problem_mechanism, targets_of
 
 
 def run_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
@@ -54,12 +54,16 @@ class SuiteResult:
     manifest: dict
     wall_s: float
     source: str | None = None
-    extra_runs: list[pd.DataFrame] = field(default_factory=list)   # imported outside results
 
 
 def _cases(config: SuiteConfig, sets: dict, problem):
     """(set name, pose index, point) of every case of ``problem``, in set then pose order."""
     return [(name, i, p) for name in config.sets for i, p in enumerate(sets[(problem.name, name)])]
+
+
+def instances_of(config: SuiteConfig, sets: dict) -> set[tuple[str, str, int]]:
+    """Every (problem, set, pose) the suite selects."""
+    return {(p.name, name, i) for p in config.problems for name, i, _ in _cases(config, sets, p)}
 
 
 def validate_suite(config: SuiteConfig) -> tuple[int, int]:
@@ -68,15 +72,13 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
     need = 0
     dims: dict[str, int] = {}
     for problem in config.problems:
-        cfg0 = run_config(config, problem, config.solvers[0], 1)
-        mech = build_mechanism(cfg0)
+        mech, _ = problem_mechanism(problem, config._folder)
         cases = _cases(config, sets, problem)
         if not cases:
             raise FkoptError(f"problems[{problem.name}]: no poses in sets {', '.join(config.sets)}")
         dim = dims[problem.name] = len(mech.unknown_names)
-        for p in (c[2] for c in cases):
-            if not np.all(mech.in_bounds(p[None])):
-                raise FkoptError(f"problems[{problem.name}]: a frozen pose lies outside mechanism.bounds")
+        if not np.all(mech.in_bounds(np.stack([c[2] for c in cases]))):
+            raise FkoptError(f"problems[{problem.name}]: a frozen pose lies outside mechanism.bounds")
         for solver in config.solvers:
             where = f"solvers[{solver.key}]"
             try:
@@ -96,22 +98,21 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
             T = cfg.iterations + 1
             need = max(need, len(cases) * config.runs * 8 * (3 * T + 2 * dim) * 2)
     if config.outside:            # read and checked now, so a bad file fails before any solve
-        instances = {(p.name, s, i) for p in config.problems for s in config.sets
-                     for i in range(len(sets[(p.name, s)]))}
+        instances = instances_of(config, sets)
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances)
     return len(config.problems) * len(config.solvers), need
 
 
 def solve_task(payload: dict) -> dict:
-    """Worker: one (problem, solver) task; returns its run rows and wall time (picklable)."""
+    """Worker: one (problem, solver) task on the cases (checked poses) the payload carries;
+    returns its run rows and wall time (picklable)."""
     config = suite_from_dict(payload["config"], "suite task")
     config._folder = Path(payload["folder"]) if payload["folder"] else None
     problem = config.problems[payload["problem"]]
     solver = config.solvers[payload["solver"]]
-    sets, _ = load_pose_sets(config)
-    cases = _cases(config, sets, problem)
-    mech = build_mechanism(run_config(config, problem, solver, 1))
+    cases = payload["cases"]
+    mech, _ = problem_mechanism(problem, config._folder)
     dim = len(mech.unknown_names)
     cfg = run_config(config, problem, solver, dim)
     points = np.stack([c[2] for c in cases])
@@ -144,11 +145,12 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     start = time.perf_counter()
     if source and config._folder is None:
         config._folder = Path(source).parent
-    _, manifest = load_pose_sets(config)
+    sets, manifest = load_pose_sets(config)
     data = config.model_dump(mode="json", by_alias=True)
     folder = str(config._folder) if config._folder is not None else ""
-    payloads = [{"config": data, "folder": folder, "problem": p, "solver": s}
-                for p in range(len(config.problems)) for s in range(len(config.solvers))]
+    payloads = [{"config": data, "folder": folder, "problem": p, "solver": s,
+                 "cases": _cases(config, sets, problem)}
+                for p, problem in enumerate(config.problems) for s in range(len(config.solvers))]
     done: list[dict] = []
 
     def collect(rec: dict) -> None:
@@ -162,9 +164,7 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     frames = [r["rows"] for r in done]
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
-        sets, _ = load_pose_sets(config)
-        instances = {(p.name, s, i) for p in config.problems for s in config.sets
-                     for i in range(len(sets[(p.name, s)]))}
+        instances = instances_of(config, sets)
         frames += [read_outside(config, k, dims, instances) for k in range(len(config.outside))]
     runs = pd.concat(frames, ignore_index=True)
     tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
