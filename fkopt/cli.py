@@ -267,7 +267,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
     if getattr(cfg, "kind", None) != "suite":
         raise FkoptError(f"{config}: not a suite file (kind: suite); run it with: fkopt run {config}")
     if quick:
-        cfg = cfg.quick_tier()
+        cfg = cfg.quick_tier(str(config))
     validate_executor(executor, jobs, scheduler)
     tasks = validate_any(cfg, str(config))
     prepare_output(cfg, out, force)

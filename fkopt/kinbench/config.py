@@ -178,10 +178,11 @@ class SuiteConfig(Located):
                                      f"({', '.join(known)})")
         return self
 
-    def quick_tier(self) -> "SuiteConfig":
+    def quick_tier(self, where: str = "suite") -> "SuiteConfig":
         """The ``--quick`` subset as a config of its own (name ``<name>-quick``, no quick block)."""
         if self.quick is None:
-            raise FkoptError(f"suite '{self.name}' has no quick: block; --quick needs one")
+            raise FkoptError(f"{where}: quick: missing; --quick needs a quick: block (fields: "
+                             f"{', '.join(QuickTier.model_fields)})")
         q = self.quick
         data = self.model_dump(mode="json", by_alias=True)
         data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci")
