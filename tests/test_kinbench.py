@@ -274,3 +274,41 @@ def test_worker_processes_write_the_same_bytes(tmp_path):
     b = run_config(load_any(path), tmp_path / "two", source=str(path), jobs=2).folder
     for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
         assert (a / name).read_bytes() == (b / name).read_bytes(), name
+
+
+def test_runs_logged_by_iohexperimenter_are_ranked(tmp_path):
+    """Outside runs written by IOHexperimenter's own Analyzer logger (not by fkopt) are read back
+    with the best-so-far fitness the runs really reached."""
+    ioh = pytest.importorskip("ioh", reason="IOHexperimenter (pip install ioh) is not installed")
+    from fkopt.experiment.runner import make_problem
+    from fkopt.kinbench.posesets import targets_of
+    path = tiny(tmp_path)
+    cfg = load_suite(path)
+    sets, _ = load_pose_sets(cfg)
+    logger = ioh.logger.Analyzer(root=str(tmp_path / "ioh-runs"), folder_name="rs", algorithm_name="RS")
+    best = {}
+    for problem in cfg.problems:
+        mech, rc = problem_mechanism(problem)
+        lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+        for name in cfg.sets:
+            for i, point in enumerate(sets[(problem.name, name)]):
+                prob = make_problem(rc, mech, targets_of(mech, point[None])[0])
+                f = ioh.wrap_problem(lambda x, p=prob: float(p.fitness(np.asarray(x))), name=f"{problem.name}__{name}",
+                                     optimization_type=ioh.OptimizationType.MIN, dimension=len(lo), instance=i + 1,
+                                     lb=-1000.0, ub=1000.0)
+                f.attach_logger(logger)
+                rng = np.random.default_rng(i)
+                for run in range(2):
+                    xs = lo + rng.random((40, len(lo))) * (hi - lo)
+                    best[(problem.name, name, i, run)] = min(f(list(x)) for x in xs)
+                    f.reset()
+    logger.close()
+    path = tiny(tmp_path / "s", outside=[{"solver": "ioh-rs", "track": "black-box", "ioh": "../ioh-runs"}])
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    runs = res.result.runs
+    got = runs[runs.solver == "ioh-rs"]
+    assert len(got) == len(best)
+    for r in got.itertuples():
+        assert r.evaluations == 40 and r.fitness == pytest.approx(best[(r.problem, r.set, r.pose, r.run)], rel=1e-9)
+    lb = pd.read_csv(res.folder / "leaderboard.csv")
+    assert "ioh-rs" in set(lb.loc[lb.scope == "track:black-box", "solver"])

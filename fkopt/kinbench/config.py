@@ -74,12 +74,23 @@ class SuiteSolver(AlgorithmSpec):
 
 
 class OutsideSolver(Strict):
-    """Results of a solver run outside fkopt (:mod:`fkopt.kinbench.outside`)."""
+    """Results of a solver run outside fkopt (:mod:`fkopt.kinbench.outside`): a CSV ``file`` or
+    an IOHprofiler folder ``ioh`` (with the ``algorithm`` to take when it holds several)."""
 
     solver: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+:-]{0,63}$")
     track: Literal["black-box", "jacobian", "exact"]
-    file: str = Field(min_length=1)
+    file: str | None = Field(None, min_length=1)
+    ioh: str | None = Field(None, min_length=1)
+    algorithm: str | None = None
     description: str = ""
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if (self.file is None) == (self.ioh is None):
+            raise ValueError("give exactly one of 'file' (CSV) and 'ioh' (IOHprofiler folder)")
+        if self.algorithm is not None and self.ioh is None:
+            raise ValueError("'algorithm' selects a solver of an 'ioh' folder; a CSV file holds one")
+        return self
 
 
 class SuiteProblem(Strict):
