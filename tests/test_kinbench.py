@@ -268,12 +268,24 @@ def test_an_outside_file_missing_an_instance_is_refused_before_solving(tmp_path)
     assert not out.exists() or not any(p.is_file() for p in out.rglob("*"))
 
 
-def test_worker_processes_write_the_same_bytes(tmp_path):
+def test_worker_processes_and_a_dask_scheduler_write_the_same_bytes(tmp_path):
     path = tiny(tmp_path, solvers=[{"name": "lm"}, {"name": "pso"}])
     a = run_config(load_any(path), tmp_path / "one", source=str(path)).folder
     b = run_config(load_any(path), tmp_path / "two", source=str(path), jobs=2).folder
-    for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
-        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+    folders = [b]
+    try:
+        from dask.distributed import LocalCluster
+    except ImportError:
+        LocalCluster = None
+    if LocalCluster is not None:     # an existing cluster reached by its address, as with --scheduler
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+            folders.append(run_config(load_any(path), tmp_path / "dask", source=str(path), executor="dask",
+                                      scheduler=cluster.scheduler_address).folder)
+    for other in folders:
+        for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+            assert (a / name).read_bytes() == (other / name).read_bytes(), (other, name)
+    if LocalCluster is None:
+        pytest.skip("dask.distributed not installed: only the worker processes were compared")
 
 
 def test_runs_logged_by_iohexperimenter_are_ranked(tmp_path):
