@@ -193,6 +193,10 @@ def test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it(tmp_path):
     assert "## Per track" in (folder / "leaderboard.md").read_text()
     chk = cli("check", folder)
     assert chk.returncode == 0, chk.stdout + chk.stderr
+    lb.loc[0, "score"] += 0.01                 # a stored number that the rerun does not give
+    lb.to_csv(folder / "leaderboard.csv", index=False, float_format="%.10g")
+    chk = cli("check", folder)
+    assert chk.returncode == 1 and "leaderboard.csv" in chk.stderr, chk.stdout + chk.stderr
 
 
 def test_fkopt_run_accepts_a_suite_and_numbers_do_not_depend_on_other_solvers(tmp_path):
