@@ -27,14 +27,14 @@ import pandas as pd
 from ..errors import FkoptError
 from ..experiment.config import RunConfig
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
-from ..solve import chunk_size, make_algorithm
+from ..solve import chunk_size
 from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
 from .outside import read_outside
 from .posesets import load_pose_sets, problem_mechanism, targets_of
 
 
-def run_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
+def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
     """The experiment layer's settings of one (problem, solver) task."""
     budget = budget_of(config, dim)
     pop = solver.population or config.population
@@ -82,13 +82,11 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
         for solver in config.solvers:
             where = f"solvers[{solver.key}]"
             try:
-                make_algorithm(solver.name, solver.params)
-                start_point(solver, mech)
-                cfg = run_config(config, problem, solver, dim)
+                cfg = task_config(config, problem, solver, dim)
                 pop = solver.population or config.population
                 chunk_size(len(cases), config.runs, pop, cfg.iterations, dim)
-                # a one-iteration probe on one pose: a solver that cannot take this problem (nr on
-                # a redundant arm, ...) fails here, before any real work
+                # a one-iteration probe on one pose: an unknown solver or parameter, a bad start, a
+                # solver that cannot take this problem (nr on a redundant arm) fail here, before any work
                 probe = cfg.model_copy(update={"runs": 1, "iterations": 1, "stop_at_threshold": False})
                 spec = cfg.algorithms[0]
                 solve_cases(probe, spec, make_problem(probe, mech, targets_of(mech, cases[0][2][None])), [0],
@@ -114,7 +112,7 @@ def solve_task(payload: dict) -> dict:
     cases = payload["cases"]
     mech, _ = problem_mechanism(problem, config._folder)
     dim = len(mech.unknown_names)
-    cfg = run_config(config, problem, solver, dim)
+    cfg = task_config(config, problem, solver, dim)
     points = np.stack([c[2] for c in cases])
     batched = make_problem(cfg, mech, targets_of(mech, points))
     seeds = [task_seed(config.seed, i, f"{problem.name}/{name}/{solver.key}") for name, i, _ in cases]
@@ -140,7 +138,7 @@ def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> p
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
-              executor: str = "local", scheduler: str | None = None, timing: bool = True) -> SuiteResult:
+              executor: str = "local", scheduler: str | None = None) -> SuiteResult:
     from ..study.executors import execute
     start = time.perf_counter()
     if source and config._folder is None:
