@@ -48,16 +48,16 @@ TARGETS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
 KNOWN_TRACKS = {"abc": "black-box", "gabc": "black-box", "pso": "black-box", "aco": "black-box",
                 "pabc": "black-box", "nr": "jacobian", "lm": "jacobian", "dls": "jacobian",
                 "abc+lm": "jacobian", "gabc+lm": "jacobian", "pso+lm": "jacobian"}
-ADAPTER_TRACK = "black-box"     # scipy:, pymoo:, niapy: minimise the fitness only
+ADAPTER_TRACK = "black-box"     # scipy:, pymoo:, niapy: (registry.ADAPTER_PREFIXES) minimise the fitness only
 MAX_BUDGET_PER_DIM = 10_000_000
 
 
 def default_track(name: str) -> str | None:
+    """The track of a built-in solver or an adapter; None for anything else (a plug-in)."""
+    from ..registry import ADAPTER_PREFIXES
     if name in KNOWN_TRACKS:
         return KNOWN_TRACKS[name]
-    if name.split(":", 1)[0] in ("scipy", "pymoo", "niapy") and "." not in name.split(":", 1)[0]:
-        return ADAPTER_TRACK
-    return None
+    return ADAPTER_TRACK if name.split(":", 1)[0] in ADAPTER_PREFIXES else None
 
 
 class SuiteSolver(AlgorithmSpec):

@@ -66,7 +66,9 @@ def set_rng(seed: int, problem: str, name: str) -> np.random.Generator:
 
 
 def problem_mechanism(problem, folder: Path | None = None):
-    """The mechanism of a suite problem (the experiment layer's builder)."""
+    """The mechanism of a suite problem (the experiment layer's builder) and the RunConfig it
+    was built from (its objective is what :func:`fkopt.experiment.runner.make_problem` reads; the
+    one algorithm entry only satisfies the schema)."""
     from ..experiment.config import RunConfig
     from ..experiment.runner import build_mechanism
     cfg = RunConfig(name="pose-set", mechanism=problem.mechanism, objective=problem.objective,
