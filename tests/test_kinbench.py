@@ -328,3 +328,22 @@ def test_runs_logged_by_iohexperimenter_are_ranked(tmp_path):
         assert r.evaluations == 40 and r.fitness == pytest.approx(best[(r.problem, r.set, r.pose, r.run)], rel=1e-9)
     lb = pd.read_csv(res.folder / "leaderboard.csv")
     assert "ioh-rs" in set(lb.loc[lb.scope == "track:black-box", "solver"])
+
+
+def test_a_urdf_arm_joins_as_a_problem_with_pose_sets_of_its_own(tmp_path):
+    """The hook for URDF arms: a problem is a mechanism spec; its frozen sets are generated like v1's."""
+    from fkopt.kinbench.posesets import write_pose_sets
+    urdf = ROOT / "fkopt" / "mechanisms" / "data" / "wang7dof.urdf"
+    data = {"kind": "suite", "name": "urdf", "pose_sets": "kb-urdf", "sets": ["uniform", "near-singular", "boundary"],
+            "problems": [{"name": "urdf-7dof", "class": "serial-ik-7dof", "objective": "geodesic",
+                          "mechanism": {"name": "urdf", "bounds": {"q1": [-180, 180]},
+                                        "geometry": {"file": str(urdf), "base": "link0", "tip": "tool"}}}],
+            "solvers": [{"name": "lm"}], "poses": 1, "runs": 1, "budget_per_dim": 200, "bootstrap": 100}
+    path = tmp_path / "urdf.yaml"
+    path.write_text(yaml.safe_dump(data))
+    cfg = load_suite(path)
+    write_pose_sets(cfg, tmp_path / "kb-urdf")
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    runs = res.result.runs
+    assert len(runs) == 3 and set(runs["set"]) == {"uniform", "near-singular", "boundary"}
+    assert (runs["dim"] == 7).all() and (runs["evaluations"] <= 200 * 7).all()
