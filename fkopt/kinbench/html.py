@@ -1,6 +1,7 @@
-"""index.html: one self-contained static page -- the leaderboards as sortable tables (a few lines
-of inline JavaScript: a click on a header sorts by that column, again reverses), the ECDF figures
-inline as ``data:`` URIs, the per-problem tables. Nothing is loaded from the network."""
+"""The pieces of index.html (put together by :func:`fkopt.kinbench.reports.html_page`): one
+self-contained static page -- sortable tables (a few lines of inline JavaScript: a click on a
+header sorts by that column, again reverses), figures inline as ``data:`` URIs. Nothing is loaded
+from the network."""
 from __future__ import annotations
 
 import base64
@@ -57,37 +58,12 @@ def table_html(df, cols: list[str], ident: str) -> str:
     return f'<table class="sortable" id="{html.escape(ident)}"><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>'
 
 
-def _img(path: Path) -> str:
+def img(path: Path) -> str:
     data = base64.b64encode(path.read_bytes()).decode("ascii")
     return f'<figure><img alt="{html.escape(path.stem)}" src="data:image/png;base64,{data}"></figure>'
 
 
-def write_page(sr, folder: Path, tables: dict) -> list[str]:
-    lb = tables.get("leaderboard.csv")
-    if lb is None:
-        return []
-    c = sr.config
-    succ = [col for col in lb.columns if col.startswith("success_")]
-    cols = ["rank", "solver", "track", "score", "ci_low", "ci_high", "instances", "better_than"] + succ
-    parts = [f"<h1>{html.escape(c.title or c.name)}</h1>",
-             f"<p>Pose sets {html.escape(c.pose_sets)}; budget {c.budget_per_dim} &times; dimension evaluations; "
-             f"{c.runs} runs per pose; targets {html.escape(', '.join(f'{t:.0e}' for t in c.targets))}. "
-             "Score: normalised area under the ECDF (higher is better) with a 95 % bootstrap interval; "
-             f"better_than: significant at &alpha; = {c.alpha}, Holm-corrected within the table. "
-             "Click a column header to sort.</p>"]
-    for k, (scope, g) in enumerate(lb.groupby("scope", sort=False)):
-        parts += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
-    figs = sorted(folder.glob("ecdf_*.png"))
-    if figs:
-        parts += ["<h2>Runtime distributions (ECDF)</h2>"] + [_img(p) for p in figs]
-    ms = tables.get("measures.csv")
-    if ms is not None:
-        parts.append("<h2>Per problem</h2>")
-        for k, (problem, g) in enumerate(ms.groupby("problem", sort=False)):
-            parts += [f"<h3>{html.escape(problem)}</h3>",
-                      table_html(g, ["set", "solver", "track", "target", "trials", "success_rate", "ert"], f"pp-{k}")]
-    page = ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f"<title>{html.escape(c.name)} leaderboard</title><style>{STYLE}</style></head><body>"
-            + "\n".join(parts) + f"<script>{SCRIPT}</script></body></html>\n")
-    (folder / "index.html").write_text(page, encoding="utf-8")
-    return ["index.html"]
+def page(title: str, body: list[str]) -> str:
+    return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>"
+            + "\n".join(body) + f"<script>{SCRIPT}</script></body></html>\n")

@@ -89,9 +89,27 @@ def _md_table(df: pd.DataFrame, cols: list[str]) -> str:
     return "\n".join(lines)
 
 
-def leaderboard_sections(sr, tables: dict) -> list[tuple[str, pd.DataFrame]]:
+def leaderboard_sections(tables: dict) -> list[tuple[str, pd.DataFrame]]:
     lb = tables["leaderboard.csv"]
     return [(scope, g) for scope, g in lb.groupby("scope", sort=False)]
+
+
+def leaderboard_columns(lb: pd.DataFrame) -> list[str]:
+    return (["rank", "solver", "track", "score", "ci_low", "ci_high", "instances", "better_than"]
+            + [col for col in lb.columns if col.startswith("success_")])
+
+
+def preamble(c) -> str:
+    """What a leaderboard is made of and how to read it (leaderboard.md and index.html)."""
+    return (f"Pose sets {c.pose_sets}; {len(c.problems)} problems, sets {', '.join(c.sets)}, "
+            f"{c.runs} runs per pose, budget {c.budget_per_dim} x dimension evaluations, targets "
+            f"{', '.join(f'{t:.0e}' for t in c.targets)}. Score: normalised area under the ECDF "
+            f"(0..1, higher is better), 95 % bootstrap CI over instances ({c.bootstrap} resamples); "
+            f"better_than: significant at alpha = {c.alpha} after Holm's correction within the table. "
+            "Tracks are ranked separately; 'overall' mixes them for reference only (docs/kinbench.md).")
+
+
+PER_PROBLEM = ["set", "solver", "track", "target", "trials", "success_rate", "ert"]
 
 
 def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
@@ -99,27 +117,19 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
     if lb is None:
         return []
     c = sr.config
-    succ = [col for col in lb.columns if col.startswith("success_")]
-    cols = ["rank", "solver", "track", "score", "ci_low", "ci_high", "better_than"] + succ
-    out = [f"# {c.title or c.name}", "",
-           f"Pose sets {c.pose_sets}; {len(c.problems)} problems, sets {', '.join(c.sets)}, "
-           f"{c.runs} runs per pose, budget {c.budget_per_dim} x dimension evaluations, targets "
-           f"{', '.join(f'{t:.0e}' for t in c.targets)}. Score: normalised area under the ECDF "
-           f"(0..1, higher is better), 95 % bootstrap CI over instances ({c.bootstrap} resamples); "
-           f"better_than: significant at alpha = {c.alpha} after Holm's correction within the scope. "
-           "Tracks are ranked separately; 'overall' mixes them for reference only (docs/kinbench.md).", ""]
+    cols = leaderboard_columns(lb)
+    out = [f"# {c.title or c.name}", "", preamble(c), ""]
     for title, pred in (("Overall", lambda s: s == "overall"), ("Per track", lambda s: s.startswith("track:")),
                         ("Per problem class", lambda s: s.startswith("class:"))):
         out += [f"## {title}", ""]
-        for scope, g in leaderboard_sections(sr, tables):
+        for scope, g in leaderboard_sections(tables):
             if pred(scope):
                 out += [f"### {scope}", "", _md_table(g, cols), ""]
     ms = tables.get("measures.csv")
     if ms is not None:
         out += ["## Per problem", "", "Success rate and ERT (evaluations) per set and target.", ""]
         for problem, g in ms.groupby("problem", sort=False):
-            out += [f"### {problem}", "", _md_table(g, ["set", "solver", "track", "target", "trials",
-                                                       "success_rate", "ert"]), ""]
+            out += [f"### {problem}", "", _md_table(g, PER_PROBLEM), ""]
     tim = getattr(sr, "timing", None)
     if tim is not None and not tim.empty:
         out += ["## Wall time per solve", "", "Amortised: the batched solve's wall time over its "
@@ -130,8 +140,28 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
 
 
 def html_page(sr, folder: Path, tables: dict) -> list[str]:
-    from .html import write_page
-    return write_page(sr, folder, tables)
+    """index.html: the leaderboards (sortable), the ECDF figures inline, the per-problem tables."""
+    import html
+    from .html import img, page, table_html
+    lb = tables.get("leaderboard.csv")
+    if lb is None:
+        return []
+    c = sr.config
+    cols = leaderboard_columns(lb)
+    body = [f"<h1>{html.escape(c.title or c.name)}</h1>",
+            f"<p>{html.escape(preamble(c))} Click a column header to sort.</p>"]
+    for k, (scope, g) in enumerate(leaderboard_sections(tables)):
+        body += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
+    figs = sorted(folder.glob("ecdf_*.png"))
+    if figs:
+        body += ["<h2>Runtime distributions (ECDF)</h2>"] + [img(p) for p in figs]
+    ms = tables.get("measures.csv")
+    if ms is not None:
+        body.append("<h2>Per problem</h2>")
+        for k, (problem, g) in enumerate(ms.groupby("problem", sort=False)):
+            body += [f"<h3>{html.escape(problem)}</h3>", table_html(g, PER_PROBLEM, f"pp-{k}")]
+    (folder / "index.html").write_text(page(f"{c.name} leaderboard", body), encoding="utf-8")
+    return ["index.html"]
 
 
 def meta(sr) -> dict:
