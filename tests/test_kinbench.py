@@ -51,7 +51,7 @@ def test_the_suite_file_and_its_quick_tier_validate():
     assert {s.key for s in q.solvers} < {s.key for s in cfg.solvers} and q.poses < cfg.poses and q.runs < cfg.runs
     assert [s.track for s in cfg.solvers if s.name == "lm"] == ["jacobian"]
     # what meta.json stores reloads as the same config (fkopt check reruns from it)
-    again = from_dict(q.model_dump(mode="json", by_alias=True), "meta")
+    again = from_dict(q.model_dump(mode="json"), "meta")
     assert again.model_dump() == q.model_dump()
 
 
@@ -193,6 +193,10 @@ def test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it(tmp_path):
     assert "## Per track" in (folder / "leaderboard.md").read_text()
     chk = cli("check", folder)
     assert chk.returncode == 0, chk.stdout + chk.stderr
+    from fkopt.experiment.kinds import prepare_output
+    assert prepare_output(load_any(path), out) == folder     # the same suite may rewrite it without --force
+    with pytest.raises(FkoptError, match="different config"):
+        prepare_output(load_any(tiny(tmp_path / "other", runs=3)), out)
     lb.loc[0, "score"] += 0.01                 # a stored number that the rerun does not give
     lb.to_csv(folder / "leaderboard.csv", index=False, float_format="%.10g")
     chk = cli("check", folder)
@@ -335,7 +339,7 @@ def test_a_urdf_arm_joins_as_a_problem_with_pose_sets_of_its_own(tmp_path):
     from fkopt.kinbench.posesets import write_pose_sets
     urdf = ROOT / "fkopt" / "mechanisms" / "data" / "wang7dof.urdf"
     data = {"kind": "suite", "name": "urdf", "pose_sets": "kb-urdf", "sets": ["uniform", "near-singular", "boundary"],
-            "problems": [{"name": "urdf-7dof", "class": "serial-ik-7dof", "objective": "geodesic",
+            "problems": [{"name": "urdf-7dof", "problem_class": "serial-ik-7dof", "objective": "geodesic",
                           "mechanism": {"name": "urdf", "bounds": {"q1": [-180, 180]},
                                         "geometry": {"file": str(urdf), "base": "link0", "tip": "tool"}}}],
             "solvers": [{"name": "lm"}], "poses": 1, "runs": 1, "budget_per_dim": 200, "bootstrap": 100}

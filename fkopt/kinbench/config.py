@@ -8,7 +8,7 @@
     pose_sets: kinbench-v1          # folder beside this file: manifest.json + one CSV per (problem, set)
     problems:
       - name: mao2017-3rps          # also the pose-set folder of this problem
-        class: parallel-fk-3dof     # ranked together with the other problems of its class
+        problem_class: parallel-fk-3dof   # ranked together with the other problems of its class
         mechanism: {name: 3-rps, geometry: {ra: 274, rb: 158}}
     sets: [uniform, near-singular, boundary, printed]
     poses: 10                       # the first N poses of every set (all when omitted)
@@ -95,11 +95,11 @@ class OutsideSolver(Strict):
 
 class SuiteProblem(Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
-    problem_class: str = Field(alias="class", min_length=1, max_length=64)
+    #: Problems of one class are ranked together (no alias such as ``class``: a stored config
+    #: must dump to the same mapping it was read from).
+    problem_class: str = Field(min_length=1, max_length=64)
     mechanism: MechanismSpec
     objective: str | None = None
-
-    model_config = {**Strict.model_config, "populate_by_name": True}
 
 
 class QuickTier(Strict):
@@ -195,7 +195,7 @@ class SuiteConfig(Located):
             raise FkoptError(f"{where}: quick: missing; --quick needs a quick: block (fields: "
                              f"{', '.join(QuickTier.model_fields)})")
         q = self.quick
-        data = self.model_dump(mode="json", by_alias=True)
+        data = self.model_dump(mode="json")
         data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci")
         if q.problems:
             data["problems"] = [p for p in data["problems"] if p["name"] in q.problems]

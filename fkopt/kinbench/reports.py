@@ -168,7 +168,7 @@ def meta(sr) -> dict:
     c = sr.config
     manifest = sr.manifest or {}
     canonical = hashlib.sha256(json.dumps(manifest, sort_keys=True).encode()).hexdigest()
-    return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json", by_alias=True),
+    return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json"),
             "config_file": sr.source,
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
             "outside": {o.solver: digest(c, o) for o in c.outside},

@@ -144,7 +144,7 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     if source and config._folder is None:
         config._folder = Path(source).parent
     sets, manifest = load_pose_sets(config)
-    data = config.model_dump(mode="json", by_alias=True)
+    data = config.model_dump(mode="json")
     folder = str(config._folder) if config._folder is not None else ""
     payloads = [{"config": data, "folder": folder, "problem": p, "solver": s,
                  "cases": _cases(config, sets, problem)}
