@@ -258,6 +258,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
           jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (or LocalCluster workers)"),
           executor: str = typer.Option("local", "--executor", help="local | dask"),
           scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of a Dask scheduler"),
+          resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted run"),
           force: bool = typer.Option(False, "--force", help="replace a stored result of a different config"),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress")):
     """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files."""
@@ -273,7 +274,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
     prepare_output(cfg, out, force)
     with _progress(_console(), cfg.name, tasks, quiet) as progress:
         outcome = run_config(cfg, out, source=str(config), progress=progress, force=force, checked=True,
-                             jobs=jobs, executor=executor, scheduler=scheduler)
+                             jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
     if not quiet:
         _console().print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
 

@@ -351,3 +351,33 @@ def test_a_urdf_arm_joins_as_a_problem_with_pose_sets_of_its_own(tmp_path):
     runs = res.result.runs
     assert len(runs) == 3 and set(runs["set"]) == {"uniform", "near-singular", "boundary"}
     assert (runs["dim"] == 7).all() and (runs["evaluations"] <= 200 * 7).all()
+
+
+def test_an_interrupted_suite_resumes_with_the_same_bytes(tmp_path):
+    from fkopt.kinbench.kind import work_folder
+    path = tiny(tmp_path)
+    whole = run_config(load_any(path), tmp_path / "whole", source=str(path)).folder
+
+    class Stop(KeyboardInterrupt):
+        pass
+
+    def stop_after_two(label, done, total):
+        if done == 2:
+            raise Stop
+    out = tmp_path / "out"
+    with pytest.raises(Stop):
+        run_config(load_any(path), out, source=str(path), progress=stop_after_two)
+    work = work_folder(out, load_any(path))
+    assert len(list(work.glob("p*-s*.json"))) == 2 and not (out / "kinbench" / "tiny").exists()
+    seen = []
+    folder = run_config(load_any(path), out, source=str(path), resume=True,
+                        progress=lambda label, done, total: seen.append((done, total))).folder
+    assert seen == [(3, 4), (4, 4)]                 # only the two missing tasks were solved
+    for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+        assert (folder / name).read_bytes() == (whole / name).read_bytes(), name
+    assert not work.exists()
+    # tasks of another version of the suite are never mixed in
+    with pytest.raises(Stop):
+        run_config(load_any(path), out, source=str(path), progress=stop_after_two)
+    with pytest.raises(FkoptError, match="another version of the suite"):
+        run_config(load_any(tiny(tmp_path / "v2", runs=3)), out, source=str(path), resume=True, force=True)

@@ -1,6 +1,7 @@
 """Suites as a kind of the one config pipeline (:mod:`fkopt.experiment.kinds`)."""
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 from ..experiment.kinds import Kind, Outcome
@@ -13,11 +14,22 @@ def _validate(config: SuiteConfig) -> tuple[int, int]:
     return validate_suite(config)
 
 
+def work_folder(out, config: SuiteConfig) -> Path:
+    """Where an unfinished run keeps its task files: ``OUT/<paper>/.<name>.partial/`` (hidden:
+    never taken for a result)."""
+    paper, name = config.folder_parts
+    return Path(out) / paper / f".{name}.partial"
+
+
 def _run(config: SuiteConfig, out, *, source=None, progress=None, jobs: int = 1, executor: str = "local",
-         scheduler: str | None = None, **_) -> Outcome:
+         scheduler: str | None = None, resume: bool = False, **_) -> Outcome:
     from .runner import run_suite
-    result = run_suite(config, source=source, progress=progress, jobs=jobs, executor=executor, scheduler=scheduler)
-    return Outcome(write_result("suite", result, out), result.wall_s, result)
+    work = work_folder(out, config)
+    result = run_suite(config, source=source, progress=progress, jobs=jobs, executor=executor, scheduler=scheduler,
+                       work=work, resume=resume)
+    folder = write_result("suite", result, out)
+    shutil.rmtree(work, ignore_errors=True)
+    return Outcome(folder, result.wall_s, result)
 
 
 def _rerun_files(config: SuiteConfig, folder: Path, source: str | None) -> None:

@@ -16,7 +16,10 @@ read from the run's cumulative evaluation counts at the last iteration within ``
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +29,7 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..experiment.config import RunConfig
+from ..files import write_json_atomically
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..solve import chunk_size
 from .budget import at_budget, budget_of
@@ -137,25 +141,68 @@ def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> p
     return pd.DataFrame(cols)
 
 
+def fingerprint(config: SuiteConfig, manifest: dict) -> str:
+    """Hash of everything that changes a task's numbers: the config's result-changing fields and
+    the pose sets (a resumed suite must match it)."""
+    from ..experiment.config import numeric_fields
+    text = json.dumps([numeric_fields(config.model_dump(mode="json")), manifest], sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _task_file(work: Path, p: int, s: int) -> Path:
+    return work / f"p{p}-s{s}.json"
+
+
+def _finished_tasks(work: Path, fp: str) -> dict[tuple[int, int], dict]:
+    """Tasks an interrupted run of the same suite finished (unreadable files are redone)."""
+    out = {}
+    for path in sorted(work.glob("p*-s*.json")):
+        try:
+            rec = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if rec.get("fingerprint") != fp:
+            raise FkoptError(f"--resume: {path} belongs to another version of the suite (its config or pose "
+                             "sets changed); rerun without --resume to start over")
+        rec["rows"] = pd.DataFrame(rec["rows"])
+        out[(rec["problem"], rec["solver"])] = rec
+    return out
+
+
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
-              executor: str = "local", scheduler: str | None = None) -> SuiteResult:
+              executor: str = "local", scheduler: str | None = None, work: Path | None = None,
+              resume: bool = False) -> SuiteResult:
+    """Every (problem, solver) task, then the imported outside results. With ``work``, each
+    finished task is written there as it arrives (``p<i>-s<j>.json``), and ``resume=True`` keeps
+    the tasks an interrupted run of the same suite left there and computes only the others."""
     from ..study.executors import execute
     start = time.perf_counter()
     if source and config._folder is None:
         config._folder = Path(source).parent
     sets, manifest = load_pose_sets(config)
+    fp = fingerprint(config, manifest)
     data = config.model_dump(mode="json")
     folder = str(config._folder) if config._folder is not None else ""
+    if work is not None:
+        if not resume:
+            shutil.rmtree(work, ignore_errors=True)
+        work.mkdir(parents=True, exist_ok=True)
+    kept = _finished_tasks(work, fp) if work is not None and resume else {}
     payloads = [{"config": data, "folder": folder, "problem": p, "solver": s,
                  "cases": _cases(config, sets, problem)}
-                for p, problem in enumerate(config.problems) for s in range(len(config.solvers))]
-    done: list[dict] = []
+                for p, problem in enumerate(config.problems) for s in range(len(config.solvers))
+                if (p, s) not in kept]
+    done: list[dict] = list(kept.values())
+    total = len(done) + len(payloads)
 
     def collect(rec: dict) -> None:
+        if work is not None:
+            stored = {**rec, "fingerprint": fp, "rows": rec["rows"].to_dict(orient="list")}
+            write_json_atomically(_task_file(work, rec["problem"], rec["solver"]), stored)
         done.append(rec)
         if progress:
             progress(f"{config.problems[rec['problem']].name} / {config.solvers[rec['solver']].key}",
-                     len(done), len(payloads))
+                     len(done), total)
 
     execute(solve_task, payloads, executor=executor, jobs=jobs, scheduler=scheduler, on_result=collect)
     done.sort(key=lambda r: (r["problem"], r["solver"]))
