@@ -37,7 +37,7 @@ table { border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.9em; }
 th, td { border: 1px solid #ccc; padding: 0.2em 0.5em; text-align: right; }
 th { background: #eee; cursor: pointer; }
 th[data-dir=asc]::after { content: " \\25B2"; } th[data-dir=desc]::after { content: " \\25BC"; }
-td.t { text-align: left; } img { max-width: 100%; }
+td.t { text-align: left; white-space: nowrap; } img { max-width: 100%; }
 """
 
 
