@@ -357,6 +357,34 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
             con.print(f"resumed: {reused} finished task(s) reused, {len(result.computed)} computed")
 
 
+@app.command()
+def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite), e.g. configs/suites/kinbench.yaml"),
+          out: Path = typer.Option(Path("results"), "--out", help="results root; writes OUT/<paper>/<name>/"),
+          quick: bool = typer.Option(False, "--quick", help="run the file's quick: tier (<name>-quick)"),
+          jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (or LocalCluster workers)"),
+          executor: str = typer.Option("local", "--executor", help="local | dask"),
+          scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of a Dask scheduler"),
+          resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted run"),
+          force: bool = typer.Option(False, "--force", help="replace a stored result of a different config"),
+          quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress")):
+    """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files."""
+    from .experiment.kinds import load_any, prepare_output, run_config, validate_any
+    from .study.executors import validate_executor
+    cfg = load_any(config)
+    if getattr(cfg, "kind", None) != "suite":
+        raise FkoptError(f"{config}: not a suite file (kind: suite); run it with: fkopt run {config}")
+    if quick:
+        cfg = cfg.quick_tier(str(config))
+    validate_executor(executor, jobs, scheduler)
+    tasks = validate_any(cfg, str(config))
+    prepare_output(cfg, out, force)
+    with _progress(_console(), cfg.name, tasks, quiet) as progress:
+        outcome = run_config(cfg, out, source=str(config), progress=progress, force=force, checked=True,
+                             jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
+    if not quiet:
+        _console().print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
+
+
 SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",
          "success_rate": "success", "median_iterations_to_threshold": "med. it→thr",
          "mean_evaluations": "mean evals"}

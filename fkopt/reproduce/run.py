@@ -47,6 +47,8 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     output_folder(out)
     for f in files:
         config = load_any(f)
+        if getattr(config, "kind", None) == "suite":    # benchmark suites: fkopt suite / make bench-suite
+            continue
         tasks = validate_any(config, str(f))
         key = tuple(config.folder_parts)
         if key in seen:
