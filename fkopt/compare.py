@@ -83,7 +83,7 @@ SOLUTION_RTOL = 1e-3
 SUMMARY_RTOL = 1e-8
 
 KEY_COLS = ("case", "algorithm", "variable", "joint", "run", "iteration", "task_seed", "pose", "step",
-            "trajectory", "metric", "algorithm_a", "algorithm_b", "solution")
+            "trajectory", "metric", "algorithm_a", "algorithm_b", "solution", "problem", "set", "solver", "scope")
 #: runs.csv columns holding path counts, compared as distributions.
 COUNT_COLS = ("evaluations", "iterations_done", "iterations_to_best", "iterations_to_threshold",
               "evaluations_to_threshold")
@@ -93,7 +93,8 @@ OUTCOME_PREFIXES = ("x_", "start_", "pose_", "abs_error", "final_", "median", "m
                     "max_abs_error", "success", "q25", "q75", "min", "max", "position_error", "n_a", "n_b",
                     "U", "p_value", "p_holm", "significant", "better", "prob_a_lower", "evaluations", "solved",
                     "fraction", "pairs", "iterations_done", "iterations_to", "hits", "residual", "starts",
-                    "outside_bounds", "solutions_found")
+                    "outside_bounds", "solutions_found", "fitness", "evals_to", "score", "ci_", "rank", "ert",
+                    "auc", "time", "wall", "ms_", "solves")
 #: Files whose rows exist per path step (a rerun may have more or fewer for a path-dependent run).
 PATH_ROWS = ("trace.csv.gz", "ecdf.csv", "convergence.csv")
 #: Files of single runs or solutions, whose path-dependent outcomes :func:`compare_runs` compares.
@@ -154,7 +155,7 @@ def _row_label(row: pd.Series, keys: list[str], i: int) -> str:
 def _dependent_mask(df: pd.DataFrame, rules: Rules) -> np.ndarray:
     if rules.tier == ANY:
         return np.ones(len(df), dtype=bool)
-    cols = [c for c in ("algorithm", "algorithm_a", "algorithm_b") if c in df.columns]
+    cols = [c for c in ("algorithm", "solver", "algorithm_a", "algorithm_b") if c in df.columns]
     if not cols:                       # a file with no algorithm column: dependent if any algorithm is
         return np.full(len(df), bool(rules.path_dependent("")))
     out = np.zeros(len(df), dtype=bool)
@@ -264,7 +265,9 @@ def compare_runs(name: str, file: str, stored: pd.DataFrame, rerun: pd.DataFrame
     ``solutions.csv``): distributions per algorithm, reached counts, solution sets (module docstring)."""
     tests: list[tuple[str, str, float, object, object, str]] = []
     out: list[Mismatch] = []
-    if "algorithm" not in stored.columns:           # solutions.csv: one path-dependent search
+    algo_col = next((c for c in ("algorithm", "solver") if c in stored.columns), None)
+    fit_col = next((c for c in ("final_fitness", "fitness") if c in stored.columns), None)
+    if algo_col is None or fit_col is None:         # solutions.csv: one path-dependent search
         xs = [c for c in ("x", "y", "z", "alpha", "beta", "gamma") if c in stored.columns]
         if xs and rules.dependent(""):
             out += _solution_sets(name, file, "all", stored[xs].apply(pd.to_numeric).to_numpy(float),
@@ -274,21 +277,21 @@ def compare_runs(name: str, file: str, stored: pd.DataFrame, rerun: pd.DataFrame
                 tests.append(("all", "hits", _rank_test(a, b), np.median(a), np.median(b), "rank test"))
         return out + _judge(name, file, tests)
     group_of = "pose" if "pose" in stored.columns and "case" not in stored.columns else "case"
-    for algo in sorted(set(stored["algorithm"]) | set(rerun["algorithm"])):
+    for algo in sorted(set(stored[algo_col]) | set(rerun[algo_col])):
         if not rules.dependent(algo):
             continue
-        s, r = stored[stored["algorithm"] == algo], rerun[rerun["algorithm"] == algo]
+        s, r = stored[stored[algo_col] == algo], rerun[rerun[algo_col] == algo]
         if len(s) != len(r):
             out.append(Mismatch(name, file, algo, "runs", len(s), len(r), "same runs"))
             continue
-        fs, fr = _numbers(s["final_fitness"]), _numbers(r["final_fitness"])
+        fs, fr = _numbers(s[fit_col]), _numbers(r[fit_col])
         ks, kr = int(np.sum(fs <= rules.reach)), int(np.sum(fr <= rules.reach))
-        tests.append((algo, "final_fitness reached", _fisher(ks, len(fs), kr, len(fr)),
+        tests.append((algo, f"{fit_col} reached", _fisher(ks, len(fs), kr, len(fr)),
                       f"{ks}/{len(fs)} reached", f"{kr}/{len(fr)} reached", "Fisher's exact test"))
-        tests.append((algo, "final_fitness", _rank_test(np.maximum(fs, rules.reach), np.maximum(fr, rules.reach)),
+        tests.append((algo, fit_col, _rank_test(np.maximum(fs, rules.reach), np.maximum(fr, rules.reach)),
                       float(np.median(fs)), float(np.median(fr)),
                       f"rank test, values <= {rules.reach:g} reached (tied)"))
-        for col in COUNT_COLS:
+        for col in [*COUNT_COLS, *(c for c in s.columns if c.startswith("evals_to_"))]:
             if col in s.columns:
                 a, b = _numbers(s[col]), _numbers(r[col])
                 tests.append((algo, col, _rank_test(a, b), float(np.nanmedian(a)) if np.any(~np.isnan(a)) else None,

@@ -92,14 +92,15 @@ def rules_for(exp: Experiment, tier: str) -> Rules:
     fitness at which a run counts as reached (the config's threshold)."""
     from ..registry import algorithm_class, mechanism_class
     cfg = exp.config if isinstance(exp.config, dict) else {}
-    mech = cfg.get("mechanism") or {}
-    try:
-        mech_cls = mechanism_class(mech.get("name"))
-        mech_ok, isolated = bool(getattr(mech_cls, "blas_free_fitness", False)), mech_cls.kind == "parallel"
+    mechs = [p.get("mechanism") or {} for p in cfg.get("problems") or []] or [cfg.get("mechanism") or {}]
+    try:                # a suite has several problems: its rows are BLAS-free only if every fitness is
+        classes = [mechanism_class(m.get("name")) for m in mechs]
+        mech_ok = all(getattr(c, "blas_free_fitness", False) for c in classes)
+        isolated = all(c.kind == "parallel" for c in classes)
     except Exception:   # an unknown or unloadable mechanism: assume BLAS on its path
         mech_ok, isolated = False, False
     free = set()
-    for a in cfg.get("algorithms") or []:
+    for a in (cfg.get("algorithms") or []) + (cfg.get("solvers") or []):
         try:
             if mech_ok and getattr(algorithm_class(a.get("name")), "blas_free", False):
                 free.add(str(a.get("label") or a.get("name")))

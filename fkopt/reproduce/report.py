@@ -59,7 +59,26 @@ def _values_view(exp: Experiment) -> pd.DataFrame | None:
     return v.dropna(axis=1, how="all")
 
 
+def suite_section(exp: Experiment, root: Path) -> str:
+    """A benchmark suite (kinbench): its overall leaderboard, linked to its page and tables."""
+    rel = exp.folder.relative_to(root)
+    lines = [f"### {exp.title}", "",
+             f"Results: [`results/{rel}/`]({rel}/) · page: [`index.html`]({rel}/index.html) · "
+             f"leaderboards: [`leaderboard.md`]({rel}/leaderboard.md) · seed {exp.config.get('seed')}, "
+             f"{exp.config.get('runs')} runs per pose, {exp.config.get('budget_per_dim')} x dimension "
+             "evaluations ([docs/kinbench.md](../docs/kinbench.md)).", ""]
+    if exp.has("leaderboard.csv"):
+        board = exp.table("leaderboard")
+        overall = board[board["scope"] == "overall"] if "scope" in board.columns else board
+        cols = [c for c in ("rank", "solver", "track", "score", "ci_low", "ci_high", "better_than") if c in board.columns]
+        lines += ["Overall (tracks mixed, for reference; each track is ranked on its own in the leaderboard):", "",
+                  md_table(overall[cols].fillna("")), ""]
+    return "\n".join(lines)
+
+
 def experiment_section(exp: Experiment, root: Path) -> str:
+    if exp.meta.get("kind") == "suite":
+        return suite_section(exp, root)
     cfg = exp.config
     rel = exp.folder.relative_to(root)
     lines = [f"### {exp.title}", ""]
@@ -185,6 +204,8 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
 
 
 def index_rows_of(exp: Experiment) -> list[dict]:
+    if not exp.has("summary.csv"):     # a suite (kinbench): its leaderboard is its index
+        return []
     s = exp.table("summary")
     rows = []
     for (algo, method), grp in s.groupby(["algorithm", "method"], sort=False):
