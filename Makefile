@@ -4,7 +4,7 @@
 PYTHON ?= $(if $(wildcard .venv/bin/python),.venv/bin/python,python3)
 FKOPT = $(PYTHON) -m fkopt.cli
 
-.PHONY: install install-peers test reproduce reproduce-peers report check bench clean constraints
+.PHONY: install install-peers test reproduce reproduce-peers report check bench bench-suite clean constraints
 
 # constraints.txt pins every dependency at the version the stored results were made with.
 install:
@@ -33,6 +33,13 @@ reproduce:
 reproduce-peers:
 	$(FKOPT) reproduce --configs peers --out results/peers
 	$(PYTHON) -m fkopt.peers results/peers
+
+# kinbench (docs/kinbench.md): the full suite and its quick tier (which CI's check reruns) into
+# results/kinbench/, then the report. Not part of `make reproduce`.
+bench-suite:
+	$(FKOPT) suite configs/suites/kinbench.yaml --out results --force --jobs 2
+	$(FKOPT) suite configs/suites/kinbench.yaml --out results --force --quick
+	$(FKOPT) report results
 
 # Regenerate the report from stored results without rerunning.
 report:

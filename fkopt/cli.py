@@ -359,7 +359,8 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
 
 @app.command()
 def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite), e.g. configs/suites/kinbench.yaml"),
-          out: Path = typer.Option(Path("results"), "--out", help="results root; writes OUT/<paper>/<name>/"),
+          out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; writes OUT/<paper>/<name>/ "
+                                   "(the tracked results/ only when asked: make bench-suite)"),
           quick: bool = typer.Option(False, "--quick", help="run the file's quick: tier (<name>-quick)"),
           jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (or LocalCluster workers)"),
           executor: str = typer.Option("local", "--executor", help="local | dask"),
