@@ -4,11 +4,18 @@
 PYTHON ?= $(if $(wildcard .venv/bin/python),.venv/bin/python,python3)
 FKOPT = $(PYTHON) -m fkopt.cli
 
-.PHONY: install install-peers test reproduce reproduce-peers report check bench clean
+.PHONY: install install-peers test reproduce reproduce-peers report check bench bench-suite clean constraints
 
+# constraints.txt pins every dependency at the version the stored results were made with.
 install:
 	test -x .venv/bin/python || python3 -m venv .venv
-	.venv/bin/python -m pip install -e ".[test]"
+	.venv/bin/python -m pip install -e ".[test]" -c constraints.txt
+
+# Move the pins on purpose: upgrade .venv (e.g. pip install -U -e ".[test]"), regenerate results/
+# (make reproduce) with it, then record what it holds here, all in one commit.
+constraints:
+	{ echo "# Every library in the venv that made results/ (make constraints); pip install -c constraints.txt"; \
+	  $(PYTHON) -m pip freeze --exclude-editable | grep -v -i '^fkopt'; } > constraints.txt
 
 # The optional libraries of the peer configs (pymoo, NiaPy); scipy's adapters need nothing.
 install-peers:
@@ -26,6 +33,13 @@ reproduce:
 reproduce-peers:
 	$(FKOPT) reproduce --configs peers --out results/peers
 	$(PYTHON) -m fkopt.peers results/peers
+
+# kinbench (docs/kinbench.md): the full suite and its quick tier (which CI's check reruns) into
+# results/kinbench/, then the report. Not part of `make reproduce`.
+bench-suite:
+	$(FKOPT) suite configs/suites/kinbench.yaml --out results --force --jobs 2
+	$(FKOPT) suite configs/suites/kinbench.yaml --out results --force --quick
+	$(FKOPT) report results
 
 # Regenerate the report from stored results without rerunning.
 report:

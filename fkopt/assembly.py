@@ -10,7 +10,7 @@ many inputs as pose variables:
    u0 drawn from the seeded stream (:class:`fkopt.streams.RunStreams`), mapped to the unknowns.
    A low-discrepancy sequence reaches every region of the start space at a steady rate, so the
    rarest basins (a few hits per thousand starts) are found after a less variable number of
-   starts than with independent draws (README, Performance).
+   starts than with independent draws (measured in the commit that introduced it).
    For a 6-SPS platform a start is a rotation -- uniform on SO(3) (Shoemake's quaternions) when
    the angle bounds cover a full turn, else uniform Euler angles inside the bounds -- and the
    position that best satisfies, in least squares, the five *linear* equations obtained by
@@ -62,7 +62,7 @@ after every round.
 
 On Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``) all 40 real
 solutions are found on every seed tried, almost always within the first round of 2000 starts
-(counts and times: README, Performance, and ``fkopt bench``, section kinematics).
+(counts and times: ``bench/targets.csv`` and ``fkopt bench``, section kinematics).
 """
 from __future__ import annotations
 

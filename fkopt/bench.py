@@ -21,7 +21,10 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    1000 reachable poses batched and one at a time, beside roboticstoolbox-python's ``ik_LM``
    (run in the Python named by ``FKOPT_RTB_PYTHON``, or /work/venv-rtb, when installed); the
    whole ``fkopt fk`` process beside ``python -c "import numpy"``.
-4c. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
+4c. ``robots`` -- ``fkopt.inverse`` on the Panda, UR5 and Kinova of example-robot-data and the
+   wang7dof arm beside roboticstoolbox's ETS ``ik_LM`` on the same poses, timed alternately
+   (:mod:`fkopt.bench_robots`).
+4d. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
    600 iterations): wall time and ns per evaluation, beside the same GABC as a plain C loop
    (``fkopt/bench_ref/gabc_3rps.c``, compiled with the system's C compiler into a temporary
    folder and run on the same 100 cases; the row is skipped with a message when there is no
@@ -652,24 +655,30 @@ def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, 
     return curves
 
 
-def plot_scaling(curves, path: Path, iterations: int) -> None:
+def plot_scaling(curves, path: Path, iterations: int):
+    """Two panels (growing population, growing runs), each with two y-axes told apart by marker,
+    line style and label as well as colour: cost per evaluation (left, circles, solid) and wall
+    time (right, squares, dashed). Returns the figure."""
     from matplotlib.figure import Figure
-    fig = Figure(figsize=(10, 4))
-    for ax, key, xlabel in zip(fig.subplots(1, 2), ("population", "runs"),
-                               ("population (30 runs)", "runs (population 10)")):
+    fig = Figure(figsize=(10, 4.2))
+    for ax, key, xlabel, title in zip(fig.subplots(1, 2), ("population", "runs"),
+                                      ("population (30 runs)", "runs (population 10)"),
+                                      ("growing the population", "growing the number of runs")):
         pts = np.array(curves[key], dtype=float)
         if not len(pts):
             continue
-        ax.loglog(pts[:, 0], pts[:, 2], "o-", color="C0", label="ns per evaluation")
+        cost, = ax.loglog(pts[:, 0], pts[:, 2], "o-", color="C0", label="ns per evaluation (left axis)")
         ax.set_xlabel(xlabel)
-        ax.set_ylabel("ns per evaluation", color="C0")
+        ax.set_ylabel("ns per evaluation  (● solid)", color="C0")
         ax2 = ax.twinx()
-        ax2.loglog(pts[:, 0], pts[:, 1], "s--", color="C1", label="wall time")
-        ax2.set_ylabel("wall time (s)", color="C1")
-        ax.set_title(f"gabc on 3-RPS, {iterations} iterations")
+        wall, = ax2.loglog(pts[:, 0], pts[:, 1], "s--", color="C1", label="wall time, s (right axis)")
+        ax2.set_ylabel("wall time, s  (■ dashed)", color="C1")
+        ax.set_title(f"{title}: gabc on 3-RPS, {iterations} iterations", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
+        ax.legend(handles=[cost, wall], loc="upper center", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
+    return fig
 
 
 # -- entry point -----------------------------------------------------------------------------
@@ -694,7 +703,7 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
-SECTIONS = ("throughput", "mao2017", "peers", "exact", "kinematics", "cases", "scaling")
+SECTIONS = ("throughput", "mao2017", "peers", "exact", "kinematics", "robots", "cases", "scaling")
 
 
 def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
@@ -729,6 +738,9 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     if "kinematics" in want:
         bench_kinematics(rows, quick, np.random.default_rng(12), messages)
         bench_cli_process(rows, quick)
+    if "robots" in want:
+        from .bench_robots import bench_robots
+        bench_robots(rows, quick, messages)
     if "cases" in want:
         bench_cases(rows, quick, rng, messages)
     if "scaling" in want:

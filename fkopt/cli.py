@@ -18,7 +18,46 @@ from . import registry
 from .errors import FkoptError
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics.")
+                  help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics. "
+                       "Start with: fkopt run configs/mao2017/tab2_tab3_fig2.yaml (writes "
+                       "./fkopt-results/); the files and commands are described in README.md and docs/.")
+
+#: Where ``fkopt run`` and ``fkopt study`` write unless given ``--out``: a git-ignored folder of the
+#: current directory, so a user's own experiment never lands in the tracked ``results/`` (which
+#: ``fkopt reproduce`` and ``fkopt check`` use) without asking for it with ``--out results``.
+DEFAULT_OUT = Path("fkopt-results")
+
+
+def _flags_without_type_tag() -> None:
+    """typer (>= 0.2x) tags every option with its type in ``--help``, flags too (``--json <bool>``);
+    a flag takes no value, so its tag only misleads. Options with a value keep theirs."""
+    try:
+        from typer.core import TyperOption
+    except ImportError:           # an older typer has neither the tags nor this class
+        return
+    shown = getattr(TyperOption, "display_type_rich", None)
+    if shown is None or getattr(shown, "_fkopt", False):
+        return
+
+    def display_type_rich(self, ctx):
+        return None if getattr(self, "is_flag", False) else shown(self, ctx)
+    display_type_rich._fkopt = True
+    TyperOption.display_type_rich = display_type_rich
+
+
+def _version(value: bool) -> None:
+    if value:
+        from . import __version__
+        typer.echo(f"fkopt {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main_options(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                               help="print fkopt's version and exit")):
+    """Rerunnable swarm-optimisation experiments for robot mechanism kinematics."""
+
+_flags_without_type_tag()
 
 #: Algorithms tried in order for a single forward/inverse solve: the most reliable first.
 RELIABLE = ("gabc+lm", "lm", "gabc")
@@ -59,8 +98,22 @@ def load_geometry(path: Optional[Path]) -> dict:
 
 
 def _mechanism(name: str, geometry: Optional[Path]):
+    """Mechanism ``name`` with the overrides of a --geometry YAML file (its relative file paths,
+    e.g. a URDF's, taken from the YAML's folder), or, for ``urdf``, a .urdf file itself."""
     from . import mechanism
-    return mechanism(name, **load_geometry(geometry))
+    from .registry import mechanism_class, resolve_files
+    if geometry is not None and geometry.suffix.lower() == ".urdf":
+        try:
+            return mechanism(name, file=str(geometry))
+        except FkoptError as err:
+            if "name geometry." not in str(err):
+                raise
+            raise FkoptError(f"{err}: with a branching tree give --geometry a YAML file with "
+                             f"'file: {geometry.name}', 'base:' and 'tip:'") from None
+    values = load_geometry(geometry)
+    if geometry is not None:
+        values = resolve_files(mechanism_class(name), values, geometry.parent)
+    return mechanism(name, **values)
 
 
 def _default_algorithm() -> str:
@@ -71,34 +124,43 @@ def _default_algorithm() -> str:
 @app.command("list")
 def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show its geometry, bounds, "
                                                               "units, pose and joint names"),
-             as_json: bool = typer.Option(False, "--json", help="machine-readable output")):
+             geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry "
+                                                     "overrides (for urdf also the .urdf file itself)"),
+             as_json: bool = typer.Option(False, "--json", help="print one JSON object instead of "
+                                          "tables: {mechanisms, algorithms, origins}, or with MECH its "
+                                          "geometry, bounds, units and names")):
     """List the mechanisms and algorithms fkopt knows, and where each comes from."""
     if mech is not None:
-        return _list_mechanism(mech, as_json)
+        return _list_mechanism(mech, as_json, geometry)
+    if geometry is not None:
+        raise FkoptError("--geometry: name the mechanism it is for (fkopt list MECH --geometry FILE)")
     mechs, algos = registry.entries("mechanism"), registry.entries("algorithm")
     if as_json:
         typer.echo(json.dumps({"mechanisms": [e.name for e in mechs], "algorithms": [e.name for e in algos],
                                "origins": {"mechanisms": {e.name: e.origin for e in mechs},
                                            "algorithms": {e.name: e.origin for e in algos}}}))
         return
+    from rich import box
     from rich.markup import escape
     from rich.table import Table
-    table = Table(title="mechanisms (fkopt list MECH for geometry and bounds)")
+    # fits 80 columns: one line per unit group in a cell, borders only under the header
+    table = Table(title="mechanisms (fkopt list MECH for geometry and bounds)", box=box.SIMPLE_HEAD,
+                  pad_edge=False)
     for col in ("name", "kind", "pose", "joints", "paper", "from"):
-        table.add_column(col, no_wrap=True)
+        table.add_column(col, no_wrap=col in ("name", "kind"))
     for e in mechs:
         try:   # class attributes only: listing builds no mechanism (the URDF one reads a file)
             m = registry.mechanism_class(e.name)
         except FkoptError as err:
             table.add_row(e.name, "", "", "", "", escape(f"{e.origin}; error: {err}"))
             continue
-        mark = " (reconstruction)" if m.reconstruction else ""
-        table.add_row(e.name, m.kind, ", ".join(f"{n} \\[{u}]" for n, u in zip(m.pose_names, m.pose_units)),
-                      ", ".join(f"{n} \\[{u}]" for n, u in zip(m.joint_names, m.joint_units)),
-                      (m.paper or "") + mark, e.origin)
+        mark = "*" if m.reconstruction else ""
+        table.add_row(e.name, m.kind, escape(unit_groups(m.pose_names, m.pose_units)),
+                      escape(unit_groups(m.joint_names, m.joint_units)), (m.paper or "") + mark, escape(e.origin))
     con = _console()
-    _print_wide(con, table)     # one line per mechanism, even in a pipe
-    table = Table(title="algorithms")
+    con.print(table)
+    con.print("* a reconstruction: the paper does not print the whole model (docs/models.md)")
+    table = Table(title="algorithms", box=box.SIMPLE_HEAD, pad_edge=False)
     for col in ("name", "parameters (defaults)", "from"):
         table.add_column(col)
     for e in algos:
@@ -113,11 +175,35 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
         params = ", ".join(f"{k}={f.default!r}" for k, f in cls.Params.model_fields.items())
         table.add_row(e.name, escape(params), e.origin)
     con.print(table)
-    typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm (see README, Plug-ins).")
+    typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm\n"
+               "(see docs/plugins.md).")
 
 
-def _list_mechanism(name: str, as_json: bool) -> None:
-    m = registry.mechanism_class(name)()
+def unit_groups(names, units) -> str:
+    """Names with their units, one line per run of names sharing a unit, numbered names as a
+    range: ``x, y, z [m]`` / ``alpha, beta, gamma [deg]``, ``q1..q7 [deg]``."""
+    import re
+    groups: list[tuple[str, list[str]]] = []
+    for name, unit in zip(names, units):
+        if groups and groups[-1][0] == unit:
+            groups[-1][1].append(name)
+        else:
+            groups.append((unit, [name]))
+    parts = []
+    for unit, members in groups:
+        numbered = [re.fullmatch(r"([A-Za-z_]+)([0-9]+)", n) for n in members]
+        if len(members) > 2 and all(numbered) and len({m.group(1) for m in numbered}) == 1 \
+                and [int(m.group(2)) for m in numbered] == list(range(int(numbered[0].group(2)),
+                                                                      int(numbered[0].group(2)) + len(members))):
+            text = f"{members[0]}..{members[-1]}"
+        else:
+            text = ", ".join(members)
+        parts.append(f"{text} [{unit}]")
+    return "\n".join(parts)
+
+
+def _list_mechanism(name: str, as_json: bool, geometry: Optional[Path] = None) -> None:
+    m = _mechanism(name, geometry)
     d = m.describe()
     origin = next((e.origin for e in registry.entries("mechanism") if e.name == name), "direct reference")
     units = dict(zip(m.unknown_names, m.unknown_units))
@@ -141,6 +227,16 @@ def _list_mechanism(name: str, as_json: bool) -> None:
     for n, (lo, hi) in d["bounds"].items():
         bounds.add_row(n, f"{lo:g}", f"{hi:g}", units.get(n, ""))
     con.print(bounds)
+    if d.get("chain_joints"):                          # URDF: every moving joint as the file has it
+        chain = Table(title="chain joints (URDF units; a mimic joint follows its unknown: "
+                            "q = multiplier * unknown + offset)")
+        for col in ("joint", "type", "lower", "upper", "unit", "unknown", "multiplier", "offset"):
+            chain.add_column(col, justify="right" if col in ("lower", "upper", "multiplier", "offset") else "left")
+        for j in d["chain_joints"]:
+            lim = j["limits"] or ("-", "-")
+            chain.add_row(escape(j["name"]), j["type"], *(f"{v:g}" if v != "-" else v for v in lim), j["unit"],
+                          escape(j["unknown"]), f"{j['multiplier']:g}", f"{j['offset']:g}")
+        con.print(chain)
     geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)")
     for col in ("key", "value", "description"):
         geo.add_column(col)
@@ -153,12 +249,16 @@ def _list_mechanism(name: str, as_json: bool) -> None:
 
 @app.command()
 def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"),
-        out: Path = typer.Option(Path("results"), "--out", help="results root; each experiment "
-                                 "writes OUT/<paper>/<name>/"),
+        out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; each experiment writes "
+                                 "OUT/<paper>/<name>/ (paper 'experiments' when the file names none); "
+                                 "the tracked paper results are --out results"),
         force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
                                    "whose result-changing fields differ"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
-    """Run experiment files and write their tables and figures."""
+    """Run experiment files and write their tables and figures.
+
+    Every file is validated, and every output folder checked, before anything runs. The fields of
+    a file are listed in docs/config-reference.md (fkopt schema prints its JSON Schema)."""
     from .experiment.kinds import load_any, prepare_output, run_config, validate_any
 
     planned, folders = [], {}
@@ -217,7 +317,7 @@ def _print_outcome(con, outcome) -> None:
 
 @app.command()
 def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)"),
-          out: Path = typer.Option(Path("results"), "--out", help="results root; the study writes "
+          out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; the study writes "
                                    "OUT/<paper>/<name>/ (paper: studies unless the file says otherwise)"),
           jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (local) or LocalCluster "
                                    "workers (dask without --scheduler)"),
@@ -229,7 +329,13 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
           force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
                                      "whose result-changing fields differ"),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
-    """Run a workspace study: algorithms x poses x runs, statistics, tracking (see fkopt.study)."""
+    """Run a workspace study: algorithms x many poses x runs, with statistics.
+
+    A study file says kind: study and draws its poses (uniform, grid, waypoints, circle) instead
+    of listing cases. It writes success rates, evaluations to the threshold, an ECDF, heat maps
+    of 2-D grids and pairwise rank tests; mode: tracking solves trajectories step by step, each
+    step warm-started from the previous one. Fields: docs/config-reference.md (study);
+    examples: configs/studies/."""
     from .experiment.kinds import prepare_output, run_config, validate_any
     from .study.config import load_study
     from .study.executors import validate_executor
@@ -249,6 +355,35 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
         reused = tasks - len(result.computed)
         if reused:
             con.print(f"resumed: {reused} finished task(s) reused, {len(result.computed)} computed")
+
+
+@app.command()
+def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite), e.g. configs/suites/kinbench.yaml"),
+          out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; writes OUT/<paper>/<name>/ "
+                                   "(the tracked results/ only when asked: make bench-suite)"),
+          quick: bool = typer.Option(False, "--quick", help="run the file's quick: tier (<name>-quick)"),
+          jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (or LocalCluster workers)"),
+          executor: str = typer.Option("local", "--executor", help="local | dask"),
+          scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of a Dask scheduler"),
+          resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted run"),
+          force: bool = typer.Option(False, "--force", help="replace a stored result of a different config"),
+          quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress")):
+    """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files."""
+    from .experiment.kinds import load_any, prepare_output, run_config, validate_any
+    from .study.executors import validate_executor
+    cfg = load_any(config)
+    if getattr(cfg, "kind", None) != "suite":
+        raise FkoptError(f"{config}: not a suite file (kind: suite); run it with: fkopt run {config}")
+    if quick:
+        cfg = cfg.quick_tier(str(config))
+    validate_executor(executor, jobs, scheduler)
+    tasks = validate_any(cfg, str(config))
+    prepare_output(cfg, out, force)
+    with _progress(_console(), cfg.name, tasks, quiet) as progress:
+        outcome = run_config(cfg, out, source=str(config), progress=progress, force=force, checked=True,
+                             jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
+    if not quiet:
+        _console().print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
 
 
 SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",
@@ -297,15 +432,21 @@ def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
 @app.command()
 def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
-       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
+                                               "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered swarm/local solver for "
                                                "a serial arm instead of fkopt.inverse"),
-       seed: int = typer.Option(0, "--seed", min=0),
+       seed: int = typer.Option(0, "--seed", min=0, help="seed of the random starts (swarm, restarts)"),
+       start: Optional[str] = typer.Option(None, "--start", help="current joints of a serial arm, e.g. "
+                                           "q1=10,q2=0,...: the search begins there (fkopt.inverse)"),
+       mask: Optional[str] = typer.Option(None, "--mask", help="task components that count, names from "
+                                          "x,y,z,rx,ry,rz (e.g. x,y,z: position only; fkopt.inverse)"),
        position_tol: float = typer.Option(1e-6, "--position-tol", help="largest accepted position error "
                                           "(the arm's length unit)"),
        orientation_tol: float = typer.Option(1e-6, "--orientation-tol", help="largest accepted geodesic "
                                              "orientation error (radians)"),
-       as_json: bool = typer.Option(False, "--json")):
+       as_json: bool = typer.Option(False, "--json", help="print one JSON object: joints, position_error "
+                                    "(length unit of the arm), rotation_error_rad, solved, ...")):
     """Inverse kinematics: closed form for a parallel mechanism, fkopt.inverse for a serial arm.
 
     Exit 1 (one line on stderr) when the answer is not a solution within the tolerances; exit 2
@@ -319,11 +460,15 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
             box = ", ".join(f"{n} [{lo:g}, {hi:g}]" for n, (lo, hi) in zip(m.pose_names, m.bounds.tolist()))
             raise FkoptError(f"--pose: outside the workspace of {mech} ({box})")
         joints = m.ik(values)
-        _emit({"joints": dict(zip(m.joint_names, map(float, joints)))}, as_json, m.joint_units)
+        _emit({"joints": dict(zip(m.joint_names, map(float, joints))), "residual": 0.0, "solved": True,
+               "algorithm": "closed form"}, as_json, m.joint_units,
+              notes={"residual": "(closed form: exact up to rounding)"})
         return
     for name, value in (("--position-tol", position_tol), ("--orientation-tol", orientation_tol)):
         if not (np.isfinite(value) and value > 0):
             raise FkoptError(f"{name}: must be a positive number, got {value}")
+    if algorithm and (start or mask):
+        raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
     if algorithm:
         from . import problems, solve
         problem = problems.ik_problem(m, values, objective="geodesic")
@@ -336,29 +481,35 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
                "solved": bool(perr <= position_tol and rerr <= orientation_tol), "algorithm": algorithm}
     else:
         from .kinematics import inverse
-        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed)
+        q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
+        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed, start=q0, mask=mask)
         out = r.as_dict()
         out["algorithm"] = "inverse"
         perr, rerr = out["position_error"], out["rotation_error_rad"]
+    unit = m.pose_units[0]
     if not out["solved"]:
-        unit = m.pose_units[0]
         _not_solved(f"no joints within the limits reach this pose: best position error {perr:.3g} {unit}, "
                     f"orientation error {rerr:.3g} rad (tolerances {position_tol:g} {unit}, "
                     f"{orientation_tol:g} rad)", out, as_json, m.joint_units)
-    _emit(out, as_json, m.joint_units)
+    _emit(out, as_json, m.joint_units,
+          notes={"position_error": f"{unit} (residual: tool position |fk(q) - target|)",
+                 "rotation_error_rad": "rad (residual: geodesic orientation error)"})
 
 
 @app.command()
 def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        joints: str = typer.Option(..., "--joints", help="e.g. d1=598.85,d2=671.92,d3=629.16"),
-       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides"),
+       geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
+                                               "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered solver (e.g. gabc+lm) "
                                                "instead of fkopt.forward"),
-       seed: int = typer.Option(0, "--seed", min=0),
+       seed: int = typer.Option(0, "--seed", min=0, help="seed of the random starts (swarm, restarts)"),
        tolerance: float = typer.Option(1e-9, "--tolerance", help="largest residual max |ik(pose) - joints| "
                                        "(joint units) accepted as a solution"),
        all_solutions: bool = typer.Option(False, "--all-solutions", help="every distinct real solution in the bounds"),
-       as_json: bool = typer.Option(False, "--json")):
+       as_json: bool = typer.Option(False, "--json", help="print one JSON object: pose, residual (joint "
+                                    "units), solved, found_by (local newton | restarts | global search), "
+                                    "evaluations")):
     """Forward kinematics: fkopt.forward for a parallel mechanism, closed form for a serial arm.
 
     Exit 1 (one line on stderr) when no pose within the bounds reproduces the joints within
@@ -397,6 +548,7 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         from .kinematics import forward
         r = forward(m, values, tol=tolerance, seed=seed)
         out = r.as_dict()
+        out["found_by"] = FOUND_BY[out.pop("stage")]
         out["algorithm"] = "forward"
         x = r.pose
     rr = m.ik(x) - values
@@ -405,13 +557,22 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         _not_solved(f"no pose within the bounds reproduces these joints: best residual {out['residual']:.3g} "
                     f"(joint units; tolerance {tolerance:g}) at "
                     f"{', '.join(f'{n}={v:.6g}' for n, v in out['pose'].items())}", out, as_json, m.pose_units)
-    _emit(out, as_json, m.pose_units)
+    _emit(out, as_json, m.pose_units,
+          notes={"residual": "(max |ik(pose) - joints|, joint units)",
+                 "fitness": "(sum of squared joint residuals)"})
 
 
-def _emit(data: dict, as_json: bool, units) -> None:
+#: What ``fkopt.forward``'s ``stage`` means, as ``fkopt fk`` prints it (``found_by``).
+FOUND_BY = {0: "local newton", 1: "restarts", 2: "global search", -1: "none"}
+
+
+def _emit(data: dict, as_json: bool, units, notes: Optional[dict] = None) -> None:
+    """The answer on stdout: JSON, or one line per variable (with its unit), then one line per
+    other entry, followed by its unit or meaning from ``notes``."""
     if as_json:
         typer.echo(json.dumps(data))
         return
+    notes = notes or {}
     key = "joints" if "joints" in data else "pose"
     for (name, value), unit in zip(data[key].items(), units):
         typer.echo(f"{name:>8} = {value:.10g} {unit}")
@@ -419,7 +580,9 @@ def _emit(data: dict, as_json: bool, units) -> None:
         if isinstance(value, dict) and name != key:
             value = ", ".join(f"{k} {v}" for k, v in value.items())
         if name != key:
-            typer.echo(f"{name:>8}: {value:.6g}" if isinstance(value, float) else f"{name:>8}: {value}")
+            text = f"{value:.6g}" if isinstance(value, float) else f"{value}"
+            note = f" {notes[name]}" if name in notes else ""
+            typer.echo(f"{name:>8}: {text}{note}")
 
 
 @app.command("export")
@@ -431,7 +594,7 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
     if fmt not in FORMATS:
         raise FkoptError(f"--format: unknown format '{fmt}'; allowed: {', '.join(FORMATS)}")
     files = ioh_export(results, out)
-    typer.echo(f"wrote {len(files) - 1} IOHprofiler index files (.json) and their .dat files to {out}")
+    typer.echo(f"wrote {len(files)} IOHprofiler index files (.json) and their .dat files to {out}")
 
 
 @app.command()
@@ -440,8 +603,16 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
-                                            "throughput, mao2017, peers, exact, kinematics, scaling")):
-    """Measure fkopt's speed (and peers') on this machine."""
+                                            "throughput, mao2017, peers, exact, kinematics, robots, cases, "
+                                            "scaling (default: all but peers)")):
+    """Measure fkopt's speed (and peers') on this machine.
+
+    Sections: throughput (batched fitness evaluations per second), mao2017 (the paper's Tab. 3
+    budget), peers (NiaPy, MEALPY, pygmo, ... on the same fitness, if installed), exact (batched
+    lm), kinematics (fkopt.forward, fkopt.inverse, all assembly modes, the fk process),
+    robots (fkopt.inverse on URDF arms from example-robot-data beside roboticstoolbox's ETS
+    ik_LM, if installed), cases (N cases x 30 runs solved together, beside a compiled C loop when a C compiler is
+    there), scaling (population and runs; draws scaling.png)."""
     from .bench import SECTIONS, run as run_bench
     from .files import output_folder
     bad = [s for s in section if s not in SECTIONS]
@@ -459,17 +630,20 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                                                  "experiments' solves (default: the CPUs available; "
                                                  "1: all in this process); timings are measured "
                                                  "afterwards, one at a time"),
-              quiet: bool = typer.Option(False, "--quiet", "-q")):
+              quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress bars and no "
+                                         "closing table; errors are still printed")):
     """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
+    from .reproduce.changes import snapshot, write_changes
     from .reproduce.report import write_report
     from .reproduce.run import default_jobs, plan, run_all
 
     if jobs is not None and jobs < 1:
         raise FkoptError(f"--jobs: must be at least 1, got {jobs}")
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
+    before = snapshot(out)              # what the tree held, for CHANGES.md
     con = _console()
     start = time.perf_counter()
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
@@ -494,7 +668,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
                        jobs=default_jobs() if jobs is None else jobs, solving=solving)
-    paths = write_report(out)
+    paths = write_report(out) + [write_changes(out, before)]
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")
@@ -504,6 +678,17 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
             table.add_row(str(d.path), str(d.folder), str(d.files), f"{d.wall_s:.1f}")
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
+
+
+@app.command()
+def schema(kind: str = typer.Argument("experiment", help="experiment | study | assembly")):
+    """Print the JSON Schema of a kind of config file, for editors.
+
+    A YAML file whose first line is `# yaml-language-server: $schema=PATH` (PATH relative to the
+    file: the committed copies are docs/schema/<kind>.json) is validated and completed by editors
+    using yaml-language-server. Every field is described in docs/config-reference.md."""
+    from .config_reference import schema_text
+    typer.echo(schema_text(kind), nl=False)
 
 
 @app.command()
@@ -525,13 +710,24 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
           allow_plugins: bool = typer.Option(False, "--allow-plugins", help="import plug-ins the stored "
                                              "configs name as package.module:Class (only for results you "
                                              "trust; registered entry points need no flag)"),
-          quiet: bool = typer.Option(False, "--quiet", "-q")):
+          tolerant: bool = typer.Option(False, "--tolerant",
+                                        help="use the cross-platform rules even where the fingerprint "
+                                             "matches (same as --tier blas)"),
+          tier: str = typer.Option("auto", "--tier", help="auto (from each stored env.json) | exact | blas | any"),
+          quiet: bool = typer.Option(False, "--quiet", "-q", help="print only drift and errors, not one "
+                                     "line per experiment")):
     """Rerun stored results from their recorded config; exit 1 if anything drifted.
 
-    Exact when the platform fingerprint in env.json matches this machine, by documented
-    tolerances otherwise (fkopt.compare); a missing or unreadable meta.json is a failure.
+    Byte for byte where the platform fingerprint in env.json matches this machine; elsewhere
+    rows no BLAS call touched stay exact and the rest follow the cross-platform rules of
+    fkopt.compare (docs/regression.md). A missing or unreadable meta.json is a failure.
     """
-    from .reproduce.check import check_experiment, select
+    from .reproduce.check import check_experiment, select, stored_tier
+    if tier not in ("auto", "exact", "blas", "any"):
+        raise FkoptError(f"--tier: '{tier}' unknown; allowed: auto, exact, blas, any")
+    if tolerant and tier not in ("auto", "blas"):
+        raise FkoptError(f"--tolerant is --tier blas; it cannot be combined with --tier {tier}")
+    forced = "blas" if tolerant else (None if tier == "auto" else tier)
     from .reproduce.store import locate
     if subset not in ("all", "ci"):
         raise FkoptError(f"--subset: '{subset}' unknown; allowed: all, ci")
@@ -549,10 +745,11 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
         raise FkoptError(f"{results}: no stored results (folders with meta.json) to check")
     failures = []
     for e in exps:
-        bad = check_experiment(e, allow_plugins=allow_plugins)
+        used = forced or stored_tier(e)
+        bad = check_experiment(e, tier=used, allow_plugins=allow_plugins)
         failures += bad
         if not quiet:
-            typer.echo(f"{'ok  ' if not bad else 'FAIL'} {e.paper}/{e.name}")
+            typer.echo(f"{'ok  ' if not bad else 'FAIL'} {e.paper}/{e.name} ({used} rules)")
     if failures:
         for m in failures[:20]:
             typer.echo(f"drift: {m}", err=True)
@@ -562,6 +759,19 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
     if not quiet:
         typer.echo(f"{len(exps)} experiments match their stored results")
 
+
+def _reflowed_help() -> None:
+    """typer's rich help keeps the line breaks of a docstring's later paragraphs, so a paragraph
+    wrapped at 100 source columns broke mid-sentence in an 80-column terminal: each command's help
+    is its docstring with every paragraph on one line, for the terminal to wrap."""
+    import inspect
+    for info in app.registered_commands:
+        if info.help is None and info.callback is not None and info.callback.__doc__:
+            paragraphs = inspect.cleandoc(info.callback.__doc__).split("\n\n")
+            info.help = "\n\n".join(" ".join(p.split()) for p in paragraphs)
+
+
+_reflowed_help()
 
 #: Commands that may skip typer's parsing (see :func:`_direct`).
 DIRECT = {"fk": "fk", "ik": "ik", "list": "list_cmd"}
@@ -646,6 +856,8 @@ def main() -> None:
         print(f"fkopt: error: {one_line(message)}", file=sys.stderr)
         sys.exit(2)
 
+    if not sys.argv[1:]:     # bare `fkopt`: the help, and success (nothing went wrong)
+        sys.argv.append("--help")
     try:
         direct = _direct(sys.argv[1:])
         if direct is not None:
@@ -670,6 +882,8 @@ def main() -> None:
         kind = type(err).__name__
         if kind == "Exit":
             sys.exit(getattr(err, "exit_code", 0))
+        if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
+            fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
         if kind == "Abort":
             print("fkopt: interrupted", file=sys.stderr)
             sys.exit(130)

@@ -21,9 +21,14 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
 
 **inverse(arm, poses[..., 6])** -- joints whose end-effector pose is ``poses`` (x, y, z in the
 arm's length unit, Z-Y-Z Euler angles in degrees as :meth:`DHArm.fk` prints them), every joint
-inside its limits. A bounded damped least-squares method on the 6 residuals
-(position error, L * rotation vector of R R_t^T with L = ``orientation_scale`` length units per
-radian, default the arm's reach; the geodesic orientation error, no Euler differences):
+inside its limits, for any frame arm (DH tables and URDF chains alike: the solver uses the arm's
+frame, frame Jacobian and periodic joints only). Internally angles are in radians and lengths
+(prismatic joints) in the arm's unit; continuous (periodic) joints are not saturated and the
+answer is wrapped into [-180, 180). ``mask`` selects task components (position only, ...);
+``start`` as the current joints gives the locally nearest solution (see :func:`inverse`).
+A bounded damped least-squares method on the 6 residuals (position error, L * rotation vector
+of R R_t^T with L = ``orientation_scale`` length units per radian, default the arm's reach; the
+geodesic orientation error, no Euler differences):
 
 * step d = J^T (J J^T + mu I)^{-1} (-r) (minimum-norm damped least squares for a redundant
   arm), mu = lambda * trace(J J^T) / 6 with lambda adapted per candidate as in
@@ -50,7 +55,7 @@ radian, default the arm's reach; the geodesic orientation error, no Euler differ
   inside the limits from a counter-based hash of (seed, row index, draw number). Measured on
   1000 random reachable poses: about 80 % of nearest-configuration starts converge against
   about 60 % of mid-range or random ones, which is why the hardest rows of a batch try 32 table
-  neighbours before the random draws (README, Performance);
+  neighbours before the random draws (measured in the commit that chose it; docs/performance.md);
 * one pose (N = 1, ``rest`` = 0, no ``exact_rotation``) runs the same iteration on Python
   floats (the arm's ``frame_jacobian1``, Cholesky solves of the 6x6 systems), its candidates
   one after another in the order of its starts, stopping at the first that converges: numpy's
@@ -90,7 +95,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from operator import mul
 
 import numpy as np
 
@@ -410,37 +414,6 @@ def _solve_small(A, b):
     return x
 
 
-def _cholesky_solve(A, b):
-    """x with A x = b for a small symmetric positive definite A on Python floats (Cholesky;
-    lists are not modified). None when A is not positive definite or x not finite."""
-    n = len(b)
-    Lc = [[0.0] * n for _ in range(n)]
-    for i in range(n):
-        Li = Lc[i]
-        Ai = A[i]
-        for j in range(i + 1):
-            Lj = Lc[j]
-            acc = Ai[j] - sum(map(mul, Li[:j], Lj[:j]))
-            if i == j:
-                if not acc > 0.0:
-                    return None
-                Li[i] = math.sqrt(acc)
-            else:
-                Li[j] = acc / Lj[j]
-    y = [0.0] * n
-    for i in range(n):
-        y[i] = (b[i] - sum(map(mul, Lc[i][:i], y[:i]))) / Lc[i][i]
-    x = [0.0] * n
-    for i in range(n - 1, -1, -1):
-        acc = y[i]
-        for k in range(i + 1, n):
-            acc -= Lc[k][i] * x[k]
-        x[i] = acc / Lc[i][i]
-    if not all(map(math.isfinite, x)):
-        return None
-    return x
-
-
 def _newton_scalar(m, x, L, ftol, evals, iterations: int = 30, halvings: int = 10):
     """:func:`_newton1` on Python floats with the mechanism's ``ik_jacobian1`` (one pose, no
     angle joints): the same iteration (Newton step capped at a quarter of the box width,
@@ -607,6 +580,24 @@ def _zyz_matrix(euler_deg: np.ndarray) -> np.ndarray:
     return R
 
 
+def _solved1(p, R, pt, Rt, W, tol) -> bool:
+    """Whether frame (p, R) on floats is within tol of target (pt, Rt), task mask W (or None)."""
+    dp = [a - b for a, b in zip(p, pt)]
+    e = _rotation_error1(R, Rt)
+    if W is not None:
+        dp, e = [v * w for v, w in zip(dp, W[:3])], [v * w for v, w in zip(e, W[3:])]
+    return math.hypot(*dp) <= tol[0] and math.hypot(*e) <= tol[1]
+
+
+def _zyz_matrix1(a: float, b: float, g: float) -> list[list[float]]:
+    """:func:`_zyz_matrix` of one triple of Euler angles (deg) on Python floats (the same formulas)."""
+    a, b, g = math.radians(a), math.radians(b), math.radians(g)
+    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+    return [[ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb],
+            [sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb],
+            [-sb * cg, sb * sg, cb]]
+
+
 def _rotation_error(R: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     """Rotation vector (k, 3) of R Rt^T (base frame), angle in [0, pi] radians."""
     M = R @ np.swapaxes(Rt, -1, -2)
@@ -616,6 +607,18 @@ def _rotation_error(R: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     angle = np.arctan2(s, c)
     k = np.where(s > 1e-12, angle / np.where(s > 1e-12, 2.0 * s, 1.0), 0.5)
     return v * k[:, None]
+
+
+def _internal(m, q):
+    """Public joint values (deg, length unit) -> inverse's internal units (rad, length unit)."""
+    a = m.angle_mask(m.joint_units)
+    return np.where(a, np.radians(q), q) if not a.all() else np.radians(q)
+
+
+def _public(m, u):
+    """Inverse's internal units (rad, length unit) -> public joint values (deg, length unit)."""
+    a = m.angle_mask(m.joint_units)
+    return np.where(a, np.degrees(u), u) if not a.all() else np.degrees(u)
 
 
 _M64 = np.uint64(0xFFFFFFFFFFFFFFFF)
@@ -637,21 +640,75 @@ def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.nd
 
 def _rotation_error1(R, T):
     """:func:`_rotation_error` of one pair of rotations given as 3 rows of 3 floats."""
-    M = [[R[i][0] * T[j][0] + R[i][1] * T[j][1] + R[i][2] * T[j][2] for j in range(3)] for i in range(3)]
-    v0, v1, v2 = M[2][1] - M[1][2], M[0][2] - M[2][0], M[1][0] - M[0][1]
+    # M = R T^T entry by entry (written out: this runs once per iteration of a one-pose inverse)
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
+    (t00, t01, t02), (t10, t11, t12), (t20, t21, t22) = T
+    v0 = (r20 * t10 + r21 * t11 + r22 * t12) - (r10 * t20 + r11 * t21 + r12 * t22)
+    v1 = (r00 * t20 + r01 * t21 + r02 * t22) - (r20 * t00 + r21 * t01 + r22 * t02)
+    v2 = (r10 * t00 + r11 * t01 + r12 * t02) - (r00 * t10 + r01 * t11 + r02 * t12)
     s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-    c = 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)
+    c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
+               + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
     k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
     return v0 * k, v1 * k, v2 * k
 
 
+_DLS: dict = {}
+
+
+def _dls_function(n: int):
+    """``dls(J, r, mu) -> d`` for a 6 x n Jacobian on Python floats: d = J^T (J J^T + mu I)^{-1} (-r)
+    by Cholesky, or None when J J^T + mu I is not positive definite or d not finite; and
+    ``trace6(J)`` = sum of J's squared entries / 6. Written out once per n (straight-line source,
+    as ``namedtuple`` builds its class) with the additions in the order of the loops it replaced
+    (dot products summed left to right from 0; Cholesky L row by row, then forward and back
+    substitution), so the answers are those loops' to the bit; a one-pose inverse spends most of
+    its time here and in the arm's ``frame_jacobian1``."""
+    got = _DLS.get(n)
+    if got is not None:
+        return got
+    R = range(6)
+    src = ["def dls(J, r, mu):", "    " + ", ".join(f"J{a}" for a in R) + " = J",
+           *(f"    " + ", ".join(f"J{a}_{i}" for i in range(n)) + f", = J{a}" for a in R),
+           "    " + ", ".join(f"b{a}" for a in R) + " = " + ", ".join(f"-r[{a}]" for a in R)]
+    dot = lambda a, b: " + ".join(f"J{a}_{i} * J{b}_{i}" for i in range(n))   # noqa: E731
+    for a in R:
+        for b in range(a, 6):
+            src.append(f"    A{a}{b} = {dot(a, b)}" + (" + mu" if a == b else ""))
+    for i in R:                                        # Cholesky, row by row
+        for j in range(i + 1):
+            prev = " + ".join(f"L{i}{k} * L{j}{k}" for k in range(j))
+            acc = f"A{j}{i} - ({prev})" if prev else f"A{j}{i} - 0"
+            if i == j:
+                src += [f"    acc = {acc}", "    if not acc > 0.0:", "        return None",
+                        f"    L{i}{i} = sqrt(acc)"]
+            else:
+                src.append(f"    L{i}{j} = ({acc}) / L{j}{j}")
+    for i in R:
+        prev = " + ".join(f"L{i}{k} * y{k}" for k in range(i))
+        src.append(f"    y{i} = (b{i} - ({prev or 0})) / L{i}{i}")
+    for i in reversed(R):
+        acc = f"y{i}" + "".join(f" - L{k}{i} * x{k}" for k in range(i + 1, 6))
+        src.append(f"    x{i} = ({acc}) / L{i}{i}")
+    src.append("    if not (" + " and ".join(f"isfinite(x{a})" for a in R) + "):")
+    src.append("        return None")
+    src.append("    return [" + ", ".join(" + ".join(f"J{a}_{i} * x{a}" for a in R) for i in range(n)) + "]")
+    src.append("def trace6(J):")
+    src.append("    return (" + " + ".join(f"J[{a}][{i}] * J[{a}][{i}]" for a in R for i in range(n)) + ") / 6.0")
+    scope = {"sqrt": math.sqrt, "isfinite": math.isfinite}
+    exec(compile("\n".join(src), f"<fkopt.kinematics dls n={n}>", "exec"), scope)
+    got = _DLS[n] = (scope["dls"], scope["trace6"])
+    return got
+
+
 def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping, down, up,
-                    step_cap, lo, hi):
+                    step_cap, lo, hi, W=None):
     """The damped least-squares iteration of :func:`inverse` for one pose on Python floats
     (the arm's ``frame_jacobian1``, 6x6 eliminations), candidates one after another in the
     order of ``start_of(j)``: the same step, damping update, saturation in the null space and
     restart rule as the batched loop. For one pose numpy's per-call overhead is most of the
-    cost of the batched loop. Returns (best joints (n,) radians, starts used, evaluations)."""
+    cost of the batched loop. ``W``: the task mask of :func:`inverse` (6 floats 0/1) or None.
+    Returns (best joints (n,) radians, starts used, evaluations)."""
     n = m.dof
     fj = m.frame_jacobian1
     t0, t1, t2 = (float(v) for v in pt)
@@ -663,27 +720,23 @@ def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping,
         p, R, J = fj(q)
         e0, e1, e2 = _rotation_error1(R, T)
         d0, d1, d2 = p[0] - t0, p[1] - t1, p[2] - t2
+        if W is not None:                              # masked task: those rows do not count
+            d0, d1, d2, e0, e1, e2 = d0 * W[0], d1 * W[1], d2 * W[2], e0 * W[3], e1 * W[4], e2 * W[5]
+            J = [[v * w for v in row] for row, w in zip(J, W)]
         r = [d0, d1, d2, L * e0, L * e1, L * e2]
-        for row in J[3:]:
-            for i in range(n):
-                row[i] *= L
+        J[3] = [v * L for v in J[3]]
+        J[4] = [v * L for v in J[4]]
+        J[5] = [v * L for v in J[5]]
         return (r, J, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
                 d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
+
+    dls0, trace6 = _dls_function(n)
 
     def dls(J, r, mu, fixed=None):
         """d = Jf^T (Jf Jf^T + mu I)^{-1} (-r), Jf = J without the columns in ``fixed``."""
         if fixed:
             J = [[0.0 if i in fixed else v for i, v in enumerate(row)] for row in J]
-        A = [[0.0] * 6 for _ in range(6)]
-        for a in range(6):
-            Ja = J[a]
-            for b in range(a, 6):
-                A[a][b] = A[b][a] = sum(map(mul, Ja, J[b]))
-            A[a][a] += mu
-        y = _cholesky_solve(A, [-v for v in r])
-        if y is None:
-            return None
-        return [sum(map(mul, col, y)) for col in zip(*J)]
+        return dls0(J, r, mu)
 
     best_q, best_m = None, math.inf
     allc = list(range(n))
@@ -695,7 +748,7 @@ def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping,
         for _ in range(iterations):
             if pe <= tp and re <= tr:
                 break
-            tr6 = sum(v * v for row in J for v in row) / 6.0
+            tr6 = trace6(J)
             mu = lam * tr6
             d = dls(J, r, mu)
             if d is None:
@@ -744,21 +797,30 @@ def _start_table(m, size: int):
     hash (independent of ``seed``) and their tool features (position, w * rotation matrix
     entries; w = reach / (3 sqrt 2), so 1 rad of rotation weighs about reach / 3): ``inverse``
     starts from the configurations nearest to each target. Cached per arm (name, DH table,
-    limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`)."""
-    base = m.__dict__.get("_start_table_key")
-    if base is None:                                 # the DH table's numbers (no pydantic model needed)
-        base = m.__dict__["_start_table_key"] = (m.name, m._a, m._d, m._ca, m._sa, m._offset, m.bounds.tobytes())
-    key = base + (size,)
+    limits) as a dict with "q", "features", "w" (and "tree", see :func:`_nearest`). The arm's
+    own forward map (``frame``) makes it, so it serves DH and URDF arms alike."""
+    key = m.kinematic_key() + (m.bounds.tobytes(), size)
     got = _TABLES.get(key)
     if got is None:
         from .rotations import to_array
-        lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+        lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
         tq = lo + (hi - lo) * _uniform_hash(0x5EED, np.arange(size), np.zeros(size, dtype=np.int64), m.dof)
-        p, R = m.frame(np.degrees(tq))
+        p, R = m.frame(_public(m, tq))
         wf = m.reach / (3.0 * np.sqrt(2.0))
         feats = np.concatenate([np.stack(p, axis=-1), wf * to_array(R).reshape(size, 9)], axis=-1)
         got = _TABLES[key] = {"q": tq, "features": feats, "w": wf}
     return got
+
+
+def _masked_table(tab: dict, W: np.ndarray) -> dict:
+    """The start table compared on the selected task components: masked position features,
+    and the rotation features only when all three rotation components count (a rotation
+    matrix entry is not one rotation-vector axis). Cached beside the table."""
+    fmask = np.concatenate([W[:3], np.full(9, float(W[3:].all()))])
+    key = ("masked", fmask.tobytes())
+    if key not in tab:
+        tab[key] = {"q": tab["q"], "features": tab["features"] * fmask, "w": tab["w"], "mask": fmask}
+    return tab[key]
 
 
 #: Batches from this many rows query the start table through scipy's k-d tree (importing
@@ -786,17 +848,205 @@ def _nearest(table: dict, feats: np.ndarray, k: int) -> np.ndarray:
     return out
 
 
-def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts: int = 200,
+#: Names of the six task components ``mask`` selects, in order.
+TASK = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def _task_mask(mask) -> np.ndarray | None:
+    """``mask`` as a (6,) array of 0/1 over (x, y, z, rx, ry, rz), or None for the full pose."""
+    if mask is None:
+        return None
+    if isinstance(mask, str):
+        mask = [name in {t.strip() for t in mask.split(",")} for name in TASK] \
+            if all(t.strip() in TASK for t in mask.split(",")) else mask
+    try:
+        W = np.asarray(mask, dtype=float)
+    except (TypeError, ValueError):
+        W = None
+    if W is None or W.shape != (6,) or not np.isin(W, (0.0, 1.0)).all() or not W.any():
+        raise FkoptError(f"inverse mask: expected 6 flags 0/1 over ({', '.join(TASK)}) with at least one "
+                         f"set, or names like 'x,y,z'; got {mask!r}")
+    return None if W.all() else W
+
+
+def _toward_start(m, q, q0, pt, Rt, L, W, tol, slo, shi, periodic, rounds: int = 30):
+    """Rows q (k, n) of solved joints (internal units) moved along the arm's self-motion towards
+    the starts q0 (k, n), staying solved: each round a null-space step dz = (I - J^+ J)(q0 - q)
+    (J^+ = J^T (J J^T + eps I)^{-1}, the task rows of ``W`` only) clipped into the limits, then up
+    to 3 damped least-squares corrections of the task; a row takes the round only if it is still
+    within ``tol`` and nearer to its start (Euclidean in rad and length units; periodic joints by
+    their angle difference wrapped into [-pi, pi)). A redundant arm (or a masked task) thus
+    returns the solution locally nearest to the current joints; a 6-joint arm with a full pose has
+    no self-motion and keeps its answer. Returns (q, Jacobian evaluations per row)."""
+    k, n = q.shape
+    to_pub = _public(m, np.ones(n))
+    Wr = np.ones(6) if W is None else np.asarray(W, dtype=float)
+    evals = np.zeros(k, dtype=np.int64)
+
+    def gap(a):
+        g = q0 - a
+        if periodic.any():
+            g[:, periodic] = (g[:, periodic] + np.pi) % (2 * np.pi) - np.pi
+        return g
+
+    def task(a):
+        p, R, J = m.frame_jacobian(a * to_pub)
+        e = _rotation_error(R, Rt)
+        J = J * to_pub * Wr[:, None]
+        J[:, 3:] *= L
+        dp, e = (p - pt) * Wr[:3], e * Wr[3:]
+        return np.concatenate([dp, L * e], axis=-1), J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
+
+    act = np.arange(k)
+    dist = np.sqrt(_sumsq(gap(q)))
+    for _ in range(rounds):
+        if not len(act):
+            break
+        qa = q[act]
+        r, J, _, _ = task(qa)
+        evals[act] += 1
+        Jt = np.swapaxes(J, 1, 2)
+        A = J @ Jt
+        A[:, _I6, _I6] += 1e-9 * np.trace(A, axis1=1, axis2=2)[:, None] + 1e-300
+        g = gap(qa)
+        dz = g - (Jt @ np.linalg.solve(A, (J @ g[..., None])))[..., 0]
+        qn = np.clip(qa + dz, slo, shi)
+        for _ in range(3):                             # back onto the task
+            r, J, pe, re = task(qn)
+            evals[act] += 1
+            if ((pe <= tol[0]) & (re <= tol[1])).all():
+                break
+            Jt = np.swapaxes(J, 1, 2)
+            A = J @ Jt
+            A[:, _I6, _I6] += 1e-9 * np.trace(A, axis1=1, axis2=2)[:, None] + 1e-300
+            qn = np.clip(qn - (Jt @ np.linalg.solve(A, r[..., None]))[..., 0], slo, shi)
+        else:
+            r, J, pe, re = task(qn)
+            evals[act] += 1
+        dn = np.sqrt(_sumsq(gap(qn)))
+        ok = (pe <= tol[0]) & (re <= tol[1]) & (dn < dist[act] - 1e-12)
+        q[act[ok]], dist[act[ok]] = qn[ok], dn[ok]
+        act = act[ok & (dn < dist[act] * (1 - 1e-6))] if ok.any() else act[:0]
+    return q, evals
+
+
+def _arm_constants(m) -> dict:
+    """Per-arm values of a one-pose :func:`inverse` as Python floats, cached on the arm (keyed by
+    its bounds, which a user may change): internal-unit limits, saturation limits (none for
+    periodic joints), the periodic mask and the unit factors."""
+    key = m.bounds.tobytes()
+    got = m.__dict__.get("_inverse_constants")
+    if got is None or got["key"] != key:
+        lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
+        per = m.periodic_mask()
+        got = m.__dict__["_inverse_constants"] = {
+            "key": key, "lo": lo, "hi": hi, "slo": np.where(per, -np.inf, lo), "shi": np.where(per, np.inf, hi),
+            "periodic": per.tolist(), "blo": m.bounds[:, 0].tolist(), "bhi": m.bounds[:, 1].tolist(),
+            "angle": m.angle_mask(m.joint_units).tolist(), "mid": (0.5 * (lo + hi)).tolist()}
+    return got
+
+
+def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
+                 down, up, step_cap, W=None) -> InverseResult:
+    """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
+    Python floats (:func:`_inverse_scalar`), the same starts in the same order (``start``, then
+    the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
+    first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
+    batch's bookkeeping costs more than the iteration itself for a single pose."""
+    tp, tr = tol
+    n = m.dof
+    c = _arm_constants(m)
+    x, y, z = (float(v) for v in pose[:3])
+    reach = m.reach
+    dist = math.sqrt(x * x + y * y + z * z)
+    if dist > reach * (1.0 + 1e-12):
+        unit = m.pose_units[0]
+        raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
+                         f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
+    lo, hi = c["lo"], c["hi"]
+    blo, bhi, angle = c["blo"], c["bhi"], c["angle"]
+    own0 = 1 if (start is not None or not table) else 0
+    if start is None:
+        q0 = c["mid"]
+    else:
+        s = _values(m, start, m.joint_names, "start")
+        if s.size != n:
+            raise FkoptError(f"{m.name} start: one pose takes one start ({n},), got shape {s.shape}")
+        sl = s.reshape(n).tolist()
+        if not all(a - 1e-9 <= v <= b + 1e-9 for v, a, b in zip(sl, blo, bhi)):
+            box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
+            raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
+        q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
+    L = float(orientation_scale) if orientation_scale else reach
+    Rt = _zyz_matrix1(*pose[3:].tolist())
+    near: list[int] = []
+    nn = min(table, kn) if table else 0
+
+    def start_of(j):
+        if j < own0:
+            return q0
+        if j < own0 + nn:
+            if not near:
+                tab = _start_table(m, table)
+                f = np.concatenate([pose[:3], tab["w"] * np.array(Rt).reshape(9)])
+                if W is not None:                      # nearest in the selected components only
+                    tab = _masked_table(tab, W)
+                    f = f * tab["mask"]
+                near.extend(_nearest(tab, f[None], nn)[0].tolist())
+                near.append(tab)
+            return near[-1]["q"][near[j - own0]].tolist()
+        return (lo + (hi - lo) * _uniform_hash(seed, np.zeros(1, dtype=np.intp),
+                                               np.array([j - own0 - nn]), n)[0]).tolist()
+
+    bq, used, ne = _inverse_scalar(m, pose[:3], Rt, L, start_of, budget, tp, tr, iterations,
+                                   damping, down, up, step_cap, c["slo"], c["shi"],
+                                   None if W is None else W.tolist())
+    if start is not None and (n > 6 or W is not None):   # self-motion towards the start
+        p1, R1, _ = m.frame_jacobian1(bq.tolist())
+        if _solved1(p1, R1, (x, y, z), Rt, W, tol):
+            q1, extra = _toward_start(m, bq[None].copy(), np.array([q0]), np.array([[x, y, z]]), np.array([Rt]),
+                                      L, W, tol, c["slo"], c["shi"], np.array(c["periodic"]))
+            bq, ne = q1[0], ne + int(extra[0])
+    # public units; continuous joints wrapped into [-180, 180); clipped into the limits
+    qd = [math.degrees(v) if a else v for v, a in zip(bq.tolist(), angle)]
+    qd = [(v + 180.0) % 360.0 - 180.0 if p else v for v, p in zip(qd, c["periodic"])]
+    qd = [min(max(v, a), b) for v, a, b in zip(qd, blo, bhi)]
+    p1, R1, _ = m.frame_jacobian1([math.radians(v) if a else v for v, a in zip(qd, angle)])
+    dp = [a - b for a, b in zip(p1, (x, y, z))]
+    e = _rotation_error1(R1, Rt)
+    if W is not None:
+        dp, e = [v * w for v, w in zip(dp, W[:3])], [v * w for v, w in zip(e, W[3:])]
+    perr, rerr = math.hypot(*dp), math.hypot(*e)
+    inside = all(a <= v <= b for v, a, b in zip(qd, blo, bhi))
+    ev = np.array(ne, dtype=np.int64)
+    return InverseResult(
+        mechanism=m.name, names=tuple(m.joint_names), joints=np.array(qd), position_error=np.array(perr),
+        rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+        solved=np.array(perr <= tp and rerr <= tr and inside), restarts=np.array(used - 1, dtype=np.int64),
+        evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
+
+
+def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0, restarts: int = 200,
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
             table: int = 4096, neighbours: int = 32, tail: int = 256) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
-    ``arm``: a registered name or a :class:`SerialMechanism` with ``frame_jacobian`` (DH arms).
-    ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles (deg), as ``arm.fk``
-    returns them. ``start``: start joints (n,) or (..., n) inside the limits (default mid-range).
-    ``tol``: (position, orientation in radians). ``seed``: the restarts' stream. ``starts``:
+    ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
+    URDF arms, through ``frame``, ``frame_jacobian``, ``frame_jacobian1``, ``kinematic_key`` and
+    ``periodic_mask`` only). ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles
+    (deg), as ``arm.fk`` returns them. ``start``: the current joints (n,) or (..., n) inside the
+    limits (default mid-range): the first candidate begins there; when it is solved and the arm
+    has self-motion (more than 6 joints, or a ``mask``), the answer is then moved along the
+    self-motion to the solution locally nearest to ``start`` (Euclidean distance in rad and
+    length units, continuous joints by their wrapped difference; :func:`_toward_start`). Nearest
+    is local: another branch of solutions may hold a nearer one.
+    ``tol``: (position, orientation in radians). ``mask``: the task components that count, 6
+    flags over (x, y, z, rx, ry, rz) -- position and rotation-vector error in the base frame,
+    as roboticstoolbox's ``we`` -- or their names (``"x,y,z"``: position only, for arms with
+    fewer than 6 joints); the errors reported are those of the selected components. ``seed``:
+    the restarts' stream. ``starts``:
     candidates solved side by side per row (the start and ``starts - 1`` random ones);
     ``restarts``: most random restarts per row. ``rest``: gain of the null-space pull towards
     mid-range (0: off). ``orientation_scale``: length units per radian weighing orientation
@@ -817,6 +1067,11 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
         raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
     P0 = _values(m, poses, m.pose_names, "target pose")
+    if P0.ndim == 1 and rest <= 0 and not exact_rotation:
+        return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
+                            int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
+                            + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap,
+                            _task_mask(mask))
     shape = P0.shape[:-1]
     P = P0.reshape(-1, 6)
     N, n = len(P), m.dof
@@ -828,8 +1083,12 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         unit = m.pose_units[0]
         raise FkoptError(f"{m.name} target ({P[k, 0]:g}, {P[k, 1]:g}, {P[k, 2]:g}) unreachable "
                          f"(distance {dist[k]:.1f} {unit} > reach {reach:.1f} {unit})")
-    lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+    lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    # saturation bounds: none for periodic (continuous) joints, wrapped at the end
+    periodic = m.periodic_mask()
+    slo, shi = (np.where(periodic, -np.inf, lo), np.where(periodic, np.inf, hi)) if periodic.any() else (lo, hi)
+    W = _task_mask(mask)
     if start is None:
         q0 = np.broadcast_to(mid, (N, n))
     else:
@@ -838,13 +1097,13 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         if not m.in_bounds(q0).all():
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
-        q0 = np.radians(q0)
+        q0 = _internal(m, q0)
     K = max(1, int(starts))
     if N * K < fill:                                   # small batches: more candidates per row
         K = max(K, fill // N)
     L = float(orientation_scale) if orientation_scale else reach
     pt, Rt = P[:, :3], _zyz_matrix(P[:, 3:])
-    to_deg = 180.0 / np.pi
+    to_deg = 180.0 / np.pi if m.angle_mask(m.joint_units).all() else _public(m, np.ones(n))
     budget = K + max(0, int(restarts))                 # starts per row, first ones included
     # start j of row i: the given start (j = 0, when given or without table), then the
     # table's configurations nearest to the target, then seeded random draws
@@ -853,12 +1112,16 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
     k0 = 0                                             # neighbours known for every row
     if table:
         tab = _start_table(m, int(table))
+        if W is not None:                              # nearest in the selected components only
+            tab = _masked_table(tab, W)
         tq = tab["q"]
         kn = min(int(table), K - own0 + int(neighbours))
         if kn > 0:
             # the first K - own0 neighbours of every row now; the full lists only for rows
             # that restart (most rows never need them)
             feats = np.concatenate([pt, tab["w"] * Rt.reshape(N, 9)], axis=-1)
+            if W is not None:
+                feats = feats * tab["mask"]
             k0 = kn if N < _TREE_MIN else max(0, min(kn, K - own0))   # brute force: all at once
             near = np.full((N, kn), -1, dtype=np.intp)
             if k0:
@@ -891,20 +1154,23 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
         evaluated.append(rows)                        # counted per row at the end
         e = _rotation_error(R, Rt[rows])
         dp = p - pt[rows]
+        J *= to_deg                                    # per radian (per length unit) of joint motion
+        if W is not None:                              # masked task: those rows do not count
+            dp, e = dp * W[:3], e * W[3:]
+            J *= W[:, None]
         r = np.concatenate([dp, L * e], axis=-1)
-        J *= to_deg                                    # per radian of joint motion
         # d e = J_l^{-1}(e) omega (left Jacobian of SO(3): e = log(R R_t^T), dR = [omega]x R)
         if exact_rotation:
             J[:, 3:] = so3_right_jacobian_inverse(-e) @ J[:, 3:]
         J[:, 3:] *= L
         return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
 
-    if N == 1 and rest <= 0 and not exact_rotation and hasattr(m, "frame_jacobian1"):
+    if N == 1 and rest <= 0 and not exact_rotation and W is None:
         def start_of(j):
             return starts_for(np.zeros(1, dtype=np.intp), np.array([j]))[0].tolist()
 
         bq, nused, ne = _inverse_scalar(m, pt[0], Rt[0], L, start_of, budget, tp, tr, iterations,
-                                        damping, down, up, step_cap, lo, hi)
+                                        damping, down, up, step_cap, slo, shi)
         best_q, used = bq[None], np.array([nused], dtype=np.int64)
         K = 1                                          # restarts: starts after the first
         ev_r = np.array([ne], dtype=np.int64)
@@ -1009,12 +1275,12 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     d += dz
                 d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
                 qn = qs + d
-                out = (qn < lo) | (qn > hi)
+                out = (qn < slo) | (qn > shi)
                 sat = np.flatnonzero(out.any(axis=-1))
                 if len(sat):                               # saturation in the null space, those rows only
                     Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
                     free = (~outv).astype(float)
-                    fixed = np.where(outv, np.clip(qn[sat], lo, hi) - qv, 0.0)
+                    fixed = np.where(outv, np.clip(qn[sat], slo, shi) - qv, 0.0)
                     qv2 = np.empty_like(qv)
                     act = slice(None)                      # rows re-solved: all, then those with new violations
                     for _ in range(2):
@@ -1026,15 +1292,15 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                         A[:, _I6, _I6] += muv[act][:, None]
                         qa = qv[act] + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed[act]
                         qv2[act] = qa
-                        outa = ((qa < lo) | (qa > hi)) & (fa > 0)
+                        outa = ((qa < slo) | (qa > shi)) & (fa > 0)
                         more = np.flatnonzero(outa.any(axis=-1))
                         if not len(more):
                             break
                         act = more if isinstance(act, slice) else act[more]
                         outa = outa[more]
-                        fixed[act] = np.where(outa, np.clip(qa[more], lo, hi) - qv[act], fixed[act])
+                        fixed[act] = np.where(outa, np.clip(qa[more], slo, shi) - qv[act], fixed[act])
                         free[act] = np.where(outa, 0.0, free[act])
-                    qn[sat] = np.clip(qv2, lo, hi)
+                    qn[sat] = np.clip(qv2, slo, shi)
                 # -- evaluate the trial points and the restarted slots in one call ----------------
                 if anyfresh:
                     qe = q.copy()
@@ -1055,18 +1321,32 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, seed: int = 0, restarts:
                     q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qe[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
         ev_r = np.bincount(np.concatenate(evaluated), minlength=N).astype(np.int64)
         ev_j = ev_r.copy()
+        if start is not None and (n > 6 or W is not None):   # self-motion towards the starts
+            good = np.flatnonzero(best_m <= 1.0)
+            if len(good):
+                qg, extra = _toward_start(m, best_q[good].copy(), q0[good], pt[good], Rt[good], L, W,
+                                          (tp, tr), slo, shi, periodic)
+                best_q[good] = qg
+                ev_r[good] += extra
+                ev_j[good] += extra
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
     from .rotations import to_array
-    qd = np.clip(np.degrees(best_q), m.bounds[:, 0], m.bounds[:, 1])
-    if N == 1 and hasattr(m, "frame_jacobian1"):    # one pose: the same formulas on floats
-        p1, R1, _ = m.frame_jacobian1(np.radians(qd[0]).tolist())
+    qd = _public(m, best_q)
+    if periodic.any():                                 # continuous joints: into [-180, 180)
+        qd = np.where(periodic, (qd + 180.0) % 360.0 - 180.0, qd)
+    qd = np.clip(qd, m.bounds[:, 0], m.bounds[:, 1])
+    if N == 1 and W is None:                           # one pose: the same formulas on floats
+        p1, R1, _ = m.frame_jacobian1(_internal(m, qd[0]).tolist())
         perr = np.array([math.dist(p1, pt[0].tolist())])
         rerr = np.array([math.hypot(*_rotation_error1(R1, Rt[0].tolist()))])
     else:
         pf, Rf = m.frame(qd)
         pf, Rf = np.stack(pf, axis=-1), to_array(Rf)
-        perr = np.sqrt(_sumsq(pf - pt))
-        rerr = np.sqrt(_sumsq(_rotation_error(Rf, Rt)))
+        dpf, ef = pf - pt, _rotation_error(Rf, Rt)
+        if W is not None:
+            dpf, ef = dpf * W[:3], ef * W[3:]
+        perr = np.sqrt(_sumsq(dpf))
+        rerr = np.sqrt(_sumsq(ef))
     ok = (perr <= tp) & (rerr <= tr) & m.in_bounds(qd)
     return InverseResult(
         mechanism=m.name, names=tuple(m.joint_names), joints=qd.reshape(shape + (n,)),

@@ -52,6 +52,7 @@ class Output:
 _EXP = "fkopt.experiment.reports"
 _STUDY = "fkopt.study.reports"
 _ASM = "fkopt.experiment.assembly"
+_SUITE = "fkopt.kinbench.reports"
 
 #: kind -> its files, in the order they are written (tables before the figures drawn from them).
 OUTPUTS: dict[str, tuple[Output, ...]] = {
@@ -92,12 +93,23 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
         Output("solutions.csv", f"{_ASM}:solutions_table", CURVES, float_format="%.12g"),
         Output("timing.csv", f"{_ASM}:timing_table", TIMING),
     ),
+    "suite": (
+        Output("leaderboard.csv", f"{_SUITE}:leaderboard_table", TABLE),
+        Output("measures.csv", f"{_SUITE}:measures_table", TABLE),
+        Output("ecdf.csv", f"{_SUITE}:ecdf_table", CURVES),
+        Output("runs.csv", f"{_SUITE}:runs_table", CURVES),
+        Output("timing.csv", f"{_SUITE}:timing_table", TIMING),
+        Output("ecdf", f"{_SUITE}:ecdf_figures", FIGURE),
+        Output("leaderboard.md", f"{_SUITE}:leaderboard_markdown", FIGURE),   # never compared
+        Output("index.html", f"{_SUITE}:html_page", FIGURE),                  # inlines the figures
+    ),
 }
 #: kind -> "module:function" making the content of meta.json (without the file digests).
 META: dict[str, str] = {
     "experiment": f"{_EXP}:meta",
     "study": f"{_STUDY}:meta",
     "assembly": f"{_ASM}:meta",
+    "suite": f"{_SUITE}:meta",
 }
 
 

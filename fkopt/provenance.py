@@ -6,11 +6,19 @@ changes with the machine and is never compared by ``fkopt check``:
 
 * ``fkopt_version`` and ``libraries`` (Python and the versions of the libraries fkopt uses);
 * ``platform`` (operating system, CPU architecture, CPU model);
-* ``fingerprint`` -- the part that decides whether floating-point results can be expected to be
-  bit-identical: Python, numpy, scipy and pandas versions, the BLAS/LAPACK build numpy uses, the
-  CPU architecture and the CPU model (OpenBLAS picks its kernels by CPU at run time).
-  ``fkopt check`` compares every deterministic file byte for byte when the stored fingerprint
-  equals this machine's, and by distribution-level tolerances otherwise (:mod:`fkopt.compare`).
+* ``fingerprint`` -- what decides the bits of a result, in two parts (:data:`BLAS_KEYS`):
+
+  - the arithmetic fkopt's own elementwise code runs: Python, numpy, scipy and pandas versions,
+    the CPU architecture and the SIMD targets numpy dispatches to on this CPU (``numpy_simd``:
+    its baseline and dispatch targets that the CPU supports; numpy picks its ufunc loops by them);
+  - the BLAS/LAPACK that ``np.linalg`` and matrix products call: the build numpy was linked with
+    (``blas``) and what runs (``blas_runtime``: library, version, the kernel OpenBLAS picked for
+    this CPU -- threadpoolctl's ``architecture``, which ``OPENBLAS_CORETYPE`` can force -- and
+    the thread count), for numpy's and scipy's copies.
+
+  The CPU model string is *not* part of it (a virtual machine may report only "Intel(R) Xeon(R)
+  Processor"); what it decides is named above. :func:`platform_tier` says which part of a stored
+  fingerprint differs from this machine's, and :mod:`fkopt.compare` picks its rules by that.
 """
 from __future__ import annotations
 
@@ -55,13 +63,63 @@ def _blas() -> str:
         return "unknown"
 
 
+def _numpy_simd() -> str:
+    """The SIMD targets numpy's ufunc loops dispatch to here: its baseline and dispatch targets
+    that this CPU supports (``NPY_DISABLE_CPU_FEATURES`` included, as numpy applies it)."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_baseline__, __cpu_dispatch__, __cpu_features__
+    except ImportError:   # numpy < 2
+        try:
+            from numpy.core._multiarray_umath import __cpu_baseline__, __cpu_dispatch__, __cpu_features__
+        except ImportError:
+            return "unknown"
+    return " ".join(t for t in [*__cpu_baseline__, *__cpu_dispatch__] if __cpu_features__.get(t))
+
+
+def _blas_runtime() -> str:
+    """The BLAS libraries loaded by numpy and scipy.linalg, with the kernel each runs (threadpoolctl)."""
+    try:
+        import numpy  # noqa: F401
+        import scipy.linalg  # noqa: F401
+        from threadpoolctl import threadpool_info
+    except ImportError:
+        return "unknown"
+    libs = sorted({f"{i.get('internal_api')} {i.get('version')} kernel={i.get('architecture')} "
+                   f"threads={i.get('num_threads')} {i.get('threading_layer')}"
+                   for i in threadpool_info() if i.get("user_api") == "blas"})
+    return "; ".join(libs) or "none"
+
+
+#: The fingerprint's BLAS part; the rest decides the bits of fkopt's own elementwise arithmetic.
+BLAS_KEYS = ("blas", "blas_runtime")
+EXACT, BLAS, ANY = "exact", "blas", "any"
+
+
 @lru_cache(maxsize=1)
 def fingerprint() -> dict[str, str]:
-    """Python, numpy, scipy, pandas, BLAS/LAPACK build, CPU architecture and model of this machine."""
+    """What decides the bits of a result on this machine (see the module docstring)."""
     libs = library_versions()
     return {"python": libs["python"], "numpy": libs.get("numpy", "?"), "scipy": libs.get("scipy", "?"),
-            "pandas": libs.get("pandas", "?"), "blas": _blas(), "machine": platform.machine(),
-            "cpu": _cpu_model()}
+            "pandas": libs.get("pandas", "?"), "machine": platform.machine(), "numpy_simd": _numpy_simd(),
+            "blas": _blas(), "blas_runtime": _blas_runtime()}
+
+
+def platform_tier(stored) -> str:
+    """How a result stored with fingerprint ``stored`` compares on this machine:
+
+    * ``"exact"`` -- the same fingerprint: every deterministic file byte for byte;
+    * ``"blas"`` -- only the BLAS part differs: results no BLAS call touches are still exact, the
+      rest follows :mod:`fkopt.compare`'s cross-platform rules;
+    * ``"any"`` -- the elementwise part differs too (another numpy, SIMD target set, Python...),
+      or the stored fingerprint is missing or of an older form: the cross-platform rules for all.
+    """
+    here = fingerprint()
+    if not isinstance(stored, dict):
+        return ANY
+    if stored == here:
+        return EXACT
+    differ = {k for k in set(stored) | set(here) if stored.get(k) != here.get(k)}
+    return BLAS if differ <= set(BLAS_KEYS) else ANY
 
 
 def environment() -> dict:

@@ -15,7 +15,7 @@ numbers are its own); the speed does: at a few rows the per-iteration cost of nu
 dominates, beyond ~10^4 points the working arrays leave the CPU caches. The size was chosen by
 measuring GABC on 3-RPS (population 10, 3000 rows), ABC on the 7-DOF arm (population 100) and
 P-ABC's ABC on 3RPUPc-UPS at several chunk sizes; ``fkopt bench`` (section ``cases``) keeps
-measuring 300 / 1000 / 3000 rows per chunk, and the README's Performance section gives the
+measuring 300 / 1000 / 3000 rows per chunk, and ``bench/bench.csv`` keeps the
 numbers. With ``batch=False`` every row is solved on its own, one after
 the other -- the reference mode that proves batching never changes the numbers.
 
@@ -77,6 +77,9 @@ class Result:
     #: Number of cases (None: a single-target problem) and the integer seed of each case.
     cases: int | None = None
     seeds: np.ndarray | None = None
+    #: Every improvement of each run's best-so-far at its exact evaluation number, as (row,
+    #: evaluation, fitness) arrays; row = case * runs + run (:class:`~fkopt.algorithms.base.RunRecord`).
+    events: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def runs(self) -> int:
@@ -95,7 +98,15 @@ class Result:
         return first
 
     def evaluations_to(self, threshold: float) -> np.ndarray:
-        """Evaluations used when each run first went below ``threshold`` (NaN: never)."""
+        """The evaluation at which each run first went below ``threshold`` (NaN: never): exact
+        from :attr:`events`; without them, the count at the end of that iteration."""
+        if self.events is not None:
+            r, e, f = self.events
+            out = np.full(self.fitness.size, np.nan)
+            below = f < threshold
+            rows, first = np.unique(r[below], return_index=True)   # events are sorted by row, evaluation
+            out[rows] = e[below][first]
+            return out.reshape(self.fitness.shape)
         it = self.iterations_to(threshold)
         ok = ~np.isnan(it)
         at = np.where(ok, it, 0).astype(np.intp)[..., None]
@@ -146,7 +157,8 @@ class Result:
             history=pick(self.history), x_history=pick(self.x_history),
             evaluation_history=pick(self.evaluation_history), iterations_done=pick(self.iterations_done),
             time_per_run=pick(self.time_per_run), extras={k: pick(v) for k, v in self.extras.items()},
-            snapshots={k: pick(v) for k, v in self.snapshots.items()}, cases=None, seeds=None)
+            snapshots={k: pick(v) for k, v in self.snapshots.items()}, cases=None, seeds=None,
+            events=pick_events(self.events, np.arange(i * self.runs, (i + 1) * self.runs)))
 
     def __repr__(self) -> str:
         where = "" if self.cases is None else f"cases={self.cases}, "
@@ -302,7 +314,7 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
         evaluation_history=lead(record.evaluation_history), iterations_done=lead(record.iterations_done),
         time_per_run=lead(times), target=target, extras={k: lead(v) for k, v in record.extras.items()},
         snapshots={k: lead(v) for k, v in record.snapshots.items()},
-        cases=cases, seeds=None if cases is None else seeds,
+        cases=cases, seeds=None if cases is None else seeds, events=record.events,
     )
 
 
@@ -394,4 +406,20 @@ def _concatenate(parts: list[RunRecord]) -> RunRecord:
         evaluation_history=cat("evaluation_history"), iterations_done=cat("iterations_done"),
         extras={k: np.concatenate([p.extras[k] for p in parts]) for k in parts[0].extras},
         snapshots={k: np.concatenate([p.snapshots[k] for p in parts]) for k in parts[0].snapshots},
+        events=None if any(p.events is None for p in parts) else tuple(
+            np.concatenate(a) for a in zip(*((p.events[0] + off, p.events[1], p.events[2]) for p, off in
+                                             zip(parts, np.cumsum([0] + [len(p.best_f) for p in parts[:-1]]))))),
     )
+
+
+def pick_events(events, rows: np.ndarray):
+    """The events of rows ``rows`` (old row numbers, in their new order), renumbered 0, 1, ..."""
+    if events is None:
+        return None
+    r, e, f = events
+    new = np.full(int(max(r.max(initial=-1), np.max(rows, initial=-1))) + 1, -1)
+    new[np.asarray(rows)] = np.arange(len(rows))
+    keep = new[r] >= 0
+    nr = new[r[keep]]
+    order = np.lexsort((e[keep], nr))
+    return nr[order], e[keep][order], f[keep][order]

@@ -15,7 +15,7 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100
     assert len(np.unique(img.reshape(-1, img.shape[-1]), axis=0)) > 10
     assert len(csv) == len(df)
-    assert set(csv.section) == {"throughput", "mao2017", "exact", "kinematics", "cases", "scaling"}
+    assert set(csv.section) == {"throughput", "mao2017", "exact", "kinematics", "robots", "cases", "scaling"}
     assert np.all(np.isfinite(csv.value)) and np.all(csv.value >= 0)
     # every registered mechanism has a throughput row
     for name in fkopt.MECHANISMS:
@@ -28,6 +28,11 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert v["6-sps-cmm lm success"] >= 99.0
     for n in (1, 10, 100):   # N cases x 30 runs together
         assert v[f"gabc {n} cases x 30 runs per evaluation"] > 0
+    # robots: the DH arm always (the URDF arms and rtb when installed), answers verified by FK
+    assert v["wang7dof inverse solved"] >= 99.0
+    notes = dict(zip(csv.item, csv.note))
+    for item in csv.item[csv.item.str.endswith("inverse solved") & (csv.section == "robots")]:
+        assert "reported solved but not: 0;" in notes[item]
 
 
 def test_batched_lm_solves_many_poses_as_cases():

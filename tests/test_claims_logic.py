@@ -5,13 +5,15 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from fkopt.algorithms.abc import quality
 from fkopt.problems import fk_problem
 from fkopt.registry import mechanism_class
 from fkopt.reproduce.check import check_experiment
-from fkopt.reproduce.claims import (HELD, NOT_HELD, WITHIN_NOISE, at_evaluations, at_iteration, compare,
-                                    faster_claim, first_below, verdict_changes)
+from fkopt.reproduce.claims import (HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, at_evaluations, at_iteration,
+                                    compare, faster_claim, first_below, verdict_changes)
+from fkopt.reproduce.engine import is_claims_file, judge
 from fkopt.reproduce.report import claims_files
 from fkopt.reproduce.store import Experiment, Store
 from fkopt.solve import solve
@@ -96,7 +98,8 @@ def test_verdict_changes_are_detected(tmp_path):
     df.loc[0, "verdict"] = HELD if df.loc[0, "verdict"] != HELD else NOT_HELD
     df.to_csv(file, index=False)
     changes = verdict_changes(root)
-    assert len(changes) == 1 and changes[0][1] == df.loc[0, "claim"]
+    assert verdict_changes(root, timing=True) == []   # timing verdicts are stored and compared apart
+    assert len(changes) == 1 and changes[0][1] == f'{df.loc[0, "id"]}: {df.loc[0, "claim"]}'
 
 
 def test_check_fails_when_a_verdict_changes(tmp_path):
@@ -113,3 +116,97 @@ def test_check_fails_when_a_verdict_changes(tmp_path):
     verdicts = [m for m in bad if m.column == "verdict"]
     assert len(verdicts) == 1 and verdicts[0].file == "claims.csv"
     assert "stored" in str(verdicts[0]) and "Fig. 3: stopping" in str(verdicts[0])
+
+
+def _two_algorithms(tmp_path) -> Store:
+    """30 runs each of "a" (10 evaluations per iteration) and "b" (20): at the end of 10 iterations b
+    is lower, but at a's 100 evaluations (b's iteration 5) a is lower."""
+    folder = tmp_path / "paper" / "exp"
+    folder.mkdir(parents=True)
+    (folder / "meta.json").write_text('{"config": {"iterations": 10}}')
+    rng = np.random.default_rng(1)
+    trace, runs = [], []
+    for algo, cost, slope in (("a", 10, 1.0), ("b", 20, 1.5)):
+        for r in range(30):
+            noise = rng.uniform(0.9, 1.1)
+            for it in range(11):
+                trace.append({"case": "c", "algorithm": algo, "run": r, "iteration": it, "evaluations": cost * it,
+                              "best_fitness": noise * 10.0 ** (-slope * it)})
+            runs.append({"case": "c", "algorithm": algo, "run": r, "final_fitness": noise * 10.0 ** (-slope * 10),
+                         "evaluations": cost * 10, "iterations_to_threshold": np.nan, "evaluations_to_threshold": np.nan})
+    pd.DataFrame(trace).to_csv(folder / "trace.csv.gz", index=False)
+    pd.DataFrame(runs).to_csv(folder / "runs.csv", index=False)
+    pd.DataFrame({"case": "c", "algorithm": ["a", "b"], "iteration": 10, "mean_evaluations": [100, 200]}).to_csv(
+        folder / "convergence.csv", index=False)
+    return Store(tmp_path)
+
+
+def test_a_comparison_reports_both_budget_bases_and_flags_their_disagreement(tmp_path):
+    store = _two_algorithms(tmp_path)
+    spec = {"id": "x", "text": "b beats a", "kind": "comparison", "experiment": "exp", "better": "b", "than": "a",
+            "basis": "iterations"}
+    c, = judge("paper", spec, store)
+    assert c.verdict == HELD and c.numbers["lower_a"] == "b" and c.numbers["lower_evaluations_a"] == "a"
+    assert c.numbers["bases_disagree"] and "bases disagree" in c.evidence
+    c, = judge("paper", {**spec, "basis": "evaluations"}, store)
+    assert c.verdict == NOT_HELD          # the same numbers on the other basis
+
+
+def test_readings_give_one_conditional_row_each_and_not_checkable_overrides(tmp_path):
+    store = _two_algorithms(tmp_path)
+    spec = {"id": "x", "text": "g beats a", "kind": "comparison", "experiment": "exp", "better": "g", "than": "a",
+            "basis": "iterations", "readings": [{"id": "r1", "condition": "reading 1", "use": {"g": "b"}},
+                                                {"id": "r2", "condition": "reading 2", "use": {"g": "a"}}]}
+    rows = judge("paper", spec, store)
+    assert [(c.id, c.verdict, c.condition) for c in rows] == [
+        ("x:r1", "conditional: held", "reading 1"), ("x:r2", "conditional: not held", "reading 2")]
+    c, = judge("paper", {**spec, "readings": None, "better": "b", "not_checkable": "the equations were lost"}, store)
+    assert c.verdict == NOT_CHECKABLE and c.evidence.startswith("the equations were lost") and "p_a" in c.numbers
+    c, = judge("paper", {**spec, "readings": None, "experiment": "absent"}, store)
+    assert c.verdict == NOT_CHECKABLE and "no stored result" in c.evidence
+
+
+def test_magnitude_uses_a_statistic_over_all_runs_never_a_maximum(tmp_path):
+    store = _two_algorithms(tmp_path)
+    spec = {"id": "m", "text": "a reaches 1e-10", "kind": "magnitude", "experiment": "exp", "algorithms": ["a"],
+            "quantity": "final_fitness", "statistic": "median", "order": 1e-10, "decades": 0.5}
+    c, = judge("paper", spec, store)
+    assert c.verdict == HELD and 0.9e-10 < c.numbers["median_a_final_fitness"] < 1.1e-10
+    assert judge("paper", {**spec, "order_at_most": 1e-12, "order": None}, store)[0].verdict == NOT_HELD
+    with pytest.raises(AssertionError):
+        judge("paper", {**spec, "statistic": "max"}, store)
+
+
+def test_a_printed_difference_inside_the_spread_is_within_noise():
+    a, b = np.linspace(100, 110, 8), np.linspace(200, 220, 8)
+    assert faster_claim("x", "A", compare("A", a, "B", b)).verdict == HELD
+    # the paper prints 361.3 vs 362.4 ms: 0.3 %, far inside a 10 % spread, whatever fkopt measures
+    c = faster_claim("x", "B", compare("A", a, "B", b), printed=(361.3, 362.4))
+    assert c.verdict == WITHIN_NOISE and "0.3 %" in c.evidence and "n = 8" in c.evidence
+
+
+def test_reproduce_never_runs_a_claims_file(tmp_path):
+    from fkopt.reproduce.run import plan
+    assert is_claims_file(ROOT / "configs" / "mao2017" / "claims.yaml")
+    (tmp_path / "p").mkdir()
+    shutil.copy(ROOT / "configs" / "mao2017" / "claims.yaml", tmp_path / "p" / "claims.yaml")
+    shutil.copy(ROOT / "configs" / "mao2017" / "tab3_floor.yaml", tmp_path / "p" / "tab3_floor.yaml")
+    assert [p.path.name for p in plan(tmp_path, tmp_path / "out")] == ["tab3_floor.yaml"]
+
+
+def test_timed_runs_are_interleaved(monkeypatch):
+    """Run k of every algorithm of a case before run k + 1 of any (A B A B ...), warm-ups first."""
+    from types import SimpleNamespace as NS
+
+    from fkopt.experiment import timing
+    calls = []
+    monkeypatch.setattr(timing, "solve", lambda problem, name, iterations, run_ids, **kw: calls.append(
+        (name, iterations, run_ids[0])))
+    config = NS(runs=3, population=5, iterations=7, threshold=None, stop_at_threshold=False)
+    recs = [NS(case=NS(index=0), spec=NS(name=n, population=None, iterations=None, start=None, params={}),
+               problem=None, seed=1) for n in ("a", "b")]
+    timing.time_single_runs(config, recs)
+    timed = [(n, k) for n, it, k in calls if it == 7]
+    assert [c[0] for c in calls[:2]] == ["a", "b"] and all(it == 2 for _, it, _ in calls[:2])   # warm-ups
+    assert timed == [("a", 0), ("b", 0), ("a", 1), ("b", 1), ("a", 2), ("b", 2)]
+    assert all(len(r.single_run_s) == 3 for r in recs)

@@ -158,8 +158,8 @@ def test_broken_plugin_is_one_line_naming_it(installed_example, tmp_path):
 
 
 def test_readme_minimal_plugin_example_works(tmp_path, monkeypatch):
-    """README's complete minimal example, named as package.module:Class, solves its FK."""
-    text = (ROOT / "README.md").read_text()
+    """docs/plugins.md's complete minimal example, named as package.module:Class, solves its FK."""
+    text = (ROOT / "docs" / "plugins.md").read_text()
     code = text.split("# mypkg/walk.py\n", 1)[1].split("```", 1)[0]
     (tmp_path / "mypkg").mkdir()
     (tmp_path / "mypkg" / "__init__.py").write_text("")

@@ -127,20 +127,23 @@ def test_exact_check_names_every_edited_file(tmp_path):
     (folder / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     _resign(folder)                                    # digests agree: only the rerun can tell
     bad = check_experiment(Store(folder.parents[1]).get("mao2017", "tab6"), exact=True)
-    assert {m.file for m in bad} == {*EDITS, "meta.json"}
-    assert all("mao2017/tab6" in str(m) and "line" in m.row for m in bad)
+    byte = [m for m in bad if "byte-identical" in m.rule]
+    assert {m.file for m in byte} == {*EDITS, "meta.json"}
+    assert all("mao2017/tab6" in str(m) and "line" in m.row for m in byte)
 
 
-def test_tolerances_catch_the_edits_of_issue_10(tmp_path):
-    """Another platform (tolerant mode) still catches mean fitness x5, success 1 -> 0.95, median
-    iterations +18 %, mean evaluations +2 % (runs/convergence edits: the digests, above)."""
+@pytest.mark.parametrize("tier", ["blas", "any"])
+def test_tolerances_catch_the_edits_of_issue_10(tmp_path, tier):
+    """The cross-platform rules still catch mean fitness x5, success 1 -> 0.95, median
+    iterations +18 %, mean evaluations +2 % with re-signed digests (runs/convergence edits: the
+    digests, above): GABC's rows touch no BLAS, and summary.csv must hold the stored runs' statistics."""
     folder = _copy(tmp_path)
     _edit_csv(folder, "summary.csv", 0, "mean_fitness", lambda v: v * 5)
     _edit_csv(folder, "summary.csv", 1, "success_rate", lambda v: 0.95)
     _edit_csv(folder, "summary.csv", 2, "median_iterations_to_threshold", lambda v: v * 1.18)
     _edit_csv(folder, "summary.csv", 3, "mean_evaluations", lambda v: v * 1.02)
     _resign(folder)
-    bad = check_experiment(Store(folder.parents[1]).get("mao2017", "tab6"), exact=False)
+    bad = check_experiment(Store(folder.parents[1]).get("mao2017", "tab6"), tier=tier)
     named = {(m.file, m.column) for m in bad}
     assert named == {("summary.csv", "mean_fitness"), ("summary.csv", "success_rate"),
                      ("summary.csv", "median_iterations_to_threshold"), ("summary.csv", "mean_evaluations")}
@@ -191,3 +194,143 @@ def test_reproduce_in_worker_processes_gives_the_serial_files(tmp_path, cli):
     assert (outs[1] / "REPORT.md").read_text() == (outs[2] / "REPORT.md").read_text()
     code, _, err = cli("reproduce", "--configs", tmp_path / "configs", "--out", outs[1], "--jobs", 0)
     assert code == 2 and "--jobs: must be at least 1" in err
+
+
+# -- passes on any machine (issue 18): tiers, path-dependent rows, checks on every platform -------
+def test_platform_tier_follows_what_decides_the_bits(monkeypatch):
+    from fkopt import provenance
+    here = provenance.fingerprint()
+    assert provenance.platform_tier(dict(here)) == "exact"
+    assert provenance.platform_tier({**here, "blas_runtime": "openblas 0.3.31 kernel=SkylakeX"}) == "blas"
+    assert provenance.platform_tier({**here, "numpy_simd": "X86_V2"}) == "any"
+    assert provenance.platform_tier({**here, "blas": "mkl", "numpy": "1.26.4"}) == "any"
+    assert provenance.platform_tier(None) == "any"
+    assert "cpu" not in here and "kernel=" in here["blas_runtime"] or here["blas_runtime"] in ("unknown", "none")
+
+
+def test_only_fkopts_own_swarms_on_builtin_mechanisms_are_blas_free():
+    from fkopt.registry import algorithm_class, mechanism_class
+    assert all(algorithm_class(n).blas_free for n in ("abc", "gabc", "pso", "aco", "pabc"))
+    assert not any(algorithm_class(n).blas_free for n in ("lm", "nr", "dls", "gabc+lm", "pso+lm", "scipy:differential_evolution"))
+    assert mechanism_class("3-rps").blas_free_fitness and not mechanism_class("urdf").blas_free_fitness
+
+
+def _nudged_starts(monkeypatch):
+    """Every exact solver's start points moved by one ulp: a stand-in for another BLAS kernel."""
+    import numpy as np
+
+    from fkopt.algorithms import dls, lm, nr
+    original = nr.start_points
+
+    def nudged(*args, **kwargs):
+        x = np.array(original(*args, **kwargs), dtype=float)
+        return np.nextafter(x, np.inf)
+    for module in (nr, lm, dls):
+        monkeypatch.setattr(module, "start_points", nudged)
+
+
+def test_one_ulp_in_the_exact_solvers_starts_passes_the_cross_platform_rules(monkeypatch, tmp_path):
+    """Two reruns on this machine, the second with every exact solver's starts one ulp away: the
+    bytes differ in the exact solvers' rows, and the "blas" rules (what --tolerant uses) pass."""
+    from fkopt.compare import compare_folders
+    from fkopt.experiment.kinds import from_dict, rerun_files
+    from fkopt.reproduce.check import rules_for
+    exp = Store(RESULTS).get("chang2024", "baselines")
+    config = from_dict(dict(exp.config), "chang2024/baselines")
+    plain, nudged = tmp_path / "plain", tmp_path / "nudged"
+    for folder in (plain, nudged):
+        folder.mkdir()
+    rerun_files(config, plain)
+    _nudged_starts(monkeypatch)
+    rerun_files(config, nudged)
+    import pandas as pd
+    a, b = (pd.read_csv(f / "runs.csv", dtype=str, keep_default_na=False) for f in (plain, nudged))
+    moved = set(a["algorithm"][(a != b).any(axis=1)])
+    assert moved and moved <= {"lm", "nr", "pso+lm"}, moved       # the nudge moved only exact solvers
+    assert compare_folders("chang2024/baselines", plain, nudged, True)            # bytes differ
+    assert compare_folders("chang2024/baselines", plain, nudged, rules_for(exp, "blas")) == []
+    assert compare_folders("chang2024/baselines", plain, nudged, rules_for(exp, "any")) == []
+
+
+@pytest.mark.parametrize("tier", ["exact", "blas", "any"])
+def test_edits_of_path_dependent_rows_and_of_runs_are_caught_in_every_tier(tmp_path, tier):
+    """An LM row's mean evaluations +2 %, a run's x moved by 5 degrees, a deleted claims.csv:
+    caught whatever the platform (digests re-signed, so only the rules can tell)."""
+    import pandas as pd
+    dst = tmp_path / "results" / "chang2024"
+    shutil.copytree(RESULTS / "chang2024" / "baselines", dst / "baselines")
+    folder = dst / "baselines"
+    summary = pd.read_csv(folder / "summary.csv")
+    row = int(summary.index[summary["algorithm"] == "lm"][0])
+    _edit_csv(folder, "summary.csv", row, "mean_evaluations", lambda v: v * 1.02)
+    runs = pd.read_csv(folder / "runs.csv")
+    run = int(runs.index[runs["algorithm"] == "abc"][2])
+    _edit_csv(folder, "runs.csv", run, "x_alpha", lambda v: v + 5)
+    _resign(folder)
+    (tmp_path / "results" / "REPORT.md").write_text("a tree written by fkopt reproduce\n")
+    bad = check_experiment(Store(tmp_path / "results").get("chang2024", "baselines"), tier=tier)
+    named = {(m.file, m.column) for m in bad}
+    assert ("summary.csv", "mean_evaluations") in named
+    assert ("runs.csv", "final_fitness") in named          # fitness(x) of the moved x is not the stored one
+    assert ("claims.csv", "file") in named                  # the paper's claims.csv was not copied
+    assert any("every platform" in m.rule for m in bad)
+
+
+def test_rank_rules_see_a_real_shift_and_forgive_noise():
+    """The distribution rule: a shifted path count fails, a reshuffle of the same values passes."""
+    import numpy as np
+    import pandas as pd
+
+    from fkopt.compare import Rules, compare_runs
+    rng = np.random.default_rng(1)
+    n = 60
+    base = pd.DataFrame({"case": "c", "algorithm": "lm", "run": np.arange(n), "final_fitness": 1e-25,
+                         "evaluations": rng.integers(10, 30, n), "x_a": 1.0, "x_b": 2.0})
+    rules = Rules("any")
+    same = base.copy()
+    same["evaluations"] = rng.permutation(base["evaluations"].to_numpy())
+    assert compare_runs("e", "runs.csv", base.astype(str), same.astype(str), rules) == []
+    shifted = base.copy()
+    shifted["evaluations"] = base["evaluations"] + 8
+    bad = compare_runs("e", "runs.csv", base.astype(str), shifted.astype(str), rules)
+    assert [m.column for m in bad] == ["evaluations"] and "Holm" in bad[0].rule
+    other = base.copy()
+    other.loc[: n // 2, "x_a"] = -1.0                      # half the runs on another solution
+    bad = compare_runs("e", "runs.csv", base.astype(str), other.astype(str), rules)
+    assert [m.column for m in bad] == ["solutions"]
+
+
+def test_a_study_run_moved_is_caught_by_its_recomputed_fitness(tmp_path):
+    from fkopt.reproduce.check import recomputed_fitness
+    from fkopt.experiment.kinds import from_dict
+    folder = _copy(tmp_path, "studies", "3rps_slice")
+    exp = Store(folder.parents[1]).get("studies", "3rps_slice")
+    config = from_dict(dict(exp.config), "studies/3rps_slice")
+    assert recomputed_fitness(exp, config) == []
+    _edit_csv(folder, "runs.csv", 7, "x_z", lambda v: v + 0.5)
+    bad = recomputed_fitness(Store(folder.parents[1]).get("studies", "3rps_slice"), config)
+    assert [(m.file, m.column) for m in bad] == [("runs.csv", "final_fitness")] and "pose" in bad[0].row
+
+
+def test_check_cli_tolerant_forces_the_cross_platform_rules(tmp_path, cli):
+    folder = _copy(tmp_path)
+    code, out, err = cli("check", folder, "--tolerant")
+    assert code == 0, err
+    assert "ok   mao2017/tab6 (blas rules)" in out
+    code, _, err = cli("check", folder, "--tier", "fuzzy")
+    assert code == 2 and "--tier: 'fuzzy' unknown; allowed: auto, exact, blas, any" in err
+
+
+def test_changes_say_what_a_regeneration_moved(tmp_path):
+    from fkopt.reproduce.changes import describe, snapshot
+    folder = _copy(tmp_path)
+    shutil.copy(RESULTS / "mao2017" / "claims.csv", folder.parent / "claims.csv")
+    before = snapshot(tmp_path / "results")
+    assert "Unchanged (every deterministic file byte-identical): mao2017/tab6." in describe(before, tmp_path / "results")
+    _edit_csv(folder, "summary.csv", 0, "mean_evaluations", lambda v: v + 20)
+    claims = (folder.parent / "claims.csv").read_text().splitlines()
+    claims[1] = claims[1].rsplit(",", 1)[0] + ",not held" if claims[1].endswith(",held") else claims[1].rsplit(",", 1)[0] + ",held"
+    (folder.parent / "claims.csv").write_text("\n".join(claims) + "\n")
+    text = describe(before, tmp_path / "results")
+    assert "## mao2017/tab6" in text and "`summary.csv`" in text and "mean_evaluations" in text and "→" in text
+    assert "## Verdicts that changed" in text and "mao2017:" in text

@@ -27,9 +27,12 @@ with B the budget and e_0 = min(population, B): t = 0 is after the first populat
 iterations at the budget, evenly spaced between. With the default budget e_t = population (t +
 1), one iteration = one population's worth of evaluations. ``evaluation_history`` holds the
 evaluations actually used by then (``min(e_t, used)``), so evaluation-based comparisons
-(``mean_evaluations``, evaluations to threshold) are exact, while iteration-based ones compare
-checkpoints, not the library's generations. ``iterations_done`` is the first record below the
-target (with ``stop_at_target``), else ``iterations``.
+(``mean_evaluations``) are exact, while iteration-based ones compare checkpoints, not the
+library's generations. ``iterations_done`` is the first record below the target (with
+``stop_at_target``), else ``iterations``; a run that stopped there holds, from that record on,
+its final fitness and point and the evaluations it used in all (the stopping batch counts
+whole). ``RunRecord.events`` keeps every improvement at its exact evaluation number (what the
+run traces and evaluations-to-threshold read), including the first evaluation.
 """
 from __future__ import annotations
 
@@ -91,7 +94,10 @@ class Counter:
         f = np.asarray(self.problem.fitness(X[:take]), dtype=float).reshape(take)
         f = np.where(np.isnan(f), np.inf, f)
         running = np.minimum.accumulate(np.concatenate([[self.best], f]))
-        for i in np.flatnonzero(running[1:] < running[:-1]):
+        better = running[1:] < running[:-1]
+        if self.n == 0:     # a run's first evaluation opens its trace, whatever its value
+            better[0] = True
+        for i in np.flatnonzero(better):
             self._evals.append(self.n + int(i) + 1)
             self._f.append(float(f[i]))
             self._x.append(X[i].copy())
@@ -268,9 +274,14 @@ def record_from_traces(traces: list[Trace], population: int, iterations: int, bu
         if stop_target is not None:
             below = np.flatnonzero(history[r] < stop_target)
             if below.size:
-                done[r] = below[0]
+                d = done[r] = below[0]
+                # stopped there: the stopping batch's last improvements and count belong to it
+                history[r, d:], x_history[r, d:], evals[r, d:] = tr.f[-1], tr.x[-1], tr.used
+    events = (np.repeat(np.arange(runs), [len(tr.evals) for tr in traces]),
+              np.concatenate([tr.evals for tr in traces]).astype(np.int64),
+              np.concatenate([tr.f for tr in traces]).astype(float))
     return RunRecord(best_x=x_history[:, -1].copy(), best_f=history[:, -1].copy(), history=history,
-                     x_history=x_history, evaluation_history=evals, iterations_done=done)
+                     x_history=x_history, evaluation_history=evals, iterations_done=done, events=events)
 
 
 __all__ = ["Counter", "ExternalAlgorithm", "ExternalParams", "Trace", "checkpoints", "record_from_traces",

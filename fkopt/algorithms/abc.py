@@ -66,7 +66,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, row_offsets, rows_of, uniform_in
+from .base import Algorithm, Params, State, evaluated, row_offsets, rows_of, uniform_in
 
 
 class ABCParams(Params):
@@ -200,6 +200,7 @@ def _aux(state: ABCState, problem) -> _Aux:
 
 class ABC(Algorithm):
     name = "abc"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = ABCParams
     evaluations_per_iteration = "2*population (+1 per scout)"
 
@@ -361,7 +362,9 @@ class ABC(Algorithm):
         n = runs * population
         pending, state.pending = state.pending, None
         if pending is None:
-            return np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf)
+            fv = np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf)
+            evaluated(state, fv)
+            return fv
         slots, fresh, count = pending
         f = state.f.reshape(-1)
         if getattr(problem, "cases", None) is None:     # one call for both
@@ -370,9 +373,13 @@ class ABC(Algorithm):
             both = np.fmin(problem.fitness(both), np.inf)
             fv = both[:n].reshape(state.f.shape)
             f[slots] = both[n:]
+            evaluated(state, fv)
+            evaluated(state, both[n:], slots // population)
         else:   # a target per row: the scouts' rows (same numbers, a second call)
             fv = np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf)
             f[slots] = np.fmin(rows_of(problem, slots // population).fitness(fresh), np.inf)
+            evaluated(state, fv)
+            evaluated(state, f[slots], slots // population)
         state.evaluations = state.evaluations + count
         return fv
 
@@ -457,6 +464,7 @@ class ABC(Algorithm):
         state.x.reshape(n, dim).take(flat, axis=0, out=v)
         v.reshape(-1)[aux.cand + j] = m
         fv = np.fmin(problem.fitness(v.reshape(state.x.shape)), np.inf).reshape(-1)
+        evaluated(state, fv.reshape(runs, population))
         # Resolve onlookers that chose the same source: per source, the lowest candidate
         # fitness, and the first onlooker reaching it.
         best = aux.inf.copy()
@@ -482,6 +490,7 @@ class ABC(Algorithm):
         sources = roulette(cdf, u)
         v = self.candidates(state, sources, problem, streams)
         fv = np.fmin(problem.fitness(v), np.inf).ravel()
+        evaluated(state, fv.reshape(runs, population))
         size = runs * population
         flat = (sources + aux.offsets).ravel()
         best = aux.inf.copy()
@@ -526,6 +535,7 @@ class ABC(Algorithm):
         f = state.f.reshape(-1)
         if evaluate:
             f[slots] = np.fmin(rows_of(problem, rows).fitness(fresh), np.inf)
+            evaluated(state, f[slots], rows)
             state.evaluations = state.evaluations + scout
         else:
             f[slots] = np.inf

@@ -61,7 +61,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, uniform_in
+from .base import Algorithm, Params, State, clip, evaluated, uniform_in
 
 
 class ACOParams(Params):
@@ -95,6 +95,7 @@ class ACOState(State):
 
 class ACO(Algorithm):
     name = "aco"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = ACOParams
     evaluations_per_iteration = "population"
 
@@ -131,6 +132,7 @@ class ACO(Algorithm):
         u = streams.uniform(population, dim)
         cand = clip(state.x + (2.0 * u - 1.0) * h, problem.bounds)
         fc = problem.fitness(cand)
+        evaluated(state, fc)
         better = fc < state.f
         if p.step_rule == "adaptive":
             state.step = np.where(local, state.step * np.where(better, p.expand, p.contract), state.step)

@@ -48,6 +48,7 @@ class State:
     evaluations: np.ndarray | None = None
     best_x: np.ndarray | None = None
     best_f: np.ndarray | None = None
+    log: "EvaluationLog | None" = None   # set by Algorithm.minimize: see evaluated()
 
 
 @dataclass
@@ -62,6 +63,94 @@ class RunRecord:
     iterations_done: np.ndarray        # (runs,) iterations actually used (< iterations if stopped)
     extras: dict[str, np.ndarray] = field(default_factory=dict)       # name -> (runs, iterations + 1)
     snapshots: dict[int, np.ndarray] = field(default_factory=dict)    # iteration -> (runs, population, dim)
+    #: Every improvement of each run's best-so-far at its exact evaluation number: (row, evaluation,
+    #: fitness) arrays sorted by row, then evaluation (:class:`EvaluationLog`); None: not kept.
+    events: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+
+
+class EvaluationLog:
+    """Improvements of the best-so-far fitness of each run at their exact evaluation number.
+
+    An algorithm reports the fitness values it computes, in the order it evaluates them, with
+    :func:`evaluated`; points of one call are counted in population order, so the improvement at
+    position ``c`` of a call gets the evaluation number ``count before the call + c * step + 1``
+    (``step``: evaluations each point costs, 1 but for local methods whose count includes the
+    Jacobian). Vectorised over (runs, points). :meth:`Algorithm.minimize` opens every iteration
+    with :meth:`start` and closes it with :meth:`finish`, which also covers an algorithm (or a
+    phase, like the LM steps of a hybrid) that does not report: an improvement that no reported
+    value explains is put at the iteration's last evaluation -- the resolution of the records.
+    """
+
+    def __init__(self, runs: int):
+        self.count = np.zeros(runs, dtype=np.int64)
+        self.best = np.full(runs, np.inf)
+        self.active = np.ones(runs, dtype=bool)
+        self.first = True
+        self._r: list[np.ndarray] = []
+        self._e: list[np.ndarray] = []
+        self._f: list[np.ndarray] = []
+
+    def start(self, evaluations: np.ndarray, active: np.ndarray) -> None:
+        self.count = np.array(evaluations, dtype=np.int64, copy=True)
+        self.active = active
+
+    def add(self, f: np.ndarray, rows: np.ndarray | None = None, step=1) -> None:
+        """Values ``f`` (runs, k) of every run, or (k,) of the runs ``rows`` (one point each)."""
+        f = np.asarray(f, dtype=float)
+        if rows is not None:
+            rows = np.asarray(rows, dtype=np.intp)
+            hit = (f < self.best[rows]) & self.active[rows]
+            r = rows[hit]
+            self._keep(r, self.count[r] + 1, f[hit])
+            self.best[rows] = np.fmin(self.best[rows], f)
+            self.count[rows] += step
+            return
+        runs, k = f.shape
+        acc = np.fmin.accumulate(f, axis=1)
+        prev = np.empty_like(f)
+        prev[:, 0] = self.best
+        np.fmin(acc[:, :-1], self.best[:, None], out=prev[:, 1:])
+        hit = f < prev
+        if self.first:          # a run's first evaluation opens its trace, whatever its value
+            hit[:, 0] = True
+            self.first = False
+        hit &= self.active[:, None]
+        r, c = np.nonzero(hit)
+        step = np.broadcast_to(np.asarray(step, dtype=np.int64), (runs,))
+        self._keep(r, self.count[r] + c * step[r] + 1, f[r, c])
+        np.fmin(self.best, acc[:, -1], out=self.best)
+        self.count = self.count + k * step
+
+    def _keep(self, r, e, f) -> None:
+        if r.size:
+            self._r.append(r)
+            self._e.append(np.asarray(e, dtype=np.int64))
+            f = np.asarray(f, dtype=float)
+            self._f.append(np.where(np.isnan(f), np.inf, f))
+
+    def finish(self, evaluations: np.ndarray, best_f: np.ndarray) -> None:
+        """Close the iteration: an improvement of ``best_f`` that no reported value reached
+        is put at the iteration's last evaluation."""
+        gap = self.active & (best_f < self.best)
+        if gap.any():
+            r = np.flatnonzero(gap)
+            self._keep(r, np.asarray(evaluations)[r], best_f[r])
+            self.best = np.where(gap, best_f, self.best)
+
+    def events(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if not self._r:
+            return np.empty(0, np.intp), np.empty(0, np.int64), np.empty(0)
+        r, e, f = (np.concatenate(a) for a in (self._r, self._e, self._f))
+        order = np.lexsort((e, r))
+        return r[order], e[order], f[order]
+
+
+def evaluated(state, f: np.ndarray, rows: np.ndarray | None = None) -> None:
+    """Report fitness values just computed, in evaluation order, to the run's
+    :class:`EvaluationLog` (nothing happens outside :meth:`Algorithm.minimize`)."""
+    log = getattr(state, "log", None)
+    if log is not None:
+        log.add(f, rows)
 
 
 @lru_cache(maxsize=64)
@@ -100,6 +189,10 @@ class Algorithm:
     Params: ClassVar[type[Params]] = Params
     #: Deterministic local methods (Newton, LM) start from ``x0`` and ignore the population.
     local: ClassVar[bool] = False
+    #: True when no BLAS/LAPACK call lies on the algorithm's own path (elementwise numpy only), so
+    #: its results do not depend on which BLAS kernel runs (:mod:`fkopt.compare`). False by default:
+    #: code fkopt has not read (adapters, plug-ins) is assumed to call BLAS somewhere.
+    blas_free: ClassVar[bool] = False
     #: Rough evaluations per iteration as a function of population, for documentation.
     evaluations_per_iteration: ClassVar[str] = "population"
 
@@ -196,7 +289,13 @@ class Algorithm:
             self.check_state(state, problem, runs, "initialize")
         state.best_f = np.full(runs, np.inf)
         state.best_x = np.full((runs, dim), np.nan)
+        log = EvaluationLog(runs)
+        f0 = np.asarray(state.f)
+        # the initial points, each costing evaluations / points (more than 1: a Jacobian too)
+        log.add(f0, step=np.maximum(np.asarray(state.evaluations, dtype=np.int64) // f0.shape[1], 1))
         self.update_best(state)
+        log.finish(state.evaluations, state.best_f)
+        state.log = log
 
         history = np.empty((runs, iterations + 1))
         xs = np.empty((runs, iterations + 1, dim)) if x_history else None
@@ -242,10 +341,12 @@ class Algorithm:
                     if done.all():
                         last = t - 1
                         break
+            log.start(state.evaluations, ~done)
             self.iterate(state, problem, streams)
             if plugin:
                 self.check_state(state, problem, runs, "iterate")
             self.update_best(state)
+            log.finish(state.evaluations, state.best_f)
             record(t)
         if stop_at_target and target is not None:
             newly = ~done & (history[:, last] < target)
@@ -260,5 +361,5 @@ class Algorithm:
         return RunRecord(
             best_x=np.array(final_x, dtype=float, copy=True), best_f=history[:, -1].copy(), history=history,
             x_history=xs, evaluation_history=evals, iterations_done=done_at,
-            extras=extra_hist, snapshots=snaps,
+            extras=extra_hist, snapshots=snaps, events=log.events(),
         )

@@ -56,6 +56,7 @@ class HybridState:
     evaluations = _swarm_field("evaluations")
     best_x = _swarm_field("best_x")
     best_f = _swarm_field("best_f")
+    log = _swarm_field("log")
 
 
 class HybridParams(Params):

@@ -41,6 +41,7 @@ class PABCState(PSOState, ABCState):
 
 class PABC(Algorithm):
     name = "pabc"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = PABCParams
     reconstruction = ("chang2024's P-ABC equations were lost in extraction; PSO then ABC seeded "
                       "with the personal bests, as reconstructed in docs/models.md")

@@ -36,7 +36,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, uniform_in
+from .base import Algorithm, Params, State, clip, evaluated, uniform_in
 
 
 class PSOParams(Params):
@@ -65,6 +65,7 @@ class PSOState(State):
 
 class PSO(Algorithm):
     name = "pso"
+    blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
     Params = PSOParams
     evaluations_per_iteration = "population"
 
@@ -115,6 +116,7 @@ class PSO(Algorithm):
         state.vel = np.where(pos != moved, 0.0, vel)
         state.pos = pos
         f = problem.fitness(pos)
+        evaluated(state, f)
         better = f < state.f
         state.x = np.where(better[..., None], pos, state.x)
         state.f = np.where(better, f, state.f)

@@ -37,7 +37,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError,
 from ..errors import FkoptError
 from ..files import MAX_COMPONENT, check_component, error_line, load_mapping
 
-#: Documented upper limits (README "Bad input"); a memory estimate refuses smaller jobs that
+#: Documented upper limits (docs/cli.md, "Bad input"); a memory estimate refuses smaller jobs that
 #: still cannot fit (:func:`fkopt.experiment.kinds.check_memory`).
 MAX_RUNS = 100_000
 MAX_POPULATION = 100_000

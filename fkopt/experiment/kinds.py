@@ -5,7 +5,8 @@ Kinds (the file's ``kind:`` key; an experiment file has none):
 * experiments: :mod:`fkopt.experiment.config` (:data:`EXPERIMENT` below);
 * ``kind: assembly``: all forward solutions, :mod:`fkopt.experiment.assembly`;
 * ``kind: study``: workspace studies, :mod:`fkopt.study` (its :class:`Kind` is in
-  :mod:`fkopt.study.kind`).
+  :mod:`fkopt.study.kind`);
+* ``kind: suite``: benchmark suites (kinbench), :mod:`fkopt.kinbench` (:mod:`fkopt.kinbench.kind`).
 
 Each kind is a :class:`Kind`, named in :data:`KINDS` by a ``"module:attribute"`` string imported
 on first use (like :mod:`fkopt.registry`), so this floor never imports the study floor above it,
@@ -49,6 +50,7 @@ KINDS: dict[str, str] = {
     "experiment": "fkopt.experiment.kinds:EXPERIMENT",
     "study": "fkopt.study.kind:STUDY",
     "assembly": "fkopt.experiment.assembly:ASSEMBLY",
+    "suite": "fkopt.kinbench.kind:SUITE",
 }
 #: Share of the currently available memory a job may be estimated to need.
 MEMORY_SHARE = 0.8
@@ -98,8 +100,12 @@ def from_dict(data: dict, where: str):
 
 
 def load_any(path: str | Path):
-    """An experiment, study or assembly config, by the file's ``kind``."""
-    return from_dict(load_mapping(path, "config fields"), str(path))
+    """An experiment, study or assembly config, by the file's ``kind``; a config with file fields
+    (a URDF's ``geometry.file``) resolves its relative paths beside the file, as ``load_config``."""
+    config = from_dict(load_mapping(path, "config fields"), str(path))
+    if "_folder" in getattr(type(config), "__private_attributes__", {}):
+        config._folder = Path(path).parent
+    return config
 
 
 def available_memory() -> int:

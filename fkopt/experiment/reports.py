@@ -127,8 +127,10 @@ def values_table(er: ExperimentResult) -> pd.DataFrame:
                     pose_error(mech, rec.outputs[med], case.reference)[j])
             if name in printed:
                 row["printed_value"] = printed[name]
-                if target is not None:
-                    row["printed_abs_error"] = _abs_diff(unit, printed[name], float(target[j]))
+                if f"{name}_error" in printed:   # the paper's error column, transcribed, never recomputed
+                    row["printed_abs_error"] = printed[f"{name}_error"]
+                if target is not None:   # |printed value - target| from the rounded printed value
+                    row["printed_value_minus_target"] = _abs_diff(unit, printed[name], float(target[j]))
             rows.append(row)
     return pd.DataFrame(rows)
 
@@ -227,7 +229,11 @@ def figure_file(er: ExperimentResult, kind: str) -> str:
 
 
 def _spec_names(er: ExperimentResult) -> dict[str, str]:
-    return {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+    """Legend names; algorithms that share a paper name (wu2015's five Newton starts) add their label."""
+    names = {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
+    counts = pd.Series(list(names.values())).value_counts()
+    return {spec.key: f"{names[spec.key]} · {spec.label}" if counts[names[spec.key]] > 1 and spec.label
+            else names[spec.key] for spec in er.config.algorithms}
 
 
 def _curve_sets(er: ExperimentResult):
@@ -291,11 +297,17 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
     runs = curves[0][2].shape[0]
     what = "best-so-far " + plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))
     axes[0].set_ylabel(what)
+    threshold = er.config.threshold
     for ax, xl in zip(axes, ("iteration", "function evaluations (mean over runs)")):
         ax.set_yscale("log")
         ax.set_xlabel(xl)
         if zero:
             plotting.mark_zero(ax, floor)
+        if threshold is not None:     # what success rates and iterations to the threshold count
+            ax.axhline(threshold, color="0.35", lw=0.9, ls=":", zorder=1,
+                       label=f"threshold {threshold:g}" if ax is axes[0] else None)
+    from matplotlib.ticker import MaxNLocator
+    axes[0].xaxis.set_major_locator(MaxNLocator(integer=True))   # iterations are whole numbers
     axes[0].legend(loc="best")
     note = "one run" if single else f"median of {runs} runs, band: quartiles"
     if er.config.stop_at_threshold:
@@ -328,7 +340,7 @@ def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         xh = r.x_history[r.median_run]
         end = int(r.iterations_done[r.median_run]) + 1
         for j, ax in enumerate(flat[:len(names)]):
-            ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key])
+            ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key], lw=1.1)
     case = recs[0].case
     if er.mechanism.kind == "parallel":
         truth, what = ((case.target, "true value") if case.target is not None
@@ -337,17 +349,23 @@ def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         truth, what = case.given_joints, "joints defining the target"
     for j, ax in enumerate(flat[:len(names)]):
         ax.set_title(f"{names[j]} ({units[j]})")
-        ax.set_xlabel("iteration")
+        # most of the movement is in the first few per cent of the iterations: a logarithmic
+        # axis (linear below 1, so iteration 0 is shown) spreads it out
+        ax.set_xscale("symlog", linthresh=1, linscale=0.3)
+        ax.set_xlabel("iteration (log scale)")
         if truth is not None:
-            ax.axhline(truth[j], color="k", lw=0.8, ls="--", label=what)
+            ax.axhline(truth[j], color="k", lw=0.8, ls="--", label=what, zorder=1)
     for ax in flat[len(names):]:
         ax.set_visible(False)
-    flat[0].legend(fontsize=7)
+    # one legend for all panels, below them: never on a curve or on the truth line
+    handles, labels = flat[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 4), fontsize=7)
     runs = recs[0].result.runs
     fig.suptitle(f"{er.config.title or er.config.name}\nbest-so-far variables of the median run "
                  f"(of {runs}), case {case.label}" if runs > 1 else
                  f"{er.config.title or er.config.name}\nbest-so-far variables, case {case.label}", fontsize=9)
-    fig.tight_layout()
+    legend_rows = int(np.ceil(len(labels) / 4))
+    fig.tight_layout(rect=(0, 0.08 * legend_rows / rows + 0.01, 1, 1))
     out = _save(fig, path)
     plt.close(fig)
     return out
@@ -513,9 +531,12 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
             ax.set_yscale("log")
             if (table[col] <= 0).any():
                 plotting.mark_zero(ax, floor)
-        _case_axis(ax, len(er.cases))
+        shown = int(table["case"].map(order).max())   # timings cover only the first timed cases
+        _case_axis(ax, shown)
         ax.set_ylabel(ylabel)
-        ax.set_title(er.config.title or er.config.name, fontsize=9)
+        ax.set_title((er.config.title or er.config.name)
+                     + (f"\ntimed poses only: the first {shown} of {len(er.cases)}" if shown < len(er.cases) else ""),
+                     fontsize=9)
         ax.legend()
         written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
@@ -558,8 +579,8 @@ def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
         ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
     ax.set_xticks(range(len(er.config.algorithms)), [names[s.key] for s in er.config.algorithms])
     ax.set_ylabel("time per run, one run at a time (ms)")
-    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} timed runs per algorithm (bar: median)",
-                 fontsize=9)
+    ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} of the {er.config.runs} runs per algorithm "
+                 "timed one at a time (fkopt's timing sample, TIMING.md; bar: median)", fontsize=9)
     out = _save(fig, path)
     plt.close(fig)
     return out

@@ -7,6 +7,8 @@ different question: it favours algorithms whose per-iteration cost is numpy over
 reverse a comparison. Every timing figure and timing claim of fkopt's reports therefore uses the
 times measured here:
 
+* **Order**: the algorithms of a case are timed interleaved, run 0 of each, then run 1 of each
+  (A B A B ...), in one process (:func:`time_single_runs`).
 * **Mode**: each sampled run is solved alone (``solve(..., batch=False, run_ids=[k])``, the same
   stream as in the batch, so the same numbers) and timed with ``time.perf_counter`` around that
   call; one untimed short warm-up solve precedes the task's first timed run.
@@ -48,25 +50,40 @@ def sample_plan(n_cases: int, runs: int) -> tuple[int, int]:
 
 
 def time_single_runs(config, records) -> None:
-    """Set ``record.single_run_ids`` and ``record.single_run_s`` (seconds) on every task record."""
+    """Set ``record.single_run_ids`` and ``record.single_run_s`` (seconds) on every task record.
+
+    The timed runs of a case's algorithms are **interleaved** (A0 B0 A1 B1 ...: round k times run k
+    of every algorithm still sampling), in this one process, so that a slow period of the machine
+    falls on every algorithm alike instead of on whichever was timed then.
+    """
     n_cases, per = sample_plan(len({r.case.index for r in records}), config.runs)
+    by_case: dict[int, list] = {}
     for rec in records:
-        if rec.case.index >= n_cases:
-            continue
-        spec = rec.spec
-        kwargs = dict(population=spec.population or config.population, runs=1, seed=rec.seed,
-                      target=config.threshold, stop_at_target=config.stop_at_threshold,
-                      x0=None if spec.start is None else _start(rec),
-                      batch=False, params=spec.params)
-        solve(rec.problem, spec.name, iterations=2, run_ids=[0], **kwargs)   # warm-up, untimed
-        seconds = []
+        if rec.case.index < n_cases:
+            by_case.setdefault(rec.case.index, []).append(rec)
+    for recs in by_case.values():
+        kwargs = {id(rec): _kwargs(config, rec) for rec in recs}
+        for rec in recs:
+            solve(rec.problem, rec.spec.name, iterations=2, run_ids=[0], **kwargs[id(rec)])   # warm-up, untimed
+        seconds: dict[int, list] = {id(rec): [] for rec in recs}
         for k in range(per):
-            start = time.perf_counter()
-            solve(rec.problem, spec.name, iterations=spec.iterations or config.iterations, run_ids=[k], **kwargs)
-            seconds.append(time.perf_counter() - start)
-            if len(seconds) >= TIMING_MIN_RUNS and sum(seconds) > TIMING_BUDGET_S:
-                break
-        rec.single_run_ids, rec.single_run_s = np.arange(len(seconds)), np.array(seconds)
+            for rec in recs:
+                s = seconds[id(rec)]
+                if len(s) >= TIMING_MIN_RUNS and sum(s) > TIMING_BUDGET_S:
+                    continue   # this task has its sample; the others keep alternating
+                start = time.perf_counter()
+                solve(rec.problem, rec.spec.name, iterations=rec.spec.iterations or config.iterations,
+                      run_ids=[k], **kwargs[id(rec)])
+                s.append(time.perf_counter() - start)
+        for rec in recs:
+            rec.single_run_ids, rec.single_run_s = np.arange(len(seconds[id(rec)])), np.array(seconds[id(rec)])
+
+
+def _kwargs(config, rec) -> dict:
+    spec = rec.spec
+    return dict(population=spec.population or config.population, runs=1, seed=rec.seed,
+                target=config.threshold, stop_at_target=config.stop_at_threshold,
+                x0=None if spec.start is None else _start(rec), batch=False, params=spec.params)
 
 
 def _start(rec) -> np.ndarray:

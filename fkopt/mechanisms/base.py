@@ -118,6 +118,9 @@ class Mechanism:
     paper: ClassVar[str | None] = None
     #: Set when the model is a reconstruction (docs/models.md), with a one-sentence explanation.
     reconstruction: ClassVar[str | None] = None
+    #: True when the fitness path (forward/inverse map, no Jacobian) is elementwise numpy, with no
+    #: BLAS call (:mod:`fkopt.compare`); False for mechanisms fkopt has not read (plug-ins).
+    blas_free_fitness: ClassVar[bool] = False
     pose_names: ClassVar[tuple[str, ...]]
     pose_units: ClassVar[tuple[str, ...]]
     joint_names: ClassVar[tuple[str, ...]]
@@ -270,8 +273,58 @@ class FrameArm(SerialMechanism):
 
     pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
 
+    #: Which unknowns are periodic (continuous joints: any angle is allowed, answers are
+    #: wrapped into the bounds); instances may set their own array.
+    periodic: np.ndarray | None = None
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
     def frame(self, joints):
         raise NotImplementedError
+
+    def frame_jacobian(self, joints):
+        """Tip position (..., 3), rotation (..., 3, 3) and geometric frame Jacobian (..., 6, n)
+        per public joint unit (rows 0-2 d(position)/dq, rows 3-5 angular velocity in the base
+        frame). Every frame arm defines it; solvers use only this interface."""
+        raise NotImplementedError
+
+    def frame_jacobian1(self, t):
+        """:meth:`frame_jacobian` of one configuration on Python floats in internal units (rad
+        for angles, the length unit for lengths; the Jacobian per internal unit)."""
+        raise NotImplementedError
+
+    def jacobian(self, joints) -> np.ndarray:
+        """The frame Jacobian (..., 6, n) of :meth:`frame_jacobian`."""
+        return self.frame_jacobian(joints)[2]
+
+    def kinematic_key(self) -> tuple:
+        """Hashable numbers that fix the arm's forward map (caches, e.g. inverse's start table)."""
+        raise NotImplementedError
+
+    def periodic_mask(self) -> np.ndarray:
+        """Boolean (n,) of periodic unknowns (all False unless the arm says otherwise)."""
+        if self.periodic is None:
+            return np.zeros(self.dof, dtype=bool)
+        return np.asarray(self.periodic, dtype=bool)
+
+    @staticmethod
+    def euler_rates(R, omega) -> np.ndarray:
+        """Z-Y-Z Euler-angle rates (..., 3, k) of angular velocities omega (..., 3, k) at
+        rotations R (..., 3, 3): with w = (w_x, w_y, w_z), alpha' = w_z - cos(beta) gamma',
+        beta' = -sin(alpha) w_x + cos(alpha) w_y, gamma' = (cos(alpha) w_x + sin(alpha) w_y) / sin(beta)
+        (from w = alpha' e_z + beta' Rz(alpha) e_y + gamma' Rz(alpha) Ry(beta) e_z); infinite at
+        sin(beta) = 0, the singularity of the angles themselves."""
+        R = np.asarray(R)
+        al = np.arctan2(R[..., 1, 2], R[..., 0, 2])[..., None]
+        sb = np.hypot(R[..., 2, 0], R[..., 2, 1])[..., None]
+        cb = R[..., 2, 2][..., None]
+        wx, wy, wz = omega[..., 0, :], omega[..., 1, :], omega[..., 2, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gd = (np.cos(al) * wx + np.sin(al) * wy) / sb
+        bd = -np.sin(al) * wx + np.cos(al) * wy
+        return np.stack([wz - cb * gd, bd, gd], axis=-2)
 
     def fk(self, joints) -> np.ndarray:
         p, R = self.frame(joints)

@@ -90,6 +90,7 @@ class DHArm(FrameArm):
     """Serial arm with revolute joints q1..qn (deg) described by a standard DH table."""
 
     name = "dh-arm"
+    blas_free_fitness = True   # elementwise map (module docstring): no BLAS on the fitness path
     pose_units = ("mm", "mm", "mm", "deg", "deg", "deg")
     Geometry = lazy_model(_dh_geometry)                # pydantic model, built on first use
     geometry_defaults = {"a": list(WANG7DOF["a"]), "alpha": list(WANG7DOF["alpha"]), "d": list(WANG7DOF["d"]),
@@ -118,10 +119,6 @@ class DHArm(FrameArm):
         self._sa = tuple(float(np.sin(np.radians(v))) for v in g.alpha)
         self._offset = tuple(float(v) for v in (g.theta_offset or [0.0] * n))
         self._offset_rad = tuple(math.radians(v) for v in self._offset)
-
-    @property
-    def dof(self) -> int:
-        return len(self.joint_names)
 
     @property
     def reach(self) -> float:
@@ -280,26 +277,9 @@ class DHArm(FrameArm):
         return (np.ascontiguousarray(p.T), np.ascontiguousarray(R.transpose(1, 0, 2)),
                 np.ascontiguousarray(J.transpose(2, 0, 1)))
 
-    def jacobian(self, joints) -> np.ndarray:
-        """The frame Jacobian (..., 6, n) of :meth:`frame_jacobian`."""
-        return self.frame_jacobian(joints)[2]
-
-    @staticmethod
-    def euler_rates(R, omega) -> np.ndarray:
-        """Z-Y-Z Euler-angle rates (..., 3, k) of angular velocities omega (..., 3, k) at
-        rotations R (..., 3, 3): with w = (w_x, w_y, w_z), alpha' = w_z - cos(beta) gamma',
-        beta' = -sin(alpha) w_x + cos(alpha) w_y, gamma' = (cos(alpha) w_x + sin(alpha) w_y) / sin(beta)
-        (from w = alpha' e_z + beta' Rz(alpha) e_y + gamma' Rz(alpha) Ry(beta) e_z); infinite at
-        sin(beta) = 0, the singularity of the angles themselves."""
-        R = np.asarray(R)
-        al = np.arctan2(R[..., 1, 2], R[..., 0, 2])[..., None]
-        sb = np.hypot(R[..., 2, 0], R[..., 2, 1])[..., None]
-        cb = R[..., 2, 2][..., None]
-        wx, wy, wz = omega[..., 0, :], omega[..., 1, :], omega[..., 2, :]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gd = (np.cos(al) * wx + np.sin(al) * wy) / sb
-        bd = -np.sin(al) * wx + np.cos(al) * wy
-        return np.stack([wz - cb * gd, bd, gd], axis=-2)
+    def kinematic_key(self) -> tuple:
+        """The DH table's numbers (no pydantic model needed)."""
+        return (self.name, self._a, self._d, self._ca, self._sa, self._offset)
 
 
 class SevenDofArm(DHArm):

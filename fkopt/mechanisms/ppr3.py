@@ -39,6 +39,7 @@ class ThreePPRGeometry(Geometry):
 
 class ThreePPR(ParallelMechanism):
     name = "3-ppr"
+    blas_free_fitness = True   # elementwise map (module docstring): no BLAS on the fitness path
     paper = "wu2015"
     reconstruction = ("wu2015 prints the inverse map but not F_i or D_i0; docs/models.md's geometry "
                       "(F_i on a circle r_F = 41.5322 mm at 210, 330, 90 deg, D1x0 = 5.4678 mm, "

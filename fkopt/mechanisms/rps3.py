@@ -72,6 +72,7 @@ class ThreeRPSGeometry(Geometry):
 
 class ThreeRPS(ParallelMechanism):
     name = "3-rps"
+    blas_free_fitness = True   # elementwise map (module docstring): no BLAS on the fitness path
     paper = "mao2017"
     pose_names = ("alpha", "beta", "z")
     pose_units = ("deg", "deg", "mm")

@@ -35,6 +35,7 @@ class RPUPcUPSGeometry(Geometry):
 
 class ThreeRPUPcUPS(ParallelMechanism):
     name = "3-rpupc-ups"
+    blas_free_fitness = True   # elementwise map (module docstring): no BLAS on the fitness path
     paper = "chang2024"
     reconstruction = ("chang2024's kinematic equations were lost in extraction; docs/models.md's model "
                       "(annular-prismatic U joints kept in the legs' vertical planes, delta = "

@@ -121,6 +121,7 @@ class SixSPS(ParallelMechanism):
     """General 6-SPS (Stewart-Gough) platform; leg i joins base i to platform i."""
 
     name = "6-sps"
+    blas_free_fitness = True   # elementwise map (module docstring): no BLAS on the fitness path
     pose_names = ("x", "y", "z", "alpha", "beta", "gamma")
     pose_units = ("m", "m", "m", "deg", "deg", "deg")
     joint_names = ("l1", "l2", "l3", "l4", "l5", "l6")

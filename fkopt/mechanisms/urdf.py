@@ -10,20 +10,30 @@ in the base frame plus the Z-Y-Z Euler angles (degrees) of :class:`fkopt.mechani
 so :class:`fkopt.problems.IKProblem` treats both alike.
 
 Bounds: revolute and prismatic joints take ``<limit lower upper>`` from the file; continuous
-joints (no limits) default to [-180, 180] deg, and any joint's bounds can be overridden by the
-config's ``mechanism.bounds`` as for every mechanism. In an experiment file, a relative
+joints (no limits) get [-180, 180] deg and are *periodic* (``arm.periodic``): solvers may move
+them through any angle and ``fkopt.inverse`` wraps the answer into [-180, 180). Any joint's
+bounds can be overridden by the config's ``mechanism.bounds`` as for every mechanism (a
+continuous joint given bounds is no longer periodic). In an experiment file, a relative
 ``geometry.file`` is relative to the config file's folder (see
 :func:`fkopt.experiment.runner.build_mechanism`); from Python, to the working directory.
 Without ``file`` the mechanism is wang7dof's arm written as URDF (``mechanisms/data/wang7dof.urdf``),
 which gives the same poses as ``7dof-arm`` with lengths in metres instead of millimetres.
 
-Parsing uses yourdfpy (meshes are not loaded); FK is vectorised over any batch shape and
-written elementwise like the DH arm, so batching never changes the numbers. No analytic
-Jacobian here: solvers that need one use their finite-difference fallback.
+Mimic joints (``<mimic joint multiplier offset>``) are not unknowns: q = multiplier * q_master
++ offset (SI units, as URDF defines it), through chains of mimics; their limits narrow the
+master's bounds, so every answer inside the bounds keeps them. A mimic whose master is not on
+the chain is refused with one line. ``geometry.tool`` adds a tool (TCP) frame on the tip link.
+
+Parsing uses the standard library's XML parser (links and joints only). FK and the analytic geometric frame Jacobian
+(:meth:`URDFArm.frame_jacobian`) share one recursion (:meth:`URDFArm._walk`), elementwise over
+the batch (no matmul), so batching never changes the numbers; ``frame_jacobian1`` is the same
+recursion on Python floats for a single configuration.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -42,15 +52,33 @@ class URDFGeometry(Geometry):
     file: str = Field(str(DEFAULT_FILE), description="URDF file (relative: to the config's folder)")
     base: str | None = Field(None, description="first link of the chain (default: the root link)")
     tip: str | None = Field(None, description="last link of the chain (default: the only leaf link)")
+    tool: list[float] | None = Field(None, min_length=6, max_length=6,
+                                     description="tool (TCP) frame on the tip link: x, y, z (m), roll, pitch, "
+                                                 "yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll) as URDF origins)")
+
+
+def _floats(text, count: int, default, what: str, path: Path) -> tuple:
+    if text is None:
+        return default
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        values = ()
+    if len(values) != count or not all(map(math.isfinite, values)):
+        raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{text}')")
+    return values
 
 
 #: Largest URDF file read (bytes): a robot description with meshes referenced, not inlined, is
-#: kilobytes; a parsed tree takes ~35 times its file size in memory.
+#: kilobytes; a parsed tree takes tens of times its file size in memory.
 MAX_URDF_BYTES = 4 << 20
 
 
-def _load(path: Path):
-    """Parse with yourdfpy; every failure is one line naming the file."""
+def _load(path: Path) -> SimpleNamespace:
+    """The links and joints of a URDF file (what a kinematic chain needs: no meshes, inertias
+    or transmissions), read with the standard library's XML parser -- importing a URDF library
+    cost 1.3-2.0 s per process. Every failure is one line naming the file."""
+    import xml.etree.ElementTree as ET
     if not path.is_file():
         raise FkoptError(f"urdf geometry.file: {path} does not exist")
     size = path.stat().st_size
@@ -58,23 +86,46 @@ def _load(path: Path):
         raise FkoptError(f"urdf {path}: {size} bytes, larger than the {MAX_URDF_BYTES} bytes accepted for "
                          "a URDF file")
     try:
-        import yourdfpy
-    except ImportError:
-        raise FkoptError("the 'urdf' mechanism needs yourdfpy: pip install yourdfpy") from None
-    from lxml import etree   # a dependency of yourdfpy
-    try:   # strict XML first: yourdfpy would log the error and retry with a recovering parser
-        etree.parse(str(path), etree.XMLParser(remove_blank_text=True))
-    except etree.XMLSyntaxError as err:
+        root = ET.parse(str(path)).getroot()
+    except ET.ParseError as err:
         raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
-    try:
-        robot = yourdfpy.URDF.load(str(path), build_scene_graph=False, build_collision_scene_graph=False,
-                                   load_meshes=False, load_collision_meshes=False)
-    except Exception as err:
-        msg = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise FkoptError(f"urdf {path}: malformed URDF ({msg})") from None
-    if robot is None or not getattr(robot, "robot", None) or not robot.link_map:
-        raise FkoptError(f"urdf {path}: malformed URDF (no <robot> with links)")
-    return robot
+    links = {e.get("name"): e for e in root.findall("link")}
+    if root.tag != "robot" or not links or None in links:
+        raise FkoptError(f"urdf {path}: malformed URDF (no <robot> with named links)")
+    joints = {}
+    for e in root.findall("joint"):
+        name, kind = e.get("name"), e.get("type")
+        parent, child = e.find("parent"), e.find("child")
+        if not name or not kind or parent is None or child is None or not parent.get("link") \
+                or not child.get("link"):
+            raise FkoptError(f"urdf {path}: malformed URDF (joint '{name}' needs name, type, "
+                             "<parent link> and <child link>)")
+        if name in joints:
+            raise FkoptError(f"urdf {path}: malformed URDF (joint '{name}' is defined twice)")
+        origin = np.eye(4)
+        o = e.find("origin")
+        if o is not None:
+            origin[:3, 3] = _floats(o.get("xyz"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin xyz", path)
+            origin[:3, :3] = _rpy(*_floats(o.get("rpy"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin rpy", path))
+        ax = e.find("axis")
+        axis = _floats(None if ax is None else ax.get("xyz"), 3, (1.0, 0.0, 0.0), f"joint '{name}' axis", path)
+        lim = e.find("limit")
+        limit = None
+        if lim is not None and lim.get("lower") is not None and lim.get("upper") is not None:
+            limit = SimpleNamespace(lower=_floats(lim.get("lower"), 1, None, f"joint '{name}' limit lower", path)[0],
+                                    upper=_floats(lim.get("upper"), 1, None, f"joint '{name}' limit upper", path)[0])
+        mi = e.find("mimic")
+        mimic = None
+        if mi is not None:
+            if not mi.get("joint"):
+                raise FkoptError(f"urdf {path}: malformed URDF (joint '{name}': <mimic> needs joint)")
+            mimic = SimpleNamespace(
+                joint=mi.get("joint"),
+                multiplier=_floats(mi.get("multiplier"), 1, (1.0,), f"joint '{name}' mimic multiplier", path)[0],
+                offset=_floats(mi.get("offset"), 1, (0.0,), f"joint '{name}' mimic offset", path)[0])
+        joints[name] = SimpleNamespace(name=name, type=kind, parent=parent.get("link"), child=child.get("link"),
+                                       origin=origin, axis=np.array(axis), limit=limit, mimic=mimic)
+    return SimpleNamespace(link_map=links, joint_map=joints)
 
 
 def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
@@ -116,6 +167,138 @@ def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
     return chain
 
 
+#: Entries of the constant rotations within this of 0 or +-1 are snapped to it: URDF files
+#: write quarter turns as rpy="0 0 1.5707963267948966", whose cosine is 6e-17, not 0; snapping
+#: moves the frame by ~1e-16 and turns most constant products into copies (fewer array ops).
+_SNAP = 1e-15
+
+
+def _rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll) (radians)."""
+    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
+                              math.cos(yaw), math.sin(yaw))
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _align(axis: np.ndarray) -> np.ndarray:
+    """A rotation A whose third column is the unit ``axis``, so that Rot(axis, t) = A Rz(t) A^T:
+    a signed permutation for a coordinate axis (the common case), else completed by
+    Gram-Schmidt."""
+    for k in range(3):
+        for sign in (1.0, -1.0):
+            if np.array_equal(axis, sign * np.eye(3)[k]):
+                i, j = (k + 1) % 3, (k + 2) % 3            # e_i x e_j = e_k
+                cols = (np.eye(3)[i], sign * np.eye(3)[j], sign * np.eye(3)[k])
+                return np.stack(cols, axis=1)
+    h = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    x = h - (h @ axis) * axis
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(axis, x), axis], axis=1)
+
+
+def _snap(a: np.ndarray) -> np.ndarray:
+    a = np.where(np.abs(a) < _SNAP, 0.0, a)
+    return np.where(np.abs(np.abs(a) - 1.0) < _SNAP, np.sign(a), a)
+
+
+def _terms(C: np.ndarray) -> tuple:
+    """The non-zero entries of a constant 3x3 rotation by output column: ((row, value), ...) per
+    column, for products ``F C`` written as sums of scaled columns of F."""
+    return tuple(tuple((m, float(C[m, c])) for m in range(3) if C[m, c] != 0.0) for c in range(3))
+
+
+def _combine(cols, terms):
+    """Columns of F C (see :func:`_terms`): a copy-free column for a +1 entry, else sums."""
+    out = []
+    for tc in terms:
+        acc = None
+        for m, v in tc:
+            t = cols[m] if v == 1.0 else (-cols[m] if v == -1.0 else cols[m] * v)
+            acc = t if acc is None else acc + t
+        out.append(acc)
+    return out
+
+
+def _offset(cols, v):
+    """F v for a constant vector v (its non-zero entries only); None when v = 0."""
+    acc = None
+    for m in range(3):
+        if v[m] != 0.0:
+            t = cols[m] * v[m]
+            acc = t if acc is None else acc + t
+    return acc
+
+
+def _lin(terms) -> str:
+    """Source of a sum ``c1 * n1 + c2 * n2 ...`` of named floats (coefficients +-1 written as signs)."""
+    out = ""
+    for name, v in terms:
+        if v == 0.0:
+            continue
+        t = name if abs(v) == 1.0 else f"{name} * {abs(v)!r}"
+        out += (" - " if v < 0 else " + ") + t if out else ("-" if v < 0 else "") + t
+    return out or "0.0"
+
+
+def _compile1(joints, tail, dof):
+    """A function t -> (p, R, J) on Python floats: :meth:`URDFArm._walk` and the Jacobian of
+    :meth:`URDFArm.frame_jacobian` unrolled for one arm's constants (zero terms dropped, +-1
+    factors as signs, the columns' names permuted instead of copied), like ``namedtuple``
+    builds its class from source. Frame columns are x0..x2, y0..y2, z0..z2, position p0..p2."""
+    src = ["def fj1(t):", "    x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0",
+           "    p0 = p1 = p2 = 0.0"]
+    names = ("x", "y", "z")
+
+    def offset(v):
+        for r in range(3):
+            e = _lin([(f"{names[m]}{r}", v[m]) for m in range(3)])
+            if e != "0.0":
+                src.append(f"    p{r} = p{r} + ({e})")
+
+    def combine(terms):
+        new = [_lin([(f"{names[m]}{r}", v) for m, v in terms[c]]) for c in range(3) for r in range(3)]
+        src.append("    x0, x1, x2, y0, y1, y2, z0, z1, z2 = " + ", ".join(new))
+
+    cols = {}
+    for i, (prismatic, terms, v, var, mult, off) in enumerate(joints):
+        src.append(f"    q = t[{var}]" + (f" * {mult!r} + {off!r}" if (mult, off) != (1.0, 0.0) else ""))
+        offset(v)
+        combine(terms)
+        src.append(f"    a{i}0, a{i}1, a{i}2, o{i}0, o{i}1, o{i}2 = z0, z1, z2, p0, p1, p2")
+        if prismatic:
+            src.append("    p0, p1, p2 = p0 + z0 * q, p1 + z1 * q, p2 + z2 * q")
+        else:
+            src.append("    c, s = cos(q), sin(q)")
+            src.append("    x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, "
+                       "y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)")
+        cols.setdefault(var, []).append((i, prismatic, mult))
+    offset(tail[1])
+    combine(tail[0])
+    rows = [[] for _ in range(6)]
+    for var in range(dof):
+        parts = [[] for _ in range(6)]
+        for i, prismatic, mult in cols.get(var, []):
+            k = "" if mult == 1.0 else f" * {mult!r}"
+            if prismatic:
+                col = (f"a{i}0", f"a{i}1", f"a{i}2", None, None, None)
+            else:
+                d = (f"(p0 - o{i}0)", f"(p1 - o{i}1)", f"(p2 - o{i}2)")
+                col = (f"(a{i}1 * {d[2]} - a{i}2 * {d[1]})", f"(a{i}2 * {d[0]} - a{i}0 * {d[2]})",
+                       f"(a{i}0 * {d[1]} - a{i}1 * {d[0]})", f"a{i}0", f"a{i}1", f"a{i}2")
+            for r in range(6):
+                if col[r] is not None:
+                    parts[r].append(col[r] + k)
+        for r in range(6):
+            rows[r].append(" + ".join(parts[r]) or "0.0")
+    src.append("    return [p0, p1, p2], [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]], ["
+               + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]")
+    scope = {"cos": math.cos, "sin": math.sin}
+    exec(compile("\n".join(src), "<fkopt.urdf frame_jacobian1>", "exec"), scope)
+    return scope["fj1"]
+
+
 class URDFArm(FrameArm):
     """Serial arm from a URDF chain (module docstring). Lengths in m, angles in deg."""
 
@@ -139,96 +322,272 @@ class URDFArm(FrameArm):
         path = Path(g.file)
         robot = _load(path)
         chain = _chain(robot, path, g.base, g.tip)
-        names, units, limits, steps = [], [], {}, []
-        for j in chain:
-            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
-            axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
-            for what, value in (("origin", origin), ("axis", axis)):
-                if not np.all(np.isfinite(value)):
-                    raise FkoptError(f"urdf {path}: joint '{j.name}' {what} holds a value that is not a finite "
-                                     "number (NaN or inf)")
-            if j.type in MOVING:
-                norm = float(np.linalg.norm(axis))
-                if not norm > 0:
-                    raise FkoptError(f"urdf {path}: joint '{j.name}' has a zero axis")
-                axis = axis / norm
+        moving = [j for j in chain if j.type in MOVING]
+        on_chain = {j.name: j for j in moving}
+        names, units, limits = [], [], {}
+        for j in moving:
+            if j.mimic is None:
                 names.append(j.name)
-                prismatic = j.type == "prismatic"
-                units.append("m" if prismatic else "deg")
-                lim = j.limit
-                if j.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
-                    if j.type != "continuous":
-                        raise FkoptError(f"urdf {path}: joint '{j.name}' ({j.type}) needs <limit lower upper>")
-                    limits[j.name] = CONTINUOUS_BOUNDS
-                else:
-                    lo, hi = float(lim.lower), float(lim.upper)
-                    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-                        raise FkoptError(f"urdf {path}: joint '{j.name}' <limit lower=\"{lim.lower}\" "
-                                         f"upper=\"{lim.upper}\">: finite numbers, lower below upper, are "
-                                         "needed (a joint without limits is type=\"continuous\")")
-                    limits[j.name] = (lo, hi) if prismatic else (round(float(np.degrees(lo)), 9),
-                                                                 round(float(np.degrees(hi)), 9))
-            steps.append((j.type, origin[:3, :3].copy(), origin[:3, 3].copy(), axis))
-        if len(set(names)) != len(names):
-            raise FkoptError(f"urdf {path}: joint names repeat along the chain")
+                units.append("m" if j.type == "prismatic" else "deg")
+        index = {n: i for i, n in enumerate(names)}
+        to_si = [math.pi / 180.0 if u == "deg" else 1.0 for u in units]
+
+        def source(j, seen=()):
+            """(unknown index, multiplier, offset) of joint j in SI units: q_j = m q_src + o."""
+            if j.mimic is None:
+                return index[j.name], 1.0, 0.0
+            master = on_chain.get(j.mimic.joint)
+            if master is None or j.name in seen:
+                why = "is not on the chain" if master is None else "mimics in a loop"
+                raise FkoptError(f"urdf {path}: joint '{j.name}' mimics '{j.mimic.joint}', which {why} "
+                                 f"between '{chain[0].parent}' and '{chain[-1].child}'")
+            var, mult, off = source(master, seen + (j.name,))
+            a = 1.0 if j.mimic.multiplier is None else float(j.mimic.multiplier)
+            b = 0.0 if j.mimic.offset is None else float(j.mimic.offset)
+            return var, a * mult, a * off + b
+
+        for j in moving:
+            lim = j.limit
+            has = lim is not None and lim.lower is not None and lim.upper is not None and j.type != "continuous"
+            if j.type != "continuous" and not has:
+                raise FkoptError(f"urdf {path}: joint '{j.name}' ({j.type}) needs <limit lower upper>")
+            var, mult, off = source(j)
+            if not has:
+                lo_si, hi_si = -math.inf, math.inf
+            else:
+                lo_si, hi_si = float(lim.lower), float(lim.upper)
+            if mult == 0.0:
+                if not lo_si <= off <= hi_si:
+                    raise FkoptError(f"urdf {path}: joint '{j.name}' mimics with multiplier 0 at offset "
+                                     f"{off:g}, outside its limits [{lo_si:g}, {hi_si:g}]")
+                continue
+            # limits of the joint as limits of its unknown: q_src in [(lo - o)/m, (hi - o)/m]
+            a, b = sorted(((lo_si - off) / mult, (hi_si - off) / mult))
+            a, b = a / to_si[var], b / to_si[var]
+            if units[var] == "deg":
+                a, b = (round(v, 9) if math.isfinite(v) else v for v in (a, b))
+            lo, hi = limits.get(names[var], (-math.inf, math.inf))
+            limits[names[var]] = (max(lo, a), min(hi, b))
+        periodic = []
+        for i, n in enumerate(names):
+            lo, hi = limits[n]
+            periodic.append(not (math.isfinite(lo) and math.isfinite(hi)))
+            if periodic[-1]:                           # continuous: documented range, wrapped
+                lo, hi = (max(lo, CONTINUOUS_BOUNDS[0]) if math.isfinite(lo) else CONTINUOUS_BOUNDS[0],
+                          min(hi, CONTINUOUS_BOUNDS[1]) if math.isfinite(hi) else CONTINUOUS_BOUNDS[1])
+                periodic[-1] = (lo, hi) == CONTINUOUS_BOUNDS
+            if not lo < hi:
+                raise FkoptError(f"urdf {path}: the limits of joint '{n}' and the joints mimicking it "
+                                 "leave no motion")
+            limits[n] = (lo, hi)
         self.joint_names = tuple(names)
         self.joint_units = tuple(units)
         self.default_bounds = limits
         super().__init__(bounds, **geometry)
+        # a continuous joint is periodic unless the config bounds it
+        self.periodic = np.array([p and tuple(b) == CONTINUOUS_BOUNDS
+                                  for p, b in zip(periodic, self.bounds.tolist())])
         self.path = path
         self.base_link = chain[0].parent
         self.tip_link = chain[-1].child
-        self._steps = steps
-        strokes = [max(abs(lo), abs(hi)) for unit, (lo, hi) in zip(self.joint_units, self.bounds) if unit == "m"]
-        self._reach = float(sum(np.linalg.norm(p) for _, _, p, _ in steps) + sum(strokes))
+        self._to_si = np.array(to_si)
+        self._build(chain, source, g.tool)
+        #: The chain's moving joints as URDF gives them (limits in rad or m; None: continuous),
+        #: with the unknown each follows (itself unless it mimics another).
+        self.chain_joints = []
+        for j in moving:
+            var, mult, off = source(j)
+            lim = j.limit
+            self.chain_joints.append({
+                "name": j.name, "type": j.type,
+                "limits": None if j.type == "continuous" or lim is None else [lim.lower, lim.upper],
+                "unit": "rad" if j.type != "prismatic" else "m",
+                "unknown": names[var], "multiplier": mult, "offset": off})
 
-    @property
-    def dof(self) -> int:
-        return len(self.joint_names)
+    def _build(self, chain, source, tool) -> None:
+        """Constant parts of the recursion (module docstring of :meth:`frame`): per moving joint
+        C_i = A_{i-1}^T T_R A_i and v_i = A_{i-1}^T T_p, with T the product of the fixed origins
+        since the previous moving joint (its own origin included) and A_i turning z onto its axis;
+        the tail (fixed joints after the last, then the tool) the same way."""
+        acc = np.eye(4)
+        A_prev = np.eye(3)
+        joints, reach = [], 0.0
+        for j in chain:
+            origin = np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float)
+            reach += float(np.linalg.norm(origin[:3, 3]))
+            acc = acc @ origin
+            if j.type == "fixed":
+                continue
+            axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
+            norm = float(np.linalg.norm(axis))
+            if not norm > 0:
+                raise FkoptError(f"urdf {self.path}: joint '{j.name}' has a zero axis")
+            A = _align(axis / norm)
+            var, mult, off = source(j)
+            joints.append((j.type == "prismatic", _terms(_snap(A_prev.T @ acc[:3, :3] @ A)),
+                           tuple(float(v) for v in A_prev.T @ acc[:3, 3]), var, mult, off))
+            if j.type == "prismatic":
+                lo, hi = self.bounds[var] * self._to_si[var]
+                reach += max(abs(mult * lo + off), abs(mult * hi + off))
+            acc, A_prev = np.eye(4), A
+        if tool is not None:
+            T = np.eye(4)
+            T[:3, :3] = _rpy(*np.radians(tool[3:]))
+            T[:3, 3] = tool[:3]
+            reach += float(np.linalg.norm(tool[:3]))
+            acc = acc @ T
+        self._joints = tuple(joints)
+        self._tail = (_terms(_snap(A_prev.T @ acc[:3, :3])), tuple(float(v) for v in A_prev.T @ acc[:3, 3]))
+        self._reach = reach
+        self._plain = all(m == 1.0 and o == 0.0 and v == i for i, (_, _, _, v, m, o) in enumerate(joints))
+        self._key = (self.name, self._joints, self._tail)
 
     @property
     def reach(self) -> float:
         """Upper bound of the tip's distance from the base origin (sum of origin offsets + strokes)."""
         return self._reach
 
-    def frame(self, joints):
-        """Tip frame as (p, R) -- p = (px, py, pz) in m, R a :data:`rotations.Matrix` -- computed
-        elementwise over the batch shape of ``joints`` (..., dof)."""
+    def kinematic_key(self) -> tuple:
+        return self._key
+
+    def _chain_values(self, q: np.ndarray) -> list:
+        """Values (SI: rad, m) of the chain's moving joints for rows q (k, dof) in public units."""
+        cols = [np.radians(q[:, i]) if u == "deg" else q[:, i] for i, u in enumerate(self.joint_units)]
+        if self._plain:
+            return cols
+        return [cols[v] * m + o if (m, o) != (1.0, 0.0) else cols[v] for _, _, _, v, m, o in self._joints]
+
+    def _walk(self, q: np.ndarray, jacobian: bool):
+        """Tip frame of rows q (k, dof): position (3, k), columns x, y, z (3, k) of R and, when
+        ``jacobian``, the axes and origins (3, k) of the moving joints. The carried frame
+        F_i = W_i A_i has joint i's axis as its z column: F_i = F_{i-1} C_i Rz(t_i), origin
+        p_i = p_{i-1} + F_{i-1} v_i (+ t_i z for a prismatic joint); the columns' update is
+        u = c x + s y, v = c y - s x (a fixed number of array operations per joint)."""
+        k = len(q)
+        t = self._chain_values(q)
+        cols = list(np.eye(3)[:, :, None] * np.ones(k))          # x, y, z of the base frame (3, k)
+        p = np.zeros((3, k))
+        axes, origins = [], []
+        for ti, (prismatic, terms, v, _, _, _) in zip(t, self._joints):
+            dp = _offset(cols, v)
+            if dp is not None:
+                p = p + dp
+            cols = _combine(cols, terms)
+            if jacobian:
+                axes.append(cols[2])
+                origins.append(p)
+            if prismatic:
+                p = p + cols[2] * ti
+            else:
+                c, s = np.cos(ti), np.sin(ti)
+                x, y = cols[0], cols[1]
+                cols = [x * c + y * s, y * c - x * s, cols[2]]
+        terms, v = self._tail
+        dp = _offset(cols, v)
+        if dp is not None:
+            p = p + dp
+        cols = _combine(cols, terms)
+        return p, cols, axes, origins
+
+    def _check(self, joints) -> np.ndarray:
         joints = np.asarray(joints, dtype=float)
         if joints.shape[-1:] != (self.dof,):
             raise FkoptError(f"{self.name} joints: expected {self.dof} values "
                              f"({', '.join(self.joint_names)}), got shape {joints.shape}")
+        return joints
+
+    def frame(self, joints):
+        """Tip frame as (p, R) -- p = (px, py, pz) in m, R a :data:`rotations.Matrix` -- computed
+        elementwise over the batch shape of ``joints`` (..., dof) (:meth:`_walk`)."""
+        joints = self._check(joints)
         shape = joints.shape[:-1]
-        zero = np.zeros(shape)
-        R = tuple(tuple(zero + (1.0 if r == c else 0.0) for c in range(3)) for r in range(3))
-        p = (zero.copy(), zero.copy(), zero.copy())
-        k = 0
-        for kind, Ro, po, axis in self._steps:
-            # fixed origin: p += R po, R = R Ro
-            p = tuple(p[r] + R[r][0] * po[0] + R[r][1] * po[1] + R[r][2] * po[2] for r in range(3))
-            R = tuple(tuple(R[r][0] * Ro[0][c] + R[r][1] * Ro[1][c] + R[r][2] * Ro[2][c] for c in range(3))
-                      for r in range(3))
-            if kind == "fixed":
-                continue
-            q = joints[..., k]
-            k += 1
-            if kind == "prismatic":
-                d = (axis[0] * q, axis[1] * q, axis[2] * q)
-                p = tuple(p[r] + R[r][0] * d[0] + R[r][1] * d[1] + R[r][2] * d[2] for r in range(3))
-                continue
-            t = np.radians(q)
-            c, s = np.cos(t), np.sin(t)
-            v = 1.0 - c
-            x, y, z = axis
-            # Rodrigues: Rot(axis, t) = c I + s [axis]x + (1 - c) axis axis^T
-            M = ((c + x * x * v, x * y * v - z * s, x * z * v + y * s),
-                 (y * x * v + z * s, c + y * y * v, y * z * v - x * s),
-                 (z * x * v - y * s, z * y * v + x * s, c + z * z * v))
-            R = tuple(tuple(R[r][0] * M[0][cc] + R[r][1] * M[1][cc] + R[r][2] * M[2][cc] for cc in range(3))
-                      for r in range(3))
-        return p, R
+        p, cols, _, _ = self._walk(joints.reshape(-1, self.dof), False)
+        return (tuple(p[r].reshape(shape) for r in range(3)),
+                tuple(tuple(cols[c][r].reshape(shape) for c in range(3)) for r in range(3)))
+
+    def frame_jacobian(self, joints) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Tip position (..., 3), rotation (..., 3, 3) and geometric frame Jacobian (..., 6, n)
+        per public joint unit (rows 0-2 d(position)/dq, rows 3-5 the angular velocity in the base
+        frame): a revolute joint with world axis z through o contributes (z x (p - o), z), a
+        prismatic one (z, 0) (Siciliano et al., Robotics, 2009, eq. 3.30); a mimicking joint adds
+        its column times its multiplier to the column of the joint it follows."""
+        joints = self._check(joints)
+        shape = joints.shape[:-1]
+        q = joints.reshape(-1, self.dof)
+        k, n = len(q), self.dof
+        p, cols, axes, origins = self._walk(q, True)
+        Z, O = np.stack(axes, axis=1), np.stack(origins, axis=1)        # (3, m, k)
+        D = p[:, None, :] - O
+        Jc = np.empty((6, len(axes), k))
+        Jc[0] = Z[1] * D[2] - Z[2] * D[1]
+        Jc[1] = Z[2] * D[0] - Z[0] * D[2]
+        Jc[2] = Z[0] * D[1] - Z[1] * D[0]
+        Jc[3:] = Z
+        pri = [i for i, j in enumerate(self._joints) if j[0]]
+        if pri:
+            Jc[:3, pri], Jc[3:, pri] = Z[:, pri], 0.0
+        if self._plain:
+            J = Jc * self._to_si[None, :, None]
+        else:
+            J = np.zeros((6, n, k))
+            for i, (_, _, _, v, m, _) in enumerate(self._joints):
+                J[:, v] += Jc[:, i] * (m * self._to_si[v])
+        R = np.stack(cols, axis=-1)                                       # (3 rows, k, 3 columns)
+        return (np.ascontiguousarray(p.T).reshape(shape + (3,)),
+                np.ascontiguousarray(R.transpose(1, 0, 2)).reshape(shape + (3, 3)),
+                np.ascontiguousarray(J.transpose(2, 0, 1)).reshape(shape + (6, n)))
+
+    def frame_jacobian1(self, t) -> tuple[list[float], list[list[float]], list[list[float]]]:
+        """:meth:`frame_jacobian` of one configuration on Python floats, in internal units (``t``
+        in rad for angles, m for lengths; the Jacobian per rad / per m): the recursion of
+        :meth:`_walk` written out for this arm's constants (:func:`_compile1`, once per arm),
+        since for one configuration the interpreter's per-operation cost is all there is."""
+        f = self.__dict__.get("_fj1")
+        if f is None:
+            f = self.__dict__["_fj1"] = _compile1(self._joints, self._tail, self.dof)
+        return f(t)
 
     def describe(self) -> dict[str, Any]:
         out = super().describe()
         out["chain"] = {"file": str(self.path), "base": self.base_link, "tip": self.tip_link}
+        out["chain_joints"] = self.chain_joints
         return out
+
+
+#: Serial chains of the PyPI package ``example-robot-data`` (version 6) that fkopt was tried on:
+#: name -> (file under its robots/ folder, base link, tip link). Tests and ``fkopt bench
+#: --section robots`` use them; docs/robots.md lists the results.
+EXAMPLE_ROBOTS = {
+    "panda": ("panda_description/urdf/panda.urdf", "panda_link0", "panda_hand_tcp"),
+    "ur5": ("ur_description/urdf/ur5_robot.urdf", "base_link", "tool0"),
+    "kinova": ("kinova_description/robots/kinova.urdf", "base", "j2s6s200_end_effector"),
+    "xarm7": ("xarm_description/urdf/xarm7.urdf", "link_base", "link_eef"),
+    "z1": ("z1_description/urdf/z1.urdf", "link00", "gripperStator"),
+    "baxter-left": ("baxter_description/urdf/baxter.urdf", "torso", "left_gripper"),
+    "pr2-left-gripper": ("pr2_description/urdf/pr2.urdf", "torso_lift_link", "l_gripper_l_finger_tip_link"),
+}
+
+
+def example_robots_folder() -> Path | None:
+    """The robots/ folder installed by the PyPI package example-robot-data (a cmeel prefix
+    with no Python module, found through the package's file list), or None."""
+    from importlib import metadata
+    try:
+        files = metadata.files("example-robot-data") or []
+    except metadata.PackageNotFoundError:
+        return None
+    for f in files:
+        if str(f).endswith("robots/panda_description/urdf/panda.urdf"):
+            return Path(f.locate()).parents[2]
+    return None
+
+
+def example_robot(name: str, **geometry: Any) -> "URDFArm":
+    """``URDFArm`` of chain ``name`` of :data:`EXAMPLE_ROBOTS` (example-robot-data must be installed)."""
+    if name not in EXAMPLE_ROBOTS:
+        raise FkoptError(f"unknown example robot '{name}'; allowed: {', '.join(EXAMPLE_ROBOTS)}")
+    folder = example_robots_folder()
+    if folder is None:
+        raise FkoptError("example-robot-data is not installed: pip install example-robot-data")
+    rel, base, tip = EXAMPLE_ROBOTS[name]
+    return URDFArm(file=str(folder / rel), **{"base": base, "tip": tip, **geometry})

@@ -8,12 +8,19 @@ results folder ``<paper>/<name>/``:
 2. every deterministic file must still have the SHA-256 recorded in ``meta.json`` when it was
    written (``files``), and no recorded file may be missing -- any edit of any stored table is
    caught, on any platform;
-3. the config is validated and rerun in this process into a scratch folder; the deterministic
-   files (all CSVs but the timing files, and ``meta.json``) are compared **byte for byte** when
-   the platform fingerprint stored in ``env.json`` equals this machine's, and by the documented
-   distribution-level tolerances of :mod:`fkopt.compare` otherwise.
-4. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
-   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.claims.rerun_verdict_drift`).
+3. on every platform: ``summary.csv`` must hold the statistics of the stored ``runs.csv``
+   (:func:`fkopt.compare.summary_consistency`), and the fitness of every stored run, recomputed
+   from its stored ``x`` (:func:`recomputed_fitness`), must equal the stored fitness within what
+   the CSV's 10 significant digits of ``x`` allow;
+4. the config is validated and rerun in this process into a scratch folder; the deterministic
+   files (all CSVs but the timing files, and ``meta.json``) are compared by the rules of the
+   platform tier (:func:`fkopt.provenance.platform_tier`, :mod:`fkopt.compare`): byte for byte
+   where the stored fingerprint equals this machine's, BLAS-free rows exactly and the rest by the
+   cross-platform rules where only the BLAS part differs, the cross-platform rules elsewhere
+   (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier);
+5. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
+   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.claims.rerun_verdict_drift`), and a paper
+   folder whose paper has claims must have its ``claims.csv``.
 
 A mismatch names the experiment, the file, the row, the column and both values. Figures are
 not compared (they depend on the plotting library's version).
@@ -25,11 +32,14 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from ..compare import (FITNESS_FLOOR, LOG10_TOL, RATE_TOL, COUNT_RTOL, EXACT_RTOL, Mismatch,  # noqa: F401
-                       compare_folders, compare_tables, deterministic_files, sha256)
+import numpy as np
+import pandas as pd
+
+from ..compare import (ALPHA, Mismatch, Rules, compare_folders, deterministic_files, sha256,  # noqa: F401
+                       summary_consistency)
 from ..errors import FkoptError
 from ..experiment.kinds import from_dict, rerun_files
-from ..provenance import ENV_FILE, fingerprint
+from ..provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
 from .store import Experiment, Store
 
 #: Compared first (so the first mismatch is the most telling), then the rest, meta.json last.
@@ -62,31 +72,121 @@ def integrity(exp: Experiment) -> list[Mismatch]:
     return out
 
 
-def same_platform(exp: Experiment) -> bool:
-    """Does the fingerprint in the stored env.json equal this machine's?"""
+def stored_tier(exp: Experiment) -> str:
+    """The platform tier of a stored result on this machine (from its env.json's fingerprint)."""
     try:
         stored = json.loads((exp.folder / ENV_FILE).read_text(encoding="utf-8")).get("fingerprint")
     except (OSError, ValueError, AttributeError):
-        return False
-    return stored == fingerprint()
+        return ANY
+    return platform_tier(stored)
 
 
-def check_experiment(exp: Experiment, config=None, exact: bool | None = None,
+def same_platform(exp: Experiment) -> bool:
+    """Does the fingerprint in the stored env.json equal this machine's?"""
+    return stored_tier(exp) == EXACT
+
+
+def rules_for(exp: Experiment, tier: str) -> Rules:
+    """The comparison rules of ``exp``: which algorithm labels are path-dependent (a BLAS call may
+    lie on their path: see ``Algorithm.blas_free`` and ``Mechanism.blas_free_fitness``), and the
+    fitness at which a run counts as reached (the config's threshold)."""
+    from ..registry import algorithm_class, mechanism_class
+    cfg = exp.config if isinstance(exp.config, dict) else {}
+    mechs = [p.get("mechanism") or {} for p in cfg.get("problems") or []] or [cfg.get("mechanism") or {}]
+    try:                # a suite has several problems: its rows are BLAS-free only if every fitness is
+        classes = [mechanism_class(m.get("name")) for m in mechs]
+        mech_ok = all(getattr(c, "blas_free_fitness", False) for c in classes)
+        isolated = all(c.kind == "parallel" for c in classes)
+    except Exception:   # an unknown or unloadable mechanism: assume BLAS on its path
+        mech_ok, isolated = False, False
+    free = set()
+    for a in (cfg.get("algorithms") or []) + (cfg.get("solvers") or []):
+        try:
+            if mech_ok and getattr(algorithm_class(a.get("name")), "blas_free", False):
+                free.add(str(a.get("label") or a.get("name")))
+        except Exception:
+            pass
+    threshold = cfg.get("threshold")
+    reach = float(threshold) if isinstance(threshold, (int, float)) and threshold > 0 else Rules.reach
+    return Rules(tier, lambda label: label not in free, reach, isolated)
+
+
+def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
+    """The fitness of every stored run of an experiment or study recomputed from its stored ``x``, against
+    the stored ``final_fitness`` (on every platform).
+
+    ``runs.csv`` keeps 10 significant digits, so x is known to within d_i = 5e-10 |x_i|. The
+    bound on |f(x_true) - f(x_stored)| is taken from f itself: 4 x sum_i max(|f(x + d_i e_i) -
+    f(x)|, |f(x - d_i e_i) - f(x)|) (first order, with a factor 2 for the curvature of a squared
+    residual and 2 for safety), plus the stored fitness' own rounding (5e-10 relative).
+    """
+    from ..experiment.kinds import config_kind
+    kind = config_kind(config).name
+    if kind not in ("experiment", "study") or not (exp.folder / "runs.csv").is_file():
+        return []
+    from ..experiment.runner import build_cases, build_mechanism, build_problem, make_problem
+    label = _label(exp)
+    try:
+        runs = pd.read_csv(exp.folder / "runs.csv")
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        return [Mismatch(label, "runs.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
+    mech = build_mechanism(config)
+    if kind == "experiment":
+        groups = [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
+                  for case in build_cases(config, mech)]
+    else:                               # a study: one problem per pose of its pose set (runs.csv: pose = i + 1)
+        from ..study.poses import build_poses
+        poses = build_poses(config, mech)
+        groups = [(f"pose {i + 1}", runs["pose"] == i + 1, lambda i=i: make_problem(config, mech, poses.inputs[i]))
+                  for i in range(len(poses))]
+    out = []
+    for where, sel, make in groups:
+        rows = runs[sel]
+        if rows.empty:
+            continue
+        problem = make()
+        xs = [c for c in runs.columns if c.startswith("x_")]
+        if len(xs) != problem.dim:
+            return [Mismatch(label, "runs.csv", where, "x", f"{len(xs)} x columns", f"{problem.dim} variables",
+                             "one x column per variable")]
+        x = rows[xs].to_numpy(float)
+        stored = rows["final_fitness"].to_numpy(float)
+        d = 5e-10 * np.abs(x)
+        eye = np.eye(problem.dim)[None] * d[:, None, :]                 # row k: d_k e_k
+        pts = np.concatenate([x[:, None, :], x[:, None, :] + eye, x[:, None, :] - eye], axis=1)
+        with np.errstate(all="ignore"):
+            f = np.asarray(problem.fitness(pts), dtype=float)           # (runs, 1 + 2 dim)
+        f0 = f[:, 0]
+        change = np.abs(f[:, 1:] - f0[:, None]).reshape(len(x), 2, problem.dim).max(axis=1).sum(axis=1)
+        tol = 4.0 * change + 5e-10 * np.abs(stored) + 1e-300
+        bad = ~(np.abs(f0 - stored) <= tol)
+        for i in np.flatnonzero(bad)[:3]:
+            row = rows.iloc[i]
+            out.append(Mismatch(label, "runs.csv", f"{where} / {row['algorithm']} / {row['run']}",
+                                "final_fitness", float(stored[i]), float(f0[i]),
+                                f"fitness(x) of the stored x, within {tol[i]:.2g} (10 digits of x; every platform)"))
+    return out
+
+
+def check_experiment(exp: Experiment, config=None, exact: bool | None = None, tier: str | None = None,
                      allow_plugins: bool = False) -> list[Mismatch]:
     """Mismatches of one stored result (any kind) against a rerun; ``[]`` when it matches.
 
-    ``exact`` forces the byte-for-byte (True) or the tolerant (False) comparison; by default it
-    is chosen by the platform fingerprint. The stored config names its mechanism and algorithms:
-    only built-in names and registered entry points are resolved (a direct reference
-    ``package.module:Class`` in someone else's meta.json is refused, not imported) unless
-    ``allow_plugins`` (:func:`fkopt.registry.registered_only`).
+    ``tier`` forces the comparison rules (``"exact"``, ``"blas"``, ``"any"``; see
+    :func:`fkopt.provenance.platform_tier`); ``exact=True``/``False`` is ``"exact"``/``"any"``. By
+    default the tier follows the stored platform fingerprint.
+
+    The stored config names its mechanism and algorithms: only built-in names, adapters and
+    registered entry points are resolved -- a direct reference ``package.module:Class`` in
+    someone else's meta.json is refused, not imported -- unless ``allow_plugins``
+    (:func:`fkopt.registry.registered_only`).
     """
     from ..registry import registered_only
     with registered_only(not allow_plugins):
-        return _check_experiment(exp, config, exact)
+        return _check_experiment(exp, config, exact, tier)
 
 
-def _check_experiment(exp: Experiment, config, exact: bool | None) -> list[Mismatch]:
+def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | None) -> list[Mismatch]:
     label = _label(exp)
     problem = exp.meta_error()
     if problem:
@@ -98,19 +198,69 @@ def _check_experiment(exp: Experiment, config, exact: bool | None) -> list[Misma
             config = from_dict(dict(exp.config), f"{label}/meta.json config")
         except FkoptError as err:
             return out + [Mismatch(label, "meta.json", "-", "config", str(err), "a valid config", "valid")]
-    exact = same_platform(exp) if exact is None else exact
+    if tier is None:
+        tier = stored_tier(exp) if exact is None else (EXACT if exact else ANY)
+    if tier not in (EXACT, BLAS, ANY):
+        raise FkoptError(f"tier: '{tier}' unknown; allowed: {EXACT}, {BLAS}, {ANY}")
+    out += summary_consistency(label, exp.folder)
+    out += recomputed_fitness(exp, config)
+    out += missing_claims(exp)
+    out += timing_verdicts(exp)
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-check-"))
     try:
         rerun_files(config, tmp, exp.meta.get("config_file"))
         names = sorted(set(deterministic_files(exp.folder)) | set(deterministic_files(tmp)))
         order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
         order += ["meta.json"]
-        out += compare_folders(label, exp.folder, tmp, exact, files=order)
+        out += compare_folders(label, exp.folder, tmp, rules_for(exp, tier), files=order)
         from .claims import rerun_verdict_drift   # a claim's verdict must not change either
         out += rerun_verdict_drift(exp, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return out
+
+
+def missing_claims(exp: Experiment) -> list[Mismatch]:
+    """In a results tree written by ``fkopt reproduce`` (REPORT.md at its root), the folder of a
+    paper with claims must keep its claims.csv: deleting it would hide the verdicts from check.
+    (A single experiment folder copied elsewhere has no REPORT.md beside its paper folder.)"""
+    from . import paper_module
+    from .claims import CLAIMS_FILE
+    if not (exp.folder.parents[1] / "REPORT.md").is_file():
+        return []
+    from .engine import load
+    module = paper_module(exp.paper)
+    has_claims = load(exp.paper) is not None or hasattr(module, "claims")
+    if not has_claims or (exp.folder.parent / CLAIMS_FILE).is_file():
+        return []
+    return [Mismatch(exp.paper, CLAIMS_FILE, "-", "file", "missing", "present",
+                     f"{exp.paper} has claims: its {CLAIMS_FILE} is part of the stored result")]
+
+
+def timing_verdicts(exp: Experiment) -> list[Mismatch]:
+    """The stored timing verdicts of ``exp``'s paper (``timing_claims.csv``) must be those its stored
+    timed runs give. Check's rerun measures no time, so this compares the stored verdicts with the
+    stored measurements: on every platform, and it catches an edited timing verdict."""
+    from .claims import TIMING_CLAIMS_FILE, claims_frame
+    from .engine import judge_paper
+    file = exp.folder.parent / TIMING_CLAIMS_FILE
+    if not file.is_file():
+        return []
+    try:
+        stored = pd.read_csv(file, keep_default_na=False)
+        judged = judge_paper(exp.paper, Store(exp.folder.parents[1]))
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, "-", "file", f"unreadable ({err})", "readable",
+                         "readable CSV")]
+    if judged is None:
+        return []
+    now = claims_frame(judged[1])
+    key = "id" if "id" in stored.columns and "id" in now.columns else "claim"
+    a = dict(zip(stored[key].astype(str), stored["verdict"].astype(str)))
+    b = dict(zip(now[key].astype(str), now["verdict"].astype(str)))
+    return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, k[:90], "verdict", a.get(k, "(absent)"), b.get(k, "(absent)"),
+                     "the verdict of the stored timed runs (every platform)")
+            for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
 
 
 def select(store: Store, subset: str = "all", paper: str | None = None, name: str | None = None) -> list[Experiment]:

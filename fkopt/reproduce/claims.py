@@ -1,20 +1,18 @@
-"""Claims of a paper, judged against fkopt's stored results: the verdict vocabulary and its rules.
+"""Claims of a paper and the verdict vocabulary: the statistics every verdict rests on.
+
+The claims themselves are data (``configs/<paper>/claims.yaml``), judged by the one engine of
+:mod:`fkopt.reproduce.engine` (rules in docs/claims.md). This module holds what the engine and the
+paper modules share: the :class:`Claim` record, the verdicts, the rank test and the reads of the
+stored runs at equal iterations and at equal evaluations, and ``claims.csv`` with its drift
+check (``fkopt check``).
 
 Verdicts (:data:`RULES` is printed in the report's preamble):
 
 * **held** / **not held** -- fkopt's numbers support / contradict the claim;
-* **not checkable** -- the claim rests on something the paper does not print (a reconstructed
-  geometry, lost equations or tables), so fkopt's numbers can neither support nor refute it;
+* **conditional: held** / **conditional: not held** -- the same, but judged under a named
+  reconstruction or reading of the paper (``claims.csv``'s ``condition`` column names it);
+* **not checkable** -- the claim rests on something the paper does not print, or is circular;
 * **within noise** -- a timing difference inside the measured run-to-run spread.
-
-Claims comparing two algorithms are decided by a two-sided Mann-Whitney rank test over the runs
-(:func:`compare`, alpha = 0.05; identical samples are no difference), never by two medians
-alone, at equal iterations *and* at equal function evaluations (:func:`at_evaluations`, from
-``trace.csv.gz``). The verdict follows the budget measure the paper used; the other is shown beside.
-
-Every claim carries the numbers behind its verdict (:attr:`Claim.numbers`): the tests assert them,
-and ``claims.csv`` (one per paper, written by ``fkopt report``) stores the verdicts that
-``fkopt check`` compares (:func:`verdict_changes`).
 """
 from __future__ import annotations
 
@@ -25,31 +23,39 @@ import numpy as np
 import pandas as pd
 
 HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE = "held", "not held", "not checkable", "within noise"
-VERDICTS = (HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE)
+CONDITIONAL = "conditional: "
+VERDICTS = (HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE, CONDITIONAL + HELD, CONDITIONAL + NOT_HELD)
 ALPHA = 0.05
 
 RULES = [
     "*held* / *not held*: fkopt's numbers support / contradict the claim.",
-    "*not checkable*: the claim rests on something the paper does not print (a reconstructed "
-    "geometry, lost equations or tables), so fkopt's numbers can neither support nor refute it; "
+    "*conditional: held* / *conditional: not held*: the same, judged under a reconstruction or one "
+    "reading of an ambiguous equation, named in the claim's *condition*; a claim with several readings "
+    "has one row per reading.",
+    "*not checkable*: the claim rests on something the paper does not print (lost tables, an error "
+    "measure that was lost), or is circular (a model fitted to the very numbers it would confirm); "
     "fkopt's numbers are shown anyway.",
-    "*within noise*: a timing difference inside the measured run-to-run spread (timing claims, "
-    "TIMING.md only).",
+    "*within noise*: a timing difference inside the measured run-to-run spread (TIMING.md only).",
     f"A claim that one algorithm beats another is decided by a two-sided Mann-Whitney rank test over "
-    f"the runs at alpha = {ALPHA} (p-value shown; identical samples count as no difference), never by "
-    "two medians alone. It is judged at equal iterations and at equal function evaluations (each "
-    "run's best-so-far after the cheaper algorithm's evaluations); the verdict follows the budget the "
-    "paper used (all five papers give every algorithm the same number of iterations), the other is "
-    "shown beside it.",
+    f"all runs at alpha = {ALPHA} (p-value shown; identical samples count as no difference), against the "
+    "algorithm the paper ran (fkopt's own variants are shown beside it), at equal iterations and at "
+    "equal function evaluations; the verdict uses the paper's budget basis and the evidence flags "
+    "**bases disagree** where the other basis would reverse it.",
+    "A magnitude claim uses the mean or the median over all runs (never one run or a maximum over "
+    "runs), per coordinate in the paper's units, against the printed order of magnitude "
+    "(docs/claims.md).",
 ]
 
 
 @dataclass
 class Claim:
-    text: str          # the paper's claim, in its own terms
+    text: str          # the paper's claim, in its own terms (with its place: "Fig. 2: ...")
     verdict: str       # one of VERDICTS
     evidence: str      # fkopt's numbers that decide it
     numbers: dict = field(default_factory=dict)   # the numbers behind the verdict (tests, claims.csv)
+    id: str = ""       # stable id (claims.yaml; one per reading)
+    condition: str = ""   # the reconstruction or reading a conditional verdict rests on
+    kind: str = ""
 
     def __post_init__(self):
         assert self.verdict in VERDICTS, self.verdict
@@ -59,8 +65,8 @@ def verdict(ok) -> str:
     return HELD if bool(ok) else NOT_HELD
 
 
-def missing(text: str, what: str) -> Claim:
-    return Claim(text, NOT_CHECKABLE, f"no stored result for {what}")
+def missing(text: str, what: str, id: str = "") -> Claim:
+    return Claim(text, NOT_CHECKABLE, f"no stored result for {what}", id=id)
 
 
 def g(x, digits: int = 3) -> str:
@@ -127,12 +133,14 @@ def compare(a: str, values_a, b: str, values_b) -> Comparison:
     return Comparison(a, b, va, vb, p)
 
 
+def _select(df: pd.DataFrame, algo: str, case: str | None) -> pd.DataFrame:
+    return df[df.algorithm == algo] if case is None else df[(df.algorithm == algo) & (df["case"] == case)]
+
+
 def at_iteration(exp, algo: str, iteration: int | None = None, case: str | None = None) -> np.ndarray:
     """Per-run best-so-far fitness after ``iteration`` (default: the end) from trace.csv.gz/runs.csv."""
     if iteration is None or not exp.has("trace.csv.gz"):
-        r = exp.table("runs")
-        r = r[r.algorithm == algo] if case is None else r[(r.algorithm == algo) & (r["case"] == case)]
-        return r.sort_values("run").final_fitness.to_numpy(float)
+        return _select(exp.table("runs"), algo, case).sort_values(["case", "run"]).final_fitness.to_numpy(float)
     return _from_trace(exp, algo, "iteration", iteration, case)
 
 
@@ -142,10 +150,9 @@ def at_evaluations(exp, algo: str, evaluations: float, case: str | None = None) 
 
 
 def _from_trace(exp, algo, column, budget, case) -> np.ndarray:
-    t = exp.table("trace")
-    t = t[t.algorithm == algo] if case is None else t[(t.algorithm == algo) & (t["case"] == case)]
+    t = _select(exp.table("trace"), algo, case)
     out = []
-    for _, grp in t.groupby("run", sort=True):
+    for _, grp in t.groupby(["case", "run"], sort=True):
         before = grp[grp[column] <= budget]
         out.append(float(before.best_fitness.iloc[-1]) if len(before) else float("inf"))
     return np.asarray(out)
@@ -154,28 +161,38 @@ def _from_trace(exp, algo, column, budget, case) -> np.ndarray:
 def first_below(exp, algo: str, level: float, case: str | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per run: (iteration, evaluations) at which the best-so-far first went below ``level``
     (inf where it never did), from trace.csv.gz."""
-    t = exp.table("trace")
-    t = t[t.algorithm == algo] if case is None else t[(t.algorithm == algo) & (t["case"] == case)]
+    t = _select(exp.table("trace"), algo, case)
     its, evs = [], []
-    for _, grp in t.groupby("run", sort=True):
+    for _, grp in t.groupby(["case", "run"], sort=True):
         hit = grp[grp.best_fitness < level]
         its.append(float(hit.iteration.iloc[0]) if len(hit) else np.inf)
         evs.append(float(hit.evaluations.iloc[0]) if len(hit) else np.inf)
     return np.asarray(its), np.asarray(evs)
 
 
+def within_of_final(exp, algo: str, fraction: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
+    """Per run: (iteration, evaluations) at which the best-so-far first came within ``fraction`` of
+    the run's own final value (f <= final x (1 + fraction)), from trace.csv.gz."""
+    t = _select(exp.table("trace"), algo, None)
+    its, evs = [], []
+    for _, grp in t.groupby(["case", "run"], sort=True):
+        final = float(grp.best_fitness.iloc[-1])
+        hit = grp[grp.best_fitness <= final * (1 + fraction)]
+        its.append(float(hit.iteration.iloc[0]))
+        evs.append(float(hit.evaluations.iloc[0]))
+    return np.asarray(its), np.asarray(evs)
+
+
 def evaluations_at(exp, algo: str, iteration: int | None = None, case: str | None = None) -> float:
-    """Evaluations spent after ``iteration``: mean over runs (convergence.csv); at the end (default)
-    the median over runs (runs.csv)."""
+    """Evaluations spent after ``iteration`` (or the last recorded one before it): mean over runs
+    (convergence.csv); at the end (default) the median over runs (runs.csv)."""
     if iteration is None:
-        r = exp.table("runs")
-        r = r[r.algorithm == algo] if case is None else r[(r.algorithm == algo) & (r["case"] == case)]
-        return float(r.evaluations.median())
+        return float(_select(exp.table("runs"), algo, case).evaluations.median())
     c = exp.table("convergence")
-    c = c[(c.algorithm == algo) & (c.iteration == iteration)]
+    c = c[(c.algorithm == algo) & (c.iteration <= iteration)]   # a shorter run: its end
     if case is not None:
         c = c[c["case"] == case]
-    return float(c.mean_evaluations.iloc[0])
+    return float(c.sort_values("iteration").mean_evaluations.iloc[-1])
 
 
 def equal_budget(exp, a: str, b: str, names: dict[str, str], case: str | None = None,
@@ -196,21 +213,7 @@ def equal_budget(exp, a: str, b: str, names: dict[str, str], case: str | None = 
     return it, evc, budget
 
 
-def better_claim(text: str, better: str, it: Comparison, ev: Comparison | None, budget: float,
-                 iterations: int, paper_measure: str = "iterations") -> Claim:
-    """'``better`` is more precise than the other': held iff significantly lower on the paper's measure."""
-    decisive = it if paper_measure == "iterations" or ev is None else ev
-    ev_text = ev.text() if ev is not None else "not stored (no per-run trace for experiments of many cases)"
-    evidence = (f"equal iterations ({iterations}): {it.text()}; equal evaluations ({budget:.0f}): {ev_text}; "
-                f"verdict on equal {paper_measure} (the paper's budget)")
-    numbers = {"p_iterations": it.p, "lower_iterations": it.lower, "median_a_iterations": it.median_a,
-               "median_b_iterations": it.median_b, "evaluations": budget}
-    if ev is not None:
-        numbers.update({"p_evaluations": ev.p, "lower_evaluations": ev.lower, "median_a_evaluations": ev.median_a,
-                        "median_b_evaluations": ev.median_b})
-    return Claim(text, verdict(decisive.lower == better), evidence, numbers)
-
-
+# -- timing ----------------------------------------------------------------------------------------
 def timing_comparison(exp, a: str, b: str, names: dict[str, str]) -> Comparison | None:
     """Single-run times (ms) of ``a`` and ``b`` (timing_runs.csv), tested like any other sample."""
     if not exp.has("timing_runs.csv"):
@@ -220,31 +223,73 @@ def timing_comparison(exp, a: str, b: str, names: dict[str, str]) -> Comparison 
                    t[t.algorithm == b].ms.to_numpy())
 
 
-def faster_claim(text: str, faster: str, cmp: Comparison | None) -> Claim:
-    """'``faster`` takes less time': held / not held / within noise (rank test on single-run times)."""
+def resolution(cmp: Comparison) -> float:
+    """The relative time difference the sample can separate: the larger relative interquartile
+    range of the two timed samples (a shift smaller than the spread is not resolved by n runs)."""
+    out = 0.0
+    for v in (cmp.values_a, cmp.values_b):
+        if v.size:
+            q1, q3 = np.percentile(v, [25, 75])
+            out = max(out, float((q3 - q1) / max(np.median(v), 1e-300)))
+    return out
+
+
+def faster_claim(text: str, faster: str, cmp: Comparison | None, printed: tuple | None = None) -> Claim:
+    """'``faster`` takes less time': held / not held / within noise.
+
+    Rank test on the interleaved single-run times at ALPHA: held when ``faster`` is significantly
+    faster, *within noise* when the test finds no difference. When fkopt finds the opposite, the
+    verdict is *not held*, unless the paper's own printed difference (``printed`` = (ms of
+    ``faster``, ms of the other)) is smaller than the spread of the timed runs: a difference the
+    paper could not resolve is not refuted by one fkopt resolves the other way (*within noise*).
+    """
     if cmp is None:
         return Claim(text, NOT_CHECKABLE, "no single-run timings stored (timing_runs.csv)")
+    res = resolution(cmp)
     lower = cmp.lower
     v = WITHIN_NOISE if lower is None else verdict(lower == faster)
-    return Claim(text, v, f"single-run ms per run: {cmp.text()}",
-                 {"p": cmp.p, "median_a_ms": cmp.median_a, "median_b_ms": cmp.median_b})
+    note = ""
+    if printed is not None and v == NOT_HELD:
+        rel = abs(printed[1] - printed[0]) / max(abs(printed[0]), abs(printed[1]))
+        if rel < res:
+            v = WITHIN_NOISE
+            note = (f"; the printed difference ({100 * rel:.1f} %) is smaller than the run-to-run spread "
+                    f"({100 * res:.1f} %), so the paper's own numbers claim no resolvable difference")
+    n = min(cmp.values_a.size, cmp.values_b.size)
+    return Claim(text, v, f"interleaved single-run ms, alpha = {ALPHA}, n = {n} per algorithm, separates "
+                 f"shifts beyond ~{100 * res:.0f} % (relative IQR): {cmp.text()}" + note,
+                 {"p": cmp.p, "median_a_ms": cmp.median_a, "median_b_ms": cmp.median_b, "resolution": res},
+                 kind="timing")
 
 
 # -- claims.csv and drift --------------------------------------------------------------------------
 CLAIMS_FILE = "claims.csv"
+#: Timing verdicts, stored apart: they change with the machine (``fkopt check`` compares them only
+#: where the platform fingerprint matches; :func:`verdict_changes` with ``timing=True``).
+TIMING_CLAIMS_FILE = "timing_claims.csv"
+COLUMNS = ["id", "claim", "verdict", "condition"]
 
 
 def claims_frame(claims: list[Claim]) -> pd.DataFrame:
-    return pd.DataFrame([{"claim": c.text, "verdict": c.verdict} for c in claims], columns=["claim", "verdict"])
+    return pd.DataFrame([{"id": c.id, "claim": c.text, "verdict": c.verdict, "condition": c.condition}
+                         for c in claims], columns=COLUMNS)
+
+
+def _key(df: pd.DataFrame) -> pd.Series:
+    """A claim's key in claims.csv: its id (files written before ids: its text)."""
+    if "id" in df and df["id"].notna().all() and (df["id"] != "").all():
+        return df["id"].astype(str)
+    return df["claim"].astype(str)
 
 
 #: Largest claims.csv read (bytes).
 MAX_CLAIMS_BYTES = 4 << 20
 
 
-def read_claims(file: str | Path) -> dict[str, str]:
-    """A stored ``claims.csv`` as {claim: verdict}; a file that is not UTF-8, too large, not a
-    CSV or without the ``claim`` and ``verdict`` columns is one line naming it."""
+def read_claims(file: str | Path) -> pd.DataFrame:
+    """A stored ``claims.csv`` (or ``timing_claims.csv``) as text columns; a file that is not
+    UTF-8, too large, not a CSV or without ``claim`` and ``verdict`` columns is one
+    :class:`~fkopt.errors.FkoptError` line naming it."""
     import io
     from ..errors import FkoptError
     from ..files import read_text
@@ -253,31 +298,35 @@ def read_claims(file: str | Path) -> dict[str, str]:
         df = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
     except (ValueError, pd.errors.ParserError) as err:
         raise FkoptError(f"{file}: not a CSV table ({(str(err).splitlines() or [''])[0][:200]})") from None
-    if list(df.columns[:2]) != ["claim", "verdict"]:
-        raise FkoptError(f"{file}: expected the columns claim, verdict; got {', '.join(map(str, df.columns[:4]))}")
-    return dict(zip(df.claim, df.verdict))
+    if not {"claim", "verdict"} <= set(df.columns):
+        raise FkoptError(f"{file}: expected the columns claim and verdict; got {', '.join(map(str, df.columns[:6]))}")
+    return df
 
 
-def verdict_changes(root: str | Path) -> list[tuple[str, str, str, str]]:
-    """(paper, claim, stored verdict, recomputed verdict) for every claim whose verdict computed
-    from the results under ``root`` differs from the stored ``<paper>/claims.csv`` (``(absent)``
-    when a claim appeared or disappeared)."""
-    from . import paper_module
+def verdict_changes(root: str | Path, timing: bool = False) -> list[tuple[str, str, str, str]]:
+    """(paper, claim, stored verdict, recomputed verdict) for every non-timing claim whose verdict
+    computed from the results under ``root`` differs from the stored ``<paper>/claims.csv``
+    (``(absent)`` when a claim appeared or disappeared). ``timing=True``: the timing claims against
+    ``<paper>/timing_claims.csv`` instead (meaningful only on the platform that measured them)."""
+    from .engine import judge_paper
     from .store import Store
     root = Path(root)
     store = Store(root)
     out = []
     for paper in store.papers():
-        mod = paper_module(paper)
-        file = root / paper / CLAIMS_FILE
-        if mod is None or not file.exists():
+        file = root / paper / (TIMING_CLAIMS_FILE if timing else CLAIMS_FILE)
+        judged = judge_paper(paper, store)
+        if judged is None or not file.exists():
             continue
         stored = read_claims(file)
-        now = {c.text: c.verdict for c in mod.claims(store)}
-        for text in sorted(set(stored) | set(now)):
-            a, b = stored.get(text, "(absent)"), now.get(text, "(absent)")
-            if a != b:
-                out.append((paper, text, a, b))
+        now = claims_frame(judged[1] if timing else judged[0])
+        by_id = "id" in stored and (stored["id"] != "").all()
+        s = dict(zip(_key(stored), zip(stored.claim, stored.verdict)))
+        n = dict(zip(now["id"] if by_id else now["claim"], zip(now.claim, now.verdict)))
+        for key in sorted(set(s) | set(n)):
+            a, b = s.get(key, (None, "(absent)")), n.get(key, (None, "(absent)"))
+            if a[1] != b[1]:
+                out.append((paper, f"{key}: {a[0] or b[0]}" if by_id else key, a[1], b[1]))
     return out
 
 

@@ -11,7 +11,8 @@ from pathlib import Path
 import pandas as pd
 
 from . import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
-from .claims import CLAIMS_FILE, RULES, Claim, claims_frame
+from .claims import CLAIMS_FILE, RULES, TIMING_CLAIMS_FILE, Claim, claims_frame
+from .engine import info, judge_paper
 from ..experiment.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
 from .store import Experiment, Store
 
@@ -58,7 +59,26 @@ def _values_view(exp: Experiment) -> pd.DataFrame | None:
     return v.dropna(axis=1, how="all")
 
 
+def suite_section(exp: Experiment, root: Path) -> str:
+    """A benchmark suite (kinbench): its overall leaderboard, linked to its page and tables."""
+    rel = exp.folder.relative_to(root)
+    lines = [f"### {exp.title}", "",
+             f"Results: [`results/{rel}/`]({rel}/) · page: [`index.html`]({rel}/index.html) · "
+             f"leaderboards: [`leaderboard.md`]({rel}/leaderboard.md) · seed {exp.config.get('seed')}, "
+             f"{exp.config.get('runs')} runs per pose, {exp.config.get('budget_per_dim')} x dimension "
+             "evaluations ([docs/kinbench.md](../docs/kinbench.md)).", ""]
+    if exp.has("leaderboard.csv"):
+        board = exp.table("leaderboard")
+        overall = board[board["scope"] == "overall"] if "scope" in board.columns else board
+        cols = [c for c in ("rank", "solver", "track", "score", "ci_low", "ci_high", "better_than") if c in board.columns]
+        lines += ["Overall (tracks mixed, for reference; each track is ranked on its own in the leaderboard):", "",
+                  md_table(overall[cols].fillna("")), ""]
+    return "\n".join(lines)
+
+
 def experiment_section(exp: Experiment, root: Path) -> str:
+    if exp.meta.get("kind") == "suite":
+        return suite_section(exp, root)
     cfg = exp.config
     rel = exp.folder.relative_to(root)
     lines = [f"### {exp.title}", ""]
@@ -92,8 +112,12 @@ def experiment_section(exp: Experiment, root: Path) -> str:
 
 
 def claims_table(claims: list[Claim]) -> str:
-    df = pd.DataFrame([{"claim": c.text, "verdict": f"**{c.verdict}**", "fkopt's evidence": c.evidence}
-                       for c in claims])
+    df = pd.DataFrame([{"id": c.id, "claim": c.text, "verdict": f"**{c.verdict}**", "condition": c.condition,
+                        "fkopt's evidence": c.evidence} for c in claims])
+    if claims and not any(c.id for c in claims):
+        df = df.drop(columns=["id"])
+    if claims and not any(c.condition for c in claims):
+        df = df.drop(columns=["condition"])
     return df.to_markdown(index=False) if claims else "_(none)_"
 
 
@@ -109,8 +133,14 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
            "judged in [TIMING.md](TIMING.md) only (one source of truth), because they change on every "
            "run while everything here is fixed by the seeds. Statistics are over all runs, never a "
            "single lucky run.", "", "**Verdicts.**", ""] + [f"- {r}" for r in RULES] + [
-           "- The verdicts of this file are stored in `results/<paper>/claims.csv`; `fkopt check` "
-           "fails when a recomputed verdict differs.", "",
+           "- The verdicts of this file are stored in `results/<paper>/claims.csv` (columns id, claim, "
+           "verdict, condition); `fkopt check` fails when a recomputed verdict differs. The claims are "
+           "data (`configs/<paper>/claims.yaml`) judged by one engine: rules in "
+           "[docs/claims.md](../docs/claims.md).",
+           "- **ABC population convention:** an ABC's population is its number of food sources (= employed "
+           "= onlooker bees), so one ABC iteration costs about 2 x population evaluations, a PSO iteration "
+           "population; at the papers' equal iterations ABC gets more evaluations, hence every comparison "
+           "at equal evaluations too ([docs/models.md](../docs/models.md)).", "",
            "**Figures** are named after the paper figure they mirror (`fig2.png`, with a PDF twin) and use "
            "the papers' algorithm names and units. A fitness of exactly 0 cannot sit on a log axis: it is "
            "drawn on a grey band labelled \"0 (exact, drawn at floor)\" a decade below the smallest "
@@ -123,7 +153,8 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
               f"n = max(1, ceil({TIMING_RUNS} / cases)), on the first {TIMING_RUNS} cases; a task stops "
               f"adding runs after {TIMING_BUDGET_S:g} s of timed runs but times at least {TIMING_MIN_RUNS}) "
               "is solved again alone with the same seed stream and timed around that call (after an "
-              "untimed warm-up). Tables give the median and quartiles of those runs; `amortised_ms_per_run` "
+              "untimed warm-up), the algorithms of a case interleaved (run 0 of each, then run 1 of each: "
+              "A B A B ...) in one process, so that a slow period of the machine hits all alike. Tables give the median and quartiles of those runs; `amortised_ms_per_run` "
               "(the batch's wall time / runs) is shown for information and never judged. Two "
               "algorithms' times differ only if a two-sided Mann-Whitney test over the timed runs "
               "rejects equality at alpha = 0.05, otherwise the verdict is *within noise*. Measured on "
@@ -133,21 +164,27 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
     out.append("")
     index_rows = []
     for paper in papers:
-        mod = paper_module(paper)
+        about = info(paper)
+        judged = judge_paper(paper, store)
         exps = store.experiments(paper)
-        order = getattr(mod, "EXPERIMENTS", [])
+        order = about["experiments"]
         exps.sort(key=lambda e: (order.index(e.name) if e.name in order else len(order), e.name))
-        title = getattr(mod, "TITLE", paper)
-        out += [f"## {paper}", "", f"**{title}**", ""]
-        for note in getattr(mod, "NOTES", []):
+        out += [f"## {paper}", "", f"**{about['title']}**", ""]
+        for note in about["notes"]:
             out.append(f"- {note}")
         out.append("")
-        if mod is not None:
-            cl = mod.claims(store)
-            n_timing = len(mod.timing_claims(store)) if hasattr(mod, "timing_claims") else 0
+        if about["inconsistencies"]:
+            out += ["### The paper's internal inconsistencies", ""]
+            out += [f"- {x}" for x in about["inconsistencies"]] + [""]
+        if judged is not None:
+            cl, tc = judged
             out += ["### Claims", "", claims_table(cl), ""]
-            if n_timing:
-                out += [f"The paper's {n_timing} claim(s) about time are judged in "
+            disagree = [c.id or c.text[:40] for c in cl if c.numbers.get("bases_disagree")]
+            if disagree:
+                out += ["Budget bases disagree (equal iterations vs equal evaluations) for: "
+                        + ", ".join(f"`{x}`" for x in disagree) + "; the verdict uses the paper's basis.", ""]
+            if tc:
+                out += [f"The paper's {len(tc)} claim(s) about time are judged in "
                         f"[TIMING.md](TIMING.md#{paper}) only.", ""]
 
         timing += [f"## {paper}", ""]
@@ -161,12 +198,14 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
                 if fig.endswith("_time.png") and fig != "cases_time.png":
                     timing.append(f"![{exp.name} {fig}]({exp.folder.relative_to(root)}/{fig})\n")
             index_rows += index_rows_of(exp)
-        if mod is not None and hasattr(mod, "timing_claims"):
-            timing += ["### Timing claims", "", claims_table(mod.timing_claims(store)), ""]
+        if judged is not None and judged[1]:
+            timing += ["### Timing claims", "", claims_table(judged[1]), ""]
     return "\n".join(out).rstrip() + "\n", "\n".join(timing).rstrip() + "\n", pd.DataFrame(index_rows)
 
 
 def index_rows_of(exp: Experiment) -> list[dict]:
+    if not exp.has("summary.csv"):     # a suite (kinbench): its leaderboard is its index
+        return []
     s = exp.table("summary")
     rows = []
     for (algo, method), grp in s.groupby(["algorithm", "method"], sort=False):
@@ -184,14 +223,17 @@ def index_rows_of(exp: Experiment) -> list[dict]:
 
 
 def claims_files(root: str | Path) -> dict[Path, pd.DataFrame]:
-    """``<paper>/claims.csv`` of every paper with claims: the verdicts ``fkopt check`` guards."""
+    """``<paper>/claims.csv`` of every paper with claims (the verdicts ``fkopt check`` guards) and
+    ``<paper>/timing_claims.csv`` (the timing verdicts, which change with the machine)."""
     root = Path(root)
     store = Store(root)
     out = {}
     for paper in store.papers():
-        mod = paper_module(paper)
-        if mod is not None:
-            out[root / paper / CLAIMS_FILE] = claims_frame(mod.claims(store))
+        judged = judge_paper(paper, store)
+        if judged is not None:
+            out[root / paper / CLAIMS_FILE] = claims_frame(judged[0])
+            if judged[1]:
+                out[root / paper / TIMING_CLAIMS_FILE] = claims_frame(judged[1])
     return out
 
 

@@ -38,7 +38,8 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     configs = Path(configs)
     if not configs.is_dir():
         raise FkoptError(f"--configs: {configs} is not a folder")
-    files = sorted(configs.rglob("*.yaml"))
+    from .engine import is_claims_file
+    files = sorted(f for f in configs.rglob("*.yaml") if not is_claims_file(f))   # claims are no experiment
     if not files:
         raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
     planned = []
@@ -46,6 +47,8 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     output_folder(out)
     for f in files:
         config = load_any(f)
+        if getattr(config, "kind", None) == "suite":    # benchmark suites: fkopt suite / make bench-suite
+            continue
         tasks = validate_any(config, str(f))
         key = tuple(config.folder_parts)
         if key in seen:

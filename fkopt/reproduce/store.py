@@ -115,6 +115,15 @@ class Store:
         return sorted({e.paper for e in self.experiments()})
 
 
+def mechanism_of(exp_or_name):
+    """The mechanism of a stored experiment (from its recorded config), or a registered name's default."""
+    from .. import registry
+    if isinstance(exp_or_name, str):
+        return registry.mechanism_class(exp_or_name)()
+    m = exp_or_name.config["mechanism"]
+    return registry.mechanism_class(m["name"])(bounds=dict(m.get("bounds") or {}), **(m.get("geometry") or {}))
+
+
 def locate(path: str | Path) -> tuple[Store, str | None, str | None]:
     """``(store, paper, name)`` for a results root, a paper folder or one experiment folder."""
     path = Path(path)

@@ -39,7 +39,7 @@ from ..files import inside, output_folder, write_atomically, write_json_atomical
 from ..outputs import write_outputs
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
-from ..solve import make_algorithm
+from ..solve import make_algorithm, pick_events
 from ..streams import case_seed
 from .config import StudyAlgorithmSpec, StudyConfig
 from .poses import PoseSet, build_poses
@@ -202,7 +202,9 @@ def _runs_of(r, x: np.ndarray, rows: slice):
     return replace(r, x=x, fitness=one(r.fitness), history=one(r.history), x_history=one(r.x_history),
                    evaluation_history=one(r.evaluation_history), iterations_done=one(r.iterations_done),
                    time_per_run=one(r.time_per_run), extras={}, snapshots={}, cases=None, seeds=None,
-                   run_ids=np.arange(len(x)))
+                   run_ids=np.arange(len(x)),
+                   events=pick_events(r.events, np.arange(r.runs * (rows.start or 0), r.runs * rows.stop,
+                                                          r.runs * (rows.step or 1))))
 
 
 # -- task files ----------------------------------------------------------------------------------

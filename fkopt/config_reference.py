@@ -1,0 +1,385 @@
+"""The reference of fkopt's config files, generated from the pydantic models that validate them.
+
+For every kind of file (:data:`MODELS`) this module gives
+
+* :func:`json_schema` -- the model's JSON Schema with every field's description, unit and an
+  example added (what ``fkopt schema KIND`` prints and ``docs/schema/<kind>.json`` holds, for
+  editors: a YAML file whose first line is ``# yaml-language-server: $schema=<path>`` is
+  validated and completed against it);
+* :func:`markdown` -- ``docs/config-reference.md``: every field, its type, default, allowed
+  values, unit and an example.
+
+Types, defaults and allowed values come from the models themselves; what a field means, its
+unit and its example come from :data:`FIELDS`, one entry per field of every model a config can
+contain (``tests/test_config_reference.py`` fails when a model gains a field without one, and
+when the committed files differ from what this module generates). Regenerate them with
+``python -m fkopt.config_reference``.
+"""
+from __future__ import annotations
+
+import importlib
+import json
+import types
+import typing
+from pathlib import Path
+from typing import Any, Literal, get_args, get_origin
+
+from .errors import FkoptError
+
+#: kind -> "module:Class" of the model that validates a file of that kind (imported on first use).
+MODELS: dict[str, str] = {
+    "experiment": "fkopt.experiment.config:ExperimentConfig",
+    "study": "fkopt.study.config:StudyConfig",
+    "assembly": "fkopt.experiment.assembly:AssemblyConfig",
+}
+#: What each kind of file is, for the reference's headings.
+KIND_TEXT = {
+    "experiment": "An experiment: listed (or random) cases of one mechanism, solved by every algorithm "
+                  "for `runs` seeded runs. Run with `fkopt run FILE`. A file without `kind:` is an experiment.",
+    "study": "A workspace study (`kind: study`): a generated pose set (uniform, grid, waypoints, circle) "
+             "solved by every algorithm; statistics, ECDF, heat maps, tracking. Run with `fkopt study FILE`.",
+    "assembly": "An assembly-mode search (`kind: assembly`): every real forward solution of one set of "
+                "joints. Run with `fkopt run FILE`.",
+}
+#: Folder of the generated files, relative to the repository root.
+DOCS = Path("docs")
+SCHEMA_DIR = DOCS / "schema"
+REFERENCE = DOCS / "config-reference.md"
+
+_POSE = "pose variables of the mechanism (`fkopt list MECH`), in its units"
+_UNKNOWN = "the mechanism's unknowns: its pose (parallel) or joints (serial), in their units"
+
+#: model class name -> field -> (description, unit, example). Units: "" when the field has none.
+FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
+    "ExperimentConfig": {
+        "name": ("Name of the results folder: the run writes OUT/<paper>/<name>/. A single safe folder "
+                 "name: letters, digits, `_.+-`, at most 64 characters.", "", "tab2_tab3_fig2"),
+        "paper": ("Groups results: the folder OUT/<paper>/. For the reproduced papers their key (mao2017, "
+                  "chang2024, wu2015, liu2008, wang7dof); `experiments` when left out.", "", "mao2017"),
+        "title": ("Title of the figures and of the report section.", "", "3-RPS FK: ACO vs ABC vs GABC"),
+        "description": ("Free text kept in meta.json; never changes the numbers.", "", "first try"),
+        "mechanism": ("The mechanism to solve, its geometry and the search bounds.", "",
+                      {"name": "3-rps", "geometry": {"ra": 274}, "bounds": {"z": [400, 700]}}),
+        "objective": ("What is minimised. Parallel mechanisms: `squared` (sum of squared joint residuals, "
+                      "default) or `absolute` (sum of absolute residuals). Serial arms: `paper` (position "
+                      "error + Euler-angle differences, default) or `geodesic` (position error + rotation "
+                      "angle). Left out: the mechanism's default.", "", "squared"),
+        "algorithms": ("The algorithms to compare, each run `runs` times on every case (`fkopt list` names "
+                       "them and their parameters).", "", [{"name": "gabc"}, {"name": "pso"}]),
+        "population": ("Agents per run (bees, particles, ants; starts for nr/lm), unless an algorithm "
+                       "overrides it.", "agents", 10),
+        "iterations": ("Iterations per run, unless an algorithm overrides it.", "iterations", 600),
+        "runs": ("Independent seeded runs of every algorithm on every case.", "runs", 30),
+        "seed": ("Seed of everything random: run k of a (case, algorithm) always draws the same numbers.",
+                 "", 2017),
+        "threshold": ("Fitness counted as solved: adds success rates and iterations/evaluations to the "
+                      "threshold to the tables, and draws it in the convergence figure. No threshold: no "
+                      "success columns.", "fitness (the objective's value)", 1e-10),
+        "stop_at_threshold": ("Stop each run when its best fitness falls below `threshold` (needs one).",
+                              "", False),
+        "figure_names": ("File stems of the figures, by figure kind (convergence, variables, snapshot_<t>, "
+                         "extras, cases, cases_time, cases_position_error, position_error, time), to name "
+                         "them after the paper figure they mirror.", "", {"convergence": "fig2"}),
+        "printed": ("The paper's printed values and notes for the report, shown beside fkopt's.", "",
+                    {"note": "Tab. 3"}),
+        "check": ("Which regression check reruns the stored result: `ci` (every test run and `make check`) "
+                  "or `full` (`make check` only, for long experiments).", "", "ci"),
+        "cases": ("The targets: a list of cases, or `{random: N, seed: S}` for N poses uniform in the "
+                  "bounds.", "", [{"pose": {"alpha": 9, "beta": 13, "z": 622}}]),
+        "batch": ("Run all runs together as arrays (default) or one after another (`false`: per-run times, "
+                  "same numbers).", "", True),
+        "snapshots": ("Iterations at which the whole population is kept (figure `snapshots`).", "iterations",
+                      [0, 10, 50]),
+        "figures": ("Extra figures: variables (best-so-far pose vs iteration), snapshots (population "
+                    "scatter), extras (algorithm records such as ACO pheromone), cases (per-case error and "
+                    "time), time (time of each timed run). The convergence figure is always drawn.", "",
+                    ["variables"]),
+    },
+    "MechanismSpec": {
+        "name": ("A mechanism name (`fkopt list`), or `package.module:Class` of a plug-in.", "", "3-rps"),
+        "geometry": ("Overrides of the mechanism's default geometry (`fkopt list MECH` lists the keys, "
+                     "defaults and units).", "the mechanism's", {"ra": 274, "rb": 158}),
+        "bounds": ("Search bounds [lower, upper] of some of " + _UNKNOWN + "; the others keep their "
+                   "defaults.", "the variable's", {"z": [400, 700]}),
+    },
+    "CaseSpec": {
+        "label": ("Name of the case in the tables (default: case-1, case-2, ...).", "", "9/13/622"),
+        "pose": ("The target pose; a parallel mechanism's joints are computed from it with fkopt's inverse "
+                 "map (or compared with `joints` when both are given). For a serial arm, the pose to reach.",
+                 "the pose variables' units", {"alpha": 9, "beta": 13, "z": 622}),
+        "joints": ("Measured joints to solve (parallel mechanisms), e.g. a paper's printed leg lengths. "
+                   "With a pose too, the mismatch between them is reported in inputs.csv.", "the joints' units",
+                   {"d1": 598.85, "d2": 671.92, "d3": 629.16}),
+        "reference": ("Another pose to compare the solution with (e.g. the exact solution of printed joints).",
+                      "the pose variables' units", {"alpha": 9.01, "beta": 12.99, "z": 622.1}),
+        "reference_label": ("Name of `reference` in the tables.", "", "exact"),
+        "printed": ("The paper's printed solution per algorithm label: {label: {variable: value}}.",
+                    "the pose variables' units", {"gabc": {"alpha": 9.0}}),
+    },
+    "RandomCases": {
+        "random": ("Number of cases: poses uniform in the bounds.", "cases", 50),
+        "seed": ("Seed of the draw (independent of the experiment's seed).", "", 7),
+    },
+    "AlgorithmSpec": {
+        "name": ("An algorithm (`fkopt list`): abc, gabc, aco, pso, pabc, nr, lm, dls, abc+lm, gabc+lm, "
+                 "pso+lm, `scipy:`/`pymoo:`/`niapy:` optimisers, or `package.module:Class`.", "", "gabc"),
+        "label": ("Name in the tables; needed when one algorithm appears twice. Default: the name.", "",
+                  "gabc_zhu2010"),
+        "params": ("The algorithm's parameters (`fkopt list` shows them with their defaults); unknown keys "
+                   "are refused.", "", {"rule": "zhu2010"}),
+        "population": ("This algorithm's population (number of starts for nr/lm), instead of the file's.",
+                       "agents", 1),
+        "iterations": ("This algorithm's iterations, instead of the file's.", "iterations", 50),
+        "start": ("Start point of the local methods (nr, lm, dls): {variable: value}; default the centre of "
+                  "the bounds.", "the unknowns' units", {"alpha": 0, "beta": 0, "z": 550}),
+        "printed": ("The paper's printed statistics for this algorithm (mean_fitness, std_fitness, time_ms, "
+                    "iterations_to_converge, ...), shown beside fkopt's.", "",
+                    {"mean_fitness": 4.1e-17, "time_ms": 361.3}),
+    },
+    "StudyConfig": {
+        "kind": ("Marks the file as a study.", "", "study"),
+        "paper": ("Groups results: the folder OUT/<paper>/.", "", "studies"),
+        "poses": ("The pose set, in the space of " + _UNKNOWN + ": `{uniform: N, seed: S}`, `{grid: ..., "
+                  "fixed: ...}`, `{waypoints: [...], points: N}`, `{circle: {...}, points: N}`; in tracking "
+                  "mode also a list of waypoint/circle trajectories.", "", {"uniform": 200, "seed": 7}),
+        "runs": ("Independent seeded runs of every algorithm on every pose.", "runs", 5),
+        "threshold": ("Fitness counted as solved: success rates, evaluations to target and the ECDF are "
+                      "against it.", "fitness (the objective's value)", 1e-10),
+        "chunk": ("Poses per task (independent mode): the unit of parallel work (`--jobs`, Dask) and of "
+                  "`--resume`; never changes the numbers.", "poses", 20),
+        "mode": ("`independent`: every pose solved on its own, cold. `tracking`: the poses are a trajectory "
+                 "solved in order, each step warm-started from the previous solution.", "", "independent"),
+        "tracking": ("Settings of tracking mode.", "", {"radius": 0.05}),
+        "alpha": ("Significance level of the pairwise rank tests (after Holm's correction).", "", 0.05),
+    },
+    "StudyAlgorithmSpec": {
+        "start": ("Start point of the local methods: a pose {variable: value}, or `centre` (the centre of "
+                  "the bounds).", "the unknowns' units", "centre"),
+        "warm_start": ("Tracking mode: start each step from the previous step's solution (default) or solve "
+                       "it cold (a baseline).", "", True),
+    },
+    "UniformPoses": {
+        "uniform": ("Number of poses uniform in the bounds.", "poses", 200),
+        "seed": ("Seed of the draw.", "", 7),
+    },
+    "GridPoses": {
+        "grid": ("A full grid: [lower, upper, points] per variable, the first varying slowest; a grid over "
+                 "two variables also gets a heat map.", "the variables' units", {"alpha": [-20, 20, 9],
+                                                                                 "beta": [-20, 20, 9]}),
+        "fixed": ("Values of the variables not in the grid.", "the variables' units", {"z": 550}),
+    },
+    "WaypointPoses": {
+        "waypoints": ("Corners of a polyline (two for a line), each a full pose.", "the variables' units",
+                      [{"alpha": 0, "beta": 0, "z": 500}, {"alpha": 10, "beta": 5, "z": 600}]),
+        "points": ("Poses along the polyline, equally spaced, both ends included.", "poses", 50),
+    },
+    "CirclePoses": {
+        "circle": ("A closed circle (or ellipse) in the plane of two variables.", "",
+                   {"centre": {"alpha": 0, "beta": 0, "z": 550}, "radius": 5, "plane": ["alpha", "beta"]}),
+        "points": ("Poses on the circle (the first not repeated).", "poses", 40),
+    },
+    "CircleSpec": {
+        "centre": ("Centre of the circle: a full pose.", "the variables' units", {"x": 0, "y": 0, "z": 0.8}),
+        "radius": ("Radius, or [r1, r2] for an ellipse (e.g. mm and degrees).", "the plane variables' units",
+                   0.05),
+        "plane": ("The two variables spanning the circle's plane.", "", ["x", "y"]),
+    },
+    "TrackingSpec": {
+        "radius": ("Half width of a swarm's warm-start box around the previous solution, as a fraction of "
+                   "each variable's box width (local methods start at the previous solution itself).",
+                   "fraction of the box width", 0.05),
+    },
+    "AssemblyConfig": {
+        "kind": ("Marks the file as an assembly-mode search.", "", "assembly"),
+        "paper": ("Groups results: the folder OUT/<paper>/.", "", "assembly"),
+        "joints": ("The joints whose forward solutions are searched.", "the joints' units",
+                   {"l1": 1.0, "l2": 1.1, "l3": 1.05, "l4": 0.95, "l5": 1.0, "l6": 1.02}),
+        "seed": ("Seed of the quasi-random starts.", "", 0),
+        "population": ("Starts per round of the multi-start Newton (default: the solver's own, 2000 for "
+                       "6-SPS).", "starts", 2000),
+        "iterations": ("Newton iterations per start.", "iterations", 60),
+        "runs": ("Always 1: a search is deterministic given its seed.", "", 1),
+        "tol": ("Largest residual max |ik(pose) - joints| accepted as a solution.", "joint units", 1e-9),
+        "dedup": ("Two solutions closer than this (in the pose space normalised by the bounds) are one.",
+                  "normalised pose distance", 1e-6),
+        "expected": ("Known number of real solutions, for the report.", "solutions", 40),
+    },
+}
+#: Fields documented once for every model that inherits them.
+SHARED = {"AssemblyConfig": "ExperimentConfig", "StudyConfig": "ExperimentConfig",
+          "StudyAlgorithmSpec": "AlgorithmSpec"}
+
+
+def kinds() -> list[str]:
+    return list(MODELS)
+
+
+def model(kind: str):
+    """The pydantic model of ``kind`` (experiment, study, assembly)."""
+    if kind not in MODELS:
+        raise FkoptError(f"schema: unknown kind '{kind}'; allowed: {', '.join(MODELS)}")
+    module, attr = MODELS[kind].split(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+def field_doc(model_name: str, field: str) -> tuple[str, str, Any] | None:
+    """(description, unit, example) of a field, looking through :data:`SHARED`."""
+    name = model_name
+    while name is not None:
+        if field in FIELDS.get(name, {}):
+            return FIELDS[name][field]
+        name = SHARED.get(name)
+    return None
+
+
+def _models_in(annotation) -> list:
+    from pydantic import BaseModel
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for arg in get_args(annotation) for m in _models_in(arg)]
+
+
+def models_of(kind: str) -> list:
+    """Every model a file of ``kind`` can contain, the top-level one first (no repeats)."""
+    seen, todo = [], [model(kind)]
+    while todo:
+        m = todo.pop(0)
+        if m in seen:
+            continue
+        seen.append(m)
+        for f in m.model_fields.values():
+            todo += _models_in(f.annotation)
+    return seen
+
+
+def _type_text(annotation) -> str:
+    origin = get_origin(annotation)
+    if annotation is type(None):
+        return "null"
+    if origin is Literal:
+        return " | ".join(json.dumps(a) if not isinstance(a, str) else a for a in get_args(annotation))
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_type_text(a) for a in get_args(annotation))
+    if origin is dict:
+        k, v = get_args(annotation)
+        return f"mapping {_type_text(k)} → {_type_text(v)}"
+    if origin is list:
+        return f"list of {_type_text(get_args(annotation)[0])}"
+    if origin is tuple:
+        return "[" + ", ".join(_type_text(a) for a in get_args(annotation)) + "]"
+    if isinstance(annotation, type):
+        names = {"str": "text", "int": "integer", "float": "number", "bool": "true | false", "Any": "any"}
+        if hasattr(annotation, "model_fields"):
+            return f"[{annotation.__name__}](#{annotation.__name__.lower()})"
+        return names.get(annotation.__name__, annotation.__name__)
+    return "any" if annotation is Any else str(annotation)
+
+
+def _limits(field) -> str:
+    words = {"ge": "≥", "gt": ">", "le": "≤", "lt": "<", "min_length": "length ≥", "max_length": "length ≤"}
+    out = []
+    for meta in field.metadata:
+        for attr, word in words.items():
+            value = getattr(meta, attr, None)
+            if value is not None:
+                out.append(f"{word} {value:,}" if isinstance(value, int) else f"{word} {value:g}")
+    return ", ".join(out)
+
+
+def _default(field) -> str:
+    if field.is_required():
+        return "required"
+    value = field.default_factory() if field.default_factory is not None else field.default
+    if hasattr(value, "model_dump"):
+        value = value.model_dump(mode="json")
+    return "`" + json.dumps(value) + "`"
+
+
+def _example_yaml(name: str, example) -> str:
+    """``name: value`` as one line of YAML (flow style)."""
+    import yaml
+    value = yaml.safe_dump(example, default_flow_style=True, sort_keys=False, width=1000).strip()
+    return f"{name}: {value.removesuffix('...').strip()}"
+
+
+def json_schema(kind: str) -> dict:
+    """The JSON Schema of ``kind`` with descriptions (including units) and examples of every field."""
+    m = model(kind)
+    schema = m.model_json_schema()
+    by_name = {x.__name__: x for x in models_of(kind)}
+    parts = [(m.__name__, schema)] + [(name, d) for name, d in schema.get("$defs", {}).items()]
+    for name, part in parts:
+        if name not in by_name:
+            continue
+        for field, prop in part.get("properties", {}).items():
+            doc = field_doc(name, field)
+            if doc is None:
+                continue
+            text, unit, example = doc
+            prop["description"] = text + (f" Unit: {unit}." if unit else "")
+            prop["examples"] = [example]
+    return {"$schema": "https://json-schema.org/draft/2020-12/schema", **schema,
+            "title": f"fkopt {kind} file", "description": KIND_TEXT[kind].replace("`", "")}
+
+
+def schema_text(kind: str) -> str:
+    return json.dumps(json_schema(kind), indent=2, ensure_ascii=False) + "\n"
+
+
+def markdown() -> str:
+    """docs/config-reference.md: one section per kind, one table per model, one row per field."""
+    lines = ["# Config reference", "",
+             "Generated by `python -m fkopt.config_reference` from the pydantic models that validate the files "
+             "(do not edit; `tests/test_config_reference.py` checks it is current). Every file is YAML; "
+             "unknown fields, NaN and infinity are refused with one line naming the file and the field.",
+             "",
+             "Editors that speak yaml-language-server validate and complete a file whose first line names its "
+             "schema, e.g. `# yaml-language-server: $schema=../../docs/schema/experiment.json` (a path "
+             "relative to the file, or a URL). The schemas are in [schema/](schema/), and `fkopt schema KIND` "
+             "prints them.", ""]
+    for kind in MODELS:
+        lines += [f"- [{kind}](#{kind}-files): {KIND_TEXT[kind]}"]
+    lines.append("")
+    documented: set[str] = set()
+    for kind in MODELS:
+        lines += [f"## {kind} files", "", KIND_TEXT[kind],
+                  f"Schema: [schema/{kind}.json](schema/{kind}.json).", ""]
+        for m in models_of(kind):
+            if m.__name__ in documented:
+                lines += [f"### {m.__name__} ({kind})", "", f"As in [{m.__name__}](#{m.__name__.lower()}) above.", ""]
+                continue
+            documented.add(m.__name__)
+            lines += [f"### {m.__name__}", ""]
+            if m is model(kind):
+                lines += [f"The top level of {'an' if kind[0] in 'aeiou' else 'a'} {kind} file.", ""]
+            lines += ["| field | type | default | allowed | unit | meaning | example |",
+                      "|---|---|---|---|---|---|---|"]
+            for name, field in m.model_fields.items():
+                text, unit, example = field_doc(m.__name__, name) or ("", "", None)
+                cells = [f"`{name}`", _type_text(field.annotation), _default(field), _limits(field) or "",
+                         unit, text, f"`{_example_yaml(name, example)}`"]
+                lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+            lines.append("")
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def generated(root: Path = Path(".")) -> dict[Path, str]:
+    """Every generated file (path under ``root``) and its text."""
+    files = {root / REFERENCE: markdown()}
+    for kind in MODELS:
+        files[root / SCHEMA_DIR / f"{kind}.json"] = schema_text(kind)
+    return files
+
+
+def write(root: Path = Path(".")) -> list[Path]:
+    written = []
+    for path, text in generated(root).items():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+        written.append(path)
+    return written
+
+
+if __name__ == "__main__":
+    for p in write(Path(__file__).resolve().parent.parent):
+        print(p)

@@ -1,0 +1,222 @@
+"""Suite files (``kind: suite``): problems x frozen pose sets x solvers x runs at fixed budgets.
+
+::
+
+    kind: suite
+    name: kinbench
+    paper: kinbench                 # results folder OUT/kinbench/kinbench/
+    pose_sets: kinbench-v1          # folder beside this file: manifest.json + one CSV per (problem, set)
+    problems:
+      - name: mao2017-3rps          # also the pose-set folder of this problem
+        problem_class: parallel-fk-3dof   # ranked together with the other problems of its class
+        mechanism: {name: 3-rps, geometry: {ra: 274, rb: 158}}
+    sets: [uniform, near-singular, boundary, printed]
+    poses: 10                       # the first N poses of every set (all when omitted)
+    solvers:
+      - {name: gabc}                # track from fkopt's table (black-box / jacobian / exact)
+      - {name: "mypkg.de:DE", track: black-box}   # plug-ins must name their track
+    budget_per_dim: 2000            # evaluation budget of a run = budget_per_dim x dimension
+    population: 20                  # swarm size (starts of a local method)
+    runs: 5
+    seed: 2026
+    targets: [1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8, 1.0e-10]
+    quick: {problems: [...], solvers: [...], poses: 3, runs: 2, budget_per_dim: 300}
+
+A solver's iterations are chosen so its swarm can spend the budget
+(``ceil(budget / population)``); every measure is taken at the budget, from the cumulative
+evaluation counts each run records, so a solver that spends more per iteration gains nothing.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import Field, PrivateAttr, ValidationError, field_validator, model_validator
+
+from ..errors import FkoptError
+from ..experiment.config import (MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict,
+                                 unique_labels)
+from ..files import error_line, load_mapping
+
+#: Pose sets of kinbench v1 (see :mod:`fkopt.kinbench.posesets`).
+SETS = ("uniform", "near-singular", "boundary", "printed")
+#: Tracks ranked separately: fitness only, Jacobian-using, exact/analytic.
+TRACKS = ("black-box", "jacobian", "exact")
+#: The COCO-style target ladder on the problem's fitness.
+TARGETS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
+#: Track of fkopt's built-in solvers and the adapters (anything else must state its track).
+KNOWN_TRACKS = {"abc": "black-box", "gabc": "black-box", "pso": "black-box", "aco": "black-box",
+                "pabc": "black-box", "nr": "jacobian", "lm": "jacobian", "dls": "jacobian",
+                "abc+lm": "jacobian", "gabc+lm": "jacobian", "pso+lm": "jacobian"}
+ADAPTER_TRACK = "black-box"     # scipy:, pymoo:, niapy: (registry.ADAPTER_PREFIXES) minimise the fitness only
+MAX_BUDGET_PER_DIM = 10_000_000
+
+
+def default_track(name: str) -> str | None:
+    """The track of a built-in solver or an adapter; None for anything else (a plug-in)."""
+    from ..registry import ADAPTER_PREFIXES
+    if name in KNOWN_TRACKS:
+        return KNOWN_TRACKS[name]
+    return ADAPTER_TRACK if name.split(":", 1)[0] in ADAPTER_PREFIXES else None
+
+
+class SuiteSolver(AlgorithmSpec):
+    track: Literal["black-box", "jacobian", "exact"] | None = None
+
+    @model_validator(mode="after")
+    def _track(self):
+        if self.track is None:
+            self.track = default_track(self.name)
+            if self.track is None:
+                raise ValueError(f"solver '{self.name}' needs 'track' (allowed: {', '.join(TRACKS)}); "
+                                 "fkopt knows the track of its own solvers and adapters only")
+        return self
+
+
+class OutsideSolver(Strict):
+    """Results of a solver run outside fkopt (:mod:`fkopt.kinbench.outside`): a CSV ``file`` or
+    an IOHprofiler folder ``ioh`` (with the ``algorithm`` to take when it holds several)."""
+
+    solver: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+:-]{0,63}$")
+    track: Literal["black-box", "jacobian", "exact"]
+    file: str | None = Field(None, min_length=1)
+    ioh: str | None = Field(None, min_length=1)
+    algorithm: str | None = None
+    description: str = ""
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if (self.file is None) == (self.ioh is None):
+            raise ValueError("give exactly one of 'file' (CSV) and 'ioh' (IOHprofiler folder)")
+        if self.algorithm is not None and self.ioh is None:
+            raise ValueError("'algorithm' selects a solver of an 'ioh' folder; a CSV file holds one")
+        return self
+
+
+class SuiteProblem(Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
+    #: Problems of one class are ranked together (no alias such as ``class``: a stored config
+    #: must dump to the same mapping it was read from).
+    problem_class: str = Field(min_length=1, max_length=64)
+    mechanism: MechanismSpec
+    objective: str | None = None
+
+
+class QuickTier(Strict):
+    """The subset ``--quick`` runs (and ``fkopt check`` reruns): fewer problems, solvers, poses,
+    runs and a smaller budget. Omitted fields keep the full suite's value."""
+
+    problems: list[str] | None = None
+    solvers: list[str] | None = None
+    sets: list[Literal["uniform", "near-singular", "boundary", "printed"]] | None = None
+    poses: int | None = Field(None, ge=1)
+    runs: int | None = Field(None, ge=1, le=MAX_RUNS)
+    budget_per_dim: int | None = Field(None, ge=1, le=MAX_BUDGET_PER_DIM)
+
+
+class SuiteConfig(Located):
+    kind: Literal["suite"]
+    pose_sets: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
+    problems: list[SuiteProblem] = Field(min_length=1)
+    sets: list[Literal["uniform", "near-singular", "boundary", "printed"]] = Field(default_factory=lambda: list(SETS))
+    poses: int | None = Field(None, ge=1)
+    solvers: list[SuiteSolver] = Field(min_length=1)
+    budget_per_dim: int = Field(1000, ge=1, le=MAX_BUDGET_PER_DIM)
+    population: int = Field(20, ge=2, le=100_000)
+    runs: int = Field(5, ge=1, le=MAX_RUNS)
+    seed: int = Seed()
+    targets: list[float] = Field(default_factory=lambda: list(TARGETS), min_length=1)
+    #: Bootstrap of the rankings: resamples of the (problem, set, pose) instances, and the level
+    #: of the Holm-corrected pairwise tests.
+    bootstrap: int = Field(1000, ge=100, le=100_000)
+    alpha: float = Field(0.05, gt=0, lt=0.5)
+    #: Solvers run elsewhere, imported from CSV files of evaluations and best-so-far per run.
+    outside: list[OutsideSolver] = Field(default_factory=list)
+    quick: QuickTier | None = None
+    check: Literal["ci", "full"] = "full"
+    _folder: Path | None = PrivateAttr(None)
+
+    @property
+    def folder_parts(self) -> tuple[str, str]:
+        return (self.paper or "suites", self.name)
+
+    @field_validator("solvers")
+    @classmethod
+    def _unique(cls, solvers):
+        return unique_labels(solvers)
+
+    @field_validator("problems")
+    @classmethod
+    def _unique_problems(cls, problems):
+        names = [p.name for p in problems]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"problem names must be unique, '{dup[0]}' repeats")
+        return problems
+
+    @model_validator(mode="after")
+    def _outside_names(self):
+        names = [s.key for s in self.solvers] + [o.solver for o in self.outside]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"solver labels must be unique over solvers and outside, '{dup[0]}' repeats")
+        return self
+
+    @field_validator("targets")
+    @classmethod
+    def _targets(cls, targets):
+        if any(t <= 0 for t in targets) or sorted(targets, reverse=True) != list(targets) \
+                or len(set(targets)) != len(targets):
+            raise ValueError("targets must be positive, distinct and in decreasing order (1e-2 ... 1e-10)")
+        return targets
+
+    @field_validator("sets")
+    @classmethod
+    def _sets(cls, sets):
+        if not sets or len(set(sets)) != len(sets):
+            raise ValueError(f"sets: one or more distinct of {', '.join(SETS)}")
+        return sets
+
+    @model_validator(mode="after")
+    def _quick_names(self):
+        if self.quick is None:
+            return self
+        for field, known in (("problems", [p.name for p in self.problems]),
+                             ("solvers", [s.key for s in self.solvers])):
+            for name in getattr(self.quick, field) or []:
+                if name not in known:
+                    raise ValueError(f"quick.{field}: '{name}' is not one of the suite's {field} "
+                                     f"({', '.join(known)})")
+        return self
+
+    def quick_tier(self, where: str = "suite") -> "SuiteConfig":
+        """The ``--quick`` subset as a config of its own (name ``<name>-quick``, no quick block)."""
+        if self.quick is None:
+            raise FkoptError(f"{where}: quick: missing; --quick needs a quick: block (fields: "
+                             f"{', '.join(QuickTier.model_fields)})")
+        q = self.quick
+        data = self.model_dump(mode="json")
+        data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci")
+        if q.problems:
+            data["problems"] = [p for p in data["problems"] if p["name"] in q.problems]
+        if q.solvers:
+            data["solvers"] = [s for s in data["solvers"] if (s.get("label") or s["name"]) in q.solvers]
+        for key in ("sets", "poses", "runs", "budget_per_dim"):
+            if getattr(q, key) is not None:
+                data[key] = getattr(q, key)
+        out = SuiteConfig(**data)
+        out._folder = self._folder
+        return out
+
+
+def suite_from_dict(data: dict, where: str) -> SuiteConfig:
+    try:
+        return SuiteConfig(**data)
+    except ValidationError as err:
+        raise FkoptError(f"{where}: {error_line(err, None, data)}") from None
+
+
+def load_suite(path: str | Path) -> SuiteConfig:
+    config = suite_from_dict(load_mapping(path, "suite fields"), str(path))
+    config._folder = Path(path).parent
+    return config

@@ -1,0 +1,148 @@
+"""The measures of a suite, as COCO defines them (Hansen et al., "COCO: Performance assessment",
+2016/2022), from the per-run table of :mod:`fkopt.kinbench.runner` -- the one place they are
+computed (tables, figures, markdown and HTML all read these functions' tables).
+
+A *trial* is one run on one (problem, set, pose) *instance*; a *triple* is (instance, target).
+
+* **success rate** of a solver at target t: the share of its trials whose best-so-far fitness
+  went below t within the budget;
+* **ERT** (expected running time) at t: total evaluations of all trials -- until t was reached,
+  or the evaluations used within the budget when it was not -- divided by the number of
+  successes (inf when there are none); also given per dimension;
+* **ECDF** (empirical runtime distribution): the share of (triple, run) pairs reached within
+  b x dimension evaluations, as a step function of b (one row per step), per solver over all
+  problems and per problem class;
+* **score** of a solver on an instance: the area under that instance's ECDF on the log axis of
+  evaluations/dimension from 1 to the budget per dimension, normalised to [0, 1] -- the mean
+  over its runs and targets of ``log(Bd / max(e/d, 1)) / log(Bd)`` for a target reached with e
+  evaluations (0 when not reached). 1 would be every target at once; it rewards reaching more
+  targets and reaching them sooner, as the area under COCO's ECDF does;
+* **ranking** within a scope (all solvers; one track; one problem class within one track):
+  solvers by mean score over the scope's instances; the 95 % confidence interval is the
+  percentile interval of the mean over ``bootstrap`` resamples of the instances (with
+  replacement; one resample shared by all solvers, so differences are paired); solver a is
+  *significantly better* than b when the two-sided bootstrap p-value of mean(a - b),
+  ``p = min(1, 2 * min(#(d <= 0) + 1, #(d >= 0) + 1) / (B + 1))``, stays below ``alpha`` after
+  Holm's correction over all pairs of the scope (:func:`fkopt.study.statistics.holm`).
+"""
+from __future__ import annotations
+
+import zlib
+from itertools import combinations
+
+import numpy as np
+import pandas as pd
+
+from ..study.statistics import ecdf_table as ecdf_steps
+from ..study.statistics import holm
+from .budget import target_column
+
+INSTANCE = ["problem", "set", "pose"]
+
+
+def hits(runs: pd.DataFrame, targets) -> np.ndarray:
+    """(rows, targets) evaluations when each target was reached (NaN: not within budget)."""
+    return runs[[target_column(t) for t in targets]].to_numpy(dtype=float)
+
+
+def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
+    """Success rate and ERT per (problem, set, solver, target): the per-problem table."""
+    rows = []
+    keys = ["problem", "class", "set", "solver", "track"]
+    for key, g in runs.groupby(keys, sort=False):
+        ev = hits(g, targets)
+        used = g["evaluations"].to_numpy(dtype=float)
+        dim = int(g["dim"].iloc[0])
+        for j, t in enumerate(targets):
+            ok = ~np.isnan(ev[:, j])
+            n_ok = int(ok.sum())
+            total = float(np.where(ok, ev[:, j], used).sum())
+            ert = total / n_ok if n_ok else np.inf
+            rows.append({**dict(zip(keys, key)), "target": t, "trials": len(g), "successes": n_ok,
+                         "success_rate": n_ok / len(g), "ert": ert, "ert_per_dim": ert / dim})
+    return pd.DataFrame(rows)
+
+
+def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFrame:
+    """Share of (problem, set, pose, target, run) reached within b x dim evaluations, per scope
+    (``all`` and ``class:<c>``) and solver: the steps of the runtime distribution
+    (:func:`fkopt.study.statistics.ecdf_table`, in evaluations / dimension)."""
+    frames = []
+    scopes = [("all", runs)] + [(f"class:{c}", g) for c, g in runs.groupby("class", sort=True)]
+    for scope, sub in scopes:
+        per_dim = hits(sub, targets) / sub["dim"].to_numpy(dtype=float)[:, None]
+        solvers = list(dict.fromkeys(sub["solver"]))
+        df = ecdf_steps({s: per_dim[(sub["solver"] == s).to_numpy()] for s in solvers})
+        df = df.rename(columns={"algorithm": "solver", "evaluations": "evals_per_dim", "solved": "reached"})
+        df.insert(0, "scope", scope)
+        df.insert(2, "track", df["solver"].map(dict(zip(sub["solver"], sub["track"]))))
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def trial_scores(runs: pd.DataFrame, targets, budget_per_dim: float) -> np.ndarray:
+    """(rows,) the normalised log-area score of every trial (see the module docstring)."""
+    per_dim = hits(runs, targets) / runs["dim"].to_numpy(dtype=float)[:, None]
+    if budget_per_dim <= 1:
+        return (~np.isnan(per_dim)).mean(axis=1)
+    top = np.log(budget_per_dim)
+    s = np.clip((top - np.log(np.maximum(np.nan_to_num(per_dim, nan=budget_per_dim), 1.0))) / top, 0, 1)
+    return np.where(np.isnan(per_dim), 0.0, s).mean(axis=1)
+
+
+def instance_scores(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFrame:
+    """(instances x solvers) mean trial score; an instance a solver did not run is NaN."""
+    df = runs[INSTANCE + ["solver"]].copy()
+    df["score"] = trial_scores(runs, targets, budget_per_dim)
+    order = list(dict.fromkeys(runs["solver"]))
+    return df.groupby(INSTANCE + ["solver"], sort=True)["score"].mean().unstack("solver")[order]
+
+
+def rank_scope(scores: pd.DataFrame, bootstrap: int, alpha: float, seed: int, scope: str) -> pd.DataFrame:
+    """Ranking of the columns of ``scores`` (instances x solvers; rows with a NaN dropped)."""
+    s = scores.dropna(axis=0, how="any")
+    solvers = list(s.columns)
+    S = s.to_numpy(dtype=float)
+    n = len(S)
+    rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([int(seed), zlib.crc32(scope.encode())])))
+    idx = np.floor(rng.random((bootstrap, n)) * n).astype(np.intp)
+    boot = S[idx].mean(axis=1)                      # (B, solvers)
+    mean = S.mean(axis=0)
+    lo, hi = np.quantile(boot, [0.025, 0.975], axis=0)
+    pairs = list(combinations(range(len(solvers)), 2))
+    pvals = []
+    for a, b in pairs:
+        d = boot[:, a] - boot[:, b]
+        pvals.append(min(1.0, 2 * min((d <= 0).sum() + 1, (d >= 0).sum() + 1) / (bootstrap + 1)))
+    adj = holm(pvals) if pairs else np.array([])
+    better = {k: [] for k in range(len(solvers))}
+    for (a, b), p in zip(pairs, adj):
+        if p < alpha and mean[a] != mean[b]:
+            win, lose = (a, b) if mean[a] > mean[b] else (b, a)
+            better[win].append(solvers[lose])
+    rank = pd.Series(-np.round(mean, 12)).rank(method="min").astype(int).to_numpy()
+    out = pd.DataFrame({"scope": scope, "solver": solvers, "instances": n, "score": mean,
+                        "ci_low": lo, "ci_high": hi, "rank": rank,
+                        "better_than": [";".join(sorted(better[k])) for k in range(len(solvers))]})
+    return out.sort_values(["rank", "solver"], kind="stable").reset_index(drop=True)
+
+
+def leaderboard_table(runs: pd.DataFrame, targets, budget_per_dim: float, *, bootstrap: int = 1000,
+                      alpha: float = 0.05, seed: int = 0) -> pd.DataFrame:
+    """Rankings of every scope: ``overall`` (all solvers, tracks mixed, for reference),
+    ``track:<t>`` and ``class:<c>/track:<t>``; with each solver's success rate per target and
+    ERT at the smallest target reached by anyone, over the scope."""
+    tracks = dict(zip(runs["solver"], runs["track"]))
+    scopes = [("overall", runs)]
+    scopes += [(f"track:{t}", g) for t, g in runs.groupby("track", sort=True)]
+    scopes += [(f"class:{c}/track:{t}", g) for (c, t), g in runs.groupby(["class", "track"], sort=True)]
+    frames = []
+    for scope, sub in scopes:
+        ranked = rank_scope(instance_scores(sub, targets, budget_per_dim), bootstrap, alpha, seed, scope)
+        ranked.insert(2, "track", ranked["solver"].map(tracks))
+        ev = hits(sub, targets)
+        for j, t in enumerate(targets):
+            rate = pd.Series(~np.isnan(ev[:, j])).groupby(sub["solver"].to_numpy()).mean()
+            ranked[f"success_{t:.0e}"] = ranked["solver"].map(rate)
+        frames.append(ranked)
+    return pd.concat(frames, ignore_index=True)

@@ -1,0 +1,141 @@
+"""Results of solvers that cannot run inside fkopt, ranked beside fkopt's.
+
+A suite's ``outside:`` list names, per solver, a CSV file or an IOHprofiler folder (paths
+relative to the suite file)::
+
+    outside:
+      - {solver: my-cmaes, track: black-box, file: outside/my-cmaes.csv}
+      - {solver: ioh-de, track: black-box, ioh: outside/ioh-runs, algorithm: DE}
+
+**CSV**: one row per logged evaluation count of a run, columns
+
+==============  ==========================================================================
+problem         a problem name of the suite (e.g. ``mao2017-3rps``)
+set             a pose set (``uniform``, ``near-singular``, ``boundary``, ``printed``)
+pose            the pose's index in its set file (0-based)
+run             the run's index (0-based; any number of runs per pose)
+evaluations     fitness evaluations used so far (an analytic Jacobian counts as one)
+best_so_far     the best fitness found so far, on the problem's fitness (see docs/kinbench.md)
+==============  ==========================================================================
+
+**IOH** (what IOHexperimenter's ``Analyzer`` logger writes, read by
+:func:`fkopt.export.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
+with its ``IOHprofiler_f*.json`` index and ``.dat`` files); the function name is ``<problem>__<set>`` (two underscores),
+the instance is the pose index + 1, each logged run one run; the ``.dat`` lines are
+``evaluations raw_y`` with raw_y the problem's fitness (minimised). ``algorithm`` picks one
+algorithm of the folder (needed when it holds several).
+
+Rows may log every evaluation or only improvements; a run's measures are read exactly as for
+fkopt's solvers (:func:`fkopt.kinbench.budget.at_budget`): cut at the suite's budget, the first
+evaluation count below each target. Every (problem, set, pose) instance the suite selects must
+have at least one run, so all solvers are ranked on the same instances. The SHA-256 of the file
+(of every file of the folder) is recorded in meta.json.
+"""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import FkoptError
+from .budget import at_budget, budget_of
+
+COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
+IOH_SEPARATOR = "__"
+
+
+def outside_path(config, entry) -> Path:
+    base = config._folder if config._folder is not None else Path(".")
+    return Path(base) / (entry.file or entry.ioh)
+
+
+def digest(config, entry) -> str:
+    path = outside_path(config, entry)
+    files = [path] if entry.file else sorted(p for p in path.rglob("*") if p.is_file())
+    h = hashlib.sha256()
+    for f in files:
+        h.update(str(f.relative_to(path) if entry.ioh else f.name).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()
+
+
+def _csv_log(path: Path, where: str) -> pd.DataFrame:
+    try:
+        df = pd.read_csv(path, dtype={"problem": str, "set": str})
+    except FileNotFoundError:
+        raise FkoptError(f"{where}: not found") from None
+    except (OSError, ValueError, pd.errors.ParserError) as err:
+        raise FkoptError(f"{where}: unreadable CSV ({err})") from None
+    missing = [c for c in COLUMNS if c not in df.columns]
+    if missing:
+        raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {', '.join(COLUMNS)}")
+    return df
+
+
+def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
+    from ..export import read_ioh
+    if not path.is_dir():
+        raise FkoptError(f"{where}: not a folder")
+    try:
+        data = read_ioh(path)
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise FkoptError(f"{where}: unreadable IOH data ({type(err).__name__}: {err})") from None
+    algos = sorted({a for a, _, _ in data})
+    if not algos:
+        raise FkoptError(f"{where}: no IOHprofiler_f*.json index files found")
+    if algorithm is None and len(algos) > 1:
+        raise FkoptError(f"{where}: holds algorithms {', '.join(algos)}; name one with 'algorithm:'")
+    pick = algorithm or algos[0]
+    if pick not in algos:
+        raise FkoptError(f"{where}: algorithm '{pick}' not found; it holds {', '.join(algos)}")
+    rows = []
+    for (algo, fname, instance), runs in sorted(data.items(), key=lambda kv: kv[0][1:]):
+        if algo != pick:
+            continue
+        problem, sep, name = fname.partition(IOH_SEPARATOR)
+        if not sep:
+            raise FkoptError(f"{where}: function name '{fname}' is not <problem>{IOH_SEPARATOR}<set>")
+        for run, (block, _) in enumerate(runs):
+            block = block.reshape(-1, 2)
+            rows += [(problem, name, int(instance) - 1, run, e, y) for e, y in block]
+    return pd.DataFrame(rows, columns=list(COLUMNS))
+
+
+def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]]) -> pd.DataFrame:
+    """The run rows (as :func:`fkopt.kinbench.runner.run_rows` makes them) of ``config.outside[k]``."""
+    entry = config.outside[k]
+    path = outside_path(config, entry)
+    where = f"outside[{k}].{'file' if entry.file else 'ioh'}: {path}"
+    df = _csv_log(path, where) if entry.file else _ioh_log(path, where, entry.algorithm)
+    for col in ("pose", "run", "evaluations", "best_so_far"):
+        vals = pd.to_numeric(df[col], errors="coerce")
+        integer = col != "best_so_far"
+        bad = vals.isna() | (vals < 0) | (~np.isfinite(vals.fillna(0)))
+        if integer:
+            bad |= vals.fillna(0) % 1 != 0
+        if bad.any():
+            raise FkoptError(f"{where}: column '{col}' needs non-negative {'integers' if integer else 'finite numbers'} "
+                             f"(row {int(np.flatnonzero(bad)[0]) + 2})")
+        df[col] = vals
+    got = set(zip(df["problem"], df["set"], df["pose"].astype(int)))
+    lacking = sorted(instances - got)
+    if lacking:
+        p, s, i = lacking[0]
+        raise FkoptError(f"{where}: no run of problem {p}, set {s}, pose {i} (every instance of the suite needs one)")
+    df = df[[key in instances for key in zip(df["problem"], df["set"], df["pose"].astype(int))]]
+    frames = []
+    classes = {p.name: p.problem_class for p in config.problems}
+    for (problem, name, pose, run), g in df.groupby(["problem", "set", "pose", "run"], sort=True):
+        g = g.sort_values("evaluations", kind="stable")
+        ev = g["evaluations"].to_numpy(dtype=float)
+        hist = np.minimum.accumulate(g["best_so_far"].to_numpy(dtype=float))
+        dim = dims[problem]
+        m = at_budget(hist[None], ev[None], budget_of(config, dim), config.targets)
+        frames.append({"problem": problem, "class": classes[problem], "set": name, "pose": int(pose),
+                       "solver": entry.solver, "track": entry.track, "run": int(run), "dim": dim,
+                       "budget": budget_of(config, dim), **{key: float(v[0]) for key, v in m.items()}})
+    out = pd.DataFrame(frames)
+    order = {(p.name, s): (i, j) for i, p in enumerate(config.problems) for j, s in enumerate(config.sets)}
+    out["_o"] = [order[(p, s)] for p, s in zip(out["problem"], out["set"])]
+    return out.sort_values(["_o", "pose", "run"], kind="stable").drop(columns="_o").reset_index(drop=True)

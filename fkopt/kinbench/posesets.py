@@ -1,0 +1,225 @@
+"""Frozen, versioned pose sets (kinbench v1): generated once from a seed, stored with SHA-256.
+
+A pose set is a list of points in the space of a problem's unknowns (the pose of a parallel
+mechanism, the joints of a serial arm), as in a study (:mod:`fkopt.study.poses`); what a solver
+must reproduce follows from it (joints = ik(pose), or pose = fk(joints)). Sets of v1, each
+drawn from its own stream ``PCG64(SeedSequence([seed, crc32(problem), crc32(set)]))``:
+
+* ``uniform`` -- uniform in the box of the unknowns (the mechanism's workspace bounds);
+* ``near-singular`` -- :data:`CANDIDATES` uniform candidates, ranked by the condition number
+  kappa(J) = sigma_max / sigma_min of the residual Jacobian dr/dx of the problem at the true
+  solution (for FK: d ik / d pose; for IK: d pose-error / d joints, in the problem's own units
+  -- mm/deg or m/deg); a candidate is near-singular when kappa is above the bound
+  :data:`SINGULAR_QUANTILE` (the 95th percentile of kappa over the candidates, recorded in the
+  manifest); the set is the first such candidates in drawing order;
+* ``boundary`` -- a uniform point with one coordinate (chosen uniformly) moved to within
+  :data:`BOUNDARY_SHARE` of its range from one of its two bounds (chosen uniformly): the
+  boundary of the box of the unknowns (the joint limits of an arm, the pose box of a platform);
+* ``printed`` -- the poses printed in the papers (:data:`PRINTED`), in the unknowns' space.
+
+Files: ``<folder>/<problem>/<set>.csv`` (one column per unknown, ``%.17g``: exact doubles) and
+``<folder>/manifest.json``: version, seed, the generator's constants, per problem its mechanism
+spec and per set the file's SHA-256, its number of poses and (near-singular) the bound.
+:func:`load_pose_sets` verifies every checksum and that each problem's mechanism spec is the one
+its sets were generated for; any mismatch is one error line naming the file. ``python -m
+fkopt.kinbench.posesets SUITE.yaml`` (re)writes a set folder; a new version is a new folder.
+"""
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import sys
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FkoptError
+
+VERSION = "kinbench-v1"
+#: Poses per generated set.
+POSES = 20
+CANDIDATES = 4000
+SINGULAR_QUANTILE = 0.95
+BOUNDARY_SHARE = 0.02
+MANIFEST = "manifest.json"
+
+#: The papers' printed poses, in the unknowns' space, by problem name (see the configs/ folders).
+PRINTED: dict[str, list[dict[str, float]]] = {
+    "mao2017-3rps": [{"alpha": 9, "beta": 13, "z": 622}, {"alpha": -13, "beta": -19, "z": 574},
+                     {"alpha": -17, "beta": 8, "z": 436}, {"alpha": 18, "beta": 11, "z": 695},
+                     {"alpha": 4, "beta": -7, "z": 509}],
+    "liu2008-6sps": [{"x": 0.039860473384495845, "y": 0.09593004555681638, "z": 0.9252345609285073,
+                      "alpha": -12.697325274301523, "beta": 6.40309494118661, "gamma": 15.133205922920425}],
+    "chang2024-3rpupc": [{"alpha": 25, "beta": 34, "gamma": 23, "z": 360}],
+    "wu2015-3ppr": [{"x": 20, "y": 30, "theta": 15}, {"x": 10, "y": 15, "theta": 5},
+                    {"x": 10, "y": 20, "theta": 10}, {"x": 15, "y": 15, "theta": 10},
+                    {"x": 15, "y": 20, "theta": 15}, {"x": 20, "y": 15, "theta": 10}],
+    "wang2020-7dof": [{"q1": 45, "q2": 0, "q3": 45, "q4": 0, "q5": 45, "q6": 0, "q7": 0}],
+}
+
+
+def set_rng(seed: int, problem: str, name: str) -> np.random.Generator:
+    key = [int(seed), zlib.crc32(problem.encode()), zlib.crc32(name.encode())]
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(key)))
+
+
+def problem_mechanism(problem, folder: Path | None = None):
+    """The mechanism of a suite problem (the experiment layer's builder) and the RunConfig it
+    was built from (its objective is what :func:`fkopt.experiment.runner.make_problem` reads; the
+    one algorithm entry only satisfies the schema)."""
+    from ..experiment.config import RunConfig
+    from ..experiment.runner import build_mechanism
+    cfg = RunConfig(name="pose-set", mechanism=problem.mechanism, objective=problem.objective,
+                    algorithms=[{"name": "lm"}])
+    cfg._folder = folder
+    return build_mechanism(cfg), cfg
+
+
+def targets_of(mech, points: np.ndarray) -> np.ndarray:
+    """What a solver must reproduce for each point: ik(pose) or fk(joints)."""
+    return mech.fk(points) if mech.kind == "serial" else mech.ik(points)
+
+
+def condition_numbers(problem, folder: Path | None, points: np.ndarray) -> np.ndarray:
+    """kappa of the residual Jacobian at the true solution of each point (inf where singular)."""
+    from ..experiment.runner import make_problem
+    mech, cfg = problem_mechanism(problem, folder)
+    prob = make_problem(cfg, mech, targets_of(mech, points))
+    x = points[:, None, :]
+    if prob.has_jacobian:
+        jac = prob.jacobian(x)[:, 0]
+    else:      # central differences (a plug-in mechanism without an analytic Jacobian)
+        h = 1e-6 * np.maximum(1.0, np.abs(points))
+        cols = []
+        for j in range(points.shape[1]):
+            e = np.zeros_like(points)
+            e[:, j] = h[:, j]
+            cols.append((prob.residuals((points + e)[:, None]) - prob.residuals((points - e)[:, None]))[:, 0]
+                        / (2 * h[:, j, None]))
+        jac = np.stack(cols, axis=-1)
+    s = np.linalg.svd(jac, compute_uv=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
+
+
+def generate(problem, seed: int, n: int = POSES, folder: Path | None = None) -> tuple[dict, dict]:
+    """Points of every v1 set of ``problem`` and what the manifest records of their generation."""
+    mech, _ = problem_mechanism(problem, folder)
+    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    dim = len(lo)
+    out, info = {}, {}
+    rng = set_rng(seed, problem.name, "uniform")
+    out["uniform"] = lo + rng.random((n, dim)) * (hi - lo)
+    rng = set_rng(seed, problem.name, "near-singular")
+    cand = lo + rng.random((CANDIDATES, dim)) * (hi - lo)
+    kappa = condition_numbers(problem, folder, cand)
+    bound = float(np.quantile(kappa[np.isfinite(kappa)], SINGULAR_QUANTILE))
+    picked = np.flatnonzero(kappa > bound)[:n]
+    out["near-singular"] = cand[picked]
+    info["near-singular"] = {"measure": "condition number of the residual Jacobian at the solution",
+                             "bound": float(f"{bound:.6g}"), "quantile": SINGULAR_QUANTILE,
+                             "candidates": CANDIDATES}
+    rng = set_rng(seed, problem.name, "boundary")
+    u = rng.random((n, dim + 3))
+    pts = lo + u[:, :dim] * (hi - lo)
+    coord = np.floor(u[:, dim] * dim).astype(int)
+    upper = u[:, dim + 1] < 0.5
+    depth = u[:, dim + 2] * BOUNDARY_SHARE * (hi - lo)[coord]
+    rows = np.arange(n)
+    pts[rows, coord] = np.where(upper, hi[coord] - depth, lo[coord] + depth)
+    out["boundary"] = pts
+    info["boundary"] = {"share_of_range": BOUNDARY_SHARE}
+    printed = PRINTED.get(problem.name, [])
+    out["printed"] = (np.array([mech.vector(p, mech.unknown_names, f"printed pose of {problem.name}")
+                                for p in printed]) if printed else np.empty((0, dim)))
+    return out, info
+
+
+def csv_bytes(names: tuple[str, ...], points: np.ndarray) -> bytes:
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    for row in points:
+        buf.write(",".join(f"{v:.17g}" for v in row) + "\n")
+    return buf.getvalue().encode("ascii")
+
+
+def sha256_bytes(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def write_pose_sets(config, folder: Path) -> Path:
+    """Generate and write every set of every problem of ``config`` into ``folder`` (frozen data:
+    run once per version, then commit the folder)."""
+    folder = Path(folder)
+    manifest = {"version": folder.name, "seed": config.seed, "poses_per_set": POSES,
+                "generator": "fkopt.kinbench.posesets.generate", "problems": {}}
+    for problem in config.problems:
+        sets, info = generate(problem, config.seed, POSES, config._folder)
+        mech, _ = problem_mechanism(problem, config._folder)
+        entry = {"mechanism": problem.mechanism.model_dump(mode="json"), "unknowns": list(mech.unknown_names),
+                 "sets": {}}
+        (folder / problem.name).mkdir(parents=True, exist_ok=True)
+        for name, pts in sets.items():
+            data = csv_bytes(mech.unknown_names, pts)
+            (folder / problem.name / f"{name}.csv").write_bytes(data)
+            entry["sets"][name] = {"file": f"{problem.name}/{name}.csv", "sha256": sha256_bytes(data),
+                                   "poses": len(pts), **info.get(name, {})}
+        manifest["problems"][problem.name] = entry
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+    return folder
+
+
+def pose_set_folder(config) -> Path:
+    base = config._folder if config._folder is not None else Path(".")
+    return Path(base) / config.pose_sets
+
+
+def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
+    """{(problem, set): points} of ``config`` (the first ``config.poses`` of each set), checked
+    against the manifest's SHA-256 and mechanism specs; and the manifest."""
+    folder = pose_set_folder(config)
+    mpath = folder / MANIFEST
+    try:
+        manifest = json.loads(mpath.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise FkoptError(f"{mpath}: pose-set manifest not found (pose_sets: '{config.pose_sets}' names a "
+                         "folder beside the suite file)") from None
+    except (OSError, ValueError) as err:
+        raise FkoptError(f"{mpath}: unreadable pose-set manifest ({err})") from None
+    out = {}
+    for problem in config.problems:
+        entry = manifest.get("problems", {}).get(problem.name)
+        if entry is None:
+            raise FkoptError(f"{mpath}: no pose sets for problem '{problem.name}' "
+                             f"(has: {', '.join(manifest.get('problems', {}))})")
+        if entry["mechanism"] != problem.mechanism.model_dump(mode="json"):
+            raise FkoptError(f"problems[{problem.name}].mechanism: differs from the mechanism its pose sets "
+                             f"in {folder} were generated for ({entry['mechanism']}); a new mechanism needs "
+                             "new pose sets (a new version)")
+        for name in config.sets:
+            meta = entry["sets"].get(name)
+            if meta is None:
+                raise FkoptError(f"{mpath}: problem '{problem.name}' has no set '{name}'")
+            path = folder / meta["file"]
+            try:
+                data = path.read_bytes()
+            except OSError as err:
+                raise FkoptError(f"{path}: cannot read pose set ({err.strerror or err})") from None
+            if sha256_bytes(data) != meta["sha256"]:
+                raise FkoptError(f"{path}: SHA-256 {sha256_bytes(data)[:16]}... differs from the manifest's "
+                                 f"{meta['sha256'][:16]}...; the frozen pose set was changed")
+            lines = data.decode("ascii").splitlines()
+            if lines[0].split(",") != entry["unknowns"]:
+                raise FkoptError(f"{path}: columns {lines[0]} differ from {entry['unknowns']}")
+            pts = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=float)
+            pts = pts.reshape(-1, len(entry["unknowns"]))
+            out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
+    return out, manifest
+
+
+if __name__ == "__main__":     # python -m fkopt.kinbench.posesets configs/suites/kinbench.yaml
+    from .config import load_suite
+    cfg = load_suite(sys.argv[1])
+    print(write_pose_sets(cfg, pose_set_folder(cfg)))

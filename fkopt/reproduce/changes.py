@@ -1,0 +1,155 @@
+"""What moved when ``fkopt reproduce`` regenerated a results tree: ``CHANGES.md`` at its root.
+
+:func:`snapshot` reads the tree before the rerun (each result's deterministic files, its
+``summary.csv``, each paper's ``claims.csv``); :func:`describe` compares it with the tree after
+and says, per result, which files changed, which summary rows moved (the column, old -> new)
+and which verdicts changed. The report (:mod:`.report`) includes it, so REPORT.md says what the
+last regeneration moved, and nobody writes that list by hand.
+"""
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from ..outputs import deterministic_files, sha256
+from .claims import CLAIMS_FILE
+from .store import Store
+
+CHANGES_FILE = "CHANGES.md"
+#: Summary columns whose move is reported (the others follow from them or are settings).
+WATCHED = ("mean_fitness", "median_fitness", "best_fitness", "success_rate", "mean_evaluations",
+           "median_evaluations_to_threshold", "solutions_found")
+MAX_ROWS = 12
+
+
+@dataclass
+class Snapshot:
+    files: dict[str, dict[str, str]] = field(default_factory=dict)     # "paper/name" -> file -> sha256
+    summaries: dict[str, str] = field(default_factory=dict)            # "paper/name" -> summary.csv text
+    claims: dict[str, str] = field(default_factory=dict)               # paper -> claims.csv text
+
+
+def snapshot(root: str | Path) -> Snapshot:
+    """The state of a results tree (empty when there is none yet)."""
+    root = Path(root)
+    snap = Snapshot()
+    if not root.is_dir():
+        return snap
+    store = Store(root)
+    for exp in store.folders(None):
+        label = f"{exp.paper}/{exp.name}"
+        snap.files[label] = {f: sha256(exp.folder / f) for f in deterministic_files(exp.folder) if f != "meta.json"}
+        if (exp.folder / "summary.csv").is_file():
+            snap.summaries[label] = (exp.folder / "summary.csv").read_text(encoding="utf-8", errors="replace")
+    for paper in store.papers():
+        file = root / paper / CLAIMS_FILE
+        if file.is_file():
+            snap.claims[paper] = file.read_text(encoding="utf-8", errors="replace")
+    return snap
+
+
+def _table(text: str | None) -> pd.DataFrame | None:
+    if not text:
+        return None
+    try:
+        return pd.read_csv(io.StringIO(text))
+    except (ValueError, pd.errors.ParserError):
+        return None
+
+
+def _fmt(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def _summary_moves(before: str | None, after: str | None) -> list[str]:
+    a, b = _table(before), _table(after)
+    if a is None or b is None:
+        return []
+    keys = [k for k in ("case", "algorithm") if k in a.columns and k in b.columns]
+    if not keys:
+        return []
+    merged = a.merge(b, on=keys, how="outer", suffixes=("_old", "_new"), indicator=True)
+    lines = []
+    for _, row in merged.iterrows():
+        key = " / ".join(str(row[k]) for k in keys)
+        if row["_merge"] != "both":
+            lines.append(f"{key}: {'new row' if row['_merge'] == 'right_only' else 'row removed'}")
+            continue
+        moved = []
+        for col in WATCHED:
+            if f"{col}_old" not in row or f"{col}_new" not in row:
+                continue
+            old, new = row[f"{col}_old"], row[f"{col}_new"]
+            if not (pd.isna(old) and pd.isna(new)) and old != new:
+                moved.append(f"{col} {_fmt(old)} → {_fmt(new)}")
+        if moved:
+            lines.append(f"{key}: " + ", ".join(moved))
+    return lines
+
+
+def _claim_moves(before: str | None, after: str | None) -> list[str]:
+    a, b = _table(before), _table(after)
+    if a is None or b is None or "claim" not in a.columns or "claim" not in b.columns:
+        return []
+    old = {str(c): str(v) for c, v in zip(a["claim"], a["verdict"])}
+    new = {str(c): str(v) for c, v in zip(b["claim"], b["verdict"])}
+    out = []
+    for text in sorted(set(old) | set(new)):
+        if old.get(text) != new.get(text):
+            out.append(f"{text[:110]}: {old.get(text, '(new claim)')} → {new.get(text, '(claim removed)')}")
+    return out
+
+
+def describe(before: Snapshot, root: str | Path) -> str:
+    """CHANGES.md: what the tree under ``root`` changed against ``before`` (timings never count)."""
+    after = snapshot(root)
+    lines = ["# What the last regeneration moved", "",
+             "Written by `fkopt reproduce` from the tree before and after it ran (`fkopt/reproduce/changes.py`); "
+             "timing files and figures are left out. Summary moves list the watched columns only.", ""]
+    added = sorted(set(after.files) - set(before.files))
+    removed = sorted(set(before.files) - set(after.files))
+    if added:
+        lines += ["New results: " + ", ".join(added), ""]
+    if removed:
+        lines += ["Results no longer produced (folders left in place): " + ", ".join(removed), ""]
+    unchanged = []
+    for label in sorted(set(after.files) & set(before.files)):
+        old, new = before.files[label], after.files[label]
+        changed = sorted(f for f in set(old) | set(new) if old.get(f) != new.get(f))
+        if not changed:
+            unchanged.append(label)
+            continue
+        lines.append(f"## {label}")
+        lines.append("")
+        lines.append("Files changed: " + ", ".join(f"`{f}`" for f in changed))
+        moves = _summary_moves(before.summaries.get(label), after.summaries.get(label))
+        if moves:
+            lines.append("")
+            lines += [f"- {m}" for m in moves[:MAX_ROWS]]
+            if len(moves) > MAX_ROWS:
+                lines.append(f"- … and {len(moves) - MAX_ROWS} more rows")
+        lines.append("")
+    verdicts = []
+    for paper in sorted(set(before.claims) | set(after.claims)):
+        verdicts += [f"- {paper}: {m}" for m in _claim_moves(before.claims.get(paper), after.claims.get(paper))]
+        if paper not in before.claims and paper in after.claims:
+            verdicts.append(f"- {paper}: claims.csv is new")
+    if verdicts:
+        lines += ["## Verdicts that changed", ""] + verdicts + [""]
+    lines += [f"Unchanged (every deterministic file byte-identical): {', '.join(unchanged) if unchanged else 'none'}.",
+              ""]
+    return "\n".join(lines)
+
+
+def write_changes(root: str | Path, before: Snapshot) -> Path:
+    """Write CHANGES.md at the root of the regenerated tree; returns its path."""
+    from ..files import write_file_atomically
+    path = Path(root) / CHANGES_FILE
+    text = describe(before, root)
+    write_file_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return path

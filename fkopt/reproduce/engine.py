@@ -1,0 +1,364 @@
+"""The one claims engine: every paper's claims, declared in ``configs/<paper>/claims.yaml``, judged by
+the same rules (docs/claims.md).
+
+A claims file holds the paper's ``title``, ``experiments`` (report order), ``notes``,
+``inconsistencies`` (the paper's internal contradictions, with numbers) and ``claims``. Each claim
+has a stable ``id``, the paper's words with their place (``text``), a ``kind`` and the fields of
+that kind:
+
+* ``comparison`` -- ``better`` is lower than each of ``than`` (the algorithm(s) the paper ran) in
+  ``quantity`` over all runs (rank test, :func:`~.claims.compare`), at equal iterations and at equal
+  evaluations; the verdict uses ``basis`` (the paper's, default ``iterations``); ``also`` lists fkopt
+  variants shown beside; ``min_orders`` additionally requires a median gain of that many decades;
+* ``magnitude`` -- the ``statistic`` (mean or median) over all runs, per coordinate, of ``quantity``
+  against the printed order (``order`` +-``decades``, ``order_at_most``, ``below`` or ``above``);
+* ``iterations_to_target`` -- the median over all runs of the iteration at which ``algorithm`` first
+  went below ``level`` within ``tolerance`` of ``printed``, and (``faster_than``) significantly
+  fewer than the other's;
+* ``timing`` -- ``faster`` takes less time than ``than`` (interleaved single runs; within noise
+  inside the spread; :func:`~.claims.faster_claim`), or every run ``below_ms``; TIMING.md only;
+* ``value`` -- a number measured by the paper module (``quantity`` names a function of its
+  ``QUANTITIES``), against the same rules as a magnitude.
+
+Any claim may carry ``condition`` (a reconstruction or reading it rests on: the verdict becomes
+``conditional: ...``), ``readings`` (one row per reading, each a ``condition`` and algorithm
+replacements ``use: {gabc: gabc_zhu2010}`` and field overrides ``set: {quantity: ...}``) or ``not_checkable`` (why; fkopt's numbers are still
+shown). Adding a claim touches the claims file only.
+"""
+from __future__ import annotations
+
+import os
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from . import paper_module
+from .claims import (ALPHA, CONDITIONAL, NOT_CHECKABLE, Claim, compare, equal_budget, faster_claim, first_below, g,
+                     missing, p_text, verdict, within_of_final)
+
+CLAIMS_YAML = "claims.yaml"
+#: Where the claims files live: the repository's configs/ (``FKOPT_CONFIGS`` points elsewhere).
+CONFIGS = Path(os.environ.get("FKOPT_CONFIGS", Path(__file__).resolve().parents[2] / "configs"))
+KINDS = ("comparison", "magnitude", "iterations_to_target", "timing", "value")
+
+
+def is_claims_file(path: str | Path) -> bool:
+    """A paper's claims file (not an experiment config: ``fkopt reproduce`` skips it)."""
+    return Path(path).name == CLAIMS_YAML
+
+
+@lru_cache(maxsize=None)
+def load(paper: str) -> dict | None:
+    """The parsed ``configs/<paper>/claims.yaml``, or None."""
+    file = CONFIGS / paper / CLAIMS_YAML
+    if not file.exists():
+        return None
+    data = yaml.safe_load(file.read_text(encoding="utf-8")) or {}
+    ids = [c["id"] for c in data.get("claims", [])]
+    assert len(ids) == len(set(ids)), f"{file}: duplicate claim ids"
+    for c in data.get("claims", []):
+        assert c.get("kind") in KINDS, f"{file}: {c['id']}: kind {c.get('kind')!r} not in {KINDS}"
+    return data
+
+
+def info(paper: str) -> dict:
+    """title, experiments, notes and inconsistencies of a paper (claims.yaml, else the module)."""
+    data = load(paper) or {}
+    mod = paper_module(paper)
+    return {"title": data.get("title") or getattr(mod, "TITLE", paper),
+            "experiments": data.get("experiments") or getattr(mod, "EXPERIMENTS", []),
+            "notes": (data.get("notes") or getattr(mod, "NOTES", [])),
+            "inconsistencies": data.get("inconsistencies") or []}
+
+
+def judge_paper(paper: str, store) -> tuple[list[Claim], list[Claim]] | None:
+    """(claims, timing claims) of a paper, or None for a folder without claims."""
+    data = load(paper)
+    mod = paper_module(paper)
+    if data is None:
+        if mod is None or not hasattr(mod, "claims"):
+            return None
+        return mod.claims(store), (mod.timing_claims(store) if hasattr(mod, "timing_claims") else [])
+    plain, timing = [], []
+    for spec in data.get("claims", []):
+        for c in judge(paper, spec, store, mod):
+            (timing if spec["kind"] == "timing" else plain).append(c)
+    return plain, timing
+
+
+def judge(paper: str, spec: dict, store, mod=None) -> list[Claim]:
+    """One claim of the claims file, judged: one Claim per reading."""
+    readings = spec.get("readings") or [{"condition": spec.get("condition", "")}]
+    out = []
+    for k, reading in enumerate(readings):
+        cid = spec["id"] if len(readings) == 1 else f"{spec['id']}:{reading.get('id', k + 1)}"
+        c = _judge_one(paper, {**spec, **(reading.get("set") or {})}, reading.get("use") or {}, store, mod, cid)
+        c.id, c.kind, c.condition = cid, spec["kind"], reading.get("condition", "") or ""
+        if spec.get("not_checkable"):
+            c.evidence = f"{spec['not_checkable'].strip()}; fkopt's numbers: {c.evidence}"
+            c.verdict = NOT_CHECKABLE
+        elif c.condition and c.verdict in ("held", "not held"):
+            c.verdict = CONDITIONAL + c.verdict
+        out.append(c)
+    return out
+
+
+def _judge_one(paper, spec, use, store, mod, cid) -> Claim:
+    text = spec["text"].strip()
+    names = {**((load(paper) or {}).get("names") or {})}
+    exp = store.get(paper, spec["experiment"]) if spec.get("experiment") else None
+    if spec.get("experiment") and exp is None:
+        return missing(text, f"{paper}/{spec['experiment']}", cid)
+    try:
+        return KIND_JUDGES[spec["kind"]](text, spec, exp, lambda a: use.get(a, a), names, store, mod)
+    except _Missing as err:
+        return missing(text, str(err), cid)
+
+
+class _Missing(Exception):
+    """A result the claim needs is not stored (an older results tree): not checkable."""
+
+
+# -- per-run quantities ------------------------------------------------------------------------
+def runs_table(exp, mod) -> pd.DataFrame:
+    """runs.csv plus the per-run columns the paper module derives (``run_columns``)."""
+    runs = exp.table("runs")
+    extra = getattr(mod, "run_columns", None)
+    return extra(exp, runs) if extra else runs
+
+
+def per_run(exp, mod, algo: str, quantity: str, spec: dict) -> tuple[np.ndarray, np.ndarray | None]:
+    """(values, values on the evaluation basis or None) of ``quantity`` per run of ``algo``, all runs.
+
+    ``final_fitness`` (at ``spec['iteration']``, default the end), ``iterations_to_threshold``,
+    ``first_below`` (``spec['level']``) and ``within_1pct_of_final`` come with their evaluation
+    twin; ``log10_change`` is log10 f at the end of ``spec['window']`` minus at its start
+    (negative is progress); any other name is a per-run column (runs.csv or ``run_columns``), final values only.
+    """
+    runs = runs_table(exp, mod)
+    if algo not in set(runs.algorithm):
+        raise _Missing(f"{exp.paper}/{exp.name}: algorithm {algo}")
+    r = runs[runs.algorithm == algo].sort_values(["case", "run"])
+    if quantity == "iterations_to_threshold":
+        return (r.iterations_to_threshold.fillna(np.inf).to_numpy(float),
+                r.evaluations_to_threshold.fillna(np.inf).to_numpy(float))
+    if quantity in ("first_below", "within_1pct_of_final", "log10_change") and not exp.has("trace.csv.gz"):
+        raise _Missing(f"{exp.paper}/{exp.name}/trace.csv.gz")
+    if quantity == "first_below":
+        return first_below(exp, algo, float(spec["level"]))
+    if quantity == "within_1pct_of_final":
+        return within_of_final(exp, algo, 0.01)
+    if quantity == "log10_change":
+        from .claims import at_iteration
+        a, b = spec["window"]
+        f0, f1 = at_iteration(exp, algo, a), at_iteration(exp, algo, b)
+        return np.log10(np.maximum(f1, 1e-300)) - np.log10(np.maximum(f0, 1e-300)), None
+    if quantity not in r:
+        raise _Missing(f"{exp.paper}/{exp.name}: per-run {quantity}")
+    return r[quantity].to_numpy(float), None
+
+
+#: final per-run values that the trace does not hold, judged at equal evaluations through the objective
+TRACED_PROXY = ("position_error",)
+
+
+# -- kinds ---------------------------------------------------------------------------------------
+def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
+    better = use(spec["better"])
+    than = [use(a) for a in _list(spec["than"])]
+    quantity = spec.get("quantity", "final_fitness")
+    basis = spec.get("basis", "iterations")
+    nm = lambda a: names.get(a, a)   # noqa: E731
+    parts, numbers, held = [], {}, {"iterations": True, "evaluations": True}
+    for other in than + [use(a) for a in _list(spec.get("also"))]:
+        beside = other not in than
+        if quantity == "final_fitness":
+            it, ev, budget = equal_budget(exp, better, other, names, iteration=spec.get("iteration"))
+            ev_label = f"equal evaluations ({budget:.0f})"
+        else:
+            va, va_ev = per_run(exp, mod, better, quantity, spec)
+            vb, vb_ev = per_run(exp, mod, other, quantity, spec)
+            it = compare(nm(better), va, nm(other), vb)
+            ev = compare(nm(better), va_ev, nm(other), vb_ev) if va_ev is not None else None
+            ev_label = "in evaluations"
+            if ev is None and quantity in TRACED_PROXY and exp.has("trace.csv.gz"):
+                # a final per-run value (e.g. position error) is not traced: the objective stands in
+                _, ev, budget = equal_budget(exp, better, other, names)
+                ev_label = f"the objective f at equal evaluations ({budget:.0f}; {quantity} is not traced)"
+        tag = f"{nm(better)} vs {nm(other)}" + (" (fkopt's variant, beside)" if beside else "")
+        ev_text = ev.text() if ev is not None else "n/a (a final per-run value; not in the trace)"
+        parts.append(f"{tag}: equal iterations: {it.text()}; {ev_label}: {ev_text}")
+        key = other if not beside else f"{other}_beside"
+        numbers.update({f"p_{key}": it.p, f"lower_{key}": it.lower, f"median_{better}": it.median_a,
+                        f"median_{other}": it.median_b})
+        if ev is not None:
+            numbers.update({f"p_evaluations_{key}": ev.p, f"lower_evaluations_{key}": ev.lower})
+        if beside:
+            continue
+        held["iterations"] &= it.lower == nm(better)
+        held["evaluations"] = held["evaluations"] and (ev.lower == nm(better) if ev is not None else None)
+        if spec.get("min_orders") is not None:
+            gain = np.log10(max(it.median_b, 1e-300)) - np.log10(max(it.median_a, 1e-300))
+            numbers[f"orders_{other}"] = float(gain)
+            parts[-1] += f"; median gain {gain:.1f} decades (the claim needs >= {spec['min_orders']})"
+            held["iterations"] &= gain >= spec["min_orders"]
+            if ev is not None:
+                gain_ev = np.log10(max(ev.median_b, 1e-300)) - np.log10(max(ev.median_a, 1e-300))
+                numbers[f"orders_evaluations_{other}"] = float(gain_ev)
+                parts[-1] += f" (at equal evaluations {gain_ev:.1f})"
+                held["evaluations"] = held["evaluations"] and gain_ev >= spec["min_orders"]
+    decisive = held[basis] if held[basis] is not None else held["iterations"]
+    other_basis = "evaluations" if basis == "iterations" else "iterations"
+    note = f"verdict on equal {basis} (the paper's basis)"
+    if held[other_basis] is not None and bool(held[other_basis]) != bool(decisive):
+        note += f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
+        numbers["bases_disagree"] = True
+    return Claim(text, verdict(decisive), "; ".join(parts) + "; " + note, numbers)
+
+
+def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str]:
+    """(held, rule text) of a number against the claim's magnitude rule (a rule's number may be a
+    mapping per algorithm, e.g. the printed mean of each)."""
+    spec = {k: (v.get(algo) if isinstance(v, dict) and k in ("order", "order_at_most", "below", "above", "at_least")
+                else v) for k, v in spec.items()}
+    if spec.get("order") is not None:
+        d = float(spec.get("decades", 0.5))
+        off = np.log10(max(value, 1e-300)) - np.log10(spec["order"])
+        return abs(off) <= d, f"{off:+.2f} decades from {g(spec['order'])} (held within +-{d:g})"
+    if spec.get("order_at_most") is not None:
+        cap = 10.0 ** (np.floor(np.log10(spec["order_at_most"])) + 1)
+        return value < cap, f"of the order of {g(spec['order_at_most'])} or below (< {g(cap)})"
+    if spec.get("below") is not None:
+        return value < spec["below"], f"below {g(spec['below'])}"
+    if spec.get("above") is not None:
+        return value > spec["above"], f"above {g(spec['above'])}"
+    if spec.get("at_least") is not None:
+        return value >= spec["at_least"], f"at least {g(spec['at_least'])}"
+    raise ValueError(f"no rule in {spec}")
+
+
+def _magnitude(text, spec, exp, use, names, store, mod) -> Claim:
+    stat = spec.get("statistic", "median")
+    assert stat in ("mean", "median"), "magnitude claims use the mean or the median over all runs"
+    fn = np.mean if stat == "mean" else np.median
+    runs = runs_table(exp, mod)
+    if spec.get("case") is not None:   # a claim about one of the experiment's cases
+        runs = runs[runs["case"] == spec["case"]]
+    quantity = spec.get("quantity", "final_fitness")
+    units = {}
+    if exp.has("values.csv") and "unit" in exp.table("values"):
+        v = exp.table("values")
+        units = dict(zip(v.variable, v.unit))
+    parts, numbers, ok = [], {}, True
+    for algo in [use(a) for a in _list(spec["algorithms"])]:
+        if algo not in set(runs.algorithm):
+            raise _Missing(f"{exp.paper}/{exp.name}: algorithm {algo}")
+        if isinstance(quantity, list):   # some coordinates (e.g. the position's)
+            cols = quantity
+        elif quantity == "abs_error":   # per coordinate, the paper's units
+            cols = [c for c in runs.columns if c.startswith("abs_error_")]
+        elif quantity in runs:
+            cols = [quantity]
+        else:
+            cols = None
+        groups = runs[runs.algorithm == algo].groupby("case", sort=False) if spec.get("per_case") else \
+            [("all", runs[runs.algorithm == algo])]
+        for case, grp in groups:
+            if cols is None:
+                values = {quantity: per_run(exp, mod, algo, quantity, spec)[0]}
+            else:
+                values = {c: grp[c].to_numpy(float) for c in cols}
+            for col, vals in values.items():
+                s = float(fn(vals))
+                good, rule = _rule(s, spec, algo)
+                ok &= good
+                var = col.removeprefix("abs_error_")
+                label = f"{names.get(algo, algo)}{'' if case == 'all' else ' ' + str(case)} {var}"
+                parts.append(f"{label} {g(s)}{' ' + units[var] if var in units else ''}")
+                numbers[f"{stat}_{algo}_{var}" + ("" if case == "all" else f"_{case}")] = s
+    return Claim(text, verdict(ok), f"{stat} over all runs, per coordinate: {', '.join(parts)}; rule: {rule}",
+                 numbers)
+
+
+def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
+    algo = use(spec["algorithm"])
+    q = "first_below" if "level" in spec else "iterations_to_threshold"
+    its, evs = per_run(exp, mod, algo, q, spec)
+    med = float(np.median(its))
+    tol = float(spec.get("tolerance", 0.25))
+    ok = abs(med - spec["printed"]) <= tol * spec["printed"]
+    level = spec.get("level", exp.config.get("threshold"))
+    ev = (f"median over all {its.size} runs of the iteration at which {names.get(algo, algo)} first went below "
+          f"{g(level)}: {g(med)} ({g(float(np.median(evs)))} evaluations; {int(np.isinf(its).sum())} runs never), "
+          f"printed {g(spec['printed'])} (held within {tol:.0%})")
+    numbers = {f"median_iterations_{algo}": med}
+    if spec.get("faster_than"):
+        other = use(spec["faster_than"])
+        o_its, o_evs = per_run(exp, mod, other, q, spec)
+        ci = compare(names.get(algo, algo), its, names.get(other, other), o_its)
+        ce = compare(names.get(algo, algo), evs, names.get(other, other), o_evs)
+        ok = ok and ci.lower == names.get(algo, algo)
+        ev += f"; vs {names.get(other, other)}: iterations {ci.text()}; evaluations {ce.text()}"
+        numbers.update({f"median_iterations_{other}": ci.median_b, "p_iterations": ci.p, "lower_iterations": ci.lower,
+                        "p_evaluations": ce.p, "lower_evaluations": ce.lower})
+        if (ce.lower == names.get(algo, algo)) != (ci.lower == names.get(algo, algo)):
+            ev += "; **bases disagree**"
+            numbers["bases_disagree"] = True
+    return Claim(text, verdict(ok), ev, numbers)
+
+
+def _timing(text, spec, exp, use, names, store, mod) -> Claim:
+    if not exp.has("timing_runs.csv"):
+        return Claim(text, NOT_CHECKABLE, "no single-run timings stored (timing_runs.csv)")
+    t = exp.table("timing_runs")
+    if "below_ms" in spec:
+        algos = [use(a) for a in _list(spec["algorithms"])]
+        worst = float(t[t.algorithm.isin(algos)].ms.max())
+        return Claim(text, verdict(worst < spec["below_ms"]),
+                     f"slowest of the {int(t.algorithm.isin(algos).sum())} timed single runs: {g(worst)} ms "
+                     f"(the claim is about every run)", {"worst_ms": worst})
+    a, b = use(spec["faster"]), use(spec["than"])
+    ms = {x: t[t.algorithm == x].ms.to_numpy(float) for x in (a, b)}
+    if not all(v.size for v in ms.values()):
+        raise _Missing(f"{exp.paper}/{exp.name}/timing_runs.csv: timed runs of {a} and {b}")
+    if spec.get("time_to_best"):   # wang7dof Tab. 3: ms x iterations to best / iterations
+        runs = runs_table(exp, mod).set_index(["case", "run"])
+        for x in (a, b):
+            tx = t[t.algorithm == x]
+            it = runs[runs.algorithm == x].iterations_to_best
+            ms[x] = tx.ms.to_numpy() * np.array([it.loc[(c, k)] for c, k in zip(tx["case"], tx.run)]) \
+                / float(exp.config["iterations"])
+    cmp = compare(names.get(a, a), ms[a], names.get(b, b), ms[b])
+    c = faster_claim(text, names.get(a, a), cmp, tuple(spec["printed_ms"]) if "printed_ms" in spec else None)
+    if "saving" in spec and c.verdict == "held":
+        saving = 1.0 - cmp.median_a / cmp.median_b
+        c.numbers["saving"] = float(saving)
+        c.evidence = f"{100 * saving:.1f} % shorter (held needs a saving within 10 points of " \
+                     f"{100 * spec['saving']:.2f} %); " + c.evidence
+        c.verdict = verdict(abs(saving - spec["saving"]) <= 0.1)
+    return c
+
+
+def _value(text, spec, exp, use, names, store, mod) -> Claim:
+    fn = (getattr(mod, "QUANTITIES", {}) or {}).get(spec["quantity"])
+    assert fn is not None, f"{spec['id']}: the paper module has no quantity {spec['quantity']!r}"
+    got = fn(store)
+    if got is None:
+        raise _Missing(f"the results behind {spec['quantity']}")
+    value, evidence, numbers = got
+    ok, rule = _rule(value, spec)
+    return Claim(text, verdict(ok), f"{evidence} (rule: {spec['quantity']} {g(value)} {rule})", numbers)
+
+
+KIND_JUDGES = {"comparison": _comparison, "magnitude": _magnitude, "iterations_to_target": _iterations_to_target,
+               "timing": _timing, "value": _value}
+
+
+def _list(x) -> list:
+    return [] if x is None else list(x) if isinstance(x, (list, tuple)) else [x]
+
+
+__all__ = ["ALPHA", "judge_paper", "judge", "load", "info", "is_claims_file", "p_text"]

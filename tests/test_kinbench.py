@@ -1,0 +1,383 @@
+"""kinbench: suite configs, frozen pose sets, COCO measures, leaderboard files, plug-ins."""
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from fkopt.errors import FkoptError
+from fkopt.experiment.kinds import from_dict, load_any, run_config
+from fkopt.kinbench import measures as M
+from fkopt.kinbench.config import load_suite
+from fkopt.kinbench.posesets import (BOUNDARY_SHARE, condition_numbers, generate, load_pose_sets,
+                                     problem_mechanism)
+from fkopt.kinbench.budget import at_budget, target_column
+
+ROOT = Path(__file__).resolve().parents[1]
+SUITES = ROOT / "configs" / "suites"
+SUITE = SUITES / "kinbench.yaml"
+PY = sys.executable
+
+
+def tiny(tmp_path, **over) -> Path:
+    """A small suite beside a copy of the frozen pose sets (the folder the YAML names)."""
+    shutil.copytree(SUITES / "kinbench-v1", tmp_path / "kinbench-v1")
+    data = yaml.safe_load(SUITE.read_text())
+    data.update(name="tiny", problems=[p for p in data["problems"] if p["name"] in ("mao2017-3rps", "wu2015-3ppr")],
+                solvers=[{"name": "pso"}, {"name": "lm"}], poses=2, runs=2, budget_per_dim=100, bootstrap=200,
+                quick=None)
+    data.update(over)
+    path = tmp_path / "tiny.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def cli(*args, cwd=None):
+    return subprocess.run([PY, "-m", "fkopt.cli", *map(str, args)], capture_output=True, text=True, cwd=cwd,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+
+
+# -- config -------------------------------------------------------------------------------------
+def test_the_suite_file_and_its_quick_tier_validate():
+    cfg = load_suite(SUITE)
+    q = cfg.quick_tier()
+    assert q.name == "kinbench-quick" and q.quick is None and q.check == "ci"
+    assert {s.key for s in q.solvers} < {s.key for s in cfg.solvers} and q.poses < cfg.poses and q.runs < cfg.runs
+    assert [s.track for s in cfg.solvers if s.name == "lm"] == ["jacobian"]
+    # what meta.json stores reloads as the same config (fkopt check reruns from it)
+    again = from_dict(q.model_dump(mode="json"), "meta")
+    assert again.model_dump() == q.model_dump()
+
+
+@pytest.mark.parametrize("change, fragment", [
+    ({"solvers": [{"name": "some.module:Solver"}]}, "needs 'track' (allowed: black-box, jacobian, exact)"),
+    ({"solvers": [{"name": "gabc", "track": "grey-box"}]}, "track"),
+    ({"sets": ["uniform", "weird"]}, "sets"),
+    ({"targets": [1e-4, 1e-2]}, "decreasing order"),
+    ({"quick": {"solvers": ["nope"]}}, "quick.solvers: 'nope' is not one of"),
+    ({"budget_per_dim": 0}, "budget_per_dim"),
+])
+def test_bad_suite_fields_are_one_line_errors(tmp_path, change, fragment):
+    path = tiny(tmp_path, **change)
+    with pytest.raises(FkoptError) as err:
+        load_any(path)
+    assert fragment in str(err.value) and str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+# -- pose sets ----------------------------------------------------------------------------------
+def test_frozen_pose_sets_are_regenerated_bit_for_bit_from_their_seed():
+    cfg = load_suite(SUITE)
+    manifest = json.loads((SUITES / "kinbench-v1" / "manifest.json").read_text())
+    from fkopt.kinbench.posesets import POSES, csv_bytes
+    for problem in cfg.problems[:2]:
+        sets, _ = generate(problem, manifest["seed"], POSES, cfg._folder)
+        mech, _ = problem_mechanism(problem)
+        for name, pts in sets.items():
+            digest = hashlib.sha256(csv_bytes(mech.unknown_names, pts)).hexdigest()
+            assert digest == manifest["problems"][problem.name]["sets"][name]["sha256"], (problem.name, name)
+
+
+def test_pose_sets_measure_what_they_claim():
+    cfg = load_suite(SUITE)
+    sets, manifest = load_pose_sets(cfg)
+    for problem in cfg.problems:
+        mech, _ = problem_mechanism(problem)
+        lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+        info = manifest["problems"][problem.name]["sets"]
+        kappa = condition_numbers(problem, None, sets[(problem.name, "near-singular")])
+        assert np.all(kappa > info["near-singular"]["bound"] * (1 - 1e-5)), problem.name
+        uni = condition_numbers(problem, None, sets[(problem.name, "uniform")])
+        assert np.median(kappa) > np.median(uni), problem.name
+        b = sets[(problem.name, "boundary")]
+        gap = np.minimum(b - lo, hi - b) / (hi - lo)
+        assert np.all(gap.min(axis=1) <= BOUNDARY_SHARE + 1e-12) and np.all(gap >= -1e-12), problem.name
+        assert len(sets[(problem.name, "printed")]) >= 1
+
+
+def test_a_changed_pose_file_is_refused_by_its_checksum(tmp_path):
+    path = tiny(tmp_path)
+    f = tmp_path / "kinbench-v1" / "mao2017-3rps" / "uniform.csv"
+    f.write_text(f.read_text().replace("1", "2", 1))
+    out = tmp_path / "out"
+    r = cli("suite", path, "--out", out, "-q")
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.count("\n") == 1 and "uniform.csv: SHA-256" in r.stderr and "Traceback" not in r.stderr
+    assert not (out / "kinbench").exists()
+
+
+def test_a_solver_that_cannot_take_a_problem_is_refused_before_solving(tmp_path):
+    data = yaml.safe_load(SUITE.read_text())
+    arm = [p for p in data["problems"] if p["name"] == "wang2020-7dof"]
+    path = tiny(tmp_path, problems=arm, solvers=[{"name": "pso"}, {"name": "nr"}])
+    r = cli("suite", path, "--out", tmp_path / "out", "-q")
+    assert r.returncode == 2 and r.stderr.startswith(f"fkopt: error: {path}: solvers[nr] on problems[wang2020-7dof]: nr needs")
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
+def test_a_mechanism_other_than_the_pose_sets_one_is_refused(tmp_path):
+    data = yaml.safe_load(SUITE.read_text())
+    probs = data["problems"][:1]
+    probs[0]["mechanism"]["geometry"]["ra"] = 275
+    with pytest.raises(FkoptError, match=r"problems\[mao2017-3rps\].mechanism: differs"):
+        from fkopt.experiment.kinds import validate_any
+        validate_any(load_any(tiny(tmp_path, problems=probs)))
+
+
+# -- measures -----------------------------------------------------------------------------------
+def test_at_budget_cuts_every_measure_at_the_budget():
+    hist = np.array([[1.0, 1e-3, 1e-5, 1e-11], [1.0, 0.5, 0.5, 0.5]])
+    ev = np.array([[10, 20, 30, 40], [10, 20, 30, 40]])
+    m = at_budget(hist, ev, 35, [1e-2, 1e-4, 1e-10])
+    assert m["evaluations"].tolist() == [30, 30] and m["fitness"].tolist() == [1e-5, 0.5]
+    assert m[target_column(1e-2)].tolist()[0] == 20 and np.isnan(m[target_column(1e-2)][1])
+    assert np.isnan(m[target_column(1e-10)][0])        # reached at 40 > budget 35
+
+
+def _runs(rows):
+    cols = ["problem", "class", "set", "pose", "solver", "track", "run", "dim", "budget", "evaluations", "fitness",
+            target_column(1e-2), target_column(1e-6)]
+    return pd.DataFrame(rows, columns=cols)
+
+
+def test_ert_and_success_rate_follow_coco():
+    nan = np.nan
+    runs = _runs([["p", "c", "u", 0, "a", "black-box", 0, 2, 100, 40, 1e-7, 10, 40],
+                  ["p", "c", "u", 0, "a", "black-box", 1, 2, 100, 100, 1e-3, 30, nan],
+                  ["p", "c", "u", 0, "a", "black-box", 2, 2, 100, 100, 1.0, nan, nan]])
+    t = M.measures_table(runs, [1e-2, 1e-6]).set_index("target")
+    assert t.loc[1e-2, "success_rate"] == pytest.approx(2 / 3)
+    assert t.loc[1e-2, "ert"] == pytest.approx((10 + 30 + 100) / 2)
+    assert t.loc[1e-6, "ert"] == pytest.approx((40 + 100 + 100) / 1) and t.loc[1e-6, "ert_per_dim"] == 120
+    e = M.ecdf_table(runs, [1e-2, 1e-6], 50)
+    e = e[e.scope == "all"]
+    assert e["fraction"].is_monotonic_increasing and e["fraction"].iloc[-1] == pytest.approx(3 / 6)
+    # targets reached after 10, 30 (1e-2) and 40 (1e-6) evaluations, dimension 2, of 6 (triple, run) pairs
+    assert e[["evals_per_dim", "reached", "pairs"]].values.tolist() == [[5, 1, 6], [15, 2, 6], [20, 3, 6]]
+
+
+def test_ranking_finds_a_real_difference_and_no_fake_one():
+    rng = np.random.default_rng(0)
+    base = rng.random(40)
+    scores = pd.DataFrame({"good": base + 0.2, "bad": base, "twin": base + rng.normal(0, 1e-3, 40)})
+    r = M.rank_scope(scores, 1000, 0.05, 1, "s").set_index("solver")
+    assert r.loc["good", "rank"] == 1 and set(r.loc["good", "better_than"].split(";")) == {"bad", "twin"}
+    assert r.loc["twin", "better_than"] == "" and r.loc["bad", "better_than"] == ""
+    assert r.loc["good", "ci_low"] < r.loc["good", "score"] < r.loc["good", "ci_high"]
+
+
+# -- end to end ---------------------------------------------------------------------------------
+def test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it(tmp_path):
+    path = tiny(tmp_path)
+    out = tmp_path / "out"
+    r = cli("suite", path, "--out", out, "-q")
+    assert r.returncode == 0, r.stderr
+    folder = out / "kinbench" / "tiny"
+    for name in ("leaderboard.csv", "leaderboard.md", "measures.csv", "ecdf.csv", "runs.csv", "timing.csv",
+                 "index.html", "ecdf_all.png", "ecdf_all.pdf", "ecdf_parallel-fk-3dof.png", "meta.json"):
+        assert (folder / name).is_file(), name
+    lb = pd.read_csv(folder / "leaderboard.csv")
+    assert set(lb.loc[lb.scope == "overall", "solver"]) == {"pso", "lm"}
+    assert {"overall", "track:black-box", "track:jacobian"} <= set(lb.scope)
+    runs = pd.read_csv(folder / "runs.csv")
+    assert len(runs) == 2 * 2 * (4 * 2) * 2     # problems x solvers x (4 sets x 2 poses) x runs
+    assert (runs["evaluations"] <= runs["budget"]).all()
+    page = (folder / "index.html").read_text()
+    assert "data:image/png;base64," in page and "http://" not in page and "https://" not in page
+    assert "<script src" not in page and "<link" not in page
+    assert "## Per track" in (folder / "leaderboard.md").read_text()
+    chk = cli("check", folder)
+    assert chk.returncode == 0, chk.stdout + chk.stderr
+    from fkopt.experiment.kinds import prepare_output
+    assert prepare_output(load_any(path), out) == folder     # the same suite may rewrite it without --force
+    with pytest.raises(FkoptError, match="different config"):
+        prepare_output(load_any(tiny(tmp_path / "other", runs=3)), out)
+    lb.loc[0, "score"] += 0.01                 # a stored number that the rerun does not give
+    lb.to_csv(folder / "leaderboard.csv", index=False, float_format="%.10g")
+    chk = cli("check", folder)
+    assert chk.returncode == 1 and "leaderboard.csv" in chk.stderr, chk.stdout + chk.stderr
+
+
+def test_fkopt_run_accepts_a_suite_and_numbers_do_not_depend_on_other_solvers(tmp_path):
+    path = tiny(tmp_path)
+    one = load_any(tiny(tmp_path / "b", solvers=[{"name": "lm"}]))
+    both = load_any(path)
+    a = run_config(both, tmp_path / "o1", source=str(path)).result.runs
+    b = run_config(one, tmp_path / "o2", source=str(tmp_path / "b" / "tiny.yaml")).result.runs
+    pd.testing.assert_frame_equal(a[a.solver == "lm"].reset_index(drop=True), b.reset_index(drop=True))
+
+
+def test_a_plugin_algorithm_from_examples_gets_a_leaderboard_row(tmp_path, monkeypatch):
+    """examples/plugin's DE, named by direct reference: nothing in fkopt knows it."""
+    monkeypatch.syspath_prepend(str(ROOT / "examples" / "plugin"))
+    path = tiny(tmp_path, solvers=[{"name": "fkopt_example.de:DE", "label": "de", "track": "black-box"},
+                                   {"name": "pso"}])
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    lb = pd.read_csv(res.folder / "leaderboard.csv")
+    row = lb[(lb.scope == "track:black-box") & (lb.solver == "de")]
+    assert len(row) == 1 and row["track"].item() == "black-box" and 0 <= row["score"].item() <= 1
+
+
+def test_reproduce_does_not_pick_up_suites(tmp_path):
+    from fkopt.reproduce.run import plan
+    shutil.copytree(SUITES, tmp_path / "configs" / "suites")
+    shutil.copy(ROOT / "configs" / "wu2015" / "tab2_nr.yaml", tmp_path / "configs" / "one.yaml")
+    planned = plan(tmp_path / "configs", tmp_path / "out")
+    assert [p.path.name for p in planned] == ["one.yaml"]
+
+
+def _outside_csv(path, rows_of):
+    """An outside solver's log: for every instance and 2 runs, rows_of(problem, set, pose, run) rows."""
+    cfg = load_suite(path)
+    sets, _ = load_pose_sets(cfg)
+    rows = []
+    for (problem, name), pts in sets.items():
+        for i in range(len(pts)):
+            for run in range(2):
+                rows += [dict(problem=problem, set=name, pose=i, run=run, evaluations=e, best_so_far=f)
+                         for e, f in rows_of(problem, name, i, run)]
+    return pd.DataFrame(rows)
+
+
+def test_outside_results_are_ranked_beside_fkopts(tmp_path):
+    path = tiny(tmp_path)
+    # a perfect outside solver: every target at 2 x dim evaluations; and one that never gets close
+    _outside_csv(path, lambda *a: [(1, 5.0), (6, 1e-12), (1000, 1e-13)]).to_csv(tmp_path / "fast.csv", index=False)
+    _outside_csv(path, lambda *a: [(1, 5.0), (300, 1.0)]).to_csv(tmp_path / "slow.csv", index=False)
+    path = tiny(tmp_path / "s", outside=[{"solver": "ext-fast", "track": "black-box", "file": "../fast.csv"},
+                                         {"solver": "ext-slow", "track": "black-box", "file": "../slow.csv"}])
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    lb = pd.read_csv(res.folder / "leaderboard.csv")
+    bb = lb[lb.scope == "track:black-box"].set_index("solver")
+    assert bb.loc["ext-fast", "rank"] == 1 and bb.loc["ext-slow", "score"] == 0
+    assert set(bb.index) == {"ext-fast", "ext-slow", "pso"}
+    assert bb.loc["ext-fast", "success_1e-10"] == 1
+    expected = np.log(100 / 2) / np.log(100)    # all 5 targets at 6 evaluations / dim 3 = 2 per dim
+    assert bb.loc["ext-fast", "score"] == pytest.approx(expected)
+    meta = json.loads((res.folder / "meta.json").read_text())
+    assert set(meta["outside"]) == {"ext-fast", "ext-slow"}
+
+
+def test_an_outside_file_missing_an_instance_is_refused_before_solving(tmp_path):
+    path = tiny(tmp_path)
+    df = _outside_csv(path, lambda *a: [(1, 5.0)])
+    df[~((df.problem == "wu2015-3ppr") & (df.set == "boundary") & (df.pose == 1))].to_csv(tmp_path / "x.csv",
+                                                                                          index=False)
+    path = tiny(tmp_path / "s", outside=[{"solver": "ext", "track": "exact", "file": "../x.csv"}])
+    out = tmp_path / "out"
+    r = cli("suite", path, "--out", out, "-q")
+    assert r.returncode == 2 and "no run of problem wu2015-3ppr, set boundary, pose 1" in r.stderr
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+    assert not out.exists() or not any(p.is_file() for p in out.rglob("*"))
+
+
+def test_worker_processes_and_a_dask_scheduler_write_the_same_bytes(tmp_path):
+    path = tiny(tmp_path, solvers=[{"name": "lm"}, {"name": "pso"}])
+    a = run_config(load_any(path), tmp_path / "one", source=str(path)).folder
+    b = run_config(load_any(path), tmp_path / "two", source=str(path), jobs=2).folder
+    folders = [b]
+    try:
+        from dask.distributed import LocalCluster
+    except ImportError:
+        LocalCluster = None
+    if LocalCluster is not None:     # an existing cluster reached by its address, as with --scheduler
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+            folders.append(run_config(load_any(path), tmp_path / "dask", source=str(path), executor="dask",
+                                      scheduler=cluster.scheduler_address).folder)
+    for other in folders:
+        for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+            assert (a / name).read_bytes() == (other / name).read_bytes(), (other, name)
+    if LocalCluster is None:
+        pytest.skip("dask.distributed not installed: only the worker processes were compared")
+
+
+def test_runs_logged_by_iohexperimenter_are_ranked(tmp_path):
+    """Outside runs written by IOHexperimenter's own Analyzer logger (not by fkopt) are read back
+    with the best-so-far fitness the runs really reached."""
+    ioh = pytest.importorskip("ioh", reason="IOHexperimenter (pip install ioh) is not installed")
+    from fkopt.experiment.runner import make_problem
+    from fkopt.kinbench.posesets import targets_of
+    path = tiny(tmp_path)
+    cfg = load_suite(path)
+    sets, _ = load_pose_sets(cfg)
+    logger = ioh.logger.Analyzer(root=str(tmp_path / "ioh-runs"), folder_name="rs", algorithm_name="RS")
+    best = {}
+    for problem in cfg.problems:
+        mech, rc = problem_mechanism(problem)
+        lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+        for name in cfg.sets:
+            for i, point in enumerate(sets[(problem.name, name)]):
+                prob = make_problem(rc, mech, targets_of(mech, point[None])[0])
+                f = ioh.wrap_problem(lambda x, p=prob: float(p.fitness(np.asarray(x))), name=f"{problem.name}__{name}",
+                                     optimization_type=ioh.OptimizationType.MIN, dimension=len(lo), instance=i + 1,
+                                     lb=-1000.0, ub=1000.0)
+                f.attach_logger(logger)
+                rng = np.random.default_rng(i)
+                for run in range(2):
+                    xs = lo + rng.random((40, len(lo))) * (hi - lo)
+                    best[(problem.name, name, i, run)] = min(f(list(x)) for x in xs)
+                    f.reset()
+    logger.close()
+    path = tiny(tmp_path / "s", outside=[{"solver": "ioh-rs", "track": "black-box", "ioh": "../ioh-runs"}])
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    runs = res.result.runs
+    got = runs[runs.solver == "ioh-rs"]
+    assert len(got) == len(best)
+    for r in got.itertuples():
+        assert r.evaluations == 40 and r.fitness == pytest.approx(best[(r.problem, r.set, r.pose, r.run)], rel=1e-9)
+    lb = pd.read_csv(res.folder / "leaderboard.csv")
+    assert "ioh-rs" in set(lb.loc[lb.scope == "track:black-box", "solver"])
+
+
+def test_a_urdf_arm_joins_as_a_problem_with_pose_sets_of_its_own(tmp_path):
+    """The hook for URDF arms: a problem is a mechanism spec; its frozen sets are generated like v1's."""
+    from fkopt.kinbench.posesets import write_pose_sets
+    urdf = ROOT / "fkopt" / "mechanisms" / "data" / "wang7dof.urdf"
+    data = {"kind": "suite", "name": "urdf", "pose_sets": "kb-urdf", "sets": ["uniform", "near-singular", "boundary"],
+            "problems": [{"name": "urdf-7dof", "problem_class": "serial-ik-7dof", "objective": "geodesic",
+                          "mechanism": {"name": "urdf", "bounds": {"q1": [-180, 180]},
+                                        "geometry": {"file": str(urdf), "base": "link0", "tip": "tool"}}}],
+            "solvers": [{"name": "lm"}], "poses": 1, "runs": 1, "budget_per_dim": 200, "bootstrap": 100}
+    path = tmp_path / "urdf.yaml"
+    path.write_text(yaml.safe_dump(data))
+    cfg = load_suite(path)
+    write_pose_sets(cfg, tmp_path / "kb-urdf")
+    res = run_config(load_any(path), tmp_path / "out", source=str(path))
+    runs = res.result.runs
+    assert len(runs) == 3 and set(runs["set"]) == {"uniform", "near-singular", "boundary"}
+    assert (runs["dim"] == 7).all() and (runs["evaluations"] <= 200 * 7).all()
+
+
+def test_an_interrupted_suite_resumes_with_the_same_bytes(tmp_path):
+    from fkopt.kinbench.kind import work_folder
+    path = tiny(tmp_path)
+    whole = run_config(load_any(path), tmp_path / "whole", source=str(path)).folder
+
+    class Stop(KeyboardInterrupt):
+        pass
+
+    def stop_after_two(label, done, total):
+        if done == 2:
+            raise Stop
+    out = tmp_path / "out"
+    with pytest.raises(Stop):
+        run_config(load_any(path), out, source=str(path), progress=stop_after_two)
+    work = work_folder(out, load_any(path))
+    assert len(list(work.glob("p*-s*.json"))) == 2 and not (out / "kinbench" / "tiny").exists()
+    seen = []
+    folder = run_config(load_any(path), out, source=str(path), resume=True,
+                        progress=lambda label, done, total: seen.append((done, total))).folder
+    assert seen == [(3, 4), (4, 4)]                 # only the two missing tasks were solved
+    for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+        assert (folder / name).read_bytes() == (whole / name).read_bytes(), name
+    assert not work.exists()
+    # tasks of another version of the suite are never mixed in
+    with pytest.raises(Stop):
+        run_config(load_any(path), out, source=str(path), progress=stop_after_two)
+    with pytest.raises(FkoptError, match="another version of the suite"):
+        run_config(load_any(tiny(tmp_path / "v2", runs=3)), out, source=str(path), resume=True, force=True)
