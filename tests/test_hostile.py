@@ -339,6 +339,35 @@ def test_report_refuses_files_linked_outside(finished_study, cli, target):
     assert victim.read_text() == "outside --out\n"
 
 
+@pytest.mark.parametrize("scheduler", [None, "tcp://127.0.0.1:1"], ids=["link", "unreachable-scheduler"])
+def test_suite_resume_refuses_links_and_keeps_its_tasks(tmp_path, monkeypatch, scheduler):
+    """The kinbench suite's .partial: a link outside --out is refused; an unreachable scheduler
+    is one line before the finished tasks are touched."""
+    monkeypatch.syspath_prepend(str(Path(__file__).parent))
+    from test_kinbench import tiny
+    from fkopt.errors import FkoptError
+    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinbench.kind import work_folder
+    path = tiny(tmp_path)
+    out = tmp_path / "out"
+    work = work_folder(out, load_any(path))
+    work.parent.mkdir(parents=True)
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    if scheduler is None:
+        work.symlink_to(outside, target_is_directory=True)
+        with pytest.raises(FkoptError, match="outside"):
+            run_config(load_any(path), out, source=str(path), resume=True)
+        assert list(outside.iterdir()) == []
+    else:
+        pytest.importorskip("dask.distributed")
+        work.mkdir()
+        (work / "p0-s0.json").write_text("{}")
+        with pytest.raises(FkoptError, match="--scheduler"):
+            run_config(load_any(path), out, source=str(path), resume=True, executor="dask", scheduler=scheduler)
+        assert (work / "p0-s0.json").read_text() == "{}"
+
+
 def test_bench_refuses_bench_csv_linked_outside(tmp_path, cli):
     bench = tmp_path / "b"
     bench.mkdir()

@@ -22,12 +22,15 @@ def work_folder(out, config: SuiteConfig) -> Path:
 
 
 def _run(config: SuiteConfig, out, *, source=None, progress=None, jobs: int = 1, executor: str = "local",
-         scheduler: str | None = None, resume: bool = False, **_) -> Outcome:
+         scheduler: str | None = None, resume: bool = False, publish_check=None, **_) -> Outcome:
+    from ..files import inside
+    from ..study.executors import check_scheduler
     from .runner import run_suite
-    work = work_folder(out, config)
+    work = inside(out, work_folder(out, config))      # no task file written or read through a link
+    check_scheduler(executor, scheduler)              # reachable before the work folder is touched
     result = run_suite(config, source=source, progress=progress, jobs=jobs, executor=executor, scheduler=scheduler,
                        work=work, resume=resume)
-    folder = write_result("suite", result, out)
+    folder = write_result("suite", result, out, publish_check)
     shutil.rmtree(work, ignore_errors=True)
     return Outcome(folder, result.wall_s, result)
 

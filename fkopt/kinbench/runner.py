@@ -29,7 +29,7 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..experiment.config import RunConfig
-from ..files import write_json_atomically
+from ..files import inside, write_json_atomically
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..solve import chunk_size
 from .budget import at_budget, budget_of
@@ -157,6 +157,7 @@ def _finished_tasks(work: Path, fp: str) -> dict[tuple[int, int], dict]:
     """Tasks an interrupted run of the same suite finished (unreadable files are redone)."""
     out = {}
     for path in sorted(work.glob("p*-s*.json")):
+        inside(work, path, "--resume")
         try:
             rec = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
@@ -198,7 +199,7 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     def collect(rec: dict) -> None:
         if work is not None:
             stored = {**rec, "fingerprint": fp, "rows": rec["rows"].to_dict(orient="list")}
-            write_json_atomically(_task_file(work, rec["problem"], rec["solver"]), stored)
+            write_json_atomically(inside(work, _task_file(work, rec["problem"], rec["solver"])), stored)
         done.append(rec)
         if progress:
             progress(f"{config.problems[rec['problem']].name} / {config.solvers[rec['solver']].key}",
