@@ -404,6 +404,17 @@ def test_resume_refuses_an_edited_task_file(finished_study, cli):
     assert snapshot(final) == before
 
 
+def test_check_fails_on_an_edited_study_task_file(finished_study, cli):
+    _, out, final, _ = finished_study
+    assert cli("check", out, "-q")[0] == 0
+    task = next((final / "tasks").glob("a*.json"))
+    rec = json.loads(task.read_text())
+    rec["fitness"][0][0] = 0.0
+    task.write_text(json.dumps(rec))
+    code, _, err = cli("check", out, "-q")
+    assert code == 1 and f"tasks/{task.name}" in err and "changed since written" in err, err
+
+
 @pytest.mark.parametrize("content", ["[]", '{"fingerprint": "x"}', '"text"', '{"id": 5}', "{not json"],
                          ids=["list", "no-id", "string", "id-number", "garbage"])
 def test_resume_refuses_corrupt_task_files(finished_study, cli, content):

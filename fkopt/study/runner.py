@@ -287,6 +287,29 @@ def read_task_files(folder: Path, config: StudyConfig, dim: int, digests: dict[s
     return out
 
 
+def task_file_problems(folder: Path) -> list[tuple[str, str]]:
+    """(file, problem) for every task file of a published study ``folder/tasks`` whose bytes no
+    longer have the SHA-256 recorded in ``tasks/study.json`` when it was written, or that no
+    record names (``fkopt check``). A study written before digests were recorded has none to
+    compare: ``[]`` (its task files are never reused by ``--resume`` either)."""
+    tasks = Path(folder) / TASKS
+    stored = _manifest(tasks / STUDY_FILE) if tasks.is_dir() else None
+    digests = stored.get("tasks") if isinstance(stored, dict) else None
+    if not isinstance(digests, dict):
+        return []
+    out = []
+    files = {p.stem: p for p in tasks.glob("a*.json")}
+    for ident in sorted(set(files) | set(digests)):
+        path = files.get(ident)
+        if path is None:
+            out.append((f"{TASKS}/{ident}.json", "missing"))
+        elif ident not in digests:
+            out.append((f"{TASKS}/{path.name}", "not recorded in study.json"))
+        elif path.is_symlink() or _digest(path) != digests[ident]:
+            out.append((f"{TASKS}/{path.name}", "changed since written"))
+    return out
+
+
 def check_records(records: dict[str, dict], folder: Path, config: StudyConfig, n_poses: int, dim: int) -> None:
     """Every reused record is a finished task of this study (see :func:`read_task_files`)."""
     planned = {t.id: t for t in plan_tasks(config, n_poses)}
