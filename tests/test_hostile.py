@@ -329,7 +329,7 @@ def test_study_resume_refuses_a_task_file_linked_outside(finished_study, cli):
     one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), "outside")
 
 
-@pytest.mark.parametrize("target", ["REPORT.md", "index.csv", "studies/claims.csv"])
+@pytest.mark.parametrize("target", ["REPORT.md", "index.csv", "studies/claims.csv", "studies/timing_claims.csv"])
 def test_report_refuses_files_linked_outside(finished_study, cli, target):
     _, out, _, outside = finished_study
     victim = outside / "keep.txt"

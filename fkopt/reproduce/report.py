@@ -256,7 +256,7 @@ def write_report(root: str | Path) -> list[Path]:
     from ..files import inside
     root = Path(root)
     paths = [root / "REPORT.md", root / "TIMING.md", root / "index.csv"]
-    claims = [root / paper / CLAIMS_FILE for paper in Store(root).papers() if paper_module(paper) is not None]
+    claims = [root / paper / name for paper in Store(root).papers() for name in (CLAIMS_FILE, TIMING_CLAIMS_FILE)]
     for path in paths + claims:
         inside(root, path, "report")
     for exp in Store(root).experiments():     # folders a paper's figures are drawn into
