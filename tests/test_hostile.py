@@ -368,6 +368,21 @@ def test_suite_resume_refuses_links_and_keeps_its_tasks(tmp_path, monkeypatch, s
         assert (work / "p0-s0.json").read_text() == "{}"
 
 
+@pytest.mark.parametrize("content", ["[]", '"text"', "7"])
+def test_suite_resume_refuses_corrupt_task_files(tmp_path, monkeypatch, content):
+    monkeypatch.syspath_prepend(str(Path(__file__).parent))
+    from test_kinbench import tiny
+    from fkopt.errors import FkoptError
+    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinbench.kind import work_folder
+    path = tiny(tmp_path)
+    work = work_folder(tmp_path / "out", load_any(path))
+    work.mkdir(parents=True)
+    (work / "p0-s0.json").write_text(content)
+    with pytest.raises(FkoptError, match="p0-s0.json"):
+        run_config(load_any(path), tmp_path / "out", source=str(path), resume=True)
+
+
 def test_bench_refuses_bench_csv_linked_outside(tmp_path, cli):
     bench = tmp_path / "b"
     bench.mkdir()

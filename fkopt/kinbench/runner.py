@@ -162,11 +162,21 @@ def _finished_tasks(work: Path, fp: str) -> dict[tuple[int, int], dict]:
             rec = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
+        redo = "delete it to recompute that task, or rerun without --resume to start over"
+        if not isinstance(rec, dict):
+            raise FkoptError(f"--resume: {path} holds a JSON {type(rec).__name__}, not a task record; {redo}")
         if rec.get("fingerprint") != fp:
             raise FkoptError(f"--resume: {path} belongs to another version of the suite (its config or pose "
                              "sets changed); rerun without --resume to start over")
-        rec["rows"] = pd.DataFrame(rec["rows"])
-        out[(rec["problem"], rec["solver"])] = rec
+        try:
+            key = (int(rec["problem"]), int(rec["solver"]))
+            if path.name != _task_file(work, *key).name or not isinstance(rec["rows"], dict):
+                raise ValueError("its problem/solver are not its file name's, or rows is not a table")
+            rec["rows"] = pd.DataFrame(rec["rows"])
+        except (KeyError, TypeError, ValueError) as err:
+            raise FkoptError(f"--resume: {path} is not a finished task of this suite ({type(err).__name__}: "
+                             f"{str(err)[:120]}); {redo}") from None
+        out[key] = rec
     return out
 
 
