@@ -12,7 +12,8 @@ from fkopt.problems import fk_problem
 from fkopt.registry import mechanism_class
 from fkopt.reproduce.check import check_experiment
 from fkopt.reproduce.claims import (HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, at_evaluations, at_iteration,
-                                    compare, faster_claim, first_below, verdict_changes)
+                                    compare, faster_claim, first_below)
+from fkopt.reproduce.drift import verdict_changes
 from fkopt.reproduce.engine import is_claims_file, judge
 from fkopt.reproduce.report import claims_files
 from fkopt.reproduce.store import Experiment, Store

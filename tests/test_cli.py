@@ -151,11 +151,14 @@ def test_stored_configs_validate():
     assert files
     from fkopt.experiment.assembly import AssemblyConfig
     from fkopt.experiment.config import RandomCases
+    from fkopt.kinbench.config import SuiteConfig
     from fkopt.study.config import StudyConfig
-    for f in files:   # experiments, studies (kind: study) and assembly modes (kind: assembly)
+    for f in files:   # experiments, studies (kind: study), assembly modes and suites
         cfg = load_any(f)
         tasks = validate_any(cfg)
-        if isinstance(cfg, AssemblyConfig):
+        if isinstance(cfg, SuiteConfig):     # one task per (problem, solver)
+            assert tasks == len(cfg.problems) * len(cfg.solvers), f
+        elif isinstance(cfg, AssemblyConfig):
             assert tasks == 1, f
         elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block
             assert tasks > 0 and tasks % len(cfg.algorithms) == 0, f

@@ -19,7 +19,7 @@ results folder ``<paper>/<name>/``:
    cross-platform rules where only the BLAS part differs, the cross-platform rules elsewhere
    (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier);
 5. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
-   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.claims.rerun_verdict_drift`), and a paper
+   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.drift.rerun_verdict_drift`), and a paper
    folder whose paper has claims must have its ``claims.csv``.
 
 A mismatch names the experiment, the file, the row, the column and both values. Figures are
@@ -216,7 +216,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
         order += ["meta.json"]
         out += compare_folders(label, exp.folder, tmp, rules_for(exp, tier), files=order)
-        from .claims import rerun_verdict_drift   # a claim's verdict must not change either
+        from .drift import rerun_verdict_drift   # a claim's verdict must not change either
         out += rerun_verdict_drift(exp, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -265,7 +265,7 @@ def faster_claim(text: str, faster: str, cmp: Comparison | None, printed: tuple 
 # -- claims.csv and drift --------------------------------------------------------------------------
 CLAIMS_FILE = "claims.csv"
 #: Timing verdicts, stored apart: they change with the machine (``fkopt check`` compares them only
-#: where the platform fingerprint matches; :func:`verdict_changes` with ``timing=True``).
+#: where the platform fingerprint matches; :func:`fkopt.reproduce.drift.verdict_changes` with ``timing=True``).
 TIMING_CLAIMS_FILE = "timing_claims.csv"
 COLUMNS = ["id", "claim", "verdict", "condition"]
 
@@ -301,56 +301,3 @@ def read_claims(file: str | Path) -> pd.DataFrame:
     if not {"claim", "verdict"} <= set(df.columns):
         raise FkoptError(f"{file}: expected the columns claim and verdict; got {', '.join(map(str, df.columns[:6]))}")
     return df
-
-
-def verdict_changes(root: str | Path, timing: bool = False) -> list[tuple[str, str, str, str]]:
-    """(paper, claim, stored verdict, recomputed verdict) for every non-timing claim whose verdict
-    computed from the results under ``root`` differs from the stored ``<paper>/claims.csv``
-    (``(absent)`` when a claim appeared or disappeared). ``timing=True``: the timing claims against
-    ``<paper>/timing_claims.csv`` instead (meaningful only on the platform that measured them)."""
-    from .engine import judge_paper
-    from .store import Store
-    root = Path(root)
-    store = Store(root)
-    out = []
-    for paper in store.papers():
-        file = root / paper / (TIMING_CLAIMS_FILE if timing else CLAIMS_FILE)
-        judged = judge_paper(paper, store)
-        if judged is None or not file.exists():
-            continue
-        stored = read_claims(file)
-        now = claims_frame(judged[1] if timing else judged[0])
-        by_id = "id" in stored and (stored["id"] != "").all()
-        s = dict(zip(_key(stored), zip(stored.claim, stored.verdict)))
-        n = dict(zip(now["id"] if by_id else now["claim"], zip(now.claim, now.verdict)))
-        for key in sorted(set(s) | set(n)):
-            a, b = s.get(key, (None, "(absent)")), n.get(key, (None, "(absent)"))
-            if a[1] != b[1]:
-                out.append((paper, f"{key}: {a[0] or b[0]}" if by_id else key, a[1], b[1]))
-    return out
-
-
-def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
-    """Verdicts of ``exp``'s paper recomputed with the rerun of ``exp`` in place of the stored folder,
-    against the stored ``claims.csv`` (``fkopt check``): one :class:`~.check.Mismatch` per change."""
-    import shutil
-    import tempfile
-    from ..compare import Mismatch
-    from ..errors import FkoptError
-    if not (exp.folder.parent / CLAIMS_FILE).exists():
-        return []
-    try:
-        read_claims(exp.folder.parent / CLAIMS_FILE)
-    except FkoptError as err:
-        return [Mismatch(f"{exp.paper}/{exp.name}", CLAIMS_FILE, "-", "file", str(err),
-                         "a UTF-8 CSV with claim, verdict", "readable")]
-    tmp = Path(tempfile.mkdtemp(prefix="fkopt-claims-"))
-    try:
-        shutil.copytree(exp.folder.parent, tmp / exp.paper)
-        shutil.rmtree(tmp / exp.paper / exp.name)
-        shutil.copytree(rerun_folder, tmp / exp.paper / exp.name)
-        changes = verdict_changes(tmp)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return [Mismatch(f"{exp.paper}/{exp.name}", CLAIMS_FILE, text[:90], "verdict", a, b, "same verdict")
-            for _, text, a, b in changes]

@@ -1,0 +1,63 @@
+"""Verdicts that a rerun changed (``fkopt check``): the stored ``<paper>/claims.csv`` (and
+``timing_claims.csv``) against the verdicts the one engine (:mod:`.engine`) computes now.
+
+Kept apart from :mod:`.claims` (the vocabulary the engine uses) so the two never import each other.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .claims import CLAIMS_FILE, TIMING_CLAIMS_FILE, _key, claims_frame, read_claims
+from .engine import judge_paper
+from .store import Store
+
+
+def verdict_changes(root: str | Path, timing: bool = False) -> list[tuple[str, str, str, str]]:
+    """(paper, claim, stored verdict, recomputed verdict) for every non-timing claim whose verdict
+    computed from the results under ``root`` differs from the stored ``<paper>/claims.csv``
+    (``(absent)`` when a claim appeared or disappeared). ``timing=True``: the timing claims against
+    ``<paper>/timing_claims.csv`` instead (meaningful only on the platform that measured them)."""
+    root = Path(root)
+    store = Store(root)
+    out = []
+    for paper in store.papers():
+        file = root / paper / (TIMING_CLAIMS_FILE if timing else CLAIMS_FILE)
+        judged = judge_paper(paper, store)
+        if judged is None or not file.exists():
+            continue
+        stored = read_claims(file)
+        now = claims_frame(judged[1] if timing else judged[0])
+        by_id = "id" in stored and (stored["id"] != "").all()
+        s = dict(zip(_key(stored), zip(stored.claim, stored.verdict)))
+        n = dict(zip(now["id"] if by_id else now["claim"], zip(now.claim, now.verdict)))
+        for key in sorted(set(s) | set(n)):
+            a, b = s.get(key, (None, "(absent)")), n.get(key, (None, "(absent)"))
+            if a[1] != b[1]:
+                out.append((paper, f"{key}: {a[0] or b[0]}" if by_id else key, a[1], b[1]))
+    return out
+
+
+def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
+    """Verdicts of ``exp``'s paper recomputed with the rerun of ``exp`` in place of the stored folder,
+    against the stored ``claims.csv`` (``fkopt check``): one :class:`~.check.Mismatch` per change."""
+    import shutil
+    import tempfile
+    from ..compare import Mismatch
+    from ..errors import FkoptError
+    if not (exp.folder.parent / CLAIMS_FILE).exists():
+        return []
+    try:
+        read_claims(exp.folder.parent / CLAIMS_FILE)
+    except FkoptError as err:
+        return [Mismatch(f"{exp.paper}/{exp.name}", CLAIMS_FILE, "-", "file", str(err),
+                         "a UTF-8 CSV with claim, verdict", "readable")]
+    tmp = Path(tempfile.mkdtemp(prefix="fkopt-claims-"))
+    try:
+        shutil.copytree(exp.folder.parent, tmp / exp.paper)
+        shutil.rmtree(tmp / exp.paper / exp.name)
+        shutil.copytree(rerun_folder, tmp / exp.paper / exp.name)
+        changes = verdict_changes(tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return [Mismatch(f"{exp.paper}/{exp.name}", CLAIMS_FILE, text[:90], "verdict", a, b, "same verdict")
+            for _, text, a, b in changes]
