@@ -160,6 +160,9 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
               "rejects equality at alpha = 0.05, otherwise the verdict is *within noise*. Measured on "
               "the machine that ran `make reproduce` last (numpy, one process); the papers' times are "
               "MATLAB/Java on their machines.", ""]
+    if (root / "CHANGES.md").is_file():    # written by fkopt reproduce (fkopt.reproduce.changes)
+        out += ["**What the last regeneration moved** (files, summary rows old → new, verdicts): "
+                "[CHANGES.md](CHANGES.md).", ""]
     out.append("Contents: " + " · ".join(f"[{p}](#{p})" for p in papers))
     out.append("")
     index_rows = []
