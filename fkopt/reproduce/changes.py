@@ -62,7 +62,7 @@ def _table(text: str | None) -> pd.DataFrame | None:
 
 def _fmt(v) -> str:
     if isinstance(v, float):
-        return f"{v:.4g}"
+        return f"{v:.6g}"
     return str(v)
 
 
@@ -96,8 +96,11 @@ def _claim_moves(before: str | None, after: str | None) -> list[str]:
     a, b = _table(before), _table(after)
     if a is None or b is None or "claim" not in a.columns or "claim" not in b.columns:
         return []
-    old = {str(c): str(v) for c, v in zip(a["claim"], a["verdict"])}
-    new = {str(c): str(v) for c, v in zip(b["claim"], b["verdict"])}
+    def keyed(df: pd.DataFrame) -> dict[str, str]:   # one row per reading: the condition tells them apart
+        cond = df["condition"].fillna("").astype(str) if "condition" in df.columns else pd.Series([""] * len(df))
+        return {str(c) + (f" [under: {k}]" if k else ""): str(v)
+                for c, k, v in zip(df["claim"], cond, df["verdict"])}
+    old, new = keyed(a), keyed(b)
     out = []
     for text in sorted(set(old) | set(new)):
         if old.get(text) != new.get(text):
