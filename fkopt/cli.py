@@ -683,7 +683,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
 
 
 @app.command()
-def schema(kind: str = typer.Argument("experiment", help="experiment | study | assembly")):
+def schema(kind: str = typer.Argument("experiment", help="experiment | study | assembly | suite")):
     """Print the JSON Schema of a kind of config file, for editors.
 
     A YAML file whose first line is `# yaml-language-server: $schema=PATH` (PATH relative to the

@@ -31,6 +31,7 @@ MODELS: dict[str, str] = {
     "experiment": "fkopt.experiment.config:ExperimentConfig",
     "study": "fkopt.study.config:StudyConfig",
     "assembly": "fkopt.experiment.assembly:AssemblyConfig",
+    "suite": "fkopt.kinbench.config:SuiteConfig",
 }
 #: What each kind of file is, for the reference's headings.
 KIND_TEXT = {
@@ -40,6 +41,8 @@ KIND_TEXT = {
              "solved by every algorithm; statistics, ECDF, heat maps, tracking. Run with `fkopt study FILE`.",
     "assembly": "An assembly-mode search (`kind: assembly`): every real forward solution of one set of "
                 "joints. Run with `fkopt run FILE`.",
+    "suite": "A benchmark suite (`kind: suite`, kinbench): problems x frozen pose sets x solvers x runs at "
+             "a budget per dimension, ranked on leaderboards. Run with `fkopt suite FILE` (docs/kinbench.md).",
 }
 #: Folder of the generated files, relative to the repository root.
 DOCS = Path("docs")
@@ -204,10 +207,64 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
                   "normalised pose distance", 1e-6),
         "expected": ("Known number of real solutions, for the report.", "solutions", 40),
     },
+    "SuiteConfig": {
+        "kind": ("Marks the file as a benchmark suite.", "", "suite"),
+        "paper": ("Groups results: the folder OUT/<paper>/.", "", "kinbench"),
+        "pose_sets": ("Version of the frozen pose sets under configs/suites/<pose_sets>/ (CSV files and a "
+                      "manifest.json of SHA-256 checksums, verified on load).", "", "kinbench-v1"),
+        "problems": ("The problems: a named mechanism (FK of a parallel mechanism, IK of a serial arm) "
+                     "and its problem class, ranked together.", "",
+                     [{"name": "mao2017-3rps", "problem_class": "parallel-fk-3dof", "mechanism": {"name": "3-rps"}}]),
+        "sets": ("Which pose sets of the version to solve.", "", ["uniform", "near-singular"]),
+        "poses": ("Poses per set (the first N of each frozen set); default all.", "poses", 10),
+        "solvers": ("The solvers (any fkopt algorithm, adapter or plug-in), each with its track.", "",
+                    [{"name": "gabc"}, {"name": "lm"}]),
+        "budget_per_dim": ("Evaluation budget of a run: this times the problem's dimension (one analytic "
+                           "Jacobian counts as one evaluation).", "evaluations per dimension", 2000),
+        "targets": ("Ladder of fitness targets at which success, ERT and the ECDF are measured.",
+                    "fitness (the problem's scale)", [1e-2, 1e-6, 1e-10]),
+        "bootstrap": ("Bootstrap resamples of the instances for the leaderboard's confidence intervals.",
+                      "resamples", 1000),
+        "alpha": ("Significance level of the pairwise tests of a leaderboard table (Holm-corrected).", "", 0.05),
+        "outside": ("Results of solvers run outside fkopt, ranked beside fkopt's (a CSV file or an "
+                    "IOHprofiler folder).", "", [{"solver": "mytool", "track": "black-box", "file": "mytool.csv"}]),
+        "quick": ("The subset `--quick` runs (and CI's check reruns): fewer problems, solvers, sets, "
+                  "poses, runs or a smaller budget.", "", {"solvers": ["gabc", "lm"], "poses": 3, "runs": 3}),
+        "check": ("`ci`: the test suite reruns the stored result; `full`: only `fkopt check --subset all`.",
+                  "", "full"),
+    },
+    "SuiteProblem": {
+        "name": ("Name of the problem in the tables.", "", "mao2017-3rps"),
+        "problem_class": ("Problems of one class are ranked together.", "", "parallel-fk-3dof"),
+        "mechanism": ("The mechanism, as in an experiment: a name, geometry and bounds.", "",
+                      {"name": "3-rps", "geometry": {"ra": 274, "rb": 158}}),
+        "objective": ("The objective, as in an experiment; default the mechanism's.", "", "absolute"),
+    },
+    "SuiteSolver": {
+        "track": ("black-box (fitness only), jacobian (uses Jacobians) or exact; fkopt knows its own "
+                  "solvers' and the adapters' tracks, a plug-in must state its own.", "", "black-box"),
+    },
+    "OutsideSolver": {
+        "solver": ("Name of the outside solver on the leaderboard.", "", "mytool"),
+        "track": ("Its track: black-box, jacobian or exact.", "", "black-box"),
+        "file": ("CSV of its runs (problem, set, pose, run, evaluations, best_so_far), relative to the "
+                 "suite file.", "", "mytool.csv"),
+        "ioh": ("An IOHprofiler data folder of its runs, relative to the suite file.", "", "ioh-data/mytool"),
+        "algorithm": ("Which algorithm of the `ioh` folder to take when it holds several.", "", "mytool"),
+        "description": ("Free text: what the solver is and how it was run.", "", "mytool 1.2, default options"),
+    },
+    "QuickTier": {
+        "problems": ("Problems of the quick tier (names); default all.", "", ["mao2017-3rps"]),
+        "solvers": ("Solvers of the quick tier (labels); default all.", "", ["gabc", "lm"]),
+        "sets": ("Pose sets of the quick tier; default the suite's.", "", ["uniform"]),
+        "poses": ("Poses per set.", "poses", 3),
+        "runs": ("Runs per pose.", "runs", 3),
+        "budget_per_dim": ("Budget per dimension.", "evaluations per dimension", 500),
+    },
 }
 #: Fields documented once for every model that inherits them.
 SHARED = {"AssemblyConfig": "ExperimentConfig", "StudyConfig": "ExperimentConfig",
-          "StudyAlgorithmSpec": "AlgorithmSpec"}
+          "StudyAlgorithmSpec": "AlgorithmSpec", "SuiteConfig": "ExperimentConfig", "SuiteSolver": "AlgorithmSpec"}
 
 
 def kinds() -> list[str]:

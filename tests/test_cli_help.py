@@ -110,13 +110,13 @@ def test_run_writes_under_fkopt_results_by_default(tmp_path):
 
 
 def test_schema_command_prints_the_committed_schemas():
-    for args, kind in (((), "experiment"), (("study",), "study"), (("assembly",), "assembly")):
+    for args, kind in (((), "experiment"), (("study",), "study"), (("assembly",), "assembly"), (("suite",), "suite")):
         proc = fkopt("schema", *args)
         assert proc.returncode == 0
         assert proc.stdout == (ROOT / "docs" / "schema" / f"{kind}.json").read_text(encoding="utf-8")
     bad = fkopt("schema", "nope")
     assert bad.returncode == 2 and bad.stderr.strip() == \
-        "fkopt: error: schema: unknown kind 'nope'; allowed: experiment, study, assembly"
+        "fkopt: error: schema: unknown kind 'nope'; allowed: experiment, study, assembly, suite"
 
 
 def test_help_paragraphs_are_wrapped_by_the_terminal_not_the_source():

@@ -48,7 +48,8 @@ def test_every_example_is_valid_for_its_field(kind):
 
 
 def _config_files():
-    return sorted((ROOT / "configs").rglob("*.yaml"))
+    """Every config file (a paper's claims.yaml is the claims engine's data, not a config)."""
+    return sorted(p for p in (ROOT / "configs").rglob("*.yaml") if p.name != "claims.yaml")
 
 
 @pytest.mark.parametrize("path", _config_files(), ids=lambda p: str(p.relative_to(ROOT / "configs")))

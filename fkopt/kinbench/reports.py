@@ -105,7 +105,7 @@ def preamble(c) -> str:
             f"{c.runs} runs per pose, budget {c.budget_per_dim} x dimension evaluations, targets "
             f"{', '.join(f'{t:.0e}' for t in c.targets)}. Score: normalised area under the ECDF "
             f"(0..1, higher is better), 95 % bootstrap CI over instances ({c.bootstrap} resamples); "
-            f"better_than: significant at alpha = {c.alpha} after Holm's correction within the table. "
+            f"better_than: Wilcoxon signed-rank test on the paired instance scores, significant at alpha = {c.alpha} after Holm's correction within the table. "
             "Tracks are ranked separately; 'overall' mixes them for reference only (docs/kinbench.md).")
 
 

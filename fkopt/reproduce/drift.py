@@ -56,6 +56,10 @@ def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
         shutil.copytree(exp.folder.parent, tmp / exp.paper)
         shutil.rmtree(tmp / exp.paper / exp.name)
         shutil.copytree(rerun_folder, tmp / exp.paper / exp.name)
+        from ..compare import TIMING_FILES   # check's rerun measures no time: the stored timings stand in,
+        for name in TIMING_FILES:            # so judging the paper (timing claims included) can read them
+            if (exp.folder / name).is_file() and not (tmp / exp.paper / exp.name / name).exists():
+                shutil.copy2(exp.folder / name, tmp / exp.paper / exp.name / name)
         changes = verdict_changes(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
