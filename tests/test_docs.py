@@ -35,3 +35,18 @@ def test_readme_python_api_block_runs():
     names: dict = {}
     exec(compile(code, "README.md (Python API)", "exec"), names)
     assert bool(names["fk"].solved) and bool(names["inv"].solved) and names["result"].success.all()
+
+
+def test_readme_quotes_the_stored_kinbench_leaderboard():
+    """README's kinbench scores are those of the stored leaderboard (rerun make bench-suite, then update)."""
+    import pandas as pd
+    board = pd.read_csv(ROOT / "results" / "kinbench" / "kinbench" / "leaderboard.csv")
+    text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    quoted = {"track:black-box": {"scipy:differential_evolution": "DE", "pso": "PSO", "pabc": "P-ABC", "abc": "ABC",
+                                  "gabc": "GABC", "aco": "ACO"},
+              "track:jacobian": {"lm": "LM", "dls": "DLS", "pso+lm": "PSO+LM", "gabc+lm": "GABC+LM"}}
+    for scope, names in quoted.items():
+        rows = board[board["scope"] == scope].sort_values("rank")
+        assert list(rows["solver"]) == list(names), scope          # README lists them in rank order
+        for solver, score in zip(rows["solver"], rows["score"]):
+            assert f"{names[solver]} {score:.3f}" in text, (solver, f"{score:.3f}")
