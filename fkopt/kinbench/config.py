@@ -47,7 +47,8 @@ TARGETS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
 #: Track of fkopt's built-in solvers and the adapters (anything else must state its track).
 KNOWN_TRACKS = {"abc": "black-box", "gabc": "black-box", "pso": "black-box", "aco": "black-box",
                 "pabc": "black-box", "nr": "jacobian", "lm": "jacobian", "dls": "jacobian",
-                "abc+lm": "jacobian", "gabc+lm": "jacobian", "pso+lm": "jacobian"}
+                "abc+lm": "jacobian", "gabc+lm": "jacobian", "pso+lm": "jacobian",
+                "forward": "exact", "inverse": "exact", "exact": "exact"}
 ADAPTER_TRACK = "black-box"     # scipy:, pymoo:, niapy: (registry.ADAPTER_PREFIXES) minimise the fitness only
 MAX_BUDGET_PER_DIM = 10_000_000
 
