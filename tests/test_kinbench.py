@@ -381,3 +381,120 @@ def test_an_interrupted_suite_resumes_with_the_same_bytes(tmp_path):
         run_config(load_any(path), out, source=str(path), progress=stop_after_two)
     with pytest.raises(FkoptError, match="another version of the suite"):
         run_config(load_any(tiny(tmp_path / "v2", runs=3)), out, source=str(path), resume=True, force=True)
+
+
+# -- kinbench v2: URDF arms, Dietmaier's platform, the exact track -------------------------------
+SUITE_V2 = SUITES / "kinbench-v2.yaml"
+V2_NEW = ("dietmaier-6sps", "ur5", "panda", "kinova-j2s6s200")
+
+
+def test_v2_pose_sets_regenerate_byte_identically_and_keep_v1s_sets(tmp_path):
+    from fkopt.kinbench.posesets import write_pose_sets
+    cfg = load_suite(SUITE_V2)
+    sets, manifest = load_pose_sets(cfg)                 # every checksum of the committed folder verified
+    assert set(V2_NEW) <= set(manifest["problems"]) and manifest["version"] == "kinbench-v2"
+    fresh = write_pose_sets(cfg, tmp_path / "kinbench-v2")
+    committed = SUITES / "kinbench-v2"
+    files = sorted(p.relative_to(committed) for p in committed.rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(fresh) for p in fresh.rglob("*") if p.is_file())
+    for rel in files:
+        assert (fresh / rel).read_bytes() == (committed / rel).read_bytes(), rel
+    v1 = json.loads((SUITES / "kinbench-v1" / "manifest.json").read_text())
+    for name, entry in v1["problems"].items():          # v1's problems keep v1's sets, byte for byte
+        assert manifest["problems"][name] == entry, name
+        for meta in entry["sets"].values():
+            assert (committed / meta["file"]).read_bytes() == (SUITES / "kinbench-v1" / meta["file"]).read_bytes()
+    for name in V2_NEW:
+        assert len(sets[(name, "uniform")]) == cfg.poses
+
+
+def test_v2_urdf_copies_match_example_robot_data():
+    """The suite's kinematics-only URDF copies give example-robot-data's FK (when it is installed)."""
+    urdf = pytest.importorskip("fkopt.mechanisms.urdf")
+    if urdf.example_robots_folder() is None:
+        pytest.skip("example-robot-data is not installed")
+    cfg = load_suite(SUITE_V2)
+    for problem, robot in (("ur5", "ur5"), ("panda", "panda"), ("kinova-j2s6s200", "kinova")):
+        mech, _ = problem_mechanism(next(p for p in cfg.problems if p.name == problem), SUITES)
+        ref = urdf.example_robot(robot)
+        assert mech.joint_names == ref.joint_names and np.array_equal(mech.bounds, ref.bounds)
+        q = mech.bounds[:, 0] + np.random.default_rng(7).random((20, mech.dof)) * np.diff(mech.bounds).ravel()
+        assert np.array_equal(mech.fk(q), ref.fk(q)), problem
+
+
+def test_exact_solvers_give_fkopt_forward_and_inverse_numbers_and_count_their_evaluations():
+    import fkopt
+    from fkopt.problems import fk_problem, ik_problem
+    from fkopt.solve import solve
+    from fkopt.algorithms.exact import row_seeds
+    from fkopt.streams import RunStreams
+    m = fkopt.mechanism("3-rps", ra=274, rb=158)
+    poses = m.bounds[:, 0] + np.random.default_rng(3).random((3, 3)) * np.diff(m.bounds).ravel()
+    res = solve(fk_problem(m, m.ik(poses)), "exact", population=20, iterations=4, runs=2, seed=[5, 6, 7])
+    seeds = row_seeds(RunStreams(np.repeat([5, 6, 7], 2), np.tile([0, 1], 3)))
+    for c in range(3):
+        ref = fkopt.forward(m, m.ik(poses[c]), seed=seeds[2 * c])
+        assert np.array_equal(res.x[c, 0], ref.pose)
+        used = int(ref.evaluations["residual"] + ref.evaluations["jacobian"]) + 1     # + the fitness of the answer
+        assert (res.evaluation_history[c, 0] == used).all() and res.fitness[c, 0] < 1e-10
+    arm = fkopt.mechanism("7dof-arm")
+    q = arm.bounds[:, 0] + np.random.default_rng(4).random((2, 7)) * np.diff(arm.bounds).ravel()
+    ik = ik_problem(arm, arm.fk(q))
+    res = solve(ik, "inverse", population=20, iterations=2, runs=1, seed=[1, 2])
+    seeds = row_seeds(RunStreams([1, 2], [0, 0]))
+    for c in range(2):
+        ref = fkopt.inverse(arm, ik.target[c], seed=seeds[c])     # the problem's target pose, as stored
+        assert np.array_equal(res.x[c, 0], ref.joints)
+        assert res.evaluation_history[c, 0, -1] == int(ref.evaluations["residual"] + ref.evaluations["jacobian"]) + 1
+    with pytest.raises(FkoptError, match="forward kinematics of a parallel mechanism"):
+        solve(ik_problem(arm, arm.fk(q)), "forward", population=20, iterations=2, runs=1, seed=[1, 2])
+
+
+def test_an_exact_answer_past_the_budget_does_not_count():
+    hist = np.array([[1e-20, 1e-20]])
+    m = at_budget(hist, np.array([[300, 300]]), 200, [1e-2])
+    assert m["fitness"][0] == np.inf and np.isnan(m[target_column(1e-2)][0])
+
+
+@pytest.fixture(scope="module")
+def v2_quick(tmp_path_factory):
+    out = tmp_path_factory.mktemp("v2") / "out"
+    r = cli("suite", SUITE_V2, "--out", out, "--quick", "-q")
+    assert r.returncode == 0, r.stderr
+    return out / "kinbench" / "kinbench-v2-quick"
+
+
+def test_v2_quick_tier_ranks_urdf_arms_dietmaier_and_the_exact_track(v2_quick):
+    lb = pd.read_csv(v2_quick / "leaderboard.csv")
+    runs = pd.read_csv(v2_quick / "runs.csv")
+    assert set(V2_NEW) <= set(runs["problem"])
+    assert {"class:serial-ik-6dof/track:exact", "class:serial-ik-7dof/track:black-box",
+            "class:parallel-fk-6dof/track:jacobian"} <= set(lb.scope)
+    md = (v2_quick / "leaderboard.md").read_text()
+    for name in V2_NEW:
+        assert name in md, name
+    exact = lb[lb.scope == "track:exact"]
+    assert list(exact.solver) == ["exact"] and int(exact["rank"].iloc[0]) == 1
+    for track in ("track:black-box", "track:jacobian"):
+        assert "exact" not in set(lb.loc[lb.scope == track, "solver"])
+    ex = runs[runs.solver == "exact"]
+    # evaluations counted (>= the solver's one + the fitness) and cut at the budget: 0 = no answer within B
+    assert (ex.track == "exact").all() and (ex.evaluations <= ex.budget).all()
+    assert ((ex.evaluations >= 2) | ((ex.evaluations == 0) & (ex.fitness == np.inf))).all()
+    # fkopt.inverse solves the URDF arms' IK to the first target on most poses within the budget
+    # (fkopt.forward on Dietmaier's platform mostly needs its global stage, past 500 x 6 evaluations)
+    for name in ("ur5", "panda", "kinova-j2s6s200"):
+        assert ex.loc[ex.problem == name, target_column(1e-2)].notna().mean() > 0.5, name
+
+
+def test_fkopt_check_passes_on_the_v2_quick_tier_and_fails_on_an_edited_number(v2_quick, tmp_path):
+    folder = tmp_path / "kinbench-v2-quick"
+    shutil.copytree(v2_quick, folder)
+    chk = cli("check", folder)
+    assert chk.returncode == 0, chk.stdout + chk.stderr
+    lb = pd.read_csv(folder / "leaderboard.csv")
+    row = lb.index[(lb.scope == "track:exact")][0]
+    lb.loc[row, "score"] += 0.01
+    lb.to_csv(folder / "leaderboard.csv", index=False, float_format="%.10g")
+    chk = cli("check", folder)
+    assert chk.returncode == 1 and "leaderboard.csv" in chk.stderr, chk.stdout + chk.stderr
