@@ -125,7 +125,8 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
     },
     "AlgorithmSpec": {
         "name": ("An algorithm (`fkopt list`): abc, gabc, aco, pso, pabc, nr, lm, dls, abc+lm, gabc+lm, "
-                 "pso+lm, `scipy:`/`pymoo:`/`niapy:` optimisers, or `package.module:Class`.", "", "gabc"),
+                 "pso+lm, the exact solvers forward, inverse and exact (fkopt.forward / fkopt.inverse), "
+                 "`scipy:`/`pymoo:`/`niapy:` optimisers, or `package.module:Class`.", "", "gabc"),
         "label": ("Name in the tables; needed when one algorithm appears twice. Default: the name.", "",
                   "gabc_zhu2010"),
         "params": ("The algorithm's parameters (`fkopt list` shows them with their defaults); unknown keys "
