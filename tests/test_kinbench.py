@@ -406,6 +406,10 @@ def test_v2_pose_sets_regenerate_byte_identically_and_keep_v1s_sets(tmp_path):
             assert (committed / meta["file"]).read_bytes() == (SUITES / "kinbench-v1" / meta["file"]).read_bytes()
     for name in V2_NEW:
         assert len(sets[(name, "uniform")]) == cfg.poses
+    lib = load_suite(SUITES / "kinbench-v2-libraries.yaml")      # the pymoo/NiaPy subset reads the same sets
+    lib_sets, _ = load_pose_sets(lib)
+    for key, pts in lib_sets.items():
+        assert np.array_equal(pts, sets[key][: lib.poses])
 
 
 def test_v2_urdf_copies_match_example_robot_data():
