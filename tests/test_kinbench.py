@@ -120,6 +120,17 @@ def test_a_solver_that_cannot_take_a_problem_is_refused_before_solving(tmp_path)
     assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
 
 
+def test_an_exact_solver_of_the_wrong_kind_is_refused_in_one_line(tmp_path):
+    data = yaml.safe_load(SUITE.read_text())
+    arm = [p for p in data["problems"] if p["name"] == "wang2020-7dof"]
+    path = tiny(tmp_path, problems=arm, solvers=[{"name": "forward"}])
+    r = cli("suite", path, "--out", tmp_path / "out", "-q")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+    assert "solvers[forward] on problems[wang2020-7dof]: algorithm 'forward' solves forward kinematics" in r.stderr
+    assert "use 'exact'" in r.stderr
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
 def test_a_mechanism_other_than_the_pose_sets_one_is_refused(tmp_path):
     data = yaml.safe_load(SUITE.read_text())
     probs = data["problems"][:1]

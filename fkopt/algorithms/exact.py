@@ -45,7 +45,8 @@ class ExactSolver(Algorithm):
         if mech is None or getattr(mech, "kind", None) not in ((self.family,) if self.family else ("parallel", "serial")):
             what = {"parallel": "forward kinematics of a parallel mechanism",
                     "serial": "inverse kinematics of a serial arm"}.get(self.family, "FK or IK of a mechanism")
-            raise FkoptError(f"algorithm '{self.name}' solves {what} only; this problem is not one")
+            raise FkoptError(f"algorithm '{self.name}' solves {what} only; this problem is not one "
+                             "(use 'exact', which picks forward or inverse by the mechanism's kind)")
         runs = streams.runs
         rows = problem.take(np.arange(runs)) if getattr(problem, "cases", None) is None else problem
         xs = np.empty((runs, problem.dim))
