@@ -34,11 +34,14 @@ reproduce-peers:
 	$(FKOPT) reproduce --configs peers --out results/peers
 	$(PYTHON) -m fkopt.peers results/peers
 
-# kinbench (docs/kinbench.md): the full suite and its quick tier (which CI's check reruns) into
-# results/kinbench/, then the report. Not part of `make reproduce`.
+# kinbench (docs/kinbench.md): v1 and v2 in full, their quick tiers (which CI's check reruns) and
+# the libraries subset into results/kinbench/, then the report (~8 min on 2 cores). Not part of
+# `make reproduce`.
 bench-suite:
-	$(FKOPT) suite configs/suites/kinbench.yaml --out results --force --jobs 2
-	$(FKOPT) suite configs/suites/kinbench.yaml --out results --force --quick
+	for s in kinbench kinbench-v2 kinbench-v2-libraries; do \
+	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --jobs 2 -q || exit 1; done
+	for s in kinbench kinbench-v2; do \
+	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --quick -q || exit 1; done
 	$(FKOPT) report results
 
 # Regenerate the report from stored results without rerunning.
