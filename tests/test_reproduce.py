@@ -334,3 +334,20 @@ def test_changes_say_what_a_regeneration_moved(tmp_path):
     text = describe(before, tmp_path / "results")
     assert "## mao2017/tab6" in text and "`summary.csv`" in text and "mean_evaluations" in text and "→" in text
     assert "## Verdicts that changed" in text and "mao2017:" in text
+
+
+def test_an_edited_timing_verdict_is_caught_on_any_platform(tmp_path):
+    """Stored timing verdicts must be those of the stored timed runs (check measures no time)."""
+    import pandas as pd
+
+    from fkopt.reproduce.check import timing_verdicts
+    shutil.copytree(RESULTS / "mao2017", tmp_path / "results" / "mao2017")
+    exp = Store(tmp_path / "results").get("mao2017", "tab6")
+    assert timing_verdicts(exp) == []
+    file = tmp_path / "results" / "mao2017" / "timing_claims.csv"
+    df = pd.read_csv(file, keep_default_na=False)
+    df.loc[0, "verdict"] = "not held" if df.loc[0, "verdict"] != "not held" else "held"
+    df.to_csv(file, index=False)
+    bad = timing_verdicts(exp)
+    assert [(m.file, m.column) for m in bad] == [("timing_claims.csv", "verdict")]
+    assert "every platform" in bad[0].rule

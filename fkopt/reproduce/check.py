@@ -251,7 +251,7 @@ def timing_verdicts(exp: Experiment) -> list[Mismatch]:
         return []
     try:
         stored = pd.read_csv(file, keep_default_na=False)
-        judged = judge_paper(exp.paper, Store(exp.folder.parents[1]))
+        judged = judge_paper(exp.paper, Store(exp.folder.parents[1]), timing_only=True)
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
         return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, "-", "file", f"unreadable ({err})", "readable",
                          "readable CSV")]

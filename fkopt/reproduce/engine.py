@@ -74,16 +74,20 @@ def info(paper: str) -> dict:
             "inconsistencies": data.get("inconsistencies") or []}
 
 
-def judge_paper(paper: str, store) -> tuple[list[Claim], list[Claim]] | None:
-    """(claims, timing claims) of a paper, or None for a folder without claims."""
+def judge_paper(paper: str, store, timing_only: bool = False) -> tuple[list[Claim], list[Claim]] | None:
+    """(claims, timing claims) of a paper, or None for a folder without claims; ``timing_only``
+    judges the timing claims alone (the first list is then empty)."""
     data = load(paper)
     mod = paper_module(paper)
     if data is None:
         if mod is None or not hasattr(mod, "claims"):
             return None
-        return mod.claims(store), (mod.timing_claims(store) if hasattr(mod, "timing_claims") else [])
+        timing = mod.timing_claims(store) if hasattr(mod, "timing_claims") else []
+        return ([] if timing_only else mod.claims(store)), timing
     plain, timing = [], []
     for spec in data.get("claims", []):
+        if timing_only and spec["kind"] != "timing":
+            continue
         for c in judge(paper, spec, store, mod):
             (timing if spec["kind"] == "timing" else plain).append(c)
     return plain, timing
