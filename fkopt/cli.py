@@ -636,7 +636,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
-    from .reproduce.changes import snapshot, write_changes
+    from .reproduce.changes import snapshot
     from .reproduce.report import write_report
     from .reproduce.run import default_jobs, plan, run_all
 
@@ -668,9 +668,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
                        jobs=default_jobs() if jobs is None else jobs, solving=solving)
-    paths = write_report(out)
-    write_changes(out, before)                  # after the verdicts are written, before the report
-    paths = write_report(out) + [out / "CHANGES.md"]   # that links it (a cheap second pass)
+    paths = write_report(out, changes_since=before)
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")

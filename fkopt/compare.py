@@ -141,7 +141,7 @@ def _py(v):
 
 def _read(path: Path) -> pd.DataFrame:
     """A CSV (or gzip'ed CSV) as text cells, so 'identical' means identical as written."""
-    return pd.read_csv(path, dtype=str, keep_default_na=False)
+    return pd.read_csv(io.BytesIO(_bytes(path)), dtype=str, keep_default_na=False)
 
 
 def _outcome(col: str) -> bool:
@@ -413,13 +413,11 @@ def compare_folders(name: str, stored: Path, rerun: Path, rules: Rules | bool,
             out += compare_meta(name, s, r)
         elif ".csv" in file:
             try:
-                table = _read(s) if not file.endswith(".gz") else pd.read_csv(io.BytesIO(_bytes(s)), dtype=str,
-                                                                               keep_default_na=False)
+                table = _read(s)
             except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, EOFError) as err:
                 out.append(Mismatch(name, file, "-", "file", f"unreadable ({err})", "readable", "readable"))
                 continue
-            other = _read(r) if not file.endswith(".gz") else pd.read_csv(io.BytesIO(_bytes(r)), dtype=str,
-                                                                           keep_default_na=False)
+            other = _read(r)
             out += compare_tables(name, file, table, other, rules)
             if file in RUN_FILES:
                 out += compare_runs(name, file, table, other, rules)

@@ -250,8 +250,10 @@ def draw_paper_figures(root: str | Path) -> list[Path]:
     return out
 
 
-def write_report(root: str | Path) -> list[Path]:
-    """Write REPORT.md, TIMING.md, index.csv and every paper's claims.csv under ``root``.
+def write_report(root: str | Path, changes_since=None) -> list[Path]:
+    """Write REPORT.md, TIMING.md, index.csv and every paper's claims.csv under ``root``;
+    with ``changes_since`` (a :class:`~.changes.Snapshot` of the tree before a rerun) also
+    CHANGES.md, after the verdicts it compares and before the report that links it.
 
     Every file is checked before anything is computed or written: it must resolve (symbolic
     links included) inside ``root`` (:func:`fkopt.files.inside`), so a link planted in a
@@ -260,18 +262,22 @@ def write_report(root: str | Path) -> list[Path]:
     root = Path(root)
     paths = [root / "REPORT.md", root / "TIMING.md", root / "index.csv"]
     claims = [root / paper / name for paper in Store(root).papers() for name in (CLAIMS_FILE, TIMING_CLAIMS_FILE)]
-    for path in paths + claims:
+    changes = [root / "CHANGES.md"] if changes_since is not None else []
+    for path in paths + claims + changes:
         inside(root, path, "report")
     for exp in Store(root).experiments():     # folders a paper's figures are drawn into
         if getattr(paper_module(exp.paper), "figures", None):
             for path in [exp.folder, *exp.folder.iterdir()]:
                 inside(root, path, "report")
     figures = draw_paper_figures(root)
+    for path, df in claims_files(root).items():
+        df.to_csv(inside(root, path, "report"), index=False)
+        paths.append(path)
+    if changes_since is not None:
+        from .changes import write_changes
+        paths.append(write_changes(root, changes_since))
     report, timing, index = build_report(root)
     paths[0].write_text(report)
     paths[1].write_text(timing)
     index.to_csv(paths[2], index=False, float_format="%.10g")
-    for path, df in claims_files(root).items():
-        df.to_csv(inside(root, path, "report"), index=False)
-        paths.append(path)
     return paths + figures
