@@ -67,7 +67,7 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from .outputs import CURVES, ENV_FILE, TIMING, deterministic_files, file_digests, files_with, sha256  # noqa: F401
+from .outputs import ENV_FILE, TIMING, deterministic_files, file_digests, files_with, sha256  # noqa: F401
 from .provenance import ANY, BLAS, EXACT  # noqa: F401
 
 #: Family-wise significance level of the rank and Fisher tests of one experiment (Holm-corrected):
@@ -99,8 +99,6 @@ OUTCOME_PREFIXES = ("x_", "start_", "pose_", "abs_error", "final_", "median", "m
 PATH_ROWS = ("trace.csv.gz", "ecdf.csv", "convergence.csv")
 #: Files of single runs or solutions, whose path-dependent outcomes :func:`compare_runs` compares.
 RUN_FILES = ("runs.csv", "solutions.csv")
-#: Files compared in shape and keys only: single runs and curves (kept for the registry's roles).
-SHAPE_ONLY = files_with(CURVES)
 #: Never deterministic: wall-clock measurements and the environment.
 TIMING_FILES = files_with(TIMING) + (ENV_FILE,)
 

@@ -9,10 +9,10 @@ this floor imports no report module) and its *role*, which is all :mod:`fkopt.co
 =========  ===================================================================================
 role       meaning
 =========  ===================================================================================
-table      deterministic statistics: byte-identical on the same platform, compared by the
-           tolerances of :mod:`fkopt.compare` on another
-curves     deterministic, but single runs or curves: on another platform only their shape and
-           keys are compared (:data:`fkopt.compare.SHAPE_ONLY` is derived from this)
+table      deterministic statistics: byte-identical on the same platform fingerprint, compared
+           by the cross-platform rules of :mod:`fkopt.compare` on another
+curves     deterministic single runs or curves: compared like tables (on another platform their
+           BLAS-free rows cell by cell, their path-dependent rows through the runs they follow from)
 timing     wall-clock measurements: never compared, skipped when ``fkopt check`` reruns
 figure     a figure (PNG + PDF twin); never compared
 =========  ===================================================================================

@@ -20,10 +20,10 @@ def test_every_maker_resolves():
 
 
 def test_compare_takes_its_file_sets_from_the_roles():
-    assert set(compare.SHAPE_ONLY) == {o.file for outs in outputs.OUTPUTS.values() for o in outs
-                                       if o.role == outputs.CURVES}
+    assert set(compare.TIMING_FILES) == {o.file for outs in outputs.OUTPUTS.values() for o in outs
+                                         if o.role == outputs.TIMING} | {"env.json"}
     assert "timing.csv" in compare.TIMING_FILES and "env.json" in compare.TIMING_FILES
-    assert "summary.csv" not in compare.SHAPE_ONLY + compare.TIMING_FILES
+    assert "summary.csv" not in compare.TIMING_FILES
 
 
 def _stored_folders():
