@@ -35,8 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..compare import (ALPHA, Mismatch, Rules, compare_folders, deterministic_files, sha256,  # noqa: F401
-                       summary_consistency)
+from ..compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
 from ..errors import FkoptError
 from ..experiment.kinds import from_dict, rerun_files
 from ..provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
@@ -79,11 +78,6 @@ def stored_tier(exp: Experiment) -> str:
     except (OSError, ValueError, AttributeError):
         return ANY
     return platform_tier(stored)
-
-
-def same_platform(exp: Experiment) -> bool:
-    """Does the fingerprint in the stored env.json equal this machine's?"""
-    return stored_tier(exp) == EXACT
 
 
 def rules_for(exp: Experiment, tier: str) -> Rules:
