@@ -67,7 +67,8 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from .outputs import ENV_FILE, TIMING, deterministic_files, file_digests, files_with, sha256  # noqa: F401
+from .outputs import (ENV_FILE, RUNS, STEPS, TIMING, deterministic_files, file_digests, files_with,  # noqa: F401
+                      files_with_rows, sha256)
 from .provenance import ANY, BLAS, EXACT  # noqa: F401
 
 #: Family-wise significance level of the rank and Fisher tests of one experiment (Holm-corrected):
@@ -95,10 +96,12 @@ OUTCOME_PREFIXES = ("x_", "start_", "pose_", "abs_error", "final_", "median", "m
                     "fraction", "pairs", "iterations_done", "iterations_to", "hits", "residual", "starts",
                     "outside_bounds", "solutions_found", "fitness", "evals_to", "score", "ci_", "rank", "ert",
                     "auc", "time", "wall", "ms_", "solves")
-#: Files whose rows exist per path step (a rerun may have more or fewer for a path-dependent run).
-PATH_ROWS = ("trace.csv.gz", "ecdf.csv", "convergence.csv")
-#: Files of single runs or solutions, whose path-dependent outcomes :func:`compare_runs` compares.
-RUN_FILES = ("runs.csv", "solutions.csv")
+#: Files whose rows exist per path step (a rerun may have more or fewer for a path-dependent run):
+#: the outputs registry's ``rows=STEPS``.
+PATH_ROWS = files_with_rows(STEPS)
+#: Files of single runs or solutions, whose path-dependent outcomes :func:`compare_runs` compares:
+#: the outputs registry's ``rows=RUNS``.
+RUN_FILES = files_with_rows(RUNS)
 #: Never deterministic: wall-clock measurements and the environment.
 TIMING_FILES = files_with(TIMING) + (ENV_FILE,)
 

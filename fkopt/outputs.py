@@ -17,6 +17,20 @@ timing     wall-clock measurements: never compared, skipped when ``fkopt check``
 figure     a figure (PNG + PDF twin); never compared
 =========  ===================================================================================
 
+A table or curves file also says what one of its rows is (``rows``), which is how ``fkopt
+check`` compares a path-dependent row on another platform:
+
+=========  ===================================================================================
+rows       meaning
+=========  ===================================================================================
+stats      statistics over runs (the default): keys and settings cell by cell, outcomes through
+           the runs they follow from
+runs       one row per run or solution: its outcomes compared run by run
+           (:func:`fkopt.compare.compare_runs`)
+steps      one row per step of a run's path (a rerun may have more or fewer): compared through
+           the runs' counts, never row by row
+=========  ===================================================================================
+
 A table maker is ``make(result) -> DataFrame | None`` (None: the file does not apply to this
 result, e.g. ``inputs.csv`` when no case gives both joints and a pose); a ``.csv.gz`` is gzip'ed
 with a fixed timestamp, so the same numbers give the same bytes. A figure maker is
@@ -36,6 +50,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 TABLE, CURVES, TIMING, FIGURE = "table", "curves", "timing", "figure"
+STATS, RUNS, STEPS = "stats", "runs", "steps"
 FLOAT = "%.10g"
 META_FILE = "meta.json"
 ENV_FILE = "env.json"
@@ -47,6 +62,7 @@ class Output:
     make: str                 # "module:function"
     role: str                 # TABLE, CURVES, TIMING or FIGURE
     float_format: str = FLOAT
+    rows: str = STATS         # STATS, RUNS or STEPS: what one row is
 
 
 _EXP = "fkopt.experiment.reports"
@@ -62,9 +78,9 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
         Output("timing_runs.csv", f"{_EXP}:timing_runs_table", TIMING),
         Output("values.csv", f"{_EXP}:values_table", TABLE),
         Output("inputs.csv", f"{_EXP}:inputs_table", TABLE),
-        Output("runs.csv", f"{_EXP}:runs_table", CURVES),
-        Output("trace.csv.gz", "fkopt.experiment.traces:trace_table", CURVES),
-        Output("convergence.csv", f"{_EXP}:convergence_table", CURVES),
+        Output("runs.csv", f"{_EXP}:runs_table", CURVES, rows=RUNS),
+        Output("trace.csv.gz", "fkopt.experiment.traces:trace_table", CURVES, rows=STEPS),
+        Output("convergence.csv", f"{_EXP}:convergence_table", CURVES, rows=STEPS),
         Output("convergence", f"{_EXP}:convergence_figure", FIGURE),
         Output("variables", f"{_EXP}:variables_figure", FIGURE),
         Output("snapshots", f"{_EXP}:snapshot_figures", FIGURE),
@@ -77,8 +93,8 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
         Output("summary.csv", f"{_STUDY}:summary_table", TABLE),
         Output("timing.csv", f"{_STUDY}:timing_table", TIMING),
         Output("poses.csv", f"{_STUDY}:poses_table", CURVES),
-        Output("runs.csv", f"{_STUDY}:runs_table", CURVES),
-        Output("ecdf.csv", f"{_STUDY}:ecdf_of", CURVES),
+        Output("runs.csv", f"{_STUDY}:runs_table", CURVES, rows=RUNS),
+        Output("ecdf.csv", f"{_STUDY}:ecdf_of", CURVES, rows=STEPS),
         Output("stats.csv", f"{_STUDY}:stats_of", CURVES),
         Output("heatmap.csv", f"{_STUDY}:heatmap_table", CURVES),
         Output("tracking.csv", f"{_STUDY}:tracking_table", CURVES),
@@ -90,14 +106,14 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
     ),
     "assembly": (
         Output("summary.csv", f"{_ASM}:summary_table", TABLE),
-        Output("solutions.csv", f"{_ASM}:solutions_table", CURVES, float_format="%.12g"),
+        Output("solutions.csv", f"{_ASM}:solutions_table", CURVES, float_format="%.12g", rows=RUNS),
         Output("timing.csv", f"{_ASM}:timing_table", TIMING),
     ),
     "suite": (
         Output("leaderboard.csv", f"{_SUITE}:leaderboard_table", TABLE),
         Output("measures.csv", f"{_SUITE}:measures_table", TABLE),
-        Output("ecdf.csv", f"{_SUITE}:ecdf_table", CURVES),
-        Output("runs.csv", f"{_SUITE}:runs_table", CURVES),
+        Output("ecdf.csv", f"{_SUITE}:ecdf_table", CURVES, rows=STEPS),
+        Output("runs.csv", f"{_SUITE}:runs_table", CURVES, rows=RUNS),
         Output("timing.csv", f"{_SUITE}:timing_table", TIMING),
         Output("ecdf", f"{_SUITE}:ecdf_figures", FIGURE),
         Output("leaderboard.md", f"{_SUITE}:leaderboard_markdown", FIGURE),   # never compared
@@ -116,6 +132,12 @@ META: dict[str, str] = {
 def files_with(role: str) -> tuple[str, ...]:
     """Names of the files of any kind that have ``role`` (sorted, each once)."""
     return tuple(sorted({o.file for outs in OUTPUTS.values() for o in outs if o.role == role}))
+
+
+def files_with_rows(rows: str) -> tuple[str, ...]:
+    """Names of the table/curves files of any kind whose rows are ``rows`` (sorted, each once)."""
+    return tuple(sorted({o.file for outs in OUTPUTS.values() for o in outs
+                         if o.role in (TABLE, CURVES) and o.rows == rows}))
 
 
 def deterministic_files(folder: Path) -> list[str]:

@@ -24,6 +24,16 @@ def test_compare_takes_its_file_sets_from_the_roles():
                                          if o.role == outputs.TIMING} | {"env.json"}
     assert "timing.csv" in compare.TIMING_FILES and "env.json" in compare.TIMING_FILES
     assert "summary.csv" not in compare.TIMING_FILES
+    # what a row of a file is (stats, runs, path steps) is the registry's too, one meaning per name
+    rows: dict[str, set] = {}
+    for outs in outputs.OUTPUTS.values():
+        for o in outs:
+            assert o.rows in (outputs.STATS, outputs.RUNS, outputs.STEPS), o
+            if o.role in (outputs.TABLE, outputs.CURVES):
+                rows.setdefault(o.file, set()).add(o.rows)
+    assert all(len(r) == 1 for r in rows.values()), rows
+    assert set(compare.RUN_FILES) == {f for f, r in rows.items() if r == {outputs.RUNS}} >= {"runs.csv"}
+    assert set(compare.PATH_ROWS) == {f for f, r in rows.items() if r == {outputs.STEPS}} >= {"trace.csv.gz"}
 
 
 def _stored_folders():
