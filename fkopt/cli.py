@@ -247,25 +247,44 @@ def _list_mechanism(name: str, as_json: bool, geometry: Optional[Path] = None) -
     con.print(geo)
 
 
+JOBS_HELP = "worker processes (local) or LocalCluster workers (dask without --scheduler)"
+
+
 @app.command()
-def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"),
-        out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; each experiment writes "
+def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any kind: experiments, studies "
+                                             "(kind: study), assembly searches, suites (kind: suite)"),
+        out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; each file writes "
                                  "OUT/<paper>/<name>/ (paper 'experiments' when the file names none); "
                                  "the tracked paper results are --out results"),
+        jobs: int = typer.Option(1, "--jobs", "-j", help=JOBS_HELP),
+        executor: str = typer.Option("local", "--executor", help="local | dask"),
+        scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of an existing Dask "
+                                                "scheduler (with --executor dask)"),
+        resume: bool = typer.Option(False, "--resume", help="studies and suites: keep the finished tasks of an "
+                                    "interrupted run of the same config and run only the others"),
         force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
                                    "whose result-changing fields differ"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
-    """Run experiment files and write their tables and figures.
+    """Run config files of any kind and write their tables and figures.
 
-    Every file is validated, and every output folder checked, before anything runs. The fields of
-    a file are listed in docs/config-reference.md (fkopt schema prints its JSON Schema)."""
-    from .experiment.kinds import load_any, prepare_output, run_config, validate_any
+    Every file is validated, and every output folder checked, before anything runs. Every kind
+    goes through the same runner: --jobs and --executor dask spread its tasks (an experiment's
+    algorithms, a study's pose chunks, a suite's problem x solver pairs) without changing a
+    number. The fields of a file are listed in docs/config-reference.md (fkopt schema prints its
+    JSON Schema)."""
+    from .experiment.kinds import load_any
+    _run_files([(path, load_any(path)) for path in configs], out, jobs=jobs, executor=executor,
+               scheduler=scheduler, resume=resume, force=force, quiet=quiet)
 
+
+def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
+               force: bool, quiet: bool) -> None:
+    """Validate every (path, config) and check every output folder, then run them in order."""
+    from .experiment.executors import validate_executor
+    from .experiment.kinds import prepare_output, run_config, validate_any
+    validate_executor(executor, jobs, scheduler)
     planned, folders = [], {}
-    for path in configs:          # fail on any bad file or output folder before running anything
-        config = load_any(path)
-        if getattr(config, "kind", None) == "study":
-            raise FkoptError(f"{path}: a study file (kind: study); run it with: fkopt study {path}")
+    for path, config in files:    # fail on any bad file or output folder before running anything
         tasks = validate_any(config, str(path))
         try:
             folder = prepare_output(config, out, force)
@@ -278,9 +297,10 @@ def run(configs: list[Path] = typer.Argument(..., help="experiment YAML file(s)"
     con = _console()
     for path, config, tasks in planned:
         with _progress(con, config.name, tasks, quiet) as progress:
-            outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True)
+            outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True,
+                                 jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
         if not quiet:
-            _print_outcome(con, outcome)
+            _print_outcome(con, outcome, tasks)
 
 
 class _progress:
@@ -306,21 +326,30 @@ class _progress:
         return False
 
 
-def _print_outcome(con, outcome) -> None:
+def _print_outcome(con, outcome, tasks: int) -> None:
     from .experiment.runner import ExperimentResult
-    if isinstance(outcome.result, ExperimentResult):
+    from .study.runner import StudyResult
+    result = outcome.result
+    if isinstance(result, ExperimentResult):
         from .experiment.reports import summary_table
-        _print_summary(con, summary_table(outcome.result), outcome.folder, outcome.wall_s)
+        _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
+    elif isinstance(result, StudyResult):
+        from .study.reports import summary_table
+        _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
+    elif getattr(result.config, "kind", None) == "suite":
+        con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
     else:
         con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s)")
+    reused = tasks - len(outcome.computed)
+    if 0 < reused <= tasks:
+        con.print(f"resumed: {reused} finished task(s) reused, {len(outcome.computed)} computed")
 
 
 @app.command()
 def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)"),
           out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; the study writes "
                                    "OUT/<paper>/<name>/ (paper: studies unless the file says otherwise)"),
-          jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (local) or LocalCluster "
-                                   "workers (dask without --scheduler)"),
+          jobs: int = typer.Option(1, "--jobs", "-j", help=JOBS_HELP),
           executor: str = typer.Option("local", "--executor", help="local | dask"),
           scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of an existing Dask "
                                                   "scheduler (with --executor dask)"),
@@ -329,32 +358,16 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
           force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
                                      "whose result-changing fields differ"),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
-    """Run a workspace study: algorithms x many poses x runs, with statistics.
+    """Run a workspace study: algorithms x many poses x runs, with statistics (= fkopt run on it).
 
     A study file says kind: study and draws its poses (uniform, grid, waypoints, circle) instead
     of listing cases. It writes success rates, evaluations to the threshold, an ECDF, heat maps
     of 2-D grids and pairwise rank tests; mode: tracking solves trajectories step by step, each
     step warm-started from the previous one. Fields: docs/config-reference.md (study);
     examples: configs/studies/."""
-    from .experiment.kinds import prepare_output, run_config, validate_any
     from .study.config import load_study
-    from .study.executors import validate_executor
-
-    cfg = load_study(config)
-    validate_executor(executor, jobs, scheduler)
-    tasks = validate_any(cfg, str(config))
-    prepare_output(cfg, out, force)
-    con = _console()
-    with _progress(con, cfg.name, tasks, quiet) as progress:
-        outcome = run_config(cfg, out, source=str(config), progress=progress, force=force, checked=True,
-                             jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
-    if not quiet:
-        from .study.reports import summary_table
-        result = outcome.result
-        _print_summary(con, summary_table(result), result.folder, result.wall_s)
-        reused = tasks - len(result.computed)
-        if reused:
-            con.print(f"resumed: {reused} finished task(s) reused, {len(result.computed)} computed")
+    _run_files([(config, load_study(config))], out, jobs=jobs, executor=executor, scheduler=scheduler,
+               resume=resume, force=force, quiet=quiet)
 
 
 @app.command()
@@ -362,28 +375,22 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
           out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; writes OUT/<paper>/<name>/ "
                                    "(the tracked results/ only when asked: make bench-suite)"),
           quick: bool = typer.Option(False, "--quick", help="run the file's quick: tier (<name>-quick)"),
-          jobs: int = typer.Option(1, "--jobs", "-j", help="worker processes (or LocalCluster workers)"),
+          jobs: int = typer.Option(1, "--jobs", "-j", help=JOBS_HELP),
           executor: str = typer.Option("local", "--executor", help="local | dask"),
           scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of a Dask scheduler"),
           resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted run"),
           force: bool = typer.Option(False, "--force", help="replace a stored result of a different config"),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress")):
-    """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files."""
-    from .experiment.kinds import load_any, prepare_output, run_config, validate_any
-    from .study.executors import validate_executor
+    """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files
+    (= fkopt run on it; --quick picks the file's quick tier)."""
+    from .experiment.kinds import load_any
     cfg = load_any(config)
     if getattr(cfg, "kind", None) != "suite":
         raise FkoptError(f"{config}: not a suite file (kind: suite); run it with: fkopt run {config}")
     if quick:
         cfg = cfg.quick_tier(str(config))
-    validate_executor(executor, jobs, scheduler)
-    tasks = validate_any(cfg, str(config))
-    prepare_output(cfg, out, force)
-    with _progress(_console(), cfg.name, tasks, quiet) as progress:
-        outcome = run_config(cfg, out, source=str(config), progress=progress, force=force, checked=True,
-                             jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
-    if not quiet:
-        _console().print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
+    _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,
+               force=force, quiet=quiet)
 
 
 SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",

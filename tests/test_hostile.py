@@ -361,11 +361,11 @@ def test_suite_resume_refuses_links_and_keeps_its_tasks(tmp_path, monkeypatch, s
         assert list(outside.iterdir()) == []
     else:
         pytest.importorskip("dask.distributed")
-        work.mkdir()
-        (work / "p0-s0.json").write_text("{}")
+        (work / "tasks").mkdir(parents=True)
+        (work / "tasks" / "p0-s0.json").write_text("{}")
         with pytest.raises(FkoptError, match="--scheduler"):
             run_config(load_any(path), out, source=str(path), resume=True, executor="dask", scheduler=scheduler)
-        assert (work / "p0-s0.json").read_text() == "{}"
+        assert (work / "tasks" / "p0-s0.json").read_text() == "{}"
 
 
 @pytest.mark.parametrize("content", ["[]", '"text"', "7"])
@@ -375,12 +375,18 @@ def test_suite_resume_refuses_corrupt_task_files(tmp_path, monkeypatch, content)
     from fkopt.errors import FkoptError
     from fkopt.experiment.kinds import load_any, run_config
     from fkopt.kinbench.kind import work_folder
+    import hashlib
     path = tiny(tmp_path)
     work = work_folder(tmp_path / "out", load_any(path))
-    work.mkdir(parents=True)
-    (work / "p0-s0.json").write_text(content)
+    (work / "tasks").mkdir(parents=True)
+    task = work / "tasks" / "p0-s0.json"
+    task.write_text(content)
+    # even with its digest recorded (forged) in the manifest, the record itself is checked
+    (work / "tasks" / "manifest.json").write_text(json.dumps(
+        {"fingerprint": None, "tasks": {"p0-s0": hashlib.sha256(task.read_bytes()).hexdigest()}}))
     with pytest.raises(FkoptError, match="p0-s0.json"):
         run_config(load_any(path), tmp_path / "out", source=str(path), resume=True)
+    assert task.read_text() == content            # nothing wiped: the user decides
 
 
 def test_bench_refuses_bench_csv_linked_outside(tmp_path, cli):
@@ -443,7 +449,7 @@ def test_resume_refuses_corrupt_task_files(finished_study, cli, content):
 
 @pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task"])
 def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli, edit):
-    """Someone who also rewrote study.json's digests still cannot slip a malformed record in."""
+    """Someone who also rewrote manifest.json's digests still cannot slip a malformed record in."""
     import hashlib
     cfg, out, final, _ = finished_study
     work = _partial_with_a_task(out, final)
@@ -460,9 +466,9 @@ def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli
     else:
         rec["task"]["stop"] = 1
     task.write_text(json.dumps(rec))
-    manifest = json.loads((work / "tasks" / "study.json").read_text())
+    manifest = json.loads((work / "tasks" / "manifest.json").read_text())
     manifest["tasks"][task.stem] = hashlib.sha256(task.read_bytes()).hexdigest()
-    (work / "tasks" / "study.json").write_text(json.dumps(manifest))
+    (work / "tasks" / "manifest.json").write_text(json.dumps(manifest))
     one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), task.name)
 
 
@@ -502,7 +508,7 @@ def test_bad_scheduler_is_one_line_and_keeps_partial(finished_study, cli, addres
 
 def test_workers_never_exceed_cpus_or_tasks():
     from fkopt.files import available_cpus
-    from fkopt.study.executors import worker_count
+    from fkopt.experiment.executors import worker_count
     assert worker_count(10_000, 10_000) == available_cpus()
     assert worker_count(12, 2) == min(2, available_cpus())
     assert worker_count(1, 5) == 1
@@ -512,7 +518,7 @@ def test_jobs_10000_starts_no_more_processes_than_cpus(tmp_path, monkeypatch):
     """--jobs 10000 on this machine asks the pool for at most the CPUs (and the tasks)."""
     import concurrent.futures
     from fkopt.files import available_cpus
-    from fkopt.study import executors
+    from fkopt.experiment import executors
     asked = []
 
     class Pool(concurrent.futures.ThreadPoolExecutor):
@@ -799,17 +805,17 @@ def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli
     out = tmp_path / "out"
     cfg = tmp_path / "a.yaml"
     cfg.write_text(yaml_of({**BASE, "name": "same"}))
-    real = runner.run_experiment
+    real = runner.merge_experiment
 
-    def meanwhile(config, **kw):
-        result = real(config, **kw)
+    def meanwhile(config, *args, **kw):
+        result = real(config, *args, **kw)
         if config.seed == 1:              # the other run finishes while this one computes
             run_config(from_dict({**BASE, "name": "same", "seed": 99}, "other"), out)
         return result
-    monkeypatch.setattr(runner, "run_experiment", meanwhile)
+    monkeypatch.setattr(runner, "merge_experiment", meanwhile)
     one_line_error(cli("run", cfg, "--out", out, "-q"), "--force", "another fkopt run")
     assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 99
-    monkeypatch.setattr(runner, "run_experiment", real)
+    monkeypatch.setattr(runner, "merge_experiment", real)
     assert cli("run", cfg, "--out", out, "-q", "--force")[0] == 0      # asked for: replaced
     assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 1
 

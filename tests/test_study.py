@@ -121,7 +121,7 @@ def test_cli_errors_are_one_line(tmp_path, cli):
                            (["study", study, "--executor", "slurm"], "--executor: 'slurm' unknown; allowed: local, dask"),
                            (["study", study, "--scheduler", "tcp://x:1"], "only used with --executor dask"),
                            (["study", tmp_path / "missing.yaml"], "cannot read"),
-                           (["run", study], "run it with: fkopt study")]:
+                           (["run", study, "--jobs", "0"], "--jobs: must be at least 1")]:
         code, _, err = cli(*args)
         err = err.strip()
         assert code == 2
@@ -200,11 +200,21 @@ def test_resume_after_interruption_matches_uninterrupted_run(tmp_path):
 
 def test_resume_refuses_tasks_of_a_changed_config(tmp_path):
     run_study(small(), tmp_path)
-    with pytest.raises(FkoptError, match="config changed"):
+    with pytest.raises(FkoptError, match="config or pose sets changed"):
         run_study(small(seed=12), tmp_path, resume=True)
     # without --resume it starts afresh
     res = run_study(small(seed=12), tmp_path)
     assert len(res.computed) == 6
+
+
+def test_fkopt_run_runs_a_study_through_the_same_pipeline(tmp_path, cli):
+    """One pipeline: ``fkopt run`` on a study file is ``fkopt study`` (same bytes, same options)."""
+    study = tmp_path / "s.yaml"
+    study.write_text(yaml.safe_dump(small(poses={"uniform": 4, "seed": 1}).model_dump(mode="json")))
+    assert cli("study", study, "--out", tmp_path / "a", "-q")[0] == 0
+    code, _, err = cli("run", study, "--out", tmp_path / "b", "-q", "--jobs", "2")
+    assert code == 0, err
+    same_files(tmp_path / "a" / "studies" / "small", tmp_path / "b" / "studies" / "small")
 
 
 def test_cli_study_and_resume(tmp_path, cli):

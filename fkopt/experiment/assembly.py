@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
@@ -24,8 +23,8 @@ from pydantic import Field, ValidationError
 
 from ..errors import FkoptError
 from ..files import error_line
-from ..outputs import write_outputs, write_result
-from .kinds import Kind, Outcome
+from .kinds import Kind
+from .tasks import Plan, Task
 from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
 
 KIND = "assembly"
@@ -126,13 +125,20 @@ def _validate(config: AssemblyConfig) -> tuple[int, int]:
     return 1, starts * len(mech.unknown_names) ** 2 * 8 * 40
 
 
-def _run(config: AssemblyConfig, out, *, source=None, progress=None, publish_check=None, **_):
-    ar = run_assembly(config, source)
-    return Outcome(write_result(KIND, ar, out, publish_check), ar.wall_s, ar.solutions)
+def _plan(config: AssemblyConfig, source: str | None):
+    """One task: the search (timed, so it runs in this process)."""
+    payload = {"config": config.model_dump(mode="json"), "source": source}
+    return Plan([Task("search", payload, "all solutions")], "fkopt.experiment.assembly:solve_task",
+                local=lambda _: run_assembly(config, source), name=config.name)
 
 
-def _rerun_files(config: AssemblyConfig, folder: Path, source: str | None) -> None:
-    write_outputs(KIND, run_assembly(config, source), folder, figures=False, timing=False)
+def solve_task(payload: dict) -> AssemblyResult:
+    """Worker: the search, rebuilt from the payload."""
+    return run_assembly(assembly_from_dict(payload["config"], "assembly task"), payload["source"])
 
 
-ASSEMBLY = Kind(KIND, assembly_from_dict, _validate, _run, _rerun_files)
+def _merge(config: AssemblyConfig, plan, ran, **_) -> AssemblyResult:
+    return ran.records["search"]
+
+
+ASSEMBLY = Kind(KIND, assembly_from_dict, _validate, _plan, _merge)

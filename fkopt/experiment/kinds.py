@@ -1,18 +1,22 @@
 """One pipeline for every kind of config file: load, validate, plan the output, run, write, check.
 
-Kinds (the file's ``kind:`` key; an experiment file has none):
+Kinds (the file's ``kind:`` key; an experiment file has none) are views of one thing, a set of
+tasks (problem x poses x solver x runs) whose records a writer turns into files:
 
-* experiments: :mod:`fkopt.experiment.config` (:data:`EXPERIMENT` below);
-* ``kind: assembly``: all forward solutions, :mod:`fkopt.experiment.assembly`;
-* ``kind: study``: workspace studies, :mod:`fkopt.study` (its :class:`Kind` is in
-  :mod:`fkopt.study.kind`);
-* ``kind: suite``: benchmark suites (kinbench), :mod:`fkopt.kinbench` (:mod:`fkopt.kinbench.kind`).
+* an experiment (:mod:`fkopt.experiment.config`, :data:`EXPERIMENT` below) is a suite of one
+  problem with listed poses: one task per algorithm, solving every case in one batch;
+* ``kind: study`` (:mod:`fkopt.study`, :mod:`fkopt.study.kind`) is a suite of one mechanism with
+  a generated pose set: one task per (pose chunk, algorithm) or per tracked algorithm;
+* ``kind: assembly`` (:mod:`fkopt.experiment.assembly`) is a suite whose solver returns many
+  solutions: one task, the search;
+* ``kind: suite`` (kinbench, :mod:`fkopt.kinbench`, :mod:`fkopt.kinbench.kind`): many problems,
+  pose sets and solvers, one task per (problem, solver).
 
 Each kind is a :class:`Kind`, named in :data:`KINDS` by a ``"module:attribute"`` string imported
-on first use (like :mod:`fkopt.registry`), so this floor never imports the study floor above it,
-and adding a config kind is one module plus one line here and its list of files in
-:data:`fkopt.outputs.OUTPUTS` (which must stay on the floor of :mod:`fkopt.compare`, which reads
-the roles). Everything else is shared:
+on first use (like :mod:`fkopt.registry`), so this floor never imports the floors above it. A
+kind says only how to read and validate its file, how it turns into a
+:class:`~fkopt.experiment.tasks.Plan` and how the records become its result object. Everything
+else is shared, once:
 
 * :func:`load_any` -- the one loader (:func:`fkopt.files.load_mapping`: size, UTF-8, no aliases,
   no duplicate keys) and the one validator entry point (pydantic, one-line errors);
@@ -21,29 +25,32 @@ the roles). Everything else is shared:
   (:func:`check_memory`);
 * :func:`prepare_output` -- the results folder, checked before any computation (safe names,
   inside ``--out``, writable, not a file) and the overwrite policy (:func:`check_overwrite`);
-* :func:`run_config` -- run and write (aside, then swapped into place);
-* :func:`rerun_files` -- rerun into a scratch folder, for ``fkopt check``.
+* :func:`run_config` -- the one runner (:func:`fkopt.experiment.tasks.run_tasks`: this process,
+  worker processes or Dask; task files with digests and ``--resume``), the one writer
+  (:func:`fkopt.outputs.write_outputs`, written aside and swapped into place);
+* :func:`rerun_files` -- the same tasks in this process into a scratch folder, for the one
+  checker (:mod:`fkopt.reproduce.check`).
 
-What the kinds share beyond this module: one solve path (:func:`fkopt.experiment.runner.solve_cases`
--- an experiment's cases, a study's pose chunks and a tracking step's trajectories are all cases
-of one problem), one list of output files with their roles and one writer (:mod:`fkopt.outputs`),
-one checker (:mod:`fkopt.reproduce.check` through :func:`rerun_files`). What stays a study's own:
-its pose sets, its task files (the unit of ``--jobs``, Dask and ``--resume``) and its
-statistics; a study keeps per-(pose, run) records, not the per-iteration histories an
-experiment's figures need.
+Below the tasks, one solve path (:func:`fkopt.experiment.runner.solve_cases`): an experiment's
+cases, a study's pose chunks, a tracking step's trajectories and a suite's poses are all cases of
+one problem, seeded by :func:`fkopt.experiment.runner.task_seed`. Adding a config kind is one
+module plus one line in :data:`KINDS` and its files in :data:`fkopt.outputs.OUTPUTS`; adding an
+output is one maker and one line there.
 """
 from __future__ import annotations
 
 import importlib
 import json
 import os
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import FkoptError
-from ..files import load_mapping, output_folder
-from ..outputs import write_outputs, write_result
+from ..files import load_mapping, output_folder, write_atomically
+from ..outputs import write_outputs
+from .tasks import Plan, Ran, TaskStore, run_tasks, work_folder
 
 #: kind -> "module:attribute" of its :class:`Kind`.
 KINDS: dict[str, str] = {
@@ -58,13 +65,17 @@ MEMORY_SHARE = 0.8
 
 @dataclass(frozen=True)
 class Kind:
-    """What the pipeline needs to know about one kind of config."""
+    """What the pipeline needs to know about one kind of config: how to read and check it, the
+    tasks it turns into (:class:`fkopt.experiment.tasks.Plan`) and how their records become
+    the result that :func:`fkopt.outputs.write_outputs` writes. Running, task files, resuming,
+    writing aside and swapping in, and rerunning for ``fkopt check`` are the pipeline's."""
 
     name: str
     from_dict: Callable[[dict, str], Any]          # (mapping, where) -> validated config
     validate: Callable[[Any], tuple[int, int]]     # config -> (tasks, estimated bytes); no work done
-    run: Callable[..., "Outcome"]                  # (config, out, source=, progress=, **options)
-    rerun_files: Callable[[Any, Path, str | None], None]   # deterministic files into a folder
+    plan: Callable[[Any, "str | None"], Plan]      # (config, source) -> its tasks
+    #: (config, plan, ran, source=, timing=, folder=) -> the result object the writers read
+    merge: Callable[..., Any]
 
 
 @dataclass
@@ -72,6 +83,7 @@ class Outcome:
     folder: Path
     wall_s: float
     result: Any = None
+    computed: list = field(default_factory=list)    # ids of the tasks this run computed (not resumed)
 
 
 def kind_of(name: str | None) -> Kind:
@@ -143,12 +155,14 @@ def validate_any(config, where: str | None = None) -> int:
 
 # -- output ----------------------------------------------------------------------------------------
 def stored_config(folder: Path) -> dict | None:
-    """The config recorded in ``folder/meta.json`` (None when there is none or it is unreadable)."""
+    """The config recorded in ``folder/meta.json``, else in the manifest of its kept task files
+    (a finished study whose tables were deleted is still fkopt's); None when there is none."""
+    from .tasks import TASKS, read_manifest
     try:
         data = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
-        return data["config"] if isinstance(data, dict) and isinstance(data.get("config"), dict) else None
-    except (OSError, ValueError, KeyError):
-        return None
+    except (OSError, ValueError):
+        data = read_manifest(folder / TASKS)
+    return data["config"] if isinstance(data, dict) and isinstance(data.get("config"), dict) else None
 
 
 def check_overwrite(folder: Path, config, force: bool) -> None:
@@ -182,31 +196,73 @@ def prepare_output(config, out: str | Path, force: bool = False) -> Path:
 
 
 def run_config(config, out: str | Path, *, source: str | None = None, progress=None, force: bool = False,
-               checked: bool = False, **options) -> Outcome:
-    """Validate, check the output, run and write one config of any kind.
+               checked: bool = False, jobs: int = 1, executor: str = "local", scheduler: str | None = None,
+               resume: bool = False, keep_tasks: bool = True, solved: dict | None = None) -> Outcome:
+    """Validate, check the output, run and write one config of any kind -- the one pipeline.
 
+    The config's :class:`~fkopt.experiment.tasks.Plan` runs through
+    :func:`~fkopt.experiment.tasks.run_tasks` (``jobs``/``executor``/``scheduler``; task files
+    and ``resume`` for the kinds that keep them, which ``keep_tasks=False`` drops from the
+    published folder); ``solved``: records of some tasks computed elsewhere (task id -> record,
+    ``fkopt reproduce``'s worker pool). The kind's merge makes the result, every file of
+    :data:`fkopt.outputs.OUTPUTS` is written aside and swapped into place
+    (:func:`fkopt.files.write_atomically`), and the work folder is removed.
     ``checked=True``: the caller has already run :func:`validate_any` and :func:`prepare_output`.
     """
+    from .executors import check_scheduler, validate_executor
     kind = config_kind(config)
+    validate_executor(executor, jobs, scheduler)
     if not checked:
         validate_any(config, source)
         prepare_output(config, out, force)
+    folder = output_folder(out, *config.folder_parts)   # safe, inside OUT, writable: before any work
+    check_scheduler(executor, scheduler)                # reachable before a .partial is touched
+    start = time.perf_counter()
+    plan = kind.plan(config, source)
+    store = None
+    if plan.stored:
+        store = TaskStore(out, work_folder(out, config.folder_parts), folder, plan.name,
+                          config.model_dump(mode="json"), plan.fingerprint)
+    ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, store=store, resume=resume,
+                    progress=progress, done=solved)
+    result = kind.merge(config, plan, ran, source=source, timing=True, folder=folder)
+    wall = getattr(result, "wall_s", None)        # the kind's own account (solves made elsewhere too)
+    wall = time.perf_counter() - start if wall is None else wall
 
-    def publish_check(folder: Path) -> None:
+    def fill(tmp: Path) -> None:
+        write_outputs(kind.name, result, tmp)
+        if store is not None and plan.keep and keep_tasks:
+            store.publish_into(tmp)
+
+    def publish_check(target: Path) -> None:
         # checked again at publish time: another fkopt run may have written a result of a
         # different config there while this one computed (two runs at once into one paper/name)
         try:
-            check_overwrite(folder, config, force)
+            check_overwrite(target, config, force)
         except FkoptError as err:
             raise FkoptError(f"{err} (it was written by another fkopt run while this one computed; "
                              "nothing of this run was published)") from None
-    options.setdefault("publish_check", publish_check)
-    return kind.run(config, out, source=source, progress=progress, **options)
+
+    write_atomically(folder, fill, publish_check)
+    if store is not None:
+        store.discard()
+    return Outcome(folder, wall, result, list(ran.computed))
+
+
+def run_in_memory(config, source: str | None = None, *, progress=None, timing: bool = True,
+                  jobs: int = 1, executor: str = "local", scheduler: str | None = None):
+    """Every task of ``config`` computed (no task files, nothing written); the kind's result."""
+    kind = config_kind(config)
+    plan = kind.plan(config, source)
+    ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, progress=progress)
+    return kind.merge(config, plan, ran, source=source, timing=timing, folder=None)
 
 
 def rerun_files(config, folder: Path, source: str | None = None) -> None:
-    """Rerun ``config`` in this process and write its deterministic files into ``folder``."""
-    config_kind(config).rerun_files(config, folder, source)
+    """Rerun ``config`` in this process and write its deterministic files into ``folder``
+    (``fkopt check``)."""
+    result = run_in_memory(config, source, timing=False)
+    write_outputs(config_kind(config).name, result, folder, figures=False, timing=False)
 
 
 # -- experiments -----------------------------------------------------------------------------------
@@ -223,7 +279,7 @@ def _experiment_validate(config) -> tuple[int, int]:
                           snapshots=len(config.snapshots), x_history=keep_x)
         need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
         need += algorithm_resources(spec, pop, its, dim)
-    return len(config.algorithms) * len(cases), need
+    return len(config.algorithms), need
 
 
 def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int:
@@ -237,16 +293,14 @@ def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int
         raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
 
 
-def _experiment_run(config, out, *, source=None, progress=None, solved=None, publish_check=None, **_) -> Outcome:
-    from .runner import run_experiment
-    er = run_experiment(config, source=source, progress=progress, solved=solved)
-    return Outcome(write_result("experiment", er, out, publish_check), er.wall_s, er)
+def _experiment_plan(config, source):
+    from .runner import experiment_plan
+    return experiment_plan(config, source)
 
 
-def _experiment_rerun(config, folder: Path, source: str | None) -> None:
-    from .runner import run_experiment
-    write_outputs("experiment", run_experiment(config, source=source, timing=False), folder,
-                  figures=False, timing=False)
+def _experiment_merge(config, plan, ran, *, source=None, timing=True, **_):
+    from .runner import merge_experiment
+    return merge_experiment(config, plan, ran, source=source, timing=timing)
 
 
 def _experiment_from_dict(data: dict, where: str):
@@ -256,5 +310,4 @@ def _experiment_from_dict(data: dict, where: str):
     return experiment_from_dict(data, where)
 
 
-EXPERIMENT = Kind("experiment", _experiment_from_dict, _experiment_validate, _experiment_run, _experiment_rerun)
-
+EXPERIMENT = Kind("experiment", _experiment_from_dict, _experiment_validate, _experiment_plan, _experiment_merge)

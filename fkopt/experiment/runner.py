@@ -9,6 +9,7 @@ these per-case seeds, and the result is sliced back into one record per (case, a
 """
 from __future__ import annotations
 
+import json
 import time
 import zlib
 from pathlib import Path
@@ -23,6 +24,7 @@ from ..problems import fk_problem, ik_problem
 from ..rotations import wrap_degrees
 from ..solve import Result, chunk_size, make_algorithm, solve
 from .config import AlgorithmSpec, ExperimentConfig, RandomCases, RunConfig
+from .tasks import Plan, Ran, Task, run_tasks
 from .timing import time_single_runs
 
 
@@ -261,55 +263,87 @@ def _seeds(config: ExperimentConfig, cases: list[Case], spec: AlgorithmSpec) -> 
     return [task_seed(config.seed, case.index, spec.key) for case in cases]
 
 
-def _solve_one(config: ExperimentConfig, mech, cases, batched, spec: AlgorithmSpec, seeds: list[int]) -> Solved:
+def _solve_one(config: ExperimentConfig, mech, cases, batched, spec: AlgorithmSpec) -> Solved:
+    seeds = _seeds(config, cases, spec)
     start = time.perf_counter()
     result = solve_cases(config, spec, batched, seeds[0] if len(cases) == 1 else seeds, x0=start_point(spec, mech),
                          batch=config.batch, snapshots=config.snapshots, x_history=keeps_x_history(config, mech))
     return Solved(result, (time.perf_counter() - start) / len(cases))    # amortised over the cases
 
 
-def solve_experiment(config: ExperimentConfig, source: str | None = None) -> list[Solved]:
-    """Only the solves of an experiment, one :class:`Solved` per algorithm (for a worker process;
-    :func:`run_experiment` builds the records from them with ``solved=``)."""
-    mech, cases, _, batched = _prepare(config, source)
-    return [_solve_one(config, mech, cases, batched, spec, _seeds(config, cases, spec)) for spec in config.algorithms]
+@dataclass
+class _Context:
+    mech: object
+    cases: list[Case]
+    problems: list
+    batched: object
+    started: float
 
 
-def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
-                   source: str | None = None, timing: bool = True,
-                   solved: list[Solved] | None = None) -> ExperimentResult:
-    """Run every (case, algorithm) task; ``progress(label, done, total)`` is called after each.
-
-    ``timing=False`` skips the single-run timing sample (:mod:`.timing`): what ``fkopt check``
-    reruns for, since timings are never compared. ``solved``: the algorithms' solves computed
-    elsewhere (:func:`solve_experiment`, e.g. in a worker process); the records, and the timing
-    sample, are then made here.
-
-    Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
-    each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
-    """
-    start_all = time.perf_counter()
+def experiment_plan(config: ExperimentConfig, source: str | None = None) -> Plan:
+    """An experiment as tasks of the one runner (:mod:`fkopt.experiment.tasks`): one task per
+    algorithm, solving every case in one call (an experiment is a suite of one problem with
+    listed poses). In this process the task uses the live mechanism and cases; a worker process
+    rebuilds them from the payload (:func:`solve_task`), with the same numbers."""
+    started = time.perf_counter()
     mech, cases, problems, batched = _prepare(config, source)
-    records: list[TaskRecord] = []
-    total = len(cases) * len(config.algorithms)
+    data = config.model_dump_json()
+    folder = str(config._folder) if getattr(config, "_folder", None) is not None else None
+    tasks = [Task(f"a{a:02d}", {"config": data, "folder": folder, "algorithm": a}, spec.key)
+             for a, spec in enumerate(config.algorithms)]
+
+    def local(payload: dict) -> Solved:
+        return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
+    return Plan(tasks, "fkopt.experiment.runner:solve_task", local=local, anywhere=True,
+                context=_Context(mech, cases, problems, batched, started), name=config.name)
+
+
+def solve_task(payload: dict) -> Solved:
+    """Worker: one algorithm of an experiment on all its cases, rebuilt from the payload."""
+    from .config import experiment_from_dict
+    config = experiment_from_dict(json.loads(payload["config"]), "experiment task")
+    if payload.get("folder"):
+        config._folder = Path(payload["folder"])
+    mech, cases, _, batched = _prepare(config, None)
+    return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
+
+
+def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: str | None = None,
+                     timing: bool = True) -> ExperimentResult:
+    """The experiment's records from its tasks' :class:`Solved` s, then (``timing``) the
+    single-run timing sample of :mod:`.timing`, in this process after every solve."""
+    ctx: _Context = plan.context
+    mech, cases, problems = ctx.mech, ctx.cases, ctx.problems
     by_algorithm: list[list[TaskRecord]] = []
-    for a, spec in enumerate(config.algorithms):
+    for task, spec in zip(plan.tasks, config.algorithms):
+        done: Solved = ran.records[task.id]
         seeds = _seeds(config, cases, spec)
-        done = _solve_one(config, mech, cases, batched, spec, seeds) if solved is None else solved[a]
         recs = []
         for i, (case, problem) in enumerate(zip(cases, problems)):
             r = done.result if len(cases) == 1 else done.result.case(i)
             pos_hist = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
             recs.append(TaskRecord(case, spec, problem, r, seeds[i], done.wall_s, outputs_of(mech, r.x), pos_hist))
-            if progress:
-                progress(f"{case.label} / {spec.key}", len(records) + len(recs), total)
-        records += recs
         by_algorithm.append(recs)
     # case-major order, as the reports expect (every algorithm of case 1, then case 2, ...)
     records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
     if timing:
         time_single_runs(config, records)
-    wall = time.perf_counter() - start_all
-    if solved is not None:      # the solves' own time, measured where they ran
-        wall += sum(d.wall_s * len(cases) for d in solved)
+    wall = time.perf_counter() - ctx.started
+    # solves computed elsewhere (fkopt reproduce's workers): their own time, measured where they ran
+    wall += sum(ran.records[t.id].wall_s * len(cases) for t in plan.tasks if t.id not in ran.computed)
     return ExperimentResult(config, mech, cases, records, wall, source)
+
+
+def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
+                   source: str | None = None, timing: bool = True) -> ExperimentResult:
+    """Run every (case, algorithm) task in this process; ``progress(label, done, total)`` is
+    called after each algorithm (one task of the one runner, :func:`experiment_plan`).
+
+    ``timing=False`` skips the single-run timing sample (:mod:`.timing`): what ``fkopt check``
+    reruns for, since timings are never compared.
+
+    Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
+    each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
+    """
+    plan = experiment_plan(config, source)
+    return merge_experiment(config, plan, run_tasks(plan, progress=progress), source=source, timing=timing)

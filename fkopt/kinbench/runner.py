@@ -6,8 +6,9 @@ one batched problem (:func:`fkopt.experiment.runner.make_problem`), solved by
 :func:`fkopt.experiment.runner.task_seed` of (suite seed, pose index within its set,
 ``"<problem>/<set>/<solver label>"``); run k of a case is its k-th child stream
 (:mod:`fkopt.streams`), so a task's numbers do not depend on which other problems, sets,
-solvers or workers there are. Tasks run in this process, in local worker processes or on Dask
-(:func:`fkopt.study.executors.execute`).
+solvers or workers there are. The tasks go to the one runner (:mod:`fkopt.experiment.tasks`,
+:func:`suite_plan`): in this process, in local worker processes or on Dask, each kept as a task
+file with its SHA-256 until the suite is written, so ``--resume`` continues after a kill.
 
 Budget: a run of a problem of dimension n may spend ``B = budget_per_dim * n`` fitness
 evaluations (an analytic Jacobian counts as one, as everywhere in fkopt). The solver gets
@@ -19,7 +20,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,8 +29,8 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..experiment.config import RunConfig
-from ..files import inside, write_json_atomically
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
+from ..experiment.tasks import Plan, Ran, Task
 from ..solve import chunk_size
 from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
@@ -108,7 +108,7 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
 
 def solve_task(payload: dict) -> dict:
     """Worker: one (problem, solver) task on the cases (checked poses) the payload carries;
-    returns its run rows and wall time (picklable)."""
+    returns its record, JSON-able (a task file): run rows as columns of lists, wall time."""
     config = suite_from_dict(payload["config"], "suite task")
     config._folder = Path(payload["folder"]) if payload["folder"] else None
     problem = config.problems[payload["problem"]]
@@ -124,9 +124,9 @@ def solve_task(payload: dict) -> dict:
     start = time.perf_counter()
     result = solve_cases(cfg, spec, batched, seeds, x0=start_point(spec, mech))
     wall = time.perf_counter() - start
-    return {"problem": payload["problem"], "solver": payload["solver"], "dim": dim,
-            "rows": run_rows(config, problem, solver, cases, result, dim),
-            "wall_s": wall, "solves": len(cases) * config.runs}
+    rows = run_rows(config, problem, solver, cases, result, dim)
+    return {"fingerprint": payload["fingerprint"], "problem": payload["problem"], "solver": payload["solver"],
+            "dim": dim, "rows": rows.to_dict(orient="list"), "wall_s": wall, "solves": len(cases) * config.runs}
 
 
 def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> pd.DataFrame:
@@ -149,81 +149,70 @@ def fingerprint(config: SuiteConfig, manifest: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def _task_file(work: Path, p: int, s: int) -> Path:
-    return work / f"p{p}-s{s}.json"
+def record_problem(task, rec) -> str | None:
+    """Why ``rec`` is not the finished record of ``task`` (a task file read back by --resume)."""
+    if not isinstance(rec, dict):
+        return f"holds a JSON {type(rec).__name__}, not a task record"
+    try:
+        if (int(rec["problem"]), int(rec["solver"])) != (task.payload["problem"], task.payload["solver"]):
+            return "its problem/solver are not its file name's"
+        rows = rec["rows"]
+        n = len(task.payload["cases"]) * int(task.payload["config"]["runs"])
+        if not isinstance(rows, dict) or any(not isinstance(v, list) or len(v) != n for v in rows.values()):
+            return f"rows: not a table of {n} run rows"
+        int(rec["dim"]), float(rec["wall_s"]), int(rec["solves"])
+    except KeyError as err:
+        return f"field {err.args[0]!r} is missing"
+    except (TypeError, ValueError) as err:
+        return f"{type(err).__name__}: {str(err)[:120]}"
+    return None
 
 
-def _finished_tasks(work: Path, fp: str) -> dict[tuple[int, int], dict]:
-    """Tasks an interrupted run of the same suite finished (unreadable files are redone)."""
-    out = {}
-    for path in sorted(work.glob("p*-s*.json")):
-        inside(work, path, "--resume")
-        try:
-            rec = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            continue
-        redo = "delete it to recompute that task, or rerun without --resume to start over"
-        if not isinstance(rec, dict):
-            raise FkoptError(f"--resume: {path} holds a JSON {type(rec).__name__}, not a task record; {redo}")
-        if rec.get("fingerprint") != fp:
-            raise FkoptError(f"--resume: {path} belongs to another version of the suite (its config or pose "
-                             "sets changed); rerun without --resume to start over")
-        try:
-            key = (int(rec["problem"]), int(rec["solver"]))
-            if path.name != _task_file(work, *key).name or not isinstance(rec["rows"], dict):
-                raise ValueError("its problem/solver are not its file name's, or rows is not a table")
-            rec["rows"] = pd.DataFrame(rec["rows"])
-        except (KeyError, TypeError, ValueError) as err:
-            raise FkoptError(f"--resume: {path} is not a finished task of this suite ({type(err).__name__}: "
-                             f"{str(err)[:120]}); {redo}") from None
-        out[key] = rec
-    return out
+@dataclass
+class _Context:
+    sets: dict
+    manifest: dict
+    started: float
 
 
-def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
-              executor: str = "local", scheduler: str | None = None, work: Path | None = None,
-              resume: bool = False) -> SuiteResult:
-    """Every (problem, solver) task, then the imported outside results. With ``work``, each
-    finished task is written there as it arrives (``p<i>-s<j>.json``), and ``resume=True`` keeps
-    the tasks an interrupted run of the same suite left there and computes only the others."""
-    from ..study.executors import execute
-    start = time.perf_counter()
+def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
+    """A suite as tasks of the one runner: one per (problem, solver), every pose of the
+    problem's selected sets a case of one batched solve; kept as task files while the suite runs
+    (``--resume``), not in the published folder (its run rows are)."""
+    started = time.perf_counter()
     if source and config._folder is None:
         config._folder = Path(source).parent
     sets, manifest = load_pose_sets(config)
     fp = fingerprint(config, manifest)
     data = config.model_dump(mode="json")
     folder = str(config._folder) if config._folder is not None else ""
-    if work is not None:
-        if not resume:
-            shutil.rmtree(work, ignore_errors=True)
-        work.mkdir(parents=True, exist_ok=True)
-    kept = _finished_tasks(work, fp) if work is not None and resume else {}
-    payloads = [{"config": data, "folder": folder, "problem": p, "solver": s,
-                 "cases": _cases(config, sets, problem)}
-                for p, problem in enumerate(config.problems) for s in range(len(config.solvers))
-                if (p, s) not in kept]
-    done: list[dict] = list(kept.values())
-    total = len(done) + len(payloads)
+    tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
+                                 "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
+             for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
+    return Plan(tasks, "fkopt.kinbench.runner:solve_task", fingerprint=fp, stored=True, check=record_problem,
+                context=_Context(sets, manifest, started), name=f"suite '{config.name}'")
 
-    def collect(rec: dict) -> None:
-        if work is not None:
-            stored = {**rec, "fingerprint": fp, "rows": rec["rows"].to_dict(orient="list")}
-            write_json_atomically(inside(work, _task_file(work, rec["problem"], rec["solver"])), stored)
-        done.append(rec)
-        if progress:
-            progress(f"{config.problems[rec['problem']].name} / {config.solvers[rec['solver']].key}",
-                     len(done), total)
 
-    execute(solve_task, payloads, executor=executor, jobs=jobs, scheduler=scheduler, on_result=collect)
-    done.sort(key=lambda r: (r["problem"], r["solver"]))
-    frames = [r["rows"] for r in done]
+def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
+    """The run rows of every task, then the imported outside results, and the timing table."""
+    ctx: _Context = plan.context
+    done = [ran.records[t.id] for t in plan.tasks]
+    frames = [pd.DataFrame(r["rows"]) for r in done]
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
-        instances = instances_of(config, sets)
+        instances = instances_of(config, ctx.sets)
         frames += [read_outside(config, k, dims, instances) for k in range(len(config.outside))]
     runs = pd.concat(frames, ignore_index=True)
     tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
                          "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
                         for r in done])
-    return SuiteResult(config, runs, tim, manifest, time.perf_counter() - start, source)
+    return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source)
+
+
+def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
+              executor: str = "local", scheduler: str | None = None) -> SuiteResult:
+    """Every (problem, solver) task computed (no task files, nothing written), then the
+    imported outside results: the suite's result (``fkopt suite`` runs it through
+    :func:`fkopt.experiment.kinds.run_config`, which keeps task files and resumes)."""
+    from ..experiment.kinds import run_in_memory
+    return run_in_memory(config, source, progress=progress, jobs=jobs, executor=executor, scheduler=scheduler)

@@ -187,8 +187,8 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         return [Mismatch(label, "meta.json", "-", "file", problem, "a readable meta.json with the config",
                          "present and readable")]
     out = integrity(exp)
-    from ..study.runner import task_file_problems     # a study's task files: digests of study.json
-    out += [Mismatch(label, name, "-", "sha256", why, "recorded in tasks/study.json", "unchanged since written")
+    from ..experiment.tasks import task_file_problems     # kept task files: digests of tasks/manifest.json
+    out += [Mismatch(label, name, "-", "sha256", why, "recorded in tasks/manifest.json", "unchanged since written")
             for name, why in task_file_problems(exp.folder)]
     if config is None:
         try:

@@ -78,38 +78,48 @@ def _cost(config) -> float:
                for a in config.algorithms)
 
 
-def _solve(payload: dict):
-    """Worker: the solves of one experiment file (:func:`fkopt.experiment.runner.solve_experiment`)."""
-    from ..experiment.runner import solve_experiment
-    source = payload["source"]
-    return payload["index"], solve_experiment(load_any(source), source=source)
-
-
 def solve_in_parallel(planned: list[Planned], jobs: int,
-                      solving: Callable[[int, int], None] | None = None) -> dict[int, list]:
-    """The solves of every experiment of ``planned`` in ``jobs`` worker processes, by index.
+                      solving: Callable[[int, int], None] | None = None) -> dict[int, dict]:
+    """The tasks of every config whose plan may run anywhere (experiments' solves), all of them
+    in one pool of ``jobs`` worker processes; records by config index, then task id.
 
-    Only the solves run there: they are deterministic (each (case, run) has its own stream), so
+    Only such tasks run there: they are deterministic (each (case, run) has its own stream), so
     the numbers are those of a serial run. Everything measured in seconds that the report judges
-    -- the single-run timing samples of :mod:`fkopt.experiment.timing`, and whole studies, whose
-    tracking times are claims -- runs afterwards in this process, one at a time, with the
-    workers gone; only the batch's amortised time (``amortised_ms_per_run``, for information)
-    is measured in a worker next to another.
+    -- the single-run timing samples of :mod:`fkopt.experiment.timing`, and whole studies and
+    assembly searches, whose times are claims -- runs afterwards in this process, one at a
+    time, with the workers gone; only the batch's amortised time (``amortised_ms_per_run``, for
+    information) is measured in a worker next to another.
     """
+    from ..experiment.executors import execute
     from ..experiment.kinds import config_kind
-    from ..study.executors import execute
-    todo = sorted((i for i, p in enumerate(planned) if config_kind(p.config).name == "experiment"),
-                  key=lambda i: -_cost(planned[i].config))
-    solved: dict[int, list] = {}
-    if jobs <= 1 or len(todo) < 2:
-        return solved
+    if jobs <= 1:
+        return {}
+    items = []
+    for i, p in enumerate(planned):
+        plan = config_kind(p.config).plan(p.config, str(p.path))
+        if plan.anywhere and not plan.stored:
+            items += [(_cost(p.config) / len(plan.tasks), i, (plan.solve, t.id, t.payload)) for t in plan.tasks]
+    if len({i for _, i, _ in items}) < 2:
+        return {}
+    items.sort(key=lambda item: -item[0])       # the longest first: the workers finish close together
+    solved: dict[int, dict] = {}
+    count = [0]
 
-    def done(item) -> None:
-        solved[item[0]] = item[1]
+    def done(result) -> None:
+        index, (ident, record) = result
+        solved.setdefault(index, {})[ident] = record
+        count[0] += 1
         if solving:
-            solving(len(solved), len(todo))
-    execute(_solve, [{"index": i, "source": str(planned[i].path)} for i in todo], jobs=jobs, on_result=done)
+            solving(count[0], len(items))
+    execute(_run_indexed, [(i, item) for _, i, item in items], jobs=jobs, on_result=done)
     return solved
+
+
+def _run_indexed(pair):
+    """Worker: one task of config ``index`` -> (index, (task id, record))."""
+    from ..experiment.tasks import run_remote
+    index, item = pair
+    return index, run_remote(item)
 
 
 def run_all(planned: list[Planned], out: str | Path,
@@ -126,9 +136,8 @@ def run_all(planned: list[Planned], out: str | Path,
     done = []
     for i, p in enumerate(planned):
         progress = started(p) if started else None
-        options = {"solved": solved[i]} if i in solved else {}
         outcome = run_config(p.config, out, source=str(p.path), progress=progress, force=True, keep_tasks=False,
-                             **options)
+                             solved=solved.get(i))
         d = Done(p.path, outcome.folder, outcome.wall_s, len(list(outcome.folder.iterdir())))
         done.append(d)
         if finished:

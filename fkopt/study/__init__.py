@@ -2,8 +2,8 @@
 
 * :mod:`.config`     -- the YAML schema (``kind: study``), :func:`load_study`, :func:`load_any`;
 * :mod:`.poses`      -- pose sets: uniform, grid, waypoints, circle;
-* :mod:`.runner`     -- tasks, task files, resume, merge: :func:`run_study`;
-* :mod:`.executors`  -- local processes or a Dask cluster;
+* :mod:`.runner`     -- a study's tasks and merge for the one runner (:mod:`fkopt.experiment.tasks`:
+  executors, task files, resume): :func:`run_study`;
 * :mod:`.statistics` -- ECDF of evaluations to target, Wilcoxon rank-sum tests with Holm;
 * :mod:`.reports`    -- the files of a study folder;
 * :mod:`.kind`       -- studies as a kind of the one config pipeline (load, run, write, check).

@@ -1,10 +1,7 @@
 """Studies as a kind of the one config pipeline (:mod:`fkopt.experiment.kinds`)."""
 from __future__ import annotations
 
-from pathlib import Path
-
-from ..experiment.kinds import Kind, Outcome
-from ..outputs import write_outputs
+from ..experiment.kinds import Kind
 from .config import StudyConfig, study_from_dict
 
 
@@ -28,20 +25,14 @@ def _validate(config: StudyConfig) -> tuple[int, int]:
     return len(plan_tasks(config, n)), work + kept
 
 
-def _run(config: StudyConfig, out, *, source=None, progress=None, jobs: int = 1, executor: str = "local",
-         scheduler: str | None = None, resume: bool = False, keep_tasks: bool = True, publish_check=None,
-         **_) -> Outcome:
-    from .runner import run_study
-    result = run_study(config, out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,
-                       progress=progress, source=source, keep_tasks=keep_tasks, publish_check=publish_check)
-    return Outcome(result.folder, result.wall_s, result)
+def _plan(config: StudyConfig, source):
+    from .runner import study_plan
+    return study_plan(config, source)
 
 
-def _rerun_files(config: StudyConfig, folder: Path, source: str | None) -> None:
-    from .runner import rerun_in_memory
-    result = rerun_in_memory(config)
-    result.source = source
-    write_outputs("study", result, folder, figures=False, timing=False)
+def _merge(config: StudyConfig, plan, ran, **options):
+    from .runner import merge_study
+    return merge_study(config, plan, ran, **options)
 
 
-STUDY = Kind("study", lambda data, where: study_from_dict(data, where), _validate, _run, _rerun_files)
+STUDY = Kind("study", lambda data, where: study_from_dict(data, where), _validate, _plan, _merge)

@@ -1,4 +1,4 @@
-"""Run a study: plan tasks, run the missing ones on an executor, keep one file per task, merge.
+"""A study's tasks, their computation and their merge, for the one runner.
 
 * A task is (pose chunk, algorithm) in ``independent`` mode and (all trajectories, algorithm)
   in ``tracking`` mode. A chunk's poses are the cases of one solve through the experiment's
@@ -7,25 +7,18 @@
   another process or on a Dask worker) and returns plain lists; the seeds come from
   :func:`fkopt.experiment.runner.task_seed` per pose (or step), so a task's numbers do not
   depend on where, when or next to what it ran.
-* An unfinished run works in the hidden sibling ``OUT/<paper>/.<name>.partial/`` (see
-  :func:`work_folder`); the previous result ``OUT/<paper>/<name>/`` is not touched until the new
-  one is complete. Every finished task is written at once as ``tasks/<task id>.json`` there (a
-  temporary file renamed into place, so a file is either complete or absent). An interrupted
-  study therefore loses at most the tasks that were running; ``resume=True``
-  (``fkopt study --resume``) keeps every task file whose config fingerprint matches (from the
-  unfinished run, or else from the finished folder's ``tasks/``) and runs only the others.
-  Without ``resume`` the unfinished run is started afresh.
-* When every task is there, :func:`merge` reads them back into a :class:`StudyResult`;
-  :mod:`fkopt.study.reports` writes the tables and figures into a temporary folder, the task
-  files move into its ``tasks/`` (unless ``keep_tasks=False``), and the folder is swapped into
-  place (:func:`fkopt.files.write_atomically`); then the ``.partial`` folder is removed.
+* :func:`study_plan` hands the tasks to the one runner (:mod:`fkopt.experiment.tasks`), which
+  keeps each finished one as a task file in ``OUT/<paper>/.<name>.partial/tasks/`` with its
+  SHA-256, resumes (``fkopt study --resume``) from the files that still pass
+  :func:`record_problem`, and publishes them in the result's ``tasks/``.
+* :func:`merge` reads the records back into a :class:`StudyResult`, which
+  :mod:`fkopt.study.reports` writes (through :mod:`fkopt.outputs`).
 """
 from __future__ import annotations
 
 import json
 import os
 import re
-import shutil
 import time
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
@@ -34,18 +27,19 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import FkoptError
-from ..files import inside, output_folder, write_atomically, write_json_atomically
-from ..outputs import write_outputs
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
 from ..solve import make_algorithm, pick_events
 from ..streams import case_seed
+from ..experiment.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder as _work_folder
 from .config import StudyAlgorithmSpec, StudyConfig
 from .poses import PoseSet, build_poses
 
-TASKS = "tasks"
-STUDY_FILE = "study.json"
+
+
+def work_folder(out: str | Path, config: StudyConfig) -> Path:
+    """Where an unfinished study keeps its task files: ``OUT/<paper>/.<name>.partial/``."""
+    return _work_folder(out, config.folder_parts)
 
 
 # -- tasks ---------------------------------------------------------------------------------------
@@ -207,26 +201,13 @@ def _runs_of(r, x: np.ndarray, rows: slice):
                                                           r.runs * (rows.step or 1))))
 
 
-# -- task files ----------------------------------------------------------------------------------
-def write_json_atomic(path: Path, data: dict) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder and os.replace."""
-    write_json_atomically(path, data, separators=(",", ":"))
-
-
-def _digest(path: Path) -> str:
-    import hashlib
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def _record_problem(rec, path: Path, planned: dict[str, Task], config: StudyConfig, dim: int) -> str | None:
-    """Why ``rec`` (read from ``path``) is not a finished task of this study; None when it is."""
+# -- checking a reused record ------------------------------------------------------------------
+def record_problem(rec, ident: str, task: Task, config: StudyConfig, dim: int) -> str | None:
+    """Why ``rec`` (the task file ``ident``) is not the finished ``task`` of this study; None when it is."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
-    if rec.get("id") != path.stem:
-        return f"its id {str(rec.get('id'))[:40]!r} is not its file name {path.stem!r}"
-    task = planned.get(path.stem)
-    if task is None:
-        return "no task of this study has that id"
+    if rec.get("id") != ident:
+        return f"its id {str(rec.get('id'))[:40]!r} is not its file name {ident!r}"
     if rec.get("task") != task.__dict__:
         return "its task (algorithm, poses) is not the one its id names"
     n = task.stop - task.start if config.mode == "independent" else None
@@ -254,71 +235,6 @@ def _record_problem(rec, path: Path, planned: dict[str, Task], config: StudyConf
     except (TypeError, ValueError):
         return f"{key}: not numbers" if "key" in locals() else "poses: not numbers"
     return None
-
-
-def read_task_files(folder: Path, config: StudyConfig, dim: int, digests: dict[str, str] | None) -> dict[str, dict]:
-    """Finished tasks in ``folder/tasks``, each checked before it is reused.
-
-    ``digests`` (task id -> SHA-256, recorded in ``study.json`` as each file was written): a file
-    whose bytes changed since, or that no record names, is refused with one line; without
-    digests (a study written by an older fkopt) no file is trusted and every task is redone.
-    A file that is not a task record of this study (``[]``, no ``id``, wrong shapes, another
-    config) is refused with one line naming it -- nothing is reused blindly.
-    """
-    if digests is None:
-        return {}
-    fingerprint = config.fingerprint()
-    out = {}
-    root = folder.parent
-    for path in sorted((folder / TASKS).glob("a*.json")):
-        inside(root, path, "--resume")
-        redo = "delete it to recompute that task, or rerun without --resume to start over"
-        if digests.get(path.stem) != _digest(path):
-            raise FkoptError(f"{path}: changed since fkopt wrote it (its SHA-256 is not the one recorded in "
-                             f"{STUDY_FILE}); {redo}")
-        try:
-            rec = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as err:
-            raise FkoptError(f"{path}: unreadable task file ({type(err).__name__}); {redo}") from None
-        if isinstance(rec, dict) and rec.get("fingerprint") != fingerprint:
-            raise FkoptError(f"{path}: belongs to another version of the study (its config changed); "
-                             "rerun without --resume to start over")
-        out[path.stem] = rec
-    return out
-
-
-def task_file_problems(folder: Path) -> list[tuple[str, str]]:
-    """(file, problem) for every task file of a published study ``folder/tasks`` whose bytes no
-    longer have the SHA-256 recorded in ``tasks/study.json`` when it was written, or that no
-    record names (``fkopt check``). A study written before digests were recorded has none to
-    compare: ``[]`` (its task files are never reused by ``--resume`` either)."""
-    tasks = Path(folder) / TASKS
-    stored = _manifest(tasks / STUDY_FILE) if tasks.is_dir() else None
-    digests = stored.get("tasks") if isinstance(stored, dict) else None
-    if not isinstance(digests, dict):
-        return []
-    out = []
-    files = {p.stem: p for p in tasks.glob("a*.json")}
-    for ident in sorted(set(files) | set(digests)):
-        path = files.get(ident)
-        if path is None:
-            out.append((f"{TASKS}/{ident}.json", "missing"))
-        elif ident not in digests:
-            out.append((f"{TASKS}/{path.name}", "not recorded in study.json"))
-        elif path.is_symlink() or _digest(path) != digests[ident]:
-            out.append((f"{TASKS}/{path.name}", "changed since written"))
-    return out
-
-
-def check_records(records: dict[str, dict], folder: Path, config: StudyConfig, n_poses: int, dim: int) -> None:
-    """Every reused record is a finished task of this study (see :func:`read_task_files`)."""
-    planned = {t.id: t for t in plan_tasks(config, n_poses)}
-    for ident, rec in records.items():
-        path = folder / TASKS / f"{ident}.json"
-        problem = _record_problem(rec, path, planned, config, dim)
-        if problem:
-            raise FkoptError(f"{path}: not a finished task of this study ({problem}); delete it to recompute "
-                             "that task, or rerun without --resume to start over")
 
 
 # -- merged result -------------------------------------------------------------------------------
@@ -403,138 +319,60 @@ def merge(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]) -
     return out
 
 
-# -- driver --------------------------------------------------------------------------------------
-def study_folder(out: str | Path, config: StudyConfig) -> Path:
-    return Path(out) / config.paper / config.name
+# -- the one runner's view of a study -------------------------------------------------------------
+@dataclass
+class _Context:
+    mech: object
+    poses: PoseSet
+    started: float
 
 
-def work_folder(out: str | Path, config: StudyConfig) -> Path:
-    """Where an unfinished run keeps its task files: ``OUT/<paper>/.<name>.partial/``."""
-    return Path(out) / config.paper / f".{config.name}.partial"
+def _label(config: StudyConfig, task: Task) -> str:
+    where = (f"poses {task.start + 1}-{task.stop}" if config.mode == "independent"
+             else f"{task.stop - task.start} steps")
+    return f"{task.label} · {where}"
 
 
-def _guard(out: str | Path, *paths: Path) -> None:
-    """Every path a study writes, reads back or swaps lies inside ``--out`` (links resolved)."""
-    for path in paths:
-        inside(out, path)
+def study_plan(config: StudyConfig, source: str | None = None) -> Plan:
+    """A study as tasks of the one runner: kept as task files (resume), published in ``tasks/``."""
+    started = time.perf_counter()
+    mech, poses = validate_study(config)
+    tasks = plan_tasks(config, len(poses))
+    by_id = {t.id: t for t in tasks}
+    dim = len(mech.unknown_names)
+    return Plan([RunnerTask(t.id, payload(config, t), _label(config, t)) for t in tasks],
+                "fkopt.study.runner:run_task", fingerprint=config.fingerprint(), stored=True, keep=True,
+                check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, dim),
+                context=_Context(mech, poses, started), name=f"study '{config.name}'")
 
 
-def _manifest(study_file: Path) -> dict | None:
-    try:
-        data = json.loads(study_file.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) else None
-
-
-def _prepare(out, final: Path, work: Path, config: StudyConfig, resume: bool) -> dict[str, str] | None:
-    """Make ``work`` ready; returns the task digests of the files that may be reused (or None)."""
-    study_file = work / TASKS / STUDY_FILE
-    _guard(out, work, work / TASKS, study_file, final, final / TASKS)
-    if not resume:
-        if work.is_symlink():
-            work.unlink()
-        shutil.rmtree(work, ignore_errors=True)
-    elif not work.exists() and (final / TASKS).is_dir():
-        # resume a finished study: start from a copy of its task files (the folder stays as it is)
-        sources = sorted((final / TASKS).glob("*.json"))
-        _guard(out, *sources)
-        (work / TASKS).mkdir(parents=True)
-        for path in sources:
-            shutil.copyfile(path, work / TASKS / path.name)
-    digests = None
-    if resume and study_file.exists():
-        stored = _manifest(study_file) or {}
-        if stored.get("fingerprint") not in (None, config.fingerprint()):
-            raise FkoptError(f"--resume: {final} holds tasks of another version of study '{config.name}' "
-                             "(its config changed); rerun without --resume to start over")
-        if isinstance(stored.get("tasks"), dict):
-            digests = {str(k): str(v) for k, v in stored["tasks"].items()}
-    (work / TASKS).mkdir(parents=True, exist_ok=True)
-    _guard(out, work, work / TASKS)
-    return digests
-
-
-def _write_manifest(study_file: Path, config: StudyConfig, digests: dict[str, str]) -> None:
-    write_json_atomic(study_file, {"name": config.name, "fingerprint": config.fingerprint(),
-                                   "config": config.model_dump(mode="json"), "tasks": dict(sorted(digests.items()))})
+def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None = None,
+                folder: Path | None = None, **_) -> StudyResult:
+    ctx: _Context = plan.context
+    return StudyResult(config, ctx.mech, ctx.poses, merge(config, ctx.mech, ctx.poses, ran.records),
+                       time.perf_counter() - ctx.started, source, list(ran.computed), folder)
 
 
 def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
               scheduler: str | None = None, resume: bool = False,
               progress: Callable[[str, int, int], None] | None = None, source: str | None = None,
-              write: bool = True, keep_tasks: bool = True, publish_check=None) -> StudyResult:
-    """Run (or resume) a study into ``OUT/<paper>/<name>/`` and write its report files.
+              keep_tasks: bool = True) -> StudyResult:
+    """Run (or resume) a study into ``OUT/<paper>/<name>/`` through the one pipeline
+    (:func:`fkopt.experiment.kinds.run_config`; the library call replaces an earlier result of
+    any config, as ``--force`` does).
 
     ``progress(label, done, total)`` is called after each finished task (``done`` counts the
     tasks already on disk too). An exception raised by it (e.g. KeyboardInterrupt) stops the
-    study; every task finished so far stays in :func:`work_folder` for ``resume=True``, and a
+    study; every task finished so far stays in the work folder for ``resume=True``, and a
     previous result stays complete. ``keep_tasks=False`` drops the task files once the study
-    is written (``fkopt reproduce``). ``publish_check(folder)`` runs just before the result is
-    swapped into place (:func:`fkopt.files.write_atomically`).
-
-    Every task file is recorded with its SHA-256 in ``tasks/study.json`` as it is written;
-    ``resume`` reuses only files that still have it and hold a task of this study.
+    is written (``fkopt reproduce``).
     """
-    from .executors import check_scheduler, execute, validate_executor
-    validate_executor(executor, jobs, scheduler)
-    mech, poses = validate_study(config)
-    folder = output_folder(out, *config.folder_parts)   # safe, inside OUT, writable: before any work
-    work = work_folder(out, config)
-    tasks = plan_tasks(config, len(poses))
-    check_scheduler(executor, scheduler)    # reachable before anything (a .partial) is touched
-    t_start = time.perf_counter()
-    digests = _prepare(out, folder, work, config, resume)
-    dim = len(mech.unknown_names)
-    records = read_task_files(work, config, dim, digests) if resume else {}
-    check_records(records, work, config, len(poses), dim)
-    kept = {k: v for k, v in (digests or {}).items() if k in records}
-    study_file = work / TASKS / STUDY_FILE
-    _write_manifest(study_file, config, kept)
-    pending = [t for t in tasks if t.id not in records]
-    computed: list[str] = []
-
-    def finished(rec: dict) -> None:
-        path = inside(out, work / TASKS / f"{rec['id']}.json")
-        write_json_atomic(path, rec)
-        kept[rec["id"]] = _digest(path)
-        _write_manifest(study_file, config, kept)
-        records[rec["id"]] = rec
-        computed.append(rec["id"])
-        if progress:
-            task = rec["task"]
-            where = (f"poses {task['start'] + 1}-{task['stop']}" if config.mode == "independent"
-                     else f"{task['stop'] - task['start']} steps")
-            progress(f"{task['label']} · {where}", len(records), len(tasks))
-
-    if progress and records:
-        progress("resumed", len(records), len(tasks))
-    execute(run_task, [payload(config, t) for t in pending], executor=executor, jobs=jobs,
-            scheduler=scheduler, on_result=finished)
-    missing = [t.id for t in tasks if t.id not in records]
-    if missing:  # pragma: no cover - execute() raises before this can happen
-        raise FkoptError(f"study '{config.name}': {len(missing)} task(s) did not finish (first: {missing[0]})")
-    result = StudyResult(config, mech, poses, merge(config, mech, poses, records),
-                         time.perf_counter() - t_start, source, computed, folder)
-    if write:
-        def fill(tmp: Path) -> None:
-            write_outputs("study", result, tmp)
-            if keep_tasks:
-                _guard(out, work / TASKS)
-                os.replace(work / TASKS, tmp / TASKS)
-
-        write_atomically(folder, fill, publish_check)
-        shutil.rmtree(work, ignore_errors=True)
-    return result
+    from ..experiment.kinds import run_config
+    return run_config(config, out, source=source, progress=progress, force=True, jobs=jobs, executor=executor,
+                      scheduler=scheduler, resume=resume, keep_tasks=keep_tasks).result
 
 
 def rerun_in_memory(config: StudyConfig) -> StudyResult:
     """Every task computed in this process, nothing written (for checks and tests)."""
-    mech, poses = validate_study(config)
-    start = time.perf_counter()
-    records = {}
-    for t in plan_tasks(config, len(poses)):
-        rec = run_task(payload(config, t))
-        records[rec["id"]] = rec
-    return StudyResult(config, mech, poses, merge(config, mech, poses, records),
-                       time.perf_counter() - start)
+    from ..experiment.kinds import run_in_memory
+    return run_in_memory(config)

@@ -1,4 +1,4 @@
-"""Where the tasks of a study run: this process, local worker processes, or a Dask cluster.
+"""Where the tasks of a config (any kind) run: this process, local worker processes, or a Dask cluster.
 
 :func:`execute` calls ``fn(payload)`` for every payload and ``on_result(result)`` in *this*
 process as each finishes (in completion order; the study writes the task file there, so a
