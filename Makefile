@@ -35,8 +35,8 @@ reproduce-peers:
 	$(PYTHON) -m fkopt.peers results/peers
 
 # kinbench (docs/kinbench.md): v1 and v2 in full, their quick tiers (which CI's check reruns) and
-# the libraries subset into results/kinbench/, then the report (~8 min on 2 cores). Not part of
-# `make reproduce`.
+# the libraries subset into results/kinbench/, then the report (~15 min on 2 cores, 7-8 of them the
+# libraries subset). Not part of `make reproduce`.
 bench-suite:
 	for s in kinbench kinbench-v2 kinbench-v2-libraries; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --jobs 2 -q || exit 1; done

@@ -610,12 +610,14 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
-                                            "throughput, mao2017, peers, exact, kinematics, robots, cases, "
-                                            "scaling (default: all but peers)")):
+                                            "throughput, mao2017, peers, adapters, exact, kinematics, robots, "
+                                            "cases, scaling (default: all but peers and adapters)")):
     """Measure fkopt's speed (and peers') on this machine.
 
     Sections: throughput (batched fitness evaluations per second), mao2017 (the paper's Tab. 3
-    budget), peers (NiaPy, MEALPY, pygmo, ... on the same fitness, if installed), exact (batched
+    budget), peers (NiaPy, MEALPY, pygmo, ... on the same fitness, if installed), adapters
+    (scipy's, pymoo's and NiaPy's DE through fkopt's adapters beside gabc, abc and the plug-in DE
+    on kinbench's problems; with --peers or named), exact (batched
     lm), kinematics (fkopt.forward, fkopt.inverse, all assembly modes, the fk process),
     robots (fkopt.inverse on URDF arms from example-robot-data beside roboticstoolbox's ETS
     ik_LM, if installed), cases (N cases x 30 runs solved together, beside a compiled C loop when a C compiler is

@@ -152,3 +152,126 @@ def test_adapter_on_a_problem_with_cases_solves_each_case_as_alone():
     assert both.fitness.shape == (2, 2)
     np.testing.assert_array_equal(both.case(1).fitness, alone.fitness)
     np.testing.assert_array_equal(both.case(1).x, alone.x)
+
+
+# -- per-point libraries: the counter's single-point path and runs in lockstep -------------------
+def _drive(counter, points, single: bool):
+    """Feed ``points`` one at a time until the counter stops the run; (values, stopped at)."""
+    out = []
+    for i, x in enumerate(points):
+        try:
+            out.append(counter.point(x) if single else float(counter.batch(x[None, :])[0]))
+        except Exception as err:
+            assert type(err).__name__ == "_Stop"
+            return out, i
+    return out, None
+
+
+class Scripted:
+    """A 2-D problem whose fitness is the first coordinate (NaN and inf included)."""
+    dim = 2
+    bounds = np.array([[-1e9, 1e9], [-1e9, 1e9]])
+
+    def __init__(self):
+        self.points = 0
+
+    def fitness(self, x):
+        x = np.asarray(x, dtype=float)
+        self.points += int(np.prod(x.shape[:-1]))
+        return x[..., 0].copy()
+
+
+@pytest.mark.parametrize("budget,target,stop", [(9, None, False), (30, None, False), (30, 0.5, True),
+                                                (30, -5.0, True), (4, 2.0, True)])
+def test_counter_point_counts_and_traces_exactly_as_a_batch_of_one(budget, target, stop):
+    values = [np.inf, np.nan, 7.0, 7.0, 3.0, np.nan, 5.0, 1.0, 0.25, 2.0, -np.inf, 0.1, -1.0]
+    points = [np.array([v, float(i)]) for i, v in enumerate(values * 2)]
+    runs = []
+    for single in (True, False):
+        p = Scripted()
+        c = Counter(p, budget, target, stop)
+        got, at = _drive(c, points, single)
+        tr = c.trace()
+        runs.append((got, at, c.n, c.best, p.points, tr.evals.tolist(), tr.f.tolist(), tr.x.tolist(), tr.used))
+    assert runs[0] == runs[1] or str(runs[0]) == str(runs[1])     # NaN-free repr equality
+    got, at, n, best, points_evaluated, evals, f, x, used = runs[0]
+    assert n == points_evaluated == used <= budget and evals[0] == 1
+
+
+def test_counter_point_keeps_its_own_copy_of_the_point():
+    p = Scripted()
+    c = Counter(p, 10)
+    x = np.array([3.0, 1.0])
+    c.point(x)
+    x[0] = -100.0                                   # a library reusing its array
+    assert c.trace().x.tolist() == [[3.0, 1.0]]
+
+
+def _niapy_names():
+    pytest.importorskip("niapy")
+    return ["niapy:DifferentialEvolution", "niapy:ArtificialBeeColonyAlgorithm", "niapy:ParticleSwarmAlgorithm"]
+
+
+@pytest.mark.parametrize("cases", [True, False])
+def test_niapy_runs_in_lockstep_give_each_run_alone_numbers_and_counts(cases, monkeypatch):
+    """Lockstep batches the runs' single-point calls; every number and count is the one of the
+    runs evaluated one point after the other, run after run (and stopping at the target or at
+    the budget works per run)."""
+    from fkopt.adapters import adapter_class
+    from fkopt.adapters import base
+    m = fkopt.mechanism("3-rps")
+    rng = np.random.default_rng(7)
+    poses = m.bounds[:, 0] + rng.random((3, 3)) * np.ptp(m.bounds, axis=1)
+    problem = fkopt.fk_problem(m, m.ik(poses)) if cases else fkopt.fk_problem(m, m.ik(poses[0]))
+    monkeypatch.setattr(base, "LOCKSTEP_RUNS", 4)  # several groups, one of them short
+    kw = dict(population=10, iterations=30, runs=3, seed=[3, 4, 5] if cases else 3, target=1e-3,
+              stop_at_target=True)
+    real = base.run_lockstep
+    for name in _niapy_names():
+        cls = adapter_class(*name.split(":"))
+        assert cls.per_point
+        calls = []
+        monkeypatch.setattr(base, "run_lockstep", lambda *a: calls.append(1) or real(*a))
+        together = fkopt.solve(problem, name, **kw)
+        assert calls, "lockstep was not used"
+        monkeypatch.setattr(cls, "per_point", False)           # one run after the other, point by point
+        alone = fkopt.solve(problem, name, **kw)
+        monkeypatch.setattr(cls, "per_point", True)
+        for field in ("history", "x", "evaluations", "fitness", "evaluation_history", "iterations_done"):
+            np.testing.assert_array_equal(getattr(together, field), getattr(alone, field), err_msg=f"{name} {field}")
+        assert np.all(together.evaluations <= 10 * 31)
+
+
+def test_lockstep_counts_every_point_once_and_passes_errors_on():
+    pytest.importorskip("niapy")
+    p = CountingSphere(dim=3)
+    r = fkopt.solve(p, "niapy:DifferentialEvolution", population=8, iterations=12, runs=5, seed=1,
+                    params={"evaluations": 77})
+    assert p.points == r.evaluations.sum() == 5 * 77
+
+    class Broken(Sphere):
+        def fitness(self, x):
+            if np.asarray(x).shape[0] > 1:         # fails on the first batched call
+                raise ValueError("no batch")
+            return super().fitness(x)
+    with pytest.raises(FkoptError, match="niapy:DifferentialEvolution.*ValueError: no batch"):
+        fkopt.solve(Broken(dim=2), "niapy:DifferentialEvolution", population=8, iterations=5, runs=3, seed=1)
+
+
+def test_batched_fitness_of_every_kinbench_problem_is_that_of_each_point_alone():
+    """What lockstep relies on: a point's fitness does not depend on the batch it is in."""
+    from pathlib import Path
+    from fkopt.experiment.runner import make_problem
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.posesets import problem_mechanism, targets_of
+    config = load_suite(Path(__file__).resolve().parents[1] / "configs" / "suites" / "kinbench-v2.yaml")
+    rng = np.random.default_rng(11)
+    for prob in config.problems:
+        mech, cfg = problem_mechanism(prob, config._folder)
+        truth = mech.bounds[:, 0] + rng.random((5, len(mech.bounds))) * np.ptp(mech.bounds, axis=1)
+        problem = make_problem(cfg, mech, targets_of(mech, truth))
+        x = mech.bounds[:, 0] + rng.random((5, len(mech.bounds))) * np.ptp(mech.bounds, axis=1)
+        rows = [4, 0, 2]
+        together = problem.take(rows).fitness(x[rows][:, None, :])[:, 0]
+        alone = [float(problem.case(r).fitness(x[r][None, :])[0]) for r in rows]
+        assert together.tolist() == alone, prob.name

@@ -15,9 +15,16 @@ For every library, fkopt -- not the library -- does the bookkeeping:
 * **Seeds.** Run k of a task gets the integer seed ``SeedSequence(seed, spawn_key=(k,))``
   ``.generate_state(1)[0]`` (scipy gets a ``Generator`` on that SeedSequence), the stream
   of :mod:`fkopt.streams` -- so run k gives the same numbers alone, in a batch or in a worker.
-* **Processes.** Runs are independent; ``workers`` (param; default 1 for libraries that
-  evaluate whole populations at once, the CPU count for per-point libraries such as NiaPy)
-  runs them in that many processes. The numbers do not depend on it.
+* **Processes.** Runs are independent; ``workers`` (param; default 1) runs them in that many
+  processes. The numbers do not depend on it. (A process pool costs ~0.5-1.5 s of start-up and
+  imports per solve, more than it saves on the small solves of a suite, whose tasks run in
+  worker processes already: hence the default of 1 for every library.)
+* **Lockstep.** A per-point library (NiaPy) run in this process calls the fitness once per
+  point; fkopt then runs up to :data:`LOCKSTEP_RUNS` runs in threads in lockstep
+  (:class:`Lockstep`), so that one batched fitness call evaluates the next point of every
+  run. Each run's numbers are those of the run alone (its own library object, stream and
+  counter; the fitness is elementwise), only the cost of a point changes: from a whole
+  single-point numpy evaluation to a share of a batched one.
 * **Target.** With ``stop_at_target`` a run stops after the call (a batch for vectorised
   libraries) whose evaluations first went below the target; the whole batch is counted.
 
@@ -36,7 +43,6 @@ run traces and evaluations-to-threshold read), including the first evaluation.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -57,8 +63,8 @@ class ExternalParams(Params):
     model_config = ConfigDict(extra="allow", frozen=True)
     evaluations: int | None = Field(None, ge=1, description="evaluation budget per run "
                                     "(default population * (iterations + 1))")
-    workers: int | None = Field(None, ge=1, description="processes running the runs "
-                                "(default 1, or the CPU count for per-point libraries)")
+    workers: int | None = Field(None, ge=1, description="processes running the runs (default 1: "
+                                "the runs in this process; per-point libraries' runs in lockstep)")
 
 
 @dataclass
@@ -75,8 +81,12 @@ class Trace:
 class Counter:
     """The fitness the library sees: counts, records improvements, enforces budget and target."""
 
-    def __init__(self, problem, budget: int, target: float | None = None, stop: bool = False):
+    def __init__(self, problem, budget: int, target: float | None = None, stop: bool = False,
+                 fitness=None):
         self.problem = problem
+        #: What evaluates the points (``problem.fitness``, or a :class:`Lockstep` member that
+        #: evaluates them together with other runs' points: the same numbers).
+        self.fitness = fitness if fitness is not None else problem.fitness
         self.budget = int(budget)
         self.stop_below = target if (stop and target is not None) else None
         self.n = 0
@@ -91,7 +101,7 @@ class Counter:
         if self.n >= self.budget or (self.stop_below is not None and self.best < self.stop_below):
             raise _Stop
         take = min(len(X), self.budget - self.n)
-        f = np.asarray(self.problem.fitness(X[:take]), dtype=float).reshape(take)
+        f = np.asarray(self.fitness(X[:take]), dtype=float).reshape(take)
         f = np.where(np.isnan(f), np.inf, f)
         running = np.minimum.accumulate(np.concatenate([[self.best], f]))
         better = running[1:] < running[:-1]
@@ -108,8 +118,26 @@ class Counter:
         return f
 
     def point(self, x) -> float:
-        """Fitness of one point ``x`` shaped (dim,) (per-point libraries)."""
-        return float(self.batch(np.asarray(x, dtype=float)[None, :])[0])
+        """Fitness of one point ``x`` shaped (dim,) (per-point libraries): :meth:`batch` of
+        ``x[None]`` with the bookkeeping done on Python floats (the same counts, trace and
+        stops; a per-point library calls this thousands of times per run)."""
+        x = np.array(x, dtype=float)            # a copy: the trace keeps it, the library may reuse its array
+        stop = self.stop_below
+        if self.n >= self.budget or (stop is not None and self.best < stop):
+            raise _Stop
+        f = float(np.asarray(self.fitness(x[None, :]), dtype=float).reshape(1)[0])
+        if f != f:                              # NaN counts as +inf, as in batch
+            f = np.inf
+        if f < self.best or self.n == 0:        # a run's first evaluation opens its trace
+            self._evals.append(self.n + 1)
+            self._f.append(f)
+            self._x.append(x)
+        if f < self.best:
+            self.best = f
+        self.n += 1
+        if stop is not None and self.best < stop:
+            raise _Stop
+        return f
 
     def trace(self) -> Trace:
         dim = self.problem.dim
@@ -140,9 +168,10 @@ def _runner(library: str):
 
 
 def run_one(library: str, method: str, params: dict, problem, population: int, budget: int,
-            seed_seq: np.random.SeedSequence, target, stop: bool, x0) -> Trace:
-    """One run of ``library:method`` (module level, so a worker process can run it)."""
-    counter = Counter(problem, budget, target, stop)
+            seed_seq: np.random.SeedSequence, target, stop: bool, x0, fitness=None) -> Trace:
+    """One run of ``library:method`` (module level, so a worker process can run it);
+    ``fitness``: what evaluates the points instead of ``problem.fitness`` (:class:`Lockstep`)."""
+    counter = Counter(problem, budget, target, stop, fitness)
     try:
         _runner(library)(method, dict(params), counter, problem, int(population), int(budget), seed_seq, x0)
     except _Stop:
@@ -160,6 +189,119 @@ def run_one(library: str, method: str, params: dict, problem, population: int, b
     return counter.trace()
 
 
+#: Runs of a per-point library that one :class:`Lockstep` group evaluates together (threads
+#: per group; more makes each handoff dearer than the batching saves).
+LOCKSTEP_RUNS = 32
+
+
+class Lockstep:
+    """Several runs of a per-point library, each in its own thread, whose single-point fitness
+    calls are evaluated together: one batched ``problem.fitness`` call for every run's next point.
+
+    Every member thread calls :meth:`member`'s function with its one point and blocks; when
+    every member still running has handed in a point, the last to arrive evaluates them all in
+    one call (on the rows of a problem with a case axis: each run's own target) and releases the
+    others. A run's numbers are the same as alone: its library object, random stream and
+    Counter are its own, it waits for its fitness before going on, and fitness is elementwise
+    (the value of a point does not depend on the other points of the batch; tested for every
+    kinbench problem). Only the order in which the runs' Python code interleaves changes."""
+
+    def __init__(self, problem, members: int, batched: bool):
+        import threading
+        self.problem = problem
+        self.batched = batched                  # member k solves row k of the case axis
+        self.active = int(members)
+        self._lock = threading.Lock()
+        self._gates: dict[int, Any] = {}
+        self._pending: dict[int, np.ndarray] = {}
+        self._out: dict[int, Any] = {}
+        self._sub: tuple[tuple[int, ...], Any] | None = None
+
+    def member(self, k: int):
+        import threading
+        gate = self._gates[k] = threading.Lock()
+        gate.acquire()
+
+        def fitness(X):
+            X = np.asarray(X, dtype=float)
+            if X.shape[0] != 1:                 # not a single point: alone (never for per-point libraries)
+                return (self.problem.case(k) if self.batched else self.problem).fitness(X)
+            with self._lock:
+                self._pending[k] = X[0]
+                woken = self._flush() if len(self._pending) == self.active else None
+            if woken is None:
+                gate.acquire()                  # released by the member that evaluates the batch
+            else:
+                self._release(woken, k)
+            out = self._out.pop(k)
+            if isinstance(out, BaseException):
+                raise out
+            return out
+        return fitness
+
+    def leave(self, k: int) -> None:
+        """Member ``k``'s run is over: the others no longer wait for its points."""
+        with self._lock:
+            self.active -= 1
+            woken = self._flush() if self._pending and len(self._pending) == self.active else None
+        if woken is not None:
+            self._release(woken, None)
+
+    def _release(self, woken, me) -> None:
+        for j in woken:
+            if j != me:
+                self._gates[j].release()
+
+    def _flush(self) -> list[int]:
+        keys = sorted(self._pending)
+        X = np.stack([self._pending[k] for k in keys])
+        self._pending.clear()
+        try:
+            if not self.batched:                # one target for every run
+                f = self.problem.fitness(X)
+            else:
+                rows = tuple(keys)
+                if self._sub is None or self._sub[0] != rows:
+                    self._sub = (rows, self.problem.take(list(rows)))
+                f = self._sub[1].fitness(X[:, None, :])[:, 0]
+            f = np.asarray(f, dtype=float).reshape(len(keys))
+            for i, k in enumerate(keys):
+                self._out[k] = f[i:i + 1]
+        except BaseException as err:            # every waiting run gets the error
+            for k in keys:
+                self._out[k] = err
+        return keys
+
+
+def run_lockstep(args: list[tuple], problem, batched: bool) -> list[Trace]:
+    """:func:`run_one` of every argument tuple, in groups of :data:`LOCKSTEP_RUNS` threads whose
+    fitness calls are batched (:class:`Lockstep`); the traces in order. An error is raised once
+    every thread of its group has finished (the first row's, as one run after the other would)."""
+    import threading
+    traces: list[Trace | None] = [None] * len(args)
+    errors: list[BaseException | None] = [None] * len(args)
+    for start in range(0, len(args), LOCKSTEP_RUNS):
+        group = list(range(start, min(start + LOCKSTEP_RUNS, len(args))))
+        gang = Lockstep(problem, len(group), batched)
+
+        def work(i: int) -> None:
+            try:
+                traces[i] = run_one(*args[i], fitness=gang.member(i))
+            except BaseException as err:         # re-raised in the calling thread below
+                errors[i] = err
+            finally:
+                gang.leave(i)
+        threads = [threading.Thread(target=work, args=(i,), daemon=True) for i in group]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for i in group:
+            if errors[i] is not None:
+                raise errors[i]
+    return traces
+
+
 class ExternalAlgorithm(Algorithm):
     """An optimiser of another library run by fkopt (see the module docstring)."""
 
@@ -167,7 +309,8 @@ class ExternalAlgorithm(Algorithm):
     library: ClassVar[str]
     method: ClassVar[str]
     target: ClassVar[Any]
-    #: Per-point libraries are slow per agent: their runs default to one process per CPU.
+    #: Per-point libraries call the fitness one point at a time: their runs go in lockstep
+    #: (:func:`run_lockstep`), so each call evaluates one point of every run at once.
     per_point: ClassVar[bool] = False   # set for niapy in fkopt.adapters.adapter_class
     evaluations_per_iteration = "population (one record per population's worth of evaluations)"
 
@@ -239,10 +382,11 @@ class ExternalAlgorithm(Algorithm):
                  population, budget, s, target, stop_at_target,
                  None if start is None else (start if start.ndim == 1 else start[i]))
                 for i, s in enumerate(seeds)]
-        workers = self.params.workers or ((os.cpu_count() or 1) if self.per_point else 1)
         from ..files import available_cpus
-        workers = min(workers, len(runs), available_cpus())
-        if workers <= 1:
+        workers = min(self.params.workers or 1, len(runs), available_cpus())
+        if workers <= 1 and self.per_point and len(args) > 1:
+            traces = run_lockstep(args, problem, batched)      # batched fitness calls, same numbers
+        elif workers <= 1:
             traces = [run_one(*a) for a in args]
         else:
             import multiprocessing

@@ -3,7 +3,10 @@
 ``pip install "fkopt[peers]"``.
 
 NiaPy evaluates one point at a time (``Problem._evaluate(x)``), so a run costs a Python call
-per evaluation: runs go to worker processes by default (``workers``). The task gets
+per evaluation. fkopt runs the runs of a solve in lockstep threads
+(:func:`fkopt.adapters.base.run_lockstep`): the points the runs ask for at the same time are
+evaluated in one batched fitness call, and each run gets exactly the value it would get alone
+(``workers: N`` runs them in N processes instead, one point per call). The task gets
 ``max_evals = budget`` (NiaPy returns ``inf`` without evaluating past it; fkopt's wrapper ends
 the run there). ``population_size`` is fkopt's population unless ``params`` give it; ``seed`` is
 fkopt's; every other key must be a parameter of the class's ``set_parameters`` (NiaPy itself
@@ -72,5 +75,5 @@ def run(method, params, counter, problem, population, budget, seed_seq, x0) -> N
     kwargs.setdefault("population_size", population)
     algo = cls(seed=int(seed_seq.generate_state(1)[0]), **kwargs)
     algo.run(Task(problem=Wrapped(), max_evals=budget))
-    if algo.exception is not None:    # NiaPy keeps exceptions raised outside the main process
+    if algo.exception is not None:    # NiaPy keeps exceptions raised outside the main process/thread
         raise algo.exception

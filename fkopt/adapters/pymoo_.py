@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+from functools import lru_cache
 
 import numpy as np
 
@@ -37,7 +38,8 @@ def resolve(method: str):
     return getattr(importlib.import_module(module), cls)
 
 
-def _accepted(cls) -> set[str]:
+@lru_cache(maxsize=None)
+def _accepted(cls) -> frozenset[str]:
     """Keyword names of every ``__init__`` along the MRO (pymoo's base classes swallow unknown
     keywords, so fkopt checks them itself); DE also forwards its ``Variant``'s (F, CR, ...)."""
     names = set()
@@ -49,7 +51,7 @@ def _accepted(cls) -> set[str]:
     if cls.__name__ == "DE":
         from pymoo.algorithms.soo.nonconvex.de import Variant
         names |= _accepted(Variant)
-    return names - {"self"}
+    return frozenset(names - {"self"})     # cached: asked once per run, inspect is ~1 ms
 
 
 def check_params(method: str, target, params: dict) -> None:
