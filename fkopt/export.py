@@ -36,14 +36,12 @@ import numpy as np
 import pandas as pd
 
 from .errors import FkoptError
+from .iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
 MARKER = "fkopt-export.txt"
 #: Marks of folders written by earlier fkopt releases (replaced like MARKER's).
 OLD_MARKERS = ("fkopt-export.json",)
-#: The ioh release whose ``ioh.logger.Analyzer`` output the index layout mirrors.
-IOH_VERSION = "0.4.2"
-ATTRIBUTES = ["evaluations", "raw_y"]
 RUN_COLUMNS = ("case", "algorithm", "run", "final_fitness")
 
 
@@ -201,28 +199,3 @@ def ioh_export(results: Path, out: Path) -> list[Path]:
 
     write_atomically(out, write)
     return sorted(out.glob("*/IOHprofiler_f*.json"))
-
-
-def read_ioh(folder: Path) -> dict:
-    """Read IOHprofiler data (the ``ioh`` Analyzer logger's layout, which :func:`ioh_export` writes):
-    ``{(algorithm, function_name, instance): [(array of (evaluations, y) rows, run info), ...]}``.
-    What :mod:`fkopt.kinbench.outside` imports results of other tools with; fkopt's own tests read
-    the export with iohinspector instead."""
-    out: dict = {}
-    for index_file in sorted(Path(folder).glob("*/IOHprofiler_f*.json")):
-        index = json.loads(index_file.read_text(encoding="utf-8"))
-        for sc in index["scenarios"]:
-            blocks, current = [], None
-            for line in (index_file.parent / sc["path"]).read_text(encoding="utf-8").splitlines():
-                if line.startswith("evaluations"):
-                    current = []
-                    blocks.append(current)
-                elif line.strip():
-                    e, y = line.split()[:2]
-                    current.append((int(e), float(y)))
-            if len(blocks) != len(sc["runs"]):
-                raise ValueError(f"{index_file}: {len(sc['runs'])} runs indexed, {len(blocks)} in the .dat")
-            for run, block in zip(sc["runs"], blocks):
-                key = (index["algorithm"]["name"], index["function_name"], run["instance"])
-                out.setdefault(key, []).append((np.array(block, dtype=float), run))
-    return out
