@@ -36,6 +36,7 @@ from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
 from .outside import read_outside
 from .posesets import load_pose_sets, problem_mechanism, targets_of
+from .traces import suite_trace, task_trace
 
 
 def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
@@ -58,6 +59,7 @@ class SuiteResult:
     manifest: dict
     wall_s: float
     source: str | None = None
+    trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
 
 
 def _cases(config: SuiteConfig, sets: dict, problem):
@@ -126,6 +128,7 @@ def solve_task(payload: dict) -> dict:
     wall = time.perf_counter() - start
     return {"problem": payload["problem"], "solver": payload["solver"], "dim": dim,
             "rows": run_rows(config, problem, solver, cases, result, dim),
+            "trace": task_trace(result, budget_of(config, dim)),
             "wall_s": wall, "solves": len(cases) * config.runs}
 
 
@@ -170,7 +173,7 @@ def _finished_tasks(work: Path, fp: str) -> dict[tuple[int, int], dict]:
                              "sets changed); rerun without --resume to start over")
         try:
             key = (int(rec["problem"]), int(rec["solver"]))
-            if path.name != _task_file(work, *key).name or not isinstance(rec["rows"], dict):
+            if path.name != _task_file(work, *key).name or not isinstance(rec["rows"], dict) or not isinstance(rec["trace"], dict):
                 raise ValueError("its problem/solver are not its file name's, or rows is not a table")
             rec["rows"] = pd.DataFrame(rec["rows"])
         except (KeyError, TypeError, ValueError) as err:
@@ -226,4 +229,4 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
                          "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
                         for r in done])
-    return SuiteResult(config, runs, tim, manifest, time.perf_counter() - start, source)
+    return SuiteResult(config, runs, tim, manifest, time.perf_counter() - start, source, suite_trace(config, done, runs))
