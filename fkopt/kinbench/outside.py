@@ -27,7 +27,8 @@ algorithm of the folder (needed when it holds several).
 
 Rows may log every evaluation or only improvements; a run's measures are read exactly as for
 fkopt's solvers (:func:`fkopt.kinbench.budget.at_budget`): cut at the suite's budget, the first
-evaluation count below each target. Every (problem, set, pose) instance the suite selects must
+evaluation count below each target; their improvements within the budget join the suite's
+``trace.csv.gz`` (:func:`fkopt.kinbench.traces.outside_trace`). Every (problem, set, pose) instance the suite selects must
 have at least one run, so all solvers are ranked on the same instances. The SHA-256 of the file
 (of every file of the folder) is recorded in meta.json.
 """
