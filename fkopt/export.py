@@ -1,15 +1,22 @@
 """Export stored results for other tools: ``fkopt export RESULTS --format ioh --out DIR``.
 
 ``ioh``: the files that the ``ioh`` package's ``ioh.logger.Analyzer`` writes (IOHexperimenter;
-what IOHanalyzer and iohinspector load), built from each experiment folder's ``meta.json``,
-``runs.csv`` and ``trace.csv.gz`` (:mod:`fkopt.experiment.traces`) -- no rerun. Mapping:
+what IOHanalyzer and iohinspector load), built from each experiment or suite folder's
+``meta.json``, ``runs.csv`` and ``trace.csv.gz`` (:mod:`fkopt.experiment.traces`,
+:mod:`fkopt.kinbench.traces`) -- no rerun. Every folder becomes IOH *functions*
+(:class:`Function`), which one writer (:func:`_write_function`) writes; mapping:
 
-* one **algorithm** folder per algorithm label: ``DIR/<label>/``;
-* one **function** per experiment: ``function_id`` numbers the exported experiments (sorted by
-  paper/name, from 1), ``function_name`` is ``<paper>_<name>``;
-* one **instance** per case (case index + 1; the labels are the experiment attribute
-  ``instances``), the **dimension** is the number of unknowns, each **run** one IOH run (per
-  instance in the order of fkopt's run ids);
+* one **algorithm** folder per algorithm label (an experiment's) or solver label (a suite's,
+  outside solvers included): ``DIR/<label>/``;
+* **functions**: an experiment is one, named ``<paper>_<name>``, with one **instance** per case
+  (case index + 1); a suite is one per problem, named by the problem, with one instance per
+  (set, pose) in the suite's set order, then pose order (from 1). The instance labels are the
+  experiment attribute ``instances`` (``1=<case>``; ``1=<set>/<pose>``). ``function_id``
+  numbers the functions from 1 over the exported folders (sorted by path) and, within a
+  suite, its problems in the suite's order -- so a suite exported alone has function_id =
+  problem order;
+* the **dimension** is the number of unknowns, each **run** one IOH run (per instance in the
+  order of the run ids);
 * ``DIR/<label>/IOHprofiler_f<id>_<name>.json`` is the index, with the keys and layout of the
   Analyzer's (``version``, ``suite``, ``function_id``, ``function_name``, ``maximization``,
   ``algorithm``, ``experiment_attributes``, ``attributes``, ``scenarios`` with per run
@@ -17,7 +24,9 @@ what IOHanalyzer and iohinspector load), built from each experiment folder's ``m
   the data: a header line ``evaluations raw_y`` opens each run, then one line per improvement of
   the best-so-far fitness at its exact evaluation number -- the first line is evaluation 1, as
   IOH readers split runs there -- and a last line at the run's final evaluation count (its
-  best-so-far fitness) when the last improvement came earlier.
+  best-so-far fitness) when the last improvement came earlier. A suite's run that had no
+  fitness value yet writes ``inf`` in the ``.dat`` and a ``null`` best ``y`` in the index
+  (strict JSON has no infinity).
 
 ``version`` is the ``ioh`` release whose Analyzer output this layout was compared with
 (:data:`IOH_VERSION`); fkopt's version is in ``algorithm.info`` and in the manifest
@@ -30,25 +39,25 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .errors import FkoptError
+from .iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
 MARKER = "fkopt-export.txt"
 #: Marks of folders written by earlier fkopt releases (replaced like MARKER's).
 OLD_MARKERS = ("fkopt-export.json",)
-#: The ioh release whose ``ioh.logger.Analyzer`` output the index layout mirrors.
-IOH_VERSION = "0.4.2"
-ATTRIBUTES = ["evaluations", "raw_y"]
 RUN_COLUMNS = ("case", "algorithm", "run", "final_fitness")
 
 
 def experiment_folders(results: Path) -> list[Path]:
-    """Experiment folders under ``results``: the folder itself, or ``*/meta.json``, ``*/*/meta.json``."""
+    """Result folders (experiments, suites, ...) under ``results``: the folder itself, or
+    ``*/meta.json``, ``*/*/meta.json``."""
     results = Path(results)
     if not results.is_dir():
         raise FkoptError(f"{results}: not a results folder (no such directory)")
@@ -56,7 +65,7 @@ def experiment_folders(results: Path) -> list[Path]:
         return [results]
     found = sorted({p.parent for pat in ("*/meta.json", "*/*/meta.json") for p in results.glob(pat)})
     if not found:
-        raise FkoptError(f"{results}: no experiment results (no meta.json in it or its subfolders)")
+        raise FkoptError(f"{results}: no experiment or suite results (no meta.json in it or its subfolders)")
     return found
 
 
@@ -76,153 +85,224 @@ def _safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "-", str(text)).strip("-") or "x"
 
 
-def _load(folder: Path):
-    """(meta, trace, runs) of an experiment folder, every field the export uses checked; None
-    for studies and assembly searches (no per-run traces)."""
+@dataclass
+class Function:
+    """One IOH function of an exported folder: an experiment, or one problem of a suite."""
+
+    name: str                        # function_name (made file-safe when written)
+    dim: int
+    instances: list[str]             # the label of instance i + 1
+    attributes: list[dict]           # experiment attributes after ``instances``
+    #: algorithm label -> (``algorithm.info`` content, runs: (instance, evaluations, best-so-far, x))
+    algorithms: dict[str, tuple[dict, list]] = field(default_factory=dict)
+
+
+def _meta(folder: Path) -> dict:
     path = folder / "meta.json"
     try:
         meta = json.loads(path.read_text())
     except (OSError, ValueError) as err:
         raise FkoptError(f"{path}: cannot read ({err})") from None
-    config = meta.get("config") if isinstance(meta, dict) else None
-    if not isinstance(config, dict):
+    if not isinstance(meta, dict) or not isinstance(meta.get("config"), dict):
         raise FkoptError(f"{path}: no 'config' object (not a meta.json that fkopt wrote)")
-    if config.get("kind") in ("study", "assembly"):
-        return None
+    return meta
+
+
+def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
+    path = folder / "runs.csv"
+    try:
+        runs = pd.read_csv(path, dtype=dict.fromkeys(labels, str))
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        raise FkoptError(f"{path}: cannot read ({str(err).strip().splitlines()[0] if str(err).strip() else err})") from None
+    missing = [c for c in columns if c not in runs.columns]
+    if missing:
+        raise FkoptError(f"{path}: missing column(s) {', '.join(missing)}")
+    for col in ("run", "pose", "dim"):
+        if col in columns:
+            num = pd.to_numeric(runs[col], errors="coerce")
+            if num.isna().any() or (num != np.floor(num)).any():
+                raise FkoptError(f"{path}: column {col}: {col} ids must be integers")
+            runs[col] = num.astype(np.int64)
+    return runs
+
+
+def _checked_groups(folder: Path, trace: pd.DataFrame, runs: pd.DataFrame, keys: list[str], what) -> dict:
+    """The trace rows of every run of ``runs`` (keyed by ``keys``), checked: every run has rows,
+    starting at evaluation 1, with increasing evaluations. ``what(key)`` names a run in errors."""
+    from .experiment.traces import FILE
+    for k in keys:                                       # labels compare as text, ids as integers
+        if trace[k].dtype.name == "category":
+            trace[k] = trace[k].astype(str)
+    grouped = trace.groupby(keys, sort=False, observed=True)["evaluations"]
+    first = grouped.first()
+    have = runs.set_index(keys).index
+    absent = ~have.isin(first.index)
+    if absent.any():
+        raise FkoptError(f"{folder / FILE}: no rows for {what(have[absent][0])} "
+                         f"({int(absent.sum())} of the {len(runs)} runs of runs.csv have none)")
+    late = first[first != 1]
+    if len(late):
+        raise FkoptError(f"{folder / FILE}: {what(late.index[0])} starts at evaluation {int(late.iloc[0])}, "
+                         "not 1 (a trace written before fkopt counted evaluations exactly); rerun it")
+    rising = grouped.diff().fillna(1) > 0
+    if not rising.all():
+        i = int(np.flatnonzero(~rising.to_numpy())[0])
+        raise FkoptError(f"{folder / FILE}: row {i + 1} ({what(tuple(trace[k].iloc[i] for k in keys))}): "
+                         "evaluations do not increase within the run")
+    return dict(list(trace.groupby(keys, sort=False, observed=True)))
+
+
+def _experiment(folder: Path, meta: dict) -> list[Function]:
+    """An experiment folder as one function (every field the export uses checked)."""
+    from .experiment.traces import FILE, read_trace
+    path, config = folder / "meta.json", meta["config"]
     bounds = (meta.get("mechanism") or {}).get("bounds") if isinstance(meta.get("mechanism"), dict) else None
     if not isinstance(bounds, dict) or not bounds:
         raise FkoptError(f"{path}: no 'mechanism' with 'bounds' (the unknowns, the IOH dimension); "
                          "not a meta.json that fkopt wrote")
     if not isinstance(config.get("name"), str) or not isinstance(config.get("algorithms"), list):
         raise FkoptError(f"{path}: 'config' lacks 'name' or the 'algorithms' list")
-    from .experiment.traces import FILE, read_trace
     if not (folder / FILE).is_file():
         raise FkoptError(f"{folder}: no {FILE} (results written before fkopt kept run traces); "
                          "rerun the experiment to export it")
     trace = read_trace(folder)
-    path = folder / "runs.csv"
-    try:
-        runs = pd.read_csv(path, dtype={"case": str, "algorithm": str})
-    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
-        raise FkoptError(f"{path}: cannot read ({str(err).strip().splitlines()[0] if str(err).strip() else err})") from None
-    missing = [c for c in RUN_COLUMNS if c not in runs.columns]
-    if missing:
-        raise FkoptError(f"{path}: missing column(s) {', '.join(missing)}")
-    runs["run"] = pd.to_numeric(runs["run"], errors="coerce")
-    if runs["run"].isna().any():
-        raise FkoptError(f"{path}: column run: run ids must be integers")
-    runs["run"] = runs["run"].astype(np.int64)
+    runs = _runs_csv(folder, RUN_COLUMNS, ("case", "algorithm"))
     keys = ["case", "algorithm", "run"]
-    grouped = trace.groupby(keys, sort=False, observed=True)["evaluations"]
-    first = grouped.first()
-    have = runs.set_index(keys).index
-    absent = ~have.isin(first.index)
-    if absent.any():
-        c, a, r = have[absent][0]
-        raise FkoptError(f"{folder / FILE}: no rows for run {r} of algorithm '{a}', case '{c}' "
-                         f"({int(absent.sum())} of the {len(runs)} runs of runs.csv have none)")
-    late = first[first != 1]
-    if len(late):
-        (c, a, r), e = late.index[0], int(late.iloc[0])
-        raise FkoptError(f"{folder / FILE}: run {r} of algorithm '{a}', case '{c}' starts at evaluation {e}, "
-                         "not 1 (a trace written before fkopt counted evaluations exactly); rerun the experiment")
-    rising = grouped.diff().fillna(1) > 0
-    if not rising.all():
-        i = int(np.flatnonzero(~rising.to_numpy())[0])
-        c, a, r = (trace[k].iloc[i] for k in keys)
-        raise FkoptError(f"{folder / FILE}: row {i + 1} (run {r} of algorithm '{a}', case '{c}'): evaluations "
-                         "do not increase within the run")
-    return meta, trace, runs
-
-
-def _index(fid: int, fname: str, label: str, spec: dict, cases: list, names: list, folder: Path,
-           data_rel: str, dim: int, runs: list) -> dict:
+    groups = _checked_groups(folder, trace, runs, keys, lambda k: f"run {k[2]} of algorithm '{k[1]}', case '{k[0]}'")
+    names = list(bounds)
+    cases = list(dict.fromkeys(runs["case"]))
+    fn = Function(f"{config.get('paper') or 'experiments'}_{config['name']}", len(names), cases,
+                  [{"variables": " ".join(names)}, {"source": str(folder)}])
     from . import __version__
+    for label in dict.fromkeys(runs["algorithm"]):
+        spec = next((a for a in config["algorithms"]
+                     if isinstance(a, dict) and (a.get("label") or a.get("name")) == label), {})
+        info = {"name": spec.get("name", label), "params": spec.get("params", {}), "fkopt": __version__}
+        runs_a = runs[runs["algorithm"] == label]
+        out = []
+        for inst, case in enumerate(cases, start=1):
+            for _, row in runs_a[runs_a["case"] == case].sort_values("run").iterrows():
+                rows = groups[(case, label, row["run"])]
+                out.append((inst, rows["evaluations"].to_numpy(), rows["best_fitness"].to_numpy(),
+                            [float(row[f"x_{n}"]) for n in names if f"x_{n}" in row]))
+        fn.algorithms[label] = (info, out)
+    return [fn]
+
+
+def _suite(folder: Path, meta: dict) -> list[Function]:
+    """A suite folder (:mod:`fkopt.kinbench`) as one function per problem, in the suite's order:
+    one instance per (set, pose) in set-then-pose order, one algorithm per solver."""
+    from .experiment.traces import FILE, read_trace
+    from .kinbench.traces import COLUMNS, KEYS
+    path, config = folder / "meta.json", meta["config"]
+    problems, sets = config.get("problems"), config.get("sets")
+    if not (isinstance(problems, list) and all(isinstance(p, dict) and isinstance(p.get("name"), str) for p in problems)
+            and isinstance(sets, list) and isinstance(config.get("name"), str)):
+        raise FkoptError(f"{path}: 'config' lacks the suite's 'name', 'problems' or 'sets'")
+    if not (folder / FILE).is_file():
+        raise FkoptError(f"{folder}: no {FILE} (suite results written before fkopt kept run traces); "
+                         "rerun the suite to export it")
+    trace = read_trace(folder, columns=COLUMNS)
+    runs = _runs_csv(folder, KEYS + ["dim", "track"], ("problem", "set", "solver", "track"))
+    groups = _checked_groups(folder, trace, runs, KEYS, lambda k: f"run {k[4]} of solver '{k[3]}', problem "
+                             f"'{k[0]}', set '{k[1]}', pose {k[2]}")
+    from . import __version__
+    specs = {(s.get("label") or s.get("name")): s for s in config.get("solvers") or [] if isinstance(s, dict)}
+    outside = {o.get("solver"): o for o in config.get("outside") or [] if isinstance(o, dict)}
+    set_order = {s: j for j, s in enumerate(sets)}
+    out = []
+    for problem in problems:
+        rp = runs[runs["problem"] == problem["name"]]
+        if rp.empty:
+            continue
+        inst = sorted(set(zip(rp["set"], rp["pose"])), key=lambda sp: (set_order.get(sp[0], len(sets)), sp[0], sp[1]))
+        number = {sp: i for i, sp in enumerate(inst, start=1)}
+        fn = Function(problem["name"], int(rp["dim"].iloc[0]), [f"{s}/{p}" for s, p in inst],
+                      [{"benchmark": f"{config.get('paper') or 'kinbench'}/{config['name']}"},
+                       {"problem_class": str(problem.get("problem_class", ""))}, {"source": str(folder)}])
+        for label in dict.fromkeys(rp["solver"]):
+            rs = rp[rp["solver"] == label]
+            spec = specs.get(label)
+            info = ({"name": spec.get("name", label), "params": spec.get("params", {})} if spec is not None else
+                    {"name": label, "outside": outside.get(label, {}).get("file") or outside.get(label, {}).get("ioh")})
+            info.update(track=str(rs["track"].iloc[0]), fkopt=__version__)
+            order = sorted(zip(rs["set"], rs["pose"], rs["run"]), key=lambda k: (number[k[:2]], k[2]))
+            runs_l = []
+            for s, p, r in order:
+                rows = groups[(problem["name"], s, p, label, r)]
+                runs_l.append((number[(s, p)], rows["evaluations"].to_numpy(), rows["best_fitness"].to_numpy(), []))
+            fn.algorithms[label] = (info, runs_l)
+        out.append(fn)
+    return out
+
+
+def _load(folder: Path) -> list[Function] | None:
+    """The IOH functions of a results folder: an experiment's one, a suite's one per problem;
+    None for studies and assembly searches (no per-run traces)."""
+    meta = _meta(folder)
+    if meta["config"].get("kind") in ("study", "assembly"):
+        return None
+    if meta.get("kind") == "suite" or meta["config"].get("kind") == "suite":
+        return _suite(folder, meta)
+    return _experiment(folder, meta)
+
+
+def _finite(y: float):
+    """A best value for the JSON index: a number, or null when none was found (strict JSON has
+    no infinity)."""
+    return y if np.isfinite(y) else None
+
+
+def _index(fid: int, fname: str, label: str, info: dict, fn: Function, data_rel: str, runs: list) -> dict:
     return {
         "version": IOH_VERSION, "suite": "fkopt", "function_id": fid, "function_name": fname,
         "maximization": False,
-        "algorithm": {"name": label, "info": json.dumps({"name": spec.get("name", label),
-                                                         "params": spec.get("params", {}),
-                                                         "fkopt": __version__})},
-        "experiment_attributes": [{"instances": "; ".join(f"{i}={c}" for i, c in enumerate(cases, start=1))},
-                                  {"variables": " ".join(names)},
-                                  {"source": str(folder)}],
+        "algorithm": {"name": label, "info": json.dumps(info)},
+        "experiment_attributes": [{"instances": "; ".join(f"{i}={c}" for i, c in enumerate(fn.instances, start=1))},
+                                  *fn.attributes],
         "attributes": ATTRIBUTES,
-        "scenarios": [{"dimension": dim, "path": data_rel, "runs": runs}],
+        "scenarios": [{"dimension": fn.dim, "path": data_rel, "runs": runs}],
     }
 
 
+def _write_function(tmp: Path, fid: int, fn: Function) -> None:
+    """One function's ``.dat`` and index per algorithm, into the export folder ``tmp``."""
+    fname = _safe(fn.name)
+    for label, (info, runs) in fn.algorithms.items():
+        algo_dir = tmp / _safe(label)
+        data_rel = f"data_f{fid}_{fname}/IOHprofiler_f{fid}_DIM{fn.dim}.dat"
+        (algo_dir / data_rel).parent.mkdir(parents=True, exist_ok=True)
+        lines, index_runs = [], []
+        for inst, e, y, x in runs:
+            lines.append(" ".join(ATTRIBUTES))
+            lines += [f"{int(a)} {b:.10g}" for a, b in zip(e, y)]
+            final = float(y[-1])
+            index_runs.append({"instance": inst, "evals": int(e[-1]),
+                               "best": {"evals": int(e[np.argmax(y <= final)]), "y": _finite(final), "x": x}})
+        (algo_dir / data_rel).write_text("\n".join(lines) + "\n")
+        index = _index(fid, fname, label, info, fn, data_rel, index_runs)
+        (algo_dir / f"IOHprofiler_f{fid}_{fname}.json").write_text(json.dumps(index, indent=1, allow_nan=False) + "\n")
+
+
 def ioh_export(results: Path, out: Path) -> list[Path]:
-    """Write the IOHprofiler files of every experiment under ``results`` into ``out``; returns
-    the index files written."""
+    """Write the IOHprofiler files of every experiment and suite under ``results`` into ``out``;
+    returns the index files written."""
     from . import __version__
     from .files import write_atomically
     folders = experiment_folders(results)
     out = check_out(out, results)
-    loaded = [(f, data) for f in folders if (data := _load(f)) is not None]
+    loaded = [(f, fns) for f in folders if (fns := _load(f)) is not None]
     if not loaded:
         raise FkoptError(f"{results}: only studies/assembly results, which have no per-run traces to export")
     from .files import output_folder   # the shared checks (a folder, writable), once the inputs are good
     output_folder(out)
 
     def write(tmp: Path) -> None:
-        for fid, (folder, (meta, trace, runs)) in enumerate(loaded, start=1):
-            config = meta["config"]
-            fname = _safe(f"{config.get('paper') or 'experiments'}_{config['name']}")
-            names = list(meta["mechanism"]["bounds"])
-            dim = len(names)
-            cases = list(dict.fromkeys(runs["case"]))
-            groups = dict(list(trace.groupby(["case", "algorithm", "run"], sort=False, observed=True)))
-            for label in dict.fromkeys(runs["algorithm"]):
-                algo_dir = tmp / _safe(label)
-                data_rel = f"data_f{fid}_{fname}/IOHprofiler_f{fid}_DIM{dim}.dat"
-                (algo_dir / data_rel).parent.mkdir(parents=True, exist_ok=True)
-                lines, index_runs = [], []
-                runs_a = runs[runs["algorithm"] == label]
-                spec = next((a for a in config["algorithms"]
-                             if isinstance(a, dict) and (a.get("label") or a.get("name")) == label), {})
-                for inst, case in enumerate(cases, start=1):
-                    for _, row in runs_a[runs_a["case"] == case].sort_values("run").iterrows():
-                        rows = groups[(case, label, row["run"])]
-                        e = rows["evaluations"].to_numpy()
-                        y = rows["best_fitness"].to_numpy()
-                        lines.append(" ".join(ATTRIBUTES))
-                        lines += [f"{int(a)} {b:.10g}" for a, b in zip(e, y)]
-                        final = float(y[-1])
-                        x = [float(row[f"x_{n}"]) for n in names if f"x_{n}" in row]
-                        index_runs.append({"instance": inst, "evals": int(e[-1]),
-                                           "best": {"evals": int(e[np.argmax(y <= final)]), "y": final, "x": x}})
-                (algo_dir / data_rel).write_text("\n".join(lines) + "\n")
-                index = _index(fid, fname, label, spec, cases, names, folder, data_rel, dim, index_runs)
-                (algo_dir / f"IOHprofiler_f{fid}_{fname}.json").write_text(json.dumps(index, indent=1) + "\n")
+        for fid, fn in enumerate((fn for _, fns in loaded for fn in fns), start=1):
+            _write_function(tmp, fid, fn)
         (tmp / MARKER).write_text("fkopt export (IOHprofiler format; this file is the export's mark, "
                                   "not data)\n" + f"format: ioh\nfkopt: {__version__}\nioh layout: {IOH_VERSION}\n"
-                                  + "experiments:\n" + "".join(f"  {f}\n" for f, _ in loaded))
+                                  + "results:\n" + "".join(f"  {f}\n" for f, _ in loaded))
 
     write_atomically(out, write)
     return sorted(out.glob("*/IOHprofiler_f*.json"))
-
-
-def read_ioh(folder: Path) -> dict:
-    """Read IOHprofiler data (the ``ioh`` Analyzer logger's layout, which :func:`ioh_export` writes):
-    ``{(algorithm, function_name, instance): [(array of (evaluations, y) rows, run info), ...]}``.
-    What :mod:`fkopt.kinbench.outside` imports results of other tools with; fkopt's own tests read
-    the export with iohinspector instead."""
-    out: dict = {}
-    for index_file in sorted(Path(folder).glob("*/IOHprofiler_f*.json")):
-        index = json.loads(index_file.read_text(encoding="utf-8"))
-        for sc in index["scenarios"]:
-            blocks, current = [], None
-            for line in (index_file.parent / sc["path"]).read_text(encoding="utf-8").splitlines():
-                if line.startswith("evaluations"):
-                    current = []
-                    blocks.append(current)
-                elif line.strip():
-                    e, y = line.split()[:2]
-                    current.append((int(e), float(y)))
-            if len(blocks) != len(sc["runs"]):
-                raise ValueError(f"{index_file}: {len(sc['runs'])} runs indexed, {len(blocks)} in the .dat")
-            for run, block in zip(sc["runs"], blocks):
-                key = (index["algorithm"]["name"], index["function_name"], run["instance"])
-                out.setdefault(key, []).append((np.array(block, dtype=float), run))
-    return out

@@ -114,6 +114,7 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
         Output("measures.csv", f"{_SUITE}:measures_table", TABLE),
         Output("ecdf.csv", f"{_SUITE}:ecdf_table", CURVES, rows=STEPS),
         Output("runs.csv", f"{_SUITE}:runs_table", CURVES, rows=RUNS),
+        Output("trace.csv.gz", "fkopt.kinbench.traces:trace_table", CURVES, rows=STEPS),
         Output("timing.csv", f"{_SUITE}:timing_table", TIMING),
         Output("ecdf", f"{_SUITE}:ecdf_figures", FIGURE),
         Output("leaderboard.md", f"{_SUITE}:leaderboard_markdown", FIGURE),   # never compared

@@ -301,7 +301,7 @@ def test_worker_processes_and_a_dask_scheduler_write_the_same_bytes(tmp_path):
             folders.append(run_config(load_any(path), tmp_path / "dask", source=str(path), executor="dask",
                                       scheduler=cluster.scheduler_address).folder)
     for other in folders:
-        for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+        for name in ("runs.csv", "trace.csv.gz", "measures.csv", "ecdf.csv", "leaderboard.csv"):
             assert (a / name).read_bytes() == (other / name).read_bytes(), (other, name)
     if LocalCluster is None:
         pytest.skip("dask.distributed not installed: only the worker processes were compared")

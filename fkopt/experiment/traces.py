@@ -108,34 +108,40 @@ def _unpacked_size(path: Path, limit: int) -> int:
     return size
 
 
-def read_trace(folder: Path, limit: int = MAX_BYTES) -> pd.DataFrame:
+#: Integer columns of a trace (of an experiment's, or a suite's: :mod:`fkopt.kinbench.traces`);
+#: ``best_fitness`` is a number, every other column a non-empty label.
+INTEGER_COLUMNS = ("pose", "run", "iteration", "evaluations")
+
+
+def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = COLUMNS) -> pd.DataFrame:
     """``folder/trace.csv.gz``, checked: a readable gzip of at most ``limit`` bytes unpacked
-    (measured before parsing, so memory stays bounded), the columns of :data:`COLUMNS`,
-    integer counts (evaluations >= 1) and numeric fitness values. Anything else is an
-    FkoptError naming the file and what is wrong."""
+    (measured before parsing, so memory stays bounded), the ``columns`` (an experiment's
+    :data:`COLUMNS` by default; a suite's trace has others), integer counts (evaluations >= 1)
+    and numeric fitness values. Anything else is an FkoptError naming the file and what is wrong."""
     import gzip
     import zlib
     from ..errors import FkoptError
     path = Path(folder) / FILE
+    labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
     try:
         if _unpacked_size(path, limit) > limit:
             raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest "
                              "trace fkopt writes is far smaller; memory stays bounded)")
-        table = pd.read_csv(path, compression="gzip", dtype={"case": "category", "algorithm": "category"})
+        table = pd.read_csv(path, compression="gzip", dtype=dict.fromkeys(labels, "category"))
     except (EOFError, gzip.BadGzipFile, zlib.error) as err:
         what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a valid gzip file ({err})"
         raise FkoptError(f"{path}: {what}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as err:
         text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise FkoptError(f"{path}: not a CSV table ({text})") from None
-    missing = [c for c in COLUMNS if c not in table.columns]
+    missing = [c for c in columns if c not in table.columns]
     if missing:
-        raise FkoptError(f"{path}: missing column(s) {', '.join(missing)}; a trace has {', '.join(COLUMNS)}")
-    for col in ("case", "algorithm"):
+        raise FkoptError(f"{path}: missing column(s) {', '.join(missing)}; a trace has {', '.join(columns)}")
+    for col in labels:
         if table[col].isna().any():
             i = int(np.flatnonzero(table[col].isna().to_numpy())[0])
             raise FkoptError(f"{path}: row {i + 1} column {col}: empty")
-    for col in ("run", "iteration", "evaluations"):
+    for col in (c for c in INTEGER_COLUMNS if c in columns):
         num = pd.to_numeric(table[col], errors="coerce")
         low = 1 if col == "evaluations" else 0
         bad = (num.isna() | (num != np.floor(num)) | (num < low)).to_numpy()

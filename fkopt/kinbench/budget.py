@@ -14,12 +14,19 @@ def budget_of(config, dim: int) -> int:
     return int(config.budget_per_dim) * int(dim)
 
 
+def last_within(evals: np.ndarray, budget: int) -> np.ndarray:
+    """Per run, the index of the last record (iteration) whose cumulative evaluations are within
+    ``budget`` (-1: none is), from ``evals`` (..., T + 1): where every measure of a run is read."""
+    within = np.asarray(evals) <= budget
+    return np.where(within.any(axis=-1), within.shape[-1] - 1 - np.argmax(within[..., ::-1], axis=-1), -1)
+
+
 def at_budget(history: np.ndarray, evals: np.ndarray, budget: int, targets) -> dict:
     """Measures of runs from their best-so-far fitness and cumulative evaluations per iteration
     (``(..., T + 1)`` each), cut at ``budget`` evaluations: evaluations used, final fitness and,
     per target, the evaluations when the target was first reached (NaN: not within the budget)."""
     within = evals <= budget
-    last = np.where(within.any(axis=-1), within.shape[-1] - 1 - np.argmax(within[..., ::-1], axis=-1), -1)
+    last = last_within(evals, budget)
     ok = last >= 0
     li = np.maximum(last, 0)[..., None]
     used = np.where(ok, np.take_along_axis(evals, li, axis=-1)[..., 0], 0).astype(float)

@@ -19,7 +19,7 @@ best_so_far     the best fitness found so far, on the problem's fitness (see doc
 ==============  ==========================================================================
 
 **IOH** (what IOHexperimenter's ``Analyzer`` logger writes, read by
-:func:`fkopt.export.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
+:func:`fkopt.iohformat.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
 with its ``IOHprofiler_f*.json`` index and ``.dat`` files); the function name is ``<problem>__<set>`` (two underscores),
 the instance is the pose index + 1, each logged run one run; the ``.dat`` lines are
 ``evaluations raw_y`` with raw_y the problem's fitness (minimised). ``algorithm`` picks one
@@ -27,7 +27,8 @@ algorithm of the folder (needed when it holds several).
 
 Rows may log every evaluation or only improvements; a run's measures are read exactly as for
 fkopt's solvers (:func:`fkopt.kinbench.budget.at_budget`): cut at the suite's budget, the first
-evaluation count below each target. Every (problem, set, pose) instance the suite selects must
+evaluation count below each target; their improvements within the budget join the suite's
+``trace.csv.gz`` (:func:`fkopt.kinbench.traces.outside_trace`). Every (problem, set, pose) instance the suite selects must
 have at least one run, so all solvers are ranked on the same instances. The SHA-256 of the file
 (of every file of the folder) is recorded in meta.json.
 """
@@ -74,7 +75,7 @@ def _csv_log(path: Path, where: str) -> pd.DataFrame:
 
 
 def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
-    from ..export import read_ioh
+    from ..iohformat import read_ioh
     if not path.is_dir():
         raise FkoptError(f"{where}: not a folder")
     try:
@@ -102,8 +103,10 @@ def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
 
-def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]]) -> pd.DataFrame:
-    """The run rows (as :func:`fkopt.kinbench.runner.run_rows` makes them) of ``config.outside[k]``."""
+def logged_runs(config, k: int, instances: set[tuple[str, str, int]]):
+    """``config.outside[k]``'s file, checked, as one (problem, set, pose, run, evaluations,
+    best-so-far) tuple per run of a selected instance (sorted keys; evaluations sorted, the
+    best-so-far accumulated)."""
     entry = config.outside[k]
     path = outside_path(config, entry)
     where = f"outside[{k}].{'file' if entry.file else 'ioh'}: {path}"
@@ -124,18 +127,29 @@ def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str,
         p, s, i = lacking[0]
         raise FkoptError(f"{where}: no run of problem {p}, set {s}, pose {i} (every instance of the suite needs one)")
     df = df[[key in instances for key in zip(df["problem"], df["set"], df["pose"].astype(int))]]
-    frames = []
-    classes = {p.name: p.problem_class for p in config.problems}
     for (problem, name, pose, run), g in df.groupby(["problem", "set", "pose", "run"], sort=True):
         g = g.sort_values("evaluations", kind="stable")
         ev = g["evaluations"].to_numpy(dtype=float)
-        hist = np.minimum.accumulate(g["best_so_far"].to_numpy(dtype=float))
-        dim = dims[problem]
-        m = at_budget(hist[None], ev[None], budget_of(config, dim), config.targets)
-        frames.append({"problem": problem, "class": classes[problem], "set": name, "pose": int(pose),
-                       "solver": entry.solver, "track": entry.track, "run": int(run), "dim": dim,
-                       "budget": budget_of(config, dim), **{key: float(v[0]) for key, v in m.items()}})
-    out = pd.DataFrame(frames)
+        yield problem, name, int(pose), int(run), ev, np.minimum.accumulate(g["best_so_far"].to_numpy(dtype=float))
+
+
+def in_suite_order(config, out: pd.DataFrame) -> pd.DataFrame:
+    """``out`` sorted by problem and set in the suite's order, then pose and run (and evaluations)."""
     order = {(p.name, s): (i, j) for i, p in enumerate(config.problems) for j, s in enumerate(config.sets)}
     out["_o"] = [order[(p, s)] for p, s in zip(out["problem"], out["set"])]
-    return out.sort_values(["_o", "pose", "run"], kind="stable").drop(columns="_o").reset_index(drop=True)
+    keys = ["_o", "pose", "run"] + (["evaluations"] if "best_fitness" in out.columns else [])
+    return out.sort_values(keys, kind="stable").drop(columns="_o").reset_index(drop=True)
+
+
+def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]]) -> pd.DataFrame:
+    """The run rows (as :func:`fkopt.kinbench.runner.run_rows` makes them) of ``config.outside[k]``."""
+    entry = config.outside[k]
+    frames = []
+    classes = {p.name: p.problem_class for p in config.problems}
+    for problem, name, pose, run, ev, hist in logged_runs(config, k, instances):
+        dim = dims[problem]
+        m = at_budget(hist[None], ev[None], budget_of(config, dim), config.targets)
+        frames.append({"problem": problem, "class": classes[problem], "set": name, "pose": pose,
+                       "solver": entry.solver, "track": entry.track, "run": run, "dim": dim,
+                       "budget": budget_of(config, dim), **{key: float(v[0]) for key, v in m.items()}})
+    return in_suite_order(config, pd.DataFrame(frames))

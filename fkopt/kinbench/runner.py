@@ -36,6 +36,7 @@ from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
 from .outside import read_outside
 from .posesets import load_pose_sets, problem_mechanism, targets_of
+from .traces import suite_trace, task_trace
 
 
 def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
@@ -58,6 +59,7 @@ class SuiteResult:
     manifest: dict
     wall_s: float
     source: str | None = None
+    trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
 
 
 def _cases(config: SuiteConfig, sets: dict, problem):
@@ -126,7 +128,8 @@ def solve_task(payload: dict) -> dict:
     wall = time.perf_counter() - start
     rows = run_rows(config, problem, solver, cases, result, dim)
     return {"fingerprint": payload["fingerprint"], "problem": payload["problem"], "solver": payload["solver"],
-            "dim": dim, "rows": rows.to_dict(orient="list"), "wall_s": wall, "solves": len(cases) * config.runs}
+            "dim": dim, "rows": rows.to_dict(orient="list"), "trace": task_trace(result, budget_of(config, dim)),
+            "wall_s": wall, "solves": len(cases) * config.runs}
 
 
 def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> pd.DataFrame:
@@ -160,6 +163,10 @@ def record_problem(task, rec) -> str | None:
         n = len(task.payload["cases"]) * int(task.payload["config"]["runs"])
         if not isinstance(rows, dict) or any(not isinstance(v, list) or len(v) != n for v in rows.values()):
             return f"rows: not a table of {n} run rows"
+        trace = rec["trace"]
+        if not isinstance(trace, dict) or any(not isinstance(trace.get(k), list)
+                                              for k in ("row", "evaluations", "best_fitness")):
+            return "trace: not the run traces (row, evaluations, best_fitness)"
         int(rec["dim"]), float(rec["wall_s"]), int(rec["solves"])
     except KeyError as err:
         return f"field {err.args[0]!r} is missing"
@@ -196,8 +203,8 @@ def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
 def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
     """The run rows of every task, then the imported outside results, and the timing table."""
     ctx: _Context = plan.context
-    done = [ran.records[t.id] for t in plan.tasks]
-    frames = [pd.DataFrame(r["rows"]) for r in done]
+    done = [{**ran.records[t.id], "rows": pd.DataFrame(ran.records[t.id]["rows"])} for t in plan.tasks]
+    frames = [r["rows"] for r in done]
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
         instances = instances_of(config, ctx.sets)
@@ -206,7 +213,8 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
                          "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
                         for r in done])
-    return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source)
+    return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source,
+                       suite_trace(config, done, runs))
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
