@@ -469,6 +469,7 @@ def test_an_exact_answer_past_the_budget_does_not_count():
     hist = np.array([[1e-20, 1e-20]])
     m = at_budget(hist, np.array([[300, 300]]), 200, [1e-2])
     assert m["fitness"][0] == np.inf and np.isnan(m[target_column(1e-2)][0])
+    assert m["evaluations"][0] == 200          # it spent the budget without an answer: counts B toward ERT
 
 
 @pytest.fixture(scope="module")

@@ -23,13 +23,16 @@ def last_within(evals: np.ndarray, budget: int) -> np.ndarray:
 
 def at_budget(history: np.ndarray, evals: np.ndarray, budget: int, targets) -> dict:
     """Measures of runs from their best-so-far fitness and cumulative evaluations per iteration
-    (``(..., T + 1)`` each), cut at ``budget`` evaluations: evaluations used, final fitness and,
-    per target, the evaluations when the target was first reached (NaN: not within the budget)."""
+    (``(..., T + 1)`` each), cut at ``budget`` evaluations: evaluations used (the budget itself for
+    a run with no record within it), final fitness and, per target, the evaluations when the
+    target was first reached (NaN: not within the budget)."""
     within = evals <= budget
     last = last_within(evals, budget)
     ok = last >= 0
     li = np.maximum(last, 0)[..., None]
-    used = np.where(ok, np.take_along_axis(evals, li, axis=-1)[..., 0], 0).astype(float)
+    # a run with no record within the budget (an exact solver whose answer cost more than B) spent
+    # the whole budget without an answer: it counts B toward ERT, not 0
+    used = np.where(ok, np.take_along_axis(evals, li, axis=-1)[..., 0], budget).astype(float)
     final = np.where(ok, np.take_along_axis(history, li, axis=-1)[..., 0], np.inf)
     out = {"evaluations": used, "fitness": final}
     for t in targets:

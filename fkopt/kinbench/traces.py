@@ -23,7 +23,7 @@ readers start a run there); when the solver reports no fitness value there -- an
 first value is its answer, at the evaluations the answer cost; an outside log may start later --
 its best_fitness is ``inf``. A run with no iteration within B (an exact solver that needed more
 than B) has the two rows (1, inf) and (B, inf): it spent the budget without an answer (runs.csv
-records 0 evaluations and fitness inf for it). Outside results (:mod:`fkopt.kinbench.outside`)
+records B evaluations and fitness inf for it). Outside results (:mod:`fkopt.kinbench.outside`)
 get rows from their logged (evaluations, best so far) pairs the same way, an evaluation count of
 0 taken as 1.
 """
