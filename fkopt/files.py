@@ -31,6 +31,7 @@ Every config file, geometry file and results folder of fkopt goes through this m
 """
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import errno
 import json
@@ -323,6 +324,41 @@ def write_atomically(final: str | Path, write: Callable[[Path], Any],
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return final
+
+
+@contextlib.contextmanager
+def run_lock(out: str | Path, folder: str | Path):
+    """Hold ``OUT/<paper>/.<name>.lock`` (an advisory ``flock``, released by the kernel when the
+    process dies, kill -9 included) while a run computes and publishes ``folder``: a second fkopt
+    run of the same paper/name at the same time is refused with one line instead of wiping the
+    first one's task files or racing its swap. The file is removed when the run ends (a stale
+    one left by a killed run is simply taken over)."""
+    import fcntl
+    folder = Path(folder)
+    path = inside(out, folder.parent / f".{folder.name}.lock")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    while True:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise FkoptError(f"{folder}: another fkopt run is computing this result right now ({path.name} is "
+                             "locked); wait for it to finish, or choose another --out or name") from None
+        try:
+            if os.stat(path).st_ino == os.fstat(fd).st_ino:
+                break           # still the file at that path (not unlinked by the previous holder)
+        except FileNotFoundError:
+            pass
+        os.close(fd)
+    try:
+        yield path
+    finally:
+        try:
+            os.unlink(path)     # while still holding it, so no one locks a file about to vanish
+        except OSError:
+            pass
+        os.close(fd)
 
 
 def write_file_atomically(path: str | Path, write: Callable[[Path], Any]) -> None:

@@ -797,11 +797,40 @@ def test_registered_only_refuses_references_but_not_built_ins():
 
 
 # -- class 8: two runs into one paper/name at once ------------------------------------------------
-def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli, monkeypatch):
-    """Run A (seed 1) computes; meanwhile run B (seed 99) publishes into the same paper/name. A
-    must not replace B's result without --force: it is refused at publish time, one line."""
+def test_a_second_run_of_the_same_name_meanwhile_is_refused(tmp_path, cli, monkeypatch):
+    """Run A computes; meanwhile run B of the same paper/name starts: B is refused with one line
+    (A holds OUT/<paper>/.<name>.lock), A publishes, and no lock file is left behind."""
+    from fkopt.errors import FkoptError
     from fkopt.experiment import runner
     from fkopt.experiment.kinds import from_dict, run_config
+    out = tmp_path / "out"
+    cfg = tmp_path / "a.yaml"
+    cfg.write_text(yaml_of({**BASE, "name": "same"}))
+    real, refused = runner.merge_experiment, []
+
+    def meanwhile(config, *args, **kw):
+        if config.seed == 1:
+            with pytest.raises(FkoptError, match="another fkopt run is computing this result") as err:
+                run_config(from_dict({**BASE, "name": "same", "seed": 99}, "other"), out)
+            refused.append(str(err.value))
+        return real(config, *args, **kw)
+    monkeypatch.setattr(runner, "merge_experiment", meanwhile)
+    (out / "test").mkdir(parents=True)
+    (out / "test" / ".same.lock").write_text("")      # a stale lock of a killed run: taken over
+    assert cli("run", cfg, "--out", out, "-q")[0] == 0
+    assert refused and len(refused[0].splitlines()) == 1
+    assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 1
+    assert not (out / "test" / ".same.lock").exists()
+
+
+def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli, monkeypatch):
+    """Where the lock cannot hold (a file system without flock, an older fkopt): run A (seed 1)
+    computes; meanwhile run B (seed 99) publishes into the same paper/name. A must not replace
+    B's result without --force: it is refused at publish time, one line."""
+    import contextlib
+    from fkopt.experiment import kinds, runner
+    from fkopt.experiment.kinds import from_dict, run_config
+    monkeypatch.setattr(kinds, "run_lock", lambda out, folder: contextlib.nullcontext())
     out = tmp_path / "out"
     cfg = tmp_path / "a.yaml"
     cfg.write_text(yaml_of({**BASE, "name": "same"}))
@@ -861,6 +890,47 @@ def test_interrupted_experiment_rerun_keeps_previous_result(tmp_path, how):
 @pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGKILL], ids=["sigint", "kill-9"])
 def test_interrupted_study_rerun_keeps_previous_result(tmp_path, how):
     _interrupt(tmp_path, {**STUDY, "name": "small"}, SLOW_STUDY, "study", how)
+
+
+def test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it(tmp_path):
+    """The one runner under a real SIGINT to the process group (workers included): the finished
+    task files stay with their digests, ``fkopt run --resume`` reuses them and computes only the
+    rest, and the result is byte for byte that of an uninterrupted run."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(Path(__file__).resolve().parents[1]),
+                                                                         os.environ.get("PYTHONPATH")]))}
+    study = {**STUDY, "name": "cut", "poses": {"uniform": 48, "seed": 1}, "population": 20, "iterations": 300,
+             "runs": 4, "chunk": 4}
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml_of(study))
+    run = [sys.executable, "-m", "fkopt.cli", "run", str(cfg), "-q"]
+    assert subprocess.run([*run, "--out", str(tmp_path / "whole")], capture_output=True, timeout=300,
+                          env=env).returncode == 0
+    out = tmp_path / "out"
+    manifest = out / "studies" / ".cut.partial" / "tasks" / "manifest.json"
+    p = subprocess.Popen([*run, "--out", str(out), "--jobs", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, start_new_session=True, env=env)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and p.poll() is None:     # until some, not all, tasks are on disk
+        try:
+            if len(json.loads(manifest.read_text())["tasks"]) >= 2:
+                break
+        except (OSError, ValueError, KeyError):
+            pass
+        time.sleep(0.05)
+    assert p.poll() is None, "the run finished before it could be interrupted"
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err[-500:]
+    assert not (out / "studies" / "cut").exists()
+    kept = json.loads(manifest.read_text())["tasks"]
+    assert 2 <= len(kept) < 12
+    proc = subprocess.run([*run[:-1], "--out", str(out), "--resume"], capture_output=True, text=True, timeout=300,
+                          env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert f"resumed: {len(kept)} finished task(s) reused, {12 - len(kept)} computed" in proc.stdout
+    for name in ("summary.csv", "runs.csv", "poses.csv", "ecdf.csv", "stats.csv"):
+        assert (out / "studies" / "cut" / name).read_bytes() == (tmp_path / "whole" / "studies" / "cut" / name
+                                                                 ).read_bytes(), name
 
 
 def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, cli):

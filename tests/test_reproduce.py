@@ -22,21 +22,9 @@ def test_every_paper_has_stored_results():
     assert set(PAPERS) <= papers, f"missing results for {set(PAPERS) - papers}"
 
 
-def _suite_stored_before_traces(exp) -> bool:
-    """A suite stored before suites kept ``trace.csv.gz`` (its meta.json lists no trace digest)."""
-    return exp.meta.get("kind") == "suite" and "trace.csv.gz" not in exp.meta.get("files", {})
-
-
 @pytest.mark.parametrize("exp", STORED, ids=[f"{e.paper}/{e.name}" for e in STORED])
 def test_stored_results_are_reproduced(exp):
     mismatches = check_experiment(exp)
-    if _suite_stored_before_traces(exp):
-        # Until `make bench-suite` rewrites results/kinbench (the lead does, after merging), the
-        # rerun's new trace.csv.gz and its digest in meta.json are the expected differences: every
-        # other file stays byte-identical, and meta.json equal but for the digests (the any tier).
-        mismatches = [m for m in mismatches if m.file != "meta.json"
-                      and not (m.file == "trace.csv.gz" and m.stored == "missing")]
-        mismatches += [m for m in check_experiment(exp, tier="any") if m.file == "meta.json"]
     assert not mismatches, "\n".join(map(str, mismatches[:10]))
 
 

@@ -48,7 +48,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import FkoptError
-from ..files import load_mapping, output_folder, write_atomically
+from ..files import load_mapping, output_folder, run_lock, write_atomically
 from ..outputs import write_outputs
 from .tasks import Plan, Ran, TaskStore, run_tasks, work_folder
 
@@ -217,6 +217,14 @@ def run_config(config, out: str | Path, *, source: str | None = None, progress=N
         prepare_output(config, out, force)
     folder = output_folder(out, *config.folder_parts)   # safe, inside OUT, writable: before any work
     check_scheduler(executor, scheduler)                # reachable before a .partial is touched
+    with run_lock(out, folder):      # one run per paper/name at a time
+        return _run_locked(kind, config, out, folder, source=source, progress=progress, force=force, jobs=jobs,
+                           executor=executor, scheduler=scheduler, resume=resume, keep_tasks=keep_tasks,
+                           solved=solved)
+
+
+def _run_locked(kind: Kind, config, out, folder: Path, *, source, progress, force, jobs, executor, scheduler,
+                resume, keep_tasks, solved) -> Outcome:
     start = time.perf_counter()
     plan = kind.plan(config, source)
     store = None
