@@ -365,8 +365,11 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
     of 2-D grids and pairwise rank tests; mode: tracking solves trajectories step by step, each
     step warm-started from the previous one. Fields: docs/config-reference.md (study);
     examples: configs/studies/."""
-    from .study.config import load_study
-    _run_files([(config, load_study(config))], out, jobs=jobs, executor=executor, scheduler=scheduler,
+    from .experiment.kinds import load_any
+    cfg = load_any(config)
+    if getattr(cfg, "kind", None) != "study":
+        raise FkoptError(f"{config}: not a study file (kind: study); run it with: fkopt run {config}")
+    _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler,
                resume=resume, force=force, quiet=quiet)
 
 

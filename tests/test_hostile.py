@@ -130,7 +130,8 @@ CORPUS = [
      ["run", "{f}", "--out", "{out}"], ["unique"]),
     ("algorithms-empty", with_(BASE, algorithms=[]), ["run", "{f}", "--out", "{out}"], ["algorithms"]),
     ("stop-without-threshold", with_(BASE, stop_at_threshold=True), ["run", "{f}", "--out", "{out}"], ["threshold"]),
-    ("study-via-run", yaml_of(STUDY), ["run", "{f}", "--out", "{out}"], ["fkopt study"]),
+    ("study-via-run-jobs-0", yaml_of(STUDY), ["run", "{f}", "--out", "{out}", "--jobs", "0"], ["--jobs"]),
+    ("experiment-via-study", yaml_of(BASE), ["study", "{f}", "--out", "{out}"], ["not a study file", "fkopt run"]),
     ("assembly-serial", with_(ASSEMBLY, mechanism={"name": "7dof-arm"}), ["run", "{f}", "--out", "{out}"], ["parallel"]),
     # -- geometry files and CLI arguments -------------------------------------------------------------
     ("geometry-not-utf8", b"ra: \xff\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
