@@ -38,11 +38,13 @@ reproduce-peers:
 # the libraries subset into results/kinbench/, then the report (~15 min on 2 cores, 7-8 of them the
 # libraries subset). Not part of `make reproduce`.
 bench-suite:
+	$(FKOPT) report results --snapshot-to .bench-suite-before.json
 	for s in kinbench kinbench-v2 kinbench-v2-libraries; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --jobs 2 -q || exit 1; done
 	for s in kinbench kinbench-v2; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --quick -q || exit 1; done
-	$(FKOPT) report results
+	$(FKOPT) report results --changes-since .bench-suite-before.json   # CHANGES.md: what the suites moved
+	rm -f .bench-suite-before.json
 
 # Regenerate the report from stored results without rerunning.
 report:

@@ -704,12 +704,22 @@ def schema(kind: str = typer.Argument("experiment", help="experiment | study | a
 
 
 @app.command()
-def report(results: Path = typer.Argument(Path("results"), help="results root")):
+def report(results: Path = typer.Argument(Path("results"), help="results root"),
+           snapshot_to: Optional[Path] = typer.Option(None, "--snapshot-to", help="only record the tree's "
+                                                      "state in FILE (before a rerun such as make bench-suite)"),
+           changes_since: Optional[Path] = typer.Option(None, "--changes-since", help="also write CHANGES.md: "
+                                                        "what moved since the state recorded in FILE")):
     """Regenerate REPORT.md, TIMING.md and index.csv from stored results (no rerun)."""
+    from .reproduce.changes import load_snapshot, save_snapshot, snapshot
     from .reproduce.report import write_report
     from .reproduce.store import Store
     Store(results).require_readable()
-    for p in write_report(results):
+    if snapshot_to is not None:
+        save_snapshot(snapshot(results), snapshot_to)
+        typer.echo(str(snapshot_to))
+        return
+    before = load_snapshot(changes_since) if changes_since is not None else None
+    for p in write_report(results, changes_since=before):
         typer.echo(str(p))
 
 

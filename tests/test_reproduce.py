@@ -351,3 +351,19 @@ def test_an_edited_timing_verdict_is_caught_on_any_platform(tmp_path):
     bad = timing_verdicts(exp)
     assert [(m.file, m.column) for m in bad] == [("timing_claims.csv", "verdict")]
     assert "every platform" in bad[0].rule
+
+
+def test_report_says_what_moved_since_a_recorded_snapshot(tmp_path, cli):
+    """make bench-suite: fkopt report --snapshot-to before the rerun, --changes-since after."""
+    folder = _copy(tmp_path)
+    snap = tmp_path / "before.json"
+    code, _, err = cli("report", tmp_path / "results", "--snapshot-to", snap)
+    assert code == 0 and snap.is_file() and not (tmp_path / "results" / "REPORT.md").exists(), err
+    _edit_csv(folder, "summary.csv", 0, "mean_evaluations", lambda v: v + 20)
+    code, _, err = cli("report", tmp_path / "results", "--changes-since", snap)
+    assert code == 0, err
+    text = (tmp_path / "results" / "CHANGES.md").read_text()
+    assert "## mao2017/tab6" in text and "mean_evaluations" in text
+    snap.write_text('{"files": []}')
+    code, _, err = cli("report", tmp_path / "results", "--changes-since", snap)
+    assert code == 2 and "not a results snapshot" in err and len(err.strip().splitlines()) == 1

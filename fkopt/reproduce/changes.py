@@ -51,6 +51,30 @@ def snapshot(root: str | Path) -> Snapshot:
     return snap
 
 
+def save_snapshot(snap: Snapshot, path: str | Path) -> None:
+    """Keep a snapshot in a JSON file (``fkopt report --snapshot-to``), e.g. before ``make
+    bench-suite`` reruns the suites, to say afterwards what they moved."""
+    import json
+    Path(path).write_text(json.dumps({"files": snap.files, "summaries": snap.summaries, "claims": snap.claims},
+                                     sort_keys=True), encoding="utf-8")
+
+
+def load_snapshot(path: str | Path) -> Snapshot:
+    """A snapshot kept by :func:`save_snapshot`; one line naming the file when it is not one."""
+    import json
+
+    from ..errors import FkoptError
+    from ..files import read_text
+    try:
+        data = json.loads(read_text(path, 256 << 20))
+        snap = Snapshot(dict(data["files"]), dict(data["summaries"]), dict(data["claims"]))
+    except (ValueError, KeyError, TypeError):
+        raise FkoptError(f"{path}: not a results snapshot (written by fkopt report --snapshot-to)") from None
+    if not all(isinstance(v, dict) for v in snap.files.values()):
+        raise FkoptError(f"{path}: not a results snapshot (written by fkopt report --snapshot-to)")
+    return snap
+
+
 def _table(text: str | None) -> pd.DataFrame | None:
     if not text:
         return None
@@ -112,7 +136,8 @@ def describe(before: Snapshot, root: str | Path) -> str:
     """CHANGES.md: what the tree under ``root`` changed against ``before`` (timings never count)."""
     after = snapshot(root)
     lines = ["# What the last regeneration moved", "",
-             "Written by `fkopt reproduce` from the tree before and after it ran (`fkopt/reproduce/changes.py`); "
+             "Written by `fkopt reproduce` (or `make bench-suite`, through `fkopt report --changes-since`) "
+             "from the tree before and after it ran (`fkopt/reproduce/changes.py`); "
              "timing files and figures are left out. Summary moves list the watched columns only.", ""]
     added = sorted(set(after.files) - set(before.files))
     removed = sorted(set(before.files) - set(after.files))
