@@ -385,8 +385,11 @@ def first_difference(name: str, file: str, stored: bytes, rerun: bytes) -> Misma
 
 
 def _bytes(path: Path) -> bytes:
-    data = path.read_bytes()
-    return gzip.decompress(data) if path.name.endswith(".gz") else data
+    if path.name.endswith(".gz"):
+        from .files import check_unpacked
+        check_unpacked(path)                     # a gzip bomb is one line, not the memory
+        return gzip.decompress(path.read_bytes())
+    return path.read_bytes()
 
 
 def compare_folders(name: str, stored: Path, rerun: Path, rules: Rules | bool,

@@ -326,6 +326,40 @@ def write_atomically(final: str | Path, write: Callable[[Path], Any],
     return final
 
 
+#: Largest decompressed ``.csv.gz`` fkopt reads (bytes). The largest it writes, kinbench v2's
+#: ``trace.csv.gz``, unpacks to ~64 MB; the cap keeps a hostile file (a small gzip that unpacks
+#: to gigabytes) from taking the memory: the size is measured by streaming decompression first.
+MAX_UNPACKED = 256 * 1024 ** 2
+
+
+def unpacked_size(path: str | Path, limit: int = MAX_UNPACKED) -> int:
+    """Decompressed size of gzip ``path``, streamed in 1 MiB pieces; stops past ``limit``."""
+    import gzip
+    size = 0
+    with gzip.open(path, "rb") as fh:
+        while chunk := fh.read(1 << 20):
+            size += len(chunk)
+            if size > limit:
+                break
+    return size
+
+
+def check_unpacked(path: str | Path, limit: int | None = None) -> None:
+    """Refuse, with one line, a gzip file that unpacks to more than ``limit`` bytes (default
+    :data:`MAX_UNPACKED`) or is no gzip."""
+    import gzip
+    import zlib
+    limit = MAX_UNPACKED if limit is None else limit
+    try:
+        too_big = unpacked_size(path, limit) > limit
+    except (EOFError, gzip.BadGzipFile, zlib.error, OSError) as err:
+        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a readable gzip file ({err})"
+        raise FkoptError(f"{path}: {what}") from None
+    if too_big:
+        raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest file fkopt "
+                         "writes is far smaller; memory stays bounded)")
+
+
 @contextlib.contextmanager
 def run_lock(out: str | Path, folder: str | Path):
     """Hold ``OUT/<paper>/.<name>.lock`` (an advisory ``flock``, released by the kernel when the

@@ -5,6 +5,7 @@ import gzip
 import json
 import warnings
 import zlib
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -302,3 +303,15 @@ def test_an_eof_anywhere_is_an_error_not_an_interruption(monkeypatch, capsys, tm
     err = capsys.readouterr().err.strip()
     assert exc.value.code == 2 and len(err.splitlines()) == 1
     assert err.startswith("fkopt: error: unexpected end of a file") and "end-of-stream" in err
+
+
+def test_check_refuses_a_stored_gzip_bomb_in_one_line(tmp_path, cli, monkeypatch):
+    """fkopt check (and report) read stored .csv.gz files through the same cap as the export."""
+    import fkopt.files
+    monkeypatch.setattr(fkopt.files, "MAX_UNPACKED", 2 << 20)
+    stored = Path(__file__).resolve().parents[1] / "results" / "mao2017" / "tab6"
+    folder = _copy(stored, tmp_path / "results" / "mao2017" / "tab6")
+    _bomb(folder / "trace.csv.gz", 3 << 20)
+    code, _, err = cli("check", tmp_path / "results", "-q")
+    assert code != 0 and "trace.csv.gz" in err and "unpacks to more than 2 MB" in err, err
+    assert "Traceback" not in err

@@ -32,6 +32,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..files import MAX_UNPACKED, unpacked_size
+
 FILE = "trace.csv.gz"
 COLUMNS = ("case", "algorithm", "run", "iteration", "evaluations", "best_fitness")
 
@@ -90,22 +92,8 @@ def trace_table(er) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-#: Largest decompressed ``trace.csv.gz`` :func:`read_trace` accepts (bytes). The largest stored
-#: trace unpacks to ~4 MB; the cap keeps a hostile file (a small gzip that unpacks to gigabytes)
-#: from taking the memory: the size is measured by streaming decompression, before parsing.
-MAX_BYTES = 128 * 1024 ** 2
-
-
-def _unpacked_size(path: Path, limit: int) -> int:
-    """Decompressed size of gzip ``path``, streamed in 1 MiB pieces; stops past ``limit``."""
-    import gzip
-    size = 0
-    with gzip.open(path, "rb") as fh:
-        while chunk := fh.read(1 << 20):
-            size += len(chunk)
-            if size > limit:
-                break
-    return size
+#: Largest decompressed ``trace.csv.gz`` :func:`read_trace` accepts (:data:`fkopt.files.MAX_UNPACKED`).
+MAX_BYTES = MAX_UNPACKED
 
 
 #: Integer columns of a trace (of an experiment's, or a suite's: :mod:`fkopt.kinbench.traces`);
@@ -124,7 +112,7 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
     path = Path(folder) / FILE
     labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
     try:
-        if _unpacked_size(path, limit) > limit:
+        if unpacked_size(path, limit) > limit:
             raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest "
                              "trace fkopt writes is far smaller; memory stays bounded)")
         table = pd.read_csv(path, compression="gzip", dtype=dict.fromkeys(labels, "category"))

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..files import check_unpacked
+
 
 @dataclass
 class Experiment:
@@ -54,6 +56,8 @@ class Experiment:
         file = name if name.endswith((".csv", ".csv.gz")) else f"{name}.csv"
         if not (self.folder / file).exists() and (self.folder / f"{file}.gz").exists():
             file += ".gz"      # trace.csv.gz (fkopt.experiment.traces)
+        if file.endswith(".gz"):
+            check_unpacked(self.folder / file)      # a gzip bomb is one line, not the memory
         return pd.read_csv(self.folder / file, keep_default_na=True)
 
     def figures(self) -> list[str]:
