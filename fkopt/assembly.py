@@ -63,7 +63,12 @@ many inputs as pose variables:
    Euler equivalence), its residual ``max |ik(pose) - joints|`` recomputed with the
    mechanism's inverse map; it is kept if that residual is at most ``tol * max(1, |joint|)``
    for every joint and the pose is inside the bounds (solutions found outside are counted in
-   ``Solutions.outside``).
+   ``Solutions.outside``). A pose at most ``_BOUND_SLACK`` (1e-3 of a width) past a bound is
+   clipped into the bounds and polished there by Gauss-Newton with the clipped variables held
+   (a root on a bound that is double, e.g. 3-PPR at x = 60, theta = 0, converges linearly and
+   stops within ``tol`` but ~1e-6 past it); it is kept if its residual is within ``tol``
+   (then it is a solution in the bounds by definition), merged into a solution already found
+   within ``dedup``.
 
 Rounds continue until ``patience`` consecutive rounds bring no new solution in the bounds,
 after at least ``min_starts`` (or until ``max_starts``), or until ``maximum`` distinct real
@@ -716,7 +721,8 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     problem = FKProblem(mechanism, joints)
     rep_keys: list[np.ndarray] = []                   # one key per distinct solution found
     hits: list[int] = []
-    found: list[tuple[np.ndarray, float] | None] = []  # (pose in bounds, residual), None: outside
+    # (pose in bounds, residual, polished onto a bound), None: outside, False: merged duplicate
+    found: list[tuple[np.ndarray, float, bool] | None | bool] = []
     unchecked: list[np.ndarray] = []                  # states of new solutions not checked yet
     history: list[tuple[int, float, int]] = []
     used, quiet = 0, 0
@@ -752,8 +758,18 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     def settle():
         """Check the round's new solutions (pose in the bounds, residual) in one call."""
         if unchecked:
+            first = len(found)
             found.extend(_check_many(mechanism, problem, model.poses(np.array(unchecked)), triple, jscale, tol))
             unchecked.clear()
+            # A root polished onto a bound may be one found inside already: merge it there.
+            for i in range(first, len(found)):
+                if found[i] is not None and found[i][2]:
+                    key = model.keys(model.from_poses(found[i][0][None]))[0]
+                    for j, fj in enumerate(found):
+                        if j != i and fj and np.abs(model.keys(model.from_poses(fj[0][None]))[0] - key).max() <= dedup:
+                            hits[j] += hits[i]
+                            found[i] = False       # a duplicate: neither a solution nor outside
+                            break
 
     def report(rows, S):
         add(S)
@@ -786,13 +802,13 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
             S0 = model.starts(_kronecker(shift, used, n, model.draws))
         else:
             S0 = model.starts(streams.uniform(n, model.draws)[0])
-        inside_before = sum(f is not None for f in found)
+        inside_before = sum(bool(f) for f in found)
         with np.errstate(all="ignore"):                 # diverging starts may overflow
             _, _, started = _newton(model, S0, ftol=ftol, iterations=iterations, pool=pool, report=report,
                                     line_search=search, capture=captured if capture else None)
         used += started
         settle()
-        inside = sum(f is not None for f in found)
+        inside = sum(bool(f) for f in found)
         history.append((used, time.perf_counter() - t0, inside))
         quiet = quiet + 1 if inside == inside_before else 0
         if used >= need and quiet >= patience:
@@ -801,7 +817,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
             break
 
     out = Solutions(sorted((Solution(pose=dict(zip(mechanism.pose_names, map(float, f[0]))), residual=f[1], hits=h)
-                            for f, h in zip(found, hits) if f is not None), key=lambda s: -s.hits))
+                            for f, h in zip(found, hits) if f), key=lambda s: -s.hits))
     out.names = tuple(mechanism.pose_names)
     out.outside = sum(f is None for f in found)
     out.starts = used
@@ -813,22 +829,92 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
 
 
 def _check_many(mechanism, problem, X, triple, jscale, tol):
-    """:func:`_check` for rows X (k, dim), residuals in one call of the inverse map."""
+    """(pose moved into the bounds, residual, on_bound) of each converged row of X (k, dim), or
+    None if it is outside or inexact; residuals in one call of the inverse map.
+
+    A row that no move by 360 deg (or the Euler equivalence) brings into the bounds is clipped
+    into them and polished there (:func:`_polish_on_bounds`), and kept (``on_bound`` True) if
+    the polished pose has a residual within ``tol``: by definition a solution in the bounds.
+    This is a root on a bound that Newton's stop left slightly past it (a double root converges
+    linearly and stops within ``tol`` some 1e-6 beyond). A solution genuinely outside keeps a
+    residual of the order of its distance to the bounds and stays outside."""
     moved = [_into_bounds(mechanism, x, triple) for x in X]
-    inb = [i for i, xb in enumerate(moved) if xb is not None]
     out: list = [None] * len(X)
+    inb = [i for i, xb in enumerate(moved) if xb is not None]
     if inb:
         r = np.abs(problem.residuals(np.array([moved[i] for i in inb])))
         for i, ri in zip(inb, r):
             if (ri / jscale <= tol).all():
-                out[i] = (moved[i], float(ri.max()))
+                out[i] = (moved[i], float(ri.max()), False)
+    rows, clipped = [], []
+    for i, xb in enumerate(moved):
+        if xb is None:
+            for c in _clipped_into_bounds(mechanism, X[i], triple):
+                rows.append(i)
+                clipped.append(c)
+    if clipped:
+        C = _polish_on_bounds(mechanism, problem, np.array(clipped))
+        r = np.abs(problem.residuals(C))
+        for i, c, ri in zip(rows, C, r):
+            if out[i] is None and (ri / jscale <= tol).all():
+                out[i] = (c, float(ri.max()), True)
     return out
 
 
-def _check(mechanism, problem, x, triple, jscale, tol):
-    """(pose moved into the bounds, residual) of a converged solution, or None if outside/inexact."""
-    xb = _into_bounds(mechanism, x, triple)
-    if xb is None:
-        return None
-    r = np.abs(problem.residuals(xb))
-    return (xb, float(r.max())) if (r / jscale <= tol).all() else None
+def _polish_on_bounds(mechanism, problem, X, steps: int = 8):
+    """Gauss-Newton in the pose variables with the variables at a bound held there (rows X
+    (k, dim) clipped into the bounds; a variable a step pushes out is clipped and held too)."""
+    lo, hi = mechanism.bounds[:, 0], mechanism.bounds[:, 1]
+    h = 1e-7 * (hi - lo)
+    X = np.array(X, dtype=float)
+    for _ in range(steps):
+        held = (X <= lo) | (X >= hi)
+        r = problem.residuals(X)
+        if problem.has_jacobian:
+            J = problem.jacobian(X)
+        else:                                      # central differences, as _GenericModel
+            E = np.eye(X.shape[1]) * h
+            J = np.stack([(problem.residuals(X + e) - problem.residuals(X - e)) / (2 * hk)
+                          for e, hk in zip(E, h)], axis=-1)
+        J = np.where(held[:, None, :], 0.0, J)
+        with np.errstate(all="ignore"):
+            dx = -np.einsum("nij,nj->ni", np.linalg.pinv(J), r)
+        if not np.isfinite(dx).all():
+            break
+        X = np.clip(X + dx, lo, hi)
+        if (np.abs(dx) <= 1e-15 * (hi - lo)).all():
+            break
+    return X
+
+
+#: How far past a bound (fraction of its width) a converged pose is clipped and polished back:
+#: a double root stops ~1e-8 of the width past it, a triple one ~1e-4 (the pose error of a
+#: k-fold root is ~ (Newton's stopping residual)^(1/k)); farther is a solution outside.
+_BOUND_SLACK = 1e-3
+
+
+def _clipped_into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> list[np.ndarray]:
+    """The pose x clipped into the bounds, once per Euler representative (plain, then the
+    equivalent triple), each angle first moved by multiples of 360 deg next to the bounds;
+    representatives more than ``_BOUND_SLACK`` of a width outside are left out."""
+    lo, hi = mechanism.bounds[:, 0], mechanism.bounds[:, 1]
+    angle = np.flatnonzero(mechanism.angle_mask(mechanism.pose_units))
+    x = np.array(x, dtype=float)
+    candidates = [x]
+    if triple is not None:
+        a, b, g = triple
+        alt = x.copy()
+        alt[a] += 180.0
+        alt[b] = 180.0 - alt[b]
+        alt[g] += 180.0
+        candidates.append(alt)
+    out = []
+    for c in candidates:
+        c = c.copy()
+        for i in angle:
+            v = lo[i] + (c[i] - lo[i]) % 360.0           # smallest representative >= lo
+            c[i] = v if v - hi[i] <= lo[i] - (v - 360.0) else v - 360.0   # the nearer side
+        inside = np.clip(c, lo, hi)
+        if (np.abs(inside - c) <= _BOUND_SLACK * (hi - lo)).all():
+            out.append(inside)
+    return out

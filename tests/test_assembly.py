@@ -159,3 +159,14 @@ def test_cmm_pose_near_a_corner_of_the_angle_box():
         sols = all_solutions(m, legs, seed=0, **kw)
         assert _found(m, sols, pose), kw
         assert all(s.residual < 1e-9 for s in sols)
+
+
+def test_double_root_on_the_bound_is_accepted():
+    # 3-PPR at x = 60 (the bound), theta = 0 is a double root: Newton converges linearly and
+    # stops at a residual within tol but ~1e-6 mm past the bound; the pose clipped into the
+    # bounds is a solution within tol and must be reported.
+    m = fkopt.mechanism("3-ppr")
+    for pose in ([60.0, 0.0, 0.0], [60.0, -60.0, 0.0], [-60.0, 0.0, 0.0]):
+        sols = all_solutions(m, m.ik(pose), seed=0)
+        assert _found(m, sols, np.array(pose)), pose
+        assert np.all(m.in_bounds(sols.poses()))
