@@ -3,6 +3,7 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 import fkopt
 from fkopt.assembly import Solutions, all_solutions, pose_distance, solutions_to_dict
@@ -146,6 +147,15 @@ def _found(m, sols, pose, within=1e-6):
     return len(sols) > 0 and float(pose_distance(m, sols.poses(), pose).min()) < within
 
 
+def _multiple_root(m, pose):
+    """Whether the legs' Jacobian in the normalised pose (lengths / width, angles in rad) is
+    singular at the pose: a multiple root, which Newton locates only to ~ tol^(1/k)."""
+    lo, hi = m.bounds.T
+    scale = np.where(m.angle_mask(m.pose_units), 180.0 / np.pi, hi - lo)
+    sv = np.linalg.svd(m.jacobian(pose) * scale, compute_uv=False)
+    return sv[-1] < 1e-6 * sv[0]
+
+
 def test_cmm_pose_near_a_corner_of_the_angle_box():
     # Regression (found by test_sps6's round trip): all three angles within 1.2-1.9 deg of -30
     # and y at 2 % of its range. The pose's Newton basin extends well beyond the angle box, but
@@ -170,3 +180,31 @@ def test_double_root_on_the_bound_is_accepted():
         sols = all_solutions(m, m.ik(pose), seed=0)
         assert _found(m, sols, np.array(pose)), pose
         assert np.all(m.in_bounds(sols.poses()))
+
+
+def _near_bound(d):
+    """Unit-box coordinates each on a bound (or mid-range), within 5 % of a bound, or anywhere."""
+    edge = st.one_of(st.sampled_from([0.0, 1.0, 0.5]), st.floats(0.0, 0.05), st.floats(0.95, 1.0), st.floats(0.0, 1.0))
+    return st.lists(edge, min_size=d, max_size=d)
+
+
+@pytest.mark.parametrize("name, starts", [("6-sps-cmm", 600), ("3-rps", None), ("3-rpupc-ups", None),
+                                          ("3-ppr", None), ("6-sps", 600)])
+def test_poses_near_the_bounds_are_found(name, starts):
+    # FK(IK(pose)) contains the pose for poses on and near the bounds (corners included).
+    m = fkopt.mechanism(name)
+    lo, hi = m.bounds.T
+
+    @settings(max_examples=40, deadline=None)
+    @given(_near_bound(len(lo)))
+    def check(u):
+        pose = lo + (hi - lo) * np.array(u)
+        legs = m.ik(pose)
+        if not np.all(np.isfinite(legs)) or np.any(legs <= 0):
+            return                                           # outside the inverse map's domain
+        sols = all_solutions(m, legs, seed=0, starts=starts)
+        # e.g. 6-sps at x = -2 S, y = z = 0, R = I (a singular pose; six solutions within 3e-6)
+        assert _found(m, sols, pose, 1e-3 if _multiple_root(m, pose) else 1e-6)
+        assert np.all(m.in_bounds(sols.poses()))
+
+    check()
