@@ -22,7 +22,8 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    batched ``lm`` in one call (the poses are the cases of one problem); ms per pose and success.
 4b. ``kinematics`` -- the exact solvers' targets side by side: 6-sps-cmm ``fkopt.forward`` on one
    pose beside a plain numpy Newton with the analytic Jacobian, batched over 10,000 poses,
-   solved-and-verified rate; Dietmaier's 40 solutions (5 seeds); 7dof-arm ``fkopt.inverse`` on
+   solved-and-verified rate; Dietmaier's 40 solutions (5 seeds); 6-sps-cmm ``all_solutions`` on
+   poses anywhere in the box and near its bounds (bounded angles: the padded start box); 7dof-arm ``fkopt.inverse`` on
    1000 reachable poses batched and one at a time, beside roboticstoolbox-python's ``ik_LM``
    (run in the Python named by ``FKOPT_RTB_PYTHON``, or /work/venv-rtb, when installed); the
    whole ``fkopt fk`` process beside ``python -c "import numpy"``.
@@ -524,6 +525,25 @@ def bench_kinematics(rows: _Rows, quick: bool, rng, messages: list[str]) -> None
     rows.add(sec, "dietmaier all solutions", float(np.median(times)) * 1e3, "ms",
              f"median of {len(times)} seeds (max {max(times) * 1e3:.1f} ms); found {found}; target <= 50 ms and 40 each: "
              f"{'met' if max(times) <= 0.05 and min(found) == 40 else 'NOT met'}")
+    # 6-sps-cmm (bounded angles): poses anywhere in the box, and near its bounds (every coordinate
+    # within 5 % of a bound), own stream so that the rows below draw what they drew before
+    prng = np.random.default_rng(2008)
+    npose = 10 if quick else 40
+    lo, hi = m.bounds.T
+    anywhere = prng.random((npose, 6))
+    near = np.where(prng.random((npose, 6)) < 0.5, 0.05 * prng.random((npose, 6)), 1 - 0.05 * prng.random((npose, 6)))
+    all_solutions(m, m.ik(lo + 0.5 * (hi - lo)), seed=0)                # warm-up
+    for label, U in (("anywhere", anywhere), ("near the bounds", near)):
+        poses = lo + U * (hi - lo)
+        times, hit = [], 0
+        for pose in poses:
+            t = time.perf_counter()
+            sols = all_solutions(m, m.ik(pose), seed=0)
+            times.append(time.perf_counter() - t)
+            hit += bool(len(sols)) and bool(np.abs(sols.poses() - pose).max(-1).min() < 1e-6)
+        rows.add(sec, f"6-sps-cmm all solutions, poses {label}", float(np.median(times)) * 1e3, "ms",
+                 f"median of {npose} poses (max {max(times) * 1e3:.1f} ms), default settings, seed 0; "
+                 f"the drawn pose among the solutions: {hit}/{npose}")
     # 7dof-arm inverse
     arm = mechanism("7dof-arm")
     ni = 200 if quick else 1000
