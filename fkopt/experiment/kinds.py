@@ -229,7 +229,7 @@ def _run_locked(kind: Kind, config, out, folder: Path, *, source, progress, forc
     plan = kind.plan(config, source)
     store = None
     if plan.stored:
-        store = TaskStore(out, work_folder(out, config.folder_parts), folder, plan.name,
+        store = TaskStore(out, work_folder(out, config), folder, plan.name,
                           config.model_dump(mode="json"), plan.fingerprint)
     ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, store=store, resume=resume,
                     progress=progress, done=solved)

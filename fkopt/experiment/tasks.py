@@ -76,10 +76,10 @@ class Ran:
     wall_s: float = 0.0
 
 
-def work_folder(out: str | Path, folder_parts) -> Path:
-    """Where an unfinished run keeps its task files: ``OUT/<paper>/.<name>.partial/`` (hidden:
-    never taken for a result)."""
-    paper, name = folder_parts
+def work_folder(out: str | Path, config) -> Path:
+    """Where an unfinished run of ``config`` (any kind) keeps its task files:
+    ``OUT/<paper>/.<name>.partial/`` (hidden: never taken for a result)."""
+    paper, name = config.folder_parts
     return Path(out) / paper / f".{name}.partial"
 
 

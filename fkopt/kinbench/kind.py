@@ -4,18 +4,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..experiment.kinds import Kind
-from ..experiment.tasks import work_folder as _work_folder
+from ..experiment.tasks import work_folder  # noqa: F401 (where a suite's task files live; tests)
 from .config import SuiteConfig, suite_from_dict
 
 
 def _validate(config: SuiteConfig) -> tuple[int, int]:
     from .runner import validate_suite
     return validate_suite(config)
-
-
-def work_folder(out, config: SuiteConfig) -> Path:
-    """Where an unfinished run keeps its task files: ``OUT/<paper>/.<name>.partial/``."""
-    return _work_folder(out, config.folder_parts)
 
 
 def _plan(config: SuiteConfig, source):

@@ -31,15 +31,9 @@ from ..experiment.runner import build_mechanism, make_problem, solve_cases, star
 from ..problems import BoxedProblem
 from ..solve import make_algorithm, pick_events
 from ..streams import case_seed
-from ..experiment.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder as _work_folder
+from ..experiment.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder  # noqa: F401 (tests, API)
 from .config import StudyAlgorithmSpec, StudyConfig
 from .poses import PoseSet, build_poses
-
-
-
-def work_folder(out: str | Path, config: StudyConfig) -> Path:
-    """Where an unfinished study keeps its task files: ``OUT/<paper>/.<name>.partial/``."""
-    return _work_folder(out, config.folder_parts)
 
 
 # -- tasks ---------------------------------------------------------------------------------------
