@@ -352,8 +352,8 @@ def check_unpacked(path: str | Path, limit: int | None = None) -> None:
     limit = MAX_UNPACKED if limit is None else limit
     try:
         too_big = unpacked_size(path, limit) > limit
-    except (EOFError, gzip.BadGzipFile, zlib.error, OSError) as err:
-        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a readable gzip file ({err})"
+    except (EOFError, gzip.BadGzipFile, zlib.error) as err:
+        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a valid gzip file ({err})"
         raise FkoptError(f"{path}: {what}") from None
     if too_big:
         raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest file fkopt "

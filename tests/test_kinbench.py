@@ -379,17 +379,30 @@ def test_an_interrupted_suite_resumes_with_the_same_bytes(tmp_path):
     with pytest.raises(Stop):
         run_config(load_any(path), out, source=str(path), progress=stop_after_two)
     work = work_folder(out, load_any(path))
-    assert len(list((work / "tasks").glob("p*-s*.json"))) == 2 and not (out / "kinbench" / "tiny").exists()
+    kept = sorted((work / "tasks").glob("p*-s*.json"))
+    assert len(kept) == 2 and not (out / "kinbench" / "tiny").exists()
+    assert all(set(json.loads(p.read_text())["trace"]) == {"row", "evaluations", "best_fitness"} for p in kept)
     seen = []
     folder = run_config(load_any(path), out, source=str(path), resume=True,
                         progress=lambda label, done, total: seen.append((done, total))).folder
     assert seen == [(2, 4), (3, 4), (4, 4)]         # two resumed, only the two missing tasks solved
-    for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv"):
+    for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv", "trace.csv.gz"):
         assert (folder / name).read_bytes() == (whole / name).read_bytes(), name
     assert not work.exists()
-    # tasks of another version of the suite are never mixed in
+    # a task file of an earlier fkopt (no trace) is refused in one line, not a traceback
     with pytest.raises(Stop):
         run_config(load_any(path), out, source=str(path), progress=stop_after_two)
+    rec = json.loads(kept[0].read_text())
+    del rec["trace"]
+    kept[0].write_text(json.dumps(rec))
+    with pytest.raises(FkoptError, match="changed since fkopt wrote it"):      # its digest no longer fits
+        run_config(load_any(path), out, source=str(path), resume=True)
+    manifest = json.loads((work / "tasks" / "manifest.json").read_text())     # even with a forged digest
+    manifest["tasks"][kept[0].stem] = hashlib.sha256(kept[0].read_bytes()).hexdigest()
+    (work / "tasks" / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(FkoptError, match="not a finished task of this run .field 'trace' is missing"):
+        run_config(load_any(path), out, source=str(path), resume=True)
+    # tasks of another version of the suite are never mixed in
     with pytest.raises(FkoptError, match="another version of suite"):
         run_config(load_any(tiny(tmp_path / "v2", runs=3)), out, source=str(path), resume=True, force=True)
 

@@ -7,7 +7,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from fkopt.errors import FkoptError
 from fkopt.experiment.kinds import load_any, run_config
 from fkopt.kinbench.budget import at_budget
 from fkopt.kinbench.traces import COLUMNS, KEYS, budget_trace
@@ -131,42 +130,6 @@ def test_budget_trace_cuts_at_the_budget_and_opens_every_run_at_evaluation_1():
     m = at_budget(hist, evals, 50, [1e-2])
     ends = np.r_[np.flatnonzero(r[1:] != r[:-1]), len(r) - 1]
     assert f[ends].tolist() == m["fitness"].tolist()
-
-
-def test_a_resumed_suite_writes_the_same_trace_bytes(tmp_path):
-    from fkopt.kinbench.kind import work_folder
-    path = tiny(tmp_path)
-    whole = run_config(load_any(path), tmp_path / "whole", source=str(path)).folder
-
-    class Stop(KeyboardInterrupt):
-        pass
-
-    def stop_after_two(label, done, total):
-        if done == 2:
-            raise Stop
-    out = tmp_path / "out"
-    with pytest.raises(Stop):
-        run_config(load_any(path), out, source=str(path), progress=stop_after_two)
-    work = work_folder(out, load_any(path))
-    kept = sorted((work / "tasks").glob("p*-s*.json"))
-    assert len(kept) == 2 and all(set(json.loads(p.read_text())["trace"]) == {"row", "evaluations", "best_fitness"}
-                                  for p in kept)
-    folder = run_config(load_any(path), out, source=str(path), resume=True).folder
-    assert (folder / "trace.csv.gz").read_bytes() == (whole / "trace.csv.gz").read_bytes()
-    # a task file of an earlier fkopt (no trace) is refused in one line, not a traceback
-    with pytest.raises(Stop):
-        run_config(load_any(path), out, source=str(path), progress=stop_after_two, force=True)
-    import hashlib
-    rec = json.loads(kept[0].read_text())
-    del rec["trace"]
-    kept[0].write_text(json.dumps(rec))
-    with pytest.raises(FkoptError, match="changed since fkopt wrote it"):      # its digest no longer fits
-        run_config(load_any(path), out, source=str(path), resume=True, force=True)
-    manifest = json.loads((work / "tasks" / "manifest.json").read_text())     # even with a forged digest
-    manifest["tasks"][kept[0].stem] = hashlib.sha256(kept[0].read_bytes()).hexdigest()
-    (work / "tasks" / "manifest.json").write_text(json.dumps(manifest))
-    with pytest.raises(FkoptError, match="not a finished task of this run .field 'trace' is missing"):
-        run_config(load_any(path), out, source=str(path), resume=True, force=True)
 
 
 def _spoil_trace(folder, change):

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..files import MAX_UNPACKED, unpacked_size
+from ..files import MAX_UNPACKED, check_unpacked
 
 FILE = "trace.csv.gz"
 COLUMNS = ("case", "algorithm", "run", "iteration", "evaluations", "best_fitness")
@@ -111,10 +111,8 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
     from ..errors import FkoptError
     path = Path(folder) / FILE
     labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
+    check_unpacked(path, limit)      # size measured by streaming, before parsing
     try:
-        if unpacked_size(path, limit) > limit:
-            raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest "
-                             "trace fkopt writes is far smaller; memory stays bounded)")
         table = pd.read_csv(path, compression="gzip", dtype=dict.fromkeys(labels, "category"))
     except (EOFError, gzip.BadGzipFile, zlib.error) as err:
         what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a valid gzip file ({err})"
