@@ -23,8 +23,7 @@ from pydantic import Field, ValidationError
 
 from ..errors import FkoptError
 from ..files import error_line
-from .kinds import Kind
-from .tasks import Plan, Task
+from .tasks import Kind, Plan, Task
 from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
 
 KIND = "assembly"
@@ -128,7 +127,7 @@ def _validate(config: AssemblyConfig) -> tuple[int, int]:
 def _plan(config: AssemblyConfig, source: str | None):
     """One task: the search (timed, so it runs in this process)."""
     payload = {"config": config.model_dump(mode="json"), "source": source}
-    return Plan([Task("search", payload, "all solutions")], "fkopt.experiment.assembly:solve_task",
+    return Plan([Task("search", payload, "all solutions")], solve_task,
                 local=lambda _: run_assembly(config, source), name=config.name)
 
 

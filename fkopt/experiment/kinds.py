@@ -12,9 +12,8 @@ tasks (problem x poses x solver x runs) whose records a writer turns into files:
 * ``kind: suite`` (kinbench, :mod:`fkopt.kinbench`, :mod:`fkopt.kinbench.kind`): many problems,
   pose sets and solvers, one task per (problem, solver).
 
-Each kind is a :class:`Kind`, named in :data:`KINDS` by a ``"module:attribute"`` string imported
-on first use (like :mod:`fkopt.registry`), so this floor never imports the floors above it. A
-kind says only how to read and validate its file, how it turns into a
+Each kind is a :class:`~fkopt.experiment.tasks.Kind` (function objects), listed in
+:data:`KINDS`; this registry imports every kind's module, and none of them imports it. A kind says only how to read and validate its file, how it turns into a
 :class:`~fkopt.experiment.tasks.Plan` and how the records become its result object. Everything
 else is shared, once:
 
@@ -39,43 +38,25 @@ output is one maker and one line there.
 """
 from __future__ import annotations
 
-import importlib
 import json
 import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from ..errors import FkoptError
 from ..files import load_mapping, output_folder, run_lock, write_atomically
 from ..outputs import write_outputs
-from .tasks import Plan, Ran, TaskStore, run_tasks, work_folder
+from ..kinbench.kind import SUITE
+from ..study.kind import STUDY
+from .assembly import ASSEMBLY
+from .kind import EXPERIMENT, check_memory
+from .tasks import Kind, TaskStore, run_tasks, work_folder
 
-#: kind -> "module:attribute" of its :class:`Kind`.
-KINDS: dict[str, str] = {
-    "experiment": "fkopt.experiment.kinds:EXPERIMENT",
-    "study": "fkopt.study.kind:STUDY",
-    "assembly": "fkopt.experiment.assembly:ASSEMBLY",
-    "suite": "fkopt.kinbench.kind:SUITE",
-}
-#: Share of the currently available memory a job may be estimated to need.
-MEMORY_SHARE = 0.8
-
-
-@dataclass(frozen=True)
-class Kind:
-    """What the pipeline needs to know about one kind of config: how to read and check it, the
-    tasks it turns into (:class:`fkopt.experiment.tasks.Plan`) and how their records become
-    the result that :func:`fkopt.outputs.write_outputs` writes. Running, task files, resuming,
-    writing aside and swapping in, and rerunning for ``fkopt check`` are the pipeline's."""
-
-    name: str
-    from_dict: Callable[[dict, str], Any]          # (mapping, where) -> validated config
-    validate: Callable[[Any], tuple[int, int]]     # config -> (tasks, estimated bytes); no work done
-    plan: Callable[[Any, "str | None"], Plan]      # (config, source) -> its tasks
-    #: (config, plan, ran, source=, timing=, folder=) -> the result object the writers read
-    merge: Callable[..., Any]
+#: kind -> its :class:`~fkopt.experiment.tasks.Kind` (function objects: the import graph shows
+#: the real layering, every kind's module below this registry).
+KINDS: dict[str, Kind] = {k.name: k for k in (EXPERIMENT, STUDY, ASSEMBLY, SUITE)}
 
 
 @dataclass
@@ -91,8 +72,7 @@ def kind_of(name: str | None) -> Kind:
     if key not in KINDS:
         raise FkoptError(f"kind: '{name}' unknown; allowed: {', '.join(k for k in KINDS if k != 'experiment')} "
                          "(an experiment file has no kind)")
-    module, attr = KINDS[key].split(":")
-    return getattr(importlib.import_module(module), attr)
+    return KINDS[key]
 
 
 def config_kind(config) -> Kind:
@@ -118,29 +98,6 @@ def load_any(path: str | Path):
     if "_folder" in getattr(type(config), "__private_attributes__", {}):
         config._folder = Path(path).parent
     return config
-
-
-def available_memory() -> int:
-    """Bytes of memory available now (``MemAvailable``; else the physical memory)."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError):
-        pass
-    try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return 1 << 62
-
-
-def check_memory(needed: int, what: str) -> None:
-    """Refuse a job estimated to need more than :data:`MEMORY_SHARE` of the available memory."""
-    avail = available_memory()
-    if needed > MEMORY_SHARE * avail:
-        raise FkoptError(f"{what} needs about {needed / 2**30:.1f} GiB of memory, more than the "
-                         f"{avail / 2**30:.1f} GiB available; reduce runs, population, iterations or cases")
 
 
 def validate_any(config, where: str | None = None) -> int:
@@ -271,51 +228,3 @@ def rerun_files(config, folder: Path, source: str | None = None) -> None:
     (``fkopt check``)."""
     result = run_in_memory(config, source, timing=False)
     write_outputs(config_kind(config).name, result, folder, figures=False, timing=False)
-
-
-# -- experiments -----------------------------------------------------------------------------------
-def _experiment_validate(config) -> tuple[int, int]:
-    from ..solve import batch_bytes, chunk_size
-    from .runner import keeps_x_history, validate_experiment
-    mech, cases, _ = validate_experiment(config)
-    dim, keep_x = len(mech.unknown_names), keeps_x_history(config, mech)
-    need = 0   # every algorithm's records stay in memory until the folder is written: the solves' sum
-    for spec in config.algorithms:
-        pop = spec.population or config.population
-        its = spec.iterations or config.iterations
-        size = chunk_size(len(cases), config.runs, pop, its, dim, batch=config.batch,
-                          snapshots=len(config.snapshots), x_history=keep_x)
-        need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
-        need += algorithm_resources(spec, pop, its, dim)
-    return len(config.algorithms), need
-
-
-def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int:
-    """An algorithm's own memory beyond fkopt's arrays (an adapter's library population), or a
-    one-line error naming it when its settings cannot run -- for every algorithm of a config,
-    before the first one starts (:meth:`fkopt.algorithms.base.Algorithm.resources`)."""
-    from ..solve import make_algorithm
-    try:
-        return int(make_algorithm(spec.name, spec.params).resources(population, iterations, dim))
-    except FkoptError as err:
-        raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
-
-
-def _experiment_plan(config, source):
-    from .runner import experiment_plan
-    return experiment_plan(config, source)
-
-
-def _experiment_merge(config, plan, ran, *, source=None, timing=True, **_):
-    from .runner import merge_experiment
-    return merge_experiment(config, plan, ran, source=source, timing=timing)
-
-
-def _experiment_from_dict(data: dict, where: str):
-    from .config import experiment_from_dict
-    if "kind" in data:
-        data = {k: v for k, v in data.items() if k != "kind"}
-    return experiment_from_dict(data, where)
-
-
-EXPERIMENT = Kind("experiment", _experiment_from_dict, _experiment_validate, _experiment_plan, _experiment_merge)

@@ -294,7 +294,7 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None) -> Plan
 
     def local(payload: dict) -> Solved:
         return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
-    return Plan(tasks, "fkopt.experiment.runner:solve_task", local=local, anywhere=True,
+    return Plan(tasks, solve_task, local=local, anywhere=True,
                 context=_Context(mech, cases, problems, batched, started), name=config.name)
 
 

@@ -3,7 +3,7 @@
 Every kind of config (:mod:`fkopt.experiment.kinds`) turns into a :class:`Plan`: a list of
 :class:`Task` s -- an experiment's algorithm on all its cases, a study's chunk of poses for one
 algorithm, a suite's (problem, solver), an assembly search -- and the worker function that
-computes one (a ``"module:function"`` string, imported where it runs, so a task can run in this
+computes one (a module-level function object, pickled by reference, so a task can run in this
 process, a local worker process or on a Dask worker; :mod:`.executors`). A task's numbers never
 depend on where or next to what it ran: each carries its own seeds.
 
@@ -21,7 +21,6 @@ written; its ``tasks/`` (when the kind keeps them) seed a resume of a finished r
 from __future__ import annotations
 
 import hashlib
-import importlib
 import json
 import os
 import shutil
@@ -53,7 +52,7 @@ class Plan:
     """The tasks of one config and how to compute, keep and check them."""
 
     tasks: list[Task]
-    solve: str                     # "module:function": payload -> record, importable anywhere
+    solve: Callable[[Any], Any]    # payload -> record; a module-level function (picklable by reference)
     fingerprint: str = ""          # of everything that changes a task's numbers
     stored: bool = False           # records are JSON and kept as task files (--resume)
     keep: bool = False             # the published folder keeps its tasks/ (studies)
@@ -67,6 +66,23 @@ class Plan:
     anywhere: bool = False
     context: Any = None            # what the kind's merge needs (mechanism, cases, pose sets, ...)
     name: str = ""
+
+
+@dataclass(frozen=True)
+class Kind:
+    """What the pipeline (:mod:`fkopt.experiment.kinds`) needs to know about one kind of config:
+    how to read and check it, the tasks it turns into (:class:`Plan`) and how their records
+    become the result that :func:`fkopt.outputs.write_outputs` writes. Running, task files,
+    resuming, writing aside and swapping in, and rerunning for ``fkopt check`` are the pipeline's.
+    Defined here, below every kind's module, so the kinds and the registry of kinds
+    (:data:`fkopt.experiment.kinds.KINDS`) import downwards only."""
+
+    name: str
+    from_dict: Callable[[dict, str], Any]          # (mapping, where) -> validated config
+    validate: Callable[[Any], tuple[int, int]]     # config -> (tasks, estimated bytes); no work done
+    plan: Callable[..., Plan]                      # (config, source, timing=True) -> its tasks
+    #: (config, plan, ran, source=, timing=, folder=) -> the result object the writers read
+    merge: Callable[..., Any]
 
 
 @dataclass
@@ -83,15 +99,10 @@ def work_folder(out: str | Path, config) -> Path:
     return Path(out) / paper / f".{name}.partial"
 
 
-def _load(ref: str) -> Callable:
-    module, attr = ref.split(":")
-    return getattr(importlib.import_module(module), attr)
-
-
-def run_remote(item: tuple[str, str, Any]) -> tuple[str, Any]:
-    """Worker entry: ``(solve ref, task id, payload) -> (task id, record)``."""
-    ref, ident, payload = item
-    return ident, _load(ref)(payload)
+def run_remote(item: tuple[Callable[[Any], Any], str, Any]) -> tuple[str, Any]:
+    """Worker entry: ``(worker function, task id, payload) -> (task id, record)``."""
+    solve, ident, payload = item
+    return ident, solve(payload)
 
 
 def sha256(path: Path) -> str:

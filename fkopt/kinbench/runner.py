@@ -30,7 +30,7 @@ import pandas as pd
 from ..errors import FkoptError
 from ..experiment.config import RunConfig
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
-from ..experiment.tasks import Plan, Ran, Task
+from ..experiment.tasks import Plan, Ran, Task, run_tasks
 from ..solve import chunk_size
 from .budget import at_budget, budget_of
 from .config import SuiteConfig, suite_from_dict
@@ -196,7 +196,7 @@ def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
     tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
-    return Plan(tasks, "fkopt.kinbench.runner:solve_task", fingerprint=fp, stored=True, check=record_problem,
+    return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
                 context=_Context(sets, manifest, started), name=f"suite '{config.name}'")
 
 
@@ -222,5 +222,6 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
     """Every (problem, solver) task computed (no task files, nothing written), then the
     imported outside results: the suite's result (``fkopt suite`` runs it through
     :func:`fkopt.experiment.kinds.run_config`, which keeps task files and resumes)."""
-    from ..experiment.kinds import run_in_memory
-    return run_in_memory(config, source, progress=progress, jobs=jobs, executor=executor, scheduler=scheduler)
+    plan = suite_plan(config, source)
+    ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, progress=progress)
+    return merge_suite(config, plan, ran, source=source)

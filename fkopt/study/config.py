@@ -224,9 +224,3 @@ def _study_error(err: ValidationError, data: dict) -> str:
 def load_study(path: str | Path) -> StudyConfig:
     """Read and validate a study file (``kind: study``)."""
     return study_from_dict(load_mapping(path, "study fields"), str(path))
-
-
-def load_any(path: str | Path):
-    """An experiment, study or assembly config, by the file's ``kind`` (:mod:`fkopt.experiment.kinds`)."""
-    from ..experiment.kinds import load_any as load
-    return load(path)

@@ -1,14 +1,14 @@
 """Studies as a kind of the one config pipeline (:mod:`fkopt.experiment.kinds`)."""
 from __future__ import annotations
 
-from ..experiment.kinds import Kind
+from ..experiment.kind import algorithm_resources
+from ..experiment.tasks import Kind
+from ..solve import batch_bytes, chunk_size
 from .config import StudyConfig, study_from_dict
+from .runner import merge_study, plan_tasks, study_plan, validate_study
 
 
 def _validate(config: StudyConfig) -> tuple[int, int]:
-    from ..experiment.kinds import algorithm_resources
-    from ..solve import batch_bytes, chunk_size
-    from .runner import plan_tasks, validate_study
     mech, poses = validate_study(config)
     dim, n = len(mech.unknown_names), len(poses)
     # rows of one solve: a chunk of poses x runs, or (tracking) the trajectories x runs of a step
@@ -25,14 +25,4 @@ def _validate(config: StudyConfig) -> tuple[int, int]:
     return len(plan_tasks(config, n)), work + kept
 
 
-def _plan(config: StudyConfig, source):
-    from .runner import study_plan
-    return study_plan(config, source)
-
-
-def _merge(config: StudyConfig, plan, ran, **options):
-    from .runner import merge_study
-    return merge_study(config, plan, ran, **options)
-
-
-STUDY = Kind("study", lambda data, where: study_from_dict(data, where), _validate, _plan, _merge)
+STUDY = Kind("study", study_from_dict, _validate, study_plan, merge_study)

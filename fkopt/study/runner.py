@@ -335,7 +335,7 @@ def study_plan(config: StudyConfig, source: str | None = None) -> Plan:
     by_id = {t.id: t for t in tasks}
     dim = len(mech.unknown_names)
     return Plan([RunnerTask(t.id, payload(config, t), _label(config, t)) for t in tasks],
-                "fkopt.study.runner:run_task", fingerprint=config.fingerprint(), stored=True, keep=True,
+                run_task, fingerprint=config.fingerprint(), stored=True, keep=True,
                 check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, dim),
                 context=_Context(mech, poses, started), name=f"study '{config.name}'")
 
@@ -346,27 +346,3 @@ def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None
     return StudyResult(config, ctx.mech, ctx.poses, merge(config, ctx.mech, ctx.poses, ran.records),
                        time.perf_counter() - ctx.started, source, list(ran.computed), folder)
 
-
-def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
-              scheduler: str | None = None, resume: bool = False,
-              progress: Callable[[str, int, int], None] | None = None, source: str | None = None,
-              keep_tasks: bool = True) -> StudyResult:
-    """Run (or resume) a study into ``OUT/<paper>/<name>/`` through the one pipeline
-    (:func:`fkopt.experiment.kinds.run_config`; the library call replaces an earlier result of
-    any config, as ``--force`` does).
-
-    ``progress(label, done, total)`` is called after each finished task (``done`` counts the
-    tasks already on disk too). An exception raised by it (e.g. KeyboardInterrupt) stops the
-    study; every task finished so far stays in the work folder for ``resume=True``, and a
-    previous result stays complete. ``keep_tasks=False`` drops the task files once the study
-    is written (``fkopt reproduce``).
-    """
-    from ..experiment.kinds import run_config
-    return run_config(config, out, source=source, progress=progress, force=True, jobs=jobs, executor=executor,
-                      scheduler=scheduler, resume=resume, keep_tasks=keep_tasks).result
-
-
-def rerun_in_memory(config: StudyConfig) -> StudyResult:
-    """Every task computed in this process, nothing written (for checks and tests)."""
-    from ..experiment.kinds import run_in_memory
-    return run_in_memory(config)
