@@ -100,6 +100,8 @@ import numpy as np
 
 from .errors import FkoptError
 from .mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
+from .numerics import path as numerics_path
+from .numerics.dls import inverse_candidates, rotation_error1
 from .problems import so3_right_jacobian_inverse
 
 #: Default forward tolerance: max |ik(pose) - joints| in the joint units.
@@ -638,155 +640,7 @@ def _uniform_hash(seed: int, row: np.ndarray, draw: np.ndarray, n: int) -> np.nd
     return (z >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
 
 
-def _rotation_error1(R, T):
-    """:func:`_rotation_error` of one pair of rotations given as 3 rows of 3 floats."""
-    # M = R T^T entry by entry (written out: this runs once per iteration of a one-pose inverse)
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
-    (t00, t01, t02), (t10, t11, t12), (t20, t21, t22) = T
-    v0 = (r20 * t10 + r21 * t11 + r22 * t12) - (r10 * t20 + r11 * t21 + r12 * t22)
-    v1 = (r00 * t20 + r01 * t21 + r02 * t22) - (r20 * t00 + r21 * t01 + r22 * t02)
-    v2 = (r10 * t00 + r11 * t01 + r12 * t02) - (r00 * t10 + r01 * t11 + r02 * t12)
-    s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-    c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
-               + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
-    k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
-    return v0 * k, v1 * k, v2 * k
-
-
-_DLS: dict = {}
-
-
-def _dls_function(n: int):
-    """``dls(J, r, mu) -> d`` for a 6 x n Jacobian on Python floats: d = J^T (J J^T + mu I)^{-1} (-r)
-    by Cholesky, or None when J J^T + mu I is not positive definite or d not finite; and
-    ``trace6(J)`` = sum of J's squared entries / 6. Written out once per n (straight-line source,
-    as ``namedtuple`` builds its class) with the additions in the order of the loops it replaced
-    (dot products summed left to right from 0; Cholesky L row by row, then forward and back
-    substitution), so the answers are those loops' to the bit; a one-pose inverse spends most of
-    its time here and in the arm's ``frame_jacobian1``."""
-    got = _DLS.get(n)
-    if got is not None:
-        return got
-    R = range(6)
-    src = ["def dls(J, r, mu):", "    " + ", ".join(f"J{a}" for a in R) + " = J",
-           *(f"    " + ", ".join(f"J{a}_{i}" for i in range(n)) + f", = J{a}" for a in R),
-           "    " + ", ".join(f"b{a}" for a in R) + " = " + ", ".join(f"-r[{a}]" for a in R)]
-    dot = lambda a, b: " + ".join(f"J{a}_{i} * J{b}_{i}" for i in range(n))   # noqa: E731
-    for a in R:
-        for b in range(a, 6):
-            src.append(f"    A{a}{b} = {dot(a, b)}" + (" + mu" if a == b else ""))
-    for i in R:                                        # Cholesky, row by row
-        for j in range(i + 1):
-            prev = " + ".join(f"L{i}{k} * L{j}{k}" for k in range(j))
-            acc = f"A{j}{i} - ({prev})" if prev else f"A{j}{i} - 0"
-            if i == j:
-                src += [f"    acc = {acc}", "    if not acc > 0.0:", "        return None",
-                        f"    L{i}{i} = sqrt(acc)"]
-            else:
-                src.append(f"    L{i}{j} = ({acc}) / L{j}{j}")
-    for i in R:
-        prev = " + ".join(f"L{i}{k} * y{k}" for k in range(i))
-        src.append(f"    y{i} = (b{i} - ({prev or 0})) / L{i}{i}")
-    for i in reversed(R):
-        acc = f"y{i}" + "".join(f" - L{k}{i} * x{k}" for k in range(i + 1, 6))
-        src.append(f"    x{i} = ({acc}) / L{i}{i}")
-    src.append("    if not (" + " and ".join(f"isfinite(x{a})" for a in R) + "):")
-    src.append("        return None")
-    src.append("    return [" + ", ".join(" + ".join(f"J{a}_{i} * x{a}" for a in R) for i in range(n)) + "]")
-    src.append("def trace6(J):")
-    src.append("    return (" + " + ".join(f"J[{a}][{i}] * J[{a}][{i}]" for a in R for i in range(n)) + ") / 6.0")
-    scope = {"sqrt": math.sqrt, "isfinite": math.isfinite}
-    exec(compile("\n".join(src), f"<fkopt.kinematics dls n={n}>", "exec"), scope)
-    got = _DLS[n] = (scope["dls"], scope["trace6"])
-    return got
-
-
-def _inverse_scalar(m, pt, Rt, L, start_of, budget, tp, tr, iterations, damping, down, up,
-                    step_cap, lo, hi, W=None):
-    """The damped least-squares iteration of :func:`inverse` for one pose on Python floats
-    (the arm's ``frame_jacobian1``, 6x6 eliminations), candidates one after another in the
-    order of ``start_of(j)``: the same step, damping update, saturation in the null space and
-    restart rule as the batched loop. For one pose numpy's per-call overhead is most of the
-    cost of the batched loop. ``W``: the task mask of :func:`inverse` (6 floats 0/1) or None.
-    Returns (best joints (n,) radians, starts used, evaluations)."""
-    n = m.dof
-    fj = m.frame_jacobian1
-    t0, t1, t2 = (float(v) for v in pt)
-    T = [[float(v) for v in row] for row in Rt]
-    lo, hi = lo.tolist(), hi.tolist()
-    evals = 0
-
-    def evaluate(q):
-        p, R, J = fj(q)
-        e0, e1, e2 = _rotation_error1(R, T)
-        d0, d1, d2 = p[0] - t0, p[1] - t1, p[2] - t2
-        if W is not None:                              # masked task: those rows do not count
-            d0, d1, d2, e0, e1, e2 = d0 * W[0], d1 * W[1], d2 * W[2], e0 * W[3], e1 * W[4], e2 * W[5]
-            J = [[v * w for v in row] for row, w in zip(J, W)]
-        r = [d0, d1, d2, L * e0, L * e1, L * e2]
-        J[3] = [v * L for v in J[3]]
-        J[4] = [v * L for v in J[4]]
-        J[5] = [v * L for v in J[5]]
-        return (r, J, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
-                d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
-
-    dls0, trace6 = _dls_function(n)
-
-    def dls(J, r, mu, fixed=None):
-        """d = Jf^T (Jf Jf^T + mu I)^{-1} (-r), Jf = J without the columns in ``fixed``."""
-        if fixed:
-            J = [[0.0 if i in fixed else v for i, v in enumerate(row)] for row in J]
-        return dls0(J, r, mu)
-
-    best_q, best_m = None, math.inf
-    allc = list(range(n))
-    for j in range(budget):
-        q = start_of(j)
-        r, J, pe, re, S = evaluate(q)
-        evals += 1
-        lam = damping
-        for _ in range(iterations):
-            if pe <= tp and re <= tr:
-                break
-            tr6 = trace6(J)
-            mu = lam * tr6
-            d = dls(J, r, mu)
-            if d is None:
-                break
-            big = max(map(abs, d))
-            if big > step_cap:
-                d = [v * (step_cap / big) for v in d]
-            qn = [a + b for a, b in zip(q, d)]
-            out = [i for i in allc if qn[i] < lo[i] or qn[i] > hi[i]]
-            if out:                                    # saturation in the null space
-                fixed = {}
-                for _ in range(2):
-                    for i in out:
-                        fixed[i] = min(max(qn[i], lo[i]), hi[i]) - q[i]
-                    rr = [r[a] + sum(J[a][i] * f for i, f in fixed.items()) for a in range(6)]
-                    ds = dls(J, rr, mu, fixed)
-                    if ds is None:
-                        break
-                    qn = [q[i] + (fixed[i] if i in fixed else ds[i]) for i in allc]
-                    out = [i for i in allc if i not in fixed and (qn[i] < lo[i] or qn[i] > hi[i])]
-                    if not out:
-                        break
-                qn = [min(max(v, a), b) for v, a, b in zip(qn, lo, hi)]
-            rn, Jn, pen, ren, Sn = evaluate(qn)
-            evals += 1
-            if Sn < S:
-                q, r, J, pe, re, S = qn, rn, Jn, pen, ren, Sn
-                lam = max(lam * down, 1e-12)
-            else:
-                lam *= up
-                if lam > 1e6:
-                    break
-        merit = max(pe / tp, re / tr)
-        if merit < best_m:
-            best_q, best_m = q, merit
-        if pe <= tp and re <= tr:
-            return np.array(best_q), j + 1, evals
-    return np.array(best_q), budget, evals
+_rotation_error1 = rotation_error1
 
 
 _TABLES: dict = {}
@@ -947,9 +801,9 @@ def _arm_constants(m) -> dict:
 
 
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
-                 down, up, step_cap, W=None) -> InverseResult:
+                 down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
-    Python floats (:func:`_inverse_scalar`), the same starts in the same order (``start``, then
+    Python floats (:func:`fkopt.numerics.dls.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
     first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
     batch's bookkeeping costs more than the iteration itself for a single pose."""
@@ -998,9 +852,23 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         return (lo + (hi - lo) * _uniform_hash(seed, np.zeros(1, dtype=np.intp),
                                                np.array([j - own0 - nn]), n)[0]).tolist()
 
-    bq, used, ne = _inverse_scalar(m, pose[:3], Rt, L, start_of, budget, tp, tr, iterations,
-                                   damping, down, up, step_cap, c["slo"], c["shi"],
-                                   None if W is None else W.tolist())
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None:
+        # the same starts as start_of, as arrays: the table's neighbours looked up now
+        if nn:
+            start_of(own0)
+            near_q = np.ascontiguousarray(near[-1]["q"][near[:-1]])
+        else:
+            near_q = np.empty((0, n))
+        Wc = np.ones(6) if W is None else np.asarray(W, dtype=float)
+        bq, used, ne = fast.inverse_one(m.chain(), np.asarray(pose[:3], dtype=float), np.array(Rt), L, Wc,
+                                        np.asarray(q0, dtype=float), own0, near_q, seed, budget, tol, iterations,
+                                        damping, down, up, step_cap, c["slo"], c["shi"], lo, hi)
+    else:
+        bq, used, ne = inverse_candidates(m.frame_jacobian1, [float(v) for v in pose[:3]], Rt, L, start_of, budget,
+                                          tol, iterations, damping, down, up, step_cap, c["slo"].tolist(),
+                                          c["shi"].tolist(), None if W is None else W.tolist())
+        bq = np.array(bq)
     if start is not None and (n > 6 or W is not None):   # self-motion towards the start
         p1, R1, _ = m.frame_jacobian1(bq.tolist())
         if _solved1(p1, R1, (x, y, z), Rt, W, tol):
@@ -1030,7 +898,8 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
-            table: int = 4096, neighbours: int = 32, tail: int = 256) -> InverseResult:
+            table: int = 4096, neighbours: int = 32, tail: int = 256, compiled: bool | None = None,
+            options=None) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
@@ -1054,8 +923,18 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     candidate before it restarts. ``table``: size of the start table (0: no table, starts at
     ``start`` or mid-range, then random); ``neighbours``: table configurations kept per row for
     restarts beyond its first starts; ``fill`` / ``tail``: candidates side by side for small
-    batches / when few remain. See the module docstring.
+    batches / when few remain. ``compiled``: one pose through the compiled loop
+    (:mod:`fkopt.numerics.compiled`; None: when numba is there and ``FKOPT_NUMERICS`` is not
+    ``numpy``; same answers as the Python loop). ``options``: an
+    :class:`fkopt.numerics.InverseOptions` holding all of the above at once (it replaces the
+    keywords). See the module docstring.
     """
+    if options is not None:
+        o = options.as_dict()
+        restarts, starts, rest, orientation_scale = o["restarts"], o["starts"], o["rest"], o["orientation_scale"]
+        iterations, damping, step_cap, down, up = o["iterations"], o["damping"], o["step_cap"], o["down"], o["up"]
+        fill, exact_rotation, table, neighbours = o["fill"], o["exact_rotation"], o["table"], o["neighbours"]
+        tail, compiled = o["tail"], o["compiled"]
     m = _mechanism(arm, SerialMechanism, "inverse")
     if not hasattr(m, "frame_jacobian"):
         raise FkoptError(f"inverse needs an arm with an analytic frame Jacobian; '{m.name}' has none "
@@ -1071,7 +950,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
                             int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
                             + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap,
-                            _task_mask(mask))
+                            _task_mask(mask), compiled)
     shape = P0.shape[:-1]
     P = P0.reshape(-1, 6)
     N, n = len(P), m.dof
@@ -1169,8 +1048,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         def start_of(j):
             return starts_for(np.zeros(1, dtype=np.intp), np.array([j]))[0].tolist()
 
-        bq, nused, ne = _inverse_scalar(m, pt[0], Rt[0], L, start_of, budget, tp, tr, iterations,
-                                        damping, down, up, step_cap, slo, shi)
+        bq, nused, ne = inverse_candidates(m.frame_jacobian1, pt[0].tolist(), Rt[0].tolist(), L, start_of, budget,
+                                           (tp, tr), iterations, damping, down, up, step_cap, slo.tolist(),
+                                           shi.tolist())
+        bq = np.array(bq)
         best_q, used = bq[None], np.array([nused], dtype=np.int64)
         K = 1                                          # restarts: starts after the first
         ev_r = np.array([ne], dtype=np.int64)

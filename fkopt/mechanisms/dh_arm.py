@@ -277,6 +277,14 @@ class DHArm(FrameArm):
         return (np.ascontiguousarray(p.T), np.ascontiguousarray(R.transpose(1, 0, 2)),
                 np.ascontiguousarray(J.transpose(2, 0, 1)))
 
+    def chain(self):
+        """The DH table as a :class:`fkopt.numerics.chain.Chain` (same numbers as :meth:`frame_jacobian1`)."""
+        got = self.__dict__.get("_chain_arrays")
+        if got is None:
+            from ..numerics.chain import from_dh
+            got = self.__dict__["_chain_arrays"] = from_dh(self._a, self._d, self._ca, self._sa, self._offset_rad)
+        return got
+
     def kinematic_key(self) -> tuple:
         """The DH table's numbers (no pydantic model needed)."""
         return (self.name, self._a, self._d, self._ca, self._sa, self._offset)

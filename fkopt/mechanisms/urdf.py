@@ -40,6 +40,7 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from ..errors import FkoptError, did_you_mean
+from ..numerics.chain import frame_jacobian1, from_terms
 from .base import FrameArm, Geometry, describe_validation_error
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.urdf"
@@ -231,72 +232,6 @@ def _offset(cols, v):
     return acc
 
 
-def _lin(terms) -> str:
-    """Source of a sum ``c1 * n1 + c2 * n2 ...`` of named floats (coefficients +-1 written as signs)."""
-    out = ""
-    for name, v in terms:
-        if v == 0.0:
-            continue
-        t = name if abs(v) == 1.0 else f"{name} * {abs(v)!r}"
-        out += (" - " if v < 0 else " + ") + t if out else ("-" if v < 0 else "") + t
-    return out or "0.0"
-
-
-def _compile1(joints, tail, dof):
-    """A function t -> (p, R, J) on Python floats: :meth:`URDFArm._walk` and the Jacobian of
-    :meth:`URDFArm.frame_jacobian` unrolled for one arm's constants (zero terms dropped, +-1
-    factors as signs, the columns' names permuted instead of copied), like ``namedtuple``
-    builds its class from source. Frame columns are x0..x2, y0..y2, z0..z2, position p0..p2."""
-    src = ["def fj1(t):", "    x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0",
-           "    p0 = p1 = p2 = 0.0"]
-    names = ("x", "y", "z")
-
-    def offset(v):
-        for r in range(3):
-            e = _lin([(f"{names[m]}{r}", v[m]) for m in range(3)])
-            if e != "0.0":
-                src.append(f"    p{r} = p{r} + ({e})")
-
-    def combine(terms):
-        new = [_lin([(f"{names[m]}{r}", v) for m, v in terms[c]]) for c in range(3) for r in range(3)]
-        src.append("    x0, x1, x2, y0, y1, y2, z0, z1, z2 = " + ", ".join(new))
-
-    cols = {}
-    for i, (prismatic, terms, v, var, mult, off) in enumerate(joints):
-        src.append(f"    q = t[{var}]" + (f" * {mult!r} + {off!r}" if (mult, off) != (1.0, 0.0) else ""))
-        offset(v)
-        combine(terms)
-        src.append(f"    a{i}0, a{i}1, a{i}2, o{i}0, o{i}1, o{i}2 = z0, z1, z2, p0, p1, p2")
-        if prismatic:
-            src.append("    p0, p1, p2 = p0 + z0 * q, p1 + z1 * q, p2 + z2 * q")
-        else:
-            src.append("    c, s = cos(q), sin(q)")
-            src.append("    x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, "
-                       "y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)")
-        cols.setdefault(var, []).append((i, prismatic, mult))
-    offset(tail[1])
-    combine(tail[0])
-    rows = [[] for _ in range(6)]
-    for var in range(dof):
-        parts = [[] for _ in range(6)]
-        for i, prismatic, mult in cols.get(var, []):
-            k = "" if mult == 1.0 else f" * {mult!r}"
-            if prismatic:
-                col = (f"a{i}0", f"a{i}1", f"a{i}2", None, None, None)
-            else:
-                d = (f"(p0 - o{i}0)", f"(p1 - o{i}1)", f"(p2 - o{i}2)")
-                col = (f"(a{i}1 * {d[2]} - a{i}2 * {d[1]})", f"(a{i}2 * {d[0]} - a{i}0 * {d[2]})",
-                       f"(a{i}0 * {d[1]} - a{i}1 * {d[0]})", f"a{i}0", f"a{i}1", f"a{i}2")
-            for r in range(6):
-                if col[r] is not None:
-                    parts[r].append(col[r] + k)
-        for r in range(6):
-            rows[r].append(" + ".join(parts[r]) or "0.0")
-    src.append("    return [p0, p1, p2], [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]], ["
-               + ", ".join("[" + ", ".join(row) + "]" for row in rows) + "]")
-    scope = {"cos": math.cos, "sin": math.sin}
-    exec(compile("\n".join(src), "<fkopt.urdf frame_jacobian1>", "exec"), scope)
-    return scope["fj1"]
 
 
 class URDFArm(FrameArm):
@@ -540,12 +475,16 @@ class URDFArm(FrameArm):
     def frame_jacobian1(self, t) -> tuple[list[float], list[list[float]], list[list[float]]]:
         """:meth:`frame_jacobian` of one configuration on Python floats, in internal units (``t``
         in rad for angles, m for lengths; the Jacobian per rad / per m): the recursion of
-        :meth:`_walk` written out for this arm's constants (:func:`_compile1`, once per arm),
-        since for one configuration the interpreter's per-operation cost is all there is."""
-        f = self.__dict__.get("_fj1")
-        if f is None:
-            f = self.__dict__["_fj1"] = _compile1(self._joints, self._tail, self.dof)
-        return f(t)
+        :meth:`_walk` on the arm's constants as a :class:`fkopt.numerics.chain.Chain`
+        (:func:`fkopt.numerics.chain.frame_jacobian1`; compiled: :mod:`fkopt.numerics.compiled`)."""
+        return frame_jacobian1(self.chain(), t)
+
+    def chain(self):
+        """The chain as arrays (:class:`fkopt.numerics.chain.Chain`) for the numerics kernels."""
+        got = self.__dict__.get("_chain_arrays")
+        if got is None:
+            got = self.__dict__["_chain_arrays"] = from_terms(self._joints, self._tail, self.dof)
+        return got
 
     def describe(self) -> dict[str, Any]:
         out = super().describe()

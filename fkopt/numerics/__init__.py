@@ -1,0 +1,15 @@
+"""fkopt's numerics, once each: serial-chain kinematics, the damped least-squares step and
+joint-limit handling of ``fkopt.inverse``, its options, and the compiled fast path.
+
+* :mod:`.chain` -- a serial chain as arrays (fixed transforms and joints about/along axes,
+  possibly mimic-coupled): DH tables, URDF chains and MJCF bodies all reduce to it; FK and the
+  geometric frame Jacobian of one configuration on Python floats (the reference).
+* :mod:`.dls` -- the damped least-squares step d = J^T (J J^T + mu I)^{-1} (-r) by Cholesky on
+  Python floats, and the saturation of joint limits in the null space.
+* :mod:`.options` -- :class:`InverseOptions`, the documented options of ``fkopt.inverse``.
+* :mod:`.compiled` -- the same kernels and the whole one-pose IK loop (restarts included)
+  compiled by numba (imported lazily, only when first used; cached on disk).
+* :mod:`.path` -- which path runs (``FKOPT_NUMERICS=numpy`` forces the numpy/Python reference)
+  and what ``env.json`` records about it.
+"""
+from .options import InverseOptions  # noqa: F401

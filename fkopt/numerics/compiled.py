@@ -1,0 +1,353 @@
+"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.dls` compiled by
+numba, operation for operation in the reference's order (numba compiles without fast-math, so no
+reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` are the C library's,
+as Python's ``math``). Importing this module imports numba (~0.5 s); :mod:`fkopt.numerics.path`
+imports it only when a compiled kernel is first asked for.
+
+Compiled code is cached on disk (``cache=True``): in the ``__pycache__`` folder beside this file,
+or, when that is not writable, numba's user-wide cache (``~/.cache/numba`` style; ``NUMBA_CACHE_DIR``
+overrides both). The first call after installing compiles (measured by ``fkopt bench --section
+numerics``); later processes load the cache.
+
+* :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
+* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
+  start (given start, start-table neighbours, seeded hash draws) and restart inside;
+* :func:`inverse_rows` -- the same loop for many poses, one row after another (``prange`` over
+  rows when numba's threading layer has more than one thread); row i draws its random starts as
+  row i of ``fkopt.inverse``'s hash.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+_M1 = np.uint64(0x9E3779B97F4A7C15)
+_M2 = np.uint64(0xBF58476D1CE4E5B9)
+_M3 = np.uint64(0x94D049BB133111EB)
+
+
+@njit(cache=True)
+def _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax):
+    """FK and Jacobian into p (3), R (3, 3) and J (6, n) (see :func:`fkopt.numerics.chain.frame_jacobian1`)."""
+    x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    m = prismatic.shape[0]
+    for i in range(m):
+        q = t[var[i]] * mult[i] + off[i]
+        v0, v1, v2 = v[i, 0], v[i, 1], v[i, 2]
+        p0, p1, p2 = (p0 + (x0 * v0 + y0 * v1 + z0 * v2), p1 + (x1 * v0 + y1 * v1 + z1 * v2),
+                      p2 + (x2 * v0 + y2 * v1 + z2 * v2))
+        c00, c01, c02 = C[i, 0, 0], C[i, 0, 1], C[i, 0, 2]
+        c10, c11, c12 = C[i, 1, 0], C[i, 1, 1], C[i, 1, 2]
+        c20, c21, c22 = C[i, 2, 0], C[i, 2, 1], C[i, 2, 2]
+        x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
+            x0 * c00 + y0 * c10 + z0 * c20, x1 * c00 + y1 * c10 + z1 * c20, x2 * c00 + y2 * c10 + z2 * c20,
+            x0 * c01 + y0 * c11 + z0 * c21, x1 * c01 + y1 * c11 + z1 * c21, x2 * c01 + y2 * c11 + z2 * c21,
+            x0 * c02 + y0 * c12 + z0 * c22, x1 * c02 + y1 * c12 + z1 * c22, x2 * c02 + y2 * c12 + z2 * c22)
+        ax[i, 0], ax[i, 1], ax[i, 2], ax[i, 3], ax[i, 4], ax[i, 5] = z0, z1, z2, p0, p1, p2
+        if prismatic[i]:
+            p0, p1, p2 = p0 + z0 * q, p1 + z1 * q, p2 + z2 * q
+        else:
+            c, s = math.cos(q), math.sin(q)
+            x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
+                                      y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
+    v0, v1, v2 = tv[0], tv[1], tv[2]
+    p0, p1, p2 = (p0 + (x0 * v0 + y0 * v1 + z0 * v2), p1 + (x1 * v0 + y1 * v1 + z1 * v2),
+                  p2 + (x2 * v0 + y2 * v1 + z2 * v2))
+    c00, c01, c02 = tC[0, 0], tC[0, 1], tC[0, 2]
+    c10, c11, c12 = tC[1, 0], tC[1, 1], tC[1, 2]
+    c20, c21, c22 = tC[2, 0], tC[2, 1], tC[2, 2]
+    x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
+        x0 * c00 + y0 * c10 + z0 * c20, x1 * c00 + y1 * c10 + z1 * c20, x2 * c00 + y2 * c10 + z2 * c20,
+        x0 * c01 + y0 * c11 + z0 * c21, x1 * c01 + y1 * c11 + z1 * c21, x2 * c01 + y2 * c11 + z2 * c21,
+        x0 * c02 + y0 * c12 + z0 * c22, x1 * c02 + y1 * c12 + z1 * c22, x2 * c02 + y2 * c12 + z2 * c22)
+    p[0], p[1], p[2] = p0, p1, p2
+    R[0, 0], R[0, 1], R[0, 2] = x0, y0, z0
+    R[1, 0], R[1, 1], R[1, 2] = x1, y1, z1
+    R[2, 0], R[2, 1], R[2, 2] = x2, y2, z2
+    J[:, :] = 0.0
+    for i in range(m):
+        a0, a1, a2 = ax[i, 0], ax[i, 1], ax[i, 2]
+        k, w = var[i], mult[i]
+        if prismatic[i]:
+            J[0, k] += a0 * w
+            J[1, k] += a1 * w
+            J[2, k] += a2 * w
+            J[3, k] += 0.0 * w
+            J[4, k] += 0.0 * w
+            J[5, k] += 0.0 * w
+        else:
+            d0, d1, d2 = p0 - ax[i, 3], p1 - ax[i, 4], p2 - ax[i, 5]
+            J[0, k] += (a1 * d2 - a2 * d1) * w
+            J[1, k] += (a2 * d0 - a0 * d2) * w
+            J[2, k] += (a0 * d1 - a1 * d0) * w
+            J[3, k] += a0 * w
+            J[4, k] += a1 * w
+            J[5, k] += a2 * w
+
+
+@njit(cache=True)
+def _frame_jacobian(prismatic, C, v, var, mult, off, tC, tv, t, n):
+    p = np.empty(3)
+    R = np.empty((3, 3))
+    J = np.empty((6, n))
+    ax = np.empty((prismatic.shape[0], 6))
+    _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax)
+    return p, R, J
+
+
+def frame_jacobian(chain, t):
+    """(p (3,), R (3, 3), J (6, n)) of one configuration ``t`` (internal units) as arrays."""
+    return _frame_jacobian(*chain.arrays(), np.ascontiguousarray(t, dtype=float), chain.dof)
+
+
+@njit(cache=True)
+def _frame_jacobian_rows(prismatic, C, v, var, mult, off, tC, tv, t, n):
+    k = t.shape[0]
+    P = np.empty((k, 3))
+    R = np.empty((k, 3, 3))
+    J = np.empty((k, 6, n))
+    ax = np.empty((prismatic.shape[0], 6))
+    for i in range(k):
+        _walk(prismatic, C, v, var, mult, off, tC, tv, t[i], P[i], R[i], J[i], ax)
+    return P, R, J
+
+
+def frame_jacobian_rows(chain, t):
+    """:func:`frame_jacobian` of rows t (k, n): (k, 3), (k, 3, 3), (k, 6, n)."""
+    return _frame_jacobian_rows(*chain.arrays(), np.ascontiguousarray(t, dtype=float), chain.dof)
+
+
+@njit(cache=True)
+def _rotation_error(R, T, e):
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2],
+                                                   R[2, 0], R[2, 1], R[2, 2])
+    t00, t01, t02, t10, t11, t12, t20, t21, t22 = (T[0, 0], T[0, 1], T[0, 2], T[1, 0], T[1, 1], T[1, 2],
+                                                   T[2, 0], T[2, 1], T[2, 2])
+    v0 = (r20 * t10 + r21 * t11 + r22 * t12) - (r10 * t20 + r11 * t21 + r12 * t22)
+    v1 = (r00 * t20 + r01 * t21 + r02 * t22) - (r20 * t00 + r21 * t01 + r22 * t02)
+    v2 = (r10 * t00 + r11 * t01 + r12 * t02) - (r00 * t10 + r01 * t11 + r02 * t12)
+    s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+    c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
+               + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
+    k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
+    e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
+
+
+@njit(cache=True)
+def _dls_step(J, r, mu, free, d, A, L, y, x):
+    """:func:`fkopt.numerics.dls.dls_step` into d; J's columns with free[i] = False count as zero.
+    Returns False when not positive definite or not finite."""
+    n = J.shape[1]
+    for a in range(6):
+        for b in range(a, 6):
+            acc = (J[a, 0] if free[0] else 0.0) * (J[b, 0] if free[0] else 0.0)
+            for i in range(1, n):
+                acc = acc + (J[a, i] if free[i] else 0.0) * (J[b, i] if free[i] else 0.0)
+            A[a, b] = acc + mu if a == b else acc
+    for i in range(6):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(j):
+                acc = L[i, k] * L[j, k] if k == 0 else acc + L[i, k] * L[j, k]
+            acc = A[j, i] - acc
+            if i == j:
+                if not acc > 0.0:
+                    return False
+                L[i, i] = math.sqrt(acc)
+            else:
+                L[i, j] = acc / L[j, j]
+    for i in range(6):
+        acc = 0.0
+        for k in range(i):
+            acc = L[i, k] * y[k] if k == 0 else acc + L[i, k] * y[k]
+        y[i] = (-r[i] - acc) / L[i, i]
+    for i in range(5, -1, -1):
+        acc = y[i]
+        for k in range(i + 1, 6):
+            acc = acc - L[k, i] * x[k]
+        x[i] = acc / L[i, i]
+    for i in range(6):
+        if not math.isfinite(x[i]):
+            return False
+    for i in range(n):
+        ji = J[0, i] if free[i] else 0.0
+        acc = ji * x[0]
+        for a in range(1, 6):
+            acc = acc + (J[a, i] if free[i] else 0.0) * x[a]
+        d[i] = acc
+    return True
+
+
+@njit(cache=True)
+def _uniform_hash(seed, row, draw, out):
+    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics._uniform_hash` (SplitMix64's finaliser)."""
+    c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
+    for k in range(out.shape[0]):
+        z = c + np.uint64(k + 1) * _M2
+        z = (z ^ (z >> np.uint64(30))) * _M2
+        z = (z ^ (z >> np.uint64(27))) * _M3
+        z = z ^ (z >> np.uint64(31))
+        out[k] = np.float64(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True)
+def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
+    """Residual r (6), scaled Jacobian J (6, n) at t; returns (pe, re, S)."""
+    prismatic, C, v, var, mult, off, tC, tv = chain
+    _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax)
+    _rotation_error(R, T, e)
+    d0, d1, d2 = (p[0] - pt[0]) * W[0], (p[1] - pt[1]) * W[1], (p[2] - pt[2]) * W[2]
+    e0, e1, e2 = e[0] * W[3], e[1] * W[4], e[2] * W[5]
+    n = J.shape[1]
+    for a in range(6):
+        for i in range(n):
+            J[a, i] = J[a, i] * W[a]
+    r[0], r[1], r[2], r[3], r[4], r[5] = d0, d1, d2, Lw * e0, Lw * e1, Lw * e2
+    for a in range(3, 6):
+        for i in range(n):
+            J[a, i] = J[a, i] * Lw
+    return (math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
+            d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
+
+
+@njit(cache=True)
+def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr, iterations, damping, down, up,
+                 step_cap, lo, hi, glo, ghi, best_q):
+    """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
+    near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
+    (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
+    (starts used, evaluations)."""
+    n = q0.shape[0]
+    m = chain[0].shape[0]
+    nn = near.shape[0]
+    r, rn, rr = np.empty(6), np.empty(6), np.empty(6)
+    J, Jn = np.empty((6, n)), np.empty((6, n))
+    p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
+    A, Lc, y, x = np.empty((6, 6)), np.empty((6, 6)), np.empty(6), np.empty(6)
+    q, qn, d, ds, u = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    fixed_val = np.empty(n)
+    fixed_order = np.empty(n, dtype=np.int64)
+    free = np.ones(n, dtype=np.bool_)
+    allfree = np.ones(n, dtype=np.bool_)
+    evals = 0
+    best_m = math.inf
+    for j in range(budget):
+        if j < own0:
+            q[:] = q0
+        elif j < own0 + nn:
+            q[:] = near[j - own0]
+        else:
+            _uniform_hash(seed, row, j - own0 - nn, u)
+            for i in range(n):
+                q[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
+        pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e)
+        evals += 1
+        lam = damping
+        for _ in range(iterations):
+            if pe <= tp and re <= tr:
+                break
+            acc = 0.0
+            for a in range(6):
+                for i in range(n):
+                    acc = acc + J[a, i] * J[a, i]
+            mu = lam * (acc / 6.0)
+            if not _dls_step(J, r, mu, allfree, d, A, Lc, y, x):
+                break
+            big = abs(d[0])
+            for i in range(1, n):
+                big = max(big, abs(d[i]))
+            if big > step_cap:
+                f = step_cap / big
+                for i in range(n):
+                    d[i] = d[i] * f
+            anyout = False
+            for i in range(n):
+                qn[i] = q[i] + d[i]
+                if qn[i] < lo[i] or qn[i] > hi[i]:
+                    anyout = True
+            if anyout:                                  # saturation in the null space
+                nf = 0
+                for i in range(n):
+                    free[i] = True
+                for _pass in range(2):
+                    for i in range(n):
+                        if free[i] and (qn[i] < lo[i] or qn[i] > hi[i]):
+                            fixed_val[i] = min(max(qn[i], lo[i]), hi[i]) - q[i]
+                            fixed_order[nf] = i
+                            nf += 1
+                    for k in range(nf):
+                        free[fixed_order[k]] = False
+                    for a in range(6):
+                        acc = 0.0
+                        for k in range(nf):
+                            acc = acc + J[a, fixed_order[k]] * fixed_val[fixed_order[k]]
+                        rr[a] = r[a] + acc
+                    if not _dls_step(J, rr, mu, free, ds, A, Lc, y, x):
+                        break
+                    more = False
+                    for i in range(n):
+                        qn[i] = q[i] + (ds[i] if free[i] else fixed_val[i])
+                        if free[i] and (qn[i] < lo[i] or qn[i] > hi[i]):
+                            more = True
+                    if not more:
+                        break
+                for i in range(n):
+                    qn[i] = min(max(qn[i], lo[i]), hi[i])
+            pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e)
+            evals += 1
+            if Sn < S:
+                q[:] = qn
+                r[:] = rn
+                J[:, :] = Jn
+                pe, re, S = pen, ren, Sn
+                lam = max(lam * down, 1e-12)
+            else:
+                lam *= up
+                if lam > 1e6:
+                    break
+        merit = max(pe / tp, re / tr)
+        if merit < best_m or j == 0:                # the reference keeps the first finite merit
+            best_m = min(merit, best_m)
+            best_q[:] = q
+        if pe <= tp and re <= tr:
+            return j + 1, evals
+    return budget, evals
+
+
+def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iterations, damping, down, up,
+                step_cap, lo, hi, glo, ghi):
+    """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
+    best = np.empty(chain.dof)
+    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, int(seed), 0, int(budget),
+                               float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
+                               float(up), float(step_cap), lo, hi, glo, ghi, best)
+    return best, used, evals
+
+
+@njit(cache=True, parallel=True)
+def _inverse_rows(chain, pt, T, Lw, W, q0, own0, near, seed, budget, tp, tr, iterations, damping, down, up,
+                  step_cap, lo, hi, glo, ghi, best_q, used, evals):
+    for k in prange(pt.shape[0]):
+        u, e = _inverse_one(chain, pt[k], T[k], Lw, W, q0[k], own0, near[k], seed, k, budget, tp, tr, iterations,
+                            damping, down, up, step_cap, lo, hi, glo, ghi, best_q[k])
+        used[k] = u
+        evals[k] = e
+
+
+def inverse_rows(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iterations, damping, down, up,
+                 step_cap, lo, hi, glo, ghi):
+    """Rows of poses: pt (N, 3), T (N, 3, 3), q0 (N, n), near (N, nn, n); row k draws as row k."""
+    N = len(pt)
+    best = np.empty((N, chain.dof))
+    used = np.empty(N, dtype=np.int64)
+    evals = np.empty(N, dtype=np.int64)
+    _inverse_rows(chain.arrays(), np.ascontiguousarray(pt), np.ascontiguousarray(T), float(L), W,
+                  np.ascontiguousarray(q0), int(own0), np.ascontiguousarray(near), int(seed), int(budget),
+                  float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down), float(up),
+                  float(step_cap), lo, hi, glo, ghi, best, used, evals)
+    return best, used, evals

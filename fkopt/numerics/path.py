@@ -1,0 +1,57 @@
+"""Which numerics path runs: the compiled one (numba) or the numpy/Python reference.
+
+``FKOPT_NUMERICS=numpy`` in the environment forces the reference everywhere (tests, machines
+without numba); ``FKOPT_NUMERICS=compiled`` makes a missing numba an error instead of a silent
+fallback. Otherwise the compiled path runs when numba is importable. numba is imported on the
+first call that wants a compiled kernel, never at ``import fkopt`` (``import numba`` alone costs
+~0.5 s; a one-pose ``fkopt ik`` process keeps the reference, see :func:`fkopt.cli`).
+"""
+from __future__ import annotations
+
+import os
+
+from ..errors import FkoptError
+
+ENV = "FKOPT_NUMERICS"
+_STATE: dict = {}
+
+
+def requested() -> str:
+    """'auto', 'numpy' or 'compiled' from ``FKOPT_NUMERICS``."""
+    v = os.environ.get(ENV, "auto").strip().lower() or "auto"
+    if v not in ("auto", "numpy", "compiled"):
+        raise FkoptError(f"{ENV}={v!r}: allowed values auto, numpy, compiled")
+    return v
+
+
+def compiled(want: bool | None = None):
+    """The :mod:`fkopt.numerics.compiled` module when the compiled path runs, else None.
+    ``want``: True/False from an option (``InverseOptions.compiled``), None for the default."""
+    mode = requested()
+    if want is False or mode == "numpy":
+        return None
+    if "module" not in _STATE:
+        try:
+            from . import compiled as mod
+        except ImportError as err:
+            if mode == "compiled" or want:
+                raise FkoptError(f"the compiled numerics path needs numba ({err}); pip install numba, "
+                                 f"or set {ENV}=numpy") from None
+            mod = None
+        _STATE["module"] = mod
+    return _STATE["module"]
+
+
+def describe() -> dict:
+    """What ``env.json`` records: the path a default call takes in this process and numba's version."""
+    try:
+        from importlib.metadata import PackageNotFoundError, version
+        try:
+            nv = version("numba")
+        except PackageNotFoundError:
+            nv = None
+    except Exception:      # pragma: no cover - importlib.metadata is standard
+        nv = None
+    mode = requested()
+    path = "numpy" if mode == "numpy" or nv is None else "compiled"
+    return {"path": path, "numba": nv, "env": os.environ.get(ENV, "")}
