@@ -492,7 +492,10 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     else:
         from .kinematics import inverse
         q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
-        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed, start=q0, mask=mask)
+        # One pose per process: loading numba and its cache (~0.7 s) costs more than the compiled
+        # loop saves, so the command keeps the reference path (fkopt.numerics.path).
+        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed, start=q0, mask=mask,
+                    compiled=False)
         out = r.as_dict()
         out["algorithm"] = "inverse"
         perr, rerr = out["position_error"], out["rotation_error_rad"]

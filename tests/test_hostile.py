@@ -802,12 +802,12 @@ def test_a_second_run_of_the_same_name_meanwhile_is_refused(tmp_path, cli, monke
     """Run A computes; meanwhile run B of the same paper/name starts: B is refused with one line
     (A holds OUT/<paper>/.<name>.lock), A publishes, and no lock file is left behind."""
     from fkopt.errors import FkoptError
-    from fkopt.experiment import runner
+    from fkopt.experiment import kind as experiment_kind
     from fkopt.experiment.kinds import from_dict, run_config
     out = tmp_path / "out"
     cfg = tmp_path / "a.yaml"
     cfg.write_text(yaml_of({**BASE, "name": "same"}))
-    real, refused = runner.merge_experiment, []
+    real, refused = experiment_kind.merge_experiment, []
 
     def meanwhile(config, *args, **kw):
         if config.seed == 1:
@@ -815,7 +815,7 @@ def test_a_second_run_of_the_same_name_meanwhile_is_refused(tmp_path, cli, monke
                 run_config(from_dict({**BASE, "name": "same", "seed": 99}, "other"), out)
             refused.append(str(err.value))
         return real(config, *args, **kw)
-    monkeypatch.setattr(runner, "merge_experiment", meanwhile)
+    monkeypatch.setattr(experiment_kind, "merge_experiment", meanwhile)   # the experiment Kind's merge calls it
     (out / "test").mkdir(parents=True)
     (out / "test" / ".same.lock").write_text("")      # a stale lock of a killed run: taken over
     assert cli("run", cfg, "--out", out, "-q")[0] == 0
@@ -829,23 +829,23 @@ def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli
     computes; meanwhile run B (seed 99) publishes into the same paper/name. A must not replace
     B's result without --force: it is refused at publish time, one line."""
     import contextlib
-    from fkopt.experiment import kinds, runner
+    from fkopt.experiment import kind as experiment_kind, kinds
     from fkopt.experiment.kinds import from_dict, run_config
     monkeypatch.setattr(kinds, "run_lock", lambda out, folder: contextlib.nullcontext())
     out = tmp_path / "out"
     cfg = tmp_path / "a.yaml"
     cfg.write_text(yaml_of({**BASE, "name": "same"}))
-    real = runner.merge_experiment
+    real = experiment_kind.merge_experiment
 
     def meanwhile(config, *args, **kw):
         result = real(config, *args, **kw)
         if config.seed == 1:              # the other run finishes while this one computes
             run_config(from_dict({**BASE, "name": "same", "seed": 99}, "other"), out)
         return result
-    monkeypatch.setattr(runner, "merge_experiment", meanwhile)
+    monkeypatch.setattr(experiment_kind, "merge_experiment", meanwhile)
     one_line_error(cli("run", cfg, "--out", out, "-q"), "--force", "another fkopt run")
     assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 99
-    monkeypatch.setattr(runner, "merge_experiment", real)
+    monkeypatch.setattr(experiment_kind, "merge_experiment", real)
     assert cli("run", cfg, "--out", out, "-q", "--force")[0] == 0      # asked for: replaced
     assert json.loads((out / "test" / "same" / "meta.json").read_text())["seed"] == 1
 

@@ -1,27 +1,24 @@
 """The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.dls` compiled by
 numba, operation for operation in the reference's order (numba compiles without fast-math, so no
 reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` are the C library's,
-as Python's ``math``). Importing this module imports numba (~0.5 s); :mod:`fkopt.numerics.path`
-imports it only when a compiled kernel is first asked for.
+as Python's ``math``). Importing this module imports numba, which costs a noticeable part of a
+second; :mod:`fkopt.numerics.path` imports it only when a compiled kernel is first asked for.
 
 Compiled code is cached on disk (``cache=True``): in the ``__pycache__`` folder beside this file,
 or, when that is not writable, numba's user-wide cache (``~/.cache/numba`` style; ``NUMBA_CACHE_DIR``
-overrides both). The first call after installing compiles (measured by ``fkopt bench --section
-numerics``); later processes load the cache.
+overrides both). The first call after installing compiles (several seconds); later processes
+load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
 * :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
-* :func:`inverse_rows` -- the same loop for many poses, one row after another (``prange`` over
-  rows when numba's threading layer has more than one thread); row i draws its random starts as
-  row i of ``fkopt.inverse``'s hash.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -326,28 +323,4 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
     used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, int(seed), 0, int(budget),
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
-    return best, used, evals
-
-
-@njit(cache=True, parallel=True)
-def _inverse_rows(chain, pt, T, Lw, W, q0, own0, near, seed, budget, tp, tr, iterations, damping, down, up,
-                  step_cap, lo, hi, glo, ghi, best_q, used, evals):
-    for k in prange(pt.shape[0]):
-        u, e = _inverse_one(chain, pt[k], T[k], Lw, W, q0[k], own0, near[k], seed, k, budget, tp, tr, iterations,
-                            damping, down, up, step_cap, lo, hi, glo, ghi, best_q[k])
-        used[k] = u
-        evals[k] = e
-
-
-def inverse_rows(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iterations, damping, down, up,
-                 step_cap, lo, hi, glo, ghi):
-    """Rows of poses: pt (N, 3), T (N, 3, 3), q0 (N, n), near (N, nn, n); row k draws as row k."""
-    N = len(pt)
-    best = np.empty((N, chain.dof))
-    used = np.empty(N, dtype=np.int64)
-    evals = np.empty(N, dtype=np.int64)
-    _inverse_rows(chain.arrays(), np.ascontiguousarray(pt), np.ascontiguousarray(T), float(L), W,
-                  np.ascontiguousarray(q0), int(own0), np.ascontiguousarray(near), int(seed), int(budget),
-                  float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down), float(up),
-                  float(step_cap), lo, hi, glo, ghi, best, used, evals)
     return best, used, evals

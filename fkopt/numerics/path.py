@@ -3,8 +3,9 @@
 ``FKOPT_NUMERICS=numpy`` in the environment forces the reference everywhere (tests, machines
 without numba); ``FKOPT_NUMERICS=compiled`` makes a missing numba an error instead of a silent
 fallback. Otherwise the compiled path runs when numba is importable. numba is imported on the
-first call that wants a compiled kernel, never at ``import fkopt`` (``import numba`` alone costs
-~0.5 s; a one-pose ``fkopt ik`` process keeps the reference, see :func:`fkopt.cli`).
+first call that wants a compiled kernel, never at ``import fkopt`` (importing numba and loading its
+cache costs more than one pose saves, so a one-pose ``fkopt ik`` process keeps the reference:
+see ``fkopt/cli.py``).
 """
 from __future__ import annotations
 
