@@ -55,6 +55,7 @@ MECHANISMS: dict[str, str] = {
     "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",
     "7dof-arm": "fkopt.mechanisms.dh_arm:SevenDofArm",
     "urdf": "fkopt.mechanisms.urdf:URDFArm",
+    "mjcf": "fkopt.mechanisms.mjcf:MJCFArm",
 }
 
 ALGORITHMS: dict[str, str] = {

@@ -255,8 +255,7 @@ class URDFArm(FrameArm):
             raise FkoptError(describe_validation_error(err, f"{self.name} geometry")
                              + f" (geometry keys: {did_you_mean('', self.Geometry.model_fields)})") from None
         path = Path(g.file)
-        robot = _load(path)
-        chain = _chain(robot, path, g.base, g.tip)
+        chain = self._read_chain(path, g)
         moving = [j for j in chain if j.type in MOVING]
         on_chain = {j.name: j for j in moving}
         names, units, limits = [], [], {}
@@ -274,7 +273,7 @@ class URDFArm(FrameArm):
             master = on_chain.get(j.mimic.joint)
             if master is None or j.name in seen:
                 why = "is not on the chain" if master is None else "mimics in a loop"
-                raise FkoptError(f"urdf {path}: joint '{j.name}' mimics '{j.mimic.joint}', which {why} "
+                raise FkoptError(f"{self.name} {path}: joint '{j.name}' mimics '{j.mimic.joint}', which {why} "
                                  f"between '{chain[0].parent}' and '{chain[-1].child}'")
             var, mult, off = source(master, seen + (j.name,))
             a = 1.0 if j.mimic.multiplier is None else float(j.mimic.multiplier)
@@ -293,7 +292,7 @@ class URDFArm(FrameArm):
                 lo_si, hi_si = float(lim.lower), float(lim.upper)
             if mult == 0.0:
                 if not lo_si <= off <= hi_si:
-                    raise FkoptError(f"urdf {path}: joint '{j.name}' mimics with multiplier 0 at offset "
+                    raise FkoptError(f"{self.name} {path}: joint '{j.name}' mimics with multiplier 0 at offset "
                                      f"{off:g}, outside its limits [{lo_si:g}, {hi_si:g}]")
                 continue
             # limits of the joint as limits of its unknown: q_src in [(lo - o)/m, (hi - o)/m]
@@ -312,7 +311,7 @@ class URDFArm(FrameArm):
                           min(hi, CONTINUOUS_BOUNDS[1]) if math.isfinite(hi) else CONTINUOUS_BOUNDS[1])
                 periodic[-1] = (lo, hi) == CONTINUOUS_BOUNDS
             if not lo < hi:
-                raise FkoptError(f"urdf {path}: the limits of joint '{n}' and the joints mimicking it "
+                raise FkoptError(f"{self.name} {path}: the limits of joint '{n}' and the joints mimicking it "
                                  "leave no motion")
             limits[n] = (lo, hi)
         self.joint_names = tuple(names)
@@ -339,6 +338,12 @@ class URDFArm(FrameArm):
                 "unit": "rad" if j.type != "prismatic" else "m",
                 "unknown": names[var], "multiplier": mult, "offset": off})
 
+    def _read_chain(self, path: Path, g) -> list:
+        """The chain from ``g.base`` to ``g.tip``: joints with name, type, parent, child, origin
+        (4x4), axis, limit and mimic as :func:`_load` gives them (the MJCF arm reads the same
+        records from MuJoCo's compiled model)."""
+        return _chain(_load(path), path, g.base, g.tip)
+
     def _build(self, chain, source, tool) -> None:
         """Constant parts of the recursion (module docstring of :meth:`frame`): per moving joint
         C_i = A_{i-1}^T T_R A_i and v_i = A_{i-1}^T T_p, with T the product of the fixed origins
@@ -356,7 +361,7 @@ class URDFArm(FrameArm):
             axis = np.array([1.0, 0.0, 0.0]) if j.axis is None else np.asarray(j.axis, dtype=float)
             norm = float(np.linalg.norm(axis))
             if not norm > 0:
-                raise FkoptError(f"urdf {self.path}: joint '{j.name}' has a zero axis")
+                raise FkoptError(f"{self.name} {self.path}: joint '{j.name}' has a zero axis")
             A = _align(axis / norm)
             var, mult, off = source(j)
             joints.append((j.type == "prismatic", _terms(_snap(A_prev.T @ acc[:3, :3] @ A)),
