@@ -4,7 +4,7 @@
 PYTHON ?= $(if $(wildcard .venv/bin/python),.venv/bin/python,python3)
 FKOPT = $(PYTHON) -m fkopt.cli
 
-.PHONY: install install-peers test reproduce reproduce-peers report check bench bench-suite clean constraints
+.PHONY: install install-peers test test-fast reproduce reproduce-peers report check bench bench-suite clean constraints
 
 # constraints.txt pins every dependency at the version the stored results were made with.
 install:
@@ -59,3 +59,8 @@ bench:
 
 clean:
 	rm -rf build dist *.egg-info .pytest_cache examples/plugin/build examples/plugin/*.egg-info
+
+# The fast tier: everything but slow, stored-results, outside-tool and browser tests (markers in
+# tests/conftest.py). Run it after every change; `make test` (the full suite) is what CI runs.
+test-fast:
+	$(PYTHON) -m pytest -q -m "not slow and not stored and not external and not browser"

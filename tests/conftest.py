@@ -54,3 +54,101 @@ def cli(monkeypatch, capsys):
         out = capsys.readouterr()
         return code, out.out, out.err
     return run
+
+
+# --- Test tiers -------------------------------------------------------------------------------
+# README's `python -m pytest` runs everything (CI). `make test-fast` runs
+#   python -m pytest -m "not slow and not stored and not external and not browser"
+# after every change: a few minutes at most on 2 cores, and still importing every module of fkopt
+# (checked at the end of such a run, see pytest_sessionfinish below).
+#   slow      seconds of solving (full budgets, whole suites, several experiments in one test)
+#   stored    reruns stored results under results/ (or a whole `fkopt reproduce`)
+#   external  needs something outside this process: pip install, a Dask cluster, worker
+#             processes killed by signals, slow comparisons with example-robot-data's robots
+#   browser   drives a real browser (selenium + chromium)
+# The markers are set here, keyed by test function, so one table shows the tiers; a name listed here
+# that no longer exists in its (collected) file is a usage error, not a silent no-op.
+FAST_TIER = "not slow and not stored and not external and not browser"
+TIERS = {
+    "tests/test_bench.py::test_quick_run_writes_csv_and_plot": ("slow",),
+    "tests/test_kinbench.py::test_fkopt_check_passes_on_the_v2_quick_tier_and_fails_on_an_edited_number":
+        ("slow", "stored"),
+    "tests/test_kinbench.py::test_v2_quick_tier_ranks_urdf_arms_dietmaier_and_the_exact_track": ("slow",),
+    "tests/test_kinbench.py::test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it": ("slow",),
+    "tests/test_kinbench.py::test_worker_processes_and_a_dask_scheduler_write_the_same_bytes": ("external",),
+    "tests/test_kinbench.py::test_an_interrupted_suite_resumes_with_the_same_bytes": ("slow",),
+    "tests/test_kinbench.py::test_fkopt_run_accepts_a_suite_and_numbers_do_not_depend_on_other_solvers":
+        ("slow",),
+    "tests/test_kinbench.py::test_v2_urdf_copies_match_example_robot_data": ("external",),
+    "tests/test_hostile.py::test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it":
+        ("external",),
+    "tests/test_hostile.py::test_interrupted_study_rerun_keeps_previous_result": ("external",),
+    "tests/test_hostile.py::test_interrupted_experiment_rerun_keeps_previous_result": ("external",),
+    "tests/test_hostile.py::test_jobs_10000_starts_no_more_processes_than_cpus": ("external",),
+    "tests/test_reproduce.py::test_stored_results_are_reproduced": ("stored",),
+    "tests/test_reproduce.py::test_reproduce_in_worker_processes_gives_the_serial_files": ("stored", "slow"),
+    "tests/test_reproduce.py::test_report_is_generated_not_edited": ("stored",),
+    "tests/test_reproduce.py::test_one_ulp_in_the_exact_solvers_starts_passes_the_cross_platform_rules":
+        ("stored",),
+    "tests/test_reproduce.py::test_edits_of_path_dependent_rows_and_of_runs_are_caught_in_every_tier":
+        ("stored",),
+    "tests/test_reproduce.py::test_tolerances_catch_the_edits_of_issue_10": ("stored",),
+    "tests/test_reproduce.py::test_check_cli_fails_and_names_experiment_column_values": ("stored",),
+    "tests/test_reproduce.py::test_check_cli_tolerant_forces_the_cross_platform_rules": ("stored",),
+    "tests/test_reproduce.py::test_check_accepts_a_paper_folder": ("stored",),
+    "tests/test_reproduce.py::test_unedited_copy_passes_both_modes": ("stored",),
+    "tests/test_study.py::test_stored_configs_run_small_and_feed_report_check_claims": ("slow",),
+    "tests/test_study.py::test_jobs_1_and_2_and_dask_give_identical_results": ("external",),
+    "tests/test_plugins.py::test_example_plugin_runs_from_yaml_end_to_end": ("external",),
+    "tests/test_plugins.py::test_example_plugin_found_through_entry_points": ("external",),
+    "tests/test_urdf.py::test_real_robot_jacobian_matches_finite_differences": ("external",),
+    "tests/test_cli.py::test_run_is_deterministic": ("slow",),
+    "tests/test_export.py::test_export_refuses_what_it_must_not_touch": ("slow",),
+}
+TIER_MARKERS = ("slow", "stored", "external", "browser")
+
+
+def _tier_key(item):
+    """`tests/test_x.py::test_name` of a collected test (its parameters and class dropped)."""
+    path = os.path.relpath(str(item.path), os.path.dirname(os.path.dirname(__file__)))
+    return f"{path.replace(os.sep, '/')}::{item.originalname}"
+
+
+@pytest.hookimpl(tryfirst=True)   # before -m/-k deselect, so every test of a collected file is seen
+def pytest_collection_modifyitems(config, items):
+    seen, files = set(), set()
+    for item in items:
+        key = _tier_key(item)
+        seen.add(key)
+        files.add(key.split("::")[0])
+        for name in TIERS.get(key, ()):
+            item.add_marker(getattr(pytest.mark, name))
+    gone = [key for key in TIERS if key.split("::")[0] in files and key not in seen]
+    if gone:
+        raise pytest.UsageError("tests/conftest.py TIERS lists tests that no longer exist: " + ", ".join(gone)
+                                + " (rename or remove them in TIERS)")
+
+
+def _every_fkopt_module():
+    import pkgutil
+
+    import fkopt
+    return sorted(name for _, name, _ in pkgutil.walk_packages(fkopt.__path__, "fkopt."))
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """After a whole fast tier (every file of tests/, `-m FAST_TIER`, no -k) that passed: fail if a module
+    of fkopt was imported by no test -- a module only slow tests reach gets no check after a change."""
+    config = session.config
+    if (exitstatus != 0 or config.option.collectonly or config.option.keyword
+            or config.option.markexpr.strip() != FAST_TIER):
+        return
+    tests_dir = os.path.dirname(os.path.abspath(__file__))
+    if any(os.path.abspath(os.path.join(str(config.invocation_params.dir), a)) != tests_dir for a in config.args):
+        return
+    missing = [name for name in _every_fkopt_module() if name not in sys.modules]
+    if missing:
+        session.config.get_terminal_writer().line(
+            "fast tier imports no test of these fkopt modules (add a small fast test): " + ", ".join(missing),
+            red=True)
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
