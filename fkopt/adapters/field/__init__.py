@@ -1,0 +1,143 @@
+"""The field's solvers through their own packages (``pip install -e ".[field]"``), for kinbench v3.
+
+Every IK wrapper here takes a fkopt URDF arm (:class:`fkopt.mechanisms.urdf.URDFArm`), is built
+once per arm (the package parses the file, outside the clock) and answers one target pose at a
+time: :meth:`FieldIK.solve1` takes a 4x4 tip frame in the arm's base frame (m) and returns the
+joints in fkopt's public units (deg, m) or ``None`` when the package gave no answer, plus what
+the package said about its own answer (``claimed``; kinbench never counts it,
+:mod:`fkopt.kinbench.physical` re-checks every answer with fkopt's FK). :func:`solve` runs a
+solver over many targets and times every query with ``time.perf_counter``.
+
+Seeds: every start configuration is drawn from the ``numpy.random.Generator`` the wrapper is
+given (no global RNG); a package whose internal restarts draw from its own RNG says so in its
+``settings`` (TRAC-IK, roboticstoolbox).
+
+``timeout`` (s) is each query's wall-clock allowance: packages with a wall-clock limit get it
+(TRAC-IK), restart loops written here stop starting new searches once it has passed, and
+packages with only iteration limits (roboticstoolbox) run to their limits -- the clock track
+(:mod:`fkopt.kinbench.v3`) counts any answer later than the timeout as a failure at the timeout.
+
+Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
+(roboticstoolbox-python ``ik_LM``, ``ik_NR``). Not yet written (issue 27): pinocchio CLIK, ikpy,
+CMA-ES, Nevergrad NGOpt, scipy L-BFGS-B, scipy ``least_squares`` for parallel FK;
+:func:`pose_objective` is the black-box objective they are meant to minimise.
+"""
+from __future__ import annotations
+
+import importlib
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ...errors import FkoptError
+
+#: name -> (module, class) of every IK wrapper; black-box ones minimise :func:`pose_objective`.
+IK_SOLVERS = {
+    "tracik": ("tracik", "TracIK"),
+    "rtb-ik_LM": ("rtb", "RtbLM"),
+    "rtb-ik_NR": ("rtb", "RtbNR"),
+}
+#: The outside package each wrapper needs (for the one-line message when it is missing).
+PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
+}
+
+
+class FieldIK:
+    """One outside IK solver on one arm; subclasses set ``name``, ``package``, ``settings``."""
+
+    name = "?"
+    package = "?"
+
+    def __init__(self, arm, *, timeout: float, rng: np.random.Generator):
+        self.arm, self.timeout, self.rng = arm, float(timeout), rng
+        self.lo_rad, self.hi_rad = internal_bounds(arm)
+        self.settings: dict[str, Any] = {"timeout_s": self.timeout}
+
+    def random_start(self) -> np.ndarray:
+        """Joints (rad, m) uniform inside the limits, from the wrapper's generator."""
+        return self.lo_rad + self.rng.random(self.arm.dof) * (self.hi_rad - self.lo_rad)
+
+    def public(self, q_internal) -> np.ndarray:
+        """Joints (rad, m) -> fkopt's public units (deg, m); continuous joints wrapped into
+        [-180, 180) as fkopt.inverse does."""
+        q = np.asarray(q_internal, dtype=float) / self.arm._to_si
+        per = self.arm.periodic_mask()
+        q[per] = (q[per] + 180.0) % 360.0 - 180.0
+        return q
+
+    def solve1(self, T: np.ndarray) -> tuple[np.ndarray | None, bool]:
+        raise NotImplementedError
+
+
+def internal_bounds(arm) -> tuple[np.ndarray, np.ndarray]:
+    """The arm's joint limits in SI units (rad, m)."""
+    return arm.bounds[:, 0] * arm._to_si, arm.bounds[:, 1] * arm._to_si
+
+
+@dataclass
+class IKAnswers:
+    """Every answer of one solver on one arm: joints (n, dof) in public units (NaN: no answer),
+    wall time per query (s), and what the solver claimed (never counted)."""
+    solver: str
+    joints: np.ndarray
+    seconds: np.ndarray
+    claimed: np.ndarray
+    settings: dict = field(default_factory=dict)
+
+
+def make_ik(name: str, arm, *, timeout: float, rng: np.random.Generator) -> FieldIK:
+    """The wrapper ``name`` of :data:`IK_SOLVERS` built on ``arm``; a missing package or an arm the
+    package cannot read is one line (:class:`FkoptError`)."""
+    if name not in IK_SOLVERS:
+        raise FkoptError(f"unknown field solver '{name}'; allowed: {', '.join(IK_SOLVERS)}")
+    module, cls = IK_SOLVERS[name]
+    try:
+        mod = importlib.import_module(f"{__name__}.{module}")
+        return getattr(mod, cls)(arm, timeout=timeout, rng=rng)
+    except ImportError as err:
+        raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[field]\"): "
+                         f"{err}") from None
+
+
+def timed1(solver: FieldIK, T: np.ndarray) -> tuple[np.ndarray, float, bool]:
+    """One query: joints (NaN when none), wall time (s), the solver's claim."""
+    t0 = time.perf_counter()
+    q, claimed = solver.solve1(T)
+    dt = time.perf_counter() - t0
+    return (np.full(solver.arm.dof, np.nan) if q is None else q), dt, bool(claimed)
+
+
+def solve(solver: FieldIK, targets: np.ndarray) -> IKAnswers:
+    """Every target (n, 4, 4) through ``solver``, one timed call per query."""
+    n = len(targets)
+    joints, secs, claimed = np.empty((n, solver.arm.dof)), np.empty(n), np.zeros(n, bool)
+    for i in range(n):
+        joints[i], secs[i], claimed[i] = timed1(solver, targets[i])
+    return IKAnswers(solver.name, joints, secs, claimed, dict(solver.settings))
+
+
+def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Position error (m) and geodesic rotation error (rad) of rows q (k, dof) against one
+    target T, from fkopt's FK: shape (k, 2)."""
+    from ...rotations import geodesic_angle
+    F = arm.fk_matrix(q_public)
+    pe = np.linalg.norm(F[:, :3, 3] - T[:3, 3], axis=-1)
+    re = geodesic_angle(soa(F[:, :3, :3]), soa(np.broadcast_to(T[:3, :3], (len(F), 3, 3))))
+    return np.stack([pe, re], axis=-1)
+
+
+def soa(R: np.ndarray):
+    """A (..., 3, 3) stack as :data:`fkopt.rotations.Matrix` (nested tuples of arrays)."""
+    return tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3))
+
+
+def pose_objective(arm, T: np.ndarray):
+    """Black-box IK objective of rows of internal joints (k, dof): |dp|^2 (m^2) + angle^2
+    (rad^2), 1 rad weighted as 1 m (the arms' reach is about a metre). Returns f (k,)."""
+    def f(X):
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        e = pose_errors_rad(arm, X / arm._to_si, T)
+        return e[:, 0] ** 2 + e[:, 1] ** 2
+    return f

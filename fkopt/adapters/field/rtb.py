@@ -1,0 +1,90 @@
+"""roboticstoolbox-python's compiled ETS solvers ``ik_LM`` (Levenberg-Marquardt, Chan's damping)
+and ``ik_NR`` (Newton-Raphson) on the chain's ETS (Corke and Haviland, ICRA 2021).
+
+Settings: ``ilimit`` = 30 iterations per search, ``slimit`` = 100 searches (rtb's defaults), ``tol``
+= 1e-16 on E = 1/2 e^T e (e = position error in m, rotation vector in rad: |e| <= 1.4e-8, so the
+stopping test implies the loosest three rungs of the ladder and the last step of a quadratic
+method usually the fourth), ``joint_limits=True`` (rtb rejects a search ending outside the
+limits), first start q0 uniform in the limits from the wrapper's generator; rtb's further searches
+draw from its own unseeded RNG. No wall-clock limit: rtb runs to ``slimit``.
+
+Quirks worked around: rtb resolves the meshes' ``package://`` paths through xacro, so it reads a
+copy of the file without visual, collision, transmission and gazebo elements (the chain needs
+none); a sub-chain ``robot.ets(start, end)`` keeps the whole robot's joint indices (``jindex``),
+so a chain starting below the root (Baxter's arm from its torso) would read q at the wrong
+places -- the wrapper renumbers the chain's joints 0..n-1; the ETS is checked against fkopt's FK
+at a random configuration when built, so an arm rtb misreads is refused with one line.
+"""
+from __future__ import annotations
+
+import tempfile
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import FkoptError
+from . import FieldIK
+
+
+def chain_ets(path: Path, base: str, tip: str):
+    """roboticstoolbox's ETS of the chain base -> tip of a URDF file, joints numbered 0..n-1."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import roboticstoolbox as rtb
+        from roboticstoolbox.models.URDF.URDFRobot import URDF_file
+    tree = ET.parse(str(path))
+    for parent in list(tree.getroot().iter()):
+        for e in list(parent):
+            if e.tag in ("visual", "collision", "transmission", "gazebo"):
+                parent.remove(e)
+    with tempfile.TemporaryDirectory() as tmp:
+        copy = Path(tmp) / Path(path).name
+        tree.write(str(copy))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            links, name, _ = URDF_file(str(copy))
+    ets = rtb.Robot(links, name=name).ets(start=base, end=tip)
+    k = 0
+    for e in ets:
+        if e.isjoint:
+            e.jindex = k
+            k += 1
+    return rtb.ETS(list(ets)), rtb.__version__
+
+
+class _Rtb(FieldIK):
+    package = "roboticstoolbox-python"
+    method = "?"
+    ILIMIT, SLIMIT, TOL = 30, 100, 1e-16
+
+    def __init__(self, arm, *, timeout, rng):
+        super().__init__(arm, timeout=timeout, rng=rng)
+        self.ets, version = chain_ets(arm.path, arm.base_link, arm.tip_link)
+        if self.ets.n != arm.dof:
+            raise FkoptError(f"{self.name}: rtb's chain of {arm.path} has {self.ets.n} joints, fkopt's {arm.dof}")
+        q = self.random_start()
+        gap = np.abs(self.ets.fkine(q).A - arm.fk_matrix(q / arm._to_si)).max()
+        if not gap < 1e-9:
+            raise FkoptError(f"{self.name}: rtb's FK of {arm.path} differs from fkopt's by {gap:.3g} "
+                             "(rtb misreads this URDF)")
+        self._call = getattr(self.ets, self.method)
+        self.settings.update(method=self.method, ilimit=self.ILIMIT, slimit=self.SLIMIT, tol=self.TOL,
+                             joint_limits=True, version=version, q0="uniform in limits (wrapper's generator)",
+                             internal_rng="rtb's own, unseeded", wall_clock_limit=False)
+
+    def solve1(self, T):
+        sol = self._call(T, q0=self.random_start(), ilimit=self.ILIMIT, slimit=self.SLIMIT, tol=self.TOL,
+                         joint_limits=True)
+        return self.public(sol.q), bool(sol.success)
+
+
+class RtbLM(_Rtb):
+    name = "rtb-ik_LM"
+    method = "ik_LM"
+
+
+class RtbNR(_Rtb):
+    name = "rtb-ik_NR"
+    method = "ik_NR"

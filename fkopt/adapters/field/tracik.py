@@ -1,0 +1,50 @@
+"""TRAC-IK through ``pytracik`` (Beeson and Ames, Humanoids 2015): KDL's Newton and an SQP solve
+run in two threads until either meets ``eps`` or the wall-clock ``timeout`` passes.
+
+Settings: solve type ``Speed`` (return the first solution), ``eps`` = 1e-5 (TRAC-IK's default:
+a twist-error bound, m and rad), timeout = the wrapper's timeout; the start is a random in-limit
+configuration from the wrapper's generator; TRAC-IK's own restarts draw from its own unseeded RNG
+and its timeout is wall-clock, so its outcomes vary run to run (compare them by timing rules).
+
+Quirks worked around: pytracik reads some URDF limits as [0, 0] (the Panda: KDL's URDF parser
+misses limits on a root link with an inertia), so the wrapper sets the limits itself from
+fkopt's chain; it stores limits as float32, so they are set rounded *inward* to float32 (an
+answer at a float32 limit rounded outward would fall outside the URDF limits); the quaternion
+argument order is (x, y, z, w) after the position, and the returned vector starts with
+the status (> 0: found).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import FieldIK
+
+
+class TracIK(FieldIK):
+    name = "tracik"
+    package = "pytracik"
+    EPS = 1e-5
+
+    def __init__(self, arm, *, timeout, rng):
+        super().__init__(arm, timeout=timeout, rng=rng)
+        import pytracik
+        self._pt = pytracik
+        self._solver = pytracik.TRAC_IK(arm.base_link, arm.tip_link, arm.path.read_text(), self.timeout,
+                                        self.EPS, pytracik.Speed)
+        if pytracik.get_num_joints(self._solver) != arm.dof:
+            from ...errors import FkoptError
+            raise FkoptError(f"tracik: {arm.path} {arm.base_link} -> {arm.tip_link} has "
+                             f"{pytracik.get_num_joints(self._solver)} joints in KDL, {arm.dof} in fkopt")
+        lo32 = np.nextafter(self.lo_rad.astype(np.float32), np.float32(np.inf))
+        hi32 = np.nextafter(self.hi_rad.astype(np.float32), np.float32(-np.inf))
+        pytracik.set_joint_limits(self._solver, lo32.astype(float).tolist(), hi32.astype(float).tolist())
+        self.settings.update(solve_type="Speed", eps=self.EPS, limits="fkopt's, float32 rounded inward",
+                             start="uniform in limits (wrapper's generator)", internal_rng="TRAC-IK's own, unseeded")
+
+    def solve1(self, T):
+        from scipy.spatial.transform import Rotation
+        x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+        out = self._pt.ik(self._solver, self.random_start(), *T[:3, 3], x, y, z, w)
+        if out[0] <= 0:
+            return None, False
+        return self.public(out[1:]), True
