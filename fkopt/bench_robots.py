@@ -33,32 +33,18 @@ ARMS = ("panda", "ur5", "kinova")
 
 
 def _rtb_ets(path: Path, base: str, tip: str):
-    """roboticstoolbox's ETS of the chain base -> tip of a URDF file, or an error message. rtb
-    resolves the meshes' ``package://`` paths through xacro; the chain needs none, so it reads a
-    copy of the file without visual, collision, transmission and gazebo elements."""
+    """roboticstoolbox's ETS of the chain base -> tip of a URDF file (the field adapter's
+    :func:`fkopt.adapters.field.rtb.chain_ets`: a copy without meshes, joints numbered 0..n-1),
+    or an error message when rtb cannot be imported."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            import roboticstoolbox as rtb
-            from roboticstoolbox.models.URDF.URDFRobot import URDF_file
+            import roboticstoolbox  # noqa: F401
     except Exception as err:          # ImportError, or a broken install
         return None, f"roboticstoolbox-python not importable ({type(err).__name__}: {err}); " \
                      "pip install roboticstoolbox-python: the rtb rows are skipped"
-    import tempfile
-    import xml.etree.ElementTree as ET
-    tree = ET.parse(str(path))
-    for parent in list(tree.getroot().iter()):
-        for e in list(parent):
-            if e.tag in ("visual", "collision", "transmission", "gazebo"):
-                parent.remove(e)
-    with tempfile.TemporaryDirectory() as tmp:
-        copy = Path(tmp) / path.name
-        tree.write(str(copy))
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            links, name, _ = URDF_file(str(copy))
-    robot = rtb.Robot(links, name=name)
-    return (robot.ets(start=base, end=tip), rtb.__version__), None
+    from .adapters.field.rtb import chain_ets
+    return chain_ets(path, base, tip), None
 
 
 def _check(m, q, Tt, tol, scale):
