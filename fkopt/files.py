@@ -130,6 +130,16 @@ def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> str:
         raise FkoptError(f"{path}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset {err.start})") from None
 
 
+def check_geometry_file(path: Path, mechanism: str, max_bytes: int, what: str) -> None:
+    """A mechanism's ``geometry.file`` exists and is at most ``max_bytes`` (checked before any parser
+    reads it); ``what`` names the format in the message, e.g. "a URDF file"."""
+    if not path.is_file():
+        raise FkoptError(f"{mechanism} geometry.file: {path} does not exist")
+    size = path.stat().st_size
+    if size > max_bytes:
+        raise FkoptError(f"{mechanism} {path}: {size} bytes, larger than the {max_bytes} bytes accepted for {what}")
+
+
 def load_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
     """Parse a YAML file with the limits above; errors name the file and the line."""
     import yaml

@@ -40,6 +40,7 @@ import numpy as np
 from pydantic import Field
 
 from ..errors import FkoptError, did_you_mean
+from ..files import check_geometry_file
 from .urdf import URDFArm, URDFGeometry
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.xml"
@@ -56,12 +57,7 @@ class MJCFGeometry(URDFGeometry):
 
 def compile_model(path: Path):
     """MuJoCo's compiled model of an MJCF file; every failure is one line naming the file."""
-    if not path.is_file():
-        raise FkoptError(f"mjcf geometry.file: {path} does not exist")
-    size = path.stat().st_size
-    if size > MAX_MJCF_BYTES:
-        raise FkoptError(f"mjcf {path}: {size} bytes, larger than the {MAX_MJCF_BYTES} bytes accepted for "
-                         "an MJCF file")
+    check_geometry_file(path, "mjcf", MAX_MJCF_BYTES, "an MJCF file")
     try:
         import mujoco
     except ImportError:

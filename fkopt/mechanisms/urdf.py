@@ -40,6 +40,7 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from ..errors import FkoptError, did_you_mean
+from ..files import check_geometry_file
 from ..numerics.chain import frame_jacobian1, from_terms
 from .base import FrameArm, Geometry, describe_validation_error
 
@@ -80,12 +81,7 @@ def _load(path: Path) -> SimpleNamespace:
     or transmissions), read with the standard library's XML parser -- importing a URDF library
     cost 1.3-2.0 s per process. Every failure is one line naming the file."""
     import xml.etree.ElementTree as ET
-    if not path.is_file():
-        raise FkoptError(f"urdf geometry.file: {path} does not exist")
-    size = path.stat().st_size
-    if size > MAX_URDF_BYTES:
-        raise FkoptError(f"urdf {path}: {size} bytes, larger than the {MAX_URDF_BYTES} bytes accepted for "
-                         "a URDF file")
+    check_geometry_file(path, "urdf", MAX_URDF_BYTES, "a URDF file")
     try:
         root = ET.parse(str(path)).getroot()
     except ET.ParseError as err:
