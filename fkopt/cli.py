@@ -303,8 +303,44 @@ def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | N
             _print_outcome(con, outcome, tasks)
 
 
+def _clock(seconds: float) -> str:
+    seconds = int(round(seconds))
+    return f"{seconds // 60}m{seconds % 60:02d}s" if seconds >= 60 else f"{seconds}s"
+
+
+def _eta(done: float, total: float, elapsed: float) -> str:
+    """Time left at the pace so far (finished work, counting the running task's fraction)."""
+    if done <= 0 or done >= total:
+        return "--" if done < total else "0s"
+    return _clock(elapsed * (total - done) / done)
+
+
+#: Seconds between plain progress lines when stdout is not a terminal.
+HEARTBEAT_S = 10.0
+
+
+class _Heartbeat:
+    """Plain progress lines for a stdout that is not a terminal (a log, CI, a pipe): one line at
+    most every ``every`` seconds, so a long run shows it is alive without a bar's escape codes."""
+
+    def __init__(self, con, every: float | None = None):
+        import time
+        self.con, self.every, self.clock = con, HEARTBEAT_S if every is None else every, time.perf_counter
+        self.start = self.last = self.clock()
+        self.on = not con.is_terminal
+
+    def beat(self, text) -> None:
+        now = self.clock()
+        if self.on and now - self.last >= self.every:
+            self.last = now
+            self.con.print(f"[{_clock(now - self.start)}] {text()}", highlight=False, markup=False)
+
+
 class _progress:
-    """A rich progress bar as a ``progress(label, done, total)`` callback (None when quiet)."""
+    """Progress of one config's tasks as the runner's ``progress(label, done, total)`` callback
+    (None when quiet): a rich bar with the time left on a terminal, a plain line every ~10 s
+    otherwise. ``running`` hears the running task's fraction (fkopt.progress), so the bar and
+    its time left move within a task too."""
 
     def __init__(self, con, name: str, total: int, quiet: bool):
         self.con, self.name, self.total, self.quiet = con, name, total, quiet
@@ -313,12 +349,22 @@ class _progress:
         if self.quiet:
             return None
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        self.heart = _Heartbeat(self.con)
         self.bar = Progress(TextColumn(f"[bold]{self.name}[/]"), BarColumn(), MofNCompleteColumn(),
-                            TextColumn("{task.description}"), TimeElapsedColumn(), console=self.con,
-                            transient=True)
+                            TextColumn("{task.description}"), TimeElapsedColumn(),
+                            TextColumn("{task.fields[left]} left"), console=self.con, transient=True,
+                            disable=not self.con.is_terminal)
         self.bar.__enter__()
-        task = self.bar.add_task("", total=self.total)
-        return lambda label, done, total: self.bar.update(task, completed=done, description=label)
+        self.task = self.bar.add_task("", total=self.total, left="--")
+        return self
+
+    def __call__(self, label: str, done: float, total: int) -> None:
+        elapsed = self.heart.clock() - self.heart.start
+        left = _eta(done, total, elapsed)
+        self.bar.update(self.task, completed=done, description=label, left=left)
+        self.heart.beat(lambda: f"{self.name}: {done:.1f}/{total} tasks ({label}), about {left} left")
+
+    running = __call__
 
     def __exit__(self, *exc):
         if not self.quiet:
@@ -657,28 +703,55 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
 
     if jobs is not None and jobs < 1:
         raise FkoptError(f"--jobs: must be at least 1, got {jobs}")
+    import tempfile
+    from .reproduce.changes import agreement
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
-    before = snapshot(out)              # what the tree held, for CHANGES.md
+    kept = tempfile.TemporaryDirectory(prefix="fkopt-reproduce-")   # the old files, to judge what moved
+    before = snapshot(out, keep=Path(kept.name))    # what the tree held, for CHANGES.md
     con = _console()
     start = time.perf_counter()
+    heart = _Heartbeat(con)
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
-                  disable=quiet) as bar:
+                  disable=quiet or not con.is_terminal) as bar:
         overall = bar.add_task("", total=len(planned), name="[bold]reproduce[/]")
-        current = {}
+        current = {"done": 0}
+
+        def status() -> str:
+            return (f"reproduce: {current['done']}/{len(planned)} configs done"
+                    + (f"; {current['now']}" if current.get("now") else ""))
+
+        class Config:     # the runner's progress callback for one config (and its running task)
+            def __init__(self, p):
+                self.name = f"{p.config.paper}/{p.config.name}"
+                self.task = bar.add_task("", total=p.tasks, name=f"  {self.name}")
+
+            def __call__(self, label, d, t):
+                bar.update(self.task, completed=d, description=label)
+                current["now"] = f"{self.name}: {d:.1f}/{t} tasks ({label})"
+                if not quiet:
+                    heart.beat(status)
+            running = __call__
 
         def started(p):
-            current["task"] = task = bar.add_task("", total=p.tasks, name=f"  {p.config.paper}/{p.config.name}")
-            return lambda label, d, t: bar.update(task, completed=d, description=label)
+            current["task"] = config = Config(p)
+            return config
 
         def finished(d):
-            bar.remove_task(current.pop("task"))
+            bar.remove_task(current.pop("task").task)
             bar.advance(overall)
+            current["done"] += 1
+            current["now"] = ""
+            if not quiet:
+                heart.beat(status)
 
         def solving(n, total):
             if "solving" not in current:
                 current["solving"] = bar.add_task("", total=total, name="  solving experiments in parallel")
             bar.update(current["solving"], completed=n)
+            current["now"] = f"solving experiments in parallel: {n}/{total}"
+            if not quiet:
+                heart.beat(status)
             if n == total:
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
@@ -693,6 +766,8 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
             table.add_row(str(d.path), str(d.folder), str(d.files), f"{d.wall_s:.1f}")
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
+    con.print(agreement(before, out), highlight=False, markup=False)   # even with -q: what a newcomer must know
+    kept.cleanup()
 
 
 @app.command()

@@ -82,6 +82,19 @@ class Problem:
         out._shapes = {}
         return out
 
+    def repeat(self, n: int) -> "Problem":
+        """A single-target problem as a batched one of ``n`` copies of its target (the inverse
+        of :meth:`case`); a batched problem is returned unchanged."""
+        if self.cases is not None:
+            return self
+        out = copy.copy(self)
+        for name in self._case_arrays:
+            a = np.asarray(getattr(self, name))
+            setattr(out, name, np.broadcast_to(a, (int(n),) + a.shape).copy())
+        out.cases = int(n)
+        out._shapes = {}
+        return out
+
     def case(self, i: int) -> "Problem":
         """Target ``i`` as a single-target problem (today's shapes)."""
         if self.cases is None:

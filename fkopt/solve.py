@@ -34,6 +34,7 @@ import numpy as np
 
 from .algorithms.base import Algorithm, RunRecord
 from .errors import FkoptError
+from .progress import part
 from .registry import algorithm_class
 from .streams import CHUNK, RunStreams, case_seed
 
@@ -297,11 +298,12 @@ def solve(problem, algorithm: str | Algorithm, *, population: int = 10, iteratio
         sub = problem if cases is None else problem.take(case_of_row[s:e])
         x0_part = x0_rows if x0_rows is None or x0_rows.ndim == 1 else x0_rows[s:e]
         start = time.perf_counter()
-        part = contained(who, lambda: algo.minimize(sub, streams=RunStreams(seed_of_row[s:e], run_of_row[s:e]),
-                                                    x0=x0_part, **kwargs))
+        with part(s / rows, e / rows):
+            chunk = contained(who, lambda: algo.minimize(sub, streams=RunStreams(seed_of_row[s:e], run_of_row[s:e]),
+                                                         x0=x0_part, **kwargs))
         if who is not None:
-            check_record(part, who, e - s, int(iterations), problem.bounds)
-        parts.append(part)
+            check_record(chunk, who, e - s, int(iterations), problem.bounds)
+        parts.append(chunk)
         times[s:e] = (time.perf_counter() - start) / (e - s)
     record = parts[0] if len(parts) == 1 else _concatenate(parts)
     shape = (len(ids),) if cases is None else (n_cases, len(ids))

@@ -40,3 +40,31 @@ def test_robots_bench_check_accepts_the_arms_own_pose_and_refuses_a_moved_or_out
     outside = q.copy()
     outside[:, 0] = m.bounds[0, 1] + 1.0
     assert not _check(m, outside, m.fk_matrix(outside), (1e-6, 1e-6), 1.0).any()
+
+
+def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cross_platform_rules(tmp_path):
+    """The line `fkopt reproduce` ends with (issue 32): nothing moved; a last-digit move that
+    fkopt check's cross-platform rules accept; a moved number they refuse."""
+    import shutil
+    from pathlib import Path
+
+    from fkopt.reproduce.changes import agreement, snapshot
+    root = tmp_path / "results"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "results" / "liu2008" / "tab3_fig4",
+                    root / "liu2008" / "tab3_fig4")
+    runs = root / "liu2008" / "tab3_fig4" / "runs.csv"
+    text = runs.read_text()
+
+    def line_after(edit):
+        keep = tmp_path / f"keep{len(list(tmp_path.iterdir()))}"
+        keep.mkdir()
+        runs.write_text(text)
+        before = snapshot(root, keep=keep)
+        runs.write_text(edit(text))
+        return agreement(before, root)
+
+    assert "byte-identical" in line_after(lambda t: t)
+    ulp = line_after(lambda t: t.replace("9.408561477e-08", "9.408561478e-08", 1))
+    assert ulp.startswith("reproduce: 1 deterministic files in 1 results moved") and "accept all" in ulp
+    big = line_after(lambda t: "".join(t.splitlines(keepends=True)[:-3]))        # runs lost
+    assert "refuse" in big and "liu2008/tab3_fig4 runs.csv" in big

@@ -51,6 +51,7 @@ from pydantic import ConfigDict, Field
 
 from ..algorithms.base import Algorithm, Params, RunRecord
 from ..errors import FkoptError
+from ..progress import tick
 
 
 class _Stop(Exception):
@@ -387,7 +388,10 @@ class ExternalAlgorithm(Algorithm):
         if workers <= 1 and self.per_point and len(args) > 1:
             traces = run_lockstep(args, problem, batched)      # batched fitness calls, same numbers
         elif workers <= 1:
-            traces = [run_one(*a) for a in args]
+            traces = []
+            for a in args:
+                traces.append(run_one(*a))
+                tick(len(traces), len(args))
         else:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor

@@ -24,6 +24,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..errors import FkoptError
+from ..progress import tick
 from ..streams import RunStreams
 
 
@@ -348,6 +349,7 @@ class Algorithm:
             self.update_best(state)
             log.finish(state.evaluations, state.best_f)
             record(t)
+            tick(t, iterations)
         if stop_at_target and target is not None:
             newly = ~done & (history[:, last] < target)
             done_at[newly] = last

@@ -19,6 +19,7 @@ import numpy as np
 from pydantic import Field
 
 from ..errors import FkoptError
+from ..progress import tick
 from ..streams import RunStreams, run_seed_sequence
 from .base import Algorithm, Params, RunRecord
 
@@ -48,11 +49,12 @@ class ExactSolver(Algorithm):
             raise FkoptError(f"algorithm '{self.name}' solves {what} only; this problem is not one "
                              "(use 'exact', which picks forward or inverse by the mechanism's kind)")
         runs = streams.runs
-        rows = problem.take(np.arange(runs)) if getattr(problem, "cases", None) is None else problem
+        rows = problem.repeat(runs)        # an experiment's one target: one row per run
         xs = np.empty((runs, problem.dim))
         used = np.empty(runs, dtype=np.int64)
         for r, seed in enumerate(row_seeds(streams)):
             xs[r], used[r] = self.solve_row(rows, r, seed)
+            tick(r + 1, runs)
         f = rows.fitness(xs[:, None, :])[:, 0]          # the problem's own score of each answer
         used += 1
         T = iterations + 1

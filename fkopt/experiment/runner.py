@@ -136,9 +136,9 @@ def build_cases(config: ExperimentConfig, mech) -> list[Case]:
         where = f"cases[{i}]"
         label = spec.label or f"case-{i + 1}"
         reference = (mech.vector(spec.reference, mech.pose_names, f"{where}.reference")
-                     if spec.reference else None)
-        pose = mech.vector(spec.pose, mech.pose_names, f"{where}.pose") if spec.pose else None
-        joints = mech.vector(spec.joints, mech.joint_names, f"{where}.joints") if spec.joints else None
+                     if spec.reference is not None else None)
+        pose = mech.vector(spec.pose, mech.pose_names, f"{where}.pose") if spec.pose is not None else None
+        joints = mech.vector(spec.joints, mech.joint_names, f"{where}.joints") if spec.joints is not None else None
         if serial:
             if joints is not None:
                 _check_in_bounds(mech, joints, f"{where}.joints")

@@ -31,6 +31,7 @@ from typing import Any, Callable
 
 from ..errors import FkoptError
 from ..files import inside, write_json_atomically
+from ..progress import listening
 
 TASKS = "tasks"
 MANIFEST = "manifest.json"
@@ -232,6 +233,23 @@ def task_file_problems(folder: Path) -> list[tuple[str, str]]:
     return out
 
 
+def _within(progress, label: str, done: int, total: int):
+    """A :func:`fkopt.progress.listening` callback for a running task: when ``progress`` has a
+    ``running`` method, ``progress.running(label, done + fraction, total)``, at most every 0.2 s
+    (a plain ``progress(label, done, total)`` callable hears finished tasks only, whole numbers)."""
+    running = getattr(progress, "running", None)
+    if running is None:
+        return None
+    last = [0.0]
+
+    def heard(fraction: float) -> None:
+        now = time.perf_counter()
+        if now - last[0] >= 0.2:
+            last[0] = now
+            running(label, done + fraction, total)
+    return heard
+
+
 def run_tasks(plan: Plan, *, executor: str = "local", jobs: int = 1, scheduler: str | None = None,
               store: TaskStore | None = None, resume: bool = False,
               progress: Callable[[str, int, int], None] | None = None,
@@ -261,9 +279,13 @@ def run_tasks(plan: Plan, *, executor: str = "local", jobs: int = 1, scheduler: 
     if progress and records:
         progress("resumed", len(records), total)
     pending = [t for t in plan.tasks if t.id not in records]
-    if plan.local is not None and executor == "local" and worker_count(jobs, len(pending)) == 1:
-        for t in pending:                # the live objects, nothing rebuilt
-            finished((t.id, plan.local(t.payload)))
+    if executor == "local" and worker_count(jobs, len(pending)) == 1:
+        for t in pending:                # in this process: the bar also moves inside each task
+            # (fkopt.progress: iterations, rows); plan.local uses the live objects, nothing rebuilt
+            solve = plan.local or plan.solve
+            with listening(_within(progress, t.label, len(records), total)):
+                record = solve(t.payload)
+            finished((t.id, record))
     else:
         execute(run_remote, [(plan.solve, t.id, t.payload) for t in pending], executor=executor, jobs=jobs,
                 scheduler=scheduler, on_result=finished)

@@ -30,18 +30,27 @@ class Snapshot:
     files: dict[str, dict[str, str]] = field(default_factory=dict)     # "paper/name" -> file -> sha256
     summaries: dict[str, str] = field(default_factory=dict)            # "paper/name" -> summary.csv text
     claims: dict[str, str] = field(default_factory=dict)               # paper -> claims.csv text
+    #: a copy of every deterministic file (snapshot(keep=True)), to judge moved files afterwards
+    copies: Path | None = None
 
 
-def snapshot(root: str | Path) -> Snapshot:
-    """The state of a results tree (empty when there is none yet)."""
+def snapshot(root: str | Path, keep: Path | None = None) -> Snapshot:
+    """The state of a results tree (empty when there is none yet). With ``keep`` (an empty
+    folder), its deterministic files are also copied there, for :func:`agreement`."""
+    import shutil
     root = Path(root)
-    snap = Snapshot()
+    snap = Snapshot(copies=keep)
     if not root.is_dir():
         return snap
     store = Store(root)
     for exp in store.folders(None):
         label = f"{exp.paper}/{exp.name}"
-        snap.files[label] = {f: sha256(exp.folder / f) for f in deterministic_files(exp.folder) if f != "meta.json"}
+        names = deterministic_files(exp.folder)
+        snap.files[label] = {f: sha256(exp.folder / f) for f in names if f != "meta.json"}
+        if keep is not None:
+            (keep / label).mkdir(parents=True, exist_ok=True)
+            for f in names:
+                shutil.copyfile(exp.folder / f, keep / label / f)
         if (exp.folder / "summary.csv").is_file():
             snap.summaries[label] = (exp.folder / "summary.csv").read_text(encoding="utf-8", errors="replace")
     for paper in store.papers():
@@ -172,6 +181,46 @@ def describe(before: Snapshot, root: str | Path) -> str:
     lines += [f"Unchanged (every deterministic file byte-identical): {', '.join(unchanged) if unchanged else 'none'}.",
               ""]
     return "\n".join(lines)
+
+
+def agreement(before: Snapshot, root: str | Path) -> str:
+    """One line for the end of ``fkopt reproduce``: how many deterministic files moved against
+    the tree before it (timings never count) and whether ``fkopt check``'s cross-platform rules
+    (:mod:`fkopt.compare`) accept the new files against the old. On the platform that made the
+    stored results nothing moves; on another CPU (another SIMD width in numpy's kernels, another
+    BLAS) the last digits of path-dependent runs move and the rules decide whether that is all.
+    Needs a snapshot taken with ``keep``."""
+    from ..compare import ANY, compare_folders
+    from .check import rules_for
+    root = Path(root)
+    after = snapshot(root)
+    moved: dict[str, list[str]] = {}
+    for label in sorted(set(after.files) & set(before.files)):
+        old, new = before.files[label], after.files[label]
+        files = sorted(f for f in set(old) | set(new) if old.get(f) != new.get(f))
+        if files:
+            moved[label] = files
+    count = sum(len(f) for f in moved.values())
+    if not count:
+        return "reproduce: every deterministic file is byte-identical to the stored one"
+    if before.copies is None:
+        return f"reproduce: {count} deterministic files in {len(moved)} results moved"
+    store = {f"{e.paper}/{e.name}": e for e in Store(root).folders(None)}
+    refused = {}
+    for label, files in moved.items():
+        found = compare_folders(label, before.copies / label, root / label, rules_for(store[label], ANY),
+                                files=[f for f in files if (before.copies / label / f).exists()
+                                       and (root / label / f).exists()])
+        if found:
+            refused[label] = found
+    head = f"reproduce: {count} deterministic files in {len(moved)} results moved from the stored ones; "
+    if not refused:
+        return head + ("fkopt check's cross-platform rules accept all of them (another CPU moves the last "
+                       "digits of path-dependent runs: docs/reproducing.md)")
+    first = next(iter(refused.values()))[0]
+    return head + (f"fkopt check's cross-platform rules refuse {sum(map(len, refused.values()))} difference(s) "
+                   f"in {len(refused)} results (first: {first.experiment} {first.file} {first.column}); "
+                   "see CHANGES.md and run `fkopt check`")
 
 
 def write_changes(root: str | Path, before: Snapshot) -> Path:
