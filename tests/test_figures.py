@@ -36,7 +36,7 @@ def test_convergence_draws_the_threshold(drawn):
     for ax in fig.axes[:2]:
         flat = [line for line in ax.get_lines() if np.allclose(line.get_ydata(), 1e-4)]
         assert flat, "no horizontal line at the threshold"
-    assert any("threshold" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+    assert any("threshold" in t.get_text() for t in fig.axes[1].get_legend().get_texts())
 
 
 def test_variables_legend_outside_the_panels_and_log_iterations(drawn):
@@ -67,3 +67,24 @@ def test_scaling_axes_differ_by_marker_style_label_and_title(tmp_path):
         assert mine.get_marker() != theirs.get_marker() and mine.get_linestyle() != theirs.get_linestyle()
         assert ax.get_ylabel() != twin.get_ylabel()
         assert len(ax.get_legend().get_texts()) == 2
+
+
+def test_serial_fitness_label_takes_the_arms_length_unit_and_legends_stay_off_the_axes():
+    """Issue 32: the Panda's convergence figure said (mm + deg) for an arm in metres, and its
+    legend covered the curves."""
+    import numpy as np
+
+    import fkopt
+    from fkopt.experiment import plotting
+    urdf = fkopt.mechanism("urdf", file="configs/suites/robots/ur5.urdf", base="base_link", tip="tool0")
+    assert plotting.fitness_label(urdf, None).endswith("(m + deg)")
+    assert plotting.fitness_label(fkopt.mechanism("7dof-arm"), "paper").endswith("(mm + deg)")
+    plt = plotting.plt()
+    fig, axes = plt.subplots(1, 2)
+    for k in range(4):
+        axes[0].plot(np.arange(10), np.arange(10) * (k + 1), label=f"curve {k}")
+    plotting.legend_off_data(axes[-1], source=axes[0])
+    fig.canvas.draw()
+    box = axes[-1].get_legend().get_window_extent()
+    assert all(not box.overlaps(ax.get_window_extent()) for ax in axes)
+    plt.close(fig)

@@ -70,14 +70,28 @@ def spec_name(spec) -> str:
     return algorithm_name(spec.name, spec.params, spec.label)
 
 
+def position_unit(mechanism) -> str:
+    """The length unit of a serial arm's pose (mm for the DH arms, m for URDF/MJCF arms)."""
+    return (getattr(mechanism, "pose_units", None) or ("mm",))[0]
+
+
 def fitness_label(mechanism, objective: str | None) -> str:
-    """Axis label of the fitness with its unit, from the mechanism's input units and the objective."""
+    """Axis label of the fitness with its unit, from the mechanism's units and the objective
+    (a serial arm: ΔP in its length unit plus ΔR in degrees, :class:`fkopt.problems.IKProblem`)."""
     if getattr(mechanism, "kind", "") == "serial":
-        return "objective f = ΔP + ΔR (mm + deg)"
+        return f"objective f = ΔP + ΔR ({position_unit(mechanism)} + deg)"
     units = sorted(set(getattr(mechanism, "joint_units", ())))
     if objective == "absolute":
         return f"fitness Σ|Δl| ({' + '.join(units)})"
     return f"fitness Σ Δ² ({' + '.join(u + '²' for u in units)})"
+
+
+def legend_off_data(ax, source=None, **kwargs) -> None:
+    """The legend of ``source``'s curves (default: ``ax``'s) to the right of ``ax``, outside
+    every axis, so it never covers data (``save``'s tight bounding box keeps it in the file)."""
+    handles, labels = (source or ax).get_legend_handles_labels()
+    if handles:
+        ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, **kwargs)
 
 
 def floor_of(*arrays) -> float:

@@ -308,7 +308,7 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
                        label=f"threshold {threshold:g}" if ax is axes[0] else None)
     from matplotlib.ticker import MaxNLocator
     axes[0].xaxis.set_major_locator(MaxNLocator(integer=True))   # iterations are whole numbers
-    axes[0].legend(loc="best")
+    plotting.legend_off_data(axes[-1], source=axes[0])
     note = "one run" if single else f"median of {runs} runs, band: quartiles"
     if er.config.stop_at_threshold:
         note += f"; runs stop at f < {er.config.threshold:g} (bar: median stop)"
@@ -464,7 +464,7 @@ def extras_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
             ax.set_title(f"{what} pheromone τ, drawn as −τ" if neg else k)
             ax.set_ylabel(f"−τ_{what} ({unit})" if neg else k)
             ax.set_xlabel("colony move (iteration)")
-    axes[0][0].legend()
+    plotting.legend_off_data(axes[0][-1], source=axes[0][0])
     fig.suptitle(f"{er.config.title or er.config.name}: case {recs[0].case.label}", fontsize=9)
     fig.tight_layout()
     out = _save(fig, path)
@@ -473,7 +473,7 @@ def extras_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
 
 
 def position_error_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
-    """Best-so-far position error (mm) vs iteration (wang7dof Figs. 5/6a), serial arms."""
+    """Best-so-far position error (the arm's length unit) vs iteration (wang7dof Figs. 5/6a), serial arms."""
     curves = [c for c in _curve_sets(er) if c[4] is not None] if er.mechanism.kind == "serial" else []
     if not curves:
         return []
@@ -488,10 +488,10 @@ def position_error_figure(er: ExperimentResult, folder: Path, tables: dict) -> l
         plotting.mark_zero(ax, floor)
     ax.set_xlabel("iteration")
     runs = curves[0][4].shape[0]
-    ax.set_ylabel("position error of the best-so-far (mm)")
+    ax.set_ylabel(f"position error of the best-so-far ({plotting.position_unit(er.mechanism)})")
     ax.set_title(f"{er.config.title or er.config.name}\n"
                  + ("one run" if runs == 1 else f"median of {runs} runs, band: quartiles"), fontsize=9)
-    ax.legend()
+    plotting.legend_off_data(ax)
     out = _save(fig, path)
     plt.close(fig)
     return out
@@ -537,7 +537,7 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
         ax.set_title((er.config.title or er.config.name)
                      + (f"\ntimed poses only: the first {shown} of {len(er.cases)}" if shown < len(er.cases) else ""),
                      fontsize=9)
-        ax.legend()
+        plotting.legend_off_data(ax)
         written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
     if er.mechanism.kind == "serial":   # wang7dof Fig. 7a: final position error per pose
@@ -555,9 +555,9 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
             line.set_ydata(np.maximum(line.get_ydata(), floor))
         ax.set_yscale("log")
         _case_axis(ax, len(er.cases))
-        ax.set_ylabel(f"{agg}final position error (mm)")
+        ax.set_ylabel(f"{agg}final position error ({plotting.position_unit(er.mechanism)})")
         ax.set_title(er.config.title or er.config.name, fontsize=9)
-        ax.legend()
+        plotting.legend_off_data(ax)
         written += _save(fig, folder / figure_file(er, "cases_position_error"))
         plt.close(fig)
     return written

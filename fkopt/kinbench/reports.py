@@ -48,7 +48,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
     named at its right end as COCO does; tracks told apart by line style."""
-    from ..experiment.plotting import plt, save
+    from ..experiment.plotting import legend_off_data, plt, save
     df = tables.get("ecdf.csv")
     if df is None or df.empty:
         return []
@@ -72,7 +72,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         ax.set_ylim(-0.02, 1.02)
         what = "all problems" if scope == "all" else scope.split(":", 1)[1]
         ax.set_title(f"{sr.config.name}: {what}; targets {targets}", fontsize=8)
-        ax.legend(loc="upper left", fontsize=7)
+        legend_off_data(ax, fontsize=7)
         stem = "ecdf_all" if scope == "all" else f"ecdf_{_slug(scope.split(':', 1)[1])}"
         names += save(fig, folder / f"{stem}.png")
         pyplot.close(fig)

@@ -222,7 +222,7 @@ def ecdf_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     ax.set_xlabel("function evaluations")
     ax.set_ylabel(f"fraction of (pose, run) pairs with fitness < {sr.config.threshold:g}")
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=7, loc="lower right")
+    plotting.legend_off_data(ax, fontsize=7)
     ax.set_title(f"{sr.config.title or sr.config.name}: {len(sr.poses)} poses x {sr.config.runs} runs",
                  fontsize=9)
     names = _save(fig, folder / "ecdf.png")
@@ -312,7 +312,7 @@ def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     for ax in axes:
         ax.set_xlabel("trajectory step")
         ax.grid(True, alpha=0.3)
-    axes[0].legend(fontsize=7)
+    plotting.legend_off_data(axes[-1], source=axes[0], fontsize=7)
     fig.suptitle(f"{sr.config.title or sr.config.name}\n(each step warm-started from the previous "
                  f"step's solution unless marked cold)", fontsize=10)
     fig.tight_layout()
@@ -339,7 +339,7 @@ def tracking_time_figure(sr: StudyResult, folder: Path, tables: dict) -> list[st
     ax.set_xlabel("trajectory step")
     ax.set_ylabel("time per step and run (ms)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    plotting.legend_off_data(ax, fontsize=7)
     names = _save(fig, folder / "tracking_time.png")
     plt.close(fig)
     return names
