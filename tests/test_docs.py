@@ -50,3 +50,18 @@ def test_readme_quotes_the_stored_kinbench_leaderboard():
         assert list(rows["solver"]) == list(names), scope          # README lists them in rank order
         for solver, score in zip(rows["solver"], rows["score"]):
             assert f"{names[solver]} {score:.3f}" in text, (solver, f"{score:.3f}")
+
+
+def test_robots_page_advice_is_the_stored_kinbench_v2_board():
+    """docs/robots.md's "which solver" table is recomputed from the stored runs.csv and timing.csv."""
+    from fkopt.kinbench.advice import advice_markdown, advice_table
+    table = advice_markdown(advice_table(ROOT / "results" / "kinbench" / "kinbench-v2"))
+    assert table in (ROOT / "docs" / "robots.md").read_text(encoding="utf-8")
+
+
+def test_mechanism_docs_do_not_contradict_the_robots_page():
+    """Issue 32: the mechanisms page said yourdfpy parses URDF, that URDF chains had no analytic
+    Jacobian and suggested `w_p: 1000` (which no schema allows); the robots page said otherwise."""
+    text = (ROOT / "docs" / "mechanisms-and-algorithms.md").read_text(encoding="utf-8")
+    for stale in ("yourdfpy parses", "no analytic Jacobian for URDF", "w_p: 1000"):
+        assert stale not in text

@@ -1,0 +1,42 @@
+"""Which solver to use for which problem, read off a stored suite's board (docs/robots.md).
+
+For each problem of a suite folder: every solver's share of (pose, run) pairs that reached a
+fitness target within the suite's budget, and its wall time per solve from ``timing.csv``,
+best first (success, then time). docs/robots.md quotes this table for kinbench v2's problems,
+and a test recomputes it from the stored ``runs.csv`` and ``timing.csv``, so the advice is the
+board's, not an opinion.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+
+def advice_table(folder: str | Path, target: str = "1e-06", top: int = 3) -> pd.DataFrame:
+    """Columns problem, class, solver, success (share reached ``target``), ms_per_solve; the
+    ``top`` solvers of each problem, best first, problems in the order runs.csv lists them."""
+    folder = Path(folder)
+    runs = pd.read_csv(folder / "runs.csv")
+    timing = pd.read_csv(folder / "timing.csv")
+    column = f"evals_to_{target}"
+    if column not in runs:
+        raise ValueError(f"{folder / 'runs.csv'}: no column {column} (targets: "
+                         + ", ".join(c.removeprefix("evals_to_") for c in runs if c.startswith("evals_to_")) + ")")
+    runs = runs.assign(reached=np.isfinite(runs[column].to_numpy(dtype=float)))
+    table = (runs.groupby(["problem", "class", "solver"], sort=False)["reached"].mean().rename("success")
+             .reset_index().merge(timing[["problem", "solver", "ms_per_solve"]], on=["problem", "solver"], how="left"))
+    order = {p: i for i, p in enumerate(runs["problem"].unique())}
+    table = table.assign(_p=table["problem"].map(order), _s=-table["success"]).sort_values(
+        ["_p", "_s", "ms_per_solve"], kind="stable")
+    return table.groupby("problem", sort=False).head(top).drop(columns=["_p", "_s"]).reset_index(drop=True)
+
+
+def advice_markdown(table: pd.DataFrame) -> str:
+    """The table as docs/robots.md prints it (one row per problem)."""
+    lines = ["| problem | class | best | second | third |", "|---|---|---|---|---|"]
+    for (problem, cls), rows in table.groupby(["problem", "class"], sort=False):
+        cells = [f"{r.solver} {100 * r.success:.0f} %, {r.ms_per_solve:.3g} ms" for r in rows.itertuples()]
+        lines.append(f"| {problem} | {cls} | " + " | ".join(cells + [""] * (3 - len(cells))) + " |")
+    return "\n".join(lines)
