@@ -526,15 +526,12 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     if algorithm and (start or mask):
         raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
     if algorithm:
-        from . import problems, solve
-        problem = problems.ik_problem(m, values, objective="geodesic")
-        res = solve(problem, algorithm, population=50, iterations=500, runs=1, seed=seed)
-        q = res.x[0]
-        perr = float(problem.position_error(q))
-        rerr = float(np.radians(problem.rotation_error(q, "geodesic")))
-        out = {"joints": dict(zip(m.joint_names, map(float, q))), "position_error": perr,
-               "rotation_error_rad": rerr, "fitness": float(res.fitness[0]), "objective": problem.objective,
-               "solved": bool(perr <= position_tol and rerr <= orientation_tol), "algorithm": algorithm}
+        from .by_algorithm import inverse_by
+        out = inverse_by(m, values, algorithm, tol=(position_tol, orientation_tol), seed=seed).as_dict()
+        out.pop("restarts")
+        out["objective"] = "geodesic"
+        out["algorithm"] = algorithm
+        perr, rerr = out["position_error"], out["rotation_error_rad"]
     else:
         from .kinematics import inverse
         q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
@@ -596,13 +593,12 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
                 _console().print(s)
         return
     if algorithm:
-        from . import fk_problem, solve
-        problem = fk_problem(m, values)
-        res = solve(problem, algorithm, population=20, iterations=300, runs=1, seed=seed)
-        x = res.x[0]
-        residual = float(np.max(np.abs(problem.residuals(x))))
-        out = {"pose": dict(zip(m.pose_names, map(float, x))), "residual": residual,
-               "solved": bool(residual <= tolerance and m.in_bounds(x)), "algorithm": algorithm}
+        from .by_algorithm import forward_by
+        r = forward_by(m, values, algorithm, tol=tolerance, seed=seed)
+        out = r.as_dict()
+        out.pop("stage")
+        out["algorithm"] = algorithm
+        x = r.pose
     else:
         from .kinematics import forward
         r = forward(m, values, tol=tolerance, seed=seed)

@@ -168,13 +168,59 @@ def load_mapping(path: str | Path, what: str) -> dict:
 
 
 # -- pydantic errors -------------------------------------------------------------------------------
-def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dict | None = None) -> str:
+def _models_in(annotation) -> list:
+    """The pydantic models an annotation can hold (through Optional/Union, list, dict, Annotated)."""
+    import typing
+
+    from pydantic import BaseModel
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for arg in typing.get_args(annotation) for m in _models_in(arg)]
+
+
+def field_names_at(model, loc: list[str]) -> list[str]:
+    """The field names (and aliases) a mapping at ``loc`` (an error's location without its last
+    part) may have, walking ``model``'s annotations; [] where that is not known."""
+    current = _models_in(model)
+    for part in loc:
+        if part.isdigit() or part.startswith(("list[", "function-", "literal[", "dict[")):
+            continue                         # list items and validator frames: same models
+        tagged = [m for m in current if m.__name__ == part]
+        if tagged:                           # a union branch pydantic tried
+            current = tagged
+            continue
+        current = [m for c in current if part in c.model_fields for m in _models_in(c.model_fields[part].annotation)]
+    names = []
+    for c in current:
+        for key, info in c.model_fields.items():
+            names += [key] + ([info.alias] if info.alias else [])
+    return sorted(set(names))
+
+
+def did_you_mean(word: str, names) -> str:
+    """`` (did you mean 'x'?)`` for the closest of ``names`` (difflib, as the CLI's options), else ``""``."""
+    import difflib
+    close = difflib.get_close_matches(str(word), [str(n) for n in names], n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dict | None = None,
+               model=None) -> str:
     """One line ``field.path: message`` from a pydantic ``ValidationError``.
 
     ``branches`` maps a union field to ``{key in the user's mapping: branch tag}``, so that the
     error of the branch the user meant (by its key) is reported, not the first branch tried.
+    With ``model`` (the validated class), an unknown field names the closest allowed one, and
+    such a typo is reported before the "Field required" it causes (``algoritms`` before
+    ``algorithms``).
     """
     errors = err.errors()
+    if model is not None:     # a misspelt field first: its "missing" twin follows from it
+        hint = {id(e): did_you_mean(e["loc"][-1], field_names_at(model, [str(p) for p in e["loc"][:-1]]))
+                for e in errors if e["type"] == "extra_forbidden"}
+        errors = sorted(errors, key=lambda e: 0 if hint.get(id(e)) else 1)
+    else:
+        hint = {}
     wanted: dict[str, str] = {}
     tags: set[str] = set()
     for field, table in (branches or {}).items():
@@ -196,7 +242,7 @@ def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dic
         loc = [p for p in loc if p not in tags and not p.startswith(("function-", "list[", "literal["))]
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
-            msg = "unknown field"
+            msg = "unknown field" + (hint.get(id(e)) or "")
         return f"{'.'.join(loc)}: {msg}" if loc else msg
     return str(err).splitlines()[0]
 

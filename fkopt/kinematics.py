@@ -108,6 +108,11 @@ from .problems import so3_right_jacobian_inverse
 FORWARD_TOL = 1e-9
 #: Default inverse tolerances: (position in the arm's length unit, orientation in radians).
 INVERSE_TOL = (1e-6, 1e-6)
+#: The swarm budget of one pose: fkopt.forward's global stage (gabc+lm) and a forward solve by a
+#: named algorithm (:func:`fkopt.by_algorithm.forward_by`, ``fkopt fk --algorithm``).
+FORWARD_SWARM = {"population": 20, "iterations": 300}
+#: The budget of one IK pose by a named algorithm (:func:`fkopt.by_algorithm.inverse_by`).
+INVERSE_SWARM = {"population": 50, "iterations": 500}
 
 
 @dataclass
@@ -547,8 +552,7 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
         from .solve import solve
         for k in todo:
             problem = fk_problem(m, L[k])
-            out = solve(problem, "gabc+lm", population=20, iterations=300, runs=1, seed=seed,
-                        run_ids=[int(k)])
+            out = solve(problem, "gabc+lm", **FORWARD_SWARM, runs=1, seed=seed, run_ids=[int(k)])
             evals[0][k] += int(out.evaluations[0])
             xs = out.x[:1]
             rs = np.abs(problem.residuals(xs)).max(axis=-1)

@@ -95,3 +95,48 @@ def test_ticks_map_a_chunk_onto_its_share_of_the_batch():
         tick(3, 3)
     tick(1, 2)                                                # nobody listening: nothing
     assert heard == [0.625, 1.0]
+
+
+@pytest.mark.parametrize("edit, expected", [
+    ({"algoritms": [{"name": "gabc"}]}, "algoritms: unknown field (did you mean 'algorithms'?)"),
+    ({"algorithms": [{"name": "gabc", "populaton": 3}]},
+     "algorithms.0.populaton: unknown field (did you mean 'population'?)"),
+    ({"cases": {"random": 3, "sed": 2}}, "cases.sed: unknown field (did you mean 'seed'?)"),
+    ({"cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}, {"random": 3}]},
+     "cases: item 1 is {random: ...}: cases is either a list of cases"),
+])
+def test_unknown_fields_name_the_closest_and_case_forms_do_not_mix(cli, tmp_path, edit, expected):
+    config = {"name": "t", "mechanism": {"name": "3-rps"}, "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}],
+              "algorithms": [{"name": "gabc"}]}
+    config.update(edit)
+    if "algoritms" in edit:
+        del config["algorithms"]
+    path = tmp_path / "t.yaml"
+    path.write_text(yaml.safe_dump(config))
+    code, out, err = cli("run", path, "--out", tmp_path / "out")
+    assert code == 2 and err.strip().count("\n") == 0 and expected in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_study_and_suite_fields_get_the_hint_too():
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.config import suite_from_dict
+    from fkopt.study.config import study_from_dict
+    with pytest.raises(FkoptError, match=r"budget_per_dm: unknown field \(did you mean 'budget_per_dim'\?\)"):
+        suite_from_dict({"kind": "suite", "name": "s", "problems": [], "solvers": [], "budget_per_dm": 3}, "s.yaml")
+    with pytest.raises(FkoptError, match=r"\(did you mean 'threshold'\?\)"):
+        study_from_dict({"kind": "study", "name": "s", "mechanism": {"name": "3-rps"}, "thresold": 1e-3,
+                         "poses": {"uniform": 5}, "algorithms": [{"name": "gabc"}]}, "s.yaml")
+
+
+def test_a_rerun_with_another_config_names_the_field_that_changed(cli, tmp_path):
+    config = {"name": "c", "mechanism": {"name": "3-rps"}, "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}],
+              "algorithms": [{"name": "gabc", "population": 4}], "runs": 2, "iterations": 5}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(config))
+    assert cli("run", path, "--out", tmp_path / "out", "-q")[0] == 0
+    config["runs"] = 3
+    config["algorithms"][0]["population"] = 6
+    path.write_text(yaml.safe_dump(config))
+    code, out, err = cli("run", path, "--out", tmp_path / "out", "-q")
+    assert code == 2 and "algorithms.0.population: 4 -> 6; runs: 2 -> 3); rerun with --force" in err, err

@@ -52,7 +52,7 @@ def assembly_from_dict(data: dict, where: str) -> AssemblyConfig:
     try:
         return AssemblyConfig(**data)
     except ValidationError as err:
-        raise FkoptError(f"{where}: {error_line(err, data=data)}") from None
+        raise FkoptError(f"{where}: {error_line(err, data=data, model=AssemblyConfig)}") from None
 
 
 @dataclass

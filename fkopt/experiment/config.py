@@ -189,6 +189,19 @@ class ExperimentConfig(RunConfig):
     #: (time of each timed run).
     figures: list[Literal["variables", "snapshots", "extras", "cases", "time"]] = Field(default_factory=list)
 
+    @field_validator("cases", mode="before")
+    @classmethod
+    def _one_form(cls, cases):
+        # the two forms do not mix: a list holds listed cases only
+        if isinstance(cases, list):
+            for i, item in enumerate(cases):
+                if isinstance(item, dict) and "random" in item:
+                    raise ValueError(f"item {i} is {{random: ...}}: cases is either a list of cases (each with "
+                                     "pose and/or joints) or one mapping {random: N, seed: S} for N poses "
+                                     "uniform in the bounds, not both; put the random cases in a config of "
+                                     "their own")
+        return cases
+
     @field_validator("cases")
     @classmethod
     def _some_cases(cls, cases):
@@ -218,7 +231,7 @@ CASE_BRANCHES = {"cases": {"random": "RandomCases"}}
 
 
 def _one_line(err: ValidationError, data: dict | None = None) -> str:
-    return error_line(err, CASE_BRANCHES, data)
+    return error_line(err, CASE_BRANCHES, data, model=ExperimentConfig)
 
 
 def experiment_from_dict(data: dict, where: str) -> ExperimentConfig:

@@ -140,9 +140,35 @@ def check_overwrite(folder: Path, config, force: bool) -> None:
         return
     if force:
         return
-    if numeric_fields(stored) != numeric_fields(config.model_dump(mode="json")):
-        raise FkoptError(f"{folder}: holds a result of a different config (its result-changing fields "
-                         "differ); rerun with --force to replace it")
+    old, new = numeric_fields(stored), numeric_fields(config.model_dump(mode="json"))
+    if old != new:
+        changed = changed_fields(old, new)
+        shown = "; ".join(changed[:3]) + (f"; and {len(changed) - 3} more" if len(changed) > 3 else "")
+        raise FkoptError(f"{folder}: holds a result of a different config ({shown}); "
+                         "rerun with --force to replace it")
+
+
+def _short(value) -> str:
+    text = json.dumps(value, sort_keys=True, default=str)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def changed_fields(old, new, path: str = "") -> list[str]:
+    """Where two config mappings differ, each as ``field.path: stored -> now`` (lists by index)."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        out = []
+        for key in sorted(set(old) | set(new), key=str):
+            where = f"{path}.{key}" if path else str(key)
+            if key not in new:
+                out.append(f"{where}: {_short(old[key])} -> (removed)")
+            elif key not in old:
+                out.append(f"{where}: (absent) -> {_short(new[key])}")
+            else:
+                out += changed_fields(old[key], new[key], where)
+        return out
+    if isinstance(old, list) and isinstance(new, list) and len(old) == len(new):
+        return [c for i, (a, b) in enumerate(zip(old, new)) for c in changed_fields(a, b, f"{path}.{i}")]
+    return [] if old == new else [f"{path or 'config'}: {_short(old)} -> {_short(new)}"]
 
 
 def prepare_output(config, out: str | Path, force: bool = False) -> Path:

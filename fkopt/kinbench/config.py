@@ -214,7 +214,7 @@ def suite_from_dict(data: dict, where: str) -> SuiteConfig:
     try:
         return SuiteConfig(**data)
     except ValidationError as err:
-        raise FkoptError(f"{where}: {error_line(err, None, data)}") from None
+        raise FkoptError(f"{where}: {error_line(err, None, data, model=SuiteConfig)}") from None
 
 
 def load_suite(path: str | Path) -> SuiteConfig:

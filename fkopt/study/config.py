@@ -218,7 +218,7 @@ POSE_BRANCHES = {"poses": {"uniform": "UniformPoses", "grid": "GridPoses", "wayp
 
 def _study_error(err: ValidationError, data: dict) -> str:
     """One line; a union of pose sets reports the branch the user meant (by its key)."""
-    return error_line(err, POSE_BRANCHES, data)
+    return error_line(err, POSE_BRANCHES, data, model=StudyConfig)
 
 
 def load_study(path: str | Path) -> StudyConfig:
