@@ -623,8 +623,8 @@ def bench_cli_process(rows: _Rows, quick: bool) -> None:
     Both with compiled bytecode cached (a temporary ``PYTHONPYCACHEPREFIX``, one warm-up run
     each), as in any installation, and, for the record, in this process's own environment
     (where ``PYTHONDONTWRITEBYTECODE=1`` makes every start compile fkopt's sources again).
-    Such a command imports numpy, typer (not run: ``fkopt.cli._direct`` parses it) and the
-    modules of the mechanism and the solver, not pydantic, pandas or matplotlib."""
+    Such a command imports numpy, typer (with pydantic) and the modules of the mechanism and
+    the solver, not pandas or matplotlib."""
     import sys
     import tempfile
     reps = 5 if quick else 15

@@ -869,79 +869,6 @@ def _reflowed_help() -> None:
 
 _reflowed_help()
 
-#: Commands that may skip typer's parsing (see :func:`_direct`).
-DIRECT = {"fk": "fk", "ik": "ik", "list": "list_cmd"}
-_NUMBER = {"int": r"[0-9]+", "float": r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?"}
-
-
-def _direct(argv: list[str]):
-    """``(function, kwargs)`` for a plain ``fk``/``ik``/``list`` command line, else ``None``.
-
-    Running a typer app builds a pydantic TypeAdapter per parameter (typer >= 0.20), and
-    importing pydantic costs more than a forward solve, so these three commands are parsed here
-    from their own typer signatures: options ``--name value`` / ``--name=value`` and flags given
-    once each, positional arguments in order, integers and floats written plainly (int options
-    inside their ``min``). Any other command line -- ``--help``, an unknown or repeated option, a
-    missing value, ``--seed -1``, a number in another spelling -- returns ``None`` and goes
-    through typer, whose messages stay the only ones users see for such input."""
-    import inspect
-    import re
-    if not argv or argv[0] not in DIRECT:
-        return None
-    func = globals()[DIRECT[argv[0]]]
-    positional, options = [], {}
-    for name, par in inspect.signature(func).parameters.items():
-        info = par.default
-        kind = "bool" if par.annotation == "bool" else par.annotation.removeprefix("Optional[").rstrip("]")
-        if kind not in ("str", "int", "float", "bool", "Path"):
-            return None
-        if type(info).__name__ == "ArgumentInfo":
-            positional.append((name, kind, info))
-        else:
-            for decl in info.param_decls:
-                options[decl] = (name, kind, info)
-    kwargs, rest = {}, []
-    tokens = iter(argv[1:])
-    for tok in tokens:
-        if not tok.startswith("-"):
-            rest.append(tok)
-            continue
-        decl, eq, value = tok.partition("=")
-        if decl not in options:
-            return None
-        name, kind, info = options[decl]
-        if name in kwargs:
-            return None
-        if kind == "bool":
-            if eq:
-                return None
-            kwargs[name] = True
-            continue
-        if not eq:
-            value = next(tokens, None)
-            if value is None or value.startswith("-") and kind not in ("int", "float"):
-                return None
-        if kind in _NUMBER:
-            if not re.fullmatch(_NUMBER[kind], value):
-                return None
-            value = int(value) if kind == "int" else float(value)
-            if kind == "int" and info.min is not None and value < info.min:
-                return None
-        elif kind == "Path":
-            value = Path(value)
-        kwargs[name] = value
-    if len(rest) > len(positional):
-        return None
-    for (name, kind, info), value in zip(positional, rest):
-        kwargs[name] = value
-    for name, kind, info in positional[len(rest):] + list(options.values()):
-        if name not in kwargs:
-            if info.default is ...:                    # required and missing: typer says so
-                return None
-            kwargs[name] = info.default
-    return func, kwargs
-
-
 def main() -> None:
     """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
     interrupted = ("fkopt: interrupted (previous results are kept; the finished tasks of a "
@@ -955,13 +882,7 @@ def main() -> None:
     if not sys.argv[1:]:     # bare `fkopt`: the help, and success (nothing went wrong)
         sys.argv.append("--help")
     try:
-        direct = _direct(sys.argv[1:])
-        if direct is not None:
-            func, kwargs = direct
-            func(**kwargs)
-            code = 0
-        else:
-            code = app(standalone_mode=False)
+        code = app(standalone_mode=False)
     except FkoptError as err:
         fail(str(err))
     except KeyboardInterrupt:
