@@ -98,11 +98,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .algorithms.hybrid import GABCLM
 from .errors import FkoptError
 from .mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from .numerics import path as numerics_path
 from .numerics.dls import inverse_candidates, rotation_error1
-from .problems import so3_right_jacobian_inverse
+from .problems import fk_problem, so3_right_jacobian_inverse
+from .solve import solve
 
 #: Default forward tolerance: max |ik(pose) - joints| in the joint units.
 FORWARD_TOL = 1e-9
@@ -548,11 +550,9 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
                 stage[todo[ok]] = 1
                 todo = todo[~ok]
     if global_search and len(todo):
-        from .problems import fk_problem
-        from .solve import solve
         for k in todo:
             problem = fk_problem(m, L[k])
-            out = solve(problem, "gabc+lm", **FORWARD_SWARM, runs=1, seed=seed, run_ids=[int(k)])
+            out = solve(problem, GABCLM(), **FORWARD_SWARM, runs=1, seed=seed, run_ids=[int(k)])
             evals[0][k] += int(out.evaluations[0])
             xs = out.x[:1]
             rs = np.abs(problem.residuals(xs)).max(axis=-1)

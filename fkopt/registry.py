@@ -70,9 +70,9 @@ ALGORITHMS: dict[str, str] = {
     "abc+lm": "fkopt.algorithms.hybrid:ABCLM",
     "gabc+lm": "fkopt.algorithms.hybrid:GABCLM",
     "pso+lm": "fkopt.algorithms.hybrid:PSOLM",
-    "forward": "fkopt.algorithms.exact:Forward",     # fkopt.forward as a solver (parallel FK)
-    "inverse": "fkopt.algorithms.exact:Inverse",     # fkopt.inverse as a solver (serial IK)
-    "exact": "fkopt.algorithms.exact:Exact",         # forward or inverse, by the mechanism's kind
+    "forward": "fkopt.exact:Forward",     # fkopt.forward as a solver (parallel FK)
+    "inverse": "fkopt.exact:Inverse",     # fkopt.inverse as a solver (serial IK)
+    "exact": "fkopt.exact:Exact",         # forward or inverse, by the mechanism's kind
 }
 
 #: Prefixes reserved for the adapters of other libraries' optimisers (fkopt.adapters).

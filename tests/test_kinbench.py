@@ -454,7 +454,7 @@ def test_exact_solvers_give_fkopt_forward_and_inverse_numbers_and_count_their_ev
     import fkopt
     from fkopt.problems import fk_problem, ik_problem
     from fkopt.solve import solve
-    from fkopt.algorithms.exact import row_seeds
+    from fkopt.exact import row_seeds
     from fkopt.streams import RunStreams
     m = fkopt.mechanism("3-rps", ra=274, rb=158)
     poses = m.bounds[:, 0] + np.random.default_rng(3).random((3, 3)) * np.diff(m.bounds).ravel()

@@ -12,16 +12,21 @@ evaluation, as everywhere in fkopt). The answer is scored by the problem's own f
 evaluation, counted). An exact solver has no iterations: every record t = 0..iterations holds
 the answer's fitness at the evaluations used, so a budget cut below them (a suite's ``B``)
 leaves the run with no answer -- the solver did not finish within the budget.
+
+This module sits beside :mod:`fkopt.kinematics` (which it wraps), not in :mod:`fkopt.algorithms`:
+an algorithm knows only the problem interface (docs/ARCHITECTURE: floor 1), and these know
+mechanisms. The registry names them like every algorithm.
 """
 from __future__ import annotations
 
 import numpy as np
 from pydantic import Field
 
-from ..errors import FkoptError
-from ..progress import tick
-from ..streams import RunStreams, run_seed_sequence
-from .base import Algorithm, Params, RunRecord
+from .algorithms.base import Algorithm, Params, RunRecord
+from .errors import FkoptError
+from .kinematics import forward, inverse
+from .progress import tick
+from .streams import RunStreams, run_seed_sequence
 
 
 def row_seeds(streams: RunStreams) -> list[int]:
@@ -76,13 +81,11 @@ class ForwardParams(Params):
 
 
 def _forward(problem, row: int, seed: int, p) -> tuple[np.ndarray, int]:
-    from ..kinematics import forward
     out = forward(problem.mechanism, problem.joints[row], tol=p.tol, seed=seed, global_search=p.global_search)
     return out.pose, int(out.evaluations["residual"]) + int(out.evaluations["jacobian"])
 
 
 def _inverse(problem, row: int, seed: int, p) -> tuple[np.ndarray, int]:
-    from ..kinematics import inverse
     out = inverse(problem.mechanism, problem.target[row], tol=(p.position_tol, p.rotation_tol), seed=seed,
                   restarts=p.restarts)
     return out.joints, int(out.evaluations["residual"]) + int(out.evaluations["jacobian"])
