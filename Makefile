@@ -63,4 +63,4 @@ clean:
 # The fast tier: everything but slow, stored-results, outside-tool and browser tests (markers in
 # tests/conftest.py). Run it after every change; `make test` (the full suite) is what CI runs.
 test-fast:
-	$(PYTHON) -m pytest -q -m "not slow and not stored and not external and not browser"
+	$(PYTHON) -m pytest -q -n 2 -m "not slow and not stored and not external and not browser"

@@ -136,17 +136,28 @@ def _every_fkopt_module():
     return sorted(name for _, name, _ in pkgutil.walk_packages(fkopt.__path__, "fkopt."))
 
 
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """pytest-xdist (make test-fast runs -n 2): a worker's imported fkopt modules, for the check below."""
+    names = getattr(node, "workeroutput", {}).get("fkopt_modules", [])
+    node.config._fkopt_worker_modules = getattr(node.config, "_fkopt_worker_modules", set()) | set(names)
+
+
 def pytest_sessionfinish(session, exitstatus):
     """After a whole fast tier (every file of tests/, `-m FAST_TIER`, no -k) that passed: fail if a module
     of fkopt was imported by no test -- a module only slow tests reach gets no check after a change."""
     config = session.config
+    if hasattr(config, "workeroutput"):       # an xdist worker: report what it imported to the controller
+        config.workeroutput["fkopt_modules"] = sorted(n for n in sys.modules if n.split(".")[0] == "fkopt")
+        return
     if (exitstatus != 0 or config.option.collectonly or config.option.keyword
             or config.option.markexpr.strip() != FAST_TIER):
         return
     tests_dir = os.path.dirname(os.path.abspath(__file__))
     if any(os.path.abspath(os.path.join(str(config.invocation_params.dir), a)) != tests_dir for a in config.args):
         return
-    missing = [name for name in _every_fkopt_module() if name not in sys.modules]
+    seen = set(sys.modules) | getattr(config, "_fkopt_worker_modules", set())
+    missing = [name for name in _every_fkopt_module() if name not in seen]
     if missing:
         session.config.get_terminal_writer().line(
             "fast tier imports no test of these fkopt modules (add a small fast test): " + ", ".join(missing),

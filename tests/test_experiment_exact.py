@@ -74,10 +74,12 @@ def test_progress_moves_inside_a_task_and_prints_plain_lines_without_a_terminal(
     and without a terminal nothing was printed. Inside the task the iterations tick
     (fkopt.progress), and a stdout that is not a terminal gets plain lines with the time left."""
     import fkopt.cli
+    import fkopt.experiment.tasks
     monkeypatch.setattr(fkopt.cli, "HEARTBEAT_S", 0.0)
+    monkeypatch.setattr(fkopt.experiment.tasks, "RUNNING_EVERY_S", 0.0)
     path = tmp_path / "p.yaml"
     path.write_text(yaml.safe_dump({"name": "p", "mechanism": {"name": "3-rps"}, "cases": {"random": 3, "seed": 1},
-                                    "algorithms": [{"name": "gabc"}], "runs": 4, "iterations": 3000}))
+                                    "algorithms": [{"name": "gabc"}], "runs": 2, "iterations": 40}))
     code, out, err = cli("run", path, "--out", tmp_path / "out")
     assert code == 0, err
     lines = [ln for ln in out.splitlines() if " tasks (gabc), about " in ln]

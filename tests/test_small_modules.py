@@ -68,3 +68,42 @@ def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cros
     assert ulp.startswith("reproduce: 1 deterministic files in 1 results moved") and "accept all" in ulp
     big = line_after(lambda t: "".join(t.splitlines(keepends=True)[:-3]))        # runs lost
     assert "refuse" in big and "liu2008/tab3_fig4 runs.csv" in big
+
+
+def test_field_solvers_answer_on_the_stored_ur5_and_kinbench_judges_them():
+    """The outside IK wrappers (TRAC-IK, rtb ik_LM/ik_NR) on the suite's stored UR5: every answer
+    judged by kinbench's own FK (the fast tier's reach; tests/test_field.py checks against pinocchio)."""
+    import numpy as np
+    import pytest
+
+    import fkopt
+    from fkopt.adapters.field import make_ik, solve
+    from fkopt.kinbench.physical import ik_verdicts
+    arm = fkopt.mechanism("urdf", file="configs/suites/robots/ur5.urdf", base="base_link", tip="tool0")
+    rng = np.random.default_rng(4)
+    q = arm.bounds[:, 0] + rng.random((3, arm.dof)) * (arm.bounds[:, 1] - arm.bounds[:, 0])
+    T = arm.fk_matrix(q)
+    for name in ("tracik", "rtb-ik_LM", "rtb-ik_NR"):
+        try:
+            solver = make_ik(name, arm, timeout=0.05, rng=np.random.default_rng(0))
+        except fkopt.FkoptError as err:       # the field extra is not installed
+            pytest.skip(str(err))
+        answers = solve(solver, T)
+        v = ik_verdicts(arm, answers.joints, T)
+        assert answers.joints.shape == (3, arm.dof) and (answers.seconds > 0).all()
+        assert v["success"][:, 0].sum() >= 2, (name, v)          # 5 mm / 0.05 rad on most of 3 poses
+
+
+def test_by_algorithm_judges_a_swarm_answer_like_the_exact_solvers():
+    import numpy as np
+
+    import fkopt
+    from fkopt.by_algorithm import forward_by, inverse_by
+    m = fkopt.mechanism("3-rps")
+    legs = m.ik(np.array([9.0, 13.0, 622.0]))
+    r = forward_by(m, legs, "gabc+lm", tol=1e-6, budget={"population": 10, "iterations": 60})
+    assert bool(r.solved) == bool(np.abs(m.ik(r.pose) - legs).max() <= 1e-6 and m.in_bounds(r.pose))
+    arm = fkopt.mechanism("7dof-arm")
+    pose = arm.fk(np.array([45.0, 0, 45, 0, 45, 0, 0]))
+    s = inverse_by(arm, pose, "pso", budget={"population": 10, "iterations": 20})
+    assert not bool(s.solved) and float(s.position_error) > 1e-6 and s.as_dict()["joints"].keys() == set(arm.joint_names)

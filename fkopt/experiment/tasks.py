@@ -233,6 +233,10 @@ def task_file_problems(folder: Path) -> list[tuple[str, str]]:
     return out
 
 
+#: Seconds between reports of a running task's fraction (fkopt.progress) to ``progress.running``.
+RUNNING_EVERY_S = 0.2
+
+
 def _within(progress, label: str, done: int, total: int):
     """A :func:`fkopt.progress.listening` callback for a running task: when ``progress`` has a
     ``running`` method, ``progress.running(label, done + fraction, total)``, at most every 0.2 s
@@ -244,7 +248,7 @@ def _within(progress, label: str, done: int, total: int):
 
     def heard(fraction: float) -> None:
         now = time.perf_counter()
-        if now - last[0] >= 0.2:
+        if now - last[0] >= RUNNING_EVERY_S:
             last[0] = now
             running(label, done + fraction, total)
     return heard
