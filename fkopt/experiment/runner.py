@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import registry
 from ..errors import FkoptError
+from ..record import concat, run_record
 from ..problems import fk_problem, ik_problem
 from ..rotations import wrap_degrees
 from ..solve import Result, chunk_size, make_algorithm, solve
@@ -65,6 +66,7 @@ class ExperimentResult:
     records: list[TaskRecord]
     wall_s: float
     source: str | None = None
+    record: object = None              # the run record (:mod:`fkopt.record`): one row per (case, algorithm, run)
 
     @property
     def compared_names(self) -> tuple[str, ...]:
@@ -331,7 +333,35 @@ def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: 
     wall = time.perf_counter() - ctx.started
     # solves computed elsewhere (fkopt reproduce's workers): their own time, measured where they ran
     wall += sum(ran.records[t.id].wall_s * len(cases) for t in plan.tasks if t.id not in ran.computed)
-    return ExperimentResult(config, mech, cases, records, wall, source)
+    return ExperimentResult(config, mech, cases, records, wall, source, experiment_record(config, mech, records))
+
+
+def experiment_record(config: ExperimentConfig, mech, records: list[TaskRecord]):
+    """The run record (:mod:`fkopt.record`) of an experiment's task records, in their order."""
+    thr = config.threshold
+    frames = []
+    for rec in records:
+        r, case = rec.result, rec.case
+        cols = {"problem": config.name, "case": case.label, "pose": case.index, "solver": rec.spec.key,
+                "run": r.run_ids, "task_seed": rec.seed, "final_fitness": r.fitness, "evaluations": r.evaluations,
+                "iterations_done": r.iterations_done,
+                # first iteration at which the run's final best-so-far fitness was reached
+                "iterations_to_best": np.argmax(r.history <= r.history[:, -1:], axis=1)}
+        if thr is not None:
+            cols["iterations_to_threshold"] = r.iterations_to(thr)
+            cols["evaluations_to_threshold"] = r.evaluations_to(thr)
+        cols.update({f"x_{name}": r.x[:, j] for j, name in enumerate(r.variable_names)})
+        if mech.kind == "serial":
+            cols.update({f"pose_{name}": rec.outputs[:, j] for j, name in enumerate(mech.pose_names)})
+        if rec.position_error_history is not None:
+            cols["position_error"] = rec.position_error_history[:, -1]
+        target = case.target if case.target is not None else case.reference
+        if target is not None:
+            err = pose_error(mech, rec.outputs, target)
+            cols.update({f"abs_error_{name}": err[:, j] for j, name in enumerate(mech.pose_names)})
+        cols.update({f"final_{key}": r.extras[key][:, -1] for key in r.extras})
+        frames.append(run_record("experiment", cols))
+    return concat(frames)
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
