@@ -29,6 +29,7 @@ import numpy as np
 
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
+from ..record import concat, run_record
 from ..solve import make_algorithm, pick_events
 from ..streams import case_seed
 from ..experiment.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder  # noqa: F401 (tests, API)
@@ -265,6 +266,7 @@ class StudyResult:
     source: str | None = None
     computed: list[str] = field(default_factory=list)   # task ids computed by this invocation
     folder: Path | None = None
+    record: object = None     # the run record (:mod:`fkopt.record`): one row per (algorithm, pose, run)
 
     @property
     def compared_names(self):
@@ -322,7 +324,7 @@ class _Context:
 
 
 def _label(config: StudyConfig, task: Task) -> str:
-    where = (f"poses {task.start + 1}-{task.stop}" if config.mode == "independent"
+    where = (f"poses {task.start}-{task.stop - 1}" if config.mode == "independent"
              else f"{task.stop - task.start} steps")
     return f"{task.label} · {where}"
 
@@ -343,6 +345,26 @@ def study_plan(config: StudyConfig, source: str | None = None) -> Plan:
 def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None = None,
                 folder: Path | None = None, **_) -> StudyResult:
     ctx: _Context = plan.context
-    return StudyResult(config, ctx.mech, ctx.poses, merge(config, ctx.mech, ctx.poses, ran.records),
-                       time.perf_counter() - ctx.started, source, list(ran.computed), folder)
+    algorithms = merge(config, ctx.mech, ctx.poses, ran.records)
+    return StudyResult(config, ctx.mech, ctx.poses, algorithms, time.perf_counter() - ctx.started, source,
+                       list(ran.computed), folder, study_record(config, ctx.mech, ctx.poses, algorithms))
+
+
+def study_record(config: StudyConfig, mech, poses: PoseSet, algorithms: list[AlgorithmResult]):
+    """The run record (:mod:`fkopt.record`) of a study: algorithm by algorithm, pose by pose (from
+    0, the index its seed takes), run by run."""
+    n, runs = len(poses), config.runs
+    frames = []
+    for ar in algorithms:
+        cols = {"problem": config.name, "pose": np.repeat(np.arange(n), runs), "solver": ar.key,
+                "run": np.tile(np.arange(runs), n), "task_seed": np.repeat(ar.seeds, runs),
+                "final_fitness": ar.fitness.ravel(), "evaluations": ar.evaluations.ravel(),
+                "iterations_done": ar.iterations_done.ravel(), "iterations_to_threshold": ar.iterations_to.ravel(),
+                "evaluations_to_threshold": ar.evaluations_to.ravel()}
+        if ar.start is not None:
+            cols.update({f"start_{name}": ar.start[:, :, j].ravel() for j, name in enumerate(poses.names)})
+        cols.update({f"x_{name}": ar.x[:, :, j].ravel() for j, name in enumerate(poses.names)})
+        cols.update({f"abs_error_{name}": ar.errors[:, :, j].ravel() for j, name in enumerate(mech.pose_names)})
+        frames.append(run_record("study", cols))
+    return concat(frames)
 
