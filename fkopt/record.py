@@ -21,7 +21,7 @@ track                       str       a suite solver's track (``black-box``, ``j
 run                         int64     run index, from 0 (the run's stream: :mod:`fkopt.streams`)
 dim                         int64     a suite problem's dimension
 budget                      int64     a suite run's evaluation budget
-task_seed                   int64     the case's seed (run k draws from its k-th child stream)
+task_seed                   Int64     the case's seed (run k draws from its k-th child stream; NA: an imported outside run)
 final_fitness               float64   best fitness at the end of the run
 evaluations                 int64     fitness evaluations used (a suite: within its budget)
 fitness                     float64   a suite run's best fitness within the budget
@@ -60,7 +60,7 @@ KINDS = ("experiment", "study", "suite")
 COLUMNS: tuple[tuple[str, str], ...] = (
     ("kind", "str"), ("problem", "str"), ("class", "str"), ("set", "str"), ("case", "str"),
     ("pose", "int64"), ("solver", "str"), ("track", "str"), ("run", "int64"), ("dim", "int64"),
-    ("budget", "int64"), ("task_seed", "int64"), ("final_fitness", "float64"), ("evaluations", "int64"),
+    ("budget", "int64"), ("task_seed", "Int64"), ("final_fitness", "float64"), ("evaluations", "int64"),
     ("fitness", "float64"), ("evals_to_", "float64"), ("iterations_done", "int64"),
     ("iterations_to_best", "int64"), ("iterations_to_threshold", "float64"),
     ("evaluations_to_threshold", "float64"), ("start_", "float64"), ("x_", "float64"), ("pose_", "float64"),
@@ -119,6 +119,8 @@ def run_record(kind: str, columns: Mapping[str, object], rows: int | None = None
         arr = np.full(n, value, dtype=object) if np.ndim(value) == 0 else np.asarray(value)
         if dtype == "str":
             data[name] = arr.astype(object) if np.ndim(value) else arr
+        elif dtype[0].isupper():            # a pandas nullable dtype (Int64: NA where a row has none)
+            data[name] = pd.array(arr, dtype=dtype)
         else:
             data[name] = arr.astype(dtype)
     return pd.DataFrame(data)

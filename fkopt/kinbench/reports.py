@@ -14,12 +14,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import record
 from . import measures as M
 from .outside import digest
 
 
 def runs_table(sr) -> pd.DataFrame:
-    return sr.runs
+    """One row per run: the run record's (:func:`fkopt.record.runs_table`)."""
+    return record.runs_table(sr.record)
 
 
 def measures_table(sr) -> pd.DataFrame:
