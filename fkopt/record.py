@@ -175,3 +175,79 @@ def summary_table(record: pd.DataFrame, settings: Mapping[str, Mapping], thresho
         row.update(s.get("printed", {}))
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+# -- timing ----------------------------------------------------------------------------------------
+#: The timing record: one row per timed sample of a solver on one case, next to the run record
+#: (timings are measurements of the machine, never part of the deterministic record).
+TIMING_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("kind", "str"),          # experiment, study or suite
+    ("problem", "str"),       # as in the run record
+    ("case", "str"),          # an experiment's case label; a study's "all"/"trajectory"
+    ("pose", "int64"),        # the pose (from 0) the sample timed (a suite's task: -1, all of them)
+    ("solver", "str"),
+    ("run", "int64"),         # the run timed alone; -1: a batch of runs
+    ("runs", "int64"),        # how many runs the sample's seconds cover
+    ("seconds", "float64"),   # wall time (time.perf_counter) of the sample
+    ("mode", "str"),          # "alone": one run solved by itself (the papers' mode, fkopt.experiment.timing);
+                              # "batch": a batch's wall time over the runs it solved (amortised)
+)
+ALONE, BATCH = "alone", "batch"
+
+
+def timing_record(kind: str, columns: Mapping[str, object]) -> pd.DataFrame:
+    """The timing record of ``columns`` (name -> one value or one per row), cast and ordered."""
+    unknown = [c for c in columns if c not in dict(TIMING_COLUMNS)]
+    if unknown or kind not in KINDS:
+        raise ValueError(f"timing record: columns {unknown} / kind {kind!r} not in fkopt.record.TIMING_COLUMNS")
+    n = max([len(v) for v in columns.values() if np.ndim(v) > 0] or [1])
+    data = {}
+    for name, dtype in TIMING_COLUMNS:
+        value = kind if name == "kind" else columns.get(name, -1 if dtype == "int64" else "")
+        arr = np.full(n, value, dtype=object) if np.ndim(value) == 0 else np.asarray(value)
+        data[name] = arr.astype(object) if dtype == "str" else arr.astype(dtype)
+    return pd.DataFrame(data)
+
+
+def timing_table(timing: pd.DataFrame, settings: Mapping[tuple, Mapping], by: tuple[str, ...] = ("case", "solver"),
+                 names: Mapping[str, str] | None = None, timed_alone: bool = False) -> pd.DataFrame:
+    """``timing.csv`` of any kind: one row per group of samples (``by``), in record order.
+
+    ``runs`` (the task's runs, from ``settings[group]``), ``timed_runs`` (the samples the
+    statistics are over: the runs timed alone if the group has any, else its batches), mean,
+    median and quartiles of the ms per run of those samples, ``amortised_ms_per_run`` (the
+    batches' ms per run, averaged), ``total_s`` (the task's wall time, from ``settings``), then
+    the rest of ``settings[group]`` (a study's ``poses``, the paper's printed times). ``names``
+    renames the key columns (``solver`` -> ``algorithm`` in experiment and study folders);
+    ``timed_alone``: only the groups with runs timed alone (an experiment's timed cases)."""
+    rows = []
+    if timed_alone:
+        keys = set(map(tuple, timing.loc[timing["mode"] == ALONE, list(by)].to_numpy().tolist()))
+        timing = timing[[tuple(k) in keys for k in timing[list(by)].to_numpy().tolist()]]
+    for key, g in timing.groupby(list(by), sort=False):
+        key = key if isinstance(key, tuple) else (key,)
+        s = dict(settings[key])
+        alone = g[g["mode"] == ALONE]
+        batch = g[g["mode"] == BATCH]
+        sample = alone if len(alone) else batch
+        ms = sample["seconds"].to_numpy(float) / sample["runs"].to_numpy(float) * 1e3
+        q25, med, q75 = np.percentile(ms, [25, 50, 75])
+        row = dict(zip(by, key))
+        row["runs"] = s.pop("runs")
+        row.update({k: s.pop(k) for k in list(s) if k in ("poses",)})
+        row.update({"timed_runs": len(ms), "mean_ms_per_run": float(np.mean(ms)), "median_ms_per_run": float(med),
+                    "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
+                    "amortised_ms_per_run": float(np.mean(batch["seconds"].to_numpy(float)
+                                                          / batch["runs"].to_numpy(float)) * 1e3) if len(batch) else np.nan,
+                    "total_s": s.pop("total_s")})
+        row.update(s)
+        rows.append(row)
+    return pd.DataFrame(rows, columns=None if rows else [*by, "runs"]).rename(columns=dict(names or {}))
+
+
+def timing_runs_table(timing: pd.DataFrame, names: Mapping[str, str] | None = None) -> pd.DataFrame:
+    """``timing_runs.csv``: every run timed alone (ms), what timing claims test for a difference."""
+    alone = timing[timing["mode"] == ALONE]
+    return pd.DataFrame({"case": alone["case"].to_numpy(), "solver": alone["solver"].to_numpy(),
+                         "run": alone["run"].to_numpy(), "ms": alone["seconds"].to_numpy(float) * 1e3}
+                        ).rename(columns=dict(names or {}))

@@ -124,8 +124,8 @@ def _validate(config: AssemblyConfig) -> tuple[int, int]:
     return 1, starts * len(mech.unknown_names) ** 2 * 8 * 40
 
 
-def _plan(config: AssemblyConfig, source: str | None):
-    """One task: the search (timed, so it runs in this process)."""
+def _plan(config: AssemblyConfig, source: str | None, timing: bool = True):
+    """One task: the search (timed, so it runs in this process; its time is part of the result)."""
     payload = {"config": config.model_dump(mode="json"), "source": source}
     return Plan([Task("search", payload, "all solutions")], solve_task,
                 local=lambda _: run_assembly(config, source), name=config.name)

@@ -62,8 +62,8 @@ def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int
         raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
 
 
-def _experiment_merge(config, plan, ran, *, source=None, timing=True, **_):
-    return merge_experiment(config, plan, ran, source=source, timing=timing)
+def _experiment_merge(config, plan, ran, *, source=None, **_):
+    return merge_experiment(config, plan, ran, source=source)
 
 
 def _experiment_from_dict(data: dict, where: str):

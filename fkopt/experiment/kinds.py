@@ -218,7 +218,7 @@ def run_in_memory(config, source: str | None = None, *, progress=None, timing: b
                   jobs: int = 1, executor: str = "local", scheduler: str | None = None):
     """Every task of ``config`` computed (no task files, nothing written); the kind's result."""
     kind = config_kind(config)
-    plan = kind.plan(config, source)
+    plan = kind.plan(config, source, timing=timing)
     ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, progress=progress)
     return kind.merge(config, plan, ran, source=source, timing=timing, folder=None)
 

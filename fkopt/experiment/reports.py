@@ -65,29 +65,17 @@ def summary_table(er: ExperimentResult) -> pd.DataFrame:
 
 
 def timing_table(er: ExperimentResult) -> pd.DataFrame:
-    """Time per run measured one run at a time on a sample of runs (:mod:`.timing`)."""
-    rows = []
-    for rec in er.records:
-        if rec.single_run_s is None:
-            continue
-        t = rec.single_run_s * 1e3
-        q25, med, q75 = np.percentile(t, [25, 50, 75])
-        row = {"case": rec.case.label, "algorithm": rec.spec.key, "runs": rec.result.runs,
-               "timed_runs": len(t), "mean_ms_per_run": float(np.mean(t)), "median_ms_per_run": float(med),
-               "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
-               "amortised_ms_per_run": float(np.mean(rec.result.time_per_run) * 1e3), "total_s": rec.wall_s}
-        for k, v in sorted(rec.spec.printed.items()):
-            if k.endswith("_ms"):
-                row[f"printed_{k}"] = v
-        rows.append(row)
-    return pd.DataFrame(rows)
+    """Time per run measured one run at a time on a sample of runs (:mod:`.timing`), per timed
+    case and algorithm (the one timing writer, :func:`fkopt.record.timing_table`)."""
+    settings = {(rec.case.label, rec.spec.key): {
+        "runs": rec.result.runs, "total_s": rec.wall_s,
+        **{f"printed_{k}": v for k, v in sorted(rec.spec.printed.items()) if k.endswith("_ms")}} for rec in er.records}
+    return record.timing_table(er.timing, settings, names=record.FILE_NAMES["experiment"], timed_alone=True)
 
 
 def timing_runs_table(er: ExperimentResult) -> pd.DataFrame:
     """Every timed single run (ms): what timing claims test for a difference."""
-    return pd.DataFrame([{"case": rec.case.label, "algorithm": rec.spec.key, "run": int(k), "ms": float(s * 1e3)}
-                         for rec in er.records if rec.single_run_s is not None
-                         for k, s in zip(rec.single_run_ids, rec.single_run_s)])
+    return record.timing_runs_table(er.timing, names=record.FILE_NAMES["experiment"])
 
 
 def values_table(er: ExperimentResult) -> pd.DataFrame:

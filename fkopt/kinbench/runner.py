@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import FkoptError
-from ..record import concat, run_record
+from ..record import BATCH, concat, run_record, timing_record
 from ..experiment.config import RunConfig
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..experiment.tasks import Plan, Ran, Task, run_tasks
@@ -56,7 +56,7 @@ def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
 class SuiteResult:
     config: SuiteConfig
     record: pd.DataFrame                 # the run record (:mod:`fkopt.record`): one row per (problem, set, pose, solver, run)
-    timing: pd.DataFrame                 # one row per (problem, solver): wall time per solve
+    timing: pd.DataFrame                 # the timing record (:mod:`fkopt.record`): one batch per (problem, solver)
     manifest: dict
     wall_s: float
     source: str | None = None
@@ -195,7 +195,7 @@ class _Context:
     started: float
 
 
-def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
+def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = True) -> Plan:
     """A suite as tasks of the one runner: one per (problem, solver), every pose of the
     problem's selected sets a case of one batched solve; kept as task files while the suite runs
     (``--resume``), not in the published folder (its run rows are)."""
@@ -223,9 +223,9 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
         instances = instances_of(config, ctx.sets)
         frames += [read_outside(config, k, dims, instances) for k in range(len(config.outside))]
     runs = concat(frames)
-    tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
-                         "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
-                        for r in done])
+    tim = concat([timing_record("suite", {"problem": config.problems[r["problem"]].name,
+                                          "solver": config.solvers[r["solver"]].key, "runs": r["solves"],
+                                          "seconds": r["wall_s"], "mode": BATCH}) for r in done])
     return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source,
                        suite_trace(config, done, runs))
 

@@ -88,14 +88,11 @@ def runs_table(sr: StudyResult) -> pd.DataFrame:
 
 
 def timing_table(sr: StudyResult) -> pd.DataFrame:
-    runs = sr.config.runs
-    rows = []
-    for ar in sr.algorithms:
-        ms = ar.time_s / runs * 1e3
-        rows.append({"case": case_label(sr), "algorithm": ar.key, "runs": runs, "poses": len(sr.poses),
-                     "mean_ms_per_run": float(np.mean(ms)), "median_ms_per_run": float(np.median(ms)),
-                     "total_s": float(ar.wall_s)})
-    return pd.DataFrame(rows)
+    """Per algorithm, ms per run of each pose (its share of the batch; the one timing writer,
+    :func:`fkopt.record.timing_table`)."""
+    settings = {(case_label(sr), ar.key): {"runs": sr.config.runs, "poses": len(sr.poses), "total_s": float(ar.wall_s)}
+                for ar in sr.algorithms}
+    return record.timing_table(sr.timing, settings, names=record.FILE_NAMES["study"])
 
 
 def ecdf_of(sr: StudyResult) -> pd.DataFrame:

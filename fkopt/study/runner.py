@@ -29,7 +29,7 @@ import numpy as np
 
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
-from ..record import concat, run_record
+from ..record import BATCH, concat, run_record, timing_record
 from ..solve import make_algorithm, pick_events
 from ..streams import case_seed
 from ..experiment.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder  # noqa: F401 (tests, API)
@@ -267,6 +267,7 @@ class StudyResult:
     computed: list[str] = field(default_factory=list)   # task ids computed by this invocation
     folder: Path | None = None
     record: object = None     # the run record (:mod:`fkopt.record`): one row per (algorithm, pose, run)
+    timing: object = None     # the timing record (:mod:`fkopt.record`): one batch per (algorithm, pose)
 
     @property
     def compared_names(self):
@@ -329,8 +330,9 @@ def _label(config: StudyConfig, task: Task) -> str:
     return f"{task.label} · {where}"
 
 
-def study_plan(config: StudyConfig, source: str | None = None) -> Plan:
-    """A study as tasks of the one runner: kept as task files (resume), published in ``tasks/``."""
+def study_plan(config: StudyConfig, source: str | None = None, timing: bool = True) -> Plan:
+    """A study as tasks of the one runner: kept as task files (resume), published in ``tasks/``
+    (its times are each task's own wall time: no separate timing tasks)."""
     started = time.perf_counter()
     mech, poses = validate_study(config)
     tasks = plan_tasks(config, len(poses))
@@ -347,7 +349,17 @@ def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None
     ctx: _Context = plan.context
     algorithms = merge(config, ctx.mech, ctx.poses, ran.records)
     return StudyResult(config, ctx.mech, ctx.poses, algorithms, time.perf_counter() - ctx.started, source,
-                       list(ran.computed), folder, study_record(config, ctx.mech, ctx.poses, algorithms))
+                       list(ran.computed), folder, study_record(config, ctx.mech, ctx.poses, algorithms),
+                       study_timing(config, ctx.poses, algorithms))
+
+
+def study_timing(config: StudyConfig, poses: PoseSet, algorithms: list[AlgorithmResult]):
+    """The timing record (:mod:`fkopt.record`) of a study: each pose's (or tracking step's) wall
+    time over its runs, per algorithm (its share of the chunk's batched solve)."""
+    case = "trajectory" if config.mode == "tracking" else "all"
+    return concat([timing_record("study", {"problem": config.name, "case": case, "pose": np.arange(len(poses)),
+                                           "solver": ar.key, "runs": config.runs, "seconds": ar.time_s,
+                                           "mode": BATCH}) for ar in algorithms])
 
 
 def study_record(config: StudyConfig, mech, poses: PoseSet, algorithms: list[AlgorithmResult]):
