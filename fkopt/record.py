@@ -181,7 +181,7 @@ def summary_table(record: pd.DataFrame, settings: Mapping[str, Mapping], thresho
 #: The timing record: one row per timed sample of a solver on one case, next to the run record
 #: (timings are measurements of the machine, never part of the deterministic record).
 TIMING_COLUMNS: tuple[tuple[str, str], ...] = (
-    ("kind", "str"),          # experiment, study or suite
+    ("kind", "str"),          # experiment, study, suite or assembly
     ("problem", "str"),       # as in the run record
     ("case", "str"),          # an experiment's case label; a study's "all"/"trajectory"
     ("pose", "int64"),        # the pose (from 0) the sample timed (a suite's task: -1, all of them)
@@ -196,9 +196,10 @@ ALONE, BATCH = "alone", "batch"
 
 
 def timing_record(kind: str, columns: Mapping[str, object]) -> pd.DataFrame:
-    """The timing record of ``columns`` (name -> one value or one per row), cast and ordered."""
+    """The timing record of ``columns`` (name -> one value or one per row), cast and ordered
+    (``kind`` may also be ``assembly``: a search's wall time, one batch)."""
     unknown = [c for c in columns if c not in dict(TIMING_COLUMNS)]
-    if unknown or kind not in KINDS:
+    if unknown or kind not in (*KINDS, "assembly"):
         raise ValueError(f"timing record: columns {unknown} / kind {kind!r} not in fkopt.record.TIMING_COLUMNS")
     n = max([len(v) for v in columns.values() if np.ndim(v) > 0] or [1])
     data = {}

@@ -23,6 +23,7 @@ from pydantic import Field, ValidationError
 
 from ..errors import FkoptError
 from ..files import error_line
+from ..record import BATCH, timing_record, timing_table as record_timing_table
 from .tasks import Kind, Plan, Task
 from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
 
@@ -101,9 +102,14 @@ def summary_table(ar: AssemblyResult) -> pd.DataFrame:
 
 
 def timing_table(ar: AssemblyResult) -> pd.DataFrame:
-    return pd.DataFrame([{"case": "given joints", "algorithm": "all_solutions", "total_s": ar.wall_s,
-                          "solver_time_s": float(ar.solutions.time_s),
-                          **{f"printed_{k}": v for k, v in sorted(ar.config.printed.items()) if k.endswith("_s")}}])
+    """The search's wall time, one batch of the timing record (the one timing writer,
+    :func:`fkopt.record.timing_table`), with the solver's own time and the printed ones."""
+    key = ("given joints", "all_solutions")
+    timing = timing_record(KIND, {"problem": ar.config.name, "case": key[0], "solver": key[1], "runs": 1,
+                                  "seconds": ar.wall_s, "mode": BATCH})
+    settings = {key: {"runs": 1, "total_s": ar.wall_s, "solver_time_s": float(ar.solutions.time_s),
+                      **{f"printed_{k}": v for k, v in sorted(ar.config.printed.items()) if k.endswith("_s")}}}
+    return record_timing_table(timing, settings, names={"solver": "algorithm"})
 
 
 def meta(ar: AssemblyResult) -> dict:
