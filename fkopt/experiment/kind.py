@@ -9,6 +9,7 @@ from ..solve import batch_bytes, chunk_size, make_algorithm
 from .config import experiment_from_dict
 from .runner import experiment_plan, keeps_x_history, merge_experiment, validate_experiment
 from .tasks import Kind
+from .timing import sample_plan
 
 #: Share of the currently available memory a job may be estimated to need.
 MEMORY_SHARE = 0.8
@@ -49,7 +50,8 @@ def _experiment_validate(config) -> tuple[int, int]:
                           snapshots=len(config.snapshots), x_history=keep_x)
         need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
         need += algorithm_resources(spec, pop, its, dim)
-    return len(config.algorithms), need
+    # the tasks of a run: one solve per algorithm, one timing task per timed case (experiment_plan)
+    return len(config.algorithms) + sample_plan(len(cases), config.runs)[0], need
 
 
 def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int:
