@@ -65,10 +65,11 @@ class AssemblyResult:
     source: str | None = None
 
 
-def run_assembly(config: AssemblyConfig, source: str | None = None) -> AssemblyResult:
+def run_assembly(config: AssemblyConfig, source: str | None = None, mech=None) -> AssemblyResult:
+    """The search; ``mech``: the config's mechanism, already built (else built here)."""
     from ..assembly import all_solutions
     from .runner import build_mechanism
-    mech = build_mechanism(config)
+    mech = build_mechanism(config) if mech is None else mech
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
                          tol=config.tol, dedup=config.dedup, iterations=config.iterations)
@@ -120,21 +121,22 @@ def meta(ar: AssemblyResult) -> dict:
 
 
 # -- the pipeline kind (fkopt.experiment.kinds) ------------------------------------------------------
-def _validate(config: AssemblyConfig) -> tuple[int, int]:
-    from .runner import build_mechanism
-    mech = build_mechanism(config)
+def _validate(config: AssemblyConfig, plan) -> int:
+    mech = plan.context                                  # built by the plan
     if mech.kind != "parallel":
         raise FkoptError(f"mechanism '{mech.name}' is {mech.kind}; assembly modes need a parallel mechanism")
     mech.vector(config.joints, mech.joint_names, "joints")
     starts = config.population or 2000
-    return 1, starts * len(mech.unknown_names) ** 2 * 8 * 40
+    return starts * len(mech.unknown_names) ** 2 * 8 * 40
 
 
 def _plan(config: AssemblyConfig, source: str | None, timing: bool = True):
     """One task: the search (timed, so it runs in this process; its time is part of the result)."""
+    from .runner import build_mechanism
+    mech = build_mechanism(config)
     payload = {"config": config.model_dump(mode="json"), "source": source}
     return Plan([Task("search", payload, "all solutions")], solve_task,
-                local=lambda _: run_assembly(config, source), name=config.name)
+                local=lambda _: run_assembly(config, source, mech), context=mech, name=config.name)
 
 
 def solve_task(payload: dict) -> AssemblyResult:
@@ -146,4 +148,4 @@ def _merge(config: AssemblyConfig, plan, ran, **_) -> AssemblyResult:
     return ran.records["search"]
 
 
-ASSEMBLY = Kind(KIND, assembly_from_dict, _validate, _plan, _merge)
+ASSEMBLY = Kind(KIND, assembly_from_dict, _plan, _validate, _merge)

@@ -280,7 +280,7 @@ class _Context:
     cases: list[Case]
     problems: list
     batched: object
-    started: float
+    prepared_s: float     # building the plan (validation); the run's own time adds the tasks' and the merge's
 
 
 def experiment_plan(config: ExperimentConfig, source: str | None = None, timing: bool = True) -> Plan:
@@ -309,7 +309,7 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None, timing:
             return time_case(config, entries, payload["runs"])
         return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
     return Plan(tasks, solve_task, local=local, anywhere=True, timed=timed,
-                context=_Context(mech, cases, problems, batched, started), name=config.name)
+                context=_Context(mech, cases, problems, batched, time.perf_counter() - started), name=config.name)
 
 
 def solve_task(payload: dict) -> Solved:
@@ -326,6 +326,7 @@ def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: 
                      **_) -> ExperimentResult:
     """The experiment's records from its tasks' :class:`Solved` s and the single-run times of
     its timing tasks (none when the plan has none: ``fkopt check``)."""
+    merging = time.perf_counter()
     ctx: _Context = plan.context
     mech, cases, problems = ctx.mech, ctx.cases, ctx.problems
     by_algorithm: list[list[TaskRecord]] = []
@@ -344,7 +345,8 @@ def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: 
         for recs, seconds in zip(by_algorithm, ran.records[task.id]):
             rec = recs[task.payload["timing"]]
             rec.single_run_ids, rec.single_run_s = np.arange(len(seconds)), np.asarray(seconds)
-    wall = time.perf_counter() - ctx.started
+    # the run's own time, wherever and however long before the plan was built
+    wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)
     # solves computed elsewhere (fkopt reproduce's workers): their own time, measured where they ran
     wall += sum(ran.records[t.id].wall_s * len(cases) for t in plan.tasks if t.id not in ran.computed)
     return ExperimentResult(config, mech, cases, records, wall, source, experiment_record(config, mech, records),

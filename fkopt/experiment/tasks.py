@@ -84,8 +84,12 @@ class Kind:
 
     name: str
     from_dict: Callable[[dict, str], Any]          # (mapping, where) -> validated config
-    validate: Callable[[Any], tuple[int, int]]     # config -> (tasks, estimated bytes); no work done
-    plan: Callable[..., Plan]                      # (config, source, timing=True) -> its tasks (timing=False: no Plan.timed)
+    #: (config, source, timing=True) -> its tasks (timing=False: no Plan.timed); building the plan
+    #: builds everything a run needs (mechanism, cases, problems, pose sets) and solves nothing: it
+    #: is the validation of a run (:func:`fkopt.experiment.kinds.plan_config`)
+    plan: Callable[..., Plan]
+    #: (config, plan) -> estimated bytes of the run, from what the plan built (nothing built again)
+    validate: Callable[[Any, Plan], int]
     #: (config, plan, ran, source=, timing=, folder=) -> the result object the writers read
     merge: Callable[..., Any]
 

@@ -78,9 +78,10 @@ def instances_of(config: SuiteConfig, sets: dict) -> set[tuple[str, str, int]]:
     return {(p.name, name, i) for p in config.problems for name, i, _ in _cases(config, sets, p)}
 
 
-def validate_suite(config: SuiteConfig) -> tuple[int, int]:
-    """Everything a suite needs, built without solving; (tasks, estimated bytes)."""
-    sets, _ = load_pose_sets(config)
+def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
+    """Everything a suite needs, built without solving (the pose sets its plan loaded, else
+    loaded here); the estimated bytes of the run."""
+    sets = plan.context.sets if plan is not None else load_pose_sets(config)[0]
     need = 0
     dims: dict[str, int] = {}
     for problem in config.problems:
@@ -111,7 +112,7 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances)
-    return len(config.problems) * len(config.solvers), need
+    return need
 
 
 def solve_task(payload: dict) -> dict:
@@ -192,7 +193,7 @@ def record_problem(task, rec) -> str | None:
 class _Context:
     sets: dict
     manifest: dict
-    started: float
+    prepared_s: float     # building the plan (validation)
 
 
 def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = True) -> Plan:
@@ -210,11 +211,12 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
-                context=_Context(sets, manifest, started), name=f"suite '{config.name}'")
+                context=_Context(sets, manifest, time.perf_counter() - started), name=f"suite '{config.name}'")
 
 
 def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
     """The run rows of every task, then the imported outside results, and the timing table."""
+    merging = time.perf_counter()
     ctx: _Context = plan.context
     done = [{**ran.records[t.id], "rows": rows_of(ran.records[t.id])} for t in plan.tasks]
     frames = [r["rows"] for r in done]
@@ -226,7 +228,8 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     tim = concat([timing_record("suite", {"problem": config.problems[r["problem"]].name,
                                           "solver": config.solvers[r["solver"]].key, "runs": r["solves"],
                                           "seconds": r["wall_s"], "mode": BATCH}) for r in done])
-    return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source,
+    wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
+    return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
                        suite_trace(config, done, runs))
 
 

@@ -321,7 +321,7 @@ def merge(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]) -
 class _Context:
     mech: object
     poses: PoseSet
-    started: float
+    prepared_s: float     # building the plan (validation)
 
 
 def _label(config: StudyConfig, task: Task) -> str:
@@ -341,14 +341,16 @@ def study_plan(config: StudyConfig, source: str | None = None, timing: bool = Tr
     return Plan([RunnerTask(t.id, payload(config, t), _label(config, t)) for t in tasks],
                 run_task, fingerprint=config.fingerprint(), stored=True, keep=True,
                 check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, dim),
-                context=_Context(mech, poses, started), name=f"study '{config.name}'")
+                context=_Context(mech, poses, time.perf_counter() - started), name=f"study '{config.name}'")
 
 
 def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None = None,
                 folder: Path | None = None, **_) -> StudyResult:
+    merging = time.perf_counter()
     ctx: _Context = plan.context
     algorithms = merge(config, ctx.mech, ctx.poses, ran.records)
-    return StudyResult(config, ctx.mech, ctx.poses, algorithms, time.perf_counter() - ctx.started, source,
+    wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
+    return StudyResult(config, ctx.mech, ctx.poses, algorithms, wall, source,
                        list(ran.computed), folder, study_record(config, ctx.mech, ctx.poses, algorithms),
                        study_timing(config, ctx.poses, algorithms))
 
