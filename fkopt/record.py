@@ -214,9 +214,9 @@ def timing_table(timing: pd.DataFrame, settings: Mapping[tuple, Mapping], by: tu
                  names: Mapping[str, str] | None = None, timed_alone: bool = False) -> pd.DataFrame:
     """``timing.csv`` of any kind: one row per group of samples (``by``), in record order.
 
-    ``runs`` (the task's runs, from ``settings[group]``), ``timed_runs`` (the samples the
-    statistics are over: the runs timed alone if the group has any, else its batches), mean,
-    median and quartiles of the ms per run of those samples, ``amortised_ms_per_run`` (the
+    ``runs`` (the task's runs, from ``settings[group]``), ``timed_runs`` (the runs covered by
+    the samples the statistics are over: the runs timed alone if the group has any, else its
+    batches), mean, median and quartiles of the ms per run of those samples, ``amortised_ms_per_run`` (the
     batches' ms per run, averaged), ``total_s`` (the task's wall time, from ``settings``), then
     the rest of ``settings[group]`` (a study's ``poses``, the paper's printed times). ``names``
     renames the key columns (``solver`` -> ``algorithm`` in experiment and study folders);
@@ -236,7 +236,7 @@ def timing_table(timing: pd.DataFrame, settings: Mapping[tuple, Mapping], by: tu
         row = dict(zip(by, key))
         row["runs"] = s.pop("runs")
         row.update({k: s.pop(k) for k in list(s) if k in ("poses",)})
-        row.update({"timed_runs": len(ms), "mean_ms_per_run": float(np.mean(ms)), "median_ms_per_run": float(med),
+        row.update({"timed_runs": int(sample["runs"].sum()), "mean_ms_per_run": float(np.mean(ms)), "median_ms_per_run": float(med),
                     "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
                     "amortised_ms_per_run": float(np.mean(batch["seconds"].to_numpy(float)
                                                           / batch["runs"].to_numpy(float)) * 1e3) if len(batch) else np.nan,
