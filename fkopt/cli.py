@@ -281,11 +281,12 @@ def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | N
                force: bool, quiet: bool) -> None:
     """Validate every (path, config) and check every output folder, then run them in order."""
     from .experiment.executors import validate_executor
-    from .experiment.kinds import prepare_output, run_config, validate_any
+    from .experiment.kinds import plan_config, prepare_output, run_config
     validate_executor(executor, jobs, scheduler)
     planned, folders = [], {}
     for path, config in files:    # fail on any bad file or output folder before running anything
-        tasks = validate_any(config, str(path))
+        plan = plan_config(config, str(path), str(path))     # the one validation; run_config runs this plan
+        tasks = len(plan.tasks) + len(plan.timed)
         try:
             folder = prepare_output(config, out, force)
         except FkoptError as err:
@@ -293,12 +294,12 @@ def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | N
         if folder in folders:
             raise FkoptError(f"{path}: writes {folder}, like {folders[folder]}; paper/name must differ")
         folders[folder] = path
-        planned.append((path, config, tasks))
+        planned.append((path, config, plan, tasks))
     con = _console()
-    for path, config, tasks in planned:
+    for path, config, plan, tasks in planned:
         with _progress(con, config.name, tasks, quiet) as progress:
             outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True,
-                                 jobs=jobs, executor=executor, scheduler=scheduler, resume=resume)
+                                 jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, plan=plan)
         if not quiet:
             _print_outcome(con, outcome, tasks)
 

@@ -204,10 +204,9 @@ def test_timed_runs_are_interleaved(monkeypatch):
     monkeypatch.setattr(timing, "solve", lambda problem, name, iterations, run_ids, **kw: calls.append(
         (name, iterations, run_ids[0])))
     config = NS(runs=3, population=5, iterations=7, threshold=None, stop_at_threshold=False)
-    recs = [NS(case=NS(index=0), spec=NS(name=n, population=None, iterations=None, start=None, params={}),
-               problem=None, seed=1) for n in ("a", "b")]
-    timing.time_single_runs(config, recs)
+    specs = [(NS(name=n, population=None, iterations=None, start=None, params={}), None, 1) for n in ("a", "b")]
+    seconds = timing.time_case(config, specs, per=3)
     timed = [(n, k) for n, it, k in calls if it == 7]
     assert [c[0] for c in calls[:2]] == ["a", "b"] and all(it == 2 for _, it, _ in calls[:2])   # warm-ups
     assert timed == [("a", 0), ("b", 0), ("a", 1), ("b", 1), ("a", 2), ("b", 2)]
-    assert all(len(r.single_run_s) == 3 for r in recs)
+    assert [len(s) for s in seconds] == [3, 3]

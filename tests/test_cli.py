@@ -163,5 +163,7 @@ def test_stored_configs_validate():
             assert tasks == 1, f
         elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block
             assert tasks > 0 and tasks % len(cfg.algorithms) == 0, f
-        else:                                # one task per algorithm, solving every case
-            assert tasks == len(cfg.algorithms), f
+        else:    # one task per algorithm, solving every case, and one timing task per timed case
+            from fkopt.experiment.timing import TIMING_RUNS
+            cases = cfg.cases.random if hasattr(cfg.cases, "random") else len(cfg.cases)
+            assert tasks == len(cfg.algorithms) + min(cases, TIMING_RUNS), f

@@ -346,12 +346,12 @@ def test_tracking_several_trajectories_report(tmp_path):
     res = run_study(tracking_config(poses=TWO_TRAJECTORIES), tmp_path)
     track = pd.read_csv(res.folder / "tracking.csv")
     lm = track[track.algorithm == "lm"]
-    assert lm.trajectory.tolist() == [1] * 6 + [2] * 4
+    assert lm.trajectory.tolist() == [0] * 6 + [1] * 4     # indices count from 0 (fkopt.record)
     assert lm.step.tolist() == [0, 1, 2, 3, 4, 5, 0, 1, 2, 3]
     assert lm.warm_start.tolist() == [False] + [True] * 5 + [False] + [True] * 3   # each starts cold
     assert (res.folder / "tracking.png").exists()
     runs = pd.read_csv(res.folder / "runs.csv")
-    first = runs[(runs.algorithm == "lm") & (runs.pose == 7)]     # trajectory 2, step 0: from the centre
+    first = runs[(runs.algorithm == "lm") & (runs.pose == 6)]     # trajectory 1, step 0: from the centre
     centre = res.mechanism.bounds.mean(axis=1)
     np.testing.assert_array_equal(first[["start_alpha", "start_beta", "start_z"]].to_numpy(),
                                   np.broadcast_to(centre, (2, 3)))

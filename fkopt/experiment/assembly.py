@@ -23,6 +23,7 @@ from pydantic import Field, ValidationError
 
 from ..errors import FkoptError
 from ..files import error_line
+from ..record import BATCH, timing_record, timing_table as record_timing_table
 from .tasks import Kind, Plan, Task
 from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
 
@@ -64,10 +65,11 @@ class AssemblyResult:
     source: str | None = None
 
 
-def run_assembly(config: AssemblyConfig, source: str | None = None) -> AssemblyResult:
+def run_assembly(config: AssemblyConfig, source: str | None = None, mech=None) -> AssemblyResult:
+    """The search; ``mech``: the config's mechanism, already built (else built here)."""
     from ..assembly import all_solutions
     from .runner import build_mechanism
-    mech = build_mechanism(config)
+    mech = build_mechanism(config) if mech is None else mech
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
                          tol=config.tol, dedup=config.dedup, iterations=config.iterations)
@@ -101,9 +103,14 @@ def summary_table(ar: AssemblyResult) -> pd.DataFrame:
 
 
 def timing_table(ar: AssemblyResult) -> pd.DataFrame:
-    return pd.DataFrame([{"case": "given joints", "algorithm": "all_solutions", "total_s": ar.wall_s,
-                          "solver_time_s": float(ar.solutions.time_s),
-                          **{f"printed_{k}": v for k, v in sorted(ar.config.printed.items()) if k.endswith("_s")}}])
+    """The search's wall time, one batch of the timing record (the one timing writer,
+    :func:`fkopt.record.timing_table`), with the solver's own time and the printed ones."""
+    key = ("given joints", "all_solutions")
+    timing = timing_record(KIND, {"problem": ar.config.name, "case": key[0], "solver": key[1], "runs": 1,
+                                  "seconds": ar.wall_s, "mode": BATCH})
+    settings = {key: {"runs": 1, "total_s": ar.wall_s, "solver_time_s": float(ar.solutions.time_s),
+                      **{f"printed_{k}": v for k, v in sorted(ar.config.printed.items()) if k.endswith("_s")}}}
+    return record_timing_table(timing, settings, names={"solver": "algorithm"})
 
 
 def meta(ar: AssemblyResult) -> dict:
@@ -114,21 +121,22 @@ def meta(ar: AssemblyResult) -> dict:
 
 
 # -- the pipeline kind (fkopt.experiment.kinds) ------------------------------------------------------
-def _validate(config: AssemblyConfig) -> tuple[int, int]:
-    from .runner import build_mechanism
-    mech = build_mechanism(config)
+def _validate(config: AssemblyConfig, plan) -> int:
+    mech = plan.context                                  # built by the plan
     if mech.kind != "parallel":
         raise FkoptError(f"mechanism '{mech.name}' is {mech.kind}; assembly modes need a parallel mechanism")
     mech.vector(config.joints, mech.joint_names, "joints")
     starts = config.population or 2000
-    return 1, starts * len(mech.unknown_names) ** 2 * 8 * 40
+    return starts * len(mech.unknown_names) ** 2 * 8 * 40
 
 
-def _plan(config: AssemblyConfig, source: str | None):
-    """One task: the search (timed, so it runs in this process)."""
+def _plan(config: AssemblyConfig, source: str | None, timing: bool = True):
+    """One task: the search (timed, so it runs in this process; its time is part of the result)."""
+    from .runner import build_mechanism
+    mech = build_mechanism(config)
     payload = {"config": config.model_dump(mode="json"), "source": source}
     return Plan([Task("search", payload, "all solutions")], solve_task,
-                local=lambda _: run_assembly(config, source), name=config.name)
+                local=lambda _: run_assembly(config, source, mech), context=mech, name=config.name)
 
 
 def solve_task(payload: dict) -> AssemblyResult:
@@ -140,4 +148,4 @@ def _merge(config: AssemblyConfig, plan, ran, **_) -> AssemblyResult:
     return ran.records["search"]
 
 
-ASSEMBLY = Kind(KIND, assembly_from_dict, _validate, _plan, _merge)
+ASSEMBLY = Kind(KIND, assembly_from_dict, _plan, _validate, _merge)

@@ -7,7 +7,7 @@ import os
 from ..errors import FkoptError
 from ..solve import batch_bytes, chunk_size, make_algorithm
 from .config import experiment_from_dict
-from .runner import experiment_plan, keeps_x_history, merge_experiment, validate_experiment
+from .runner import experiment_plan, keeps_x_history, merge_experiment
 from .tasks import Kind
 
 #: Share of the currently available memory a job may be estimated to need.
@@ -38,8 +38,8 @@ def check_memory(needed: int, what: str) -> None:
 
 
 # -- experiments -----------------------------------------------------------------------------------
-def _experiment_validate(config) -> tuple[int, int]:
-    mech, cases, _ = validate_experiment(config)
+def _experiment_validate(config, plan) -> int:
+    mech, cases = plan.context.mech, plan.context.cases     # validated by experiment_plan
     dim, keep_x = len(mech.unknown_names), keeps_x_history(config, mech)
     need = 0   # every algorithm's records stay in memory until the folder is written: the solves' sum
     for spec in config.algorithms:
@@ -49,7 +49,7 @@ def _experiment_validate(config) -> tuple[int, int]:
                           snapshots=len(config.snapshots), x_history=keep_x)
         need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
         need += algorithm_resources(spec, pop, its, dim)
-    return len(config.algorithms), need
+    return need
 
 
 def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int:
@@ -62,8 +62,8 @@ def algorithm_resources(spec, population: int, iterations: int, dim: int) -> int
         raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
 
 
-def _experiment_merge(config, plan, ran, *, source=None, timing=True, **_):
-    return merge_experiment(config, plan, ran, source=source, timing=timing)
+def _experiment_merge(config, plan, ran, *, source=None, **_):
+    return merge_experiment(config, plan, ran, source=source)
 
 
 def _experiment_from_dict(data: dict, where: str):
@@ -72,4 +72,4 @@ def _experiment_from_dict(data: dict, where: str):
     return experiment_from_dict(data, where)
 
 
-EXPERIMENT = Kind("experiment", _experiment_from_dict, _experiment_validate, experiment_plan, _experiment_merge)
+EXPERIMENT = Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate, _experiment_merge)

@@ -19,9 +19,10 @@ else is shared, once:
 
 * :func:`load_any` -- the one loader (:func:`fkopt.files.load_mapping`: size, UTF-8, no aliases,
   no duplicate keys) and the one validator entry point (pydantic, one-line errors);
-* :func:`validate_any` -- builds everything a config needs without running it (unknown names,
-  poses outside the workspace, ...) and refuses a job whose memory estimate does not fit
-  (:func:`check_memory`);
+* :func:`plan_config` -- the one validation: the config's plan, which builds everything a run
+  needs without running it (unknown names, poses outside the workspace, ...), and the refusal of
+  a job whose memory estimate does not fit (:func:`check_memory`); :func:`run_config` runs that
+  plan, so nothing is validated or built twice (:func:`validate_any`: its task count);
 * :func:`prepare_output` -- the results folder, checked before any computation (safe names,
   inside ``--out``, writable, not a file) and the overwrite policy (:func:`check_overwrite`);
 * :func:`run_config` -- the one runner (:func:`fkopt.experiment.tasks.run_tasks`: this process,
@@ -52,7 +53,7 @@ from ..kinbench.kind import SUITE
 from ..study.kind import STUDY
 from .assembly import ASSEMBLY
 from .kind import EXPERIMENT, check_memory
-from .tasks import Kind, TaskStore, run_tasks, work_folder
+from .tasks import Kind, Plan, TaskStore, run_tasks, work_folder
 
 #: kind -> its :class:`~fkopt.experiment.tasks.Kind` (function objects: the import graph shows
 #: the real layering, every kind's module below this registry).
@@ -100,14 +101,25 @@ def load_any(path: str | Path):
     return config
 
 
-def validate_any(config, where: str | None = None) -> int:
-    """Build everything a config needs without running it; returns its number of tasks."""
+def plan_config(config, where: str | None = None, source: str | None = None, timing: bool = True) -> Plan:
+    """The one validation of a run: ``config``'s plan, which builds everything the run needs
+    (mechanism, cases, problems, pose sets) and solves nothing, and its memory estimate, from
+    what the plan built. Bad input fails here, one line naming ``where``; the plan is what
+    :func:`run_config` then runs (``plan=``), so nothing is validated or built twice."""
+    kind = config_kind(config)
     try:
-        tasks, needed = config_kind(config).validate(config)
-        check_memory(needed, "this job (runs x population x iterations x cases)")
+        plan = kind.plan(config, source, timing=timing)
+        check_memory(kind.validate(config, plan), "this job (runs x population x iterations x cases)")
     except FkoptError as err:
         raise FkoptError(f"{where}: {err}" if where else str(err)) from None
-    return tasks
+    return plan
+
+
+def validate_any(config, where: str | None = None) -> int:
+    """Build everything a config needs without running it (:func:`plan_config`); returns its
+    number of tasks (what a progress bar counts: solves and planned timing tasks)."""
+    plan = plan_config(config, where, where)
+    return len(plan.tasks) + len(plan.timed)
 
 
 # -- output ----------------------------------------------------------------------------------------
@@ -180,7 +192,8 @@ def prepare_output(config, out: str | Path, force: bool = False) -> Path:
 
 def run_config(config, out: str | Path, *, source: str | None = None, progress=None, force: bool = False,
                checked: bool = False, jobs: int = 1, executor: str = "local", scheduler: str | None = None,
-               resume: bool = False, keep_tasks: bool = True, solved: dict | None = None) -> Outcome:
+               resume: bool = False, keep_tasks: bool = True, solved: dict | None = None,
+               plan: Plan | None = None) -> Outcome:
     """Validate, check the output, run and write one config of any kind -- the one pipeline.
 
     The config's :class:`~fkopt.experiment.tasks.Plan` runs through
@@ -190,26 +203,27 @@ def run_config(config, out: str | Path, *, source: str | None = None, progress=N
     ``fkopt reproduce``'s worker pool). The kind's merge makes the result, every file of
     :data:`fkopt.outputs.OUTPUTS` is written aside and swapped into place
     (:func:`fkopt.files.write_atomically`), and the work folder is removed.
-    ``checked=True``: the caller has already run :func:`validate_any` and :func:`prepare_output`.
+    ``plan``: the config's validated plan (:func:`plan_config`; made here when None).
+    ``checked=True``: the caller has already run :func:`prepare_output`.
     """
     from .executors import check_scheduler, validate_executor
     kind = config_kind(config)
     validate_executor(executor, jobs, scheduler)
+    if plan is None:
+        plan = plan_config(config, source, source)
     if not checked:
-        validate_any(config, source)
         prepare_output(config, out, force)
     folder = output_folder(out, *config.folder_parts)   # safe, inside OUT, writable: before any work
     check_scheduler(executor, scheduler)                # reachable before a .partial is touched
     with run_lock(out, folder):      # one run per paper/name at a time
-        return _run_locked(kind, config, out, folder, source=source, progress=progress, force=force, jobs=jobs,
+        return _run_locked(kind, plan, config, out, folder, source=source, progress=progress, force=force, jobs=jobs,
                            executor=executor, scheduler=scheduler, resume=resume, keep_tasks=keep_tasks,
                            solved=solved)
 
 
-def _run_locked(kind: Kind, config, out, folder: Path, *, source, progress, force, jobs, executor, scheduler,
-                resume, keep_tasks, solved) -> Outcome:
+def _run_locked(kind: Kind, plan: Plan, config, out, folder: Path, *, source, progress, force, jobs, executor,
+                scheduler, resume, keep_tasks, solved) -> Outcome:
     start = time.perf_counter()
-    plan = kind.plan(config, source)
     store = None
     if plan.stored:
         store = TaskStore(out, work_folder(out, config), folder, plan.name,
@@ -244,7 +258,7 @@ def run_in_memory(config, source: str | None = None, *, progress=None, timing: b
                   jobs: int = 1, executor: str = "local", scheduler: str | None = None):
     """Every task of ``config`` computed (no task files, nothing written); the kind's result."""
     kind = config_kind(config)
-    plan = kind.plan(config, source)
+    plan = kind.plan(config, source, timing=timing)
     ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, progress=progress)
     return kind.merge(config, plan, ran, source=source, timing=timing, folder=None)
 

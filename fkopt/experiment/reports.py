@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..files import nanmedian as _nanmedian
+from .. import record
 from ..outputs import FLOAT, write_outputs, write_result
 from . import plotting
 from .runner import ExperimentResult, pose_error
@@ -53,54 +53,29 @@ MAX_CASE_CURVES = 6
 
 # -- tables ------------------------------------------------------------------------------------
 def summary_table(er: ExperimentResult) -> pd.DataFrame:
-    thr = er.config.threshold
-    rows = []
+    """Per case and algorithm, over its runs (the one summary writer, :func:`fkopt.record.summary_table`)."""
+    settings = {}
     for rec in er.records:
         r, spec = rec.result, rec.spec
-        row = {
-            "case": rec.case.label, "algorithm": spec.key, "method": spec.name,
-            "population": r.population, "iterations": r.iterations, "runs": r.runs,
-            "mean_fitness": float(np.mean(r.fitness)), "std_fitness": float(np.std(r.fitness, ddof=1)) if r.runs > 1 else 0.0,
-            "best_fitness": float(np.min(r.fitness)), "worst_fitness": float(np.max(r.fitness)),
-            "median_fitness": float(np.median(r.fitness)),
-            "mean_evaluations": float(np.mean(r.evaluations)),
-            "threshold": thr,
-        }
-        if thr is not None:
-            row["success_rate"] = float(np.mean(r.succeeded(thr)))
-            row["median_iterations_to_threshold"] = _nanmedian(r.iterations_to(thr))
-            row["median_evaluations_to_threshold"] = _nanmedian(r.evaluations_to(thr))
-        for k, v in sorted(spec.printed.items()):   # sorted: a config reloaded from meta.json has sorted keys
-            if not k.endswith("_ms"):
-                row[f"printed_{k}"] = v
-        rows.append(row)
-    return pd.DataFrame(rows)
+        # sorted: a config reloaded from meta.json has sorted keys
+        printed = {f"printed_{k}": v for k, v in sorted(spec.printed.items()) if not k.endswith("_ms")}
+        settings[spec.key] = {"method": spec.name, "population": r.population, "iterations": r.iterations,
+                              "runs": r.runs, "printed": printed}
+    return record.summary_table(er.record, settings, er.config.threshold)
 
 
 def timing_table(er: ExperimentResult) -> pd.DataFrame:
-    """Time per run measured one run at a time on a sample of runs (:mod:`.timing`)."""
-    rows = []
-    for rec in er.records:
-        if rec.single_run_s is None:
-            continue
-        t = rec.single_run_s * 1e3
-        q25, med, q75 = np.percentile(t, [25, 50, 75])
-        row = {"case": rec.case.label, "algorithm": rec.spec.key, "runs": rec.result.runs,
-               "timed_runs": len(t), "mean_ms_per_run": float(np.mean(t)), "median_ms_per_run": float(med),
-               "q25_ms_per_run": float(q25), "q75_ms_per_run": float(q75),
-               "amortised_ms_per_run": float(np.mean(rec.result.time_per_run) * 1e3), "total_s": rec.wall_s}
-        for k, v in sorted(rec.spec.printed.items()):
-            if k.endswith("_ms"):
-                row[f"printed_{k}"] = v
-        rows.append(row)
-    return pd.DataFrame(rows)
+    """Time per run measured one run at a time on a sample of runs (:mod:`.timing`), per timed
+    case and algorithm (the one timing writer, :func:`fkopt.record.timing_table`)."""
+    settings = {(rec.case.label, rec.spec.key): {
+        "runs": rec.result.runs, "total_s": rec.wall_s,
+        **{f"printed_{k}": v for k, v in sorted(rec.spec.printed.items()) if k.endswith("_ms")}} for rec in er.records}
+    return record.timing_table(er.timing, settings, names=record.FILE_NAMES["experiment"], timed_alone=True)
 
 
 def timing_runs_table(er: ExperimentResult) -> pd.DataFrame:
     """Every timed single run (ms): what timing claims test for a difference."""
-    return pd.DataFrame([{"case": rec.case.label, "algorithm": rec.spec.key, "run": int(k), "ms": float(s * 1e3)}
-                         for rec in er.records if rec.single_run_s is not None
-                         for k, s in zip(rec.single_run_ids, rec.single_run_s)])
+    return record.timing_runs_table(er.timing, names=record.FILE_NAMES["experiment"])
 
 
 def values_table(er: ExperimentResult) -> pd.DataFrame:
@@ -153,35 +128,8 @@ def inputs_table(er: ExperimentResult) -> pd.DataFrame | None:
 
 
 def runs_table(er: ExperimentResult) -> pd.DataFrame:
-    thr = er.config.threshold
-    frames = []
-    for rec in er.records:
-        r = rec.result
-        df = pd.DataFrame({"case": rec.case.label, "algorithm": rec.spec.key, "run": r.run_ids,
-                           "task_seed": rec.seed, "final_fitness": r.fitness, "evaluations": r.evaluations,
-                           "iterations_done": r.iterations_done,
-                           # first iteration at which the run's final best-so-far fitness was reached
-                           "iterations_to_best": np.argmax(r.history <= r.history[:, -1:], axis=1)})
-        if thr is not None:
-            df["iterations_to_threshold"] = r.iterations_to(thr)
-            df["evaluations_to_threshold"] = r.evaluations_to(thr)
-        for j, name in enumerate(r.variable_names):
-            df[f"x_{name}"] = r.x[:, j]
-        if er.mechanism.kind == "serial":
-            for j, name in enumerate(er.compared_names):
-                df[f"pose_{name}"] = rec.outputs[:, j]
-        if rec.position_error_history is not None:
-            df["position_error"] = rec.position_error_history[:, -1]
-        case = rec.case
-        target = case.target if case.target is not None else case.reference
-        if target is not None:
-            err = pose_error(er.mechanism, rec.outputs, target)
-            for j, name in enumerate(er.compared_names):
-                df[f"abs_error_{name}"] = err[:, j]
-        for key in r.extras:
-            df[f"final_{key}"] = r.extras[key][:, -1]
-        frames.append(df)
-    return pd.concat(frames, ignore_index=True)
+    """One row per run: the run record's (:func:`fkopt.record.runs_table`)."""
+    return record.runs_table(er.record)
 
 
 def convergence_table(er: ExperimentResult) -> pd.DataFrame:

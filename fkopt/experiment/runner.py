@@ -20,12 +20,13 @@ import numpy as np
 
 from .. import registry
 from ..errors import FkoptError
+from ..record import ALONE, BATCH, concat, run_record, timing_record
 from ..problems import fk_problem, ik_problem
 from ..rotations import wrap_degrees
 from ..solve import Result, chunk_size, make_algorithm, solve
 from .config import AlgorithmSpec, ExperimentConfig, RandomCases, RunConfig
 from .tasks import Plan, Ran, Task, run_tasks
-from .timing import time_single_runs
+from .timing import sample_plan, time_case
 
 
 @dataclass
@@ -65,6 +66,8 @@ class ExperimentResult:
     records: list[TaskRecord]
     wall_s: float
     source: str | None = None
+    record: object = None              # the run record (:mod:`fkopt.record`): one row per (case, algorithm, run)
+    timing: object = None              # the timing record (:mod:`fkopt.record`): its timed samples
 
     @property
     def compared_names(self) -> tuple[str, ...]:
@@ -277,25 +280,36 @@ class _Context:
     cases: list[Case]
     problems: list
     batched: object
-    started: float
+    prepared_s: float     # building the plan (validation); the run's own time adds the tasks' and the merge's
 
 
-def experiment_plan(config: ExperimentConfig, source: str | None = None) -> Plan:
+def experiment_plan(config: ExperimentConfig, source: str | None = None, timing: bool = True) -> Plan:
     """An experiment as tasks of the one runner (:mod:`fkopt.experiment.tasks`): one task per
     algorithm, solving every case in one call (an experiment is a suite of one problem with
-    listed poses). In this process the task uses the live mechanism and cases; a worker process
-    rebuilds them from the payload (:func:`solve_task`), with the same numbers."""
+    listed poses), and (``timing``) one timing task per timed case (:mod:`.timing`'s sample:
+    every algorithm's runs solved alone, interleaved), run after the solves, in this process
+    (:attr:`~fkopt.experiment.tasks.Plan.timed`). In this process a task uses the live mechanism
+    and cases; a worker process rebuilds them from the payload (:func:`solve_task`), with the
+    same numbers."""
     started = time.perf_counter()
     mech, cases, problems, batched = _prepare(config, source)
     data = config.model_dump_json()
     folder = str(config._folder) if getattr(config, "_folder", None) is not None else None
     tasks = [Task(f"a{a:02d}", {"config": data, "folder": folder, "algorithm": a}, spec.key)
              for a, spec in enumerate(config.algorithms)]
+    timed_cases, per = sample_plan(len(cases), config.runs)
+    timed = [Task(f"t{c:02d}", {"timing": c, "runs": per}, f"timing · {cases[c].label}")
+             for c in range(timed_cases)] if timing else []
 
-    def local(payload: dict) -> Solved:
+    def local(payload: dict):
+        if "timing" in payload:
+            c = payload["timing"]
+            entries = [(spec, problems[c], task_seed(config.seed, cases[c].index, spec.key))
+                       for spec in config.algorithms]
+            return time_case(config, entries, payload["runs"])
         return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
-    return Plan(tasks, solve_task, local=local, anywhere=True,
-                context=_Context(mech, cases, problems, batched, started), name=config.name)
+    return Plan(tasks, solve_task, local=local, anywhere=True, timed=timed,
+                context=_Context(mech, cases, problems, batched, time.perf_counter() - started), name=config.name)
 
 
 def solve_task(payload: dict) -> Solved:
@@ -309,9 +323,10 @@ def solve_task(payload: dict) -> Solved:
 
 
 def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: str | None = None,
-                     timing: bool = True) -> ExperimentResult:
-    """The experiment's records from its tasks' :class:`Solved` s, then (``timing``) the
-    single-run timing sample of :mod:`.timing`, in this process after every solve."""
+                     **_) -> ExperimentResult:
+    """The experiment's records from its tasks' :class:`Solved` s and the single-run times of
+    its timing tasks (none when the plan has none: ``fkopt check``)."""
+    merging = time.perf_counter()
     ctx: _Context = plan.context
     mech, cases, problems = ctx.mech, ctx.cases, ctx.problems
     by_algorithm: list[list[TaskRecord]] = []
@@ -326,12 +341,58 @@ def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: 
         by_algorithm.append(recs)
     # case-major order, as the reports expect (every algorithm of case 1, then case 2, ...)
     records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
-    if timing:
-        time_single_runs(config, records)
-    wall = time.perf_counter() - ctx.started
+    for task in plan.timed:               # seconds per algorithm of one timed case
+        for recs, seconds in zip(by_algorithm, ran.records[task.id]):
+            rec = recs[task.payload["timing"]]
+            rec.single_run_ids, rec.single_run_s = np.arange(len(seconds)), np.asarray(seconds)
+    # the run's own time, wherever and however long before the plan was built
+    wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)
     # solves computed elsewhere (fkopt reproduce's workers): their own time, measured where they ran
     wall += sum(ran.records[t.id].wall_s * len(cases) for t in plan.tasks if t.id not in ran.computed)
-    return ExperimentResult(config, mech, cases, records, wall, source)
+    return ExperimentResult(config, mech, cases, records, wall, source, experiment_record(config, mech, records),
+                            experiment_timing(config, records))
+
+
+def experiment_timing(config: ExperimentConfig, records: list[TaskRecord]):
+    """The timing record (:mod:`fkopt.record`): every run timed alone, and every run's share
+    of its batch (the amortised time, for information)."""
+    frames = []
+    for rec in records:
+        common = {"problem": config.name, "case": rec.case.label, "pose": rec.case.index, "solver": rec.spec.key}
+        if rec.single_run_s is not None:
+            frames.append(timing_record("experiment", {**common, "run": rec.single_run_ids, "runs": 1,
+                                                       "seconds": rec.single_run_s, "mode": ALONE}))
+        frames.append(timing_record("experiment", {**common, "run": rec.result.run_ids, "runs": 1,
+                                                   "seconds": rec.result.time_per_run, "mode": BATCH}))
+    return concat(frames)
+
+
+def experiment_record(config: ExperimentConfig, mech, records: list[TaskRecord]):
+    """The run record (:mod:`fkopt.record`) of an experiment's task records, in their order."""
+    thr = config.threshold
+    frames = []
+    for rec in records:
+        r, case = rec.result, rec.case
+        cols = {"problem": config.name, "case": case.label, "pose": case.index, "solver": rec.spec.key,
+                "run": r.run_ids, "task_seed": rec.seed, "final_fitness": r.fitness, "evaluations": r.evaluations,
+                "iterations_done": r.iterations_done,
+                # first iteration at which the run's final best-so-far fitness was reached
+                "iterations_to_best": np.argmax(r.history <= r.history[:, -1:], axis=1)}
+        if thr is not None:
+            cols["iterations_to_threshold"] = r.iterations_to(thr)
+            cols["evaluations_to_threshold"] = r.evaluations_to(thr)
+        cols.update({f"x_{name}": r.x[:, j] for j, name in enumerate(r.variable_names)})
+        if mech.kind == "serial":
+            cols.update({f"pose_{name}": rec.outputs[:, j] for j, name in enumerate(mech.pose_names)})
+        if rec.position_error_history is not None:
+            cols["position_error"] = rec.position_error_history[:, -1]
+        target = case.target if case.target is not None else case.reference
+        if target is not None:
+            err = pose_error(mech, rec.outputs, target)
+            cols.update({f"abs_error_{name}": err[:, j] for j, name in enumerate(mech.pose_names)})
+        cols.update({f"final_{key}": r.extras[key][:, -1] for key in r.extras})
+        frames.append(run_record("experiment", cols))
+    return concat(frames)
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
@@ -345,5 +406,5 @@ def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, in
     Every algorithm solves all cases in one call of :func:`fkopt.solve` (cases x runs rows),
     each case with its own :func:`task_seed`, so a case's numbers are those it gets alone.
     """
-    plan = experiment_plan(config, source)
-    return merge_experiment(config, plan, run_tasks(plan, progress=progress), source=source, timing=timing)
+    plan = experiment_plan(config, source, timing=timing)
+    return merge_experiment(config, plan, run_tasks(plan, progress=progress), source=source)

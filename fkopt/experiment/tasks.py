@@ -67,6 +67,11 @@ class Plan:
     anywhere: bool = False
     context: Any = None            # what the kind's merge needs (mechanism, cases, pose sets, ...)
     name: str = ""
+    #: tasks that measure wall time (an experiment's single-run timing sample,
+    #: :mod:`fkopt.experiment.timing`): run after every task above, in this process through
+    #: ``local``, one at a time with nothing else running; never on a worker, never taken from
+    #: ``done`` or a task file, never stored. Empty when the caller wants no timings (``fkopt check``).
+    timed: list[Task] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -80,8 +85,12 @@ class Kind:
 
     name: str
     from_dict: Callable[[dict, str], Any]          # (mapping, where) -> validated config
-    validate: Callable[[Any], tuple[int, int]]     # config -> (tasks, estimated bytes); no work done
-    plan: Callable[..., Plan]                      # (config, source, timing=True) -> its tasks
+    #: (config, source, timing=True) -> its tasks (timing=False: no Plan.timed); building the plan
+    #: builds everything a run needs (mechanism, cases, problems, pose sets) and solves nothing: it
+    #: is the validation of a run (:func:`fkopt.experiment.kinds.plan_config`)
+    plan: Callable[..., Plan]
+    #: (config, plan) -> estimated bytes of the run, from what the plan built (nothing built again)
+    validate: Callable[[Any, Plan], int]
     #: (config, plan, ran, source=, timing=, folder=) -> the result object the writers read
     merge: Callable[..., Any]
 
@@ -264,16 +273,18 @@ def run_tasks(plan: Plan, *, executor: str = "local", jobs: int = 1, scheduler: 
     ``progress``) stops the run; with a store, every task finished so far stays on disk."""
     from .executors import execute, worker_count
     start = time.perf_counter()
-    records: dict[str, Any] = dict(done or {})
+    timed = {t.id for t in plan.timed}
+    # timings are measured by this run, never taken from elsewhere
+    records: dict[str, Any] = {k: v for k, v in (done or {}).items() if k not in timed}
     if store is not None:
         records.update(store.open(plan, resume))
-    labels = {t.id: t.label for t in plan.tasks}
-    total = len(plan.tasks)
+    labels = {t.id: t.label for t in plan.tasks + plan.timed}
+    total = len(plan.tasks) + len(plan.timed)
     computed: list[str] = []
 
     def finished(item: tuple[str, Any]) -> None:
         ident, record = item
-        if store is not None:
+        if store is not None and ident not in timed:
             store.add(ident, record)
         records[ident] = record
         computed.append(ident)
@@ -296,4 +307,6 @@ def run_tasks(plan: Plan, *, executor: str = "local", jobs: int = 1, scheduler: 
     missing = [t.id for t in plan.tasks if t.id not in records]
     if missing:  # pragma: no cover - execute() raises before this can happen
         raise FkoptError(f"{plan.name}: {len(missing)} task(s) did not finish (first: {missing[0]})")
-    return Ran({t.id: records[t.id] for t in plan.tasks}, computed, time.perf_counter() - start)
+    for t in plan.timed:                 # after every solve, here, alone (see Plan.timed)
+        finished((t.id, plan.local(t.payload)))
+    return Ran({t.id: records[t.id] for t in plan.tasks + plan.timed}, computed, time.perf_counter() - start)

@@ -8,7 +8,9 @@ reverse a comparison. Every timing figure and timing claim of fkopt's reports th
 times measured here:
 
 * **Order**: the algorithms of a case are timed interleaved, run 0 of each, then run 1 of each
-  (A B A B ...), in one process (:func:`time_single_runs`).
+  (A B A B ...), in one process (:func:`time_case`): one planned timing task per timed case,
+  run after every solve of the experiment, in this process, with nothing else running
+  (:attr:`fkopt.experiment.tasks.Plan.timed`).
 * **Mode**: each sampled run is solved alone (``solve(..., batch=False, run_ids=[k])``, the same
   stream as in the batch, so the same numbers) and timed with ``time.perf_counter`` around that
   call; one untimed short warm-up solve precedes the task's first timed run.
@@ -49,42 +51,35 @@ def sample_plan(n_cases: int, runs: int) -> tuple[int, int]:
     return cases, min(runs, max(1, math.ceil(TIMING_RUNS / n_cases)))
 
 
-def time_single_runs(config, records) -> None:
-    """Set ``record.single_run_ids`` and ``record.single_run_s`` (seconds) on every task record.
+def time_case(config, timed: list[tuple], per: int) -> list[np.ndarray]:
+    """Seconds of the timed runs ``0 .. per-1`` of every algorithm of one case, as
+    ``timed = [(spec, problem, seed), ...]``: one array per algorithm, in that order (shorter
+    than ``per`` once an algorithm has its sample: :data:`TIMING_BUDGET_S`).
 
     The timed runs of a case's algorithms are **interleaved** (A0 B0 A1 B1 ...: round k times run k
     of every algorithm still sampling), in this one process, so that a slow period of the machine
-    falls on every algorithm alike instead of on whichever was timed then.
+    falls on every algorithm alike instead of on whichever was timed then. One planned timing task
+    of an experiment (:func:`fkopt.experiment.runner.experiment_plan`) is one call.
     """
-    n_cases, per = sample_plan(len({r.case.index for r in records}), config.runs)
-    by_case: dict[int, list] = {}
-    for rec in records:
-        if rec.case.index < n_cases:
-            by_case.setdefault(rec.case.index, []).append(rec)
-    for recs in by_case.values():
-        kwargs = {id(rec): _kwargs(config, rec) for rec in recs}
-        for rec in recs:
-            solve(rec.problem, rec.spec.name, iterations=2, run_ids=[0], **kwargs[id(rec)])   # warm-up, untimed
-        seconds: dict[int, list] = {id(rec): [] for rec in recs}
-        for k in range(per):
-            for rec in recs:
-                s = seconds[id(rec)]
-                if len(s) >= TIMING_MIN_RUNS and sum(s) > TIMING_BUDGET_S:
-                    continue   # this task has its sample; the others keep alternating
-                start = time.perf_counter()
-                solve(rec.problem, rec.spec.name, iterations=rec.spec.iterations or config.iterations,
-                      run_ids=[k], **kwargs[id(rec)])
-                s.append(time.perf_counter() - start)
-        for rec in recs:
-            rec.single_run_ids, rec.single_run_s = np.arange(len(seconds[id(rec)])), np.array(seconds[id(rec)])
+    kwargs = [_kwargs(config, spec, problem, seed) for spec, problem, seed in timed]
+    for (spec, problem, _), kw in zip(timed, kwargs):
+        solve(problem, spec.name, iterations=2, run_ids=[0], **kw)   # warm-up, untimed
+    seconds: list[list[float]] = [[] for _ in timed]
+    for k in range(per):
+        for (spec, problem, _), kw, s in zip(timed, kwargs, seconds):
+            if len(s) >= TIMING_MIN_RUNS and sum(s) > TIMING_BUDGET_S:
+                continue   # this task has its sample; the others keep alternating
+            start = time.perf_counter()
+            solve(problem, spec.name, iterations=spec.iterations or config.iterations, run_ids=[k], **kw)
+            s.append(time.perf_counter() - start)
+    return [np.array(s) for s in seconds]
 
 
-def _kwargs(config, rec) -> dict:
-    spec = rec.spec
-    return dict(population=spec.population or config.population, runs=1, seed=rec.seed,
+def _kwargs(config, spec, problem, seed: int) -> dict:
+    return dict(population=spec.population or config.population, runs=1, seed=seed,
                 target=config.threshold, stop_at_target=config.stop_at_threshold,
-                x0=None if spec.start is None else _start(rec), batch=False, params=spec.params)
+                x0=None if spec.start is None else _start(spec, problem), batch=False, params=spec.params)
 
 
-def _start(rec) -> np.ndarray:
-    return np.asarray([rec.spec.start[n] for n in rec.problem.variable_names], dtype=float)
+def _start(spec, problem) -> np.ndarray:
+    return np.asarray([spec.start[n] for n in problem.variable_names], dtype=float)

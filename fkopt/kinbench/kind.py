@@ -16,4 +16,4 @@ def _from_dict(data: dict, where: str) -> SuiteConfig:
     return config
 
 
-SUITE = Kind("suite", _from_dict, validate_suite, suite_plan, merge_suite)
+SUITE = Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite)

@@ -41,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import FkoptError
+from ..record import run_record
 from .budget import at_budget, budget_of
 
 COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
@@ -152,4 +153,5 @@ def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str,
         frames.append({"problem": problem, "class": classes[problem], "set": name, "pose": pose,
                        "solver": entry.solver, "track": entry.track, "run": run, "dim": dim,
                        "budget": budget_of(config, dim), **{key: float(v[0]) for key, v in m.items()}})
-    return in_suite_order(config, pd.DataFrame(frames))
+    rows = pd.DataFrame(frames)
+    return in_suite_order(config, run_record("suite", {c: rows[c].to_numpy() for c in rows.columns}))

@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import FkoptError
+from ..record import BATCH, concat, run_record, timing_record
 from ..experiment.config import RunConfig
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..experiment.tasks import Plan, Ran, Task, run_tasks
@@ -54,12 +55,17 @@ def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
 @dataclass
 class SuiteResult:
     config: SuiteConfig
-    runs: pd.DataFrame                   # one row per (problem, set, pose, solver, run)
-    timing: pd.DataFrame                 # one row per (problem, solver): wall time per solve
+    record: pd.DataFrame                 # the run record (:mod:`fkopt.record`): one row per (problem, set, pose, solver, run)
+    timing: pd.DataFrame                 # the timing record (:mod:`fkopt.record`): one batch per (problem, solver)
     manifest: dict
     wall_s: float
     source: str | None = None
     trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
+
+    @property
+    def runs(self) -> pd.DataFrame:
+        """The run record (what the measures, the ECDF and the leaderboard are computed from)."""
+        return self.record
 
 
 def _cases(config: SuiteConfig, sets: dict, problem):
@@ -72,9 +78,10 @@ def instances_of(config: SuiteConfig, sets: dict) -> set[tuple[str, str, int]]:
     return {(p.name, name, i) for p in config.problems for name, i, _ in _cases(config, sets, p)}
 
 
-def validate_suite(config: SuiteConfig) -> tuple[int, int]:
-    """Everything a suite needs, built without solving; (tasks, estimated bytes)."""
-    sets, _ = load_pose_sets(config)
+def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
+    """Everything a suite needs, built without solving (the pose sets its plan loaded, else
+    loaded here); the estimated bytes of the run."""
+    sets = plan.context.sets if plan is not None else load_pose_sets(config)[0]
     need = 0
     dims: dict[str, int] = {}
     for problem in config.problems:
@@ -105,7 +112,7 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances)
-    return len(config.problems) * len(config.solvers), need
+    return need
 
 
 def solve_task(payload: dict) -> dict:
@@ -126,22 +133,29 @@ def solve_task(payload: dict) -> dict:
     start = time.perf_counter()
     result = solve_cases(cfg, spec, batched, seeds, x0=start_point(spec, mech))
     wall = time.perf_counter() - start
-    rows = run_rows(config, problem, solver, cases, result, dim)
+    rows = run_rows(config, problem, solver, cases, result, dim, seeds)
     return {"fingerprint": payload["fingerprint"], "problem": payload["problem"], "solver": payload["solver"],
             "dim": dim, "rows": rows.to_dict(orient="list"), "trace": task_trace(result, budget_of(config, dim)),
             "wall_s": wall, "solves": len(cases) * config.runs}
 
 
-def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int) -> pd.DataFrame:
+def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int, seeds) -> pd.DataFrame:
+    """The task's rows of the run record (:mod:`fkopt.record`), measured at the budget."""
     budget = budget_of(config, dim)
     m = at_budget(result.history, result.evaluation_history, budget, config.targets)
     n, runs = len(cases), config.runs
     cols = {"problem": problem.name, "class": problem.problem_class,
             "set": np.repeat([c[0] for c in cases], runs), "pose": np.repeat([c[1] for c in cases], runs),
             "solver": solver.key, "track": solver.track, "run": np.tile(np.arange(runs), n),
-            "dim": dim, "budget": budget}
+            "dim": dim, "budget": budget, "task_seed": np.repeat(seeds, runs)}
     cols.update({k: np.asarray(v).reshape(n * runs) for k, v in m.items()})
-    return pd.DataFrame(cols)
+    return run_record("suite", cols)
+
+
+def rows_of(record: dict) -> pd.DataFrame:
+    """A task file's run rows (columns of lists) as run-record rows, dtypes restored."""
+    rows = record["rows"]
+    return run_record("suite", {k: v for k, v in rows.items() if k != "kind"})
 
 
 def fingerprint(config: SuiteConfig, manifest: dict) -> str:
@@ -179,10 +193,10 @@ def record_problem(task, rec) -> str | None:
 class _Context:
     sets: dict
     manifest: dict
-    started: float
+    prepared_s: float     # building the plan (validation)
 
 
-def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
+def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = True) -> Plan:
     """A suite as tasks of the one runner: one per (problem, solver), every pose of the
     problem's selected sets a case of one batched solve; kept as task files while the suite runs
     (``--resume``), not in the published folder (its run rows are)."""
@@ -197,23 +211,25 @@ def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
-                context=_Context(sets, manifest, started), name=f"suite '{config.name}'")
+                context=_Context(sets, manifest, time.perf_counter() - started), name=f"suite '{config.name}'")
 
 
 def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
     """The run rows of every task, then the imported outside results, and the timing table."""
+    merging = time.perf_counter()
     ctx: _Context = plan.context
-    done = [{**ran.records[t.id], "rows": pd.DataFrame(ran.records[t.id]["rows"])} for t in plan.tasks]
+    done = [{**ran.records[t.id], "rows": rows_of(ran.records[t.id])} for t in plan.tasks]
     frames = [r["rows"] for r in done]
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
         instances = instances_of(config, ctx.sets)
         frames += [read_outside(config, k, dims, instances) for k in range(len(config.outside))]
-    runs = pd.concat(frames, ignore_index=True)
-    tim = pd.DataFrame([{"problem": config.problems[r["problem"]].name, "solver": config.solvers[r["solver"]].key,
-                         "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
-                        for r in done])
-    return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source,
+    runs = concat(frames)
+    tim = concat([timing_record("suite", {"problem": config.problems[r["problem"]].name,
+                                          "solver": config.solvers[r["solver"]].key, "runs": r["solves"],
+                                          "seconds": r["wall_s"], "mode": BATCH}) for r in done])
+    wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
+    return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
                        suite_trace(config, done, runs))
 
 

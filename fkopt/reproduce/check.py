@@ -128,10 +128,12 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     if kind == "experiment":
         groups = [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
                   for case in build_cases(config, mech)]
-    else:                               # a study: one problem per pose of its pose set (runs.csv: pose = i + 1)
+    else:                               # a study: one problem per pose of its pose set
         from ..study.poses import build_poses
         poses = build_poses(config, mech)
-        groups = [(f"pose {i + 1}", runs["pose"] == i + 1, lambda i=i: make_problem(config, mech, poses.inputs[i]))
+        # poses count from 0 (fkopt.record); a folder written before the run record counted from 1
+        first = 1 if len(runs) and runs["pose"].min() >= 1 else 0
+        groups = [(f"pose {i}", runs["pose"] == i + first, lambda i=i: make_problem(config, mech, poses.inputs[i]))
                   for i in range(len(poses))]
     out = []
     for where, sel, make in groups:

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import FkoptError
-from ..experiment.kinds import load_any, prepare_output, run_config, validate_any
+from ..experiment.kinds import load_any, plan_config, prepare_output, run_config
 from ..files import output_folder
 
 
@@ -24,6 +24,7 @@ class Planned:
     path: Path
     config: Any
     tasks: int
+    plan: Any = None       # the validated plan (fkopt.experiment.kinds.plan_config), run as it is
 
 
 @dataclass
@@ -49,7 +50,8 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
         config = load_any(f)
         if getattr(config, "kind", None) == "suite":    # benchmark suites: fkopt suite / make bench-suite
             continue
-        tasks = validate_any(config, str(f))
+        config_plan = plan_config(config, str(f), str(f))       # the one validation of this config
+        tasks = len(config_plan.tasks) + len(config_plan.timed)
         key = tuple(config.folder_parts)
         if key in seen:
             raise FkoptError(f"{f}: writes {'/'.join(key)}, like {seen[key]}; paper/name must differ")
@@ -58,7 +60,7 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
             prepare_output(config, out, force=True)
         except FkoptError as err:
             raise FkoptError(f"{f}: {err}") from None
-        planned.append(Planned(f, config, tasks))
+        planned.append(Planned(f, config, tasks, config_plan))
     return planned
 
 
@@ -96,7 +98,7 @@ def solve_in_parallel(planned: list[Planned], jobs: int,
         return {}
     items = []
     for i, p in enumerate(planned):
-        plan = config_kind(p.config).plan(p.config, str(p.path))
+        plan = p.plan if p.plan is not None else config_kind(p.config).plan(p.config, str(p.path))
         if plan.anywhere and not plan.stored:
             items += [(_cost(p.config) / len(plan.tasks), i, (plan.solve, t.id, t.payload)) for t in plan.tasks]
     if len({i for _, i, _ in items}) < 2:
@@ -137,7 +139,7 @@ def run_all(planned: list[Planned], out: str | Path,
     for i, p in enumerate(planned):
         progress = started(p) if started else None
         outcome = run_config(p.config, out, source=str(p.path), progress=progress, force=True, keep_tasks=False,
-                             solved=solved.get(i))
+                             solved=solved.get(i), plan=p.plan)
         d = Done(p.path, outcome.folder, outcome.wall_s, len(list(outcome.folder.iterdir())))
         done.append(d)
         if finished:

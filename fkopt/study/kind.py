@@ -5,11 +5,11 @@ from ..experiment.kind import algorithm_resources
 from ..experiment.tasks import Kind
 from ..solve import batch_bytes, chunk_size
 from .config import StudyConfig, study_from_dict
-from .runner import merge_study, plan_tasks, study_plan, validate_study
+from .runner import merge_study, study_plan
 
 
-def _validate(config: StudyConfig) -> tuple[int, int]:
-    mech, poses = validate_study(config)
+def _validate(config: StudyConfig, plan) -> int:
+    mech, poses = plan.context.mech, plan.context.poses     # validated by study_plan
     dim, n = len(mech.unknown_names), len(poses)
     # rows of one solve: a chunk of poses x runs, or (tracking) the trajectories x runs of a step
     cases = len(poses.segments) if config.mode == "tracking" else min(config.chunk, n)
@@ -22,7 +22,7 @@ def _validate(config: StudyConfig) -> tuple[int, int]:
                    + algorithm_resources(spec, pop, its, dim))
         # kept for every (pose, run): fitness, counts, solution, as JSON task records (~10x)
         kept += n * config.runs * (dim + 6) * 8 * 10
-    return len(plan_tasks(config, n)), work + kept
+    return work + kept
 
 
-STUDY = Kind("study", study_from_dict, _validate, study_plan, merge_study)
+STUDY = Kind("study", study_from_dict, study_plan, _validate, merge_study)

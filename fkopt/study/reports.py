@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import record
 from ..experiment import plotting
 from ..experiment.reports import _plt, _save
 from ..files import nanmedian as _nanmedian
@@ -48,22 +49,11 @@ def case_label(sr: StudyResult) -> str:
 
 # -- tables --------------------------------------------------------------------------------------
 def summary_table(sr: StudyResult) -> pd.DataFrame:
-    thr = sr.config.threshold
-    rows = []
-    for ar in sr.algorithms:
-        f = ar.fitness.ravel()
-        rows.append({
-            "case": case_label(sr), "algorithm": ar.key, "method": ar.spec.name,
-            "population": ar.population, "iterations": ar.iterations, "runs": sr.config.runs,
-            "mean_fitness": float(np.mean(f)), "std_fitness": float(np.std(f, ddof=1)) if f.size > 1 else 0.0,
-            "best_fitness": float(np.min(f)), "worst_fitness": float(np.max(f)),
-            "median_fitness": float(np.median(f)), "mean_evaluations": float(np.mean(ar.evaluations)),
-            "threshold": thr, "success_rate": float(np.mean(f < thr)),
-            "median_iterations_to_threshold": _nanmedian(ar.iterations_to),
-            "median_evaluations_to_threshold": _nanmedian(ar.evaluations_to),
-            "poses": len(sr.poses),
-        })
-    return pd.DataFrame(rows)
+    """Per algorithm over every (pose, run) (the one summary writer, :func:`fkopt.record.summary_table`)."""
+    settings = {ar.key: {"method": ar.spec.name, "population": ar.population, "iterations": ar.iterations,
+                         "runs": sr.config.runs} for ar in sr.algorithms}
+    return record.summary_table(sr.record, settings, sr.config.threshold, by=("solver",), case=case_label(sr),
+                                extra={"poses": len(sr.poses)})
 
 
 def _pose_columns(sr: StudyResult, i: np.ndarray | int) -> dict:
@@ -80,7 +70,7 @@ def poses_table(sr: StudyResult) -> pd.DataFrame:
     frames = []
     for ar in sr.algorithms:
         med_ev = np.array([_nanmedian(row) for row in ar.evaluations_to])
-        df = pd.DataFrame({"pose": idx + 1, "label": [sr.poses.label(i) for i in idx], **_pose_columns(sr, idx),
+        df = pd.DataFrame({"pose": idx, "label": [sr.poses.label(i) for i in idx], **_pose_columns(sr, idx),
                            "algorithm": ar.key, "median_fitness": np.median(ar.fitness, axis=1),
                            "best_fitness": np.min(ar.fitness, axis=1),
                            "success_rate": np.mean(ar.fitness < thr, axis=1),
@@ -93,37 +83,16 @@ def poses_table(sr: StudyResult) -> pd.DataFrame:
 
 
 def runs_table(sr: StudyResult) -> pd.DataFrame:
-    n, runs = len(sr.poses), sr.config.runs
-    pose = np.repeat(np.arange(n), runs)
-    run = np.tile(np.arange(runs), n)
-    frames = []
-    for ar in sr.algorithms:
-        df = pd.DataFrame({"pose": pose + 1, "algorithm": ar.key, "run": run,
-                           "task_seed": np.repeat(ar.seeds, runs),
-                           "final_fitness": ar.fitness.ravel(), "evaluations": ar.evaluations.ravel().astype(np.int64),
-                           "iterations_done": ar.iterations_done.ravel().astype(np.int64),
-                           "iterations_to_threshold": ar.iterations_to.ravel(),
-                           "evaluations_to_threshold": ar.evaluations_to.ravel()})
-        if ar.start is not None:
-            for j, name in enumerate(sr.poses.names):
-                df[f"start_{name}"] = ar.start[:, :, j].ravel()
-        for j, name in enumerate(sr.poses.names):
-            df[f"x_{name}"] = ar.x[:, :, j].ravel()
-        for j, name in enumerate(sr.compared_names):
-            df[f"abs_error_{name}"] = ar.errors[:, :, j].ravel()
-        frames.append(df)
-    return pd.concat(frames, ignore_index=True)
+    """One row per (pose, algorithm, run), poses from 0: the run record's (:func:`fkopt.record.runs_table`)."""
+    return record.runs_table(sr.record)
 
 
 def timing_table(sr: StudyResult) -> pd.DataFrame:
-    runs = sr.config.runs
-    rows = []
-    for ar in sr.algorithms:
-        ms = ar.time_s / runs * 1e3
-        rows.append({"case": case_label(sr), "algorithm": ar.key, "runs": runs, "poses": len(sr.poses),
-                     "mean_ms_per_run": float(np.mean(ms)), "median_ms_per_run": float(np.median(ms)),
-                     "total_s": float(ar.wall_s)})
-    return pd.DataFrame(rows)
+    """Per algorithm, ms per run of each pose (its share of the batch; the one timing writer,
+    :func:`fkopt.record.timing_table`)."""
+    settings = {(case_label(sr), ar.key): {"runs": sr.config.runs, "poses": len(sr.poses), "total_s": float(ar.wall_s)}
+                for ar in sr.algorithms}
+    return record.timing_table(sr.timing, settings, names=record.FILE_NAMES["study"])
 
 
 def ecdf_of(sr: StudyResult) -> pd.DataFrame:
@@ -162,7 +131,7 @@ def tracking_table(sr: StudyResult) -> pd.DataFrame | None:
     frames = []
     for ar in sr.algorithms:
         warm = (step > 0) & ar.spec.warm_start
-        df = pd.DataFrame({"trajectory": sr.poses.trajectory + 1, "step": step, "algorithm": ar.key,
+        df = pd.DataFrame({"trajectory": sr.poses.trajectory, "step": step, "algorithm": ar.key,
                            "warm_start": warm,
                            **{n_: sr.poses.points[:, j] for j, n_ in enumerate(sr.poses.names)},
                            "median_fitness": np.median(ar.fitness, axis=1),
@@ -178,7 +147,7 @@ def tracking_timing_table(sr: StudyResult) -> pd.DataFrame | None:
     if sr.config.mode != "tracking":
         return None
     runs = sr.config.runs
-    return pd.concat([pd.DataFrame({"trajectory": sr.poses.trajectory + 1, "step": sr.poses.step,
+    return pd.concat([pd.DataFrame({"trajectory": sr.poses.trajectory, "step": sr.poses.step,
                                     "algorithm": ar.key, "ms_per_run": ar.time_s / runs * 1e3})
                       for ar in sr.algorithms], ignore_index=True)
 

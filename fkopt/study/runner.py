@@ -29,6 +29,7 @@ import numpy as np
 
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
+from ..record import BATCH, concat, run_record, timing_record
 from ..solve import make_algorithm, pick_events
 from ..streams import case_seed
 from ..experiment.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder  # noqa: F401 (tests, API)
@@ -265,6 +266,8 @@ class StudyResult:
     source: str | None = None
     computed: list[str] = field(default_factory=list)   # task ids computed by this invocation
     folder: Path | None = None
+    record: object = None     # the run record (:mod:`fkopt.record`): one row per (algorithm, pose, run)
+    timing: object = None     # the timing record (:mod:`fkopt.record`): one batch per (algorithm, pose)
 
     @property
     def compared_names(self):
@@ -318,17 +321,18 @@ def merge(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]) -
 class _Context:
     mech: object
     poses: PoseSet
-    started: float
+    prepared_s: float     # building the plan (validation)
 
 
 def _label(config: StudyConfig, task: Task) -> str:
-    where = (f"poses {task.start + 1}-{task.stop}" if config.mode == "independent"
+    where = (f"poses {task.start}-{task.stop - 1}" if config.mode == "independent"
              else f"{task.stop - task.start} steps")
     return f"{task.label} · {where}"
 
 
-def study_plan(config: StudyConfig, source: str | None = None) -> Plan:
-    """A study as tasks of the one runner: kept as task files (resume), published in ``tasks/``."""
+def study_plan(config: StudyConfig, source: str | None = None, timing: bool = True) -> Plan:
+    """A study as tasks of the one runner: kept as task files (resume), published in ``tasks/``
+    (its times are each task's own wall time: no separate timing tasks)."""
     started = time.perf_counter()
     mech, poses = validate_study(config)
     tasks = plan_tasks(config, len(poses))
@@ -337,12 +341,44 @@ def study_plan(config: StudyConfig, source: str | None = None) -> Plan:
     return Plan([RunnerTask(t.id, payload(config, t), _label(config, t)) for t in tasks],
                 run_task, fingerprint=config.fingerprint(), stored=True, keep=True,
                 check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, dim),
-                context=_Context(mech, poses, started), name=f"study '{config.name}'")
+                context=_Context(mech, poses, time.perf_counter() - started), name=f"study '{config.name}'")
 
 
 def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None = None,
                 folder: Path | None = None, **_) -> StudyResult:
+    merging = time.perf_counter()
     ctx: _Context = plan.context
-    return StudyResult(config, ctx.mech, ctx.poses, merge(config, ctx.mech, ctx.poses, ran.records),
-                       time.perf_counter() - ctx.started, source, list(ran.computed), folder)
+    algorithms = merge(config, ctx.mech, ctx.poses, ran.records)
+    wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
+    return StudyResult(config, ctx.mech, ctx.poses, algorithms, wall, source,
+                       list(ran.computed), folder, study_record(config, ctx.mech, ctx.poses, algorithms),
+                       study_timing(config, ctx.poses, algorithms))
+
+
+def study_timing(config: StudyConfig, poses: PoseSet, algorithms: list[AlgorithmResult]):
+    """The timing record (:mod:`fkopt.record`) of a study: each pose's (or tracking step's) wall
+    time over its runs, per algorithm (its share of the chunk's batched solve)."""
+    case = "trajectory" if config.mode == "tracking" else "all"
+    return concat([timing_record("study", {"problem": config.name, "case": case, "pose": np.arange(len(poses)),
+                                           "solver": ar.key, "runs": config.runs, "seconds": ar.time_s,
+                                           "mode": BATCH}) for ar in algorithms])
+
+
+def study_record(config: StudyConfig, mech, poses: PoseSet, algorithms: list[AlgorithmResult]):
+    """The run record (:mod:`fkopt.record`) of a study: algorithm by algorithm, pose by pose (from
+    0, the index its seed takes), run by run."""
+    n, runs = len(poses), config.runs
+    frames = []
+    for ar in algorithms:
+        cols = {"problem": config.name, "pose": np.repeat(np.arange(n), runs), "solver": ar.key,
+                "run": np.tile(np.arange(runs), n), "task_seed": np.repeat(ar.seeds, runs),
+                "final_fitness": ar.fitness.ravel(), "evaluations": ar.evaluations.ravel(),
+                "iterations_done": ar.iterations_done.ravel(), "iterations_to_threshold": ar.iterations_to.ravel(),
+                "evaluations_to_threshold": ar.evaluations_to.ravel()}
+        if ar.start is not None:
+            cols.update({f"start_{name}": ar.start[:, :, j].ravel() for j, name in enumerate(poses.names)})
+        cols.update({f"x_{name}": ar.x[:, :, j].ravel() for j, name in enumerate(poses.names)})
+        cols.update({f"abs_error_{name}": ar.errors[:, :, j].ravel() for j, name in enumerate(mech.pose_names)})
+        frames.append(run_record("study", cols))
+    return concat(frames)
 
