@@ -167,6 +167,31 @@ def test_readings_give_one_conditional_row_each_and_not_checkable_overrides(tmp_
     assert c.verdict == NOT_CHECKABLE and "no stored result" in c.evidence
 
 
+def test_a_reconstruction_makes_every_verdict_resting_on_it_conditional_either_way(tmp_path, monkeypatch):
+    """Provenance is data: the engine, not a paper module, names the reconstruction in the condition
+    of every verdict that rests on it (held or not), and a part fitted to a claim makes it not checkable."""
+    from fkopt.reproduce import engine
+    store = _two_algorithms(tmp_path)
+    data = {"provenance": {"b": {"as": "reconstruction", "name": "B", "chosen": "lost equations, fkopt's choice"},
+                           "a": {"as": "printed", "name": "A"},
+                           "model": {"as": "reconstruction", "name": "model", "chosen": "fitted", "circular": ["fit"]}}}
+    monkeypatch.setattr(engine, "load", lambda paper: data)
+    spec = {"id": "x", "text": "b beats a", "kind": "comparison", "experiment": "exp", "better": "b", "than": "a",
+            "basis": "iterations"}
+    held, = judge("paper", spec, store)
+    lost, = judge("paper", {**spec, "basis": "evaluations"}, store)
+    assert (held.verdict, lost.verdict) == ("conditional: held", "conditional: not held")
+    assert held.condition == lost.condition == "reconstructed B: lost equations, fkopt's choice"
+    printed, = judge("paper", {**spec, "better": "a", "than": "a", "also": ["b"]}, store)   # beside: no condition
+    assert printed.verdict == NOT_HELD and printed.condition == ""
+    fit = {"id": "fit", "text": "a reaches 1e-10", "kind": "magnitude", "experiment": "exp", "algorithms": ["a"],
+           "quantity": "final_fitness", "statistic": "median", "below": 1.0, "rests_on": ["model"]}
+    c, = judge("paper", fit, store)
+    assert c.verdict == NOT_CHECKABLE and c.evidence.startswith("circular: the reconstructed model")
+    c, = judge("paper", {**fit, "id": "other"}, store)
+    assert c.verdict == "conditional: held" and c.condition == "reconstructed model: fitted"
+
+
 def test_magnitude_uses_a_statistic_over_all_runs_never_a_maximum(tmp_path):
     store = _two_algorithms(tmp_path)
     spec = {"id": "m", "text": "a reaches 1e-10", "kind": "magnitude", "experiment": "exp", "algorithms": ["a"],

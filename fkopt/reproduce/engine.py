@@ -36,13 +36,13 @@ import pandas as pd
 import yaml
 
 from . import paper_module
-from .claims import (ALPHA, CONDITIONAL, NOT_CHECKABLE, Claim, compare, equal_budget, faster_claim, first_below, g,
-                     missing, p_text, verdict, within_of_final)
+from .claims import (ALPHA, CONDITIONAL, HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, Claim, compare, equal_budget,
+                     faster_claim, first_below, g, missing, p_text, verdict, within_of_final)
 
 CLAIMS_YAML = "claims.yaml"
 #: Where the claims files live: the repository's configs/ (``FKOPT_CONFIGS`` points elsewhere).
 CONFIGS = Path(os.environ.get("FKOPT_CONFIGS", Path(__file__).resolve().parents[2] / "configs"))
-KINDS = ("comparison", "magnitude", "iterations_to_target", "timing", "value")
+KINDS = ("comparison", "magnitude", "iterations_to_target", "timing", "value", "statement")
 
 
 def is_claims_file(path: str | Path) -> bool:
@@ -94,28 +94,83 @@ def judge_paper(paper: str, store, timing_only: bool = False) -> tuple[list[Clai
 
 
 def judge(paper: str, spec: dict, store, mod=None) -> list[Claim]:
-    """One claim of the claims file, judged: one Claim per reading."""
+    """One claim of the claims file, judged: one Claim per reading.
+
+    The verdict's condition is the reading's (or the claim's) ``condition`` plus every
+    reconstruction the claim rests on (:func:`rests_on`, from the paper's ``provenance``), named,
+    whichever way the verdict goes; a part recorded as fitted to this very claim (``circular``)
+    makes it *not checkable*; an absolute time limit is judged on fkopt's machine, never the
+    paper's, and says so (:data:`HARDWARE_CONDITION`).
+    """
+    data = load(paper) or {}
     readings = spec.get("readings") or [{"condition": spec.get("condition", "")}]
     out = []
     for k, reading in enumerate(readings):
         cid = spec["id"] if len(readings) == 1 else f"{spec['id']}:{reading.get('id', k + 1)}"
-        c = _judge_one(paper, {**spec, **(reading.get("set") or {})}, reading.get("use") or {}, store, mod, cid)
-        c.id, c.kind, c.condition = cid, spec["kind"], reading.get("condition", "") or ""
+        spec_r = {**spec, **(reading.get("set") or {})}
+        use = reading.get("use") or {}
+        c = _judge_one(paper, spec_r, use, store, mod, cid)
+        c.id, c.kind = cid, spec["kind"]
+        parts = rests_on(data, spec_r, use)
+        conditions = [reading.get("condition", "") or ""]
+        conditions += [f"reconstructed {e.get('name', key)}: {e['chosen'].strip()}" for key, e in parts
+                       if e.get("as") == RECONSTRUCTION]
+        if spec["kind"] == "timing" and _absolute_time(spec_r):
+            conditions.append(HARDWARE_CONDITION.format(hardware=data.get("hardware") or "not printed"))
+        c.condition = "; ".join(x.strip() for x in conditions if x and x.strip())
+        circular = [(key, e) for key, e in parts if spec["id"] in (e.get("circular") or [])]
         if spec.get("not_checkable"):
-            c.evidence = f"{spec['not_checkable'].strip()}; fkopt's numbers: {c.evidence}"
+            c.evidence = spec["not_checkable"].strip() + (f"; fkopt's numbers: {c.evidence}" if c.evidence else "")
             c.verdict = NOT_CHECKABLE
-        elif c.condition and c.verdict in ("held", "not held"):
+        elif circular:
+            names = " and ".join(e.get("name", key) for key, e in circular)
+            c.evidence = (f"circular: the reconstructed {names} was fitted to these very numbers, so agreeing "
+                          f"with them confirms nothing; fkopt's numbers: {c.evidence}")
+            c.verdict = NOT_CHECKABLE
+        elif c.condition and c.verdict in (HELD, NOT_HELD, WITHIN_NOISE):
             c.verdict = CONDITIONAL + c.verdict
         out.append(c)
     return out
 
 
+RECONSTRUCTION, PRINTED = "reconstruction", "printed"
+#: The condition of every absolute time limit (``below_ms``, ``above_ms``): one rule for all papers.
+HARDWARE_CONDITION = ("an absolute time, measured on fkopt's machine (TIMING.md's platform), not on the paper's "
+                      "({hardware})")
+#: The claim fields that name the algorithms a verdict rests on (``also``: shown beside, never judged).
+ALGORITHM_FIELDS = ("better", "than", "algorithms", "algorithm", "faster_than", "faster")
+
+
+def _absolute_time(spec: dict) -> bool:
+    return "below_ms" in spec or "above_ms" in spec
+
+
+def rests_on(data: dict, spec: dict, use: dict | None = None) -> list[tuple[str, dict]]:
+    """The parts of the paper's ``provenance`` a claim rests on: (key, entry) pairs.
+
+    The algorithms the verdict compares (:data:`ALGORITHM_FIELDS`, after the reading's ``use``),
+    the parts with ``scope: all`` when the claim is judged on a stored experiment (the mechanism
+    and the error measure every run used), and the parts the claim lists in ``rests_on`` (claims
+    about printed numbers name what they use). A part that is not in ``provenance`` rests on
+    nothing recorded (a claims file's test requires every algorithm to be recorded).
+    """
+    prov = data.get("provenance") or {}
+    use = use or {}
+    keys = [use.get(a, a) for f in ALGORITHM_FIELDS for a in _list(spec.get(f))]
+    if spec.get("experiment"):
+        keys += [k for k, e in prov.items() if e.get("scope") == "all"]
+    keys += [use.get(a, a) for a in _list(spec.get("rests_on"))]
+    return [(k, prov[k]) for k in dict.fromkeys(keys) if k in prov]
+
+
 def _judge_one(paper, spec, use, store, mod, cid) -> Claim:
     text = spec["text"].strip()
     names = {**((load(paper) or {}).get("names") or {})}
-    exp = store.get(paper, spec["experiment"]) if spec.get("experiment") else None
+    # ``experiment: other_paper/name`` judges a claim on another paper's stored runs (wu2015's ACO on mao2017's 3-RPS)
+    where, _, name = str(spec.get("experiment", "")).rpartition("/")
+    exp = store.get(where or paper, name) if spec.get("experiment") else None
     if spec.get("experiment") and exp is None:
-        return missing(text, f"{paper}/{spec['experiment']}", cid)
+        return missing(text, f"{where or paper}/{name}", cid)
     try:
         return KIND_JUDGES[spec["kind"]](text, spec, exp, lambda a: use.get(a, a), names, store, mod)
     except _Missing as err:
@@ -357,7 +412,13 @@ def _value(text, spec, exp, use, names, store, mod) -> Claim:
     return Claim(text, verdict(ok), f"{evidence} (rule: {spec['quantity']} {g(value)} {rule})", numbers)
 
 
-KIND_JUDGES = {"comparison": _comparison, "magnitude": _magnitude, "iterations_to_target": _iterations_to_target,
+def _statement(text, spec, exp, use, names, store, mod) -> Claim:
+    """A claim no stored number can decide: its row says why (``not_checkable``)."""
+    assert spec.get("not_checkable"), f"{spec['id']}: a statement is judged not checkable and says why"
+    return Claim(text, NOT_CHECKABLE, "")
+
+
+KIND_JUDGES = {"statement": _statement, "comparison": _comparison, "magnitude": _magnitude, "iterations_to_target": _iterations_to_target,
                "timing": _timing, "value": _value}
 
 
