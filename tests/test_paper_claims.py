@@ -10,6 +10,7 @@ skipped, never passed.
 ``FKOPT_RESULTS`` points the tests at another results tree (default: the repository's results/).
 """
 import os
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -136,6 +137,20 @@ def test_every_claim_is_covered(claims):
     for paper, cl in claims.items():
         ids = {e[1] for e in EXPECTED if e[0] == paper}
         assert {c.id for c in cl} == ids, f"{paper}: claims without a test or tests without a claim"
+
+
+def test_evidence_states_the_outcome_before_the_rule(claims):
+    """The measured outcome comes first, the rule after it: no row reads 'held within' (or any
+    verdict word) as its rule, least of all a row that is not held."""
+    for paper, cl in claims.items():
+        for c in cl:
+            if c.evidence.startswith("no stored result") or c.kind == "statement":
+                continue
+            assert "held within" not in c.evidence, f"{c.id}: {c.evidence}"
+            assert "rule" in c.evidence, f"{c.id}: evidence without its rule: {c.evidence}"
+            if c.verdict.endswith("not held"):
+                assert "outside" in c.evidence or re.search(r"\bnot\b|slower|faster", c.evidence), \
+                    f"{c.id}: a row not held whose evidence does not say what failed: {c.evidence}"
 
 
 def test_claims_files_declare_every_field():

@@ -271,31 +271,45 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
                 held["evaluations"] = held["evaluations"] and gain_ev >= spec["min_orders"]
     decisive = held[basis] if held[basis] is not None else held["iterations"]
     other_basis = "evaluations" if basis == "iterations" else "iterations"
-    note = f"verdict on equal {basis} (the paper's basis)"
+    note = ""
     if held[other_basis] is not None and bool(held[other_basis]) != bool(decisive):
-        note += f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
+        note = f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
         numbers["bases_disagree"] = True
-    return Claim(text, verdict(decisive), "; ".join(parts) + "; " + note, numbers)
+    outcome = (f"{nm(better)} {'is' if decisive else 'is not'} significantly lower than "
+               f"{' and '.join(nm(x) for x in than)} at equal {basis}"
+               + (f" by >= {spec['min_orders']} decades" if spec.get("min_orders") is not None else ""))
+    rule = (f"rule: two-sided rank test over all runs at alpha = {ALPHA} on the paper's basis (equal {basis})"
+            + (f", and a median gain of >= {spec['min_orders']} decades" if spec.get("min_orders") is not None else ""))
+    return Claim(text, verdict(decisive), f"{outcome}: " + "; ".join(parts) + f"; {rule}" + note, numbers)
 
 
-def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str]:
-    """(held, rule text) of a number against the claim's magnitude rule (a rule's number may be a
-    mapping per algorithm, e.g. the printed mean of each)."""
-    spec = {k: (v.get(algo) if isinstance(v, dict) and k in ("order", "order_at_most", "below", "above", "at_least")
-                else v) for k, v in spec.items()}
+RULE_FIELDS = ("order", "order_at_most", "below", "above", "at_least")
+
+
+def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str, str]:
+    """(held, outcome, rule) of a number against the claim's magnitude rule: the outcome says what
+    was measured against the printed number ("+1.2 decades from the printed 1e-20, outside"), the
+    rule states the test ("within +-0.5 decades of the printed order"). A rule's number may be a
+    mapping per algorithm, e.g. the printed mean of each."""
+    per_algo = any(isinstance(spec.get(k), dict) for k in RULE_FIELDS)
+    spec = {k: (v.get(algo) if isinstance(v, dict) and k in RULE_FIELDS else v) for k, v in spec.items()}
+    each = "each algorithm's printed " if per_algo else ""
     if spec.get("order") is not None:
         d = float(spec.get("decades", 0.5))
         off = np.log10(max(value, 1e-300)) - np.log10(spec["order"])
-        return abs(off) <= d, f"{off:+.2f} decades from {g(spec['order'])} (held within +-{d:g})"
+        ok = abs(off) <= d
+        return ok, f"{off:+.2f} decades from the printed {g(spec['order'])}, {'within' if ok else 'outside'} +-{d:g}", \
+            f"within +-{d:g} decades of {each or 'the printed '}order"
     if spec.get("order_at_most") is not None:
         cap = 10.0 ** (np.floor(np.log10(spec["order_at_most"])) + 1)
-        return value < cap, f"of the order of {g(spec['order_at_most'])} or below (< {g(cap)})"
-    if spec.get("below") is not None:
-        return value < spec["below"], f"below {g(spec['below'])}"
-    if spec.get("above") is not None:
-        return value > spec["above"], f"above {g(spec['above'])}"
-    if spec.get("at_least") is not None:
-        return value >= spec["at_least"], f"at least {g(spec['at_least'])}"
+        ok = value < cap
+        return ok, f"{'below' if ok else 'not below'} {g(cap)}", \
+            f"of {each or 'the printed '}order ({g(spec['order_at_most'])}) or below, i.e. below the next decade"
+    for key, word in (("below", "below"), ("above", "above"), ("at_least", "at least")):
+        if spec.get(key) is not None:
+            x = spec[key]
+            ok = value < x if key == "below" else value > x if key == "above" else value >= x
+            return ok, f"{'' if ok else 'not '}{word} {g(x)}", f"{word} {g(x) if not per_algo else each + 'value'}"
     raise ValueError(f"no rule in {spec}")
 
 
@@ -332,14 +346,14 @@ def _magnitude(text, spec, exp, use, names, store, mod) -> Claim:
                 values = {c: grp[c].to_numpy(float) for c in cols}
             for col, vals in values.items():
                 s = float(fn(vals))
-                good, rule = _rule(s, spec, algo)
+                good, outcome, rule = _rule(s, spec, algo)
                 ok &= good
                 var = col.removeprefix("abs_error_")
                 label = f"{names.get(algo, algo)}{'' if case == 'all' else ' ' + str(case)} {var}"
-                parts.append(f"{label} {g(s)}{' ' + units[var] if var in units else ''}")
+                parts.append(f"{label} {g(s)}{' ' + units[var] if var in units else ''} ({outcome})")
                 numbers[f"{stat}_{algo}_{var}" + ("" if case == "all" else f"_{case}")] = s
-    return Claim(text, verdict(ok), f"{stat} over all runs, per coordinate: {', '.join(parts)}; rule: {rule}",
-                 numbers)
+    return Claim(text, verdict(ok), f"{stat} over all runs, per coordinate: {', '.join(parts)}; rule: the {stat} of "
+                 f"each {rule}", numbers)
 
 
 def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
@@ -350,9 +364,11 @@ def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
     tol = float(spec.get("tolerance", 0.25))
     ok = abs(med - spec["printed"]) <= tol * spec["printed"]
     level = spec.get("level", exp.config.get("threshold"))
+    off = (med - spec["printed"]) / spec["printed"]
     ev = (f"median over all {its.size} runs of the iteration at which {names.get(algo, algo)} first went below "
           f"{g(level)}: {g(med)} ({g(float(np.median(evs)))} evaluations; {int(np.isinf(its).sum())} runs never), "
-          f"printed {g(spec['printed'])} (held within {tol:.0%})")
+          f"{abs(100 * off):.0f} % {'above' if off > 0 else 'below'} the printed {g(spec['printed'])}, "
+          f"{'within' if abs(off) <= tol else 'outside'} {tol:.0%}")
     numbers = {f"median_iterations_{algo}": med}
     if spec.get("faster_than"):
         other = use(spec["faster_than"])
@@ -366,6 +382,9 @@ def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
         if (ce.lower == names.get(algo, algo)) != (ci.lower == names.get(algo, algo)):
             ev += "; **bases disagree**"
             numbers["bases_disagree"] = True
+    ev += f"; rule: the median within +-{tol:.0%} of the printed count" + (
+        f" and significantly fewer iterations than {names.get(spec['faster_than'], spec['faster_than'])}"
+        if spec.get("faster_than") else "")
     return Claim(text, verdict(ok), ev, numbers)
 
 
@@ -446,8 +465,8 @@ def _value(text, spec, exp, use, names, store, mod) -> Claim:
     if got is None:
         raise _Missing(f"the results behind {spec['quantity']}")
     value, evidence, numbers = got
-    ok, rule = _rule(value, spec)
-    return Claim(text, verdict(ok), f"{evidence} (rule: {spec['quantity']} {g(value)} {rule})", numbers)
+    ok, outcome, rule = _rule(value, spec)
+    return Claim(text, verdict(ok), f"{spec['quantity']} = {g(value)}, {outcome}: {evidence}; rule: {rule}", numbers)
 
 
 def _statement(text, spec, exp, use, names, store, mod) -> Claim:
