@@ -64,6 +64,20 @@ def test_best_so_far_at_equal_evaluations_and_iterations(tmp_path):
     np.testing.assert_array_equal(ev, [300, 200])
 
 
+def test_equal_evaluations_read_what_the_algorithm_returns(tmp_path):
+    """Not the lowest fitness ever evaluated: a Karaboga ABC cannot tell f under ~1.1e-16 apart and
+    keeps the first such source, so that is what it returns; a finished run returns its final answer."""
+    from fkopt.reproduce.claims import accepted_trace
+    f = np.array([1.0, 1e-3, 1e-17, 5e-18, 1e-19])
+    np.testing.assert_array_equal(accepted_trace(f, "raw"), f)
+    np.testing.assert_array_equal(accepted_trace(f, "karaboga"), [1.0, 1e-3, 1e-17, 1e-17, 1e-17])
+    exp = _fake_experiment(tmp_path)
+    runs = pd.read_csv(exp.folder / "runs.csv")
+    runs.loc[1, "final_fitness"] = 0.7   # the returned answer, not the trace's lowest 0.5
+    runs.to_csv(exp.folder / "runs.csv", index=False)
+    np.testing.assert_array_equal(at_evaluations(exp, "a", 250), [4.0, 0.7])   # run 1 (200 evaluations) is done
+
+
 def test_timing_verdicts_follow_the_spread():
     fast, slow = np.linspace(10, 12, 10), np.linspace(20, 24, 10)
     assert faster_claim("x", "A", compare("A", fast, "B", slow)).verdict == HELD

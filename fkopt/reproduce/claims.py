@@ -146,16 +146,52 @@ def at_iteration(exp, algo: str, iteration: int | None = None, case: str | None 
 
 
 def at_evaluations(exp, algo: str, evaluations: float, case: str | None = None) -> np.ndarray:
-    """Per-run best-so-far fitness after ``evaluations`` function evaluations (trace.csv.gz)."""
-    return _from_trace(exp, algo, "evaluations", evaluations, case)
+    """Per run, what ``algo`` returns after ``evaluations`` function evaluations.
+
+    A run that spent no more than ``evaluations`` in all returns its final answer (runs.csv's
+    ``final_fitness``). A run cut by the budget returns its incumbent then: the trace's
+    best-so-far (the lowest fitness evaluated) read through the algorithm's own acceptance rule,
+    which for an ABC selecting on Karaboga's quality 1/(1+f) (``selection: karaboga``) keeps an
+    improvement only when the quality rises, so it never returns the lower f it could not tell
+    apart (:func:`accepted_trace`).
+    """
+    values = _from_trace(exp, algo, "evaluations", evaluations, case, accepted=True)
+    runs = _select(exp.table("runs"), algo, case).sort_values(["case", "run"])
+    if len(runs) == values.size and "evaluations" in runs:
+        done = runs.evaluations.to_numpy(float) <= evaluations
+        values = np.where(done, runs.final_fitness.to_numpy(float), values)
+    return values
 
 
-def _from_trace(exp, algo, column, budget, case) -> np.ndarray:
+def selection_of(exp, algo: str) -> str:
+    """The greedy selection an algorithm of the experiment used (``params.selection``; raw f by default)."""
+    for a in (exp.config or {}).get("algorithms") or []:
+        if (a.get("label") or a.get("name")) == algo:
+            return str((a.get("params") or {}).get("selection", "raw"))
+    return "raw"
+
+
+def accepted_trace(fitness: np.ndarray, selection: str) -> np.ndarray:
+    """The incumbent an algorithm holds after each trace row: the best-so-far itself (raw f), or,
+    under Karaboga's quality (``karaboga``), the last value whose quality 1/(1+f) rose."""
+    f = np.asarray(fitness, float)
+    if selection != "karaboga" or f.size == 0:
+        return f
+    from ..algorithms.abc import quality
+    q = quality(f)
+    rose = np.r_[True, q[1:] > np.maximum.accumulate(q)[:-1]]
+    idx = np.maximum.accumulate(np.where(rose, np.arange(f.size), 0))
+    return f[idx]
+
+
+def _from_trace(exp, algo, column, budget, case, accepted: bool = False) -> np.ndarray:
     t = _select(exp.table("trace"), algo, case)
+    selection = selection_of(exp, algo) if accepted else "raw"
     out = []
     for _, grp in t.groupby(["case", "run"], sort=True):
-        before = grp[grp[column] <= budget]
-        out.append(float(before.best_fitness.iloc[-1]) if len(before) else float("inf"))
+        held = accepted_trace(grp.best_fitness.to_numpy(float), selection)
+        before = (grp[column] <= budget).to_numpy()
+        out.append(float(held[before][-1]) if before.any() else float("inf"))
     return np.asarray(out)
 
 
