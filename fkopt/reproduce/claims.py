@@ -110,6 +110,9 @@ class Comparison:
         return self.a if _u_lower(self.values_a, self.values_b) else self.b
 
     def text(self, fmt=g) -> str:
+        if all(v.size and np.isin(v, (0.0, 1.0)).all() for v in (self.values_a, self.values_b)):   # a 0/1 per run
+            return (f"{self.a} {int(self.values_a.sum())} of {self.values_a.size} runs vs {self.b} "
+                    f"{int(self.values_b.sum())} of {self.values_b.size}, {p_text(self.p)}")
         return (f"median {self.a} {fmt(self.median_a)} vs {self.b} {fmt(self.median_b)}, {p_text(self.p)} "
                 f"({len(self.values_a)} vs {len(self.values_b)} runs)")
 
