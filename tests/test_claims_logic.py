@@ -179,6 +179,12 @@ def test_readings_give_one_conditional_row_each_and_not_checkable_overrides(tmp_
     assert c.verdict == NOT_CHECKABLE and c.evidence.startswith("the equations were lost") and "p_a" in c.numbers
     c, = judge("paper", {**spec, "readings": None, "experiment": "absent"}, store)
     assert c.verdict == NOT_CHECKABLE and "no stored result" in c.evidence
+    c, = judge("paper", {"id": "s", "text": "DOF 4", "kind": "statement", "not_checkable": "lost"}, store)
+    assert c.verdict == NOT_CHECKABLE and c.evidence == "lost"   # a claim nothing can decide still has its row
+    spread = {"id": "v", "text": "a is stabler", "kind": "comparison", "experiment": "exp", "better": "a", "than": "b",
+              "quantity": "spread:final_fitness", "basis": "iterations"}
+    c, = judge("paper", spread, store)     # |f - median f| per run: b's final values spread less (10^-15 scale)
+    assert c.numbers["lower_b"] == "b" and c.verdict == NOT_HELD
 
 
 def test_a_reconstruction_makes_every_verdict_resting_on_it_conditional_either_way(tmp_path, monkeypatch):

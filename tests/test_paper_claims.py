@@ -50,6 +50,10 @@ EXPECTED = [
      {"median_iterations_gabc": between(155, 195), "lower_iterations": equal("ABC")}),
     ("mao2017", "fig2-gabc-fastest:zhu-kwong", C_HELD,
      {"median_iterations_gabc_zhu2010": between(70, 95), "p_iterations": SIGNIFICANT}),
+    # the reconstructed ACO is slow (528 vs 110 iterations to 1e-10) but not flat (10 decades after iteration 150)
+    ("mao2017", "fig2-aco-slow:vs-abc", C_HELD, {"lower_aco": equal("ABC"), "p_aco": SIGNIFICANT}),
+    ("mao2017", "fig2-aco-slow:vs-gabc", C_HELD, {"lower_aco": equal("GABC (eq. 19)"), "p_aco": SIGNIFICANT}),
+    ("mao2017", "fig2-aco-flat", C_NOT_HELD, {"median_aco_log10_change": between(-13.0, -5.0)}),
     ("mao2017", "tab2-below-1e-10:raw-f", C_HELD, {"mean_abc_z": below(1e-12), "mean_gabc_beta": below(1e-12)}),
     # Karaboga's selection, the reading the report uses for Tab. 3: errors of 1e-9 (the paper prints 5e-10)
     ("mao2017", "tab2-below-1e-10:karaboga", C_NOT_HELD,
@@ -69,6 +73,9 @@ EXPECTED = [
     # -- chang2024: every comparison rests on the reconstructed P-ABC
     ("chang2024", "case-inputs", NOT_CHECKABLE,
      {"difference_l1": between(3.4e-4, 3.6e-4), "difference_delta": between(-2e-5, -1.6e-5)}),
+    ("chang2024", "dof-4-coupling-2", NOT_CHECKABLE, {}),
+    ("chang2024", "fig3-solidworks", NOT_CHECKABLE, {}),
+    ("chang2024", "simpler-than-ref25", NOT_CHECKABLE, {}),
     ("chang2024", "tab1-orders", NOT_CHECKABLE, {"mean_pso_final_fitness": between(1e-5, 1e-3)}),
     ("chang2024", "tab1-pabc-vs-abc", C_NOT_HELD,
      {"lower_abc": equal("ABC"), "p_abc": SIGNIFICANT, "lower_evaluations_abc": equal("P-ABC"),
@@ -80,6 +87,7 @@ EXPECTED = [
     ("chang2024", "fig7-pabc-lowest-at-300", C_NOT_HELD, {"lower_abc": equal("ABC"), "lower_pso": equal("P-ABC")}),
     ("chang2024", "tab2-pabc-1e-20", NOT_CHECKABLE, {"median_pabc_final_fitness": between(1e-13, 1e-10)}),
     # -- wu2015: the reconstructed geometry's mirror decides most claims
+    ("wu2015", "dof-3", HELD, {"mobility": equal(3), "jacobian_rank": equal(3)}),
     ("wu2015", "example-inputs", NOT_CHECKABLE, {"max_difference_mm": below(5e-5)}),
     ("wu2015", "example-printed-fitness", C_NOT_HELD, {"fitness": between(5e-7, 8e-7)}),
     ("wu2015", "unique-solution", C_NOT_HELD, {"mirrors_in_workspace": equal(6), "runs_on_mirror": between(40, 120)}),
@@ -93,6 +101,7 @@ EXPECTED = [
     ("wu2015", "nr-depends-on-start", C_NOT_HELD, {"max_abs_error": below(1e-10)}),
     ("wu2015", "nr-theta10-differ", NOT_HELD, {"spread": below(1e-6)}),
     ("wu2015", "aco-more-precise-than-nr", C_NOT_HELD, {"lower": equal("NR"), "median_nr": below(1e-12)}),
+    ("wu2015", "other-mechanisms", C_HELD, {"median_aco_final_fitness": below(1e-5)}),
     # -- liu2008
     ("liu2008", "iterations-55", NOT_HELD, {"median_iterations_pso": between(72, 100)}),
     ("liu2008", "micrometre-precision", HELD, {"mean_pso_x": below(1e-6)}),
@@ -121,6 +130,13 @@ EXPECTED = [
     ("wang7dof", "abc-more-precise:constriction", C_NOT_HELD,
      {"lower_pso": equal("PSO (fkopt's constriction)"), "p_pso": SIGNIFICANT}),
     ("wang7dof", "abc-below-1e-4-mm", C_NOT_HELD, {"median_abc_position_error": between(0.5, 5.0)}),
+    ("wang7dof", "fig6a-pso-below-1e-3-mm:eq10", C_NOT_HELD, {"median_pso_eq10_position_error": between(1.0, 100.0)}),
+    ("wang7dof", "fig6a-pso-below-1e-3-mm:constriction", C_NOT_HELD,
+     {"median_pso_position_error": between(1e-3, 3e-3)}),
+    ("wang7dof", "abc-more-stable:eq10", C_HELD, {"lower_pso_eq10": equal("ABC"), "p_pso_eq10": SIGNIFICANT}),
+    ("wang7dof", "abc-more-stable:constriction", C_NOT_HELD, {"lower_pso": equal("PSO (fkopt's constriction)")}),
+    ("wang7dof", "abc-more-robust:eq10", C_HELD, {"lower_pso_eq10": equal("ABC"), "p_pso_eq10": SIGNIFICANT}),
+    ("wang7dof", "abc-more-robust:constriction", C_NOT_HELD, {"lower_pso": equal("PSO (fkopt's constriction)")}),
     ("wang7dof", "requirement-met:eq10", C_NOT_HELD, {"mean_abc_meets_requirement": equal(0.0)}),
     ("wang7dof", "requirement-met:constriction", C_NOT_HELD, {"mean_abc_meets_requirement": equal(0.0)}),
     ("wang7dof", "eq10-pso-reaches-tab3", C_NOT_HELD, {"median_pso_eq10_position_error": between(1.0, 100.0)}),
@@ -166,7 +182,7 @@ def test_evidence_states_the_outcome_before_the_rule(claims):
             assert "held within" not in c.evidence, f"{c.id}: {c.evidence}"
             assert "rule" in c.evidence, f"{c.id}: evidence without its rule: {c.evidence}"
             if c.verdict.endswith("not held"):
-                assert "outside" in c.evidence or re.search(r"\bnot\b|slower|faster", c.evidence), \
+                assert "outside" in c.evidence or re.search(r"\bnot\b|slower|faster|higher than", c.evidence), \
                     f"{c.id}: a row not held whose evidence does not say what failed: {c.evidence}"
 
 

@@ -183,8 +183,11 @@ class _Missing(Exception):
 
 # -- per-run quantities ------------------------------------------------------------------------
 def runs_table(exp, mod) -> pd.DataFrame:
-    """runs.csv plus the per-run columns the paper module derives (``run_columns``)."""
+    """runs.csv plus the per-run columns the experiment's own paper module derives (``run_columns``;
+    a claim judged on another paper's experiment gets that paper's columns)."""
     runs = exp.table("runs")
+    if getattr(exp, "paper", None) and paper_module(exp.paper) is not None:
+        mod = paper_module(exp.paper)
     extra = getattr(mod, "run_columns", None)
     return extra(exp, runs) if extra else runs
 
@@ -215,6 +218,12 @@ def per_run(exp, mod, algo: str, quantity: str, spec: dict) -> tuple[np.ndarray,
         a, b = spec["window"]
         f0, f1 = at_iteration(exp, algo, a), at_iteration(exp, algo, b)
         return np.log10(np.maximum(f1, 1e-300)) - np.log10(np.maximum(f0, 1e-300)), None
+    if quantity.startswith("spread:"):   # run-to-run stability: each run's |value - the median run's|
+        base = quantity.removeprefix("spread:")
+        if base not in r:
+            raise _Missing(f"{exp.paper}/{exp.name}: per-run {base}")
+        v = r[base].to_numpy(float)
+        return np.abs(v - np.median(v)), None
     if quantity not in r:
         raise _Missing(f"{exp.paper}/{exp.name}: per-run {quantity}")
     return r[quantity].to_numpy(float), None
@@ -275,15 +284,22 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
     if held[other_basis] is not None and bool(held[other_basis]) != bool(decisive):
         note = f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
         numbers["bases_disagree"] = True
-    outcome = (f"{nm(better)} {'is' if decisive else 'is not'} significantly lower than "
-               f"{' and '.join(nm(x) for x in than)} at equal {basis}"
-               + (f" by >= {spec['min_orders']} decades" if spec.get("min_orders") is not None else ""))
+    on_basis = {o: numbers.get(f"lower_{o}" if basis == "iterations" else f"lower_evaluations_{o}",
+                               numbers.get(f"lower_{o}")) for o in than}
+    relation = lambda low: ("significantly lower than" if low == nm(better) else   # noqa: E731
+                            "not significantly different from" if low is None else "significantly higher than")
+    words = [f"{relation(low)} {nm(o)}" for o, low in on_basis.items()]
+    outcome = f"{nm(better)} is {' and '.join(words)} at equal {basis}"
+    if spec.get("min_orders") is not None:
+        lower_everywhere = all(low == nm(better) for low in on_basis.values())
+        outcome += (f" (the claim also needs >= {spec['min_orders']} decades: "
+                    f"{'reached' if decisive else 'not reached' if lower_everywhere else 'moot'})")
     rule = (f"rule: two-sided rank test over all runs at alpha = {ALPHA} on the paper's basis (equal {basis})"
             + (f", and a median gain of >= {spec['min_orders']} decades" if spec.get("min_orders") is not None else ""))
     return Claim(text, verdict(decisive), f"{outcome}: " + "; ".join(parts) + f"; {rule}" + note, numbers)
 
 
-RULE_FIELDS = ("order", "order_at_most", "below", "above", "at_least")
+RULE_FIELDS = ("order", "order_at_most", "below", "above", "at_least", "equals")
 
 
 def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str, str]:
@@ -305,10 +321,10 @@ def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str,
         ok = value < cap
         return ok, f"{'below' if ok else 'not below'} {g(cap)}", \
             f"of {each or 'the printed '}order ({g(spec['order_at_most'])}) or below, i.e. below the next decade"
-    for key, word in (("below", "below"), ("above", "above"), ("at_least", "at least")):
+    for key, word in (("below", "below"), ("above", "above"), ("at_least", "at least"), ("equals", "equal to")):
         if spec.get(key) is not None:
             x = spec[key]
-            ok = value < x if key == "below" else value > x if key == "above" else value >= x
+            ok = {"below": value < x, "above": value > x, "at_least": value >= x, "equals": value == x}[key]
             return ok, f"{'' if ok else 'not '}{word} {g(x)}", f"{word} {g(x) if not per_algo else each + 'value'}"
     raise ValueError(f"no rule in {spec}")
 
@@ -450,7 +466,8 @@ def _time_to_best(text, spec, exp, mod, a, b, ms, names) -> Claim:
     outcome = (f"time to best over all {tbest.values_a.size} vs {tbest.values_b.size} runs: median {nm(a)} "
                f"{g(tbest.median_a)} ms vs {nm(b)} {g(tbest.median_b)} ms, {p_text(tbest.p)}")
     return Claim(text, v, f"{outcome}; iterations to best (every run): {it_cmp.text()}; a whole "
-                 f"{exp.config['iterations']}-iteration run (timed runs): {run_cmp.text(lambda x: g(x) + ' ms')}; rule: "
+                 f"{exp.config['iterations']}-iteration run (timed runs): {run_cmp.text(lambda x: g(x) + ' ms')}; "
+                 "rule: "
                  "each run's iterations to best x its algorithm's median ms per iteration, rank test at alpha = "
                  f"{ALPHA} over all runs, within noise only without a significant difference",
                  {"p": tbest.p, "median_a_ms": tbest.median_a, "median_b_ms": tbest.median_b,
@@ -475,7 +492,8 @@ def _statement(text, spec, exp, use, names, store, mod) -> Claim:
     return Claim(text, NOT_CHECKABLE, "")
 
 
-KIND_JUDGES = {"statement": _statement, "comparison": _comparison, "magnitude": _magnitude, "iterations_to_target": _iterations_to_target,
+KIND_JUDGES = {"statement": _statement, "comparison": _comparison, "magnitude": _magnitude,
+               "iterations_to_target": _iterations_to_target,
                "timing": _timing, "value": _value}
 
 

@@ -323,7 +323,24 @@ def aco_minus_nr_median_relative_error(store):
         {"p": c.p, "lower": c.lower, "median_aco": c.median_a, "median_nr": c.median_b}
 
 
-QUANTITIES = {f.__name__: f for f in (example_inputs_difference_mm, printed_answer_decades_from_printed_f,
+#: The 3-PPR's topology as printed (Sec. 2): a base, a moving platform and three legs of two links each,
+#: every leg prismatic (actuated) - prismatic - revolute; every joint a planar lower pair (1 DOF).
+TOPOLOGY = {"links": 1 + 1 + 3 * 2, "joints": 3 * 3}
+
+
+def gruebler_mobility(store):
+    """Planar Gruebler-Kutzbach mobility M = 3 (n - 1) - 2 j of the printed topology (no geometry
+    enters), with the rank of eq. (7)'s Jacobian at the example beside it (reconstructed geometry)."""
+    n, j = TOPOLOGY["links"], TOPOLOGY["joints"]
+    mobility = 3 * (n - 1) - 2 * j
+    mech = _mechanism()
+    rank = int(np.linalg.matrix_rank(mech.jacobian(mech.vector(EXAMPLE, mech.pose_names, "example"))))
+    return float(mobility), (f"planar Gruebler-Kutzbach M = 3 (n - 1) - 2 j with n = {n} links and j = {j} one-DOF "
+                             f"joints (three P-P-R legs); the Jacobian of eq. (7) at the example has rank {rank}"), \
+        {"mobility": mobility, "jacobian_rank": rank}
+
+
+QUANTITIES = {f.__name__: f for f in (gruebler_mobility, example_inputs_difference_mm, printed_answer_decades_from_printed_f,
                                       mirrors_in_workspace, tab1_worst_median_relative_error, mean_ant_fitness,
                                       share_on_target, nr_largest_abs_error, nr_theta10_spread_decades,
                                       aco_minus_nr_median_relative_error)}
