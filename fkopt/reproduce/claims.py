@@ -12,7 +12,7 @@ Verdicts (:data:`RULES` is printed in the report's preamble):
 * **conditional: held** / **conditional: not held** -- the same, but judged under a named
   reconstruction or reading of the paper (``claims.csv``'s ``condition`` column names it);
 * **not checkable** -- the claim rests on something the paper does not print, or is circular;
-* **within noise** -- a timing difference inside the measured run-to-run spread.
+* **within noise** -- no significant timing difference (a significant one the other way is *not held*).
 """
 from __future__ import annotations
 
@@ -32,16 +32,21 @@ RULES = [
     "*held* / *not held*: fkopt's numbers support / contradict the claim.",
     "*conditional: held* / *conditional: not held*: the same, judged under a reconstruction or one "
     "reading of an ambiguous equation, named in the claim's *condition*; a claim with several readings "
-    "has one row per reading.",
+    "has one row per reading. Every verdict that rests on a reconstruction (the paper's `provenance`: "
+    "lost equations, unprinted constants, departures from the print) is conditional and names it, "
+    "whichever way it goes; an absolute time is conditional on fkopt's machine.",
     "*not checkable*: the claim rests on something the paper does not print (lost tables, an error "
     "measure that was lost), or is circular (a model fitted to the very numbers it would confirm); "
     "fkopt's numbers are shown anyway.",
-    "*within noise*: a timing difference inside the measured run-to-run spread (TIMING.md only).",
+    "*within noise*: no significant timing difference (TIMING.md only); a significant difference the "
+    "other way is *not held*.",
     f"A claim that one algorithm beats another is decided by a two-sided Mann-Whitney rank test over "
     f"all runs at alpha = {ALPHA} (p-value shown; identical samples count as no difference), against the "
     "algorithm the paper ran (fkopt's own variants are shown beside it), at equal iterations and at "
-    "equal function evaluations; the verdict uses the paper's budget basis and the evidence flags "
-    "**bases disagree** where the other basis would reverse it.",
+    "equal function evaluations (each run read at what the algorithm returns after the budget); the "
+    "verdict uses the paper's budget basis and the evidence flags **bases disagree** where the other "
+    "basis would reverse it. Where the paper's comparator is underspecified, each candidate "
+    "reconstruction has its row.",
     "A magnitude claim uses the mean or the median over all runs (never one run or a maximum over "
     "runs), per coordinate in the paper's units, against the printed order of magnitude "
     "(docs/claims.md).",

@@ -20,8 +20,14 @@ that kind:
 * ``value`` -- a number measured by the paper module (``quantity`` names a function of its
   ``QUANTITIES``), against the same rules as a magnitude.
 
-Any claim may carry ``condition`` (a reconstruction or reading it rests on: the verdict becomes
-``conditional: ...``), ``readings`` (one row per reading, each a ``condition`` and algorithm
+The paper's ``provenance`` records every algorithm, comparator and mechanism as ``printed`` or a
+``reconstruction`` (with what fkopt ``chose``); :func:`judge` makes every verdict resting on a
+reconstruction conditional, naming it, and a reconstruction fitted to a claim (``circular``) makes
+that claim not checkable. ``hardware`` names the paper's machine for absolute times; kind
+``statement`` is a claim no number decides (``not_checkable`` says why).
+
+Any claim may carry ``condition`` (a reading it rests on: the verdict becomes
+``conditional: ...``), ``rests_on`` (parts of ``provenance`` beyond the algorithms it names), ``readings`` (one row per reading, each a ``condition`` and algorithm
 replacements ``use: {gabc: gabc_zhu2010}`` and field overrides ``set: {quantity: ...}``) or ``not_checkable`` (why; fkopt's numbers are still
 shown). Adding a claim touches the claims file only.
 """
