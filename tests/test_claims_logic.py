@@ -64,6 +64,20 @@ def test_best_so_far_at_equal_evaluations_and_iterations(tmp_path):
     np.testing.assert_array_equal(ev, [300, 200])
 
 
+def test_equal_evaluations_read_what_the_algorithm_returns(tmp_path):
+    """Not the lowest fitness ever evaluated: a Karaboga ABC cannot tell f under ~1.1e-16 apart and
+    keeps the first such source, so that is what it returns; a finished run returns its final answer."""
+    from fkopt.reproduce.claims import accepted_trace
+    f = np.array([1.0, 1e-3, 1e-17, 5e-18, 1e-19])
+    np.testing.assert_array_equal(accepted_trace(f, "raw"), f)
+    np.testing.assert_array_equal(accepted_trace(f, "karaboga"), [1.0, 1e-3, 1e-17, 1e-17, 1e-17])
+    exp = _fake_experiment(tmp_path)
+    runs = pd.read_csv(exp.folder / "runs.csv")
+    runs.loc[1, "final_fitness"] = 0.7   # the returned answer, not the trace's lowest 0.5
+    runs.to_csv(exp.folder / "runs.csv", index=False)
+    np.testing.assert_array_equal(at_evaluations(exp, "a", 250), [4.0, 0.7])   # run 1 (200 evaluations) is done
+
+
 def test_timing_verdicts_follow_the_spread():
     fast, slow = np.linspace(10, 12, 10), np.linspace(20, 24, 10)
     assert faster_claim("x", "A", compare("A", fast, "B", slow)).verdict == HELD
@@ -165,6 +179,37 @@ def test_readings_give_one_conditional_row_each_and_not_checkable_overrides(tmp_
     assert c.verdict == NOT_CHECKABLE and c.evidence.startswith("the equations were lost") and "p_a" in c.numbers
     c, = judge("paper", {**spec, "readings": None, "experiment": "absent"}, store)
     assert c.verdict == NOT_CHECKABLE and "no stored result" in c.evidence
+    c, = judge("paper", {"id": "s", "text": "DOF 4", "kind": "statement", "not_checkable": "lost"}, store)
+    assert c.verdict == NOT_CHECKABLE and c.evidence == "lost"   # a claim nothing can decide still has its row
+    spread = {"id": "v", "text": "a is stabler", "kind": "comparison", "experiment": "exp", "better": "a", "than": "b",
+              "quantity": "spread:final_fitness", "basis": "iterations"}
+    c, = judge("paper", spread, store)     # |f - median f| per run: b's final values spread less (10^-15 scale)
+    assert c.numbers["lower_b"] == "b" and c.verdict == NOT_HELD
+
+
+def test_a_reconstruction_makes_every_verdict_resting_on_it_conditional_either_way(tmp_path, monkeypatch):
+    """Provenance is data: the engine, not a paper module, names the reconstruction in the condition
+    of every verdict that rests on it (held or not), and a part fitted to a claim makes it not checkable."""
+    from fkopt.reproduce import engine
+    store = _two_algorithms(tmp_path)
+    data = {"provenance": {"b": {"as": "reconstruction", "name": "B", "chosen": "lost equations, fkopt's choice"},
+                           "a": {"as": "printed", "name": "A"},
+                           "model": {"as": "reconstruction", "name": "model", "chosen": "fitted", "circular": ["fit"]}}}
+    monkeypatch.setattr(engine, "load", lambda paper: data)
+    spec = {"id": "x", "text": "b beats a", "kind": "comparison", "experiment": "exp", "better": "b", "than": "a",
+            "basis": "iterations"}
+    held, = judge("paper", spec, store)
+    lost, = judge("paper", {**spec, "basis": "evaluations"}, store)
+    assert (held.verdict, lost.verdict) == ("conditional: held", "conditional: not held")
+    assert held.condition == lost.condition == "reconstructed B: lost equations, fkopt's choice"
+    printed, = judge("paper", {**spec, "better": "a", "than": "a", "also": ["b"]}, store)   # beside: no condition
+    assert printed.verdict == NOT_HELD and printed.condition == ""
+    fit = {"id": "fit", "text": "a reaches 1e-10", "kind": "magnitude", "experiment": "exp", "algorithms": ["a"],
+           "quantity": "final_fitness", "statistic": "median", "below": 1.0, "rests_on": ["model"]}
+    c, = judge("paper", fit, store)
+    assert c.verdict == NOT_CHECKABLE and c.evidence.startswith("circular: the reconstructed model")
+    c, = judge("paper", {**fit, "id": "other"}, store)
+    assert c.verdict == "conditional: held" and c.condition == "reconstructed model: fitted"
 
 
 def test_magnitude_uses_a_statistic_over_all_runs_never_a_maximum(tmp_path):
@@ -178,12 +223,33 @@ def test_magnitude_uses_a_statistic_over_all_runs_never_a_maximum(tmp_path):
         judge("paper", {**spec, "statistic": "max"}, store)
 
 
-def test_a_printed_difference_inside_the_spread_is_within_noise():
+def test_a_significant_opposite_time_is_not_held_even_when_the_printed_difference_is_tiny():
     a, b = np.linspace(100, 110, 8), np.linspace(200, 220, 8)
     assert faster_claim("x", "A", compare("A", a, "B", b)).verdict == HELD
-    # the paper prints 361.3 vs 362.4 ms: 0.3 %, far inside a 10 % spread, whatever fkopt measures
+    # the paper prints 361.3 vs 362.4 ms (0.3 %, inside a 10 % spread); fkopt measures B significantly
+    # slower: that contradicts "B is shorter", it is not noise; the evidence still says the paper cannot resolve it
     c = faster_claim("x", "B", compare("A", a, "B", b), printed=(361.3, 362.4))
-    assert c.verdict == WITHIN_NOISE and "0.3 %" in c.evidence and "n = 8" in c.evidence
+    assert c.verdict == NOT_HELD and "0.3 %" in c.evidence and "n = 8" in c.evidence
+    assert c.evidence.startswith("B ") and "slower than A (significant)" in c.evidence
+    same = faster_claim("x", "B", compare("A", a, "B", a[::-1] + 0.01), printed=(361.3, 362.4))
+    assert same.verdict == WITHIN_NOISE and "no significant difference" in same.evidence
+
+
+def test_time_to_best_is_judged_over_every_run_not_the_timed_ones(tmp_path):
+    """Each run's iterations to best (all 30) x its algorithm's median ms per iteration (5 timed runs)."""
+    store = _two_algorithms(tmp_path)
+    folder = tmp_path / "paper" / "exp"
+    runs = pd.read_csv(folder / "runs.csv")
+    runs["iterations_to_best"] = np.where(runs.algorithm == "a", 3, 8) + runs.run % 2   # a reaches its best sooner
+    runs.to_csv(folder / "runs.csv", index=False)
+    # a's whole run takes 1.5x b's: still a finds its best sooner (3.5 x 15 ms vs 8.5 x 10 ms)
+    pd.DataFrame({"case": "c", "algorithm": ["a", "b"] * 5, "run": np.repeat(np.arange(5), 2),
+                  "ms": [150, 100, 151, 101, 149, 99, 152, 98, 148, 102]}).to_csv(folder / "timing_runs.csv", index=False)
+    spec = {"id": "t", "text": "a finds its best sooner", "kind": "timing", "experiment": "exp", "faster": "a",
+            "than": "b", "time_to_best": True}
+    c, = judge("paper", spec, store)
+    assert c.verdict == HELD and "over all 30 vs 30 runs" in c.evidence and c.numbers["lower_iterations"] == "a"
+    assert c.numbers["lower_run_ms"] == "b" and c.numbers["median_a_ms"] < c.numbers["median_b_ms"]
 
 
 def test_reproduce_never_runs_a_claims_file(tmp_path):

@@ -12,7 +12,7 @@ Verdicts (:data:`RULES` is printed in the report's preamble):
 * **conditional: held** / **conditional: not held** -- the same, but judged under a named
   reconstruction or reading of the paper (``claims.csv``'s ``condition`` column names it);
 * **not checkable** -- the claim rests on something the paper does not print, or is circular;
-* **within noise** -- a timing difference inside the measured run-to-run spread.
+* **within noise** -- no significant timing difference (a significant one the other way is *not held*).
 """
 from __future__ import annotations
 
@@ -24,23 +24,29 @@ import pandas as pd
 
 HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE = "held", "not held", "not checkable", "within noise"
 CONDITIONAL = "conditional: "
-VERDICTS = (HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE, CONDITIONAL + HELD, CONDITIONAL + NOT_HELD)
+VERDICTS = (HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE, CONDITIONAL + HELD, CONDITIONAL + NOT_HELD,
+            CONDITIONAL + WITHIN_NOISE)
 ALPHA = 0.05
 
 RULES = [
     "*held* / *not held*: fkopt's numbers support / contradict the claim.",
     "*conditional: held* / *conditional: not held*: the same, judged under a reconstruction or one "
     "reading of an ambiguous equation, named in the claim's *condition*; a claim with several readings "
-    "has one row per reading.",
+    "has one row per reading. Every verdict that rests on a reconstruction (the paper's `provenance`: "
+    "lost equations, unprinted constants, departures from the print) is conditional and names it, "
+    "whichever way it goes; an absolute time is conditional on fkopt's machine.",
     "*not checkable*: the claim rests on something the paper does not print (lost tables, an error "
     "measure that was lost), or is circular (a model fitted to the very numbers it would confirm); "
     "fkopt's numbers are shown anyway.",
-    "*within noise*: a timing difference inside the measured run-to-run spread (TIMING.md only).",
+    "*within noise*: no significant timing difference (TIMING.md only); a significant difference the "
+    "other way is *not held*.",
     f"A claim that one algorithm beats another is decided by a two-sided Mann-Whitney rank test over "
     f"all runs at alpha = {ALPHA} (p-value shown; identical samples count as no difference), against the "
     "algorithm the paper ran (fkopt's own variants are shown beside it), at equal iterations and at "
-    "equal function evaluations; the verdict uses the paper's budget basis and the evidence flags "
-    "**bases disagree** where the other basis would reverse it.",
+    "equal function evaluations (each run read at what the algorithm returns after the budget); the "
+    "verdict uses the paper's budget basis and the evidence flags **bases disagree** where the other "
+    "basis would reverse it. Where the paper's comparator is underspecified, each candidate "
+    "reconstruction has its row.",
     "A magnitude claim uses the mean or the median over all runs (never one run or a maximum over "
     "runs), per coordinate in the paper's units, against the printed order of magnitude "
     "(docs/claims.md).",
@@ -109,6 +115,9 @@ class Comparison:
         return self.a if _u_lower(self.values_a, self.values_b) else self.b
 
     def text(self, fmt=g) -> str:
+        if all(v.size and np.isin(v, (0.0, 1.0)).all() for v in (self.values_a, self.values_b)):   # a 0/1 per run
+            return (f"{self.a} {int(self.values_a.sum())} of {self.values_a.size} runs vs {self.b} "
+                    f"{int(self.values_b.sum())} of {self.values_b.size}, {p_text(self.p)}")
         return (f"median {self.a} {fmt(self.median_a)} vs {self.b} {fmt(self.median_b)}, {p_text(self.p)} "
                 f"({len(self.values_a)} vs {len(self.values_b)} runs)")
 
@@ -145,16 +154,52 @@ def at_iteration(exp, algo: str, iteration: int | None = None, case: str | None 
 
 
 def at_evaluations(exp, algo: str, evaluations: float, case: str | None = None) -> np.ndarray:
-    """Per-run best-so-far fitness after ``evaluations`` function evaluations (trace.csv.gz)."""
-    return _from_trace(exp, algo, "evaluations", evaluations, case)
+    """Per run, what ``algo`` returns after ``evaluations`` function evaluations.
+
+    A run that spent no more than ``evaluations`` in all returns its final answer (runs.csv's
+    ``final_fitness``). A run cut by the budget returns its incumbent then: the trace's
+    best-so-far (the lowest fitness evaluated) read through the algorithm's own acceptance rule,
+    which for an ABC selecting on Karaboga's quality 1/(1+f) (``selection: karaboga``) keeps an
+    improvement only when the quality rises, so it never returns the lower f it could not tell
+    apart (:func:`accepted_trace`).
+    """
+    values = _from_trace(exp, algo, "evaluations", evaluations, case, accepted=True)
+    runs = _select(exp.table("runs"), algo, case).sort_values(["case", "run"])
+    if len(runs) == values.size and "evaluations" in runs:
+        done = runs.evaluations.to_numpy(float) <= evaluations
+        values = np.where(done, runs.final_fitness.to_numpy(float), values)
+    return values
 
 
-def _from_trace(exp, algo, column, budget, case) -> np.ndarray:
+def selection_of(exp, algo: str) -> str:
+    """The greedy selection an algorithm of the experiment used (``params.selection``; raw f by default)."""
+    for a in (exp.config or {}).get("algorithms") or []:
+        if (a.get("label") or a.get("name")) == algo:
+            return str((a.get("params") or {}).get("selection", "raw"))
+    return "raw"
+
+
+def accepted_trace(fitness: np.ndarray, selection: str) -> np.ndarray:
+    """The incumbent an algorithm holds after each trace row: the best-so-far itself (raw f), or,
+    under Karaboga's quality (``karaboga``), the last value whose quality 1/(1+f) rose."""
+    f = np.asarray(fitness, float)
+    if selection != "karaboga" or f.size == 0:
+        return f
+    from ..algorithms.abc import quality
+    q = quality(f)
+    rose = np.r_[True, q[1:] > np.maximum.accumulate(q)[:-1]]
+    idx = np.maximum.accumulate(np.where(rose, np.arange(f.size), 0))
+    return f[idx]
+
+
+def _from_trace(exp, algo, column, budget, case, accepted: bool = False) -> np.ndarray:
     t = _select(exp.table("trace"), algo, case)
+    selection = selection_of(exp, algo) if accepted else "raw"
     out = []
     for _, grp in t.groupby(["case", "run"], sort=True):
-        before = grp[grp[column] <= budget]
-        out.append(float(before.best_fitness.iloc[-1]) if len(before) else float("inf"))
+        held = accepted_trace(grp.best_fitness.to_numpy(float), selection)
+        before = (grp[column] <= budget).to_numpy()
+        out.append(float(held[before][-1]) if before.any() else float("inf"))
     return np.asarray(out)
 
 
@@ -238,27 +283,34 @@ def faster_claim(text: str, faster: str, cmp: Comparison | None, printed: tuple 
     """'``faster`` takes less time': held / not held / within noise.
 
     Rank test on the interleaved single-run times at ALPHA: held when ``faster`` is significantly
-    faster, *within noise* when the test finds no difference. When fkopt finds the opposite, the
-    verdict is *not held*, unless the paper's own printed difference (``printed`` = (ms of
-    ``faster``, ms of the other)) is smaller than the spread of the timed runs: a difference the
-    paper could not resolve is not refuted by one fkopt resolves the other way (*within noise*).
+    faster, *not held* when it is significantly slower, *within noise* only when the test finds no
+    difference. The paper's printed difference (``printed`` = (ms of ``faster``, ms of the other))
+    never turns a significant measurement into noise: when it is smaller than the spread of the
+    timed runs the evidence says the paper's own numbers do not resolve it, beside the verdict.
     """
     if cmp is None:
         return Claim(text, NOT_CHECKABLE, "no single-run timings stored (timing_runs.csv)")
     res = resolution(cmp)
     lower = cmp.lower
     v = WITHIN_NOISE if lower is None else verdict(lower == faster)
+    other = cmp.b if faster == cmp.a else cmp.a
+    med = {cmp.a: cmp.median_a, cmp.b: cmp.median_b}
+    shift = med[faster] / max(med[other], 1e-300) - 1.0
+    size = f"{abs(100 * shift):.1f} %" if abs(shift) < 1 else f"{shift + 1:.1f} x as long,"
+    outcome = (f"{faster} {size} {'faster' if shift < 0 else 'slower'} than {other} "
+               + ("(no significant difference)" if lower is None else "(significant)"))
     note = ""
-    if printed is not None and v == NOT_HELD:
+    if printed is not None:
         rel = abs(printed[1] - printed[0]) / max(abs(printed[0]), abs(printed[1]))
         if rel < res:
-            v = WITHIN_NOISE
-            note = (f"; the printed difference ({100 * rel:.1f} %) is smaller than the run-to-run spread "
-                    f"({100 * res:.1f} %), so the paper's own numbers claim no resolvable difference")
+            note = (f"; the paper's printed difference ({100 * rel:.1f} %) is smaller than the run-to-run spread "
+                    f"({100 * res:.1f} %): its own numbers do not resolve it")
     n = min(cmp.values_a.size, cmp.values_b.size)
-    return Claim(text, v, f"interleaved single-run ms, alpha = {ALPHA}, n = {n} per algorithm, separates "
-                 f"shifts beyond ~{100 * res:.0f} % (relative IQR): {cmp.text()}" + note,
-                 {"p": cmp.p, "median_a_ms": cmp.median_a, "median_b_ms": cmp.median_b, "resolution": res},
+    return Claim(text, v, f"{outcome}: {cmp.text(lambda x: g(x) + ' ms')}; rule: rank test of interleaved single-run ms at alpha = "
+                 f"{ALPHA}, n = {n} per algorithm, within noise only without a significant difference (the "
+                 f"samples' relative IQR is {100 * res:.1f} %)" + note,
+                 {"p": cmp.p, "median_a_ms": cmp.median_a, "median_b_ms": cmp.median_b, "resolution": res,
+                  "shift": float(shift)},
                  kind="timing")
 
 

@@ -20,8 +20,14 @@ that kind:
 * ``value`` -- a number measured by the paper module (``quantity`` names a function of its
   ``QUANTITIES``), against the same rules as a magnitude.
 
-Any claim may carry ``condition`` (a reconstruction or reading it rests on: the verdict becomes
-``conditional: ...``), ``readings`` (one row per reading, each a ``condition`` and algorithm
+The paper's ``provenance`` records every algorithm, comparator and mechanism as ``printed`` or a
+``reconstruction`` (with what fkopt ``chose``); :func:`judge` makes every verdict resting on a
+reconstruction conditional, naming it, and a reconstruction fitted to a claim (``circular``) makes
+that claim not checkable. ``hardware`` names the paper's machine for absolute times; kind
+``statement`` is a claim no number decides (``not_checkable`` says why).
+
+Any claim may carry ``condition`` (a reading it rests on: the verdict becomes
+``conditional: ...``), ``rests_on`` (parts of ``provenance`` beyond the algorithms it names), ``readings`` (one row per reading, each a ``condition`` and algorithm
 replacements ``use: {gabc: gabc_zhu2010}`` and field overrides ``set: {quantity: ...}``) or ``not_checkable`` (why; fkopt's numbers are still
 shown). Adding a claim touches the claims file only.
 """
@@ -36,13 +42,13 @@ import pandas as pd
 import yaml
 
 from . import paper_module
-from .claims import (ALPHA, CONDITIONAL, NOT_CHECKABLE, Claim, compare, equal_budget, faster_claim, first_below, g,
-                     missing, p_text, verdict, within_of_final)
+from .claims import (ALPHA, CONDITIONAL, HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, Claim, compare, equal_budget,
+                     faster_claim, first_below, g, missing, p_text, verdict, within_of_final)
 
 CLAIMS_YAML = "claims.yaml"
 #: Where the claims files live: the repository's configs/ (``FKOPT_CONFIGS`` points elsewhere).
 CONFIGS = Path(os.environ.get("FKOPT_CONFIGS", Path(__file__).resolve().parents[2] / "configs"))
-KINDS = ("comparison", "magnitude", "iterations_to_target", "timing", "value")
+KINDS = ("comparison", "magnitude", "iterations_to_target", "timing", "value", "statement")
 
 
 def is_claims_file(path: str | Path) -> bool:
@@ -94,28 +100,83 @@ def judge_paper(paper: str, store, timing_only: bool = False) -> tuple[list[Clai
 
 
 def judge(paper: str, spec: dict, store, mod=None) -> list[Claim]:
-    """One claim of the claims file, judged: one Claim per reading."""
+    """One claim of the claims file, judged: one Claim per reading.
+
+    The verdict's condition is the reading's (or the claim's) ``condition`` plus every
+    reconstruction the claim rests on (:func:`rests_on`, from the paper's ``provenance``), named,
+    whichever way the verdict goes; a part recorded as fitted to this very claim (``circular``)
+    makes it *not checkable*; an absolute time limit is judged on fkopt's machine, never the
+    paper's, and says so (:data:`HARDWARE_CONDITION`).
+    """
+    data = load(paper) or {}
     readings = spec.get("readings") or [{"condition": spec.get("condition", "")}]
     out = []
     for k, reading in enumerate(readings):
         cid = spec["id"] if len(readings) == 1 else f"{spec['id']}:{reading.get('id', k + 1)}"
-        c = _judge_one(paper, {**spec, **(reading.get("set") or {})}, reading.get("use") or {}, store, mod, cid)
-        c.id, c.kind, c.condition = cid, spec["kind"], reading.get("condition", "") or ""
+        spec_r = {**spec, **(reading.get("set") or {})}
+        use = reading.get("use") or {}
+        c = _judge_one(paper, spec_r, use, store, mod, cid)
+        c.id, c.kind = cid, spec["kind"]
+        parts = rests_on(data, spec_r, use)
+        conditions = [reading.get("condition", "") or ""]
+        conditions += [f"reconstructed {e.get('name', key)}: {e['chosen'].strip()}" for key, e in parts
+                       if e.get("as") == RECONSTRUCTION]
+        if spec["kind"] == "timing" and _absolute_time(spec_r):
+            conditions.append(HARDWARE_CONDITION.format(hardware=data.get("hardware") or "not printed"))
+        c.condition = "; ".join(x.strip() for x in conditions if x and x.strip())
+        circular = [(key, e) for key, e in parts if spec["id"] in (e.get("circular") or [])]
         if spec.get("not_checkable"):
-            c.evidence = f"{spec['not_checkable'].strip()}; fkopt's numbers: {c.evidence}"
+            c.evidence = spec["not_checkable"].strip() + (f"; fkopt's numbers: {c.evidence}" if c.evidence else "")
             c.verdict = NOT_CHECKABLE
-        elif c.condition and c.verdict in ("held", "not held"):
+        elif circular:
+            names = " and ".join(e.get("name", key) for key, e in circular)
+            c.evidence = (f"circular: the reconstructed {names} was fitted to these very numbers, so agreeing "
+                          f"with them confirms nothing; fkopt's numbers: {c.evidence}")
+            c.verdict = NOT_CHECKABLE
+        elif c.condition and c.verdict in (HELD, NOT_HELD, WITHIN_NOISE):
             c.verdict = CONDITIONAL + c.verdict
         out.append(c)
     return out
 
 
+RECONSTRUCTION, PRINTED = "reconstruction", "printed"
+#: The condition of every absolute time limit (``below_ms``, ``above_ms``): one rule for all papers.
+HARDWARE_CONDITION = ("an absolute time, measured on fkopt's machine (TIMING.md's platform), not on the paper's "
+                      "({hardware})")
+#: The claim fields that name the algorithms a verdict rests on (``also``: shown beside, never judged).
+ALGORITHM_FIELDS = ("better", "than", "algorithms", "algorithm", "faster_than", "faster")
+
+
+def _absolute_time(spec: dict) -> bool:
+    return "below_ms" in spec or "above_ms" in spec
+
+
+def rests_on(data: dict, spec: dict, use: dict | None = None) -> list[tuple[str, dict]]:
+    """The parts of the paper's ``provenance`` a claim rests on: (key, entry) pairs.
+
+    The algorithms the verdict compares (:data:`ALGORITHM_FIELDS`, after the reading's ``use``),
+    the parts with ``scope: all`` when the claim is judged on a stored experiment (the mechanism
+    and the error measure every run used), and the parts the claim lists in ``rests_on`` (claims
+    about printed numbers name what they use). A part that is not in ``provenance`` rests on
+    nothing recorded (a claims file's test requires every algorithm to be recorded).
+    """
+    prov = data.get("provenance") or {}
+    use = use or {}
+    keys = [use.get(a, a) for f in ALGORITHM_FIELDS for a in _list(spec.get(f))]
+    if spec.get("experiment"):
+        keys += [k for k, e in prov.items() if e.get("scope") == "all"]
+    keys += [use.get(a, a) for a in _list(spec.get("rests_on"))]
+    return [(k, prov[k]) for k in dict.fromkeys(keys) if k in prov]
+
+
 def _judge_one(paper, spec, use, store, mod, cid) -> Claim:
     text = spec["text"].strip()
     names = {**((load(paper) or {}).get("names") or {})}
-    exp = store.get(paper, spec["experiment"]) if spec.get("experiment") else None
+    # ``experiment: other_paper/name`` judges a claim on another paper's stored runs (wu2015's ACO on mao2017's 3-RPS)
+    where, _, name = str(spec.get("experiment", "")).rpartition("/")
+    exp = store.get(where or paper, name) if spec.get("experiment") else None
     if spec.get("experiment") and exp is None:
-        return missing(text, f"{paper}/{spec['experiment']}", cid)
+        return missing(text, f"{where or paper}/{name}", cid)
     try:
         return KIND_JUDGES[spec["kind"]](text, spec, exp, lambda a: use.get(a, a), names, store, mod)
     except _Missing as err:
@@ -128,8 +189,11 @@ class _Missing(Exception):
 
 # -- per-run quantities ------------------------------------------------------------------------
 def runs_table(exp, mod) -> pd.DataFrame:
-    """runs.csv plus the per-run columns the paper module derives (``run_columns``)."""
+    """runs.csv plus the per-run columns the experiment's own paper module derives (``run_columns``;
+    a claim judged on another paper's experiment gets that paper's columns)."""
     runs = exp.table("runs")
+    if getattr(exp, "paper", None) and paper_module(exp.paper) is not None:
+        mod = paper_module(exp.paper)
     extra = getattr(mod, "run_columns", None)
     return extra(exp, runs) if extra else runs
 
@@ -160,6 +224,12 @@ def per_run(exp, mod, algo: str, quantity: str, spec: dict) -> tuple[np.ndarray,
         a, b = spec["window"]
         f0, f1 = at_iteration(exp, algo, a), at_iteration(exp, algo, b)
         return np.log10(np.maximum(f1, 1e-300)) - np.log10(np.maximum(f0, 1e-300)), None
+    if quantity.startswith("spread:"):   # run-to-run stability: each run's |value - the median run's|
+        base = quantity.removeprefix("spread:")
+        if base not in r:
+            raise _Missing(f"{exp.paper}/{exp.name}: per-run {base}")
+        v = r[base].to_numpy(float)
+        return np.abs(v - np.median(v)), None
     if quantity not in r:
         raise _Missing(f"{exp.paper}/{exp.name}: per-run {quantity}")
     return r[quantity].to_numpy(float), None
@@ -216,31 +286,52 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
                 held["evaluations"] = held["evaluations"] and gain_ev >= spec["min_orders"]
     decisive = held[basis] if held[basis] is not None else held["iterations"]
     other_basis = "evaluations" if basis == "iterations" else "iterations"
-    note = f"verdict on equal {basis} (the paper's basis)"
+    note = ""
     if held[other_basis] is not None and bool(held[other_basis]) != bool(decisive):
-        note += f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
+        note = f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
         numbers["bases_disagree"] = True
-    return Claim(text, verdict(decisive), "; ".join(parts) + "; " + note, numbers)
+    on_basis = {o: numbers.get(f"lower_{o}" if basis == "iterations" else f"lower_evaluations_{o}",
+                               numbers.get(f"lower_{o}")) for o in than}
+    relation = lambda low: ("significantly lower than" if low == nm(better) else   # noqa: E731
+                            "not significantly different from" if low is None else "significantly higher than")
+    words = [f"{relation(low)} {nm(o)}" for o, low in on_basis.items()]
+    outcome = f"{nm(better)} is {' and '.join(words)} at equal {basis}"
+    if spec.get("min_orders") is not None:
+        lower_everywhere = all(low == nm(better) for low in on_basis.values())
+        outcome += (f" (the claim also needs >= {spec['min_orders']} decades: "
+                    f"{'reached' if decisive else 'not reached' if lower_everywhere else 'moot'})")
+    rule = (f"rule: two-sided rank test over all runs at alpha = {ALPHA} on the paper's basis (equal {basis})"
+            + (f", and a median gain of >= {spec['min_orders']} decades" if spec.get("min_orders") is not None else ""))
+    return Claim(text, verdict(decisive), f"{outcome}: " + "; ".join(parts) + f"; {rule}" + note, numbers)
 
 
-def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str]:
-    """(held, rule text) of a number against the claim's magnitude rule (a rule's number may be a
-    mapping per algorithm, e.g. the printed mean of each)."""
-    spec = {k: (v.get(algo) if isinstance(v, dict) and k in ("order", "order_at_most", "below", "above", "at_least")
-                else v) for k, v in spec.items()}
+RULE_FIELDS = ("order", "order_at_most", "below", "above", "at_least", "equals")
+
+
+def _rule(value: float, spec: dict, algo: str | None = None) -> tuple[bool, str, str]:
+    """(held, outcome, rule) of a number against the claim's magnitude rule: the outcome says what
+    was measured against the printed number ("+1.2 decades from the printed 1e-20, outside"), the
+    rule states the test ("within +-0.5 decades of the printed order"). A rule's number may be a
+    mapping per algorithm, e.g. the printed mean of each."""
+    per_algo = any(isinstance(spec.get(k), dict) for k in RULE_FIELDS)
+    spec = {k: (v.get(algo) if isinstance(v, dict) and k in RULE_FIELDS else v) for k, v in spec.items()}
+    each = "each algorithm's printed " if per_algo else ""
     if spec.get("order") is not None:
         d = float(spec.get("decades", 0.5))
         off = np.log10(max(value, 1e-300)) - np.log10(spec["order"])
-        return abs(off) <= d, f"{off:+.2f} decades from {g(spec['order'])} (held within +-{d:g})"
+        ok = abs(off) <= d
+        return ok, f"{off:+.2f} decades from the printed {g(spec['order'])}, {'within' if ok else 'outside'} +-{d:g}", \
+            f"within +-{d:g} decades of {each or 'the printed '}order"
     if spec.get("order_at_most") is not None:
         cap = 10.0 ** (np.floor(np.log10(spec["order_at_most"])) + 1)
-        return value < cap, f"of the order of {g(spec['order_at_most'])} or below (< {g(cap)})"
-    if spec.get("below") is not None:
-        return value < spec["below"], f"below {g(spec['below'])}"
-    if spec.get("above") is not None:
-        return value > spec["above"], f"above {g(spec['above'])}"
-    if spec.get("at_least") is not None:
-        return value >= spec["at_least"], f"at least {g(spec['at_least'])}"
+        ok = value < cap
+        return ok, f"{'below' if ok else 'not below'} {g(cap)}", \
+            f"of {each or 'the printed '}order ({g(spec['order_at_most'])}) or below, i.e. below the next decade"
+    for key, word in (("below", "below"), ("above", "above"), ("at_least", "at least"), ("equals", "equal to")):
+        if spec.get(key) is not None:
+            x = spec[key]
+            ok = {"below": value < x, "above": value > x, "at_least": value >= x, "equals": value == x}[key]
+            return ok, f"{'' if ok else 'not '}{word} {g(x)}", f"{word} {g(x) if not per_algo else each + 'value'}"
     raise ValueError(f"no rule in {spec}")
 
 
@@ -277,14 +368,14 @@ def _magnitude(text, spec, exp, use, names, store, mod) -> Claim:
                 values = {c: grp[c].to_numpy(float) for c in cols}
             for col, vals in values.items():
                 s = float(fn(vals))
-                good, rule = _rule(s, spec, algo)
+                good, outcome, rule = _rule(s, spec, algo)
                 ok &= good
                 var = col.removeprefix("abs_error_")
                 label = f"{names.get(algo, algo)}{'' if case == 'all' else ' ' + str(case)} {var}"
-                parts.append(f"{label} {g(s)}{' ' + units[var] if var in units else ''}")
+                parts.append(f"{label} {g(s)}{' ' + units[var] if var in units else ''} ({outcome})")
                 numbers[f"{stat}_{algo}_{var}" + ("" if case == "all" else f"_{case}")] = s
-    return Claim(text, verdict(ok), f"{stat} over all runs, per coordinate: {', '.join(parts)}; rule: {rule}",
-                 numbers)
+    return Claim(text, verdict(ok), f"{stat} over all runs, per coordinate: {', '.join(parts)}; rule: the {stat} of "
+                 f"each {rule}", numbers)
 
 
 def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
@@ -295,9 +386,11 @@ def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
     tol = float(spec.get("tolerance", 0.25))
     ok = abs(med - spec["printed"]) <= tol * spec["printed"]
     level = spec.get("level", exp.config.get("threshold"))
+    off = (med - spec["printed"]) / spec["printed"]
     ev = (f"median over all {its.size} runs of the iteration at which {names.get(algo, algo)} first went below "
           f"{g(level)}: {g(med)} ({g(float(np.median(evs)))} evaluations; {int(np.isinf(its).sum())} runs never), "
-          f"printed {g(spec['printed'])} (held within {tol:.0%})")
+          f"{abs(100 * off):.0f} % {'above' if off > 0 else 'below'} the printed {g(spec['printed'])}, "
+          f"{'within' if abs(off) <= tol else 'outside'} {tol:.0%}")
     numbers = {f"median_iterations_{algo}": med}
     if spec.get("faster_than"):
         other = use(spec["faster_than"])
@@ -311,6 +404,9 @@ def _iterations_to_target(text, spec, exp, use, names, store, mod) -> Claim:
         if (ce.lower == names.get(algo, algo)) != (ci.lower == names.get(algo, algo)):
             ev += "; **bases disagree**"
             numbers["bases_disagree"] = True
+    ev += f"; rule: the median within +-{tol:.0%} of the printed count" + (
+        f" and significantly fewer iterations than {names.get(spec['faster_than'], spec['faster_than'])}"
+        if spec.get("faster_than") else "")
     return Claim(text, verdict(ok), ev, numbers)
 
 
@@ -318,32 +414,71 @@ def _timing(text, spec, exp, use, names, store, mod) -> Claim:
     if not exp.has("timing_runs.csv"):
         return Claim(text, NOT_CHECKABLE, "no single-run timings stored (timing_runs.csv)")
     t = exp.table("timing_runs")
-    if "below_ms" in spec:
-        algos = [use(a) for a in _list(spec["algorithms"])]
-        worst = float(t[t.algorithm.isin(algos)].ms.max())
-        return Claim(text, verdict(worst < spec["below_ms"]),
-                     f"slowest of the {int(t.algorithm.isin(algos).sum())} timed single runs: {g(worst)} ms "
-                     f"(the claim is about every run)", {"worst_ms": worst})
+    if "below_ms" in spec or "above_ms" in spec:
+        return _time_limit(text, spec, t, use, names)
     a, b = use(spec["faster"]), use(spec["than"])
     ms = {x: t[t.algorithm == x].ms.to_numpy(float) for x in (a, b)}
     if not all(v.size for v in ms.values()):
         raise _Missing(f"{exp.paper}/{exp.name}/timing_runs.csv: timed runs of {a} and {b}")
-    if spec.get("time_to_best"):   # wang7dof Tab. 3: ms x iterations to best / iterations
-        runs = runs_table(exp, mod).set_index(["case", "run"])
-        for x in (a, b):
-            tx = t[t.algorithm == x]
-            it = runs[runs.algorithm == x].iterations_to_best
-            ms[x] = tx.ms.to_numpy() * np.array([it.loc[(c, k)] for c, k in zip(tx["case"], tx.run)]) \
-                / float(exp.config["iterations"])
+    if spec.get("time_to_best"):
+        return _time_to_best(text, spec, exp, mod, a, b, ms, names)
     cmp = compare(names.get(a, a), ms[a], names.get(b, b), ms[b])
     c = faster_claim(text, names.get(a, a), cmp, tuple(spec["printed_ms"]) if "printed_ms" in spec else None)
     if "saving" in spec and c.verdict == "held":
         saving = 1.0 - cmp.median_a / cmp.median_b
         c.numbers["saving"] = float(saving)
-        c.evidence = f"{100 * saving:.1f} % shorter (held needs a saving within 10 points of " \
-                     f"{100 * spec['saving']:.2f} %); " + c.evidence
         c.verdict = verdict(abs(saving - spec["saving"]) <= 0.1)
+        c.evidence = (f"{100 * saving:.1f} % shorter, {'within' if c.verdict == HELD else 'more than'} 10 points of "
+                      f"the printed {100 * spec['saving']:.2f} % (rule: within 10 points); " + c.evidence)
     return c
+
+
+def _time_limit(text, spec, t, use, names) -> Claim:
+    """Every timed run below ``below_ms`` (a claim about every run: the slowest decides), or the
+    median timed run above ``above_ms`` (an algorithm too slow for a limit)."""
+    algos = [use(a) for a in _list(spec["algorithms"])]
+    ms = t[t.algorithm.isin(algos)].ms.to_numpy(float)
+    if not ms.size:
+        raise _Missing(f"timed runs of {', '.join(algos)}")
+    who = ", ".join(names.get(a, a) for a in algos)
+    if "below_ms" in spec:
+        worst = float(ms.max())
+        ok = worst < spec["below_ms"]
+        return Claim(text, verdict(ok), f"slowest of the {ms.size} timed single runs of {who}: {g(worst)} ms, "
+                     f"{'below' if ok else 'not below'} {g(spec['below_ms'])} ms (rule: every run below the limit, "
+                     "so the slowest decides)", {"worst_ms": worst})
+    med = float(np.median(ms))
+    ok = med > spec["above_ms"]
+    return Claim(text, verdict(ok), f"median of the {ms.size} timed single runs of {who}: {g(med)} ms, "
+                 f"{'above' if ok else 'not above'} {g(spec['above_ms'])} ms (rule: the median run above the limit)",
+                 {"median_ms": med})
+
+
+def _time_to_best(text, spec, exp, mod, a, b, ms, names) -> Claim:
+    """'``a`` finds its best in less time than ``b``' over ALL runs, not the timed ones: each run's
+    iterations to its best (runs.csv, every run) times its algorithm's median time per iteration
+    (the timed single runs, interleaved), rank-tested; both factors are tested and shown."""
+    runs = runs_table(exp, mod)
+    per_it = {x: float(np.median(ms[x])) / float(exp.config["iterations"]) for x in (a, b)}
+    its = {x: runs[runs.algorithm == x].sort_values(["case", "run"]).iterations_to_best.to_numpy(float) for x in (a, b)}
+    if not all(v.size for v in its.values()):
+        raise _Missing(f"{exp.paper}/{exp.name}: runs of {a} and {b}")
+    nm = lambda x: names.get(x, x)   # noqa: E731
+    tbest = compare(nm(a), its[a] * per_it[a], nm(b), its[b] * per_it[b])
+    it_cmp = compare(nm(a), its[a], nm(b), its[b])
+    run_cmp = compare(nm(a), ms[a], nm(b), ms[b])
+    lower = tbest.lower
+    v = WITHIN_NOISE if lower is None else verdict(lower == nm(a))
+    outcome = (f"time to best over all {tbest.values_a.size} vs {tbest.values_b.size} runs: median {nm(a)} "
+               f"{g(tbest.median_a)} ms vs {nm(b)} {g(tbest.median_b)} ms, {p_text(tbest.p)}")
+    return Claim(text, v, f"{outcome}; iterations to best (every run): {it_cmp.text()}; a whole "
+                 f"{exp.config['iterations']}-iteration run (timed runs): {run_cmp.text(lambda x: g(x) + ' ms')}; "
+                 "rule: "
+                 "each run's iterations to best x its algorithm's median ms per iteration, rank test at alpha = "
+                 f"{ALPHA} over all runs, within noise only without a significant difference",
+                 {"p": tbest.p, "median_a_ms": tbest.median_a, "median_b_ms": tbest.median_b,
+                  "p_iterations": it_cmp.p, "lower_iterations": it_cmp.lower, "p_run_ms": run_cmp.p,
+                  "lower_run_ms": run_cmp.lower}, kind="timing")
 
 
 def _value(text, spec, exp, use, names, store, mod) -> Claim:
@@ -353,11 +488,18 @@ def _value(text, spec, exp, use, names, store, mod) -> Claim:
     if got is None:
         raise _Missing(f"the results behind {spec['quantity']}")
     value, evidence, numbers = got
-    ok, rule = _rule(value, spec)
-    return Claim(text, verdict(ok), f"{evidence} (rule: {spec['quantity']} {g(value)} {rule})", numbers)
+    ok, outcome, rule = _rule(value, spec)
+    return Claim(text, verdict(ok), f"{spec['quantity']} = {g(value)}, {outcome}: {evidence}; rule: {rule}", numbers)
 
 
-KIND_JUDGES = {"comparison": _comparison, "magnitude": _magnitude, "iterations_to_target": _iterations_to_target,
+def _statement(text, spec, exp, use, names, store, mod) -> Claim:
+    """A claim no stored number can decide: its row says why (``not_checkable``)."""
+    assert spec.get("not_checkable"), f"{spec['id']}: a statement is judged not checkable and says why"
+    return Claim(text, NOT_CHECKABLE, "")
+
+
+KIND_JUDGES = {"statement": _statement, "comparison": _comparison, "magnitude": _magnitude,
+               "iterations_to_target": _iterations_to_target,
                "timing": _timing, "value": _value}
 
 

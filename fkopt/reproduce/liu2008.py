@@ -25,9 +25,20 @@ def _printed_pose_legs() -> pd.DataFrame:
                          "of_printed_pose_m": legs, "difference_um": (legs - np.array(PRINTED_LEGS)) * 1e6})
 
 
+#: A run that reached the threshold farther than this from the exact solution (m, deg) found another
+#: assembly mode: another forward solution of the same legs (a successful run lands within ~1e-4).
+OTHER_MODE_TOL = 1e-3
+
+
 def run_columns(exp, runs: pd.DataFrame) -> pd.DataFrame:
-    """runs.csv plus ``failed``: 1 for a run that never reached the threshold."""
-    return runs.assign(failed=runs.iterations_to_threshold.isna().astype(float))
+    """runs.csv plus ``failed`` (1: the run never reached the threshold), ``other_mode`` (1: it reached
+    it on another assembly mode, > OTHER_MODE_TOL from the exact solution in some coordinate) and
+    ``misses`` (either: the run did not find the paper's pose)."""
+    failed = runs.iterations_to_threshold.isna()
+    err = runs[[c for c in runs.columns if c.startswith("abs_error_")]].max(axis=1)
+    other = ~failed & (err > OTHER_MODE_TOL)
+    return runs.assign(failed=failed.astype(float), other_mode=other.astype(float),
+                       misses=(failed | other).astype(float))
 
 
 def printed_pose_in_half_units(store):

@@ -211,6 +211,20 @@ def extra_tables(exp) -> list[tuple[str, pd.DataFrame]]:
     return []
 
 
+#: Sec. 5's printed fitness of the example's answer: a run "solves" the example at or below it.
+SOLVED_F = PRINTED_F
+
+
+def run_columns(exp, runs: pd.DataFrame) -> pd.DataFrame:
+    """runs.csv plus ``on_target`` (1: the run solved the inputs, f <= 2.25e-4, on the paper's pose)
+    and ``any_solution`` (1: it solved them on the pose or on its mirror, which reproduces the same
+    inputs): the one rule for mirror outcomes counts a mirror run as solving the inputs only."""
+    b = branch_of_runs(exp)
+    solved = b.final_fitness.to_numpy(float) <= SOLVED_F
+    return runs.assign(on_target=(solved & (b.branch == "target").to_numpy()).astype(float),
+                       any_solution=(solved & (b.branch != "neither").to_numpy()).astype(float))
+
+
 # -- the numbers claims.yaml names -------------------------------------------------------------
 def _exp(store, name):
     return store.get("wu2015", name)
@@ -304,11 +318,29 @@ def aco_minus_nr_median_relative_error(store):
     r = t2.table("runs")
     nr = (r[["abs_error_x", "abs_error_y", "abs_error_theta"]].to_numpy() / np.array([20.0, 30.0, 15.0])).max(axis=1)
     c = compare("ACO", aco, "NR", nr)
-    return c.median_a - c.median_b, f"largest relative error per run on the example: {c.text()}", \
+    return c.median_a - c.median_b, (f"largest relative error per run on the example, over the {aco.size} ACO runs "
+                                     f"that end on the target pose (the others end on its mirror): {c.text()}"), \
         {"p": c.p, "lower": c.lower, "median_aco": c.median_a, "median_nr": c.median_b}
 
 
-QUANTITIES = {f.__name__: f for f in (example_inputs_difference_mm, printed_answer_decades_from_printed_f,
+#: The 3-PPR's topology as printed (Sec. 2): a base, a moving platform and three legs of two links each,
+#: every leg prismatic (actuated) - prismatic - revolute; every joint a planar lower pair (1 DOF).
+TOPOLOGY = {"links": 1 + 1 + 3 * 2, "joints": 3 * 3}
+
+
+def gruebler_mobility(store):
+    """Planar Gruebler-Kutzbach mobility M = 3 (n - 1) - 2 j of the printed topology (no geometry
+    enters), with the rank of eq. (7)'s Jacobian at the example beside it (reconstructed geometry)."""
+    n, j = TOPOLOGY["links"], TOPOLOGY["joints"]
+    mobility = 3 * (n - 1) - 2 * j
+    mech = _mechanism()
+    rank = int(np.linalg.matrix_rank(mech.jacobian(mech.vector(EXAMPLE, mech.pose_names, "example"))))
+    return float(mobility), (f"planar Gruebler-Kutzbach M = 3 (n - 1) - 2 j with n = {n} links and j = {j} one-DOF "
+                             f"joints (three P-P-R legs); the Jacobian of eq. (7) at the example has rank {rank}"), \
+        {"mobility": mobility, "jacobian_rank": rank}
+
+
+QUANTITIES = {f.__name__: f for f in (gruebler_mobility, example_inputs_difference_mm, printed_answer_decades_from_printed_f,
                                       mirrors_in_workspace, tab1_worst_median_relative_error, mean_ant_fitness,
                                       share_on_target, nr_largest_abs_error, nr_theta10_spread_decades,
                                       aco_minus_nr_median_relative_error)}
