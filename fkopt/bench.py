@@ -30,6 +30,10 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
 4c. ``robots`` -- ``fkopt.inverse`` on the Panda, UR5 and Kinova of example-robot-data and the
    wang7dof arm beside roboticstoolbox's ETS ``ik_LM`` on the same poses, timed alternately
    (:mod:`fkopt.bench_robots`).
+4e. ``ik-one-pose`` and ``ik-batch`` -- ``fkopt.inverse`` on 14 arms of example-robot-data beside
+   roboticstoolbox's ETS ``ik_LM`` at 1e-6 m and 1e-6 rad, one pose per call alternating query by
+   query, and 1000 poses in one fkopt call beside rtb per pose; every answer verified by
+   pinocchio's FK; ratios per arm and their median (:mod:`fkopt.bench_ik`).
 4d. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
    600 iterations): wall time and ns per evaluation, beside the same GABC as a plain C loop
    (``fkopt/bench_ref/gabc_3rps.c``, compiled with the system's C compiler into a temporary
@@ -823,7 +827,8 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
-SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "robots", "cases", "scaling")
+SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "robots", "ik-one-pose", "ik-batch",
+            "cases", "scaling")
 
 
 def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
@@ -863,6 +868,12 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     if "robots" in want:
         from .bench_robots import bench_robots
         bench_robots(rows, quick, messages)
+    if "ik-one-pose" in want:
+        from .bench_ik import bench_ik_one_pose
+        bench_ik_one_pose(rows, quick, messages)
+    if "ik-batch" in want:
+        from .bench_ik import bench_ik_batch
+        bench_ik_batch(rows, quick, messages)
     if "cases" in want:
         bench_cases(rows, quick, rng, messages)
     if "scaling" in want:
