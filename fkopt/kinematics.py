@@ -800,6 +800,38 @@ def _arm_constants(m) -> dict:
     return got
 
 
+def _fast_context(m, table: int, W) -> dict:
+    """Per-arm constants of the compiled one-pose call (:func:`fkopt.numerics.compiled.inverse_pose`),
+    as typed arrays, cached beside :func:`_arm_constants` (so a change of the bounds renews them):
+    the chain, limits, unit and periodic masks, and the start table (or its masked copy for task
+    mask W) with its features transposed for the compiled nearest-neighbour search."""
+    c = _arm_constants(m)
+    key = ("fast", table, None if W is None else W.tobytes())
+    got = c.get(key)
+    if got is None:
+        n = m.dof
+        if table:
+            tab = _start_table(m, table)
+            if W is not None:
+                tab = _masked_table(tab, W)
+            if "norms" not in tab:
+                tab["norms"] = _sumsq(tab["features"])
+            tq, F, norms, w = tab["q"], tab["features"], tab["norms"], float(tab["w"])
+            fmask = tab.get("mask", np.ones(12))
+        else:
+            tq, F, norms, w, fmask = np.zeros((0, n)), np.zeros((0, 12)), np.zeros(0), 0.0, np.ones(12)
+        got = c[key] = {
+            "n": n, "chain": m.chain().arrays(), "tq": np.ascontiguousarray(tq, dtype=float),
+            "Ft": np.ascontiguousarray(F.T, dtype=float), "norms": np.ascontiguousarray(norms, dtype=float), "w": w,
+            "fmask": np.ascontiguousarray(fmask, dtype=float), "W": np.ones(6) if W is None else np.asarray(W, float),
+            "slo": np.asarray(c["slo"], dtype=float), "shi": np.asarray(c["shi"], dtype=float),
+            "lo": np.asarray(c["lo"], dtype=float), "hi": np.asarray(c["hi"], dtype=float),
+            "angle": np.array(c["angle"], dtype=np.bool_), "periodic": np.array(c["periodic"], dtype=np.bool_),
+            "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
+            "mid": np.array(c["mid"], dtype=float)}
+    return got
+
+
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
@@ -853,6 +885,18 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
                                                np.array([j - own0 - nn]), n)[0]).tolist()
 
     fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and (start is None or (n <= 6 and W is None)):
+        # no self-motion step after the loop: pose to answer in one compiled call
+        ctx = _fast_context(m, int(table), W)
+        out, info = fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"],
+                                      ctx["mid"] if start is None else np.array(q0), own0, nn, int(seed), int(budget),
+                                      tol, int(iterations), float(damping), float(down), float(up), float(step_cap))
+        perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
+        return InverseResult(
+            mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
+            rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+            solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
+            evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
     if fast is not None:
         # the same starts as start_of, as arrays: the table's neighbours looked up now
         if nn:

@@ -324,3 +324,103 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
     return best, used, evals
+
+
+@njit(cache=True)
+def _nearest_into(Ft, norms, f, idx, best):
+    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx:
+    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics._nearest`'s brute force; the dot product
+    summed feature by feature, rows side by side, from ``Ft`` = F transposed), the k smallest kept
+    sorted by insertion (ties: the lower row first)."""
+    c, N = Ft.shape
+    k = idx.shape[0]
+    d2 = np.zeros(N)
+    for j in range(c):
+        fj = f[j]
+        for i in range(N):
+            d2[i] += Ft[j, i] * fj
+    m = 0
+    for i in range(N):
+        v = norms[i] - 2.0 * d2[i]
+        if m < k:
+            pos = m
+            m += 1
+        elif v < best[k - 1]:
+            pos = k - 1
+        else:
+            continue
+        while pos > 0 and best[pos - 1] > v:
+            best[pos] = best[pos - 1]
+            idx[pos] = idx[pos - 1]
+            pos -= 1
+        best[pos] = v
+        idx[pos] = i
+
+
+@njit(cache=True)
+def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
+    """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
+    the target rotation (ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`), the
+    start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
+    (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
+    [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
+    target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
+    used, evaluations)."""
+    n = q0.shape[0]
+    d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
+    r2d = 180.0 / math.pi
+    a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
+    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+    T = np.empty((3, 3))
+    T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+    T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+    T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
+    pt = pose[:3].copy()
+    near = np.empty((nn, n))
+    if nn > 0:
+        f = np.empty(12)
+        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
+        for r in range(3):
+            for c in range(3):
+                f[3 + 3 * r + c] = wf * T[r, c]
+        for j in range(12):
+            f[j] = f[j] * fmask[j]
+        idx = np.empty(nn, dtype=np.int64)
+        _nearest_into(Ft, norms, f, idx, np.empty(nn))
+        for k in range(nn):
+            near[k, :] = tq[idx[k]]
+    best = np.empty(n)
+    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, 0, budget, tp, tr, iterations, damping,
+                               down, up, step_cap, slo, shi, lo, hi, best)
+    t = np.empty(n)
+    inside = True
+    for i in range(n):
+        v = best[i] * r2d if angle[i] else best[i]
+        if periodic[i]:
+            v = (v + 180.0) % 360.0 - 180.0
+        v = min(max(v, blo[i]), bhi[i])
+        out[i] = v
+        inside = inside and blo[i] <= v <= bhi[i]
+        t[i] = v * d2r if angle[i] else v
+    prismatic, C, v_, var, mult, off, tC, tv = chain
+    p, R, J, ax, e = np.empty(3), np.empty((3, 3)), np.empty((6, n)), np.empty((prismatic.shape[0], 6)), np.empty(3)
+    _walk(prismatic, C, v_, var, mult, off, tC, tv, t, p, R, J, ax)
+    _rotation_error(R, T, e)
+    d0, d1, d2 = (p[0] - pt[0]) * W[0], (p[1] - pt[1]) * W[1], (p[2] - pt[2]) * W[2]
+    e0, e1, e2 = e[0] * W[3], e[1] * W[4], e[2] * W[5]
+    info[0] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    info[1] = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    info[2] = 1.0 if inside else 0.0
+    info[3] = used
+    info[4] = evals
+
+
+def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+    """One pose through :func:`_inverse_pose` with the per-arm constants ``ctx`` (see
+    :func:`fkopt.kinematics._fast_context`): (public joints (n,), info (5,))."""
+    out, info = np.empty(ctx["n"]), np.empty(5)
+    _inverse_pose(ctx["chain"], pose, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+                  seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
+                  ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
+    return out, info
