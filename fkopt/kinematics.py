@@ -864,9 +864,22 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
     L = float(orientation_scale) if orientation_scale else reach
+    nn = min(table, kn) if table else 0
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and (start is None or (n <= 6 and W is None)):
+        # no self-motion step after the loop: pose to answer in one compiled call
+        ctx = _fast_context(m, int(table), W)
+        out, info = fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"],
+                                      ctx["mid"] if start is None else np.array(q0), own0, nn, int(seed), int(budget),
+                                      tol, int(iterations), float(damping), float(down), float(up), float(step_cap))
+        perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
+        return InverseResult(
+            mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
+            rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+            solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
+            evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
     Rt = _zyz_matrix1(*pose[3:].tolist())
     near: list[int] = []
-    nn = min(table, kn) if table else 0
 
     def start_of(j):
         if j < own0:
@@ -884,19 +897,6 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         return (lo + (hi - lo) * _uniform_hash(seed, np.zeros(1, dtype=np.intp),
                                                np.array([j - own0 - nn]), n)[0]).tolist()
 
-    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
-    if fast is not None and (start is None or (n <= 6 and W is None)):
-        # no self-motion step after the loop: pose to answer in one compiled call
-        ctx = _fast_context(m, int(table), W)
-        out, info = fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"],
-                                      ctx["mid"] if start is None else np.array(q0), own0, nn, int(seed), int(budget),
-                                      tol, int(iterations), float(damping), float(down), float(up), float(step_cap))
-        perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
-        return InverseResult(
-            mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
-            rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
-            solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
-            evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
     if fast is not None:
         # the same starts as start_of, as arrays: the table's neighbours looked up now
         if nn:
@@ -984,7 +984,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         raise FkoptError(f"inverse needs an arm with an analytic frame Jacobian; '{m.name}' has none "
                          "(use fkopt.solve with an ik_problem)")
     try:
-        tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
+        if isinstance(tol, tuple) and len(tol) == 2:      # the common case, without numpy's broadcast
+            tp, tr = float(tol[0]), float(tol[1])
+        else:
+            tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
     except (TypeError, ValueError):
         raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
     if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):

@@ -18,10 +18,16 @@ _STATE: dict = {}
 
 
 def requested() -> str:
-    """'auto', 'numpy' or 'compiled' from ``FKOPT_NUMERICS``."""
-    v = os.environ.get(ENV, "auto").strip().lower() or "auto"
+    """'auto', 'numpy' or 'compiled' from ``FKOPT_NUMERICS`` (read on every call: a test or a
+    caller may change it; the parsed value is kept per raw string)."""
+    raw = os.environ.get(ENV)
+    got = _STATE.get(("requested", raw))
+    if got is not None:
+        return got
+    v = (raw or "auto").strip().lower() or "auto"
     if v not in ("auto", "numpy", "compiled"):
         raise FkoptError(f"{ENV}={v!r}: allowed values auto, numpy, compiled")
+    _STATE[("requested", raw)] = v
     return v
 
 
