@@ -1024,6 +1024,27 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = _internal(m, q0)
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and rest <= 0 and not exact_rotation and (start is None or (n <= 6 and W is None)):
+        # every row as its one-pose call (same starts, restarts and answer), rows on all cores
+        own0 = 1 if (start is not None or not table) else 0
+        first = max(1, int(starts), fill)
+        nn = min(int(table), first - own0 + int(neighbours)) if table else 0
+        ctx = _fast_context(m, int(table), W)
+        out, info = fast.inverse_rows(ctx, np.ascontiguousarray(P, dtype=float),
+                                      float(orientation_scale) if orientation_scale else reach, ctx["W"],
+                                      np.ascontiguousarray(q0, dtype=float), own0, nn, int(seed),
+                                      first + max(0, int(restarts)), (tp, tr), int(iterations), float(damping),
+                                      float(down), float(up), float(step_cap))
+        perr, rerr = info[:, 0], info[:, 1]
+        ev = info[:, 4].astype(np.int64)
+        return InverseResult(
+            mechanism=m.name, names=tuple(m.joint_names), joints=out.reshape(shape + (n,)),
+            position_error=perr.reshape(shape), rotation_error=rerr.reshape(shape),
+            residual=np.maximum(perr / tp, rerr / tr).reshape(shape),
+            solved=((perr <= tp) & (rerr <= tr) & (info[:, 2] > 0)).reshape(shape),
+            restarts=(info[:, 3].astype(np.int64) - 1).reshape(shape),
+            evaluations={"residual": ev.reshape(shape), "jacobian": ev.copy().reshape(shape)}, tol=(tp, tr))
     K = max(1, int(starts))
     if N * K < fill:                                   # small batches: more candidates per row
         K = max(K, fill // N)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -421,6 +421,27 @@ def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, d
     :func:`fkopt.kinematics._fast_context`): (public joints (n,), info (5,))."""
     out, info = np.empty(ctx["n"]), np.empty(5)
     _inverse_pose(ctx["chain"], pose, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+                  seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
+                  ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
+    return out, info
+
+
+@njit(cache=True, parallel=True)
+def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
+    """:func:`_inverse_pose` of every row of ``poses`` (k, 6) from start row ``q0[k]``, rows spread
+    over the cores (numba's ``prange``); row k's answer is the one-pose call's."""
+    for k in prange(poses.shape[0]):
+        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr,
+                      iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
+                      out[k], info[k])
+
+
+def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+    """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5))."""
+    k = poses.shape[0]
+    out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
+    _inverse_rows(ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
                   seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
                   ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
     return out, info
