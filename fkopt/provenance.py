@@ -6,6 +6,10 @@ changes with the machine and is never compared by ``fkopt check``:
 
 * ``fkopt_version`` and ``libraries`` (Python and the versions of the libraries fkopt uses);
 * ``platform`` (operating system, CPU architecture, CPU model);
+* ``numerics`` -- which numerics path made the result (``"compiled"`` or ``"numpy"``), numba's
+  version and the ``FKOPT_NUMERICS`` setting (:func:`fkopt.numerics.path.describe`); ``fkopt
+  check`` reruns with that path (:func:`fkopt.numerics.path.forced`). Not part of the
+  fingerprint: one-pose answers are the same on both paths (tests/test_numerics.py);
 * ``fingerprint`` -- what decides the bits of a result, in two parts (:data:`BLAS_KEYS`):
 
   - the arithmetic fkopt's own elementwise code runs: Python, numpy, scipy and pandas versions,
@@ -26,6 +30,8 @@ import platform
 import sys
 from functools import lru_cache
 from importlib.metadata import PackageNotFoundError, version
+
+from .numerics import path as numerics_path
 
 ENV_FILE = "env.json"
 LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich", "pymoo", "niapy",
@@ -131,4 +137,4 @@ def environment() -> dict:
     return {"fkopt_version": fkopt_version, "libraries": library_versions(),
             "platform": {"system": platform.system(), "machine": platform.machine(),
                          "python_implementation": platform.python_implementation(), "cpu": _cpu_model()},
-            "fingerprint": fingerprint()}
+            "fingerprint": fingerprint(), "numerics": numerics_path.describe()}

@@ -73,3 +73,45 @@ def test_compiled_batch_rows_are_the_one_pose_reference_answers(name, arm):
         assert int(a.evaluations["jacobian"]) == int(b.evaluations["jacobian"][k])
         assert float(a.position_error) == pytest.approx(float(b.position_error[k]), abs=1e-12)
         assert float(a.rotation_error) == pytest.approx(float(b.rotation_error[k]), abs=1e-12)
+
+
+def test_env_json_records_the_numerics_path_and_numbas_version(monkeypatch):
+    from importlib.metadata import version
+    from fkopt.provenance import environment
+    monkeypatch.delenv(numerics_path.ENV, raising=False)
+    got = environment()["numerics"]
+    assert got == {"path": "compiled", "numba": version("numba"), "env": ""}
+    monkeypatch.setenv(numerics_path.ENV, "numpy")
+    assert environment()["numerics"]["path"] == "numpy"
+    assert numerics_path.recorded({"numerics": {"path": "numpy"}}) == "numpy"
+    assert numerics_path.recorded({"fingerprint": {}}) is None           # stored before the record
+    assert numerics_path.recorded({"numerics": {"path": "fast"}}) is None
+
+
+@pytest.mark.parametrize("stored", ["numpy", "compiled"])
+def test_check_reruns_with_the_path_env_json_recorded(tmp_path, monkeypatch, stored):
+    """fkopt check sets FKOPT_NUMERICS from the stored env.json for the rerun, then restores it."""
+    import json
+    import shutil
+    from pathlib import Path
+    from fkopt.reproduce import check
+    from fkopt.reproduce.store import Store
+    src = Path(__file__).parents[1] / "results" / "mao2017" / "tab3_floor"     # a small stored result
+    root = tmp_path / "results"
+    shutil.copytree(src, root / src.parent.name / src.name)
+    env_file = root / src.parent.name / src.name / "env.json"
+    env = json.loads(env_file.read_text()) if env_file.exists() else {}
+    env["numerics"] = {"path": stored, "numba": "x", "env": ""}
+    env_file.write_text(json.dumps(env))
+    seen = []
+
+    def rerun(config, folder, source=None):             # the stored files, as a rerun that matches
+        seen.append(numerics_path.requested())
+        for f in (root / src.parent.name / src.name).iterdir():
+            if f.is_file():
+                shutil.copy(f, folder / f.name)
+    monkeypatch.setattr(check, "rerun_files", rerun)
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    check.check_experiment(Store(root).get(src.parent.name, src.name))
+    assert seen == [stored]
+    assert numerics_path.requested() == "auto"

@@ -10,6 +10,7 @@ see ``fkopt/cli.py``).
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 
 from ..errors import FkoptError
 
@@ -62,3 +63,38 @@ def describe() -> dict:
     mode = requested()
     path = "numpy" if mode == "numpy" or nv is None else "compiled"
     return {"path": path, "numba": nv, "env": os.environ.get(ENV, "")}
+
+
+def recorded(env: dict | None) -> str | None:
+    """The path recorded in a stored ``env.json`` (its ``numerics.path``: 'compiled' or 'numpy'),
+    or None when it records none (results stored before the record existed)."""
+    got = (env or {}).get("numerics") if isinstance(env, dict) else None
+    path = got.get("path") if isinstance(got, dict) else None
+    return path if path in ("compiled", "numpy") else None
+
+
+@contextmanager
+def forced(path: str | None):
+    """``FKOPT_NUMERICS`` set to ``path`` ('compiled' or 'numpy') inside the block (worker
+    processes started inside inherit it), restored after; None leaves it alone. A stored
+    'compiled' on a machine without numba runs the reference ('auto'): the one-pose answers are
+    the same on both paths, and fkopt's comparison then reports what differs."""
+    if path is None:
+        yield
+        return
+    if path == "compiled":
+        try:
+            from importlib.util import find_spec
+            have = find_spec("numba") is not None
+        except (ImportError, ValueError):
+            have = False
+        path = "compiled" if have else "auto"
+    before = os.environ.get(ENV)
+    os.environ[ENV] = path
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(ENV, None)
+        else:
+            os.environ[ENV] = before
