@@ -40,6 +40,9 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    folder and run on the same 100 cases; the row is skipped with a message when there is no
    compiler), the ratio and whether the target (<= 2x the compiled loop) is met; and the chunk
    size (rows per chunk) that :data:`fkopt.solve.CHUNK_POINTS` was chosen from.
+4f. ``swarms`` -- GABC, ABC and PSO on 3-RPS at 1 case and 100 cases x 30 runs beside the same
+   algorithm as the C loop of ``fkopt/bench_ref/gabc_3rps.c``, alternating: ns per evaluation and
+   the ratio (issue 29's targets: <= 3 at 1 case, <= 1.5 at 100 cases).
 5. ``scaling`` -- GABC on the 3-RPS case with population 10..1000 (30 runs) and runs 1..1000
    (population 10): wall time and ns per evaluation; plotted into ``scaling.png``.
 
@@ -681,12 +684,13 @@ def compile_reference(folder: Path) -> tuple[Path, str] | str:
 
 
 def run_reference(exe: Path, joints: np.ndarray, iterations: int, population: int, runs: int,
-                  seed: int = 1) -> dict[str, float]:
-    """Solve every row of ``joints`` (cases, 3) ``runs`` times with the compiled loop: evaluations,
-    seconds (of the solves, timed inside the program), median and largest final fitness."""
+                  seed: int = 1, algorithm: str = "gabc") -> dict[str, float]:
+    """Solve every row of ``joints`` (cases, 3) ``runs`` times with the compiled loop of
+    ``algorithm`` (gabc, abc or pso): evaluations, seconds (of the solves, timed inside the
+    program), median and largest final fitness."""
     import subprocess
     data = "\n".join(" ".join(repr(float(v)) for v in row) for row in np.atleast_2d(joints)) + "\n"
-    p = subprocess.run([str(exe), str(iterations), str(population), str(runs), str(seed)], input=data,
+    p = subprocess.run([str(exe), str(iterations), str(population), str(runs), str(seed), algorithm], input=data,
                        capture_output=True, text=True, timeout=1800, check=True)
     evals, seconds, median, worst = p.stdout.split()
     return {"evaluations": float(evals), "seconds": float(seconds), "median": float(median),
@@ -759,6 +763,46 @@ def bench_cases(rows: _Rows, quick: bool, rng, messages: list[str] | None = None
 
 
 # -- 5. scaling ------------------------------------------------------------------------------
+#: Section ``swarms``: issue 29's targets, fkopt / C loop per evaluation at 1 case and 100 cases.
+SWARM_TARGETS = {1: 3.0, 100: 1.5}
+
+
+def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
+    """GABC, ABC and PSO on 3-RPS (population 10, 600 iterations; 100 in quick mode; 30 runs) at
+    1 case and at 100 cases, beside the same algorithm as the plain C loop of
+    :data:`REFERENCE_C` on the same cases; alternating fkopt solve, C run (best of 2 each; 1 in
+    quick mode). Rows: ns per evaluation of each and the ratio fkopt / C, against
+    :data:`SWARM_TARGETS`. Skipped with a message when there is no C compiler."""
+    import tempfile
+    from . import mechanism
+    from .solve import solve
+    m = mechanism("3-rps")
+    iterations = 100 if quick else 600
+    reps = 1 if quick else 2
+    joints = m.ik(_uniform(m.bounds, (100,), rng))
+    with tempfile.TemporaryDirectory() as tmp:
+        built = compile_reference(Path(tmp))
+        if isinstance(built, str):
+            messages.append(f"swarms: section skipped: {built}")
+            return
+        for alg in ("gabc", "abc", "pso"):
+            for n in SWARM_TARGETS:
+                problem = fk_problem(m, joints[:n])
+                f_ns = c_ns = np.inf
+                for _ in range(reps):
+                    t = time.perf_counter()
+                    res = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
+                    f_ns = min(f_ns, (time.perf_counter() - t) / float(res.evaluations.sum()) * 1e9)
+                    ref = run_reference(built[0], joints[:n], iterations, 10, 30, algorithm=alg)
+                    c_ns = min(c_ns, ref["seconds"] / ref["evaluations"] * 1e9)
+                ratio, target = f_ns / c_ns, SWARM_TARGETS[n]
+                rows.add("swarms", f"{alg} {n} case{'s' if n > 1 else ''} x 30 runs", ratio, "x C loop",
+                         f"fkopt {f_ns:.0f} ns/eval, C loop {c_ns:.0f} ns/eval ({built[1]}); {iterations} it, "
+                         f"population 10; best of {reps}; median final fitness fkopt "
+                         f"{float(np.median(res.fitness)):.2g}, C {ref['median']:.2g}; target <= {target:g}: "
+                         f"{'met' if ratio <= target else 'NOT met'}")
+
+
 def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, float]]]:
     from .solve import solve
     problem = mao_problem()
@@ -828,7 +872,7 @@ def _fmt(v: float) -> str:
 
 
 SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "robots", "ik-one-pose", "ik-batch",
-            "cases", "scaling")
+            "cases", "swarms", "scaling")
 
 
 def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
@@ -876,6 +920,8 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
         bench_ik_batch(rows, quick, messages)
     if "cases" in want:
         bench_cases(rows, quick, rng, messages)
+    if "swarms" in want:
+        bench_swarms(rows, quick, np.random.default_rng(29), messages)
     if "scaling" in want:
         curves = bench_scaling(rows, quick)
         plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
