@@ -897,33 +897,41 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     messages: list[str] = []
     start = time.perf_counter()
 
+    spent: dict[str, float] = {}                       # seconds per section, printed at the end
+
+    def timed(name, fn, *args):
+        t = time.perf_counter()
+        got = fn(*args)
+        spent[name] = spent.get(name, 0.0) + time.perf_counter() - t
+        return got
+
     if "throughput" in want:
-        bench_throughput(rows, quick, rng)
-    per_run = bench_mao2017(rows, quick) if ("mao2017" in want or "peers" in want) else {}
+        timed("throughput", bench_throughput, rows, quick, rng)
+    per_run = timed("mao2017", bench_mao2017, rows, quick) if ("mao2017" in want or "peers" in want) else {}
     if peers and "peers" in want:
-        bench_peers(rows, quick, per_run.get("gabc"), messages)
+        timed("peers", bench_peers, rows, quick, per_run.get("gabc"), messages)
     if (peers or sections) and "adapters" in want:       # opt-in, as peers: needs pymoo/NiaPy
-        bench_adapters(rows, quick, messages)
+        timed("adapters", bench_adapters, rows, quick, messages)
     if "exact" in want:
-        bench_exact(rows, quick, rng)
+        timed("exact", bench_exact, rows, quick, rng)
     if "kinematics" in want:
-        bench_kinematics(rows, quick, np.random.default_rng(12), messages)
-        bench_cli_process(rows, quick)
+        timed("kinematics", bench_kinematics, rows, quick, np.random.default_rng(12), messages)
+        timed("kinematics", bench_cli_process, rows, quick)
     if "robots" in want:
         from .bench_robots import bench_robots
-        bench_robots(rows, quick, messages)
+        timed("robots", bench_robots, rows, quick, messages)
     if "ik-one-pose" in want:
         from .bench_ik import bench_ik_one_pose
-        bench_ik_one_pose(rows, quick, messages)
+        timed("ik-one-pose", bench_ik_one_pose, rows, quick, messages)
     if "ik-batch" in want:
         from .bench_ik import bench_ik_batch
-        bench_ik_batch(rows, quick, messages)
+        timed("ik-batch", bench_ik_batch, rows, quick, messages)
     if "cases" in want:
-        bench_cases(rows, quick, rng, messages)
+        timed("cases", bench_cases, rows, quick, rng, messages)
     if "swarms" in want:
-        bench_swarms(rows, quick, np.random.default_rng(29), messages)
+        timed("swarms", bench_swarms, rows, quick, np.random.default_rng(29), messages)
     if "scaling" in want:
-        curves = bench_scaling(rows, quick)
+        curves = timed("scaling", bench_scaling, rows, quick)
         plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
 
     df = pd.DataFrame(rows.rows, columns=["section", "item", "value", "unit", "note"])
@@ -940,5 +948,6 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     for msg in messages:
         console.print(msg)
     wrote = f"{out / 'bench.csv'}" + (f" and {out / 'scaling.png'}" if "scaling" in want else "")
-    console.print(f"total {time.perf_counter() - start:.1f} s; wrote {wrote}")
+    per = ", ".join(f"{k} {v:.1f}" for k, v in spent.items())
+    console.print(f"total {time.perf_counter() - start:.1f} s ({per}); wrote {wrote}")
     return df
