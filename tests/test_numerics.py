@@ -115,3 +115,43 @@ def test_check_reruns_with_the_path_env_json_recorded(tmp_path, monkeypatch, sto
     check.check_experiment(Store(root).get(src.parent.name, src.name))
     assert seen == [stored]
     assert numerics_path.requested() == "auto"
+
+
+def test_compiled_3rps_fitness_within_its_documented_tolerance(monkeypatch):
+    """FKOPT_NUMERICS=compiled: the 3-RPS fitness in one compiled pass. Its tan is the C
+    library's, numpy's may be SIMD code an ulp away, so the tolerance is on the residual norm:
+    |sqrt(f_compiled) - sqrt(f_numpy)| <= 1e-11 mm (legs of ~600 mm: ~100 ulps), at random
+    poses and at poses 1e-6 away from the solution; the default path does not change."""
+    m = fkopt.mechanism("3-rps")
+    rng = np.random.default_rng(5)
+    targets = m.bounds[:, 0] + rng.random((50, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    p = fkopt.fk_problem(m, m.ik(targets))
+    x = np.concatenate([m.bounds[:, 0] + rng.random((50, 200, 3)) * (m.bounds[:, 1] - m.bounds[:, 0]),
+                        targets[:, None, :] + rng.normal(0.0, 1e-6, (50, 200, 3))], axis=1)
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    f_numpy = p.fitness(x)
+    assert m.compiled_fitness(x.reshape(-1, 3), m.ik(targets).T, False) is None
+    monkeypatch.setenv(numerics_path.ENV, "compiled")
+    f_compiled = p.fitness(x)
+    assert f_compiled.shape == f_numpy.shape == (50, 400)
+    assert np.abs(np.sqrt(f_compiled) - np.sqrt(f_numpy)).max() <= 1e-11
+    p_abs = fkopt.fk_problem(m, m.ik(targets), objective="absolute")
+    a_compiled = p_abs.fitness(x)
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    assert np.abs(a_compiled - p_abs.fitness(x)).max() <= 1e-11
+
+
+@pytest.mark.parametrize("algorithm", ["gabc", "abc", "pso"])
+def test_swarms_on_the_compiled_3rps_fitness_reach_what_the_numpy_path_reaches(monkeypatch, algorithm):
+    """A swarm turns an ulp into another run, so the swarm tolerance is on outcomes: mao2017's
+    case, 30 runs x 600 iterations, every run below 1e-12 on both paths (as the numpy path's
+    stored results), with the same evaluation budget."""
+    m = fkopt.mechanism("3-rps")
+    p = fkopt.fk_problem(m, m.ik(np.array([9.0, 13.0, 622.0])))
+    got = {}
+    for mode in ("numpy", "compiled"):
+        monkeypatch.setenv(numerics_path.ENV, mode)
+        got[mode] = fkopt.solve(p, algorithm, population=10, iterations=600, runs=30, seed=1)
+    for r in got.values():
+        assert (r.fitness < 1e-12).all()
+    assert abs(got["numpy"].evaluations.mean() - got["compiled"].evaluations.mean()) <= 30

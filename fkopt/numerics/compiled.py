@@ -445,3 +445,56 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
                   seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
                   ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
     return out, info
+
+
+@njit(cache=True)
+def _rps3_fitness(P, J, ra, rb, absolute, out):
+    """Fitness of 3-RPS poses P (n, 3) (alpha, beta in deg, z) against leg rows J (3, 1) or (3, n):
+    the operations of :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` in their order, point by point,
+    then :meth:`fkopt.problems.FKProblem.fitness` (sum of squared or absolute residuals). ``tan``
+    is the C library's; numpy's (SIMD) may differ from it by an ulp (see tests/test_numerics.py)."""
+    half = math.pi / 360.0
+    s3 = 0.5 * math.sqrt(3.0)
+    pm_rb, pm_2 = s3 * rb, -2.0 * s3
+    one = J.shape[1] == 1
+    for i in range(P.shape[0]):
+        ta, tb, z = math.tan(P[i, 0] * half), math.tan(P[i, 1] * half), P[i, 2]
+        ta2, tb2 = ta * ta, tb * tb
+        ra_, rb_ = 1.0 / (1.0 + ta2), 1.0 / (1.0 + tb2)
+        sa, sb = (ta + ta) * ra_, (tb + tb) * rb_
+        ca, cb = (1.0 - ta2) * ra_, (1.0 - tb2) * rb_
+        sbsa = sb * sa
+        tg = sbsa / (ca + cb)
+        cg = 1.0 / math.sqrt(1.0 + tg * tg)
+        sg = tg * cg
+        R00, R10 = cg * cb, sg * cb
+        R11 = sg * sbsa + cg * ca
+        R01 = cg * sbsa - sg * ca
+        h = (0.5 * rb) * R11
+        e = (1.5 * rb) * R00 - h - ra
+        f = z - rb * sb
+        d1 = math.sqrt(e * e + f * f)
+        ax = 0.5 * ra - h
+        bx = pm_rb * R01
+        ay = (-1.5 * rb) * R10
+        by = pm_2 * ax
+        az = z + (0.5 * rb) * sb
+        bz = pm_rb * (cb * sa)
+        u, v, w = ax + bx, ay + by, az + bz
+        d2 = math.sqrt((u * u + v * v) + w * w)
+        u, v, w = ax + (-bx), ay + (-by), az + (-bz)
+        d3 = math.sqrt((u * u + v * v) + w * w)
+        c = 0 if one else i
+        r1, r2, r3 = d1 - J[0, c], d2 - J[1, c], d3 - J[2, c]
+        if absolute:
+            out[i] = (abs(r1) + abs(r2)) + abs(r3)
+        else:
+            out[i] = (r1 * r1 + r2 * r2) + r3 * r3
+
+
+def rps3_fitness(P, J, ra, rb, absolute):
+    """:func:`_rps3_fitness` of poses (n, 3) against leg rows J: fitness (n,)."""
+    out = np.empty(P.shape[0])
+    _rps3_fitness(np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(J, dtype=float), float(ra), float(rb),
+                  bool(absolute), out)
+    return out
