@@ -6,10 +6,12 @@ changes with the machine and is never compared by ``fkopt check``:
 
 * ``fkopt_version`` and ``libraries`` (Python and the versions of the libraries fkopt uses);
 * ``platform`` (operating system, CPU architecture, CPU model);
-* ``numerics`` -- which numerics path made the result (``"compiled"`` or ``"numpy"``), numba's
-  version and the ``FKOPT_NUMERICS`` setting (:func:`fkopt.numerics.path.describe`); ``fkopt
-  check`` reruns with that path (:func:`fkopt.numerics.path.forced`). Not part of the
-  fingerprint: one-pose answers are the same on both paths (tests/test_numerics.py);
+* ``numerics`` -- which numerics path made the result (``path``: ``"compiled"`` or ``"numpy"``),
+  the ``FKOPT_NUMERICS`` mode it ran under and numba's version
+  (:func:`fkopt.numerics.path.describe`); ``fkopt check`` reruns under that mode
+  (:func:`fkopt.numerics.path.forced`). Not part of the fingerprint: one-pose inverse answers
+  are the same on both paths (tests/test_numerics.py), and the compiled swarm fitness runs
+  only under an explicit ``FKOPT_NUMERICS=compiled``, which is recorded;
 * ``fingerprint`` -- what decides the bits of a result, in two parts (:data:`BLAS_KEYS`):
 
   - the arithmetic fkopt's own elementwise code runs: Python, numpy, scipy and pandas versions,

@@ -80,15 +80,17 @@ def test_env_json_records_the_numerics_path_and_numbas_version(monkeypatch):
     from fkopt.provenance import environment
     monkeypatch.delenv(numerics_path.ENV, raising=False)
     got = environment()["numerics"]
-    assert got == {"path": "compiled", "numba": version("numba"), "env": ""}
+    assert got == {"path": "compiled", "mode": "auto", "compiled_fitness": False, "numba": version("numba"), "env": ""}
     monkeypatch.setenv(numerics_path.ENV, "numpy")
     assert environment()["numerics"]["path"] == "numpy"
-    assert numerics_path.recorded({"numerics": {"path": "numpy"}}) == "numpy"
-    assert numerics_path.recorded({"fingerprint": {}}) is None           # stored before the record
-    assert numerics_path.recorded({"numerics": {"path": "fast"}}) is None
+    monkeypatch.setenv(numerics_path.ENV, "compiled")
+    assert environment()["numerics"]["compiled_fitness"] is True
+    assert numerics_path.recorded({"numerics": {"mode": "numpy"}}) == "numpy"
+    assert numerics_path.recorded({"fingerprint": {}}) == "auto"          # stored before the record
+    assert numerics_path.recorded({"numerics": {"mode": "fast"}}) == "auto"
 
 
-@pytest.mark.parametrize("stored", ["numpy", "compiled"])
+@pytest.mark.parametrize("stored", ["numpy", "compiled", None])
 def test_check_reruns_with_the_path_env_json_recorded(tmp_path, monkeypatch, stored):
     """fkopt check sets FKOPT_NUMERICS from the stored env.json for the rerun, then restores it."""
     import json
@@ -101,7 +103,9 @@ def test_check_reruns_with_the_path_env_json_recorded(tmp_path, monkeypatch, sto
     shutil.copytree(src, root / src.parent.name / src.name)
     env_file = root / src.parent.name / src.name / "env.json"
     env = json.loads(env_file.read_text()) if env_file.exists() else {}
-    env["numerics"] = {"path": stored, "numba": "x", "env": ""}
+    env.pop("numerics", None)
+    if stored is not None:
+        env["numerics"] = {"path": stored, "mode": stored, "numba": "x", "env": ""}
     env_file.write_text(json.dumps(env))
     seen = []
 
@@ -111,10 +115,10 @@ def test_check_reruns_with_the_path_env_json_recorded(tmp_path, monkeypatch, sto
             if f.is_file():
                 shutil.copy(f, folder / f.name)
     monkeypatch.setattr(check, "rerun_files", rerun)
-    monkeypatch.setenv(numerics_path.ENV, "auto")
+    monkeypatch.setenv(numerics_path.ENV, "numpy" if stored == "compiled" else "compiled")
     check.check_experiment(Store(root).get(src.parent.name, src.name))
-    assert seen == [stored]
-    assert numerics_path.requested() == "auto"
+    assert seen == [stored or "auto"]                  # no record: auto, whatever is set here
+    assert numerics_path.requested() == ("numpy" if stored == "compiled" else "compiled")
 
 
 def test_compiled_3rps_fitness_within_its_documented_tolerance(monkeypatch):

@@ -51,7 +51,10 @@ def compiled(want: bool | None = None):
 
 
 def describe() -> dict:
-    """What ``env.json`` records: the path a default call takes in this process and numba's version."""
+    """What ``env.json`` records (its ``numerics``): ``path``, the path a default ``fkopt.inverse``
+    call takes in this process ('compiled' with numba, else 'numpy'); ``mode``, the
+    ``FKOPT_NUMERICS`` setting it ran under ('auto', 'numpy' or 'compiled': with 'compiled' the
+    3-RPS swarm fitness is compiled too, ``compiled_fitness``); numba's version; the raw variable."""
     try:
         from importlib.metadata import PackageNotFoundError, version
         try:
@@ -62,23 +65,26 @@ def describe() -> dict:
         nv = None
     mode = requested()
     path = "numpy" if mode == "numpy" or nv is None else "compiled"
-    return {"path": path, "numba": nv, "env": os.environ.get(ENV, "")}
+    return {"path": path, "mode": mode, "compiled_fitness": mode == "compiled" and nv is not None, "numba": nv,
+            "env": os.environ.get(ENV, "")}
 
 
-def recorded(env: dict | None) -> str | None:
-    """The path recorded in a stored ``env.json`` (its ``numerics.path``: 'compiled' or 'numpy'),
-    or None when it records none (results stored before the record existed)."""
-    got = (env or {}).get("numerics") if isinstance(env, dict) else None
-    path = got.get("path") if isinstance(got, dict) else None
-    return path if path in ("compiled", "numpy") else None
+def recorded(env: dict | None) -> str:
+    """The ``FKOPT_NUMERICS`` mode a stored result ran under, from its ``env.json``: its
+    ``numerics.mode``; 'auto' when it records none -- results stored before the record existed
+    ran the numpy swarm fitness and one-pose inverse answers that both paths give alike, which
+    'auto' reproduces."""
+    got = env.get("numerics") if isinstance(env, dict) else None
+    mode = got.get("mode") if isinstance(got, dict) else None
+    return mode if mode in ("auto", "numpy", "compiled") else "auto"
 
 
 @contextmanager
 def forced(path: str | None):
-    """``FKOPT_NUMERICS`` set to ``path`` ('compiled' or 'numpy') inside the block (worker
-    processes started inside inherit it), restored after; None leaves it alone. A stored
-    'compiled' on a machine without numba runs the reference ('auto'): the one-pose answers are
-    the same on both paths, and fkopt's comparison then reports what differs."""
+    """``FKOPT_NUMERICS`` set to ``path`` ('auto', 'numpy' or 'compiled') inside the block (worker
+    processes started inside inherit it), restored after; None leaves it alone. 'compiled' on a
+    machine without numba runs 'auto' (the reference): the one-pose inverse answers are the same
+    on both paths, and fkopt check's comparison reports whatever else differs."""
     if path is None:
         yield
         return

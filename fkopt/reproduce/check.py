@@ -18,7 +18,7 @@ results folder ``<paper>/<name>/``:
    where the stored fingerprint equals this machine's, BLAS-free rows exactly and the rest by the
    cross-platform rules where only the BLAS part differs, the cross-platform rules elsewhere
    (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier); the rerun takes the
-   numerics path recorded in ``env.json`` (``FKOPT_NUMERICS`` set from it: :func:`stored_numerics`);
+   numerics mode recorded in ``env.json`` (``FKOPT_NUMERICS`` set from it: :func:`stored_numerics`);
 5. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
    ``<paper>/claims.csv`` (:func:`fkopt.reproduce.drift.rerun_verdict_drift`), and a paper
    folder whose paper has claims must have its ``claims.csv``.
@@ -82,12 +82,13 @@ def stored_tier(exp: Experiment) -> str:
     return platform_tier(stored)
 
 
-def stored_numerics(exp: Experiment) -> str | None:
-    """The numerics path ('compiled' or 'numpy') recorded in a stored result's env.json, or None."""
+def stored_numerics(exp: Experiment) -> str:
+    """The ``FKOPT_NUMERICS`` mode a stored result ran under (its env.json's ``numerics.mode``;
+    'auto' for results stored before the record existed: :func:`fkopt.numerics.path.recorded`)."""
     try:
         env = json.loads((exp.folder / ENV_FILE).read_text(encoding="utf-8"))
     except (OSError, ValueError):
-        return None
+        env = None
     return numerics_path.recorded(env)
 
 
