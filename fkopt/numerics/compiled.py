@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -426,24 +426,41 @@ def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, d
     return out, info
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True)
 def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
-    """:func:`_inverse_pose` of every row of ``poses`` (k, 6) from start row ``q0[k]``, rows spread
-    over the cores (numba's ``prange``); row k's answer is the one-pose call's."""
-    for k in prange(poses.shape[0]):
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
+    """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
+    ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
+    share a batch (:func:`inverse_rows`)."""
+    for k in range(first, poses.shape[0], step):
         _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr,
                       iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
                       out[k], info[k])
 
 
+#: Batches from this many rows are shared by one thread per core.
+THREAD_ROWS = 64
+
+
 def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
-    """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5))."""
+    """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5)). From
+    :data:`THREAD_ROWS` rows, one Python thread per core takes every t-th row (interleaved, so
+    that the rows needing restarts spread evenly): plain threads rather than numba's parallel
+    layer, whose OpenMP runtime does not survive a fork and whose fallback is not thread-safe."""
+    import os
     k = poses.shape[0]
     out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
-    _inverse_rows(ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
-                  seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
-                  ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
+    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+            seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
+            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
+    threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
+    if k < THREAD_ROWS or threads < 2:
+        _inverse_rows(*args, 0, 1)
+        return out, info
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(threads) as pool:
+        for f in [pool.submit(_inverse_rows, *args, t, threads) for t in range(threads)]:
+            f.result()
     return out, info
 
 
