@@ -159,3 +159,36 @@ def test_swarms_on_the_compiled_3rps_fitness_reach_what_the_numpy_path_reaches(m
     for r in got.values():
         assert (r.fitness < 1e-12).all()
     assert abs(got["numpy"].evaluations.mean() - got["compiled"].evaluations.mean()) <= 30
+
+
+def test_compiled_pso_step_is_the_numpy_step_up_to_the_fitness_tolerance(monkeypatch):
+    """FKOPT_NUMERICS=compiled runs a PSO iteration on a 3-RPS FK problem in one compiled pass:
+    from the same state and the same uniforms, positions and velocities equal numpy's bit for bit
+    (the same operations in the same order), the fitness within the fitness tolerance
+    (|sqrt(f_c) - sqrt(f_n)| <= 1e-11 mm), personal bests equal where the comparison agrees."""
+    import copy
+    from fkopt.algorithms.pso import PSO
+    from fkopt.streams import RunStreams
+    m = fkopt.mechanism("3-rps")
+    targets = m.bounds[:, 0] + np.random.default_rng(6).random((4, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    p = fkopt.fk_problem(m, m.ik(targets))
+    alg = PSO()
+    state = alg.initialize(p, 10, RunStreams(7, range(4)), None, 50)
+    state.best_x, state.best_f = state.x[:, 0].copy(), state.f[:, 0].copy()
+    for _ in range(3):                                     # a few numpy iterations: non-zero velocities
+        alg.iterate(state, p, RunStreams(8, range(4)))
+    got = {}
+    for mode in ("numpy", "compiled"):
+        monkeypatch.setenv(numerics_path.ENV, mode)
+        s = copy.deepcopy(state)
+        alg.iterate(s, p, RunStreams(9, range(4)))
+        got[mode] = s
+    a, b = got["numpy"], got["compiled"]
+    assert PSO._compiled_step(p) is not None
+    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.vel, b.vel)
+    assert np.abs(np.sqrt(a.f) - np.sqrt(b.f)).max() <= 1e-11
+    assert np.array_equal(a.evaluations, b.evaluations)
+    same = (a.f < state.f) == (b.f < state.f)
+    assert np.array_equal(a.x[same], b.x[same])
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    assert PSO._compiled_step(p) is None                  # the default keeps numpy's bits

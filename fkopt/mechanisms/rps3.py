@@ -225,6 +225,19 @@ class ThreeRPS(ParallelMechanism):
         mod = numerics_path.compiled(True)
         return mod.rps3_fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute)
 
+    def compiled_pso_step(self):
+        """A function (state arrays, ...) -> new arrays running one PSO iteration with this fitness
+        compiled (:func:`fkopt.numerics.compiled.pso_rps3`, same arguments after the fitness'
+        leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as :meth:`compiled_fitness`)."""
+        if numerics_path.requested() != "compiled":
+            return None
+        mod = numerics_path.compiled(True)
+        ra, rb = self.geometry.ra, self.geometry.rb
+
+        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute):
+            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute)
+        return step
+
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
 

@@ -465,48 +465,97 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
 
 
 @njit(cache=True)
-def _rps3_fitness(P, J, ra, rb, absolute, out):
-    """Fitness of 3-RPS poses P (n, 3) (alpha, beta in deg, z) against leg rows J (3, 1) or (3, n):
-    the operations of :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` in their order, point by point,
-    then :meth:`fkopt.problems.FKProblem.fitness` (sum of squared or absolute residuals). ``tan``
-    is the C library's; numpy's (SIMD) may differ from it by an ulp (see tests/test_numerics.py)."""
+def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
+    """Fitness of one 3-RPS pose (alpha, beta in deg, z) against legs (j0, j1, j2): the operations
+    of :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` in their order, then
+    :meth:`fkopt.problems.FKProblem.fitness` (sum of squared or absolute residuals). ``tan`` is
+    the C library's; numpy's (SIMD) may differ from it by an ulp (see tests/test_numerics.py)."""
     half = math.pi / 360.0
     s3 = 0.5 * math.sqrt(3.0)
     pm_rb, pm_2 = s3 * rb, -2.0 * s3
+    ta, tb = math.tan(p0 * half), math.tan(p1 * half)
+    ta2, tb2 = ta * ta, tb * tb
+    ra_, rb_ = 1.0 / (1.0 + ta2), 1.0 / (1.0 + tb2)
+    sa, sb = (ta + ta) * ra_, (tb + tb) * rb_
+    ca, cb = (1.0 - ta2) * ra_, (1.0 - tb2) * rb_
+    sbsa = sb * sa
+    tg = sbsa / (ca + cb)
+    cg = 1.0 / math.sqrt(1.0 + tg * tg)
+    sg = tg * cg
+    R00, R10 = cg * cb, sg * cb
+    R11 = sg * sbsa + cg * ca
+    R01 = cg * sbsa - sg * ca
+    h = (0.5 * rb) * R11
+    e = (1.5 * rb) * R00 - h - ra
+    f = z - rb * sb
+    d1 = math.sqrt(e * e + f * f)
+    ax = 0.5 * ra - h
+    bx = pm_rb * R01
+    ay = (-1.5 * rb) * R10
+    by = pm_2 * ax
+    az = z + (0.5 * rb) * sb
+    bz = pm_rb * (cb * sa)
+    u, v, w = ax + bx, ay + by, az + bz
+    d2 = math.sqrt((u * u + v * v) + w * w)
+    u, v, w = ax + (-bx), ay + (-by), az + (-bz)
+    d3 = math.sqrt((u * u + v * v) + w * w)
+    r1, r2, r3 = d1 - j0, d2 - j1, d3 - j2
+    if absolute:
+        return (abs(r1) + abs(r2)) + abs(r3)
+    return (r1 * r1 + r2 * r2) + r3 * r3
+
+
+@njit(cache=True)
+def _rps3_fitness(P, J, ra, rb, absolute, out):
+    """:func:`_rps3_point` of poses P (n, 3) against leg rows J (3, 1) or (3, n) into out (n,)."""
     one = J.shape[1] == 1
     for i in range(P.shape[0]):
-        ta, tb, z = math.tan(P[i, 0] * half), math.tan(P[i, 1] * half), P[i, 2]
-        ta2, tb2 = ta * ta, tb * tb
-        ra_, rb_ = 1.0 / (1.0 + ta2), 1.0 / (1.0 + tb2)
-        sa, sb = (ta + ta) * ra_, (tb + tb) * rb_
-        ca, cb = (1.0 - ta2) * ra_, (1.0 - tb2) * rb_
-        sbsa = sb * sa
-        tg = sbsa / (ca + cb)
-        cg = 1.0 / math.sqrt(1.0 + tg * tg)
-        sg = tg * cg
-        R00, R10 = cg * cb, sg * cb
-        R11 = sg * sbsa + cg * ca
-        R01 = cg * sbsa - sg * ca
-        h = (0.5 * rb) * R11
-        e = (1.5 * rb) * R00 - h - ra
-        f = z - rb * sb
-        d1 = math.sqrt(e * e + f * f)
-        ax = 0.5 * ra - h
-        bx = pm_rb * R01
-        ay = (-1.5 * rb) * R10
-        by = pm_2 * ax
-        az = z + (0.5 * rb) * sb
-        bz = pm_rb * (cb * sa)
-        u, v, w = ax + bx, ay + by, az + bz
-        d2 = math.sqrt((u * u + v * v) + w * w)
-        u, v, w = ax + (-bx), ay + (-by), az + (-bz)
-        d3 = math.sqrt((u * u + v * v) + w * w)
         c = 0 if one else i
-        r1, r2, r3 = d1 - J[0, c], d2 - J[1, c], d3 - J[2, c]
-        if absolute:
-            out[i] = (abs(r1) + abs(r2)) + abs(r3)
-        else:
-            out[i] = (r1 * r1 + r2 * r2) + r3 * r3
+        out[i] = _rps3_point(P[i, 0], P[i, 1], P[i, 2], J[0, c], J[1, c], J[2, c], ra, rb, absolute)
+
+
+@njit(cache=True)
+def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolute, nx, nf, npos, nvel, fout):
+    """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem, every run
+    and particle in one pass: velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations
+    in their order), clamp, move, clip onto the box (velocity zeroed where clipped), the
+    fitness (:func:`_rps3_point`) and the personal best; new arrays nx, nf, npos, nvel, fout."""
+    runs, pop, dim = pos.shape
+    one = J.shape[1] == 1
+    for a in range(runs):
+        for i in range(pop):
+            for d in range(dim):
+                v = vel[a, i, d] * w + (r[a, 0, i, d] * c1) * (x[a, i, d] - pos[a, i, d])
+                v = v + (r[a, 1, i, d] * c2) * (g[a, d] - pos[a, i, d])
+                v = min(max(v, -limit[d]), limit[d])
+                mv = pos[a, i, d] + v
+                cp = min(max(mv, lo[d]), hi[d])
+                nvel[a, i, d] = 0.0 if cp != mv else v
+                npos[a, i, d] = cp
+            c = 0 if one else a * pop + i
+            f = _rps3_point(npos[a, i, 0], npos[a, i, 1], npos[a, i, 2], J[0, c], J[1, c], J[2, c], ra, rb,
+                            absolute)
+            fout[a, i] = f
+            if f < fb[a, i]:
+                nf[a, i] = f
+                for d in range(dim):
+                    nx[a, i, d] = npos[a, i, d]
+            else:
+                nf[a, i] = fb[a, i]
+                for d in range(dim):
+                    nx[a, i, d] = x[a, i, d]
+
+
+def pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute):
+    """:func:`_pso_rps3`: (personal bests x, their fitness, positions, velocities, fitness of the
+    positions), all new arrays."""
+    nx, nf, npos, nvel, fout = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel), \
+        np.empty_like(fb)
+    _pso_rps3(x, fb, pos, vel, np.ascontiguousarray(g), r, float(w), float(c1), float(c2),
+              np.ascontiguousarray(limit, dtype=float), np.ascontiguousarray(bounds[:, 0], dtype=float),
+              np.ascontiguousarray(bounds[:, 1], dtype=float), np.ascontiguousarray(J, dtype=float), float(ra),
+              float(rb), bool(absolute), nx, nf, npos, nvel, fout)
+    return nx, nf, npos, nvel, fout
 
 
 def rps3_fitness(P, J, ra, rb, absolute):
