@@ -30,12 +30,19 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
 4c. ``robots`` -- ``fkopt.inverse`` on the Panda, UR5 and Kinova of example-robot-data and the
    wang7dof arm beside roboticstoolbox's ETS ``ik_LM`` on the same poses, timed alternately
    (:mod:`fkopt.bench_robots`).
+4e. ``ik-one-pose`` and ``ik-batch`` -- ``fkopt.inverse`` on 14 arms of example-robot-data beside
+   roboticstoolbox's ETS ``ik_LM`` at 1e-6 m and 1e-6 rad, one pose per call alternating query by
+   query, and 1000 poses in one fkopt call beside rtb per pose; every answer verified by
+   pinocchio's FK; ratios per arm and their median (:mod:`fkopt.bench_ik`).
 4d. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
    600 iterations): wall time and ns per evaluation, beside the same GABC as a plain C loop
    (``fkopt/bench_ref/gabc_3rps.c``, compiled with the system's C compiler into a temporary
    folder and run on the same 100 cases; the row is skipped with a message when there is no
    compiler), the ratio and whether the target (<= 2x the compiled loop) is met; and the chunk
    size (rows per chunk) that :data:`fkopt.solve.CHUNK_POINTS` was chosen from.
+4f. ``swarms`` -- GABC, ABC and PSO on 3-RPS at 1 case and 100 cases x 30 runs beside the same
+   algorithm as the C loop of ``fkopt/bench_ref/gabc_3rps.c``, alternating: ns per evaluation and
+   the ratio (issue 29's targets: <= 3 at 1 case, <= 1.5 at 100 cases).
 5. ``scaling`` -- GABC on the 3-RPS case with population 10..1000 (30 runs) and runs 1..1000
    (population 10): wall time and ns per evaluation; plotted into ``scaling.png``.
 
@@ -677,12 +684,13 @@ def compile_reference(folder: Path) -> tuple[Path, str] | str:
 
 
 def run_reference(exe: Path, joints: np.ndarray, iterations: int, population: int, runs: int,
-                  seed: int = 1) -> dict[str, float]:
-    """Solve every row of ``joints`` (cases, 3) ``runs`` times with the compiled loop: evaluations,
-    seconds (of the solves, timed inside the program), median and largest final fitness."""
+                  seed: int = 1, algorithm: str = "gabc") -> dict[str, float]:
+    """Solve every row of ``joints`` (cases, 3) ``runs`` times with the compiled loop of
+    ``algorithm`` (gabc, abc or pso): evaluations, seconds (of the solves, timed inside the
+    program), median and largest final fitness."""
     import subprocess
     data = "\n".join(" ".join(repr(float(v)) for v in row) for row in np.atleast_2d(joints)) + "\n"
-    p = subprocess.run([str(exe), str(iterations), str(population), str(runs), str(seed)], input=data,
+    p = subprocess.run([str(exe), str(iterations), str(population), str(runs), str(seed), algorithm], input=data,
                        capture_output=True, text=True, timeout=1800, check=True)
     evals, seconds, median, worst = p.stdout.split()
     return {"evaluations": float(evals), "seconds": float(seconds), "median": float(median),
@@ -755,6 +763,68 @@ def bench_cases(rows: _Rows, quick: bool, rng, messages: list[str] | None = None
 
 
 # -- 5. scaling ------------------------------------------------------------------------------
+#: Section ``swarms``: issue 29's targets, fkopt / C loop per evaluation at 1 case and 100 cases.
+SWARM_TARGETS = {1: 3.0, 100: 1.5}
+
+
+def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
+    """GABC, ABC and PSO on 3-RPS (population 10, 600 iterations; 100 in quick mode; 30 runs) at
+    1 case and at 100 cases, beside the same algorithm as the plain C loop of
+    :data:`REFERENCE_C` on the same cases; alternating fkopt solve, C run (best of 2 each; 1 in
+    quick mode). Rows: ns per evaluation of each and the ratio fkopt / C, against
+    :data:`SWARM_TARGETS`, for the default path and, with numba, ``FKOPT_NUMERICS=compiled``
+    (the 3-RPS fitness compiled; PSO's whole iteration; ABC's and GABC's steps stay numpy). Skipped with a message when there
+    is no C compiler."""
+    import tempfile
+    from . import mechanism
+    from .solve import solve
+    from .numerics import path as numerics_path
+    m = mechanism("3-rps")
+    iterations = 100 if quick else 600
+    reps = 1 if quick else 2
+    joints = m.ik(_uniform(m.bounds, (100,), rng))
+    try:
+        with numerics_path.forced("compiled"):
+            fast = numerics_path.compiled() is not None
+            if fast:                   # numba's import and cache load before any timing
+                fk_problem(m, joints[:1]).fitness(m.bounds.mean(axis=1)[None])
+    except Exception:                  # numba missing or broken: the default path's rows only
+        fast = False
+    with tempfile.TemporaryDirectory() as tmp:
+        built = compile_reference(Path(tmp))
+        if isinstance(built, str):
+            messages.append(f"swarms: section skipped: {built}")
+            return
+        for alg in ("gabc", "abc", "pso"):
+            for n in SWARM_TARGETS:
+                problem = fk_problem(m, joints[:n])
+                f_ns, k_ns, c_ns = np.inf, np.inf, np.inf
+                for _ in range(reps):              # default path, compiled 3-RPS fitness, C loop
+                    t = time.perf_counter()
+                    res = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
+                    f_ns = min(f_ns, (time.perf_counter() - t) / float(res.evaluations.sum()) * 1e9)
+                    if fast:
+                        with numerics_path.forced("compiled"):
+                            t = time.perf_counter()
+                            rk = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
+                            k_ns = min(k_ns, (time.perf_counter() - t) / float(rk.evaluations.sum()) * 1e9)
+                    ref = run_reference(built[0], joints[:n], iterations, 10, 30, algorithm=alg)
+                    c_ns = min(c_ns, ref["seconds"] / ref["evaluations"] * 1e9)
+                ratio, target = f_ns / c_ns, SWARM_TARGETS[n]
+                label = f"{alg} {n} case{'s' if n > 1 else ''} x 30 runs"
+                rows.add("swarms", label, ratio, "x C loop",
+                         f"fkopt {f_ns:.0f} ns/eval, C loop {c_ns:.0f} ns/eval ({built[1]}); {iterations} it, "
+                         f"population 10; best of {reps}; median final fitness fkopt "
+                         f"{float(np.median(res.fitness)):.2g}, C {ref['median']:.2g}; target <= {target:g}: "
+                         f"{'met' if ratio <= target else 'NOT met'}")
+                if fast:
+                    what = "the whole iteration" if alg == "pso" else "the 3-RPS fitness; the steps numpy"
+                    rows.add("swarms", label + ", FKOPT_NUMERICS=compiled", k_ns / c_ns, "x C loop",
+                             f"compiled: {what}; {k_ns:.0f} ns/eval; "
+                             f"median final fitness {float(np.median(rk.fitness)):.2g}; target <= {target:g}: "
+                             f"{'met' if k_ns <= target * c_ns else 'NOT met'}")
+
+
 def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, float]]]:
     from .solve import solve
     problem = mao_problem()
@@ -823,7 +893,8 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
-SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "robots", "cases", "scaling")
+SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "robots", "ik-one-pose", "ik-batch",
+            "cases", "swarms", "scaling")
 
 
 def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
@@ -848,25 +919,41 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     messages: list[str] = []
     start = time.perf_counter()
 
+    spent: dict[str, float] = {}                       # seconds per section, printed at the end
+
+    def timed(name, fn, *args):
+        t = time.perf_counter()
+        got = fn(*args)
+        spent[name] = spent.get(name, 0.0) + time.perf_counter() - t
+        return got
+
     if "throughput" in want:
-        bench_throughput(rows, quick, rng)
-    per_run = bench_mao2017(rows, quick) if ("mao2017" in want or "peers" in want) else {}
+        timed("throughput", bench_throughput, rows, quick, rng)
+    per_run = timed("mao2017", bench_mao2017, rows, quick) if ("mao2017" in want or "peers" in want) else {}
     if peers and "peers" in want:
-        bench_peers(rows, quick, per_run.get("gabc"), messages)
+        timed("peers", bench_peers, rows, quick, per_run.get("gabc"), messages)
     if (peers or sections) and "adapters" in want:       # opt-in, as peers: needs pymoo/NiaPy
-        bench_adapters(rows, quick, messages)
+        timed("adapters", bench_adapters, rows, quick, messages)
     if "exact" in want:
-        bench_exact(rows, quick, rng)
+        timed("exact", bench_exact, rows, quick, rng)
     if "kinematics" in want:
-        bench_kinematics(rows, quick, np.random.default_rng(12), messages)
-        bench_cli_process(rows, quick)
+        timed("kinematics", bench_kinematics, rows, quick, np.random.default_rng(12), messages)
+        timed("kinematics", bench_cli_process, rows, quick)
     if "robots" in want:
         from .bench_robots import bench_robots
-        bench_robots(rows, quick, messages)
+        timed("robots", bench_robots, rows, quick, messages)
+    if "ik-one-pose" in want:
+        from .bench_ik import bench_ik_one_pose
+        timed("ik-one-pose", bench_ik_one_pose, rows, quick, messages)
+    if "ik-batch" in want:
+        from .bench_ik import bench_ik_batch
+        timed("ik-batch", bench_ik_batch, rows, quick, messages)
     if "cases" in want:
-        bench_cases(rows, quick, rng, messages)
+        timed("cases", bench_cases, rows, quick, rng, messages)
+    if "swarms" in want:
+        timed("swarms", bench_swarms, rows, quick, np.random.default_rng(29), messages)
     if "scaling" in want:
-        curves = bench_scaling(rows, quick)
+        curves = timed("scaling", bench_scaling, rows, quick)
         plot_scaling(curves, out / "scaling.png", 50 if quick else 200)
 
     df = pd.DataFrame(rows.rows, columns=["section", "item", "value", "unit", "note"])
@@ -883,5 +970,6 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     for msg in messages:
         console.print(msg)
     wrote = f"{out / 'bench.csv'}" + (f" and {out / 'scaling.png'}" if "scaling" in want else "")
-    console.print(f"total {time.perf_counter() - start:.1f} s; wrote {wrote}")
+    per = ", ".join(f"{k} {v:.1f}" for k, v in spent.items())
+    console.print(f"total {time.perf_counter() - start:.1f} s ({per}); wrote {wrote}")
     return df

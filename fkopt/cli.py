@@ -654,13 +654,16 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
 
 
 @app.command()
-def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s)"),
+def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~30 s on a busy 2-core machine: "
+                                     "27-29 s measured; the first run after installing also compiles the "
+                                     "numerics, ~25 s more)"),
           peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
                                             "throughput, mao2017, peers, adapters, exact, kinematics, robots, "
-                                            "cases, scaling (default: all but peers and adapters)")):
+                                            "ik-one-pose, ik-batch, cases, swarms, scaling (default: all but peers "
+                                            "and adapters)")):
     """Measure fkopt's speed (and peers') on this machine.
 
     Sections: throughput (batched fitness evaluations per second), mao2017 (the paper's Tab. 3
@@ -669,8 +672,11 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     on kinbench's problems; with --peers or named), exact (batched
     lm), kinematics (fkopt.forward, fkopt.inverse, all assembly modes, the fk process),
     robots (fkopt.inverse on URDF arms from example-robot-data beside roboticstoolbox's ETS
-    ik_LM, if installed), cases (N cases x 30 runs solved together, beside a compiled C loop when a C compiler is
-    there), scaling (population and runs; draws scaling.png)."""
+    ik_LM, if installed), ik-one-pose and ik-batch (fkopt.inverse on 14 example-robot-data arms beside
+    rtb's ik_LM at 1e-6 m / 1e-6 rad, one pose per call and 1000 poses in one call, answers checked
+    by pinocchio's FK), cases (N cases x 30 runs solved together, beside a compiled C loop when a C
+    compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop), scaling
+    (population and runs; draws scaling.png). The last line gives the seconds per section."""
     from .bench import SECTIONS, run as run_bench
     from .files import output_folder
     bad = [s for s in section if s not in SECTIONS]

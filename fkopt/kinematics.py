@@ -804,6 +804,38 @@ def _arm_constants(m) -> dict:
     return got
 
 
+def _fast_context(m, table: int, W) -> dict:
+    """Per-arm constants of the compiled one-pose call (:func:`fkopt.numerics.compiled.inverse_pose`),
+    as typed arrays, cached beside :func:`_arm_constants` (so a change of the bounds renews them):
+    the chain, limits, unit and periodic masks, and the start table (or its masked copy for task
+    mask W) with its features transposed for the compiled nearest-neighbour search."""
+    c = _arm_constants(m)
+    key = ("fast", table, None if W is None else W.tobytes())
+    got = c.get(key)
+    if got is None:
+        n = m.dof
+        if table:
+            tab = _start_table(m, table)
+            if W is not None:
+                tab = _masked_table(tab, W)
+            if "norms" not in tab:
+                tab["norms"] = _sumsq(tab["features"])
+            tq, F, norms, w = tab["q"], tab["features"], tab["norms"], float(tab["w"])
+            fmask = tab.get("mask", np.ones(12))
+        else:
+            tq, F, norms, w, fmask = np.zeros((0, n)), np.zeros((0, 12)), np.zeros(0), 0.0, np.ones(12)
+        got = c[key] = {
+            "n": n, "chain": m.chain().arrays(), "tq": np.ascontiguousarray(tq, dtype=float),
+            "Ft": np.ascontiguousarray(F.T, dtype=float), "norms": np.ascontiguousarray(norms, dtype=float), "w": w,
+            "fmask": np.ascontiguousarray(fmask, dtype=float), "W": np.ones(6) if W is None else np.asarray(W, float),
+            "slo": np.asarray(c["slo"], dtype=float), "shi": np.asarray(c["shi"], dtype=float),
+            "lo": np.asarray(c["lo"], dtype=float), "hi": np.asarray(c["hi"], dtype=float),
+            "angle": np.array(c["angle"], dtype=np.bool_), "periodic": np.array(c["periodic"], dtype=np.bool_),
+            "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
+            "mid": np.array(c["mid"], dtype=float)}
+    return got
+
+
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
@@ -836,9 +868,22 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
     L = float(orientation_scale) if orientation_scale else reach
+    nn = min(table, kn) if table else 0
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and (start is None or (n <= 6 and W is None)):
+        # no self-motion step after the loop: pose to answer in one compiled call
+        ctx = _fast_context(m, int(table), W)
+        out, info = fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"],
+                                      ctx["mid"] if start is None else np.array(q0), own0, nn, int(seed), int(budget),
+                                      tol, int(iterations), float(damping), float(down), float(up), float(step_cap))
+        perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
+        return InverseResult(
+            mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
+            rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+            solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
+            evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
     Rt = _zyz_matrix1(*pose[3:].tolist())
     near: list[int] = []
-    nn = min(table, kn) if table else 0
 
     def start_of(j):
         if j < own0:
@@ -856,7 +901,6 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         return (lo + (hi - lo) * _uniform_hash(seed, np.zeros(1, dtype=np.intp),
                                                np.array([j - own0 - nn]), n)[0]).tolist()
 
-    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
     if fast is not None:
         # the same starts as start_of, as arrays: the table's neighbours looked up now
         if nn:
@@ -944,7 +988,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         raise FkoptError(f"inverse needs an arm with an analytic frame Jacobian; '{m.name}' has none "
                          "(use fkopt.solve with an ik_problem)")
     try:
-        tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
+        if isinstance(tol, tuple) and len(tol) == 2:      # the common case, without numpy's broadcast
+            tp, tr = float(tol[0]), float(tol[1])
+        else:
+            tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
     except (TypeError, ValueError):
         raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
     if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
@@ -981,6 +1028,27 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = _internal(m, q0)
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and rest <= 0 and not exact_rotation and (start is None or (n <= 6 and W is None)):
+        # every row as its one-pose call (same starts, restarts and answer), rows on all cores
+        own0 = 1 if (start is not None or not table) else 0
+        first = max(1, int(starts), fill)
+        nn = min(int(table), first - own0 + int(neighbours)) if table else 0
+        ctx = _fast_context(m, int(table), W)
+        out, info = fast.inverse_rows(ctx, np.ascontiguousarray(P, dtype=float),
+                                      float(orientation_scale) if orientation_scale else reach, ctx["W"],
+                                      np.ascontiguousarray(q0, dtype=float), own0, nn, int(seed),
+                                      first + max(0, int(restarts)), (tp, tr), int(iterations), float(damping),
+                                      float(down), float(up), float(step_cap))
+        perr, rerr = info[:, 0], info[:, 1]
+        ev = info[:, 4].astype(np.int64)
+        return InverseResult(
+            mechanism=m.name, names=tuple(m.joint_names), joints=out.reshape(shape + (n,)),
+            position_error=perr.reshape(shape), rotation_error=rerr.reshape(shape),
+            residual=np.maximum(perr / tp, rerr / tr).reshape(shape),
+            solved=((perr <= tp) & (rerr <= tr) & (info[:, 2] > 0)).reshape(shape),
+            restarts=(info[:, 3].astype(np.int64) - 1).reshape(shape),
+            evaluations={"residual": ev.reshape(shape), "jacobian": ev.copy().reshape(shape)}, tol=(tp, tr))
     K = max(1, int(starts))
     if N * K < fill:                                   # small batches: more candidates per row
         K = max(K, fill // N)

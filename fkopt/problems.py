@@ -196,6 +196,11 @@ class FKProblem(Problem):
         if self.cases is not None:
             self._check_cases(x)
         lead = x.shape[:-1]
+        compiled = getattr(self.mechanism, "compiled_fitness", None)
+        if compiled is not None and not self._angle.any():   # FKOPT_NUMERICS=compiled only
+            got = compiled(x.reshape(-1, x.shape[-1]), self._joint_rows(lead), self.objective == "absolute")
+            if got is not None:
+                return got.reshape(lead)
         r = columns(x)
         np.subtract(r, self._joint_rows(lead), out=r)
         if self._angle.any():

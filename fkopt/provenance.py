@@ -6,6 +6,12 @@ changes with the machine and is never compared by ``fkopt check``:
 
 * ``fkopt_version`` and ``libraries`` (Python and the versions of the libraries fkopt uses);
 * ``platform`` (operating system, CPU architecture, CPU model);
+* ``numerics`` -- which numerics path made the result (``path``: ``"compiled"`` or ``"numpy"``),
+  the ``FKOPT_NUMERICS`` mode it ran under and numba's version
+  (:func:`fkopt.numerics.path.describe`); ``fkopt check`` reruns under that mode
+  (:func:`fkopt.numerics.path.forced`). Not part of the fingerprint: one-pose inverse answers
+  are the same on both paths (tests/test_numerics.py), and the compiled swarm fitness runs
+  only under an explicit ``FKOPT_NUMERICS=compiled``, which is recorded;
 * ``fingerprint`` -- what decides the bits of a result, in two parts (:data:`BLAS_KEYS`):
 
   - the arithmetic fkopt's own elementwise code runs: Python, numpy, scipy and pandas versions,
@@ -26,6 +32,8 @@ import platform
 import sys
 from functools import lru_cache
 from importlib.metadata import PackageNotFoundError, version
+
+from .numerics import path as numerics_path
 
 ENV_FILE = "env.json"
 LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "typer", "rich", "pymoo", "niapy",
@@ -131,4 +139,4 @@ def environment() -> dict:
     return {"fkopt_version": fkopt_version, "libraries": library_versions(),
             "platform": {"system": platform.system(), "machine": platform.machine(),
                          "python_implementation": platform.python_implementation(), "cpu": _cpu_model()},
-            "fingerprint": fingerprint()}
+            "fingerprint": fingerprint(), "numerics": numerics_path.describe()}

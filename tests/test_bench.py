@@ -15,7 +15,8 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100
     assert len(np.unique(img.reshape(-1, img.shape[-1]), axis=0)) > 10
     assert len(csv) == len(df)
-    assert set(csv.section) == {"throughput", "mao2017", "exact", "kinematics", "robots", "cases", "scaling"}
+    core = {"throughput", "mao2017", "exact", "kinematics", "robots", "cases", "scaling"}
+    assert core <= set(csv.section) <= core | {"ik-one-pose", "ik-batch", "swarms"}   # when rtb, pinocchio, a C compiler are there
     assert np.all(np.isfinite(csv.value)) and np.all(csv.value >= 0)
     # every registered mechanism has a throughput row
     for name in fkopt.MECHANISMS:
@@ -79,3 +80,23 @@ def test_compiled_reference_solves_the_same_problem(tmp_path):
     assert abs(per_run - r.evaluations.mean()) < 50
     assert out["median"] < 1e-12 and np.median(r.fitness) < 1e-12
     assert out["seconds"] > 0
+
+
+def test_compiled_reference_abc_and_pso_loops_solve_the_same_problem(tmp_path):
+    """The swarms section's C loops of ABC and PSO: fkopt's budget in evaluations (PSO exactly
+    population per iteration), and they solve the poses as fkopt does (a broken loop would not)."""
+    import pytest
+    built = bench.compile_reference(tmp_path)
+    if isinstance(built, str):
+        pytest.skip(built)
+    m = fkopt.mechanism("3-rps")
+    poses = m.bounds[:, 0] + np.random.default_rng(4).random((4, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    joints = m.ik(poses)
+    for alg, iterations in (("abc", 300), ("pso", 300)):
+        out = bench.run_reference(built[0], joints, iterations, 10, 5, algorithm=alg)
+        r = fkopt.solve(fkopt.fk_problem(m, joints), alg, population=10, iterations=iterations, runs=5, seed=1)
+        per_run = out["evaluations"] / 20
+        assert abs(per_run - r.evaluations.mean()) < 50, alg
+        if alg == "pso":
+            assert per_run == 10 * (iterations + 1)
+        assert out["median"] < 1e-6 and np.median(r.fitness) < 1e-6, (alg, out["median"], np.median(r.fitness))

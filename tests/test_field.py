@@ -73,3 +73,17 @@ def test_field_solver_answers_verified(solver, name):
     v = ik_verdicts(m, a.joints, T)
     assert v["success"][:, 1].mean() >= 0.7
     assert (v["success"][:, 1] <= v["in_limits"]).all()
+
+
+@pytest.mark.parametrize("name", ["pr2-left", "tiago", "talos-left"])
+def test_rtb_chain_below_a_moving_joint_has_the_chains_joints_only(name):
+    """rtb's robot.ets(base, tip) takes the joint into base too when it moves (PR2's and TIAGo's
+    torso lift, Talos's torso); the adapter's ETS has the chain's joints, with fkopt's FK."""
+    pytest.importorskip("roboticstoolbox")
+    from fkopt.adapters.field.rtb import chain_ets
+    m = arm(name)
+    ets, _ = chain_ets(m.path, m.base_link, m.tip_link)
+    q, T = targets(m, 3, 6)
+    assert ets.n == m.dof
+    for k in range(3):
+        assert np.abs(ets.fkine(np.radians(q[k])).A - T[k]).max() < 1e-12

@@ -92,11 +92,38 @@ class PSO(Algorithm):
             return p.w
         return p.w_max - (p.w_max - p.w_min) * min(state.t, state.span) / state.span
 
+    @staticmethod
+    def _compiled_step(problem):
+        """(compiled iteration, absolute objective) when the problem's mechanism offers one
+        (``compiled_pso_step``: the 3-RPS FK fitness under ``FKOPT_NUMERICS=compiled``), else None.
+        The same operations as below; the fitness' ``tan`` may be an ulp from numpy's."""
+        mech = getattr(problem, "mechanism", None)
+        make = getattr(mech, "compiled_pso_step", None)
+        rows = getattr(problem, "_joint_rows", None)
+        if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
+            return None
+        step = make()
+        if step is None:
+            return None
+        return step, problem.objective == "absolute"
+
     def iterate(self, state, problem, streams):
         p = self.params
         state.t += 1
         runs, population, dim = state.x.shape
         r = streams.uniform(2, population, dim)     # a fresh view: ours to overwrite
+        fused = self._compiled_step(problem)
+        if fused is not None:                      # FKOPT_NUMERICS=compiled on a built-in fitness
+            step, absolute = fused
+            if problem.cases is not None:
+                problem._check_cases(state.pos)
+            J = problem._joint_rows(state.pos.shape[:-1])     # the fitness' target rows
+            state.x, state.f, state.pos, state.vel, f = step(
+                state.x, state.f, state.pos, state.vel, state.best_x, r, self.inertia_weight(state), p.c1, p.c2,
+                self.velocity_limit(problem.bounds), problem.bounds, J, absolute)
+            evaluated(state, f)
+            state.evaluations = state.evaluations + population
+            return
         g = state.best_x[:, None, :]
         # w v + c1 r1 (p - x) + c2 r2 (g - x), the same operations in the same order, in place
         cognitive, social = r[:, 0], r[:, 1]

@@ -11,12 +11,18 @@
  *     onlooker roulette on fit = 1/(1+f); limit = SN * dim; per iteration a scout (the source
  *     with most trials, if above limit, evaluated with the employed bees), the employed phase,
  *     the best-so-far update, the onlooker phase, the best-so-far update.
+ * ABC (algorithm "abc"): the same loop with Karaboga's move v_j = x_j + phi (x_j - x_kj).
+ * PSO (algorithm "pso", fkopt/algorithms/pso.py defaults): global best, w = 0.7298,
+ *   c1 = c2 = 1.49618, velocity clamp 0.2 x box width per coordinate, positions clipped onto the
+ *   box and the velocity component that hit it set to zero, initial velocities zero, gbest read
+ *   once per iteration; population evaluations per iteration.
  * Differences that do not change the cost per evaluation: onlookers act one after the other
  * (Karaboga's loop; fkopt resolves them synchronously), and the random numbers come from a
  * PCG64 (XSL-RR 128/64, the generator numpy uses) seeded here by splitmix64, so the numbers
  * are not fkopt's.
  *
- * Usage: gabc_3rps ITERATIONS POPULATION RUNS SEED < joints   (one "d1 d2 d3" line per case)
+ * Usage: gabc_3rps ITERATIONS POPULATION RUNS SEED [gabc|abc|pso] < joints   (one "d1 d2 d3" line
+ * per case; the algorithm defaults to gabc)
  * Prints one line: "evaluations seconds median_final_fitness max_final_fitness", where seconds
  * covers the solves only (clock_gettime, CLOCK_MONOTONIC), not reading the input.
  */
@@ -32,6 +38,8 @@
 static const double LO[DIM] = {-20.0, -20.0, 400.0};
 static const double HI[DIM] = {20.0, 20.0, 700.0};
 static const double RA = 274.0, RB = 158.0;
+enum { GABC, ABC, PSO };
+static int algorithm = GABC;
 
 /* -- PCG64 (XSL-RR 128/64) ------------------------------------------------------------------ */
 typedef struct { __uint128_t state, inc; } pcg64;
@@ -113,7 +121,8 @@ static void try_move(colony *c, int i, int sn, pcg64 *g, const double *joints) {
     k += k >= i;
     double phi = 2.0 * uniform(g) - 1.0;
     double v[DIM] = {c->x[i][0], c->x[i][1], c->x[i][2]};
-    double m = v[j] + (phi * (v[j] - c->x[k][j]) + phi * (c->best_x[j] - c->x[k][j]));
+    double m = algorithm == ABC ? v[j] + phi * (v[j] - c->x[k][j])
+                                : v[j] + (phi * (v[j] - c->x[k][j]) + phi * (c->best_x[j] - c->x[k][j]));
     v[j] = m < LO[j] ? LO[j] : (m > HI[j] ? HI[j] : m);
     double fv = fitness(v, joints);
     if (fv < c->f[i]) {
@@ -165,15 +174,58 @@ static double gabc_run(int iterations, int sn, pcg64 *g, const double *joints, l
     return c.best_f;
 }
 
+/* -- PSO, one run ---------------------------------------------------------------------------- */
+static double pso_run(int iterations, int n, pcg64 *g, const double *joints, long *evals) {
+    static double pos[MAXPOP][DIM], vel[MAXPOP][DIM], px[MAXPOP][DIM], pf[MAXPOP];
+    const double w = 0.7298, c1 = 1.49618, c2 = 1.49618;
+    double vmax[DIM], gx[DIM] = {0.0, 0.0, 0.0}, gf = INFINITY;
+    for (int d = 0; d < DIM; d++) vmax[d] = 0.2 * (HI[d] - LO[d]);
+    for (int i = 0; i < n; i++) {
+        for (int d = 0; d < DIM; d++) {
+            pos[i][d] = px[i][d] = LO[d] + uniform(g) * (HI[d] - LO[d]);
+            vel[i][d] = 0.0;
+        }
+        pf[i] = fitness(px[i], joints);
+    }
+    *evals += n;
+    for (int i = 0; i < n; i++)
+        if (pf[i] < gf) { gf = pf[i]; for (int d = 0; d < DIM; d++) gx[d] = px[i][d]; }
+    for (int t = 1; t <= iterations; t++) {
+        for (int i = 0; i < n; i++) {
+            for (int d = 0; d < DIM; d++) {
+                double r1 = uniform(g), r2 = uniform(g);
+                double v = w * vel[i][d] + c1 * r1 * (px[i][d] - pos[i][d]) + c2 * r2 * (gx[d] - pos[i][d]);
+                v = v < -vmax[d] ? -vmax[d] : (v > vmax[d] ? vmax[d] : v);
+                double m = pos[i][d] + v, c = m < LO[d] ? LO[d] : (m > HI[d] ? HI[d] : m);
+                vel[i][d] = c != m ? 0.0 : v;
+                pos[i][d] = c;
+            }
+            double f = fitness(pos[i], joints);
+            if (f < pf[i]) { pf[i] = f; for (int d = 0; d < DIM; d++) px[i][d] = pos[i][d]; }
+        }
+        *evals += n;
+        for (int i = 0; i < n; i++)
+            if (pf[i] < gf) { gf = pf[i]; for (int d = 0; d < DIM; d++) gx[d] = px[i][d]; }
+    }
+    return gf;
+}
+
 static int cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
 }
 
 int main(int argc, char **argv) {
-    if (argc != 5) {
-        fprintf(stderr, "usage: %s ITERATIONS POPULATION RUNS SEED < joints\n", argv[0]);
+    if (argc != 5 && argc != 6) {
+        fprintf(stderr, "usage: %s ITERATIONS POPULATION RUNS SEED [gabc|abc|pso] < joints\n", argv[0]);
         return 2;
+    }
+    if (argc == 6) {
+        const char *a = argv[5];
+        if (a[0] == 'g' && a[1] == 'a') algorithm = GABC;
+        else if (a[0] == 'a' && a[1] == 'b') algorithm = ABC;
+        else if (a[0] == 'p' && a[1] == 's') algorithm = PSO;
+        else { fprintf(stderr, "algorithm: gabc, abc or pso\n"); return 2; }
     }
     int iterations = atoi(argv[1]), sn = atoi(argv[2]), runs = atoi(argv[3]);
     uint64_t seed = strtoull(argv[4], NULL, 10);
@@ -199,7 +251,8 @@ int main(int argc, char **argv) {
         for (int r = 0; r < runs; r++) {
             pcg64 g;
             pcg64_seed(&g, seed, (uint64_t)c * 1000003ULL + (uint64_t)r);
-            final[c * runs + r] = gabc_run(iterations, sn, &g, &joints[DIM * c], &evals);
+            final[c * runs + r] = algorithm == PSO ? pso_run(iterations, sn, &g, &joints[DIM * c], &evals)
+                                                   : gabc_run(iterations, sn, &g, &joints[DIM * c], &evals);
         }
     clock_gettime(CLOCK_MONOTONIC, &t1);
     double seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);

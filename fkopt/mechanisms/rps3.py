@@ -22,6 +22,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import rotations
+from ..numerics import path as numerics_path
 from .base import Geometry, ParallelMechanism
 
 
@@ -210,6 +211,32 @@ class ThreeRPS(ParallelMechanism):
         add(BX, BY, BX)
         add(BX, BZ, BX)
         np.sqrt(BX, out[1:3])                               # d2, d3
+
+    def compiled_fitness(self, poses, rows, absolute: bool):
+        """The fitness of :meth:`fkopt.problems.FKProblem.fitness` of poses (n, 3) against leg rows
+        (3, 1) or (3, n) in one compiled pass (:func:`fkopt.numerics.compiled.rps3_fitness`), or
+        None unless ``FKOPT_NUMERICS=compiled`` asks for it: its ``tan`` is the C library's, which
+        may differ from numpy's SIMD one by an ulp, and a swarm amplifies an ulp into another
+        run, so the default keeps numpy's bits (the stored results') and importing numba (~0.9 s)
+        pays only in long runs. Tested to 1e-9 relative against the numpy path per evaluation,
+        and on swarm outcomes (tests/test_numerics.py)."""
+        if numerics_path.requested() != "compiled":
+            return None
+        mod = numerics_path.compiled(True)
+        return mod.rps3_fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute)
+
+    def compiled_pso_step(self):
+        """A function (state arrays, ...) -> new arrays running one PSO iteration with this fitness
+        compiled (:func:`fkopt.numerics.compiled.pso_rps3`, same arguments after the fitness'
+        leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as :meth:`compiled_fitness`)."""
+        if numerics_path.requested() != "compiled":
+            return None
+        mod = numerics_path.compiled(True)
+        ra, rb = self.geometry.ra, self.geometry.rb
+
+        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute):
+            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute)
+        return step
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.

@@ -505,6 +505,15 @@ EXAMPLE_ROBOTS = {
     "z1": ("z1_description/urdf/z1.urdf", "link00", "gripperStator"),
     "baxter-left": ("baxter_description/urdf/baxter.urdf", "torso", "left_gripper"),
     "pr2-left-gripper": ("pr2_description/urdf/pr2.urdf", "torso_lift_link", "l_gripper_l_finger_tip_link"),
+    "ur3": ("ur_description/urdf/ur3_robot.urdf", "base_link", "tool0"),
+    "ur10": ("ur_description/urdf/ur10_robot.urdf", "base_link", "tool0"),
+    "baxter-right": ("baxter_description/urdf/baxter.urdf", "torso", "right_gripper"),
+    "pr2-left": ("pr2_description/urdf/pr2.urdf", "torso_lift_link", "l_wrist_roll_link"),
+    "romeo-left": ("romeo_description/urdf/romeo.urdf", "torso", "l_wrist"),
+    "tiago": ("tiago_description/robots/tiago_no_hand.urdf", "torso_lift_link", "arm_tool_link"),
+    "talos-left": ("talos_data/robots/talos_reduced.urdf", "torso_2_link", "gripper_left_base_link"),
+    "icub-left": ("icub_description/robots/icub.urdf", "chest", "l_hand"),
+    "g1-left": ("g1_description/urdf/g1_29dof_rev_1_0.urdf", "torso_link", "left_rubber_hand"),
 }
 
 

@@ -324,3 +324,243 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
     return best, used, evals
+
+
+@njit(cache=True)
+def _nearest_into(Ft, norms, f, idx, best):
+    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx:
+    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics._nearest`'s brute force; the dot product
+    summed feature by feature, rows side by side, from ``Ft`` = F transposed), the k smallest kept
+    sorted by insertion (ties: the lower row first)."""
+    c, N = Ft.shape
+    k = idx.shape[0]
+    d2 = np.zeros(N)
+    for j in range(c):
+        fj = f[j]
+        for i in range(N):
+            d2[i] += Ft[j, i] * fj
+    m = 0
+    for i in range(N):
+        v = norms[i] - 2.0 * d2[i]
+        if m < k:
+            pos = m
+            m += 1
+        elif v < best[k - 1]:
+            pos = k - 1
+        else:
+            continue
+        while pos > 0 and best[pos - 1] > v:
+            best[pos] = best[pos - 1]
+            idx[pos] = idx[pos - 1]
+            pos -= 1
+        best[pos] = v
+        idx[pos] = i
+
+
+@njit(cache=True)
+def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
+    """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
+    the target rotation (ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`), the
+    start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
+    (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
+    [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
+    target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
+    used, evaluations)."""
+    n = q0.shape[0]
+    d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
+    r2d = 180.0 / math.pi
+    a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
+    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+    T = np.empty((3, 3))
+    T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+    T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+    T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
+    pt = pose[:3].copy()
+    near = np.empty((nn, n))
+    if nn > 0:
+        f = np.empty(12)
+        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
+        for r in range(3):
+            for c in range(3):
+                f[3 + 3 * r + c] = wf * T[r, c]
+        for j in range(12):
+            f[j] = f[j] * fmask[j]
+        idx = np.empty(nn, dtype=np.int64)
+        _nearest_into(Ft, norms, f, idx, np.empty(nn))
+        for k in range(nn):
+            near[k, :] = tq[idx[k]]
+    best = np.empty(n)
+    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, 0, budget, tp, tr, iterations, damping,
+                               down, up, step_cap, slo, shi, lo, hi, best)
+    t = np.empty(n)
+    inside = True
+    for i in range(n):
+        v = best[i] * r2d if angle[i] else best[i]
+        if periodic[i]:
+            v = (v + 180.0) % 360.0 - 180.0
+        v = min(max(v, blo[i]), bhi[i])
+        out[i] = v
+        inside = inside and blo[i] <= v <= bhi[i]
+        t[i] = v * d2r if angle[i] else v
+    prismatic, C, v_, var, mult, off, tC, tv = chain
+    p, R, J, ax, e = np.empty(3), np.empty((3, 3)), np.empty((6, n)), np.empty((prismatic.shape[0], 6)), np.empty(3)
+    _walk(prismatic, C, v_, var, mult, off, tC, tv, t, p, R, J, ax)
+    _rotation_error(R, T, e)
+    d0, d1, d2 = (p[0] - pt[0]) * W[0], (p[1] - pt[1]) * W[1], (p[2] - pt[2]) * W[2]
+    e0, e1, e2 = e[0] * W[3], e[1] * W[4], e[2] * W[5]
+    info[0] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    info[1] = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    info[2] = 1.0 if inside else 0.0
+    info[3] = used
+    info[4] = evals
+
+
+def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+    """One pose through :func:`_inverse_pose` with the per-arm constants ``ctx`` (see
+    :func:`fkopt.kinematics._fast_context`): (public joints (n,), info (5,))."""
+    out, info = np.empty(ctx["n"]), np.empty(5)
+    _inverse_pose(ctx["chain"], pose, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+                  seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
+                  ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
+    return out, info
+
+
+@njit(cache=True, nogil=True)
+def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
+    """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
+    ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
+    share a batch (:func:`inverse_rows`)."""
+    for k in range(first, poses.shape[0], step):
+        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr,
+                      iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
+                      out[k], info[k])
+
+
+#: Batches from this many rows are shared by one thread per core.
+THREAD_ROWS = 64
+
+
+def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+    """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5)). From
+    :data:`THREAD_ROWS` rows, one Python thread per core takes every t-th row (interleaved, so
+    that the rows needing restarts spread evenly): plain threads rather than numba's parallel
+    layer, whose OpenMP runtime does not survive a fork and whose fallback is not thread-safe."""
+    import os
+    k = poses.shape[0]
+    out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
+    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+            seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
+            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
+    threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
+    if k < THREAD_ROWS or threads < 2:
+        _inverse_rows(*args, 0, 1)
+        return out, info
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(threads) as pool:
+        for f in [pool.submit(_inverse_rows, *args, t, threads) for t in range(threads)]:
+            f.result()
+    return out, info
+
+
+@njit(cache=True)
+def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
+    """Fitness of one 3-RPS pose (alpha, beta in deg, z) against legs (j0, j1, j2): the operations
+    of :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` in their order, then
+    :meth:`fkopt.problems.FKProblem.fitness` (sum of squared or absolute residuals). ``tan`` is
+    the C library's; numpy's (SIMD) may differ from it by an ulp (see tests/test_numerics.py)."""
+    half = math.pi / 360.0
+    s3 = 0.5 * math.sqrt(3.0)
+    pm_rb, pm_2 = s3 * rb, -2.0 * s3
+    ta, tb = math.tan(p0 * half), math.tan(p1 * half)
+    ta2, tb2 = ta * ta, tb * tb
+    ra_, rb_ = 1.0 / (1.0 + ta2), 1.0 / (1.0 + tb2)
+    sa, sb = (ta + ta) * ra_, (tb + tb) * rb_
+    ca, cb = (1.0 - ta2) * ra_, (1.0 - tb2) * rb_
+    sbsa = sb * sa
+    tg = sbsa / (ca + cb)
+    cg = 1.0 / math.sqrt(1.0 + tg * tg)
+    sg = tg * cg
+    R00, R10 = cg * cb, sg * cb
+    R11 = sg * sbsa + cg * ca
+    R01 = cg * sbsa - sg * ca
+    h = (0.5 * rb) * R11
+    e = (1.5 * rb) * R00 - h - ra
+    f = z - rb * sb
+    d1 = math.sqrt(e * e + f * f)
+    ax = 0.5 * ra - h
+    bx = pm_rb * R01
+    ay = (-1.5 * rb) * R10
+    by = pm_2 * ax
+    az = z + (0.5 * rb) * sb
+    bz = pm_rb * (cb * sa)
+    u, v, w = ax + bx, ay + by, az + bz
+    d2 = math.sqrt((u * u + v * v) + w * w)
+    u, v, w = ax + (-bx), ay + (-by), az + (-bz)
+    d3 = math.sqrt((u * u + v * v) + w * w)
+    r1, r2, r3 = d1 - j0, d2 - j1, d3 - j2
+    if absolute:
+        return (abs(r1) + abs(r2)) + abs(r3)
+    return (r1 * r1 + r2 * r2) + r3 * r3
+
+
+@njit(cache=True)
+def _rps3_fitness(P, J, ra, rb, absolute, out):
+    """:func:`_rps3_point` of poses P (n, 3) against leg rows J (3, 1) or (3, n) into out (n,)."""
+    one = J.shape[1] == 1
+    for i in range(P.shape[0]):
+        c = 0 if one else i
+        out[i] = _rps3_point(P[i, 0], P[i, 1], P[i, 2], J[0, c], J[1, c], J[2, c], ra, rb, absolute)
+
+
+@njit(cache=True)
+def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolute, nx, nf, npos, nvel, fout):
+    """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem, every run
+    and particle in one pass: velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations
+    in their order), clamp, move, clip onto the box (velocity zeroed where clipped), the
+    fitness (:func:`_rps3_point`) and the personal best; new arrays nx, nf, npos, nvel, fout."""
+    runs, pop, dim = pos.shape
+    one = J.shape[1] == 1
+    for a in range(runs):
+        for i in range(pop):
+            for d in range(dim):
+                v = vel[a, i, d] * w + (r[a, 0, i, d] * c1) * (x[a, i, d] - pos[a, i, d])
+                v = v + (r[a, 1, i, d] * c2) * (g[a, d] - pos[a, i, d])
+                v = min(max(v, -limit[d]), limit[d])
+                mv = pos[a, i, d] + v
+                cp = min(max(mv, lo[d]), hi[d])
+                nvel[a, i, d] = 0.0 if cp != mv else v
+                npos[a, i, d] = cp
+            c = 0 if one else a * pop + i
+            f = _rps3_point(npos[a, i, 0], npos[a, i, 1], npos[a, i, 2], J[0, c], J[1, c], J[2, c], ra, rb,
+                            absolute)
+            fout[a, i] = f
+            if f < fb[a, i]:
+                nf[a, i] = f
+                for d in range(dim):
+                    nx[a, i, d] = npos[a, i, d]
+            else:
+                nf[a, i] = fb[a, i]
+                for d in range(dim):
+                    nx[a, i, d] = x[a, i, d]
+
+
+def pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute):
+    """:func:`_pso_rps3`: (personal bests x, their fitness, positions, velocities, fitness of the
+    positions), all new arrays."""
+    nx, nf, npos, nvel, fout = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel), \
+        np.empty_like(fb)
+    _pso_rps3(x, fb, pos, vel, np.ascontiguousarray(g), r, float(w), float(c1), float(c2),
+              np.ascontiguousarray(limit, dtype=float), np.ascontiguousarray(bounds[:, 0], dtype=float),
+              np.ascontiguousarray(bounds[:, 1], dtype=float), np.ascontiguousarray(J, dtype=float), float(ra),
+              float(rb), bool(absolute), nx, nf, npos, nvel, fout)
+    return nx, nf, npos, nvel, fout
+
+
+def rps3_fitness(P, J, ra, rb, absolute):
+    """:func:`_rps3_fitness` of poses (n, 3) against leg rows J: fitness (n,)."""
+    out = np.empty(P.shape[0])
+    _rps3_fitness(np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(J, dtype=float), float(ra), float(rb),
+                  bool(absolute), out)
+    return out

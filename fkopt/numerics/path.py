@@ -10,6 +10,7 @@ see ``fkopt/cli.py``).
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 
 from ..errors import FkoptError
 
@@ -18,10 +19,16 @@ _STATE: dict = {}
 
 
 def requested() -> str:
-    """'auto', 'numpy' or 'compiled' from ``FKOPT_NUMERICS``."""
-    v = os.environ.get(ENV, "auto").strip().lower() or "auto"
+    """'auto', 'numpy' or 'compiled' from ``FKOPT_NUMERICS`` (read on every call: a test or a
+    caller may change it; the parsed value is kept per raw string)."""
+    raw = os.environ.get(ENV)
+    got = _STATE.get(("requested", raw))
+    if got is not None:
+        return got
+    v = (raw or "auto").strip().lower() or "auto"
     if v not in ("auto", "numpy", "compiled"):
         raise FkoptError(f"{ENV}={v!r}: allowed values auto, numpy, compiled")
+    _STATE[("requested", raw)] = v
     return v
 
 
@@ -44,7 +51,10 @@ def compiled(want: bool | None = None):
 
 
 def describe() -> dict:
-    """What ``env.json`` records: the path a default call takes in this process and numba's version."""
+    """What ``env.json`` records (its ``numerics``): ``path``, the path a default ``fkopt.inverse``
+    call takes in this process ('compiled' with numba, else 'numpy'); ``mode``, the
+    ``FKOPT_NUMERICS`` setting it ran under ('auto', 'numpy' or 'compiled': with 'compiled' the
+    3-RPS swarm fitness is compiled too, ``compiled_fitness``); numba's version; the raw variable."""
     try:
         from importlib.metadata import PackageNotFoundError, version
         try:
@@ -55,4 +65,42 @@ def describe() -> dict:
         nv = None
     mode = requested()
     path = "numpy" if mode == "numpy" or nv is None else "compiled"
-    return {"path": path, "numba": nv, "env": os.environ.get(ENV, "")}
+    return {"path": path, "mode": mode, "compiled_fitness": mode == "compiled" and nv is not None, "numba": nv,
+            "env": os.environ.get(ENV, "")}
+
+
+def recorded(env: dict | None) -> str:
+    """The ``FKOPT_NUMERICS`` mode a stored result ran under, from its ``env.json``: its
+    ``numerics.mode``; 'auto' when it records none -- results stored before the record existed
+    ran the numpy swarm fitness and one-pose inverse answers that both paths give alike, which
+    'auto' reproduces."""
+    got = env.get("numerics") if isinstance(env, dict) else None
+    mode = got.get("mode") if isinstance(got, dict) else None
+    return mode if mode in ("auto", "numpy", "compiled") else "auto"
+
+
+@contextmanager
+def forced(path: str | None):
+    """``FKOPT_NUMERICS`` set to ``path`` ('auto', 'numpy' or 'compiled') inside the block (worker
+    processes started inside inherit it), restored after; None leaves it alone. 'compiled' on a
+    machine without numba runs 'auto' (the reference): the one-pose inverse answers are the same
+    on both paths, and fkopt check's comparison reports whatever else differs."""
+    if path is None:
+        yield
+        return
+    if path == "compiled":
+        try:
+            from importlib.util import find_spec
+            have = find_spec("numba") is not None
+        except (ImportError, ValueError):
+            have = False
+        path = "compiled" if have else "auto"
+    before = os.environ.get(ENV)
+    os.environ[ENV] = path
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop(ENV, None)
+        else:
+            os.environ[ENV] = before

@@ -17,7 +17,8 @@ results folder ``<paper>/<name>/``:
    platform tier (:func:`fkopt.provenance.platform_tier`, :mod:`fkopt.compare`): byte for byte
    where the stored fingerprint equals this machine's, BLAS-free rows exactly and the rest by the
    cross-platform rules where only the BLAS part differs, the cross-platform rules elsewhere
-   (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier);
+   (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier); the rerun takes the
+   numerics mode recorded in ``env.json`` (``FKOPT_NUMERICS`` set from it: :func:`stored_numerics`);
 5. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
    ``<paper>/claims.csv`` (:func:`fkopt.reproduce.drift.rerun_verdict_drift`), and a paper
    folder whose paper has claims must have its ``claims.csv``.
@@ -38,6 +39,7 @@ import pandas as pd
 from ..compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
 from ..errors import FkoptError
 from ..experiment.kinds import from_dict, rerun_files
+from ..numerics import path as numerics_path
 from ..provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
 from .store import Experiment, Store
 
@@ -78,6 +80,16 @@ def stored_tier(exp: Experiment) -> str:
     except (OSError, ValueError, AttributeError):
         return ANY
     return platform_tier(stored)
+
+
+def stored_numerics(exp: Experiment) -> str:
+    """The ``FKOPT_NUMERICS`` mode a stored result ran under (its env.json's ``numerics.mode``;
+    'auto' for results stored before the record existed: :func:`fkopt.numerics.path.recorded`)."""
+    try:
+        env = json.loads((exp.folder / ENV_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        env = None
+    return numerics_path.recorded(env)
 
 
 def rules_for(exp: Experiment, tier: str) -> Rules:
@@ -207,7 +219,8 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
     out += timing_verdicts(exp)
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-check-"))
     try:
-        rerun_files(config, tmp, exp.meta.get("config_file"))
+        with numerics_path.forced(stored_numerics(exp)):          # the path that made it
+            rerun_files(config, tmp, exp.meta.get("config_file"))
         names = sorted(set(deterministic_files(exp.folder)) | set(deterministic_files(tmp)))
         order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
         order += ["meta.json"]

@@ -12,7 +12,8 @@ Quirks worked around: rtb resolves the meshes' ``package://`` paths through xacr
 copy of the file without visual, collision, transmission and gazebo elements (the chain needs
 none); a sub-chain ``robot.ets(start, end)`` keeps the whole robot's joint indices (``jindex``),
 so a chain starting below the root (Baxter's arm from its torso) would read q at the wrong
-places -- the wrapper renumbers the chain's joints 0..n-1; the ETS is checked against fkopt's FK
+places, and it includes the joint into ``start`` when that one moves -- the wrapper composes the
+links' own ETS from below ``base`` to ``tip`` and renumbers the chain's joints 0..n-1; the ETS is checked against fkopt's FK
 at a random configuration when built, so an arm rtb misreads is refused with one line.
 """
 from __future__ import annotations
@@ -45,7 +46,19 @@ def chain_ets(path: Path, base: str, tip: str):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             links, name, _ = URDF_file(str(copy))
-    ets = rtb.Robot(links, name=name).ets(start=base, end=tip)
+    robot = rtb.Robot(links, name=name)
+    # the links strictly below ``base`` up to ``tip``, each with the ETS from its parent (joint
+    # included): rtb's own ``robot.ets(start, end)`` also takes the joint *into* ``base`` when that
+    # joint moves (PR2's torso lift, TIAGo's, Talos's torso), one joint too many
+    link, below = robot.link_dict.get(tip), []
+    while link is not None and link.name != base:
+        below.append(link)
+        link = link.parent
+    if link is None:
+        raise FkoptError(f"rtb: link '{tip}' of {path} is not below '{base}'")
+    ets = rtb.ETS()
+    for lk in reversed(below):
+        ets = ets * lk.ets
     k = 0
     for e in ets:
         if e.isjoint:

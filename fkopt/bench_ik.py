@@ -1,0 +1,235 @@
+"""``fkopt bench --section ik-one-pose`` and ``--section ik-batch``: ``fkopt.inverse`` on real arms
+beside roboticstoolbox's ETS ``ik_LM`` (C++), the answers of both verified by pinocchio's FK.
+
+Arms (:data:`ARMS`, chains of :data:`fkopt.mechanisms.urdf.EXAMPLE_ROBOTS` in example-robot-data):
+Panda, UR3, UR5, UR10, Kinova j2s6s200, xArm7, Unitree Z1, Baxter's two arms, PR2's left arm,
+Romeo's left arm, TIAGo's arm, Talos's left arm, Unitree G1's left arm (6 and 7 joints). An arm
+whose rtb ETS disagrees with fkopt's FK when read (iCub's arm: rtb misreads its URDF) or that
+pinocchio reads differently is left out with a message.
+
+Per arm ``n`` poses: joints uniform inside the limits (generator seeded per arm), target frame =
+pinocchio's FK of those joints (not fkopt's, not rtb's). Tolerance 1e-6 m and 1e-6 rad for both:
+fkopt gets ``tol=(1e-6, 1e-6)``; rtb stops at E = 1/2 |e|^2 < tol (e = position error, rotation
+vector) and gets tol = 1/2 (1e-6)^2, which implies both (and is no looser). rtb: ``ilimit=30``,
+``slimit=100`` (its defaults), ``joint_limits=True``, first start q0 uniform in the limits from a
+seeded generator. An answer counts as solved only when pinocchio's FK of it (continuous joints
+wrapped) is within both tolerances of the target and it is inside the limits; neither library's own
+verdict is counted.
+
+* ``ik-one-pose``: one pose per call, fkopt (``fkopt.inverse(arm, pose)``, the compiled one-pose
+  loop unless ``FKOPT_NUMERICS=numpy``) and rtb alternating query by query in this process (which
+  of the two goes first alternates too), after one warm-up call each (numba's cache load and the
+  arm's start table happen there, reported on the row "first call"). Per arm: median ms of each,
+  the ratio of the medians fkopt/rtb, solved fraction of each; then the median ratio over arms and
+  the largest (targets <= 1 and <= 2, issue 29).
+* ``ik-batch``: all ``n`` poses (1000; 200 in quick mode) in one ``fkopt.inverse`` call beside rtb
+  called per pose on the same poses, alternating call by call (best of 2; 1 in quick mode); per
+  arm µs per pose of each and their ratio; median over arms (target <= 0.5, none above 1).
+
+Timings are wall-clock on whatever else the machine is doing: read the ratios, not the times.
+Skipped with a message when roboticstoolbox-python, pinocchio or example-robot-data is missing.
+"""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+
+import numpy as np
+
+ARMS = ("panda", "ur3", "ur5", "ur10", "kinova", "xarm7", "z1", "baxter-left", "baxter-right", "pr2-left",
+        "romeo-left", "tiago", "talos-left", "g1-left", "icub-left")
+#: Quick mode: a subset (6 and 7 joints, the slowest arms of the last measurement included).
+QUICK_ARMS = ("panda", "ur5", "ur10", "kinova", "xarm7", "romeo-left")
+TOL = (1e-6, 1e-6)                # m, rad
+RTB_TOL = 0.5 * TOL[0] ** 2       # E = 1/2 |e|^2 < tol  =>  |e| < 1e-6, both errors below their tolerances
+
+
+class PinocchioFK:
+    """Frame of the tip in the base of an arm's URDF chain by pinocchio's own reader and FK
+    (Carpentier et al., SII 2019): the independent check of every answer here. Continuous joints
+    are pinocchio's (cos, sin) pairs; joints outside the chain stay at pinocchio's neutral."""
+
+    def __init__(self, arm):
+        import pinocchio as pin
+        self.pin = pin
+        self.model = pin.buildModelFromUrdf(str(arm.path))
+        self.data = self.model.createData()
+        self.base = self.model.getFrameId(arm.base_link, pin.FrameType.BODY)
+        self.tip = self.model.getFrameId(arm.tip_link, pin.FrameType.BODY)
+        js = [self.model.joints[self.model.getJointId(n)] for n in arm.joint_names]
+        self.idx = [(j.idx_q, j.nq) for j in js]
+        self.x0 = self.pin.neutral(self.model)
+
+    def frame(self, q_rad) -> np.ndarray:
+        """4x4 tip-in-base frame at chain joints ``q_rad`` (n,), SI units."""
+        x = self.x0.copy()
+        for (i, nq), v in zip(self.idx, q_rad):
+            if nq == 2:
+                x[i], x[i + 1] = math.cos(v), math.sin(v)
+            else:
+                x[i] = v
+        self.pin.framesForwardKinematics(self.model, self.data, x)
+        return (self.data.oMf[self.base].inverse() * self.data.oMf[self.tip]).homogeneous
+
+
+def frame_errors(T, Tt) -> tuple[float, float]:
+    """(position error, geodesic rotation error in rad) of frame T against target Tt (4x4):
+    the angle from atan2(|vee(M - M^T)| / 2, (tr M - 1) / 2), M = R^T Rt, accurate near 0."""
+    M = T[:3, :3].T @ Tt[:3, :3]
+    s = 0.5 * math.sqrt((M[2, 1] - M[1, 2]) ** 2 + (M[0, 2] - M[2, 0]) ** 2 + (M[1, 0] - M[0, 1]) ** 2)
+    c = 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)
+    return float(np.linalg.norm(T[:3, 3] - Tt[:3, 3])), math.atan2(s, c)
+
+
+class _Arm:
+    """One arm of the bench: fkopt's model, rtb's ETS, pinocchio's check, poses and targets."""
+
+    def __init__(self, name, n, seed):
+        from .adapters.field.rtb import chain_ets
+        from .mechanisms import urdf
+        self.name = name
+        self.m = m = urdf.example_robot(name)
+        self.pfk = PinocchioFK(m)
+        self.ets, self.rtb_version = chain_ets(m.path, m.base_link, m.tip_link)
+        rng = np.random.default_rng(seed)
+        self.Q = m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
+        self.T = np.array([self.pfk.frame(np.radians(q)) for q in self.Q])
+        self.P = m.fk(self.Q)                                  # the same targets as fkopt's poses
+        lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+        self.q0 = lo + rng.random((n, m.dof)) * (hi - lo)     # rtb's first start per pose
+        self.periodic = m.periodic_mask()
+
+    def problem(self) -> str | None:
+        """Why this arm cannot be compared (readers disagree), or None."""
+        m = self.m
+        if self.ets.n != m.dof:
+            return f"{self.name}: rtb's chain has {self.ets.n} joints, fkopt's {m.dof}"
+        q = np.radians(self.Q[0])
+        gap_rtb = np.abs(self.ets.fkine(q).A - m.fk_matrix(self.Q[:1])[0]).max()
+        gap_pin = np.abs(self.T[0] - m.fk_matrix(self.Q[:1])[0]).max()
+        if not gap_pin < 1e-9:
+            return f"{self.name}: pinocchio's FK differs from fkopt's by {gap_pin:.2g} m"
+        if not gap_rtb < 1e-9:
+            return f"{self.name}: rtb's ETS FK differs from pinocchio's and fkopt's by {gap_rtb:.2g} (rtb misreads it)"
+        return None
+
+    def rtb(self, k):
+        sol = self.ets.ik_LM(self.T[k], q0=self.q0[k], ilimit=30, slimit=100, tol=RTB_TOL, joint_limits=True)
+        return np.degrees(sol.q if hasattr(sol, "q") else sol[0])
+
+    def verified(self, q_deg, k) -> bool:
+        """pinocchio's check of one answer (deg) to pose k: both tolerances, inside the limits."""
+        q = np.array(q_deg, dtype=float)
+        if not np.isfinite(q).all():
+            return False
+        q[self.periodic] = (q[self.periodic] + 180.0) % 360.0 - 180.0
+        b = self.m.bounds
+        if not ((q >= b[:, 0]) & (q <= b[:, 1])).all():
+            return False
+        pe, re = frame_errors(self.pfk.frame(np.radians(q)), self.T[k])
+        return pe <= TOL[0] and re <= TOL[1]
+
+
+def _arms(names, n, messages):
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            import pinocchio  # noqa: F401
+            import roboticstoolbox  # noqa: F401
+    except Exception as err:
+        messages.append(f"ik sections skipped: {type(err).__name__}: {err} (pip install roboticstoolbox-python pin)")
+        return []
+    from .mechanisms import urdf
+    if urdf.example_robots_folder() is None:
+        messages.append("ik sections skipped: example-robot-data not installed (pip install example-robot-data)")
+        return []
+    out = []
+    for i, name in enumerate(names):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            a = _Arm(name, n, 2026 + i)
+        why = a.problem()
+        if why:
+            messages.append(f"ik sections: {why}; left out")
+        else:
+            out.append(a)
+    return out
+
+
+def _summary(rows, sec, ratios, target_median, target_max, what):
+    names = list(ratios)
+    r = np.array([ratios[k] for k in names])
+    worst = names[int(np.argmax(r))]
+    rows.add(sec, "median over arms", float(np.median(r)), "x rtb",
+             f"{what}; {len(r)} arms; target <= {target_median}: {'met' if np.median(r) <= target_median else 'NOT met'}")
+    rows.add(sec, "largest", float(r.max()), "x rtb",
+             f"{worst}; target <= {target_max}: {'met' if r.max() <= target_max else 'NOT met'}; "
+             f"arms above: {', '.join(k for k in names if ratios[k] > target_max) or 'none'}")
+
+
+def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
+    from . import kinematics
+    from .numerics import path
+    sec = "ik-one-pose"
+    n = 20 if quick else 100
+    arms = _arms(QUICK_ARMS if quick else ARMS, n, messages)
+    if not arms:
+        return
+    fast = path.compiled()
+    ratios = {}
+    for a in arms:
+        t = time.perf_counter()
+        kinematics.inverse(a.m, a.P[0], tol=TOL)
+        t_first = time.perf_counter() - t
+        a.rtb(0)
+        tf, tr, okf, okr = [], [], 0, 0
+        for k in range(n):
+            for who in ((0, 1) if k % 2 == 0 else (1, 0)):
+                if who == 0:
+                    t = time.perf_counter()
+                    res = kinematics.inverse(a.m, a.P[k], tol=TOL)
+                    tf.append(time.perf_counter() - t)
+                    okf += a.verified(res.joints, k)
+                else:
+                    t = time.perf_counter()
+                    q = a.rtb(k)
+                    tr.append(time.perf_counter() - t)
+                    okr += a.verified(q, k)
+        f_ms, r_ms = float(np.median(tf)) * 1e3, float(np.median(tr)) * 1e3
+        ratios[a.name] = f_ms / r_ms
+        rows.add(sec, a.name, f_ms / r_ms, "x rtb",
+                 f"{a.m.dof} joints; fkopt median {f_ms:.3f} ms (mean {np.mean(tf) * 1e3:.3f}), rtb median "
+                 f"{r_ms:.3f} ms (mean {np.mean(tr) * 1e3:.3f}); solved (pinocchio FK, 1e-6 m, 1e-6 rad, limits) "
+                 f"fkopt {okf}/{n}, rtb {okr}/{n}; first call {t_first * 1e3:.0f} ms")
+    _summary(rows, sec, ratios, 1, 2, f"ratio of median times per pose, {n} poses per arm, "
+             f"fkopt path {'compiled' if fast is not None else 'numpy'}, rtb {arms[0].rtb_version}")
+
+
+def bench_ik_batch(rows, quick: bool, messages: list[str]) -> None:
+    from . import kinematics
+    sec = "ik-batch"
+    n = 200 if quick else 1000
+    reps = 1 if quick else 2
+    arms = _arms(QUICK_ARMS if quick else ARMS, n, messages)
+    if not arms:
+        return
+    ratios = {}
+    for a in arms:
+        kinematics.inverse(a.m, a.P[:64], tol=TOL)                # warm: start table, tree, compile
+        best_f = best_r = np.inf
+        for _ in range(reps):
+            t = time.perf_counter()
+            res = kinematics.inverse(a.m, a.P, tol=TOL)
+            best_f = min(best_f, time.perf_counter() - t)
+            t = time.perf_counter()
+            qr = [a.rtb(k) for k in range(n)]
+            best_r = min(best_r, time.perf_counter() - t)
+        okf = sum(a.verified(res.joints[k], k) for k in range(n))
+        okr = sum(a.verified(qr[k], k) for k in range(n))
+        f_us, r_us = best_f / n * 1e6, best_r / n * 1e6
+        ratios[a.name] = f_us / r_us
+        rows.add(sec, a.name, f_us / r_us, "x rtb",
+                 f"{a.m.dof} joints; fkopt {f_us:.0f} µs/pose in one call of {n}, rtb {r_us:.0f} µs/pose "
+                 f"(one call per pose); best of {reps}; solved (pinocchio FK) fkopt {okf}/{n}, rtb {okr}/{n}")
+    _summary(rows, sec, ratios, 0.5, 1, f"µs per pose, fkopt batched ({n} poses) / rtb per pose")

@@ -1,0 +1,57 @@
+"""fkopt.bench_ik: the IK sections' independent check (pinocchio's FK) and their rows, on the UR5
+of example-robot-data (no timing is asserted)."""
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.external
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    pytest.importorskip("pinocchio")
+    pytest.importorskip("roboticstoolbox")
+    from fkopt.mechanisms import urdf
+    if urdf.example_robots_folder() is None:
+        pytest.skip("example-robot-data is not installed")
+    from fkopt.bench_ik import _Arm
+    return _Arm("ur5", 4, 7)
+
+
+def test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones(ur5):
+    assert ur5.problem() is None
+    for k in range(4):
+        assert ur5.verified(ur5.Q[k], k)
+        off = ur5.Q[k].copy()
+        off[0] += 1e-3                                   # 1e-3 deg at the base: > 1e-6 m at the tip
+        assert not ur5.verified(off, k)
+        assert not ur5.verified(np.full(ur5.m.dof, np.nan), k)
+    q = ur5.Q[0].copy()
+    q[1] = ur5.m.bounds[1, 1] + 1e-6                     # outside the limits, whatever its pose
+    assert not ur5.verified(q, 0)
+
+
+def test_frame_errors_of_a_known_rotation_and_offset():
+    from fkopt.bench_ik import frame_errors
+    T = np.eye(4)
+    U = np.eye(4)
+    a = 1e-7
+    U[:3, :3] = [[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]]
+    U[:3, 3] = [3e-7, 4e-7, 0]
+    pe, re = frame_errors(T, U)
+    assert pe == pytest.approx(5e-7, rel=1e-9) and re == pytest.approx(a, rel=1e-6)
+
+
+def test_ik_sections_report_every_arm_ratios_and_verified_counts(ur5, monkeypatch):
+    from fkopt import bench_ik
+    from fkopt.bench import _Rows
+    monkeypatch.setattr(bench_ik, "QUICK_ARMS", ("ur5",))
+    rows, msgs = _Rows(), []
+    bench_ik.bench_ik_one_pose(rows, True, msgs)
+    bench_ik.bench_ik_batch(rows, True, msgs)
+    got = {(r["section"], r["item"]): r for r in rows.rows}
+    for sec, n in (("ik-one-pose", 20), ("ik-batch", 200)):
+        r = got[(sec, "ur5")]
+        assert r["unit"] == "x rtb" and np.isfinite(r["value"]) and r["value"] > 0
+        assert f"fkopt {n}/{n}" in r["note"] or f"fkopt {n - 1}/{n}" in r["note"]
+        assert (sec, "median over arms") in got and (sec, "largest") in got
+    assert not msgs
