@@ -1,0 +1,95 @@
+"""kinbench's real arms (fkopt.kinbench.robots): each stored kinematics-only copy gives its package's
+own FK -- pinocchio on example-robot-data's original URDF, MuJoCo's mj_kinematics on robosuite's
+original MJCF -- on random configurations inside the joint limits."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fkopt
+from fkopt.kinbench.robots import ARMS, original_file
+
+SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
+
+
+def stored_arm(arm):
+    return fkopt.mechanism(arm.format, file=str(SUITES / arm.file), base=arm.base, tip=arm.tip)
+
+
+def random_joints(mech, rows=25, seed=5):
+    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    return lo + np.random.default_rng(seed).random((rows, mech.dof)) * (hi - lo)
+
+
+def si_values(mech, row) -> dict:
+    """Joint name -> value in SI units (rad, m) of every chain joint, mimics from their masters."""
+    si = {n: np.radians(v) if u == "deg" else v for n, v, u in zip(mech.joint_names, row, mech.joint_units)}
+    return {cj["name"]: cj["multiplier"] * si[cj["unknown"]] + cj["offset"] for cj in mech.chain_joints}
+
+
+def frames(mech, q):
+    p, R = mech.frame(q)
+    return (np.stack(p, axis=-1), np.stack([np.stack(r, axis=-1) for r in R], axis=-2))
+
+
+def test_the_table_holds_twenty_arms_of_five_to_fifteen_joints_and_every_stored_file_loads():
+    dofs = {}
+    for arm in ARMS:
+        text = (SUITES / arm.file).read_text(encoding="utf-8")
+        assert arm.licence in text and arm.source in text and "<mesh" not in text and "<visual" not in text
+        dofs[arm.name] = stored_arm(arm).dof
+    assert len(ARMS) >= 20 and all(5 <= d <= 15 for d in dofs.values()), dofs
+    assert sum(a.format == "mjcf" for a in ARMS) >= 4 and sum(d > 7 for d in dofs.values()) >= 2
+    pr2 = stored_arm(next(a for a in ARMS if a.name == "pr2-left-gripper"))
+    assert any(cj["unknown"] != cj["name"] for cj in pr2.chain_joints)          # the mimic joint
+
+
+@pytest.mark.parametrize("arm", [a for a in ARMS if a.format == "urdf"], ids=lambda a: a.name)
+def test_stored_urdf_copy_matches_pinocchio_on_the_original(arm):
+    pin = pytest.importorskip("pinocchio")
+    src = original_file(arm)
+    if src is None:
+        pytest.skip(f"{arm.package} is not installed")
+    model = pin.buildModelFromUrdf(str(src))
+    data = model.createData()
+    base, tip = (model.getFrameId(n, pin.FrameType.BODY) for n in (arm.base, arm.tip))     # the link, not its joint
+    mech = stored_arm(arm)
+    q = random_joints(mech)
+    p, R = frames(mech, q)
+    for i, row in enumerate(q):
+        x = pin.neutral(model)
+        for name, v in si_values(mech, row).items():
+            j = model.joints[model.getJointId(name)]
+            if j.nq == 2:                          # continuous joint: (cos, sin)
+                x[j.idx_q:j.idx_q + 2] = np.cos(v), np.sin(v)
+            else:
+                x[j.idx_q] = v
+        pin.framesForwardKinematics(model, data, x)
+        rel = data.oMf[base].inverse() * data.oMf[tip]
+        assert np.abs(rel.translation - p[i]).max() < 1e-12, arm.name
+        assert np.abs(rel.rotation - R[i]).max() < 1e-12, arm.name
+
+
+@pytest.mark.parametrize("arm", [a for a in ARMS if a.format == "mjcf"], ids=lambda a: a.name)
+def test_stored_mjcf_copy_matches_mj_kinematics_on_the_original(arm):
+    mujoco = pytest.importorskip("mujoco")
+    src = original_file(arm)
+    if src is None:
+        pytest.skip(f"{arm.package} is not installed")
+    model = mujoco.MjModel.from_xml_path(str(src))
+    data = mujoco.MjData(model)
+    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, arm.tip)
+    site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, arm.tip)
+    b0 = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, arm.base)
+    mech = stored_arm(arm)
+    q = random_joints(mech)
+    p, R = frames(mech, q)
+    for i, row in enumerate(q):
+        data.qpos[:] = model.qpos0
+        for name, v in si_values(mech, row).items():
+            data.qpos[model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)]] = v
+        mujoco.mj_kinematics(model, data)
+        pt, Rt = ((data.xpos[body], data.xmat[body]) if body >= 0 else (data.site_xpos[site], data.site_xmat[site]))
+        R0 = data.xmat[b0].reshape(3, 3)
+        assert np.abs(R0.T @ (pt - data.xpos[b0]) - p[i]).max() < 1e-12, arm.name
+        assert np.abs(R0.T @ Rt.reshape(3, 3) - R[i]).max() < 1e-12, arm.name
