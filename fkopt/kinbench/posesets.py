@@ -216,6 +216,8 @@ def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
             pts = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=float)
             pts = pts.reshape(-1, len(entry["unknowns"]))
             out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
+    from .releases import check_release
+    check_release(config, manifest)      # a released version: every file as released, not only as its manifest says
     return out, manifest
 
 
