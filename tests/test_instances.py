@@ -1,5 +1,5 @@
 """Geometry instances of the parallel mechanisms (fkopt.kinbench.instances): `instances: K` on a suite
-problem yields name#1..name#K, drawn from the suite's seed inside the documented ranges, each
+problem yields name-i1..name-iK, drawn from the suite's seed inside the documented ranges, each
 non-degenerate with its workspace box."""
 import numpy as np
 import pytest
@@ -30,7 +30,7 @@ def one(name, k=10, **extra):
 def test_instances_are_seeded_inside_the_documented_ranges_and_not_degenerate(name):
     import fkopt
     cfg = suite([one(name)])
-    assert [p.name for p in cfg.problems] == [f"{name}#{k}" for k in range(1, 11)]
+    assert [p.name for p in cfg.problems] == [f"{name}-i{k}" for k in range(1, 11)]
     again = suite([one(name)])
     assert [p.mechanism for p in cfg.problems] == [p.mechanism for p in again.problems]
     other = suite([one(name)], seed=1)
@@ -61,7 +61,7 @@ def test_instances_survive_the_quick_tier_and_a_dump_and_reload():
     cfg = suite([one("mao2017-3rps", 3), {"name": "wu2015-3ppr", "problem_class": "c", "mechanism": PAPERS["wu2015-3ppr"]}])
     again = suite_from_dict(cfg.model_dump(mode="json"), "dump")
     assert [p.model_dump() for p in again.problems] == [p.model_dump() for p in cfg.problems]
-    assert [p.name for p in cfg.problems] == ["mao2017-3rps#1", "mao2017-3rps#2", "mao2017-3rps#3", "wu2015-3ppr"]
+    assert [p.name for p in cfg.problems] == ["mao2017-3rps-i1", "mao2017-3rps-i2", "mao2017-3rps-i3", "wu2015-3ppr"]
 
 
 def test_refusals_are_one_line(monkeypatch):

@@ -95,14 +95,14 @@ class OutsideSolver(Strict):
 
 
 class SuiteProblem(Strict):
-    #: ``name#k`` is instance k of a problem with ``instances`` (:mod:`fkopt.kinbench.instances`).
-    name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,59}(#[0-9]{1,3})?$")
+    #: ``name-ik`` is instance k of a problem with ``instances`` (:mod:`fkopt.kinbench.instances`).
+    name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
     #: Problems of one class are ranked together (no alias such as ``class``: a stored config
     #: must dump to the same mapping it was read from).
     problem_class: str = Field(min_length=1, max_length=64)
     mechanism: MechanismSpec
     objective: str | None = None
-    #: K seeded geometries of a parallel mechanism: the problem stands for name#1 ... name#K.
+    #: K seeded geometries of a parallel mechanism: the problem stands for name-i1 ... name-iK.
     instances: int | None = Field(None, ge=1, le=100)
 
 

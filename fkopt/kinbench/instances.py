@@ -6,8 +6,10 @@ make a result about the mechanism class (as COCO's instances of a function). A s
     - {name: mao2017-3rps, problem_class: parallel-fk-3dof, instances: 10,
        mechanism: {name: 3-rps, geometry: {ra: 274, rb: 158}}}
 
-stands for the problems ``mao2017-3rps#1`` ... ``mao2017-3rps#10`` (the problem as written, the
-paper's geometry, is not among them: list it as well to keep it). Instance k's geometry is the
+stands for the problems ``mao2017-3rps-i1`` ... ``mao2017-3rps-i10`` (the problem as written, the
+paper's geometry, is not among them: list it as well to keep it). The suffix ``-ik`` rather than
+``#k``: a problem's name is also a folder (its pose sets) and a label in the HTML board, where
+``#`` is not a safe character. Instance k's geometry is the
 problem's geometry (over the mechanism's defaults) with each parameter of :data:`SPREADS` drawn
 from the stream ``PCG64(SeedSequence([suite seed, crc32(problem name), crc32("instance"), k]))``:
 
@@ -104,6 +106,8 @@ def expand(problem: dict, seed: int, where: str) -> list[dict]:
     from ..experiment.config import MechanismSpec
     from .posesets import problem_mechanism
     k_total = problem["instances"]
+    if len(f"{problem['name']}-i{k_total}") > 64:
+        raise FkoptError(f"{where}.name: '{problem['name']}' is too long for its instance names (64 characters)")
     name = problem["mechanism"]["name"]
     if name not in SPREADS:
         raise FkoptError(f"{where}.instances: mechanism '{name}' has no geometry instances (allowed for: "
@@ -130,6 +134,6 @@ def expand(problem: dict, seed: int, where: str) -> list[dict]:
         else:
             raise FkoptError(f"{where}.instances: no non-degenerate geometry for instance {k} in {ATTEMPTS} draws "
                              f"(last: {why})")
-        out.append({**{f: v for f, v in problem.items() if f != "instances"}, "name": f"{problem['name']}#{k}",
+        out.append({**{f: v for f, v in problem.items() if f != "instances"}, "name": f"{problem['name']}-i{k}",
                     "mechanism": spec.model_dump(mode="json")})
     return out
