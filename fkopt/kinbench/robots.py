@@ -60,9 +60,9 @@ ARMS: tuple[Arm, ...] = (
     Arm("kinova-j2s6s200", "urdf", _ERD, "kinova_description/robots/kinova.urdf", "base", "j2s6s200_end_effector",
         "Kinova JACO2 j2s6s200", "https://github.com/Kinovarobotics/kinova-ros", "BSD", "kinbench-v2"),
     Arm("ur3", "urdf", _ERD, "ur_description/urdf/ur3_robot.urdf", "base_link", "tool0", "Universal Robots UR3",
-        "https://github.com/ros-industrial/universal_robot", "BSD-3-Clause"),
+        "https://github.com/ros-industrial/universal_robot", "BSD"),
     Arm("ur10", "urdf", _ERD, "ur_description/urdf/ur10_robot.urdf", "base_link", "tool0", "Universal Robots UR10",
-        "https://github.com/ros-industrial/universal_robot", "BSD-3-Clause"),
+        "https://github.com/ros-industrial/universal_robot", "BSD"),
     Arm("xarm7", "urdf", _ERD, "xarm_description/urdf/xarm7.urdf", "link_base", "link_eef", "UFACTORY xArm 7",
         "https://github.com/xArm-Developer/xarm_ros2", "BSD-3-Clause"),
     Arm("z1", "urdf", _ERD, "z1_description/urdf/z1.urdf", "link00", "gripperStator", "Unitree Z1",
@@ -70,16 +70,16 @@ ARMS: tuple[Arm, ...] = (
     Arm("so101", "urdf", _ERD, "so_arm_description/urdf/so101.urdf", "base_link", "gripper_link",
         "TheRobotStudio SO-101", "https://github.com/TheRobotStudio/SO-ARM100", "Apache-2.0"),
     Arm("baxter-left", "urdf", _ERD, "baxter_description/urdf/baxter.urdf", "torso", "left_gripper",
-        "Rethink Baxter, left arm", "https://github.com/RethinkRobotics/baxter_common", "BSD-3-Clause"),
+        "Rethink Baxter, left arm", "https://github.com/RethinkRobotics/baxter_common", "BSD"),
     Arm("pr2-left-gripper", "urdf", _ERD, "pr2_description/urdf/pr2.urdf", "torso_lift_link",
         "l_gripper_l_finger_tip_link", "Willow Garage PR2, left arm to a finger tip (mimic joint)",
-        "https://github.com/pr2/pr2_common", "BSD-3-Clause"),
+        "https://github.com/pr2/pr2_common", "BSD"),
     Arm("tiago-torso", "urdf", _ERD, "tiago_description/robots/tiago.urdf", "base_footprint", "arm_tool_link",
         "PAL TIAGo, torso lift + arm", "https://github.com/pal-robotics/tiago_robot", "Apache-2.0"),
     Arm("talos-left", "urdf", _ERD, "talos_data/robots/talos_reduced.urdf", "base_link", "gripper_left_base_link",
         "PAL TALOS, torso + left arm", "https://github.com/pal-robotics/talos_robot", "Apache-2.0"),
     Arm("romeo-left", "urdf", _ERD, "romeo_description/urdf/romeo.urdf", "body", "l_wrist",
-        "Aldebaran Romeo, trunk + left arm", "https://github.com/laas/romeo", "BSD-3-Clause"),
+        "Aldebaran Romeo, trunk + left arm", "https://github.com/laas/romeo", "BSD"),
     Arm("icub-left", "urdf", _ERD, "icub_description/robots/icub.urdf", "root_link", "l_hand",
         "IIT iCub, torso + left arm", "https://github.com/robotology/icub-models", "CC-BY-SA-4.0"),
     Arm("g1-left", "urdf", _ERD, "g1_description/urdf/g1_29dof_rev_1_0.urdf", "pelvis", "left_wrist_yaw_link",
@@ -131,8 +131,8 @@ def original_file(arm: Arm) -> Path | None:
 
 def _header(arm: Arm, kept: str) -> str:
     return (f" {arm.title}, kinematics only ({kept}), cut by fkopt.kinbench.robots from {arm.source} of "
-            f"{arm.package} {package_version(arm.package)} (PyPI); upstream {arm.upstream}, licence {arm.licence} "
-            f"(the licence text ships in that package). Chain used by kinbench: {arm.base} to {arm.tip}. "
+            f"{arm.package} {package_version(arm.package)} (PyPI); upstream {arm.upstream}; licence {arm.licence} "
+            f"(as {arm.package} states it for this robot). Chain used by kinbench: {arm.base} to {arm.tip}. "
             "Lengths in m; angles in rad (URDF) or as the compiler says (MJCF). ")
 
 
