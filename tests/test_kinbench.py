@@ -172,6 +172,22 @@ def test_ert_and_success_rate_follow_coco():
     assert e[["evals_per_dim", "reached", "pairs"]].values.tolist() == [[5, 1, 6], [15, 2, 6], [20, 3, 6]]
 
 
+def test_the_scaling_table_gives_ert_per_dimension_for_classes_of_several_dimensions():
+    nan = np.nan
+    same = _runs([["p", "c", "u", 0, "a", "black-box", 0, 2, 100, 40, 1e-7, 10, 40],
+                  ["q", "c", "u", 0, "a", "black-box", 0, 2, 100, 40, 1e-7, 10, 40]])
+    assert M.scaling_table(same, [1e-2, 1e-6]) is None          # one dimension per class: no file
+    runs = _runs([["chain-3", "chain", "u", 0, "a", "black-box", 0, 3, 300, 60, 1e-7, 30, 60],
+                  ["chain-3", "chain", "u", 1, "a", "black-box", 0, 3, 300, 300, 1e-3, 90, nan],
+                  ["chain-6", "chain", "u", 0, "a", "black-box", 0, 6, 600, 600, 1.0, nan, nan],
+                  ["chain-6", "chain", "b", 0, "a", "black-box", 0, 6, 600, 240, 1e-7, 120, 240]])
+    t = M.scaling_table(runs, [1e-2, 1e-6]).set_index(["dim", "target"])
+    assert t.loc[(3, 1e-2), "ert"] == pytest.approx((30 + 90) / 2) and t.loc[(3, 1e-2), "trials"] == 2
+    assert t.loc[(3, 1e-6), "ert_per_dim"] == pytest.approx((60 + 300) / 1 / 3)
+    assert t.loc[(6, 1e-6), "ert"] == pytest.approx((600 + 240) / 1)     # sets pooled within a dimension
+    assert list(t.reset_index()["class"].unique()) == ["chain"]
+
+
 def test_ranking_finds_a_real_difference_and_no_fake_one():
     rng = np.random.default_rng(0)
     base = rng.random(40)
@@ -614,6 +630,10 @@ def test_v3_quick_tier_ranks_instances_urdf_and_mjcf_arms_and_chains(tmp_path):
     lb = pd.read_csv(folder / "leaderboard.csv")
     assert {"class:dh-chain/track:exact", "class:serial-ik-8to10dof/track:jacobian",
             "class:parallel-fk-6dof/track:black-box"} <= set(lb.scope)
+    scaling = pd.read_csv(folder / "scaling.csv")            # cost against the number of joints
+    assert set(scaling.loc[scaling["class"] == "dh-chain", "dim"]) == {3, 12, 30}
+    assert (folder / "scaling_dh-chain.png").exists() and "## Cost against dimension" in \
+        (folder / "leaderboard.md").read_text()
     ex = runs[runs.solver == "exact"]
     for name in ("ur5", "iiwa-mj", "pr2-left-gripper", "g1-left", "gr1-left-mj", "dh-chain-12"):
         assert ex.loc[ex.problem == name, target_column(1e-2)].notna().mean() > 0.5, name

@@ -47,11 +47,10 @@ def hits(runs: pd.DataFrame, targets) -> np.ndarray:
     return runs[[target_column(t) for t in targets]].to_numpy(dtype=float)
 
 
-def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
-    """Success rate and ERT per (problem, set, solver, target): the per-problem table."""
+def _ert_rows(runs: pd.DataFrame, keys: list[str], targets, sort: bool) -> pd.DataFrame:
+    """Success rate and ERT per group of ``keys`` and target (one group has one dimension)."""
     rows = []
-    keys = ["problem", "class", "set", "solver", "track"]
-    for key, g in runs.groupby(keys, sort=False):
+    for key, g in runs.groupby(keys, sort=sort):
         ev = hits(g, targets)
         used = g["evaluations"].to_numpy(dtype=float)
         dim = int(g["dim"].iloc[0])
@@ -63,6 +62,22 @@ def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
             rows.append({**dict(zip(keys, key)), "target": t, "trials": len(g), "successes": n_ok,
                          "success_rate": n_ok / len(g), "ert": ert, "ert_per_dim": ert / dim})
     return pd.DataFrame(rows)
+
+
+def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
+    """Success rate and ERT per (problem, set, solver, target): the per-problem table."""
+    return _ert_rows(runs, ["problem", "class", "set", "solver", "track"], targets, sort=False)
+
+
+def scaling_table(runs: pd.DataFrame, targets) -> pd.DataFrame | None:
+    """Success rate and ERT per (class, solver, dimension, target) over every problem, set and pose
+    of that dimension, for the classes whose problems differ in dimension (kinbench v3's dh-chain
+    family, n = 3 ... 30): how a solver's cost grows with the number of unknowns, COCO's scaling
+    plot (ERT / dimension against dimension). None when no class has two dimensions."""
+    multi = sorted(c for c, g in runs.groupby("class") if g["dim"].nunique() > 1)
+    if not multi:
+        return None
+    return _ert_rows(runs[runs["class"].isin(multi)], ["class", "solver", "track", "dim"], targets, sort=True)
 
 
 def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFrame:
