@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import fkopt
-from fkopt.kinbench.robots import ARMS, original_file
+from fkopt.kinbench.robots import ARMS, original_file, original_model
 
 SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
 
@@ -76,7 +76,7 @@ def test_stored_mjcf_copy_matches_mj_kinematics_on_the_original(arm):
     src = original_file(arm)
     if src is None:
         pytest.skip(f"{arm.package} is not installed")
-    model = mujoco.MjModel.from_xml_path(str(src))
+    model = original_model(arm)
     data = mujoco.MjData(model)
     body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, arm.tip)
     site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, arm.tip)

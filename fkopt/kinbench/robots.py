@@ -96,6 +96,10 @@ ARMS: tuple[Arm, ...] = (
         "https://github.com/ARISE-Initiative/robosuite", "MIT"),
     Arm("tiago-right-mj", "mjcf", _RS, "tiago/robot.xml", "base", "right_hand",
         "PAL TIAGo (robosuite), torso lift + right arm", "https://github.com/ARISE-Initiative/robosuite", "MIT"),
+    Arm("sawyer-mj", "mjcf", _RS, "sawyer/robot.xml", "base", "right_hand", "Rethink Sawyer",
+        "https://github.com/ARISE-Initiative/robosuite", "MIT"),
+    Arm("baxter-right-mj", "mjcf", _RS, "baxter/robot.xml", "base", "right_hand", "Rethink Baxter, right arm",
+        "https://github.com/ARISE-Initiative/robosuite", "MIT"),
     Arm("gr1-left-mj", "mjcf", _RS, "gr1/robot.xml", "whole_body", "left_eef", "Fourier GR1, waist + left arm",
         "https://github.com/ARISE-Initiative/robosuite", "MIT"),
 )
@@ -127,6 +131,23 @@ def package_folder(package: str) -> Path | None:
 def original_file(arm: Arm) -> Path | None:
     folder = package_folder(arm.package)
     return None if folder is None else folder / arm.source
+
+
+def original_model(arm: Arm):
+    """MuJoCo's compiled model of ``arm``'s original MJCF. Sawyer's and Baxter's meshes are too thin
+    for MuJoCo 4's volume-based mesh inertia ("mesh volume is too small"); they are compiled with
+    shell inertia instead, as MuJoCo's message suggests -- inertia does not enter kinematics."""
+    import mujoco
+    path = original_file(arm)
+    try:
+        return mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as err:
+        if "mesh volume is too small" not in str(err):
+            raise
+    spec = mujoco.MjSpec.from_file(str(path))
+    for mesh in spec.meshes:
+        mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+    return spec.compile()
 
 
 def _header(arm: Arm, kept: str) -> str:
