@@ -159,7 +159,10 @@ class SuiteConfig(Located):
             if not (isinstance(p, dict) and p.get("instances")):
                 out.append(p)
                 continue
-            checked = SuiteProblem(**p).model_dump(mode="json")       # its fields first, then the draws
+            try:                                                       # its fields first, then the draws
+                checked = SuiteProblem(**p).model_dump(mode="json")
+            except ValidationError as err:
+                raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
             from .instances import expand

@@ -151,8 +151,8 @@ def check_release(config, manifest: dict) -> None:
                          f"this fkopt has version {FITNESS_VERSION} (CHANGES.md){new}")
     base = Path(config._folder if config._folder is not None else ".")
     folder = base / config.pose_sets
-    release_folder = next(iter(release.files)).split("/", 1)[0]
-    expected = {(f"{config.pose_sets}/{k.split('/', 1)[1]}" if k.startswith(release_folder + "/") else k): v
+    # the release's pose sets are in the folder named as the version; a copy may be named otherwise
+    expected = {(f"{config.pose_sets}/{k.split('/', 1)[1]}" if k.startswith(name + "/") else k): v
                 for k, v in release.files.items()}
     for rel, digest in sorted(expected.items(), key=lambda kv: kv[0].endswith("/manifest.json")):  # data first
         path = base / rel
