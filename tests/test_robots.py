@@ -1,6 +1,7 @@
 """kinbench's real arms (fkopt.kinbench.robots): each stored kinematics-only copy gives its package's
 own FK -- pinocchio on example-robot-data's original URDF, MuJoCo's mj_kinematics on robosuite's
 original MJCF -- on random configurations inside the joint limits."""
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -93,3 +94,29 @@ def test_stored_mjcf_copy_matches_mj_kinematics_on_the_original(arm):
         R0 = data.xmat[b0].reshape(3, 3)
         assert np.abs(R0.T @ (pt - data.xpos[b0]) - p[i]).max() < 1e-12, arm.name
         assert np.abs(R0.T @ Rt.reshape(3, 3) - R[i]).max() < 1e-12, arm.name
+
+
+def test_the_cutters_keep_only_the_chain_and_refuse_what_they_do_not_cut(tmp_path):
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.robots import cut_mjcf, cut_urdf
+    f = tmp_path / "arm.xml"
+    f.write_text("""<mujoco><compiler angle="degree"/><asset><mesh name="m" file="m.stl"/></asset><worldbody>
+      <body name="b0"><geom type="sphere" size="0.1"/><body name="l1" pos="0 0 0.3"><joint name="j1" axis="0 0 1"
+        damping="3" range="-90 90"/><geom type="mesh" mesh="m"/><body name="tip" pos="0.2 0 0"/></body>
+        <body name="other"><joint name="j9"/></body></body></worldbody><actuator><motor joint="j1"/></actuator>
+      <equality><joint joint1="j9" joint2="j1"/></equality></mujoco>""")
+    text = ET.tostring(cut_mjcf(f, "b0", "tip"), "unicode")
+    assert 'name="other"' not in text and "mesh" not in text and "geom" not in text and "damping" not in text
+    assert "motor" not in text and "equality" not in text and 'range="-90 90"' in text and 'angle="degree"' in text
+    f.write_text('<mujoco><worldbody><frame pos="1 0 0"><body name="a"><joint/><body name="t"/></body></frame>'
+                 '</worldbody></mujoco>')
+    with pytest.raises(FkoptError, match="a <frame> on the chain is not cut"):
+        cut_mjcf(f, "a", "t")
+    u = tmp_path / "arm.urdf"
+    u.write_text('<robot name="r"><link name="a"><visual/></link><link name="b"/><link name="c"/>'
+                 '<joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+                 '<limit lower="-1" upper="1"/><dynamics damping="1"/></joint></robot>')
+    text = ET.tostring(cut_urdf(u, "a", "b"), "unicode")
+    assert "visual" not in text and "dynamics" not in text and 'lower="-1"' in text
+    with pytest.raises(FkoptError, match="link 'c' is not below link 'a'"):
+        cut_urdf(u, "a", "c")

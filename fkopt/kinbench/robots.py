@@ -224,6 +224,9 @@ def cut_mjcf(path: Path, base: str, tip: str) -> ET.Element:
         path_bodies.append(b)
         b = parents[b]
     path_bodies.reverse()
+    if any(b.tag != "body" for b in path_bodies):
+        raise FkoptError(f"{path}: a <{next(b.tag for b in path_bodies if b.tag != 'body')}> on the chain is not "
+                         "cut; compile and save the model first")
     names = [b.get("name") for b in path_bodies]
     if base not in names:
         raise FkoptError(f"{path}: '{tip}' is not below body '{base}'")
