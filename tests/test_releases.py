@@ -144,3 +144,16 @@ def test_fkopt_check_refuses_a_run_whose_released_pose_sets_were_swapped_after_i
     r = subprocess.run([sys.executable, "-m", "fkopt.cli", "check", str(out)], capture_output=True, text=True, env=env)
     assert r.returncode != 0 and "released kinbench-v1" in r.stdout + r.stderr, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_freeze_prints_the_release_entry_of_a_suite_and_refuses_bad_usage(capsys):
+    from fkopt.kinbench.freeze import main
+    assert main(["release", str(SUITES / "kinbench-v2.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith('    "kinbench-v2": Release(fitness=1, files={')
+    for name, digest in RELEASES["kinbench-v2"].files.items():
+        assert f'        "{name}": "{digest}",' in out
+    assert main(["pose-set"]) == 2 and "usage:" in capsys.readouterr().err
+    assert main(["release", str(SUITES / "missing.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1

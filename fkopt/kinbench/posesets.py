@@ -22,14 +22,13 @@ Files: ``<folder>/<problem>/<set>.csv`` (one column per unknown, ``%.17g``: exac
 spec and per set the file's SHA-256, its number of poses and (near-singular) the bound.
 :func:`load_pose_sets` verifies every checksum and that each problem's mechanism spec is the one
 its sets were generated for; any mismatch is one error line naming the file. ``python -m
-fkopt.kinbench.posesets SUITE.yaml`` (re)writes a set folder; a new version is a new folder.
+fkopt.kinbench.freeze pose-sets SUITE.yaml`` (re)writes a set folder; a new version is a new folder.
 """
 from __future__ import annotations
 
 import hashlib
 import io
 import json
-import sys
 import zlib
 from pathlib import Path
 
@@ -238,12 +237,3 @@ def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
     from .releases import check_release
     check_release(config, manifest)      # a released version: every file as released, not only as its manifest says
     return out, manifest
-
-
-if __name__ == "__main__":
-    # python -m fkopt.kinbench.posesets configs/suites/kinbench.yaml              (v1, v2: 20, condition)
-    # python -m fkopt.kinbench.posesets configs/suites/kinbench-v3.yaml 100 sigma (v3)
-    from .config import load_suite
-    cfg = load_suite(sys.argv[1])
-    print(write_pose_sets(cfg, pose_set_folder(cfg), *([int(sys.argv[2])] if len(sys.argv) > 2 else []),
-                          *sys.argv[3:4]))

@@ -16,13 +16,12 @@ version is checked against it by :func:`check_release` whenever its pose sets ar
 version other than this fkopt's, is refused with one line naming the file. A changed suite must
 name itself a new version (a new ``pose_sets`` folder whose manifest says that new version).
 
-``python -m fkopt.kinbench.releases SUITE.yaml`` prints the table entry of a suite's version
+``python -m fkopt.kinbench.freeze release SUITE.yaml`` prints the table entry of a suite's version
 (the step of making a release; an entry is never edited afterwards).
 """
 from __future__ import annotations
 
 import hashlib
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -167,12 +166,3 @@ def check_release(config, manifest: dict) -> None:
     for rel in problem_files(config):
         if rel not in expected:
             raise FkoptError(f"{base / rel}: problem file not part of released {name}{new}")
-
-
-if __name__ == "__main__":    # python -m fkopt.kinbench.releases configs/suites/kinbench-v2.yaml
-    from .config import load_suite
-    cfg = load_suite(sys.argv[1])
-    print(f'    "{cfg.pose_sets}": Release(fitness={FITNESS_VERSION}, files={{')
-    for k, v in release_files(cfg).items():
-        print(f'        "{k}": "{v}",')
-    print("    }),")

@@ -18,12 +18,11 @@ reads:
 Every copy opens with a comment naming its source file, package and version, its upstream and
 its licence. ``tests/test_robots.py`` checks each copy against its package's own model --
 pinocchio on the original URDF, MuJoCo's ``mj_kinematics`` on the original MJCF -- on random
-configurations. ``python -m fkopt.kinbench.robots configs/suites/robots`` (re)writes the copies of
+configurations. ``python -m fkopt.kinbench.freeze robots configs/suites/robots`` (re)writes the copies of
 the arms added in v3 (v2's three copies stay as they were released).
 """
 from __future__ import annotations
 
-import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -290,8 +289,3 @@ def write_robots(folder: Path) -> list[Path]:
         path.write_text(stored_text(arm), encoding="utf-8")
         out.append(path)
     return out
-
-
-if __name__ == "__main__":      # python -m fkopt.kinbench.robots configs/suites/robots
-    for p in write_robots(Path(sys.argv[1])):
-        print(p)
