@@ -240,6 +240,9 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "mechanism": ("The mechanism, as in an experiment: a name, geometry and bounds.", "",
                       {"name": "3-rps", "geometry": {"ra": 274, "rb": 158}}),
         "objective": ("The objective, as in an experiment; default the mechanism's.", "", "absolute"),
+        "instances": ("K seeded geometries of a parallel mechanism around this geometry, each with its "
+                      "workspace box: the problem stands for `<name>-i1` ... `<name>-iK` "
+                      "(docs/kinbench.md, geometry instances).", "", 10),
     },
     "SuiteSolver": {
         "track": ("black-box (fitness only), jacobian (uses Jacobians) or exact; fkopt knows its own "

@@ -112,11 +112,13 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
     "suite": (
         Output("leaderboard.csv", f"{_SUITE}:leaderboard_table", TABLE),
         Output("measures.csv", f"{_SUITE}:measures_table", TABLE),
+        Output("scaling.csv", f"{_SUITE}:scaling_table", TABLE),      # classes of several dimensions only
         Output("ecdf.csv", f"{_SUITE}:ecdf_table", CURVES, rows=STEPS),
         Output("runs.csv", f"{_SUITE}:runs_table", CURVES, rows=RUNS),
         Output("trace.csv.gz", "fkopt.kinbench.traces:trace_table", CURVES, rows=STEPS),
         Output("timing.csv", f"{_SUITE}:timing_table", TIMING),
         Output("ecdf", f"{_SUITE}:ecdf_figures", FIGURE),
+        Output("scaling", f"{_SUITE}:scaling_figures", FIGURE),
         Output("leaderboard.md", f"{_SUITE}:leaderboard_markdown", FIGURE),   # never compared
         Output("index.html", f"{_SUITE}:html_page", FIGURE),                  # inlines the figures
     ),

@@ -24,6 +24,13 @@ from . import rotations
 from .mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from .rotations import wrap_degrees
 
+#: Version of the fitness definitions below (residuals, objectives, the IK pose error and its
+#: weights). Every released kinbench version records the one it was ranked with
+#: (:mod:`fkopt.kinbench.releases`); a change that alters any fitness value is a new number here
+#: and a new kinbench version, said in CHANGES.md (tests/test_releases.py holds fitness values of
+#: each released problem, so an unannounced change fails).
+FITNESS_VERSION = 1
+
 #: Objectives built from residuals r: "squared" = sum r_i^2 (mao2017 eq. 12, wu2015, chang2024),
 #: "absolute" = sum |r_i| (liu2008 as printed).
 OBJECTIVES = ("squared", "absolute")

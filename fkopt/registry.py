@@ -54,6 +54,7 @@ MECHANISMS: dict[str, str] = {
     "3-ppr": "fkopt.mechanisms.ppr3:ThreePPR",
     "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",
     "7dof-arm": "fkopt.mechanisms.dh_arm:SevenDofArm",
+    "dh-chain": "fkopt.mechanisms.dh_chain:DHChain",   # seeded spatial chains, n joints (kinbench v3)
     "urdf": "fkopt.mechanisms.urdf:URDFArm",
     "mjcf": "fkopt.mechanisms.mjcf:MJCFArm",
 }

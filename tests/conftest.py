@@ -80,6 +80,11 @@ TIERS = {
     "tests/test_kinbench.py::test_fkopt_run_accepts_a_suite_and_numbers_do_not_depend_on_other_solvers":
         ("slow",),
     "tests/test_kinbench.py::test_v2_urdf_copies_match_example_robot_data": ("external",),
+    "tests/test_kinbench.py::test_v3_quick_tier_ranks_instances_urdf_and_mjcf_arms_and_chains": ("slow",),
+    "tests/test_releases.py::test_fkopt_check_refuses_a_run_whose_released_pose_sets_were_swapped_after_it":
+        ("slow",),
+    "tests/test_robots.py::test_stored_urdf_copy_matches_pinocchio_on_the_original": ("external",),
+    "tests/test_robots.py::test_stored_mjcf_copy_matches_mj_kinematics_on_the_original": ("external",),
     "tests/test_hostile.py::test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it":
         ("external",),
     "tests/test_hostile.py::test_interrupted_study_rerun_keeps_previous_result": ("external",),

@@ -172,6 +172,22 @@ def test_ert_and_success_rate_follow_coco():
     assert e[["evals_per_dim", "reached", "pairs"]].values.tolist() == [[5, 1, 6], [15, 2, 6], [20, 3, 6]]
 
 
+def test_the_scaling_table_gives_ert_per_dimension_for_classes_of_several_dimensions():
+    nan = np.nan
+    same = _runs([["p", "c", "u", 0, "a", "black-box", 0, 2, 100, 40, 1e-7, 10, 40],
+                  ["q", "c", "u", 0, "a", "black-box", 0, 2, 100, 40, 1e-7, 10, 40]])
+    assert M.scaling_table(same, [1e-2, 1e-6]) is None          # one dimension per class: no file
+    runs = _runs([["chain-3", "chain", "u", 0, "a", "black-box", 0, 3, 300, 60, 1e-7, 30, 60],
+                  ["chain-3", "chain", "u", 1, "a", "black-box", 0, 3, 300, 300, 1e-3, 90, nan],
+                  ["chain-6", "chain", "u", 0, "a", "black-box", 0, 6, 600, 600, 1.0, nan, nan],
+                  ["chain-6", "chain", "b", 0, "a", "black-box", 0, 6, 600, 240, 1e-7, 120, 240]])
+    t = M.scaling_table(runs, [1e-2, 1e-6]).set_index(["dim", "target"])
+    assert t.loc[(3, 1e-2), "ert"] == pytest.approx((30 + 90) / 2) and t.loc[(3, 1e-2), "trials"] == 2
+    assert t.loc[(3, 1e-6), "ert_per_dim"] == pytest.approx((60 + 300) / 1 / 3)
+    assert t.loc[(6, 1e-6), "ert"] == pytest.approx((600 + 240) / 1)     # sets pooled within a dimension
+    assert list(t.reset_index()["class"].unique()) == ["chain"]
+
+
 def test_ranking_finds_a_real_difference_and_no_fake_one():
     rng = np.random.default_rng(0)
     base = rng.random(40)
@@ -527,3 +543,97 @@ def test_fkopt_check_passes_on_the_v2_quick_tier_and_fails_on_an_edited_number(v
     lb.to_csv(folder / "leaderboard.csv", index=False, float_format="%.10g")
     chk = cli("check", folder)
     assert chk.returncode == 1 and "leaderboard.csv" in chk.stderr, chk.stdout + chk.stderr
+
+
+# -- kinbench v3: real arms, geometry instances, the chain family, 100 poses, a unit-free measure --
+SUITE_V3 = SUITES / "kinbench-v3.yaml"
+
+
+def test_v3_holds_the_breadth_and_its_frozen_sets_verify():
+    from fkopt.kinbench.instances import SPREADS
+    from fkopt.kinbench.robots import ARMS
+    cfg = load_suite(SUITE_V3)
+    sets, manifest = load_pose_sets(cfg)               # every checksum of the committed folder verified
+    assert manifest["version"] == "kinbench-v3" and manifest["near_singular_measure"] == "sigma"
+    names = {p.name: p for p in cfg.problems}
+    for arm in ARMS:                                   # the 22 arms, each from its stored copy
+        assert names[arm.name].mechanism.geometry == {"file": arm.file, "base": arm.base, "tip": arm.tip}
+    chains = sorted(p.mechanism.geometry["joints"] for p in cfg.problems if p.mechanism.name == "dh-chain")
+    assert chains[0] == 3 and chains[-1] == 30 and len(chains) >= 10
+    for mech in SPREADS:                               # >= 10 instances of every parallel mechanism
+        inst = [p for p in cfg.problems if p.mechanism.name == mech and "-i" in p.name]
+        assert len(inst) >= 10 and len({repr(p.mechanism.geometry) for p in inst}) == len(inst), mech
+    for (problem, name), pts in sets.items():
+        if name != "printed":
+            assert len(pts) >= 100, (problem, name)
+    quick = cfg.quick_tier()
+    assert {p.name for p in quick.problems} <= set(names) and quick.poses == 2
+
+
+def test_v3_pose_sets_regenerate_bit_for_bit_from_their_seed():
+    """A sample of v3's problems (an instance, a URDF arm with a mimic, an MJCF arm, chains) regenerated
+    from the manifest's seed, size and measure give the committed bytes."""
+    from fkopt.kinbench.posesets import csv_bytes
+    cfg = load_suite(SUITE_V3)
+    manifest = json.loads((SUITES / "kinbench-v3" / "manifest.json").read_text())
+    for name in ("chang2024-3rpupc-i4", "pr2-left-gripper", "gr1-left-mj", "dh-chain-25"):
+        problem = next(p for p in cfg.problems if p.name == name)
+        mech, _ = problem_mechanism(problem, SUITES)
+        fresh, info = generate(problem, manifest["seed"], manifest["poses_per_set"], SUITES, "sigma")
+        for set_name, pts in fresh.items():
+            committed = (SUITES / "kinbench-v3" / name / f"{set_name}.csv").read_bytes()
+            assert csv_bytes(mech.unknown_names, pts) == committed, (name, set_name)
+        assert info["near-singular"] == {k: v for k, v in manifest["problems"][name]["sets"]["near-singular"].items()
+                                         if k not in ("file", "sha256", "poses")}
+
+
+def test_v3_near_singular_sets_are_nearer_to_a_singularity_than_uniform_ones():
+    from fkopt.kinbench.measures import unit_free_sigma_min
+    cfg = load_suite(SUITE_V3)
+    sets, manifest = load_pose_sets(cfg)
+    for name in ("mao2017-3rps-i2", "dietmaier-6sps", "ur5", "iiwa-mj", "dh-chain-7"):
+        problem = next(p for p in cfg.problems if p.name == name)
+        mech, _ = problem_mechanism(problem, SUITES)
+        meta = manifest["problems"][name]["sets"]["near-singular"]
+        near = unit_free_sigma_min(mech, sets[(name, "near-singular")], meta["characteristic_length"])
+        uniform = unit_free_sigma_min(mech, sets[(name, "uniform")], meta["characteristic_length"])
+        assert np.all(near < meta["bound"] * (1 + 1e-5)) and np.mean(uniform > meta["bound"]) > 0.8, name
+
+
+def test_the_unit_free_singularity_measure_does_not_depend_on_units_or_scale():
+    import fkopt
+    from fkopt.kinbench.measures import characteristic_length, unit_free_sigma_min
+    mm, m = fkopt.mechanism("7dof-arm"), fkopt.mechanism("urdf")     # wang7dof's arm in mm (DH) and in m (URDF)
+    q = mm.bounds[:, 0] + np.random.default_rng(0).random((50, 7)) * np.diff(mm.bounds).ravel()
+    L_mm, L_m = characteristic_length(mm, q), characteristic_length(m, q)
+    assert L_mm == pytest.approx(1000 * L_m)
+    assert np.allclose(unit_free_sigma_min(mm, q, L_mm), unit_free_sigma_min(m, q, L_m), rtol=1e-9, atol=1e-12)
+    small = fkopt.mechanism("3-rps", ra=274, rb=158)                  # the same 3-RPS, twice as large
+    large = fkopt.mechanism("3-rps", ra=548, rb=316, bounds={"z": (800, 1400)})
+    x = small.bounds[:, 0] + np.random.default_rng(1).random((50, 3)) * np.diff(small.bounds).ravel()
+    s_small = unit_free_sigma_min(small, x, characteristic_length(small, x))
+    s_large = unit_free_sigma_min(large, x * [1, 1, 2], characteristic_length(large, x))
+    assert np.allclose(s_small, s_large, rtol=1e-6) and np.all(s_small > 0)
+    ur5 = fkopt.mechanism("urdf", file=str(SUITES / "robots" / "ur5.urdf"), base="base_link", tip="tool0")
+    stretched = np.array([[0.0, -90.0, 0.0, -90.0, 0.0, 0.0]])           # elbow straight: UR5's singularity
+    assert unit_free_sigma_min(ur5, stretched, 1.0)[0] < 1e-12 < unit_free_sigma_min(ur5, stretched + 30, 1.0)[0]
+
+
+def test_v3_quick_tier_ranks_instances_urdf_and_mjcf_arms_and_chains(tmp_path):
+    r = cli("suite", SUITE_V3, "--out", tmp_path / "out", "--quick", "-q")
+    assert r.returncode == 0, r.stderr
+    folder = tmp_path / "out" / "kinbench" / "kinbench-v3-quick"
+    runs = pd.read_csv(folder / "runs.csv")
+    quick = load_suite(SUITE_V3).quick_tier()
+    assert set(runs["problem"]) == {p.name for p in quick.problems}
+    assert set(runs.loc[runs.problem.str.startswith("dh-chain"), "dim"]) == {3, 12, 30}
+    lb = pd.read_csv(folder / "leaderboard.csv")
+    assert {"class:dh-chain/track:exact", "class:serial-ik-8to10dof/track:jacobian",
+            "class:parallel-fk-6dof/track:black-box"} <= set(lb.scope)
+    scaling = pd.read_csv(folder / "scaling.csv")            # cost against the number of joints
+    assert set(scaling.loc[scaling["class"] == "dh-chain", "dim"]) == {3, 12, 30}
+    assert (folder / "scaling_dh-chain.png").exists() and "## Cost against dimension" in \
+        (folder / "leaderboard.md").read_text()
+    ex = runs[runs.solver == "exact"]
+    for name in ("ur5", "iiwa-mj", "pr2-left-gripper", "g1-left", "gr1-left-mj", "dh-chain-12"):
+        assert ex.loc[ex.problem == name, target_column(1e-2)].notna().mean() > 0.5, name

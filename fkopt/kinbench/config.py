@@ -95,12 +95,15 @@ class OutsideSolver(Strict):
 
 
 class SuiteProblem(Strict):
+    #: ``name-ik`` is instance k of a problem with ``instances`` (:mod:`fkopt.kinbench.instances`).
     name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
     #: Problems of one class are ranked together (no alias such as ``class``: a stored config
     #: must dump to the same mapping it was read from).
     problem_class: str = Field(min_length=1, max_length=64)
     mechanism: MechanismSpec
     objective: str | None = None
+    #: K seeded geometries of a parallel mechanism: the problem stands for name-i1 ... name-iK.
+    instances: int | None = Field(None, ge=1, le=100)
 
 
 class QuickTier(Strict):
@@ -140,6 +143,34 @@ class SuiteConfig(Located):
     @property
     def folder_parts(self) -> tuple[str, str]:
         return (self.paper or "suites", self.name)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _instances(cls, data):
+        """Problems with ``instances: K`` become their K geometry instances (drawn from ``seed``)."""
+        if not isinstance(data, dict) or not isinstance(data.get("problems"), list):
+            return data
+        problems = [p.model_dump(mode="json") if isinstance(p, SuiteProblem) else p for p in data["problems"]]
+        if not any(isinstance(p, dict) and p.get("instances") for p in problems):
+            return data
+        seed = data.get("seed", cls.model_fields["seed"].default)
+        out = []
+        for i, p in enumerate(problems):
+            if not (isinstance(p, dict) and p.get("instances")):
+                out.append(p)
+                continue
+            try:                                                       # its fields first, then the draws
+                checked = SuiteProblem(**p).model_dump(mode="json")
+            except ValidationError as err:
+                raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
+            if not isinstance(seed, int) or isinstance(seed, bool):
+                raise ValueError("seed: an integer (instances are drawn from it)")
+            from .instances import expand
+            try:
+                out += expand(checked, seed, f"problems[{i}]")
+            except FkoptError as err:
+                raise ValueError(str(err)) from None
+        return {**data, "problems": out}
 
     @field_validator("solvers")
     @classmethod

@@ -47,11 +47,10 @@ def hits(runs: pd.DataFrame, targets) -> np.ndarray:
     return runs[[target_column(t) for t in targets]].to_numpy(dtype=float)
 
 
-def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
-    """Success rate and ERT per (problem, set, solver, target): the per-problem table."""
+def _ert_rows(runs: pd.DataFrame, keys: list[str], targets, sort: bool) -> pd.DataFrame:
+    """Success rate and ERT per group of ``keys`` and target (one group has one dimension)."""
     rows = []
-    keys = ["problem", "class", "set", "solver", "track"]
-    for key, g in runs.groupby(keys, sort=False):
+    for key, g in runs.groupby(keys, sort=sort):
         ev = hits(g, targets)
         used = g["evaluations"].to_numpy(dtype=float)
         dim = int(g["dim"].iloc[0])
@@ -63,6 +62,22 @@ def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
             rows.append({**dict(zip(keys, key)), "target": t, "trials": len(g), "successes": n_ok,
                          "success_rate": n_ok / len(g), "ert": ert, "ert_per_dim": ert / dim})
     return pd.DataFrame(rows)
+
+
+def measures_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
+    """Success rate and ERT per (problem, set, solver, target): the per-problem table."""
+    return _ert_rows(runs, ["problem", "class", "set", "solver", "track"], targets, sort=False)
+
+
+def scaling_table(runs: pd.DataFrame, targets) -> pd.DataFrame | None:
+    """Success rate and ERT per (class, solver, dimension, target) over every problem, set and pose
+    of that dimension, for the classes whose problems differ in dimension (kinbench v3's dh-chain
+    family, n = 3 ... 30): how a solver's cost grows with the number of unknowns, COCO's scaling
+    plot (ERT / dimension against dimension). None when no class has two dimensions."""
+    multi = sorted(c for c, g in runs.groupby("class") if g["dim"].nunique() > 1)
+    if not multi:
+        return None
+    return _ert_rows(runs[runs["class"].isin(multi)], ["class", "solver", "track", "dim"], targets, sort=True)
 
 
 def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFrame:
@@ -149,3 +164,85 @@ def leaderboard_table(runs: pd.DataFrame, targets, budget_per_dim: float, *, boo
             ranked[f"success_{t:.0e}"] = ranked["solver"].map(rate)
         frames.append(ranked)
     return pd.concat(frames, ignore_index=True)
+
+
+# -- nearness to a singularity, unit-free -------------------------------------------------------
+# The condition number of a Jacobian mixing mm and degrees (v1/v2's near-singular sets) changes
+# with the choice of units. kinbench v3 measures a pose's nearness to a singularity by the
+# smallest singular value of the Jacobian made unit-free: angles in radians and lengths divided
+# by a characteristic length L of the mechanism (Angeles, "Fundamentals of Robotic Mechanical
+# Systems", 4th ed., sec. 5.8 -- the characteristic length that makes a Jacobian dimensionally
+# homogeneous). sigma_min = 0 at a singularity; a value of s means a unit-free joint (or leg)
+# motion of 1 moves the tool (or platform) by no more than s in some direction.
+#
+# * serial arm: J = the geometric frame Jacobian (position rows, angular-velocity rows) of
+#   :meth:`FrameArm.frame_jacobian`; scaled J~ = diag(1/L, 1/L, 1/L, 1, 1, 1) J diag(c_j), c_j =
+#   180/pi for a joint in degrees (per radian), L for a joint in a length unit. The IK of the
+#   pose is ill-posed where J~ loses rank (of a redundant arm: the 6th singular value; of an arm
+#   with n < 6 joints: the n-th). L = the largest distance of the tool point from the base origin
+#   over the configurations measured (the pose set's candidates): the arm's reach.
+# * parallel mechanism: J = d ik / d pose (joints per pose coordinate, central differences of the
+#   closed-form inverse map); J~ = diag(r_i) J diag(c_j), r_i = 1/L for a length joint and pi/180
+#   for a joint in degrees, c_j = L for a length coordinate and 180/pi for an angle. FK is
+#   ill-posed where J~ loses rank (a direct-kinematics singularity, Gosselin & Angeles 1990,
+#   "Singularity analysis of closed-loop kinematic chains"). L = the mean absolute value of the
+#   length-unit joints at the centre of the workspace box (leg lengths / slider positions at home).
+LENGTH_UNITS = ("mm", "m")
+
+
+def _unit_factors(units, length: float, inverse: bool) -> np.ndarray:
+    """Per coordinate: the factor from public units to unit-free ones (deg -> rad, length -> /L), or
+    (``inverse``) the factor per unit-free unit (rad -> 180/pi deg, /L -> L)."""
+    out = []
+    for u in units:
+        f = np.pi / 180.0 if u == "deg" else 1.0 / length if u in LENGTH_UNITS else 1.0
+        out.append(1.0 / f if inverse else f)
+    return np.array(out)
+
+
+def characteristic_length(mech, points: np.ndarray) -> float:
+    """L of the module's note above: a serial arm's largest tool distance over ``points`` (joint
+    configurations), a parallel mechanism's mean absolute length-unit joint at the box centre."""
+    if mech.kind == "serial":
+        p, _, _ = mech.frame_jacobian(points)
+        length = float(np.linalg.norm(p, axis=-1).max())
+    else:
+        centre = mech.bounds.mean(axis=1)
+        legs = np.asarray(mech.ik(centre), dtype=float)
+        lengths = [abs(v) for v, u in zip(legs, mech.joint_units) if u in LENGTH_UNITS]
+        length = float(np.mean(lengths)) if lengths else 1.0
+    return length if np.isfinite(length) and length > 0 else 1.0
+
+
+def unit_free_jacobian(mech, points: np.ndarray, length: float) -> np.ndarray:
+    """(k, rows, cols) the Jacobian J~ of the note above at each of ``points`` (k, unknowns)."""
+    points = np.asarray(points, dtype=float)
+    if mech.kind == "serial":
+        if not hasattr(mech, "frame_jacobian"):
+            from ..errors import FkoptError
+            raise FkoptError(f"{mech.name}: the unit-free singularity measure needs a frame Jacobian "
+                             "(a frame arm: DH, URDF, MJCF)")
+        _, _, J = mech.frame_jacobian(points)
+        rows = np.array([1.0 / length] * 3 + [1.0] * 3)
+        cols = _unit_factors(mech.joint_units, length, inverse=True)
+        return rows[:, None] * J * cols[None, :]
+    h = 1e-6 * np.maximum(1.0, np.abs(points))
+    cols = []
+    for j in range(points.shape[1]):
+        e = np.zeros_like(points)
+        e[:, j] = h[:, j]
+        cols.append((np.asarray(mech.ik(points + e)) - np.asarray(mech.ik(points - e))) / (2 * h[:, j, None]))
+    J = np.stack(cols, axis=-1)
+    rows = _unit_factors(mech.joint_units, length, inverse=False)
+    colf = _unit_factors(mech.pose_units, length, inverse=True)
+    return rows[:, None] * J * colf[None, :]
+
+
+def unit_free_sigma_min(mech, points: np.ndarray, length: float) -> np.ndarray:
+    """(k,) the smallest singular value of J~ (0 at a singularity; NaN where J~ is not finite)."""
+    J = unit_free_jacobian(mech, points, length)
+    ok = np.all(np.isfinite(J), axis=(1, 2))
+    out = np.full(len(J), np.nan)
+    if ok.any():
+        out[ok] = np.linalg.svd(J[ok], compute_uv=False)[:, -1]
+    return out

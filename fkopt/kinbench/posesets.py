@@ -22,14 +22,13 @@ Files: ``<folder>/<problem>/<set>.csv`` (one column per unknown, ``%.17g``: exac
 spec and per set the file's SHA-256, its number of poses and (near-singular) the bound.
 :func:`load_pose_sets` verifies every checksum and that each problem's mechanism spec is the one
 its sets were generated for; any mismatch is one error line naming the file. ``python -m
-fkopt.kinbench.posesets SUITE.yaml`` (re)writes a set folder; a new version is a new folder.
+fkopt.kinbench.freeze pose-sets SUITE.yaml`` (re)writes a set folder; a new version is a new folder.
 """
 from __future__ import annotations
 
 import hashlib
 import io
 import json
-import sys
 import zlib
 from pathlib import Path
 
@@ -104,8 +103,12 @@ def condition_numbers(problem, folder: Path | None, points: np.ndarray) -> np.nd
         return np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
 
 
-def generate(problem, seed: int, n: int = POSES, folder: Path | None = None) -> tuple[dict, dict]:
-    """Points of every v1 set of ``problem`` and what the manifest records of their generation."""
+def generate(problem, seed: int, n: int = POSES, folder: Path | None = None,
+             measure: str = "condition") -> tuple[dict, dict]:
+    """Points of every set of ``problem`` and what the manifest records of their generation.
+    ``measure`` picks the near-singular set: ``"condition"`` (v1, v2: kappa of the residual
+    Jacobian above its 95th percentile) or ``"sigma"`` (v3: the unit-free smallest singular value
+    of :func:`fkopt.kinbench.measures.unit_free_sigma_min` below its 5th percentile)."""
     mech, _ = problem_mechanism(problem, folder)
     lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
     dim = len(lo)
@@ -114,13 +117,25 @@ def generate(problem, seed: int, n: int = POSES, folder: Path | None = None) -> 
     out["uniform"] = lo + rng.random((n, dim)) * (hi - lo)
     rng = set_rng(seed, problem.name, "near-singular")
     cand = lo + rng.random((CANDIDATES, dim)) * (hi - lo)
-    kappa = condition_numbers(problem, folder, cand)
-    bound = float(np.quantile(kappa[np.isfinite(kappa)], SINGULAR_QUANTILE))
-    picked = np.flatnonzero(kappa > bound)[:n]
+    if measure == "condition":
+        kappa = condition_numbers(problem, folder, cand)
+        bound = float(np.quantile(kappa[np.isfinite(kappa)], SINGULAR_QUANTILE))
+        picked = np.flatnonzero(kappa > bound)[:n]
+        info["near-singular"] = {"measure": "condition number of the residual Jacobian at the solution",
+                                 "bound": float(f"{bound:.6g}"), "quantile": SINGULAR_QUANTILE,
+                                 "candidates": CANDIDATES}
+    elif measure == "sigma":
+        from .measures import characteristic_length, unit_free_sigma_min
+        length = characteristic_length(mech, cand)
+        sigma = unit_free_sigma_min(mech, cand, length)
+        bound = float(np.quantile(sigma[np.isfinite(sigma)], 1.0 - SINGULAR_QUANTILE))
+        picked = np.flatnonzero(sigma < bound)[:n]
+        info["near-singular"] = {"measure": "unit-free smallest singular value of the Jacobian (lengths / L)",
+                                 "bound": float(f"{bound:.6g}"), "quantile": float(f"{1.0 - SINGULAR_QUANTILE:.6g}"),
+                                 "candidates": CANDIDATES, "characteristic_length": float(f"{length:.6g}")}
+    else:
+        raise FkoptError(f"pose sets: measure '{measure}' unknown; allowed: condition, sigma")
     out["near-singular"] = cand[picked]
-    info["near-singular"] = {"measure": "condition number of the residual Jacobian at the solution",
-                             "bound": float(f"{bound:.6g}"), "quantile": SINGULAR_QUANTILE,
-                             "candidates": CANDIDATES}
     rng = set_rng(seed, problem.name, "boundary")
     u = rng.random((n, dim + 3))
     pts = lo + u[:, :dim] * (hi - lo)
@@ -149,14 +164,17 @@ def sha256_bytes(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def write_pose_sets(config, folder: Path) -> Path:
+def write_pose_sets(config, folder: Path, poses: int = POSES, measure: str = "condition") -> Path:
     """Generate and write every set of every problem of ``config`` into ``folder`` (frozen data:
-    run once per version, then commit the folder)."""
+    run once per version, then commit the folder). v1 and v2: 20 poses, ``condition``; v3: 100
+    poses, ``sigma`` (recorded in the manifest, only when not v1's/v2's defaults)."""
     folder = Path(folder)
-    manifest = {"version": folder.name, "seed": config.seed, "poses_per_set": POSES,
+    manifest = {"version": folder.name, "seed": config.seed, "poses_per_set": poses,
                 "generator": "fkopt.kinbench.posesets.generate", "problems": {}}
+    if measure != "condition":
+        manifest["near_singular_measure"] = measure
     for problem in config.problems:
-        sets, info = generate(problem, config.seed, POSES, config._folder)
+        sets, info = generate(problem, config.seed, poses, config._folder, measure)
         mech, _ = problem_mechanism(problem, config._folder)
         entry = {"mechanism": problem.mechanism.model_dump(mode="json"), "unknowns": list(mech.unknown_names),
                  "sets": {}}
@@ -216,10 +234,6 @@ def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
             pts = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=float)
             pts = pts.reshape(-1, len(entry["unknowns"]))
             out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
+    from .releases import check_release
+    check_release(config, manifest)      # a released version: every file as released, not only as its manifest says
     return out, manifest
-
-
-if __name__ == "__main__":     # python -m fkopt.kinbench.posesets configs/suites/kinbench.yaml
-    from .config import load_suite
-    cfg = load_suite(sys.argv[1])
-    print(write_pose_sets(cfg, pose_set_folder(cfg)))

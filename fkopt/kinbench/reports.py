@@ -46,6 +46,15 @@ def timing_table(sr) -> pd.DataFrame:
     return record.timing_table(sr.timing, settings, by=("problem", "solver"))
 
 
+def scaling_table(sr) -> pd.DataFrame | None:
+    return M.scaling_table(sr.runs, sr.config.targets)
+
+
+def scaling_target(targets) -> float:
+    """The target the scaling figure and section show: the middle of the ladder (1e-6 of v1-v3's)."""
+    return sorted(targets, reverse=True)[len(targets) // 2]
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.+-]+", "_", text).strip("_")
 
@@ -83,6 +92,41 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         names += save(fig, folder / f"{stem}.png")
         pyplot.close(fig)
     return names
+
+
+def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
+    """One figure per class of several dimensions (scaling.csv): log10(ERT / dimension) at the
+    middle target against the dimension, one line per solver; a dimension no run of a solver
+    solved is left out of its line (ERT infinite), as COCO's scaling plots do."""
+    df = tables.get("scaling.csv")
+    if df is None or df.empty:
+        return []
+    from ..experiment.plotting import plt, save
+    pyplot = plt()
+    styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
+    target = scaling_target(sr.config.targets)
+    names = []
+    for cls, g in df[np.isclose(df["target"], target)].groupby("class", sort=True):
+        fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
+        for (solver, track), s in g.groupby(["solver", "track"], sort=False):
+            s = s[np.isfinite(s["ert_per_dim"])]
+            if len(s):
+                ax.plot(s["dim"], np.log10(s["ert_per_dim"]), marker="o", linestyle=styles.get(track, "-"),
+                        label=f"{solver} ({track})")
+        ax.set_xscale("log")
+        ax.minorticks_off()
+        dims = sorted(set(g["dim"]))
+        ax.set_xticks(dims, [str(d) for d in dims], fontsize=7)
+        ax.set_xlabel("dimension (number of joints)")
+        ax.set_ylabel(f"log10(ERT / dimension) at {target:.0e}")
+        ax.set_title(f"{sr.config.name}: {cls}, cost against dimension", fontsize=8)
+        ax.legend(loc="best", fontsize=7)
+        names += save(fig, folder / f"scaling_{_slug(cls)}.png")
+        pyplot.close(fig)
+    return names
+
+
+SCALING = ["dim", "solver", "track", "trials", "success_rate", "ert", "ert_per_dim"]
 
 
 def _md_table(df: pd.DataFrame, cols: list[str]) -> str:
@@ -131,6 +175,14 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
         for scope, g in leaderboard_sections(tables):
             if pred(scope):
                 out += [f"### {scope}", "", _md_table(g, cols), ""]
+    sc = tables.get("scaling.csv")
+    if sc is not None:
+        target = scaling_target(c.targets)
+        out += ["## Cost against dimension", "", f"ERT (evaluations) and ERT / dimension at target {target:.0e} "
+                "over every problem, set and pose of a dimension, for the classes of several dimensions "
+                "(scaling.csv has every target).", ""]
+        for cls, g in sc[np.isclose(sc["target"], target)].groupby("class", sort=True):
+            out += [f"### {cls}", "", _md_table(g.sort_values(["solver", "dim"], kind="stable"), SCALING), ""]
     ms = tables.get("measures.csv")
     if ms is not None:
         out += ["## Per problem", "", "Success rate and ERT (evaluations) per set and target.", ""]
@@ -161,6 +213,13 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
     figs = sorted(folder.glob("ecdf_*.png"))
     if figs:
         body += ["<h2>Runtime distributions (ECDF)</h2>"] + [img(p) for p in figs]
+    sc = tables.get("scaling.csv")
+    if sc is not None:
+        target = scaling_target(c.targets)
+        body.append(f"<h2>Cost against dimension (target {target:.0e})</h2>")
+        body += [img(p) for p in sorted(folder.glob("scaling_*.png"))]
+        for k, (cls, g) in enumerate(sc[np.isclose(sc["target"], target)].groupby("class", sort=True)):
+            body += [f"<h3>{html.escape(cls)}</h3>", table_html(g, SCALING, f"sc-{k}")]
     ms = tables.get("measures.csv")
     if ms is not None:
         body.append("<h2>Per problem</h2>")
