@@ -34,11 +34,13 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
+import io
 import json
 import os
 import re
 import shutil
 import signal
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any, Callable
@@ -112,32 +114,148 @@ def _loader():
     return Loader
 
 
-def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> str:
-    """The UTF-8 text of a user file, at most ``max_bytes``; every failure is one line."""
+#: Largest magnitude of a number fkopt takes from a user's file or command line where no
+#: schema bounds it (URDF lengths and angles, --joints/--pose values), in the file's own units:
+#: 1e9 m is six times the Earth-Sun distance, 1e9 deg 2.8 million turns. Past it a value is a
+#: typo or an attack, and its square in FK or a Jacobian overflows to inf (docs/reliability.md).
+MAX_MAGNITUDE = 1e9
+
+
+# -- reading files fkopt did not write -------------------------------------------------------------
+#: Largest file of another tool read (bytes): an outside CSV, an IOH ``.dat`` or index, a pose-set
+#: CSV, a stored result's table. Checked on the file's size before a byte is read; a compressed
+#: file (``.gz``) is also refused once it unpacks to more than ``unpacked`` bytes.
+MAX_INPUT_BYTES = 64 << 20
+
+
+def _file_kind(mode: int) -> str:
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def _where(path: Path, field: str | None) -> str:
+    return f"{field}: {path}" if field else str(path)
+
+
+def check_within(path: str | Path, root: str | Path, field: str | None = None) -> Path:
+    """``path`` unchanged after checking that it resolves (symbolic links included) inside the
+    folder ``root`` it was named from; else one line naming the file and the folder."""
     path = Path(path)
     try:
-        if path.is_dir():
-            raise FkoptError(f"{path}: is a folder, expected a file")
-        with open(path, "rb") as fh:
-            data = fh.read(max_bytes + 1)
+        base, resolved = Path(root).resolve(), path.resolve()
+    except (OSError, RuntimeError) as err:       # a loop of links
+        raise FkoptError(f"{_where(path, field)}: cannot resolve ({getattr(err, 'strerror', None) or err})") from None
+    if resolved != base and base not in resolved.parents:
+        raise FkoptError(f"{_where(path, field)}: resolves outside {root}; only files inside that folder are read")
+    return path
+
+
+def open_input(path: str | Path, max_bytes: int, field: str | None = None,
+               within: str | Path | None = None) -> int:
+    """A read-only descriptor of the regular file ``path`` (the caller closes it), after every
+    check a file of another tool gets: inside ``within`` (when given), a regular file (not a
+    folder, FIFO or device: a FIFO would block, ``/dev/zero`` never ends; checked on the opened
+    file, so a link swapped meanwhile changes nothing) and at most ``max_bytes`` by its size."""
+    path = Path(path)
+    where = _where(path, field)
+    if within is not None:
+        check_within(path, within, field)
+    try:    # O_NONBLOCK: opening a FIFO does not wait for a writer; no effect on regular files
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except OSError as err:
-        raise FkoptError(f"{path}: cannot read ({err.strerror or err})") from None
-    if len(data) > max_bytes:
-        raise FkoptError(f"{path}: larger than the {max_bytes} bytes accepted for this file")
+        raise FkoptError(f"{where}: cannot read ({err.strerror or err})") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise FkoptError(f"{where}: is {_file_kind(info.st_mode)}; only regular files are read")
+        if info.st_size > max_bytes:
+            raise FkoptError(f"{where}: {info.st_size} bytes, larger than the {max_bytes} bytes accepted "
+                             "for this file")
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
+def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
+               within: str | Path | None = None, unpacked: int | None = None) -> bytes:
+    """The bytes of a file fkopt did not write in this run (configs, URDF, pose sets, outside
+    results, IOH data, stored results), read with a bound: :func:`open_input`'s checks, then at
+    most ``max_bytes`` read (a file growing meanwhile is refused too). A ``.gz`` file is
+    decompressed as a stream and refused past ``unpacked`` bytes (default ``max_bytes``) --
+    a 3 MB gzip cannot unpack into gigabytes. Every refusal is one line naming ``field`` and
+    the file."""
+    import gzip
+    import zlib
+    path = Path(path)
+    where = _where(path, field)
+    fd = open_input(path, max_bytes, field, within)
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            data = fh.read(max_bytes + 1)
+        except OSError as err:
+            raise FkoptError(f"{where}: cannot read ({err.strerror or err})") from None
+        if len(data) > max_bytes:
+            raise FkoptError(f"{where}: larger than the {max_bytes} bytes accepted for this file")
+    if not path.name.endswith(".gz"):
+        return data
+    limit = max_bytes if unpacked is None else unpacked
+    chunks, size = [], 0
+    try:
+        with gzip.GzipFile(fileobj=io.BytesIO(data)) as gz:
+            while chunk := gz.read(1 << 20):
+                size += len(chunk)
+                if size > limit:
+                    raise FkoptError(f"{where}: unpacks to more than {limit} bytes, the most accepted for this "
+                                     "file; refused (memory stays bounded)")
+                chunks.append(chunk)
+    except (EOFError, gzip.BadGzipFile, zlib.error) as err:
+        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else "not a valid gzip file"
+        raise FkoptError(f"{where}: {what}") from None
+    return b"".join(chunks)
+
+
+def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str | None = None,
+              within: str | Path | None = None, unpacked: int | None = None) -> str:
+    """The UTF-8 text of a user file (:func:`read_input`'s bounds); every failure is one line."""
+    data = read_input(path, max_bytes, field=field, within=within, unpacked=unpacked)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise FkoptError(f"{path}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset {err.start})") from None
+        raise FkoptError(f"{_where(Path(path), field)}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset "
+                         f"{err.start})") from None
+
+
+def read_json(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
+              within: str | Path | None = None) -> Any:
+    """A JSON file fkopt did not write in this run: bounded (:func:`read_input`), UTF-8, strict
+    JSON (``NaN``/``Infinity`` refused), nesting bounded; every failure is one line."""
+    text = read_text(path, max_bytes, field=field, within=within)
+
+    def constant(name):
+        raise ValueError(f"{name} is not JSON")
+    try:
+        return json.loads(text, parse_constant=constant)
+    except RecursionError:
+        raise FkoptError(f"{_where(Path(path), field)}: nested too deeply") from None
+    except ValueError as err:
+        raise FkoptError(f"{_where(Path(path), field)}: not valid JSON ({str(err)[:80]})") from None
 
 
 def check_geometry_file(path: Path, mechanism: str, max_bytes: int, what: str) -> None:
-    """A mechanism's ``geometry.file`` exists and is at most ``max_bytes`` (checked before any parser
-    reads it); ``what`` names the format in the message, e.g. "a URDF file"."""
-    if not path.is_file():
+    """A mechanism's ``geometry.file`` is a regular file (not a folder, FIFO or device) of at
+    most ``max_bytes`` (checked before any parser reads it); ``what`` names the format in the
+    message, e.g. "a URDF file"."""
+    if not Path(path).exists() and not Path(path).is_symlink():
         raise FkoptError(f"{mechanism} geometry.file: {path} does not exist")
-    size = path.stat().st_size
-    if size > max_bytes:
-        raise FkoptError(f"{mechanism} {path}: {size} bytes, larger than the {max_bytes} bytes accepted for {what}")
+    try:
+        os.close(open_input(path, max_bytes, f"{mechanism} geometry.file"))
+    except FkoptError as err:
+        raise FkoptError(str(err).replace("for this file", f"for {what}")) from None
 
 
 def load_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
