@@ -230,20 +230,26 @@ def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str |
                          f"{err.start})") from None
 
 
-def read_json(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
-              within: str | Path | None = None) -> Any:
-    """A JSON file fkopt did not write in this run: bounded (:func:`read_input`), UTF-8, strict
-    JSON (``NaN``/``Infinity`` refused), nesting bounded; every failure is one line."""
-    text = read_text(path, max_bytes, field=field, within=within)
-
+def parse_json(data: bytes, where: str) -> Any:
+    """Strict JSON from the bytes of a file fkopt did not write (``where`` names it): UTF-8,
+    ``NaN``/``Infinity`` refused, nesting bounded; every failure is one line."""
     def constant(name):
         raise ValueError(f"{name} is not JSON")
     try:
-        return json.loads(text, parse_constant=constant)
+        return json.loads(data.decode("utf-8"), parse_constant=constant)
+    except UnicodeDecodeError as err:
+        raise FkoptError(f"{where}: not UTF-8 text (offset {err.start})") from None
     except RecursionError:
-        raise FkoptError(f"{_where(Path(path), field)}: nested too deeply") from None
+        raise FkoptError(f"{where}: nested too deeply") from None
     except ValueError as err:
-        raise FkoptError(f"{_where(Path(path), field)}: not valid JSON ({str(err)[:80]})") from None
+        raise FkoptError(f"{where}: not valid JSON ({one_line(str(err), 80)})") from None
+
+
+def read_json(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
+              within: str | Path | None = None) -> Any:
+    """A JSON file fkopt did not write in this run: bounded (:func:`read_input`), then
+    :func:`parse_json`."""
+    return parse_json(read_input(path, max_bytes, field=field, within=within), _where(Path(path), field))
 
 
 def check_geometry_file(path: Path, mechanism: str, max_bytes: int, what: str) -> None:
