@@ -182,13 +182,13 @@ def open_input(path: str | Path, max_bytes: int, field: str | None = None,
 
 
 def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
-               within: str | Path | None = None, unpacked: int | None = None) -> bytes:
+               within: str | Path | None = None, unpacked: int | None = None, unpack: bool = True) -> bytes:
     """The bytes of a file fkopt did not write in this run (configs, URDF, pose sets, outside
     results, IOH data, stored results), read with a bound: :func:`open_input`'s checks, then at
     most ``max_bytes`` read (a file growing meanwhile is refused too). A ``.gz`` file is
     decompressed as a stream and refused past ``unpacked`` bytes (default ``max_bytes``) --
-    a 3 MB gzip cannot unpack into gigabytes. Every refusal is one line naming ``field`` and
-    the file."""
+    a 3 MB gzip cannot unpack into gigabytes (``unpack=False``: the file's own bytes, e.g. for
+    a digest). Every refusal is one line naming ``field`` and the file."""
     import gzip
     import zlib
     path = Path(path)
@@ -201,7 +201,7 @@ def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str
             raise FkoptError(f"{where}: cannot read ({err.strerror or err})") from None
         if len(data) > max_bytes:
             raise FkoptError(f"{where}: larger than the {max_bytes} bytes accepted for this file")
-    if not path.name.endswith(".gz"):
+    if not unpack or not path.name.endswith(".gz"):
         return data
     limit = max_bytes if unpacked is None else unpacked
     chunks, size = [], 0
@@ -569,6 +569,14 @@ def nanmedian(a) -> float:
     a = np.asarray(a, dtype=float)
     ok = ~np.isnan(a)
     return float(np.median(a[ok])) if ok.any() else float("nan")
+
+
+def short_token(text: Any, limit: int = 40) -> str:
+    """A short, printable excerpt of a hostile file's text for an error line: whitespace runs
+    made one space, non-printable characters ``?``, at most ``limit`` characters."""
+    text = " ".join(str(text).split())
+    text = "".join(c if c.isprintable() else "?" for c in text)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def one_line(text: str, limit: int = 2000) -> str:

@@ -40,7 +40,7 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from ..errors import FkoptError, did_you_mean
-from ..files import MAX_MAGNITUDE, check_geometry_file, read_input
+from ..files import MAX_MAGNITUDE, check_geometry_file, read_input, short_token
 from ..numerics.chain import frame_jacobian1, from_terms
 from .base import FrameArm, Geometry, describe_validation_error
 
@@ -67,18 +67,11 @@ def _floats(text, count: int, default, what: str, path: Path) -> tuple:
     except ValueError:
         values = ()
     if len(values) != count or not all(map(math.isfinite, values)):
-        raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{_token(text)}')")
+        raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{short_token(text)}')")
     if any(abs(v) > MAX_URDF_VALUE for v in values):
-        raise FkoptError(f"urdf {path}: {what}: {_token(text)} is past the bound |v| <= {MAX_URDF_VALUE:g} "
+        raise FkoptError(f"urdf {path}: {what}: {short_token(text)} is past the bound |v| <= {MAX_URDF_VALUE:g} "
                          "(m, rad) accepted for a URDF number")
     return values
-
-
-def _token(text: str, limit: int = 40) -> str:
-    """A short, printable excerpt of a file's text for an error line (never the whole file)."""
-    text = " ".join(str(text).split())
-    text = "".join(c if c.isprintable() else "?" for c in text)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 #: Largest magnitude of a number of a URDF file (lengths in m, angles in rad, factors): the one
