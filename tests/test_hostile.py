@@ -983,3 +983,143 @@ def test_swap_keeps_previous_until_replaced(tmp_path):
     (new / "c.csv").write_text("3\n")
     swap_into_place(new, final)
     assert sorted(p.name for p in final.iterdir()) == ["c.csv"] and not new.exists()
+
+
+# == issue 30: hostile inputs, third round ==========================================================
+# Every file fkopt did not write in this run is read bounded (files.read_input) and validated.
+import gzip as _gzip
+import shutil as _shutil
+
+SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
+MINI_SETS = "my-sets"
+
+
+def mini_suite(root: Path, sets_folder: str = MINI_SETS, **over) -> Path:
+    """A one-problem suite (mao2017-3rps, set uniform, 2 poses, lm) beside a copy of its pose sets
+    under a private version name (so the released-version check does not mask what is tested)."""
+    root.mkdir(parents=True, exist_ok=True)
+    sets = root / sets_folder
+    if not sets.exists():
+        _shutil.copytree(SUITES / "kinbench-v1" / "mao2017-3rps", sets / "mao2017-3rps")
+        manifest = json.loads((SUITES / "kinbench-v1" / "manifest.json").read_text())
+        manifest["problems"] = {"mao2017-3rps": manifest["problems"]["mao2017-3rps"]}
+        manifest["version"] = sets_folder
+        (sets / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+    data = yaml.safe_load((SUITES / "kinbench.yaml").read_text())
+    data.update(name="mini", pose_sets=sets_folder, problems=data["problems"][:1], sets=["uniform"], poses=2,
+                runs=1, solvers=[{"name": "lm"}], budget_per_dim=50, bootstrap=100, quick=None)
+    data.update(over)
+    path = root / "mini.yaml"
+    path.write_text(yaml_of(data))
+    return path
+
+
+def resign(sets: Path, rel: str) -> None:
+    """Update the manifest's SHA-256 of ``rel`` (a forged signature: the file is then 'valid')."""
+    manifest = json.loads((sets / "manifest.json").read_text())
+    name = Path(rel).stem
+    manifest["problems"]["mao2017-3rps"]["sets"][name]["sha256"] = hashlib.sha256((sets / rel).read_bytes()).hexdigest()
+    (sets / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+
+
+def refused(cli, argv, root: Path, *fragments) -> str:
+    """``fkopt argv`` is exit 2, one line holding ``fragments``, and nothing under ``root`` changed."""
+    before = snapshot(root)
+    line = one_line_error(cli(*argv), *fragments)
+    assert snapshot(root) == before, "a refused input wrote or changed a file"
+    return line
+
+
+# -- pose sets: every malformed input is one line (findings 1, 3 and 5) ---------------------------
+UNIFORM = f"{MINI_SETS}/mao2017-3rps/uniform.csv"
+
+
+def _csv(text):
+    def spoil(sets):
+        (sets / "mao2017-3rps" / "uniform.csv").write_bytes(text if isinstance(text, bytes) else text.encode())
+        resign(sets, "mao2017-3rps/uniform.csv")
+    return spoil
+
+
+def _manifest(change):
+    def spoil(sets):
+        m = json.loads((sets / "manifest.json").read_text())
+        m = change(m)
+        (sets / "manifest.json").write_text(json.dumps(m))
+    return spoil
+
+
+def _entry(change):
+    return _manifest(lambda m: (change(m["problems"]["mao2017-3rps"]), m)[1])
+
+
+def _link(target):
+    def spoil(sets):
+        f = sets / "mao2017-3rps" / "uniform.csv"
+        f.unlink()
+        f.symlink_to(target)
+    return spoil
+
+
+def _fifo(sets):
+    f = sets / "mao2017-3rps" / "uniform.csv"
+    f.unlink()
+    os.mkfifo(f)
+
+
+POSESET_CASES = [
+    ("csv-empty", _csv(""), ["uniform.csv", "empty"]),
+    ("csv-non-ascii", _csv("alpha,beta,z\n1,2,caf\u00e9\n"), ["uniform.csv", "not ASCII"]),
+    ("csv-cell-text", _csv("alpha,beta,z\n1,2,<script>\n"), ["uniform.csv", "line 2", "not a number"]),
+    ("csv-ragged", _csv("alpha,beta,z\n1,2,600\n1,2\n"), ["uniform.csv", "line 3", "needs 3"]),
+    ("csv-nan", _csv("alpha,beta,z\n1,2,nan\n"), ["uniform.csv", "finite"]),
+    ("csv-header", _csv("a,b,c\n1,2,600\n"), ["uniform.csv", "header", "alpha,beta,z"]),
+    ("csv-poses-count", _csv("alpha,beta,z\n1,2,600\n"), ["poses", "has 1 poses"]),
+    ("csv-fifo", _fifo, ["uniform.csv", "FIFO", "only regular files"]),
+    ("csv-dev-zero", _link("/dev/zero"), ["uniform.csv", "outside"]),
+    ("csv-folder", lambda s: ((s / "mao2017-3rps" / "uniform.csv").unlink(),
+                              (s / "mao2017-3rps" / "uniform.csv").mkdir()), ["uniform.csv", "a folder"]),
+    ("csv-link-outside", lambda s: _link(s.parent / "elsewhere.csv")(s), ["uniform.csv", "outside"]),
+    ("file-escapes", _entry(lambda e: e["sets"]["uniform"].update(file="../../x.csv")), ["file", "outside"]),
+    ("file-absolute", _entry(lambda e: e["sets"]["uniform"].update(file="/etc/passwd")), ["file", "outside"]),
+    ("file-not-text", _entry(lambda e: e["sets"]["uniform"].update(file=7)), ["sets.uniform.file"]),
+    ("manifest-list", _manifest(lambda m: []), ["manifest.json", "JSON mapping"]),
+    ("manifest-not-json", lambda s: (s / "manifest.json").write_text("{not json"), ["manifest.json", "not valid JSON"]),
+    ("manifest-nan", lambda s: (s / "manifest.json").write_text('{"problems": NaN}'), ["manifest.json", "NaN"]),
+    ("manifest-problems-list", _manifest(lambda m: {**m, "problems": []}), ["problems", "mapping"]),
+    ("manifest-no-mechanism", _entry(lambda e: e.pop("mechanism")), ["problems.mao2017-3rps.mechanism", "missing"]),
+    ("manifest-sets-list", _entry(lambda e: e.update(sets=[])), ["problems.mao2017-3rps.sets", "mapping"]),
+    ("manifest-no-sha", _entry(lambda e: e["sets"]["uniform"].pop("sha256")), ["sets.uniform.sha256", "64"]),
+    ("manifest-no-set", _entry(lambda e: e["sets"].pop("uniform")), ["has no set 'uniform'"]),
+    ("manifest-unknowns", _entry(lambda e: e.update(unknowns="alpha")), ["unknowns", "list"]),
+    ("manifest-poses-text", _entry(lambda e: e["sets"]["uniform"].update(poses="20")), ["poses", "integer"]),
+    ("manifest-huge", lambda s: (s / "manifest.json").write_bytes(b" " * (2 << 20)), ["manifest.json", "larger than"]),
+]
+
+
+@pytest.mark.parametrize("case", POSESET_CASES, ids=[c[0] for c in POSESET_CASES])
+def test_pose_set_inputs_are_one_line(case, tmp_path, cli):
+    ident, spoil, fragments = case
+    path = mini_suite(tmp_path / "s")
+    (tmp_path / "s" / "elsewhere.csv").write_text((SUITES / "kinbench-v1" / "mao2017-3rps" / "uniform.csv").read_text())
+    spoil(tmp_path / "s" / MINI_SETS)
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q"], tmp_path, *fragments)
+    assert "<script>" not in line and "root:" not in line       # no file content quoted
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
+def test_a_swapped_released_set_with_a_resigned_manifest_is_refused(tmp_path, cli):
+    path = mini_suite(tmp_path / "s", sets_folder="kinbench-v1")
+    # the copy trimmed the manifest: a re-signed released version, as an attacker would make it
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q"], tmp_path, "not the released kinbench-v1")
+    assert "new version" in line
+    # the committed release itself loads (its manifest is the released one, byte for byte)
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.posesets import load_pose_sets
+    assert load_pose_sets(load_suite(SUITES / "kinbench.yaml"))[1]["version"] == "kinbench-v1"
+
+
+def test_a_mini_suite_of_a_private_version_still_validates(tmp_path):
+    from fkopt.experiment.kinds import load_any, validate_any
+    path = mini_suite(tmp_path / "s")
+    assert validate_any(load_any(path), str(path)) == 1
