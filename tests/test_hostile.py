@@ -1123,3 +1123,141 @@ def test_a_mini_suite_of_a_private_version_still_validates(tmp_path):
     from fkopt.experiment.kinds import load_any, validate_any
     path = mini_suite(tmp_path / "s")
     assert validate_any(load_any(path), str(path)) == 1
+
+
+# -- outside results: CSV and IOH (findings 1, 4 and 5) ---------------------------------------------
+GOOD_CSV = "problem,set,pose,run,evaluations,best_so_far\n" + "".join(
+    f"mao2017-3rps,uniform,{p},0,{e},{f}\n" for p in (0, 1) for e, f in ((1, 5.0), (6, 1e-12)))
+GOOD_DAT = "evaluations raw_y\n1 5.0\n6 1e-12\n" * 2
+SECRET = "root:x:0:0:SECRET-TOKEN"
+
+
+def ioh_folder(root: Path, index=None, dat=GOOD_DAT) -> Path:
+    """An IOHprofiler folder of one algorithm with both poses of the mini suite."""
+    folder = root / "ioh"
+    (folder / "run" / "data_f1").mkdir(parents=True, exist_ok=True)
+    index = index if index is not None else {
+        "algorithm": {"name": "RS"}, "function_name": "mao2017-3rps__uniform",
+        "scenarios": [{"path": "data_f1/IOHprofiler_f1_DIM3.dat", "runs": [{"instance": 1}, {"instance": 2}]}]}
+    (folder / "run" / "IOHprofiler_f1.json").write_text(index if isinstance(index, str) else json.dumps(index))
+    (folder / "run" / "data_f1" / "IOHprofiler_f1_DIM3.dat").write_text(dat)
+    return folder
+
+
+def _index(**change):
+    data = {"algorithm": {"name": "RS"}, "function_name": "mao2017-3rps__uniform",
+            "scenarios": [{"path": "data_f1/IOHprofiler_f1_DIM3.dat", "runs": [{"instance": 1}, {"instance": 2}]}]}
+    data.update(change)
+    return data
+
+
+def _runs(*instances):
+    return _index(scenarios=[{"path": "data_f1/IOHprofiler_f1_DIM3.dat", "runs": [{"instance": i} for i in instances]}])
+
+
+def _path(p):
+    return _index(scenarios=[{"path": p, "runs": [{"instance": 1}, {"instance": 2}]}])
+
+
+def _write_csv(text):
+    return lambda root: (root / "x.csv").write_text(text)
+
+
+def _gzip_bomb(root):
+    with _gzip.open(root / "x.csv.gz", "wb", compresslevel=1) as fh:
+        fh.write(GOOD_CSV.encode())
+        chunk = b"0" * (1 << 20)
+        for _ in range(65):
+            fh.write(chunk)
+
+
+def _sparse(root):
+    with open(root / "x.csv", "wb") as fh:
+        fh.truncate(65 << 20)         # a size past the cap, without writing 65 MB
+
+
+OUTSIDE_CASES = [   # (id, make the input under root, outside entry, fragments)
+    ("csv-gzip-bomb", _gzip_bomb, {"file": "x.csv.gz"}, ["outside[0].file", "x.csv.gz", "unpacks to more than"]),
+    ("csv-too-large", _sparse, {"file": "x.csv"}, ["outside[0].file", "larger than"]),
+    ("csv-fifo", lambda root: os.mkfifo(root / "x.csv"), {"file": "x.csv"}, ["outside[0].file", "FIFO"]),
+    ("csv-dev-zero", lambda root: (root / "x.csv").symlink_to("/dev/zero"), {"file": "x.csv"},
+     ["outside[0].file", "character device"]),
+    ("csv-folder", lambda root: (root / "x.csv").mkdir(), {"file": "x.csv"}, ["outside[0].file", "a folder"]),
+    ("csv-evaluations-1e300", _write_csv(GOOD_CSV.replace(",6,", ",1e300,")), {"file": "x.csv"},
+     ["column 'evaluations'", "[0, 2^53]"]),
+    ("csv-evaluations-2e53", _write_csv(GOOD_CSV.replace(",6,", f",{2**53 + 2},")), {"file": "x.csv"},
+     ["column 'evaluations'", "[0, 2^53]"]),
+    ("csv-run-1e300", _write_csv(GOOD_CSV.replace(",0,6,", ",1e300,6,")), {"file": "x.csv"}, ["column 'run'"]),
+    ("csv-empty", _write_csv(""), {"file": "x.csv"}, ["outside[0].file", "unreadable CSV"]),
+    ("ioh-no-header", lambda root: ioh_folder(root, dat="1 5.0\n6 1e-12\n"), {"ioh": "ioh"},
+     ["IOHprofiler_f1_DIM3.dat", "line 1", "header"]),
+    ("ioh-dat-text", lambda root: ioh_folder(root, dat=f"evaluations raw_y\n1 {SECRET}\n"), {"ioh": "ioh"},
+     ["line 2", "two numbers"]),
+    ("ioh-dat-1e300", lambda root: ioh_folder(root, dat="evaluations raw_y\n1e300 5\n" * 2), {"ioh": "ioh"},
+     ["evaluations", "[0, 2^53]"]),
+    ("ioh-instance-text", lambda root: ioh_folder(root, _runs("x", 2)), {"ioh": "ioh"},
+     ["scenarios[0].runs[0].instance", "integer >= 1"]),
+    ("ioh-instance-null", lambda root: ioh_folder(root, _runs(None, 2)), {"ioh": "ioh"},
+     ["scenarios[0].runs[0].instance"]),
+    ("ioh-instance-bool", lambda root: ioh_folder(root, _runs(True, 2)), {"ioh": "ioh"}, ["instance"]),
+    ("ioh-function-number", lambda root: ioh_folder(root, _index(function_name=7)), {"ioh": "ioh"},
+     ["function_name", "must be text"]),
+    ("ioh-mixed-function-names", lambda root: (ioh_folder(root), (root / "ioh" / "run2").mkdir(),
+                                               (root / "ioh" / "run2" / "IOHprofiler_f2.json").write_text(
+                                                   json.dumps(_index(function_name=2)))),
+     {"ioh": "ioh"}, ["IOHprofiler_f2.json", "function_name"]),
+    ("ioh-no-algorithm", lambda root: ioh_folder(root, _index(algorithm="RS")), {"ioh": "ioh"}, ["algorithm.name"]),
+    ("ioh-scenarios-map", lambda root: ioh_folder(root, _index(scenarios={})), {"ioh": "ioh"}, ["'scenarios'"]),
+    ("ioh-index-list", lambda root: ioh_folder(root, "[]"), {"ioh": "ioh"}, ["IOHprofiler_f1.json", "mapping"]),
+    ("ioh-index-infinity", lambda root: ioh_folder(root, '{"algorithm": Infinity}'), {"ioh": "ioh"},
+     ["IOHprofiler_f1.json", "Infinity"]),
+    ("ioh-index-deep", lambda root: ioh_folder(root, "[" * 100_000 + "]" * 100_000), {"ioh": "ioh"},
+     ["IOHprofiler_f1.json"]),
+    ("ioh-path-dotdot", lambda root: ioh_folder(root, _path("../../secret.dat")), {"ioh": "ioh"},
+     ["scenarios[0].path", "outside"]),
+    ("ioh-path-absolute", lambda root: ioh_folder(root, _path(str(root / "secret.dat"))), {"ioh": "ioh"},
+     ["scenarios[0].path", "outside"]),
+    ("ioh-path-etc", lambda root: ioh_folder(root, _path("/etc/passwd")), {"ioh": "ioh"},
+     ["scenarios[0].path", "outside"]),
+    ("ioh-path-fifo", lambda root: (ioh_folder(root), (root / "ioh" / "run" / "p").mkdir(),
+                                    os.mkfifo(root / "ioh" / "run" / "p" / "f.dat"),
+                                    ioh_folder(root, _path("p/f.dat"))), {"ioh": "ioh"}, ["FIFO"]),
+    ("ioh-path-number", lambda root: ioh_folder(root, _path(5)), {"ioh": "ioh"}, ["scenarios[0].path"]),
+    ("ioh-run-folder-link", lambda root: (ioh_folder(root / "elsewhere"), (root / "ioh").mkdir(),
+                                          (root / "ioh" / "run").symlink_to(root / "elsewhere" / "ioh" / "run")),
+     {"ioh": "ioh"}, ["outside"]),
+]
+
+
+@pytest.mark.parametrize("case", OUTSIDE_CASES, ids=[c[0] for c in OUTSIDE_CASES])
+def test_outside_inputs_are_one_line(case, tmp_path, cli):
+    ident, make, entry, fragments = case
+    root = tmp_path / "s"
+    root.mkdir()
+    (root / "secret.dat").write_text(f"evaluations raw_y\n{SECRET} 1\n")
+    make(root)
+    path = mini_suite(root, outside=[{"solver": "ext", "track": "black-box", **entry}])
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q"], tmp_path, *fragments)
+    assert "SECRET" not in line                              # never a token of a file it reached
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
+def test_good_outside_csv_gz_and_ioh_still_validate(tmp_path):
+    """The checks above refuse only what is wrong: the same mini suite with well-formed files loads."""
+    from fkopt.experiment.kinds import load_any, validate_any
+    from fkopt.kinbench.outside import logged_runs
+    from fkopt.kinbench.runner import instances_of
+    from fkopt.kinbench.posesets import load_pose_sets
+    root = tmp_path / "s"
+    root.mkdir()
+    with _gzip.open(root / "x.csv.gz", "wt") as fh:
+        fh.write(GOOD_CSV)
+    ioh_folder(root)
+    path = mini_suite(root, outside=[{"solver": "ext", "track": "black-box", "file": "x.csv.gz"},
+                                     {"solver": "ioh", "track": "black-box", "ioh": "ioh"}])
+    cfg = load_any(path)
+    assert validate_any(cfg, str(path)) == 1
+    instances = instances_of(cfg, load_pose_sets(cfg)[0])
+    for k in (0, 1):
+        runs = list(logged_runs(cfg, k, instances))
+        assert [(r[2], list(r[4]), list(r[5])) for r in runs] == [(p, [1.0, 6.0], [5.0, 1e-12]) for p in (0, 1)]
