@@ -1261,3 +1261,74 @@ def test_good_outside_csv_gz_and_ioh_still_validate(tmp_path):
     for k in (0, 1):
         runs = list(logged_runs(cfg, k, instances))
         assert [(r[2], list(r[4]), list(r[5])) for r in runs] == [(p, [1.0, 6.0], [5.0, 1e-12]) for p in (0, 1)]
+
+
+# -- --resume: task records checked against the plan, even with a forged digest (finding 2) ------
+def _forge_task(tmp_path, edit):
+    """The mini suite's one task, computed, edited by ``edit`` and kept as a task file of an
+    interrupted run with its digest re-signed in the manifest (what an attacker can do)."""
+    from fkopt.experiment.kinds import load_any
+    from fkopt.kinbench.kind import work_folder
+    from fkopt.kinbench.runner import solve_task, suite_plan
+    path = mini_suite(tmp_path / "s")
+    cfg = load_any(path)
+    plan = suite_plan(cfg, str(path))
+    rec = json.loads(json.dumps(solve_task(plan.tasks[0].payload)))
+    edit(rec)
+    work = work_folder(tmp_path / "out", cfg)
+    (work / "tasks").mkdir(parents=True)
+    task = work / "tasks" / f"{plan.tasks[0].id}.json"
+    task.write_text(json.dumps(rec))
+    (work / "tasks" / "manifest.json").write_text(json.dumps(
+        {"fingerprint": plan.fingerprint, "tasks": {plan.tasks[0].id: hashlib.sha256(task.read_bytes()).hexdigest()}}))
+    return path, task
+
+
+def _row(col, value, i=0):
+    return lambda rec: rec["rows"][col].__setitem__(i, value)
+
+
+RECORD_EDITS = [
+    ("fitness-text", _row("fitness", "x"), ["rows.fitness", "not numbers"]),
+    ("fitness-nan", _row("fitness", float("nan")), ["rows.fitness"]),
+    ("fitness-negative", _row("fitness", -1.0), ["rows.fitness"]),
+    ("solver-relabelled", lambda r: r["rows"].update(solver=["pso"] * len(r["rows"]["solver"])),
+     ["rows.solver", "'pso'", "'lm'"]),
+    ("problem-renamed", _row("problem", "wu2015-3ppr"), ["rows.problem"]),
+    ("set-renamed", _row("set", "boundary"), ["rows.set"]),
+    ("pose-moved", _row("pose", 7), ["rows.pose"]),
+    ("pose-text", _row("pose", "0"), ["rows.pose"]),
+    ("run-renumbered", _row("run", 3), ["rows.run"]),
+    ("track-changed", _row("track", "exact"), ["rows.track"]),
+    ("evaluations-1e300", _row("evaluations", 1e300), ["rows.evaluations"]),
+    ("evaluations-past-budget", _row("evaluations", 10_000.0), ["rows.evaluations"]),
+    ("target-text", _row("evals_to_1e-02", "soon"), ["rows.evals_to_1e-02"]),
+    ("rows-short", lambda r: [v.pop() for v in r["rows"].values()], ["rows", "run rows"]),
+    ("rows-column-missing", lambda r: r["rows"].pop("fitness"), ["rows", "columns"]),
+    ("rows-column-extra", lambda r: r["rows"].update(extra=[0] * 2), ["rows", "columns"]),
+    ("dim-text", lambda r: r.update(dim="3"), ["dim"]),
+    ("trace-row-outside", lambda r: r["trace"]["row"].__setitem__(0, 99), ["trace.row"]),
+    ("trace-ragged", lambda r: r["trace"]["row"].pop(), ["trace", "length"]),
+    ("trace-fitness-text", lambda r: r["trace"]["best_fitness"].__setitem__(0, "x"), ["trace.best_fitness"]),
+    ("solves-changed", lambda r: r.update(solves=99), ["solves"]),
+    ("wall-negative", lambda r: r.update(wall_s=-1), ["wall_s"]),
+]
+
+
+@pytest.mark.parametrize("case", RECORD_EDITS, ids=[c[0] for c in RECORD_EDITS])
+def test_resume_checks_suite_records_against_the_plan(case, tmp_path, cli):
+    ident, edit, fragments = case
+    path, task = _forge_task(tmp_path, edit)
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q", "--resume"], tmp_path,
+                   task.name, "not a finished task of this run", *fragments)
+    assert "--resume" in line or "delete it" in line
+    assert not (tmp_path / "out" / "kinbench" / "mini").exists()        # nothing published
+
+
+def test_resume_reuses_an_untouched_suite_record(tmp_path, cli):
+    """The check above refuses only edits: the genuine record is reused and published."""
+    path, task = _forge_task(tmp_path, lambda rec: None)
+    code, _, err = cli("suite", path, "--out", tmp_path / "out", "-q", "--resume")
+    assert code == 0, err
+    runs = (tmp_path / "out" / "kinbench" / "mini" / "runs.csv").read_text()
+    assert runs.count("\n") == 3 and ",lm," in runs
