@@ -448,7 +448,8 @@ def test_resume_refuses_corrupt_task_files(finished_study, cli, content):
     assert task.read_text() == content            # nothing wiped: the user decides
 
 
-@pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task"])
+@pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task", "fitness-text", "fitness-nan",
+                                  "fitness-inf", "evaluations-negative", "wall-inf"])
 def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli, edit):
     """Someone who also rewrote manifest.json's digests still cannot slip a malformed record in."""
     import hashlib
@@ -464,6 +465,12 @@ def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli
         rec["fitness"] = rec["fitness"][:1]
     elif edit == "strings":
         rec["x"] = "abc"
+    elif edit.startswith("fitness-"):           # issue 30: a value of the wrong type or range
+        rec["fitness"][0][0] = {"fitness-text": "x", "fitness-nan": float("nan"), "fitness-inf": float("inf")}[edit]
+    elif edit == "evaluations-negative":
+        rec["evaluations"][0][0] = -5
+    elif edit == "wall-inf":
+        rec["wall_s"] = float("inf")
     else:
         rec["task"]["stop"] = 1
     task.write_text(json.dumps(rec))
