@@ -137,6 +137,10 @@ def _file_kind(mode: int) -> str:
     return "not a regular file"
 
 
+def _size(n: int) -> str:
+    return f"{n >> 20} MB" if n >= 1 << 20 and n % (1 << 20) == 0 else f"{n} bytes"
+
+
 def _where(path: Path, field: str | None) -> str:
     return f"{field}: {path}" if field else str(path)
 
@@ -173,7 +177,7 @@ def open_input(path: str | Path, max_bytes: int, field: str | None = None,
         if not stat.S_ISREG(info.st_mode):
             raise FkoptError(f"{where}: is {_file_kind(info.st_mode)}; only regular files are read")
         if info.st_size > max_bytes:
-            raise FkoptError(f"{where}: {info.st_size} bytes, larger than the {max_bytes} bytes accepted "
+            raise FkoptError(f"{where}: {info.st_size} bytes, larger than the {_size(max_bytes)} accepted "
                              "for this file")
     except BaseException:
         os.close(fd)
@@ -200,7 +204,7 @@ def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str
         except OSError as err:
             raise FkoptError(f"{where}: cannot read ({err.strerror or err})") from None
         if len(data) > max_bytes:
-            raise FkoptError(f"{where}: larger than the {max_bytes} bytes accepted for this file")
+            raise FkoptError(f"{where}: larger than the {_size(max_bytes)} accepted for this file")
     if not unpack or not path.name.endswith(".gz"):
         return data
     limit = max_bytes if unpacked is None else unpacked
@@ -210,7 +214,7 @@ def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str
             while chunk := gz.read(1 << 20):
                 size += len(chunk)
                 if size > limit:
-                    raise FkoptError(f"{where}: unpacks to more than {limit} bytes, the most accepted for this "
+                    raise FkoptError(f"{where}: unpacks to more than {_size(limit)}, the most accepted for this "
                                      "file; refused (memory stays bounded)")
                 chunks.append(chunk)
     except (EOFError, gzip.BadGzipFile, zlib.error) as err:
@@ -250,6 +254,31 @@ def read_json(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str 
     """A JSON file fkopt did not write in this run: bounded (:func:`read_input`), then
     :func:`parse_json`."""
     return parse_json(read_input(path, max_bytes, field=field, within=within), _where(Path(path), field))
+
+
+def read_stored(folder: str | Path, name: str | Path, unpack: bool = True) -> bytes:
+    """A file of a stored result (``folder/name``), read back by ``check``, ``report``,
+    ``export`` or ``compare``: inside ``folder`` (a link out of it is refused), a regular file,
+    at most :data:`MAX_UNPACKED` bytes, unpacked too."""
+    return read_input(Path(folder) / name, MAX_UNPACKED, within=folder, unpacked=MAX_UNPACKED, unpack=unpack)
+
+
+def odd_entries(folder: str | Path) -> list[tuple[str, str]]:
+    """(relative path, what it is) of every entry below ``folder`` that is not a plain file or
+    folder: symbolic links (wherever they point), FIFOs, devices, sockets. A results folder
+    fkopt wrote holds none, so ``fkopt check`` refuses to read one that does (a ``runs.csv``
+    linked to ``/dev/zero`` or outside the folder)."""
+    folder = Path(folder)
+    out = []
+    for base, dirs, files in os.walk(folder, followlinks=False):
+        for name in sorted(dirs) + sorted(files):
+            path = Path(base) / name
+            mode = os.lstat(path).st_mode
+            if stat.S_ISLNK(mode):
+                out.append((str(path.relative_to(folder)), "a symbolic link"))
+            elif not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+                out.append((str(path.relative_to(folder)), _file_kind(mode)))
+    return out
 
 
 def check_geometry_file(path: Path, mechanism: str, max_bytes: int, what: str) -> None:

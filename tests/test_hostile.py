@@ -1339,3 +1339,23 @@ def test_resume_reuses_an_untouched_suite_record(tmp_path, cli):
     assert code == 0, err
     runs = (tmp_path / "out" / "kinbench" / "mini" / "runs.csv").read_text()
     assert runs.count("\n") == 3 and ",lm," in runs
+
+
+# -- stored results read back by check: regular files inside the folder only (finding 9) --------
+@pytest.mark.parametrize("how", ["link-outside", "link-dev-zero", "fifo", "link-inside"])
+def test_check_refuses_a_runs_csv_that_is_not_a_regular_file_of_the_folder(finished_study, cli, how):
+    cfg, out, final, outside = finished_study
+    runs = final / "runs.csv"
+    (outside / "runs.csv").write_bytes(runs.read_bytes())     # the same bytes: only the link is wrong
+    if how == "link-inside":
+        (final / "copy.csv").write_bytes(runs.read_bytes())
+    runs.unlink()
+    if how == "fifo":
+        os.mkfifo(runs)
+    else:
+        runs.symlink_to({"link-outside": outside / "runs.csv", "link-dev-zero": Path("/dev/zero"),
+                         "link-inside": final / "copy.csv"}[how])
+    code, _, err = cli("check", out, "-q")                     # returns at once: nothing read through it
+    assert code == 1 and "Traceback" not in err, err
+    assert "runs.csv" in err and ("symbolic link" in err or "FIFO" in err)
+    assert err.strip().splitlines()[-1].startswith("fkopt: check failed:")
