@@ -37,6 +37,7 @@ input file has been read and checked, and only over a folder that ``fkopt export
 """
 from __future__ import annotations
 
+import io
 import json
 import re
 from dataclasses import dataclass, field
@@ -46,6 +47,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import FkoptError
+from .files import parse_json, read_stored
 from .iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
@@ -99,10 +101,7 @@ class Function:
 
 def _meta(folder: Path) -> dict:
     path = folder / "meta.json"
-    try:
-        meta = json.loads(path.read_text())
-    except (OSError, ValueError) as err:
-        raise FkoptError(f"{path}: cannot read ({err})") from None
+    meta = parse_json(read_stored(folder, "meta.json"), str(path))
     if not isinstance(meta, dict) or not isinstance(meta.get("config"), dict):
         raise FkoptError(f"{path}: no 'config' object (not a meta.json that fkopt wrote)")
     return meta
@@ -111,7 +110,7 @@ def _meta(folder: Path) -> dict:
 def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
     path = folder / "runs.csv"
     try:
-        runs = pd.read_csv(path, dtype=dict.fromkeys(labels, str))
+        runs = pd.read_csv(io.BytesIO(read_stored(folder, "runs.csv")), dtype=dict.fromkeys(labels, str))
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
         raise FkoptError(f"{path}: cannot read ({str(err).strip().splitlines()[0] if str(err).strip() else err})") from None
     missing = [c for c in columns if c not in runs.columns]

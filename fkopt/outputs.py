@@ -152,7 +152,11 @@ def deterministic_files(folder: Path) -> list[str]:
 
 
 def sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a file's own bytes, read bounded (a regular file: a FIFO or ``/dev/zero`` in a
+    results folder is one line, never a hang)."""
+    from .files import read_stored
+    path = Path(path)
+    return hashlib.sha256(read_stored(path.parent, path.name, unpack=False)).hexdigest()
 
 
 def file_digests(folder: Path) -> dict[str, str]:
