@@ -101,7 +101,10 @@ class Function:
 
 def _meta(folder: Path) -> dict:
     path = folder / "meta.json"
-    meta = parse_json(read_stored(folder, "meta.json"), str(path))
+    try:
+        meta = parse_json(read_stored(folder, "meta.json"), str(path))
+    except FkoptError as err:
+        raise FkoptError(f"{path}: cannot read ({str(err).removeprefix(f'{path}: ')})") from None
     if not isinstance(meta, dict) or not isinstance(meta.get("config"), dict):
         raise FkoptError(f"{path}: no 'config' object (not a meta.json that fkopt wrote)")
     return meta
