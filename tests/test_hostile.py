@@ -1359,3 +1359,76 @@ def test_check_refuses_a_runs_csv_that_is_not_a_regular_file_of_the_folder(finis
     assert code == 1 and "Traceback" not in err, err
     assert "runs.csv" in err and ("symbolic link" in err or "FIFO" in err)
     assert err.strip().splitlines()[-1].startswith("fkopt: check failed:")
+
+
+# -- huge finite numbers and deep chains in URDF and on the command line (findings 6 and 9) -------
+def urdf_chain(n=2, *, axis="0 0 1", xyz="0 0 0.1", rpy="0 0 0", lower="-1", upper="1", mimic=False,
+               multiplier="1") -> str:
+    s = ['<robot name="r">'] + [f'<link name="l{i}"/>' for i in range(n + 1)]
+    for i in range(n):
+        m = f'<mimic joint="j{i - 1}" multiplier="{multiplier}"/>' if mimic and i > 0 else ""
+        s.append(f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+                 f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/><limit lower="{lower}" upper="{upper}"/>'
+                 f'{m}</joint>')
+    return "\n".join(s + ["</robot>"])
+
+
+def _urdf(text):
+    return lambda root: (root / "arm.urdf").write_text(text)
+
+
+URDF_CASES = [   # (id, make root/arm.urdf, fragments)
+    ("axis-1e308", _urdf(urdf_chain(axis="0 0 1e308")), ["arm.urdf", "joint 'j0' axis", "|v| <= 1e+09"]),
+    ("origin-1e308", _urdf(urdf_chain(xyz="1e308 0 0")), ["origin xyz", "|v| <= 1e+09"]),
+    ("origin-negative-huge", _urdf(urdf_chain(xyz="0 -2e9 0")), ["origin xyz", "|v| <= 1e+09"]),
+    ("rpy-1e10", _urdf(urdf_chain(rpy="0 1e10 0")), ["origin rpy", "|v| <= 1e+09"]),
+    ("limit-1e300", _urdf(urdf_chain(lower="-1e300")), ["limit lower", "|v| <= 1e+09"]),
+    ("limit-reversed", _urdf(urdf_chain(lower="1", upper="-1")), ["joint 'j0' <limit>", "lower 1 > upper -1",
+                                                                  "needs lower <= upper"]),
+    ("mimic-multiplier-huge", _urdf(urdf_chain(3, mimic=True, multiplier="1e300")), ["multiplier", "|v| <= 1e+09"]),
+    ("mimic-product-overflow", _urdf(urdf_chain(40, mimic=True, multiplier="1e8")), ["chain of mimics", "1e+09"]),
+    ("mimic-3000-deep", _urdf(urdf_chain(3000, mimic=True)), ["arm.urdf", "3000 joints", "at most 1000"]),
+    ("chain-2000", _urdf(urdf_chain(2000)), ["arm.urdf", "2000 joints", "at most 1000", "geometry.tip"]),
+    ("fifo", lambda root: os.mkfifo(root / "arm.urdf"), ["arm.urdf", "FIFO", "only regular files"]),
+    ("dev-zero", lambda root: (root / "arm.urdf").symlink_to("/dev/zero"), ["arm.urdf", "character device"]),
+    ("folder", lambda root: (root / "arm.urdf").mkdir(), ["arm.urdf", "a folder"]),
+    ("too-large", lambda root: open(root / "arm.urdf", "wb").truncate(5 << 20), ["arm.urdf", "larger than the 4 MB"]),
+]
+
+
+@pytest.mark.parametrize("command", ["fk", "ik"])
+@pytest.mark.parametrize("case", URDF_CASES, ids=[c[0] for c in URDF_CASES])
+def test_urdf_inputs_are_one_line(case, command, tmp_path, cli):
+    ident, make, fragments = case
+    make(tmp_path)
+    geometry = tmp_path / "g.yaml"
+    geometry.write_text(f"file: {tmp_path / 'arm.urdf'}\n")
+    argv = (["fk", "urdf", "--geometry", geometry, "--joints", "j0=0.1"] if command == "fk" else
+            ["ik", "urdf", "--geometry", geometry, "--pose", "x=0,y=0,z=0.2,alpha=0,beta=0,gamma=0"])
+    line = refused(cli, argv, tmp_path, *fragments)
+    assert "e+308" not in line.split("bound")[-1]          # never a result printed from such a number
+
+
+def test_a_500_deep_mimic_chain_and_numbers_within_the_bound_still_work(tmp_path, cli):
+    """No recursion in following mimics, and |v| <= 1e9 is accepted: the refusals above are bounds."""
+    (tmp_path / "arm.urdf").write_text(urdf_chain(500, mimic=True, xyz="0 0 1e-3", lower="-1e9", upper="1e9"))
+    geometry = tmp_path / "g.yaml"
+    geometry.write_text(f"file: {tmp_path / 'arm.urdf'}\n")
+    code, out, err = cli("fk", "urdf", "--geometry", geometry, "--joints", "j0=0", "--json")
+    assert code == 0, err
+    assert json.loads(out)["pose"]["z"] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("argv, fragments", [
+    (["fk", "3-rps", "--joints", "d1=1e300,d2=1e300,d3=1e300", "--all-solutions"], ["--joints", "'d1'", "1e+09"]),
+    (["fk", "3-rps", "--joints", "d1=600,d2=600,d3=-1e300"], ["--joints", "'d3'", "1e+09"]),
+    (["ik", "3-rps", "--pose", "alpha=0,beta=1e200,z=600"], ["--pose", "'beta'", "1e+09"]),
+    (["fk", "6-sps", "--joints", ",".join(f"l{i}=1e300" for i in range(1, 7))], ["--joints", "1e+09"]),
+], ids=["3rps-all-solutions", "3rps-negative", "ik-pose", "6sps"])
+def test_huge_command_line_values_are_one_line(argv, fragments, tmp_path, cli):
+    refused(cli, argv, tmp_path, *fragments)
+
+
+def test_within_the_bound_no_solution_stays_exit_1(cli):
+    code, _, err = cli("fk", "3-rps", "--joints", "d1=1e8,d2=1e8,d3=1e8")
+    assert code == 1 and "no pose" in err and "Traceback" not in err

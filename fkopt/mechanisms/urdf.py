@@ -74,6 +74,9 @@ def _floats(text, count: int, default, what: str, path: Path) -> tuple:
     return values
 
 
+#: Most joints (moving, fixed and mimic) on the chain base -> tip: real arms have tens; FK, the
+#: Jacobian and IK are linear in the chain's length and a 2000-joint IK took 30 s.
+MAX_CHAIN_JOINTS = 1000
 #: Largest magnitude of a number of a URDF file (lengths in m, angles in rad, factors): the one
 #: bound of :data:`fkopt.files.MAX_MAGNITUDE`.
 MAX_URDF_VALUE = MAX_MAGNITUDE
@@ -166,6 +169,9 @@ def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
         if len(chain) > len(robot.joint_map):
             raise FkoptError(f"urdf {path}: the joints form a loop")
     chain.reverse()
+    if len(chain) > MAX_CHAIN_JOINTS:
+        raise FkoptError(f"urdf {path}: the chain '{base}' -> '{tip}' has {len(chain)} joints; at most "
+                         f"{MAX_CHAIN_JOINTS} are accepted (geometry.base, geometry.tip pick a shorter chain)")
     for j in chain:
         if j.type not in (*MOVING, "fixed"):
             raise FkoptError(f"urdf {path}: joint '{j.name}' has type '{j.type}'; the chain may hold "
