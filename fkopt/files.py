@@ -364,6 +364,35 @@ def check_component(value: Any, field: str) -> str:
     return value
 
 
+def file_names(names, reserved=(), allowed: str = "A-Za-z0-9_.+-", sep: str = "_") -> dict[str, str]:
+    """A file-name stem for each of ``names``, never the same for two distinct names (nor equal
+    to a ``reserved`` stem), compared ignoring case (a case-insensitive file system).
+
+    A name made only of ``allowed`` characters keeps itself (so existing files keep their
+    names); any other name has each run of other characters replaced by ``sep``, and when that
+    stem is taken -- by a name spelled so (``pso-lm`` beside ``pso+lm``, ``a_b`` beside ``a b``),
+    by a reserved stem (``all``) or by another such name -- gets ``sep`` and 8 hex digits of
+    its SHA-256 (then a counter, should even that be taken). Deterministic: the same set of
+    names gives the same stems."""
+    import hashlib
+    unsafe = re.compile(f"[^{allowed}]+")
+    names = sorted(set(map(str, names)))
+    taken = {r.lower() for r in reserved}
+    out: dict[str, str] = {}
+    owners = [n for n in names if n and not unsafe.search(n) and not n.startswith(".")]
+    for group in (owners, [n for n in names if n not in set(owners)]):
+        for name in group:
+            stem = name if group is owners else (unsafe.sub(sep, name).strip(sep + ".") or "x")[:48]
+            if stem.lower() in taken:
+                stem = f"{stem[:48]}{sep}{hashlib.sha256(name.encode()).hexdigest()[:8]}"
+                base, k = stem, 2
+                while stem.lower() in taken:
+                    stem, k = f"{base}{sep}{k}", k + 1
+            taken.add(stem.lower())
+            out[name] = stem
+    return out
+
+
 def inside(root: str | Path, path: str | Path, option: str = "--out") -> Path:
     """``path`` unchanged, after checking that it resolves (every symbolic link on the way,
     including ``path`` itself) to ``root`` or below it; else one line naming both."""

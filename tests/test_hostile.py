@@ -1432,3 +1432,76 @@ def test_huge_command_line_values_are_one_line(argv, fragments, tmp_path, cli):
 def test_within_the_bound_no_solution_stays_exit_1(cli):
     code, _, err = cli("fk", "3-rps", "--joints", "d1=1e8,d2=1e8,d3=1e8")
     assert code == 1 and "no pose" in err and "Traceback" not in err
+
+
+# -- names on disk are collision-free (finding 7) ---------------------------------------------------
+def _crafted(name, sep="-"):
+    """The stem a hash suffix would give ``name``: an attacker's label spelled as it."""
+    import re as _re
+    return _re.sub(r"[^A-Za-z0-9_.-]+", sep, name).strip(sep) + sep + hashlib.sha256(name.encode()).hexdigest()[:8]
+
+
+@pytest.mark.parametrize("names", [
+    ["pso+lm", "pso-lm", "pso lm", "pso--lm", _crafted("pso+lm"), "PSO-LM", "pso/lm", "../pso-lm", ".pso-lm"],
+    ["a b", "a_b", "a__b", "a\nb", "a\x1b[31mb", "A_B", "all", "ALL", "", "x", "\u00e9", "\u00e8"],
+], ids=["labels", "classes"])
+def test_two_distinct_names_never_share_a_file(names, tmp_path):
+    from fkopt.files import file_names
+    for allowed, sep in (("A-Za-z0-9_.-", "-"), ("A-Za-z0-9_.+-", "_")):
+        stems = file_names(names, reserved=("all",), allowed=allowed, sep=sep)
+        assert set(stems) == set(names)
+        assert len({s.lower() for s in stems.values()}) == len(names)          # also case-insensitively
+        assert "all" not in {s.lower() for s in stems.values()}
+        for s in stems.values():           # each a file in the folder, none hidden or outside it
+            assert s and not s.startswith(".") and "/" not in s and (tmp_path / s).resolve().parent == tmp_path
+            (tmp_path / f"{s}.txt").write_text(s)
+        assert len(list(tmp_path.glob("*.txt"))) == len(names)
+        for p in tmp_path.glob("*.txt"):
+            p.unlink()
+    assert file_names(["pso-lm", "abc"]) == {"pso-lm": "pso-lm", "abc": "abc"}    # safe names keep themselves
+
+
+def test_export_keeps_pso_plus_lm_and_an_outside_pso_minus_lm_apart(tmp_path, cli):
+    root = tmp_path / "s"
+    root.mkdir()
+    (root / "x.csv").write_text(GOOD_CSV)
+    path = mini_suite(root, solvers=[{"name": "pso+lm"}], outside=[{"solver": "pso-lm", "track": "black-box",
+                                                                     "file": "x.csv"}])
+    assert cli("suite", path, "--out", tmp_path / "out", "-q")[0] == 0
+    code, _, err = cli("export", tmp_path / "out", "--format", "ioh", "--out", tmp_path / "ioh")
+    assert code == 0, err
+    indexes = sorted((tmp_path / "ioh").glob("*/IOHprofiler_f*.json"))
+    names = {json.loads(p.read_text())["algorithm"]["name"]: p.parent.name for p in indexes}
+    assert set(names) == {"pso+lm", "pso-lm"} and len(set(names.values())) == 2 and len(indexes) == 2
+    assert names["pso-lm"] == "pso-lm"
+
+
+def test_export_writes_one_folder_per_label(tmp_path):
+    """The fast form of the test above: the export's writer, two functions, colliding labels."""
+    import numpy as np
+    from fkopt.export import Function, _write_function, algorithm_folders
+    runs = [(1, np.array([1, 6]), np.array([5.0, 1e-12]), [0.0])]
+    fns = [Function(name=f"p{i}__uniform", dim=1, instances=["0"], attributes=[],
+                    algorithms={"pso+lm": ({}, runs), "pso-lm": ({}, runs), "pso lm": ({}, runs)}) for i in (1, 2)]
+    folders = algorithm_folders(label for fn in fns for label in fn.algorithms)
+    for fid, fn in enumerate(fns, start=1):
+        _write_function(tmp_path, fid, fn, folders)
+    indexes = sorted(tmp_path.glob("*/IOHprofiler_f*.json"))
+    by_folder = {}
+    for p in indexes:
+        by_folder.setdefault(p.parent.name, set()).add(json.loads(p.read_text())["algorithm"]["name"])
+    assert len(indexes) == 6 and len(by_folder) == 3 and all(len(v) == 1 for v in by_folder.values())
+
+
+def test_every_problem_class_gets_its_own_figure(tmp_path):
+    from types import SimpleNamespace
+    import pandas as pd
+    from fkopt.kinbench.reports import ecdf_figures
+    scopes = ["all", "class:all", "class:a b", "class:a_b"]
+    df = pd.DataFrame([{"scope": s, "solver": "lm", "track": "jacobian", "evals_per_dim": 2.0, "reached": 1,
+                        "pairs": 1, "fraction": 1.0} for s in scopes])
+    sr = SimpleNamespace(config=SimpleNamespace(targets=[1e-2], budget_per_dim=50, name="mini"))
+    names = ecdf_figures(sr, tmp_path, {"ecdf.csv": df})
+    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert len(pngs) == len(scopes) and "ecdf_all.png" in pngs and "ecdf_a_b.png" in pngs
+    assert len([n for n in names if n.endswith(".png")]) == len(scopes)

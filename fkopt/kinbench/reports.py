@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ..files import file_names
 from . import measures as M
 from .outside import digest
 
@@ -40,10 +40,6 @@ def timing_table(sr) -> pd.DataFrame:
     return sr.timing
 
 
-def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.+-]+", "_", text).strip("_")
-
-
 def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
@@ -56,6 +52,9 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     names = []
     targets = ", ".join(f"{t:.0e}" for t in sr.config.targets)
+    # one file per scope: a class "all" does not overwrite ecdf_all, "a b" and "a_b" differ
+    scopes = [s for s in df["scope"].unique() if s != "all"]
+    stems = file_names((s.removeprefix("class:") for s in scopes), reserved=("all",))
     for scope, g in df.groupby("scope", sort=False):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
         top = float(sr.config.budget_per_dim)
@@ -73,7 +72,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         what = "all problems" if scope == "all" else scope.split(":", 1)[1]
         ax.set_title(f"{sr.config.name}: {what}; targets {targets}", fontsize=8)
         ax.legend(loc="upper left", fontsize=7)
-        stem = "ecdf_all" if scope == "all" else f"ecdf_{_slug(scope.split(':', 1)[1])}"
+        stem = "ecdf_all" if scope == "all" else f"ecdf_{stems[scope.removeprefix('class:')]}"
         names += save(fig, folder / f"{stem}.png")
         pyplot.close(fig)
     return names
