@@ -607,6 +607,37 @@ def write_json_atomically(path: str | Path, data: Any, **dump) -> None:
     write_file_atomically(path, lambda p: p.write_text(text + ("\n" if dump.get("indent") else "")))
 
 
+def strict_json(data: Any, **dump) -> str:
+    """``data`` as strict JSON (RFC 8259: no ``NaN``/``Infinity``, which strict parsers reject),
+    for every ``--json`` output: a number that is not finite becomes ``null`` and the object gets
+    a ``"non_finite"`` mapping from that field's path (``position_error``, ``solutions[0].x``)
+    to ``"inf"``, ``"-inf"`` or ``"nan"`` -- nothing is lost, nothing guessed (docs/cli.md)."""
+    import math
+    flags: dict[str, str] = {}
+
+    def clean(value, path):
+        if isinstance(value, dict):
+            return {k: clean(v, f"{path}.{k}" if path else str(k)) for k, v in value.items()}
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if isinstance(value, (list, tuple)):
+            return [clean(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        if isinstance(value, np.integer):
+            return int(value)
+        if isinstance(value, (float, np.floating)):
+            value = float(value)
+            if not math.isfinite(value):
+                flags[path] = "nan" if value != value else ("inf" if value > 0 else "-inf")
+                return None
+        return value
+    out = clean(data, "")
+    if flags and isinstance(out, dict):
+        out["non_finite"] = flags
+    return json.dumps(out, allow_nan=False, default=str, **dump)
+
+
 def write_json(path: str | Path, data: Any) -> None:
     """The one JSON layout of results files (sorted keys, indent 2, newline at the end)."""
     Path(path).write_text(json.dumps(data, indent=2, sort_keys=True, default=float) + "\n")
@@ -627,6 +658,28 @@ def nanmedian(a) -> float:
     a = np.asarray(a, dtype=float)
     ok = ~np.isnan(a)
     return float(np.median(a[ok])) if ok.any() else float("nan")
+
+
+#: Characters that mean something in Markdown tables, links, code or HTML, and their escapes.
+_MD_ESCAPES = {"\\": "\\\\", "`": "\\`", "*": "\\*", "[": "\\[", "]": "\\]", "|": "\\|",
+               "<": "&lt;", ">": "&gt;", "&": "&amp;"}
+
+
+def md_text(value: Any) -> str:
+    """``value`` as literal text inside a Markdown file (a table cell, a heading): HTML (``<script>``,
+    ``<img onerror>``) and entities, link and image brackets, table bars, code ticks and
+    emphasis stars escaped; newlines, terminal escape sequences and other control characters
+    shown as ``\\xNN`` text instead of acting (a title cannot start a new heading or recolour a
+    terminal that shows the file)."""
+    out = []
+    for c in str(value):
+        if c in _MD_ESCAPES:
+            out.append(_MD_ESCAPES[c])
+        elif not c.isprintable():
+            out.append(f"\\\\x{ord(c):02x}" if ord(c) < 256 else f"\\\\u{ord(c):04x}")
+        else:
+            out.append(c)
+    return "".join(out)
 
 
 def short_token(text: Any, limit: int = 40) -> str:

@@ -1505,3 +1505,67 @@ def test_every_problem_class_gets_its_own_figure(tmp_path):
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
     assert len(pngs) == len(scopes) and "ecdf_all.png" in pngs and "ecdf_a_b.png" in pngs
     assert len([n for n in names if n.endswith(".png")]) == len(scopes)
+
+
+# -- strict JSON and escaped Markdown (finding 8) ---------------------------------------------------
+def _strict_loads(text):
+    def refuse(name):
+        raise ValueError(f"{name} is not strict JSON")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_strict_json_writes_null_and_names_every_non_finite_number():
+    import numpy as np
+    from fkopt.files import strict_json
+    data = {"pose": {"x": float("inf"), "y": np.float64("nan"), "z": 1.5}, "error": -np.inf,
+            "solutions": [{"x": [1.0, float("nan")]}], "n": np.int64(3), "ok": np.bool_(True)}
+    out = _strict_loads(strict_json(data))
+    assert out["pose"] == {"x": None, "y": None, "z": 1.5} and out["error"] is None and out["n"] == 3
+    assert out["non_finite"] == {"pose.x": "inf", "pose.y": "nan", "error": "-inf", "solutions[0].x[1]": "nan"}
+    assert "non_finite" not in _strict_loads(strict_json({"a": 1.0}))       # only when there is one
+
+
+@pytest.mark.parametrize("argv", [["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--json"],
+                                  ["fk", "3-rps", "--joints", "d1=598.85,d2=671.92,d3=629.16", "--json"]],
+                         ids=["ik", "fk"])
+def test_json_outputs_are_strict_even_when_a_number_is_not_finite(argv, cli, monkeypatch):
+    import numpy as np
+    from fkopt.mechanisms.rps3 import ThreeRPS
+    real = ThreeRPS.ik
+    if argv[0] == "ik":      # an answer holding inf and NaN (as a broken plug-in could return)
+        monkeypatch.setattr(ThreeRPS, "ik", lambda self, pose: np.array([np.inf, np.nan, 600.0]))
+    code, out, err = cli(*argv)
+    data = _strict_loads(out.strip().splitlines()[0])          # a strict parser accepts it
+    if argv[0] == "ik":
+        assert data["joints"]["d1"] is None and data["non_finite"] == {"joints.d1": "inf", "joints.d2": "nan"}
+    else:
+        assert code == 0 and data["solved"] is True and "non_finite" not in data
+    monkeypatch.setattr(ThreeRPS, "ik", real)
+
+
+HOSTILE_TEXT = ["<script>alert(1)</script>", "<img src=x onerror=alert(1)>", "\x1b[31mred\x1b[0m\x07",
+                "a\n# injected heading", "a | b | c", "[link](javascript:alert(1))", "![i](http://x/y.png)", "`code`"]
+
+
+def test_leaderboard_md_escapes_what_it_copies(tmp_path):
+    from types import SimpleNamespace
+    import pandas as pd
+    from markdown_it import MarkdownIt
+    from fkopt.kinbench.reports import leaderboard_markdown
+    config = SimpleNamespace(title=" ".join(HOSTILE_TEXT), name="mini", pose_sets="my-sets", problems=[1],
+                             sets=["uniform"], runs=1, budget_per_dim=50, targets=[1e-2], bootstrap=100, alpha=0.05)
+    lb = pd.DataFrame([{"scope": scope, "rank": i + 1, "solver": text, "track": "black-box", "score": 0.5,
+                        "ci_low": 0.4, "ci_high": 0.6, "instances": 2, "better_than": text, "success_1e-02": 1.0}
+                       for scope in ("overall", f"class:{HOSTILE_TEXT[0]}") for i, text in enumerate(HOSTILE_TEXT)])
+    ms = pd.DataFrame([{"problem": HOSTILE_TEXT[1], "set": "uniform", "solver": t, "track": "black-box",
+                        "target": 1e-2, "trials": 1, "success_rate": 1.0, "ert": 6.0} for t in HOSTILE_TEXT])
+    leaderboard_markdown(SimpleNamespace(config=config, timing=None), tmp_path, {"leaderboard.csv": lb,
+                                                                                 "measures.csv": ms})
+    text = (tmp_path / "leaderboard.md").read_text()
+    assert "\x1b" not in text and "\x07" not in text and "<script" not in text and "<img" not in text
+    rendered = MarkdownIt("commonmark").enable("table").render(text)
+    assert "<script" not in rendered and "<img" not in rendered and "<a " not in rendered and "<code>" not in rendered
+    assert rendered.count("<h1>") == 1                       # the newline did not start a heading
+    rows = [ln for ln in text.splitlines() if ln.startswith("| ")]
+    assert all(ln.count(" | ") == rows[0].count(" | ") for ln in rows if ln.count(" | ") >= 7)  # no cell split
+    assert rendered.count("<tr>") == 2 * (len(HOSTILE_TEXT) + 1) + len(HOSTILE_TEXT) + 1

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..files import file_names
+from ..files import file_names, md_text
 from . import measures as M
 from .outside import digest
 
@@ -82,7 +82,7 @@ def _md_table(df: pd.DataFrame, cols: list[str]) -> str:
     def fmt(v):
         if isinstance(v, float):
             return "inf" if np.isinf(v) else f"{v:.4g}"
-        return str(v)
+        return md_text(v)        # solver labels, classes, problem names: text of a config file
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     lines += ["| " + " | ".join(fmt(v) for v in row) + " |" for row in df[cols].itertuples(index=False)]
     return "\n".join(lines)
@@ -117,18 +117,18 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
         return []
     c = sr.config
     cols = leaderboard_columns(lb)
-    out = [f"# {c.title or c.name}", "", preamble(c), ""]
+    out = [f"# {md_text(c.title or c.name)}", "", md_text(preamble(c)), ""]
     for title, pred in (("Overall", lambda s: s == "overall"), ("Per track", lambda s: s.startswith("track:")),
                         ("Per problem class", lambda s: s.startswith("class:"))):
         out += [f"## {title}", ""]
         for scope, g in leaderboard_sections(tables):
             if pred(scope):
-                out += [f"### {scope}", "", _md_table(g, cols), ""]
+                out += [f"### {md_text(scope)}", "", _md_table(g, cols), ""]
     ms = tables.get("measures.csv")
     if ms is not None:
         out += ["## Per problem", "", "Success rate and ERT (evaluations) per set and target.", ""]
         for problem, g in ms.groupby("problem", sort=False):
-            out += [f"### {problem}", "", _md_table(g, PER_PROBLEM), ""]
+            out += [f"### {md_text(problem)}", "", _md_table(g, PER_PROBLEM), ""]
     tim = getattr(sr, "timing", None)
     if tim is not None and not tim.empty:
         out += ["## Wall time per solve", "", "Amortised: the batched solve's wall time over its "
