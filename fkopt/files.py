@@ -512,6 +512,13 @@ def write_atomically(final: str | Path, write: Callable[[Path], Any],
         if check is not None:
             check(final)
         swap_into_place(tmp, final)
+    except OSError as err:
+        shutil.rmtree(tmp, ignore_errors=True)
+        name = Path(err.filename) if err.filename else None
+        if name is not None and (name == tmp or tmp in name.parents):   # the file as the user knows it
+            name = final / name.relative_to(tmp)
+        where = f"{name}: " if name is not None else f"{final}: "
+        raise FkoptError(f"{where}cannot write ({err.strerror or err}); the previous result is kept") from None
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
@@ -593,13 +600,27 @@ def write_file_atomically(path: str | Path, write: Callable[[Path], Any]) -> Non
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
-        write(Path(tmp))
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
+        with naming_the_file(path):
+            write(Path(tmp))
+            with open(tmp, "rb") as fh:
+                os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def naming_the_file(path: str | Path):
+    """An OSError raised while writing ``path`` without naming a file (a full disk, a quota: the
+    kernel reports ENOSPC at write or close, not at open) is re-raised naming ``path``, so the
+    one line says which file could not be written (the previous result is kept by the swap)."""
+    try:
+        yield
+    except OSError as err:
+        if err.filename:
+            raise
+        raise OSError(err.errno, err.strerror or str(err), str(path)) from None
 
 
 def write_json_atomically(path: str | Path, data: Any, **dump) -> None:

@@ -1569,3 +1569,29 @@ def test_leaderboard_md_escapes_what_it_copies(tmp_path):
     rows = [ln for ln in text.splitlines() if ln.startswith("| ")]
     assert all(ln.count(" | ") == rows[0].count(" | ") for ln in rows if ln.count(" | ") >= 7)  # no cell split
     assert rendered.count("<tr>") == 2 * (len(HOSTILE_TEXT) + 1) + len(HOSTILE_TEXT) + 1
+
+
+# -- a full disk names the file; the previous result stays (finding 9) ------------------------------
+@pytest.mark.parametrize("victim", ["runs.csv", "meta.json"])
+def test_disk_full_names_the_file_and_keeps_the_previous_result(victim, tmp_path, cli, monkeypatch):
+    import errno
+    import pandas as pd
+    import fkopt.files
+    cfg = tmp_path / "e.yaml"
+    cfg.write_text(with_(BASE, name="full", runs=1, iterations=2))
+    out = tmp_path / "out"
+    assert cli("run", cfg, "--out", out, "-q")[0] == 0
+    before = snapshot(out)
+
+    def full(*args, **kwargs):         # what the kernel says at write(): ENOSPC, no file name
+        raise OSError(errno.ENOSPC, "No space left on device")
+    if victim == "runs.csv":
+        real = pd.DataFrame.to_csv
+        monkeypatch.setattr(pd.DataFrame, "to_csv", lambda self, path=None, *a, **k: full() if Path(str(path)).name
+                            == victim else real(self, path, *a, **k))
+    else:
+        monkeypatch.setattr(fkopt.files, "write_json", lambda path, data: full())
+    line = one_line_error(cli("run", cfg, "--out", out, "-q"), "No space left on device", "previous result is kept")
+    assert f"{out / 'test' / 'full' / victim}: cannot write" in line       # the file as the user knows it
+    assert snapshot(out) == before
+    assert not any(".new-" in p.name for p in out.rglob(".*"))
