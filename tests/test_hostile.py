@@ -1595,3 +1595,31 @@ def test_disk_full_names_the_file_and_keeps_the_previous_result(victim, tmp_path
     assert f"{out / 'test' / 'full' / victim}: cannot write" in line       # the file as the user knows it
     assert snapshot(out) == before
     assert not any(".new-" in p.name for p in out.rglob(".*"))
+
+
+# -- configs and geometry YAML are read bounded too (finding 1) --------------------------------------
+def _config_path(how, root):
+    f = root / "c.yaml"
+    if how == "fifo":
+        os.mkfifo(f)
+    elif how == "dev-zero":
+        f.symlink_to("/dev/zero")
+    elif how == "folder":
+        f.mkdir()
+    elif how == "sparse":
+        with open(f, "wb") as fh:
+            fh.truncate(2 << 20)
+    return f
+
+
+CONFIG_READS = [("fifo", "FIFO"), ("dev-zero", "character device"), ("folder", "a folder"), ("sparse", "larger than")]
+
+
+@pytest.mark.parametrize("how, fragment", CONFIG_READS, ids=[c[0] for c in CONFIG_READS])
+@pytest.mark.parametrize("command", ["run", "suite", "geometry"])
+def test_config_and_geometry_files_that_are_not_regular_files_are_one_line(command, how, fragment, tmp_path, cli):
+    f = _config_path(how, tmp_path)
+    argv = {"run": ["run", f, "--out", tmp_path / "out"], "suite": ["suite", f, "--out", tmp_path / "out"],
+            "geometry": ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", f]}[command]
+    refused(cli, argv, tmp_path, "c.yaml", fragment)
+    assert not (tmp_path / "out").exists()
