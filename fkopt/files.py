@@ -26,6 +26,14 @@ Every config file, geometry file and results folder of fkopt goes through this m
   place with one ``renameat2(RENAME_EXCHANGE)`` system call (two renames with signals blocked
   where that call does not exist). The previous result stays complete until the new one is.
 * :func:`write_file_atomically` -- the same for one file (task files, JSON, CSV).
+* :func:`read_input` -- the one bounded reader of every file fkopt did not write in this run
+  (configs, URDF, pose sets, outside results, IOH data; :func:`read_stored` for stored results):
+  regular files only, inside the folder they were named from, a size cap checked before
+  reading, ``.gz`` streamed with a cap on the unpacked size; :func:`read_text`,
+  :func:`parse_json` / :func:`read_json` (strict JSON) on top. :func:`odd_entries` lists what a
+  results folder must not hold (links, FIFOs, devices).
+* :func:`file_names` -- collision-free file-name stems for user-given names.
+* :func:`strict_json` and :func:`md_text` -- strict JSON output and Markdown-escaped text.
 * :func:`error_line` -- one line from a pydantic ``ValidationError`` (field path and message).
 * :func:`nanmedian` -- median over the non-NaN values (NaN if there are none).
 """
@@ -126,6 +134,11 @@ MAX_MAGNITUDE = 1e9
 #: CSV, a stored result's table. Checked on the file's size before a byte is read; a compressed
 #: file (``.gz``) is also refused once it unpacks to more than ``unpacked`` bytes.
 MAX_INPUT_BYTES = 64 << 20
+#: Largest decompressed ``.csv.gz`` fkopt reads (bytes), and the largest file of a stored result
+#: read back (:func:`read_stored`). The largest it writes, kinbench v2's ``trace.csv.gz``, unpacks
+#: to ~64 MB; the cap keeps a hostile file (a small gzip that unpacks to gigabytes) from taking
+#: the memory: :func:`read_input` streams the decompression and stops past it.
+MAX_UNPACKED = 256 * 1024 ** 2
 
 
 def _file_kind(mode: int) -> str:
@@ -523,40 +536,6 @@ def write_atomically(final: str | Path, write: Callable[[Path], Any],
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return final
-
-
-#: Largest decompressed ``.csv.gz`` fkopt reads (bytes). The largest it writes, kinbench v2's
-#: ``trace.csv.gz``, unpacks to ~64 MB; the cap keeps a hostile file (a small gzip that unpacks
-#: to gigabytes) from taking the memory: the size is measured by streaming decompression first.
-MAX_UNPACKED = 256 * 1024 ** 2
-
-
-def unpacked_size(path: str | Path, limit: int = MAX_UNPACKED) -> int:
-    """Decompressed size of gzip ``path``, streamed in 1 MiB pieces; stops past ``limit``."""
-    import gzip
-    size = 0
-    with gzip.open(path, "rb") as fh:
-        while chunk := fh.read(1 << 20):
-            size += len(chunk)
-            if size > limit:
-                break
-    return size
-
-
-def check_unpacked(path: str | Path, limit: int | None = None) -> None:
-    """Refuse, with one line, a gzip file that unpacks to more than ``limit`` bytes (default
-    :data:`MAX_UNPACKED`) or is no gzip."""
-    import gzip
-    import zlib
-    limit = MAX_UNPACKED if limit is None else limit
-    try:
-        too_big = unpacked_size(path, limit) > limit
-    except (EOFError, gzip.BadGzipFile, zlib.error) as err:
-        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a valid gzip file ({err})"
-        raise FkoptError(f"{path}: {what}") from None
-    if too_big:
-        raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest file fkopt "
-                         "writes is far smaller; memory stays bounded)")
 
 
 @contextlib.contextmanager
