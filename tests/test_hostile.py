@@ -1623,3 +1623,19 @@ def test_config_and_geometry_files_that_are_not_regular_files_are_one_line(comma
             "geometry": ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", f]}[command]
     refused(cli, argv, tmp_path, "c.yaml", fragment)
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("budget", [1, 50], ids=["no-answer-within-budget", "answers"])
+def test_genuine_suite_records_of_every_track_pass_the_resume_check(budget, tmp_path):
+    """The check refuses only what the plan would not produce: every track's own records pass,
+    also a run with no answer within its budget (fitness inf, evaluations = budget)."""
+    from fkopt.experiment.kinds import load_any
+    from fkopt.kinbench.runner import record_problem, solve_task, suite_plan
+    path = mini_suite(tmp_path / "s", solvers=[{"name": "lm"}, {"name": "forward"}, {"name": "pso"},
+                                               {"name": "gabc+lm"}], budget_per_dim=budget)
+    plan = suite_plan(load_any(path), str(path))
+    for task in plan.tasks:
+        rec = json.loads(json.dumps(solve_task(task.payload)))        # as a task file holds it
+        assert record_problem(task, rec) is None, task.label
+        if budget == 1:
+            assert rec["rows"]["fitness"][0] == float("inf")
