@@ -1230,6 +1230,8 @@ OUTSIDE_CASES = [   # (id, make the input under root, outside entry, fragments)
                                     os.mkfifo(root / "ioh" / "run" / "p" / "f.dat"),
                                     ioh_folder(root, _path("p/f.dat"))), {"ioh": "ioh"}, ["FIFO"]),
     ("ioh-path-number", lambda root: ioh_folder(root, _path(5)), {"ioh": "ioh"}, ["scenarios[0].path"]),
+    ("ioh-stray-link-outside", lambda root: (ioh_folder(root), (root / "ioh" / "run" / "notes.txt").symlink_to(
+        root / "secret.dat")), {"ioh": "ioh"}, ["notes.txt", "outside"]),
     ("ioh-run-folder-link", lambda root: (ioh_folder(root / "elsewhere"), (root / "ioh").mkdir(),
                                           (root / "ioh" / "run").symlink_to(root / "elsewhere" / "ioh" / "run")),
      {"ioh": "ioh"}, ["outside"]),

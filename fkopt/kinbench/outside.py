@@ -62,7 +62,7 @@ MAX_COUNT = 2 ** 53
 def digest(config, entry) -> str:
     """SHA-256 of the file (of every file of the IOH folder, by relative path), read bounded."""
     path = outside_path(config, entry)
-    files = [path] if entry.file else sorted(p for p in path.rglob("*") if p.is_file() or p.is_symlink())
+    files = [path] if entry.file else sorted(p for p in path.rglob("*") if p.is_file())
     h = hashlib.sha256()
     for f in files:
         data = read_input(f, MAX_INPUT_BYTES, within=None if entry.file else path, unpack=False)

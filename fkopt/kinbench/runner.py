@@ -34,7 +34,7 @@ from ..experiment.tasks import Plan, Ran, Task, run_tasks
 from ..solve import chunk_size
 from .budget import at_budget, budget_of, target_column
 from .config import SuiteConfig, suite_from_dict
-from .outside import read_outside
+from .outside import digest, read_outside
 from .posesets import load_pose_sets, problem_mechanism, targets_of
 from .traces import suite_trace, task_trace
 
@@ -105,6 +105,7 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances)
+            digest(config, config.outside[k])   # every file meta.json will hash, read bounded now
     return len(config.problems) * len(config.solvers), need
 
 
