@@ -230,7 +230,7 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     """The points of a pose-set CSV: ASCII, a header of exactly ``unknowns``, every row that
     many finite numbers; anything else one line naming the file, the line and what is allowed
     (no cell of the file is quoted beyond a short sanitised token)."""
-    from ..files import one_line
+    from ..files import short_token
     try:
         text = data.decode("ascii")
     except UnicodeDecodeError as err:
@@ -240,7 +240,7 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     if not lines:
         raise FkoptError(f"{path}: empty; needs the header {','.join(unknowns)} and one row per pose")
     if lines[0].split(",") != unknowns:
-        raise FkoptError(f"{path}: header '{one_line(lines[0], 60)}' differs from the unknowns "
+        raise FkoptError(f"{path}: header '{short_token(lines[0])}' differs from the unknowns "
                          f"{','.join(unknowns)}")
     pts = np.empty((len(lines) - 1, len(unknowns)))
     for i, line in enumerate(lines[1:]):
