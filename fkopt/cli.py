@@ -16,7 +16,7 @@ import typer
 
 from . import registry
 from .errors import FkoptError
-from .files import MAX_MAGNITUDE, strict_json
+from .files import strict_json
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics. "
@@ -85,9 +85,6 @@ def parse_assignments(text: str, option: str) -> dict[str, float]:
             raise FkoptError(f"{option}: '{name}' needs a number, got '{value}'") from None
         if not math.isfinite(number):
             raise FkoptError(f"{option}: '{name}' needs a finite number, got '{value.strip()}'")
-        if abs(number) > MAX_MAGNITUDE:
-            raise FkoptError(f"{option}: '{name}' = {number:g} is past the bound |value| <= {MAX_MAGNITUDE:g} "
-                             "(in the mechanism's units)")
         out[name] = number
     if not out:
         raise FkoptError(f"{option}: no values given")

@@ -187,6 +187,17 @@ CORPUS = [
     ("reproduce-out-file", None, ["reproduce", "--configs", "{root}/configs", "--out", "{root}/afile"], ["is a file"]),
     ("reproduce-clash", None, ["reproduce", "--configs", "{root}/clash", "--out", "{out}"], ["paper/name must differ"]),
     ("report-corrupt-meta", None, ["report", "{root}/corrupt"], ["meta.json", "unreadable"]),
+    # -- issue 30: huge finite numbers in configs and geometry (|v| <= 1e9) ----------------------------
+    ("case-joints-1e300", with_(BASE, cases=[{"joints": {"d1": 1e300, "d2": 600, "d3": 600}}]),
+     ["run", "{f}", "--out", "{out}"], ["cases[0].joints", "'d1'", "|value| <= 1e+09"]),
+    ("case-pose-1e300", with_(BASE, cases=[{"pose": {"alpha": 0, "beta": 0, "z": 1e300}}]),
+     ["run", "{f}", "--out", "{out}"], ["cases[0].pose", "'z'", "1e+09"]),
+    ("assembly-joints-1e300", with_(ASSEMBLY, joints={"d1": 1e300, "d2": 1e300, "d3": 1e300}),
+     ["run", "{f}", "--out", "{out}"], ["joints", "'d1'", "1e+09"]),
+    ("geometry-1e300", "ra: 1.0e+300\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
+     ["geometry.ra", "|value| <= 1e+09"]),
+    ("config-geometry-1e300", with_(BASE, mechanism={"name": "3-rps", "geometry": {"rb": 2e9}}),
+     ["run", "{f}", "--out", "{out}"], ["geometry.rb", "1e+09"]),
 ]
 
 
