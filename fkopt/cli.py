@@ -16,6 +16,7 @@ import typer
 
 from . import registry
 from .errors import FkoptError
+from .files import strict_json
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics. "
@@ -136,7 +137,7 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
         raise FkoptError("--geometry: name the mechanism it is for (fkopt list MECH --geometry FILE)")
     mechs, algos = registry.entries("mechanism"), registry.entries("algorithm")
     if as_json:
-        typer.echo(json.dumps({"mechanisms": [e.name for e in mechs], "algorithms": [e.name for e in algos],
+        typer.echo(strict_json({"mechanisms": [e.name for e in mechs], "algorithms": [e.name for e in algos],
                                "origins": {"mechanisms": {e.name: e.origin for e in mechs},
                                            "algorithms": {e.name: e.origin for e in algos}}}))
         return
@@ -208,7 +209,7 @@ def _list_mechanism(name: str, as_json: bool, geometry: Optional[Path] = None) -
     origin = next((e.origin for e in registry.entries("mechanism") if e.name == name), "direct reference")
     units = dict(zip(m.unknown_names, m.unknown_units))
     if as_json:
-        typer.echo(json.dumps({**d, "from": origin, "bounds_units": units}, default=str))
+        typer.echo(strict_json({**d, "from": origin, "bounds_units": units}))
         return
     from rich.markup import escape
     from rich.table import Table
@@ -481,7 +482,7 @@ def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
     """A computed answer that is not a solution within tolerance: the best answer on stdout
     (JSON with ``"solved": false``, or nothing), one line on stderr, exit status 1."""
     if as_json:
-        typer.echo(json.dumps(data))
+        typer.echo(strict_json(data))
     print(f"fkopt: error: {message}", file=sys.stderr)
     raise typer.Exit(1)
 
@@ -587,7 +588,7 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         found = find_all(m, values, seed=seed)
         data = solutions_to_dict(found)
         if as_json:
-            typer.echo(json.dumps(data))
+            typer.echo(strict_json(data))
         else:
             _console().print(f"{len(data['solutions'])} distinct solutions")
             for s in data["solutions"]:
@@ -626,7 +627,7 @@ def _emit(data: dict, as_json: bool, units, notes: Optional[dict] = None) -> Non
     """The answer on stdout: JSON, or one line per variable (with its unit), then one line per
     other entry, followed by its unit or meaning from ``notes``."""
     if as_json:
-        typer.echo(json.dumps(data))
+        typer.echo(strict_json(data))
         return
     notes = notes or {}
     key = "joints" if "joints" in data else "pose"

@@ -57,7 +57,6 @@ A mismatch names the experiment, the file, the row, the column, both values and 
 """
 from __future__ import annotations
 
-import gzip
 import io
 import math
 from dataclasses import dataclass
@@ -67,6 +66,7 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
+from .errors import FkoptError
 from .outputs import (ENV_FILE, RUNS, STEPS, TIMING, deterministic_files, file_digests, files_with,  # noqa: F401
                       files_with_rows, sha256)
 from .provenance import ANY, BLAS, EXACT  # noqa: F401
@@ -143,6 +143,11 @@ def _py(v):
 def _read(path: Path) -> pd.DataFrame:
     """A CSV (or gzip'ed CSV) as text cells, so 'identical' means identical as written."""
     return pd.read_csv(io.BytesIO(_bytes(path)), dtype=str, keep_default_na=False)
+
+
+def _stored_csv(folder: Path, name: str) -> pd.DataFrame:
+    from .files import read_stored
+    return pd.read_csv(io.BytesIO(read_stored(folder, name)))
 
 
 def _outcome(col: str) -> bool:
@@ -323,8 +328,8 @@ def summary_consistency(name: str, folder: Path) -> list[Mismatch]:
     if not (folder / "summary.csv").is_file() or not (folder / "runs.csv").is_file():
         return []
     try:
-        summary, runs = pd.read_csv(folder / "summary.csv"), pd.read_csv(folder / "runs.csv")
-    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        summary, runs = _stored_csv(folder, "summary.csv"), _stored_csv(folder, "runs.csv")
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(name, "summary.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
     if "final_fitness" not in runs.columns or "algorithm" not in runs.columns:
         return [Mismatch(name, "runs.csv", "-", "columns", list(runs.columns), "final_fitness, algorithm",
@@ -385,11 +390,10 @@ def first_difference(name: str, file: str, stored: bytes, rerun: bytes) -> Misma
 
 
 def _bytes(path: Path) -> bytes:
-    if path.name.endswith(".gz"):
-        from .files import check_unpacked
-        check_unpacked(path)                     # a gzip bomb is one line, not the memory
-        return gzip.decompress(path.read_bytes())
-    return path.read_bytes()
+    """The (unpacked) bytes of a result file, bounded: inside its folder, a regular file, a gzip
+    bomb one line, not the memory (:func:`fkopt.files.read_stored`)."""
+    from .files import read_stored
+    return read_stored(path.parent, path.name)
 
 
 def compare_folders(name: str, stored: Path, rerun: Path, rules: Rules | bool,
@@ -418,7 +422,7 @@ def compare_folders(name: str, stored: Path, rerun: Path, rules: Rules | bool,
         elif ".csv" in file:
             try:
                 table = _read(s)
-            except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, EOFError) as err:
+            except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, EOFError, FkoptError) as err:
                 out.append(Mismatch(name, file, "-", "file", f"unreadable ({err})", "readable", "readable"))
                 continue
             other = _read(r)
@@ -436,10 +440,10 @@ def compare_meta(name: str, stored: Path, rerun: Path) -> list[Mismatch]:
     """meta.json on another platform: everything but the file digests must be equal."""
     import json
     try:
-        a = json.loads(Path(stored).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as err:
+        a = json.loads(_bytes(Path(stored)).decode("utf-8"))
+    except (OSError, ValueError, FkoptError) as err:
         return [Mismatch(name, "meta.json", "-", "file", f"unreadable ({err})", "readable", "valid JSON")]
-    b = json.loads(Path(rerun).read_text(encoding="utf-8"))
+    b = json.loads(_bytes(Path(rerun)).decode("utf-8"))
     out = []
     for key in sorted(set(a) | set(b)):
         if key not in META_VARIABLE and a.get(key) != b.get(key):

@@ -37,6 +37,7 @@ input file has been read and checked, and only over a folder that ``fkopt export
 """
 from __future__ import annotations
 
+import io
 import json
 import re
 from dataclasses import dataclass, field
@@ -46,6 +47,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import FkoptError
+from .files import file_names, parse_json, read_stored
 from .iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
@@ -85,6 +87,12 @@ def _safe(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "-", str(text)).strip("-") or "x"
 
 
+def algorithm_folders(labels) -> dict[str, str]:
+    """The export's folder of each algorithm label, one per label (:func:`fkopt.files.file_names`):
+    ``pso+lm`` and an outside solver ``pso-lm`` never share a folder (nor its index files)."""
+    return file_names(labels, allowed="A-Za-z0-9_.-", sep="-")
+
+
 @dataclass
 class Function:
     """One IOH function of an exported folder: an experiment, or one problem of a suite."""
@@ -100,9 +108,9 @@ class Function:
 def _meta(folder: Path) -> dict:
     path = folder / "meta.json"
     try:
-        meta = json.loads(path.read_text())
-    except (OSError, ValueError) as err:
-        raise FkoptError(f"{path}: cannot read ({err})") from None
+        meta = parse_json(read_stored(folder, "meta.json"), str(path))
+    except FkoptError as err:
+        raise FkoptError(f"{path}: cannot read ({str(err).removeprefix(f'{path}: ')})") from None
     if not isinstance(meta, dict) or not isinstance(meta.get("config"), dict):
         raise FkoptError(f"{path}: no 'config' object (not a meta.json that fkopt wrote)")
     return meta
@@ -111,7 +119,7 @@ def _meta(folder: Path) -> dict:
 def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
     path = folder / "runs.csv"
     try:
-        runs = pd.read_csv(path, dtype=dict.fromkeys(labels, str))
+        runs = pd.read_csv(io.BytesIO(read_stored(folder, "runs.csv")), dtype=dict.fromkeys(labels, str))
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
         raise FkoptError(f"{path}: cannot read ({str(err).strip().splitlines()[0] if str(err).strip() else err})") from None
     missing = [c for c in columns if c not in runs.columns]
@@ -265,11 +273,12 @@ def _index(fid: int, fname: str, label: str, info: dict, fn: Function, data_rel:
     }
 
 
-def _write_function(tmp: Path, fid: int, fn: Function) -> None:
-    """One function's ``.dat`` and index per algorithm, into the export folder ``tmp``."""
+def _write_function(tmp: Path, fid: int, fn: Function, folders: dict[str, str]) -> None:
+    """One function's ``.dat`` and index per algorithm, into the export folder ``tmp``
+    (``folders``: each label's folder, :func:`algorithm_folders`)."""
     fname = _safe(fn.name)
     for label, (info, runs) in fn.algorithms.items():
-        algo_dir = tmp / _safe(label)
+        algo_dir = tmp / folders[label]
         data_rel = f"data_f{fid}_{fname}/IOHprofiler_f{fid}_DIM{fn.dim}.dat"
         (algo_dir / data_rel).parent.mkdir(parents=True, exist_ok=True)
         lines, index_runs = [], []
@@ -297,9 +306,12 @@ def ioh_export(results: Path, out: Path) -> list[Path]:
     from .files import output_folder   # the shared checks (a folder, writable), once the inputs are good
     output_folder(out)
 
+    functions = [fn for _, fns in loaded for fn in fns]
+    folders = algorithm_folders(label for fn in functions for label in fn.algorithms)
+
     def write(tmp: Path) -> None:
-        for fid, fn in enumerate((fn for _, fns in loaded for fn in fns), start=1):
-            _write_function(tmp, fid, fn)
+        for fid, fn in enumerate(functions, start=1):
+            _write_function(tmp, fid, fn, folders)
         (tmp / MARKER).write_text("fkopt export (IOHprofiler format; this file is the export's mark, "
                                   "not data)\n" + f"format: ioh\nfkopt: {__version__}\nioh layout: {IOH_VERSION}\n"
                                   + "results:\n" + "".join(f"  {f}\n" for f, _ in loaded))

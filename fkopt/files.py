@@ -26,6 +26,14 @@ Every config file, geometry file and results folder of fkopt goes through this m
   place with one ``renameat2(RENAME_EXCHANGE)`` system call (two renames with signals blocked
   where that call does not exist). The previous result stays complete until the new one is.
 * :func:`write_file_atomically` -- the same for one file (task files, JSON, CSV).
+* :func:`read_input` -- the one bounded reader of every file fkopt did not write in this run
+  (configs, URDF, pose sets, outside results, IOH data; :func:`read_stored` for stored results):
+  regular files only, inside the folder they were named from, a size cap checked before
+  reading, ``.gz`` streamed with a cap on the unpacked size; :func:`read_text`,
+  :func:`parse_json` / :func:`read_json` (strict JSON) on top. :func:`odd_entries` lists what a
+  results folder must not hold (links, FIFOs, devices).
+* :func:`file_names` -- collision-free file-name stems for user-given names.
+* :func:`strict_json` and :func:`md_text` -- strict JSON output and Markdown-escaped text.
 * :func:`error_line` -- one line from a pydantic ``ValidationError`` (field path and message).
 * :func:`nanmedian` -- median over the non-NaN values (NaN if there are none).
 """
@@ -34,11 +42,13 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
+import io
 import json
 import os
 import re
 import shutil
 import signal
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any, Callable
@@ -112,32 +122,188 @@ def _loader():
     return Loader
 
 
-def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> str:
-    """The UTF-8 text of a user file, at most ``max_bytes``; every failure is one line."""
+#: Largest magnitude of a number fkopt takes from a user's file or command line where no
+#: schema bounds it (URDF lengths and angles, --joints/--pose values), in the file's own units:
+#: 1e9 m is six times the Earth-Sun distance, 1e9 deg 2.8 million turns. Past it a value is a
+#: typo or an attack, and its square in FK or a Jacobian overflows to inf (docs/reliability.md).
+MAX_MAGNITUDE = 1e9
+
+
+# -- reading files fkopt did not write -------------------------------------------------------------
+#: Largest file of another tool read (bytes): an outside CSV, an IOH ``.dat`` or index, a pose-set
+#: CSV, a stored result's table. Checked on the file's size before a byte is read; a compressed
+#: file (``.gz``) is also refused once it unpacks to more than ``unpacked`` bytes.
+MAX_INPUT_BYTES = 64 << 20
+#: Largest decompressed ``.csv.gz`` fkopt reads (bytes), and the largest file of a stored result
+#: read back (:func:`read_stored`). The largest it writes, kinbench v2's ``trace.csv.gz``, unpacks
+#: to ~64 MB; the cap keeps a hostile file (a small gzip that unpacks to gigabytes) from taking
+#: the memory: :func:`read_input` streams the decompression and stops past it.
+MAX_UNPACKED = 256 * 1024 ** 2
+
+
+def _file_kind(mode: int) -> str:
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def _size(n: int) -> str:
+    return f"{n >> 20} MB" if n >= 1 << 20 and n % (1 << 20) == 0 else f"{n} bytes"
+
+
+def _where(path: Path, field: str | None) -> str:
+    return f"{field}: {path}" if field else str(path)
+
+
+def check_within(path: str | Path, root: str | Path, field: str | None = None) -> Path:
+    """``path`` unchanged after checking that it resolves (symbolic links included) inside the
+    folder ``root`` it was named from; else one line naming the file and the folder."""
     path = Path(path)
     try:
-        if path.is_dir():
-            raise FkoptError(f"{path}: is a folder, expected a file")
-        with open(path, "rb") as fh:
-            data = fh.read(max_bytes + 1)
+        base, resolved = Path(root).resolve(), path.resolve()
+    except (OSError, RuntimeError) as err:       # a loop of links
+        raise FkoptError(f"{_where(path, field)}: cannot resolve ({getattr(err, 'strerror', None) or err})") from None
+    if resolved != base and base not in resolved.parents:
+        raise FkoptError(f"{_where(path, field)}: resolves outside {root}; only files inside that folder are read")
+    return path
+
+
+def open_input(path: str | Path, max_bytes: int, field: str | None = None,
+               within: str | Path | None = None) -> int:
+    """A read-only descriptor of the regular file ``path`` (the caller closes it), after every
+    check a file of another tool gets: inside ``within`` (when given), a regular file (not a
+    folder, FIFO or device: a FIFO would block, ``/dev/zero`` never ends; checked on the opened
+    file, so a link swapped meanwhile changes nothing) and at most ``max_bytes`` by its size."""
+    path = Path(path)
+    where = _where(path, field)
+    if within is not None:
+        check_within(path, within, field)
+    try:    # O_NONBLOCK: opening a FIFO does not wait for a writer; no effect on regular files
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except OSError as err:
-        raise FkoptError(f"{path}: cannot read ({err.strerror or err})") from None
-    if len(data) > max_bytes:
-        raise FkoptError(f"{path}: larger than the {max_bytes} bytes accepted for this file")
+        raise FkoptError(f"{where}: cannot read ({err.strerror or err})") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise FkoptError(f"{where}: is {_file_kind(info.st_mode)}; only regular files are read")
+        if info.st_size > max_bytes:
+            raise FkoptError(f"{where}: {info.st_size} bytes, larger than the {_size(max_bytes)} accepted "
+                             "for this file")
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
+def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
+               within: str | Path | None = None, unpacked: int | None = None, unpack: bool = True) -> bytes:
+    """The bytes of a file fkopt did not write in this run (configs, URDF, pose sets, outside
+    results, IOH data, stored results), read with a bound: :func:`open_input`'s checks, then at
+    most ``max_bytes`` read (a file growing meanwhile is refused too). A ``.gz`` file is
+    decompressed as a stream and refused past ``unpacked`` bytes (default ``max_bytes``) --
+    a 3 MB gzip cannot unpack into gigabytes (``unpack=False``: the file's own bytes, e.g. for
+    a digest). Every refusal is one line naming ``field`` and the file."""
+    import gzip
+    import zlib
+    path = Path(path)
+    where = _where(path, field)
+    fd = open_input(path, max_bytes, field, within)
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            data = fh.read(max_bytes + 1)
+        except OSError as err:
+            raise FkoptError(f"{where}: cannot read ({err.strerror or err})") from None
+        if len(data) > max_bytes:
+            raise FkoptError(f"{where}: larger than the {_size(max_bytes)} accepted for this file")
+    if not unpack or not path.name.endswith(".gz"):
+        return data
+    limit = max_bytes if unpacked is None else unpacked
+    chunks, size = [], 0
+    try:
+        with gzip.GzipFile(fileobj=io.BytesIO(data)) as gz:
+            while chunk := gz.read(1 << 20):
+                size += len(chunk)
+                if size > limit:
+                    raise FkoptError(f"{where}: unpacks to more than {_size(limit)}, the most accepted for this "
+                                     "file; refused (memory stays bounded)")
+                chunks.append(chunk)
+    except (EOFError, gzip.BadGzipFile, zlib.error) as err:
+        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else "not a valid gzip file"
+        raise FkoptError(f"{where}: {what}") from None
+    return b"".join(chunks)
+
+
+def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str | None = None,
+              within: str | Path | None = None, unpacked: int | None = None) -> str:
+    """The UTF-8 text of a user file (:func:`read_input`'s bounds); every failure is one line."""
+    data = read_input(path, max_bytes, field=field, within=within, unpacked=unpacked)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise FkoptError(f"{path}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset {err.start})") from None
+        raise FkoptError(f"{_where(Path(path), field)}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset "
+                         f"{err.start})") from None
+
+
+def parse_json(data: bytes, where: str) -> Any:
+    """Strict JSON from the bytes of a file fkopt did not write (``where`` names it): UTF-8,
+    ``NaN``/``Infinity`` refused, nesting bounded; every failure is one line."""
+    def constant(name):
+        raise ValueError(f"{name} is not JSON")
+    try:
+        return json.loads(data.decode("utf-8"), parse_constant=constant)
+    except UnicodeDecodeError as err:
+        raise FkoptError(f"{where}: not UTF-8 text (offset {err.start})") from None
+    except RecursionError:
+        raise FkoptError(f"{where}: nested too deeply") from None
+    except ValueError as err:
+        raise FkoptError(f"{where}: not valid JSON ({one_line(str(err), 80)})") from None
+
+
+def read_json(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
+              within: str | Path | None = None) -> Any:
+    """A JSON file fkopt did not write in this run: bounded (:func:`read_input`), then
+    :func:`parse_json`."""
+    return parse_json(read_input(path, max_bytes, field=field, within=within), _where(Path(path), field))
+
+
+def read_stored(folder: str | Path, name: str | Path, unpack: bool = True) -> bytes:
+    """A file of a stored result (``folder/name``), read back by ``check``, ``report``,
+    ``export`` or ``compare``: inside ``folder`` (a link out of it is refused), a regular file,
+    at most :data:`MAX_UNPACKED` bytes, unpacked too."""
+    return read_input(Path(folder) / name, MAX_UNPACKED, within=folder, unpacked=MAX_UNPACKED, unpack=unpack)
+
+
+def odd_entries(folder: str | Path) -> list[tuple[str, str]]:
+    """(relative path, what it is) of every entry below ``folder`` that is not a plain file or
+    folder: symbolic links (wherever they point), FIFOs, devices, sockets. A results folder
+    fkopt wrote holds none, so ``fkopt check`` refuses to read one that does (a ``runs.csv``
+    linked to ``/dev/zero`` or outside the folder)."""
+    folder = Path(folder)
+    out = []
+    for base, dirs, files in os.walk(folder, followlinks=False):
+        for name in sorted(dirs) + sorted(files):
+            path = Path(base) / name
+            mode = os.lstat(path).st_mode
+            if stat.S_ISLNK(mode):
+                out.append((str(path.relative_to(folder)), "a symbolic link"))
+            elif not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+                out.append((str(path.relative_to(folder)), _file_kind(mode)))
+    return out
 
 
 def check_geometry_file(path: Path, mechanism: str, max_bytes: int, what: str) -> None:
-    """A mechanism's ``geometry.file`` exists and is at most ``max_bytes`` (checked before any parser
-    reads it); ``what`` names the format in the message, e.g. "a URDF file"."""
-    if not path.is_file():
+    """A mechanism's ``geometry.file`` is a regular file (not a folder, FIFO or device) of at
+    most ``max_bytes`` (checked before any parser reads it); ``what`` names the format in the
+    message, e.g. "a URDF file"."""
+    if not Path(path).exists() and not Path(path).is_symlink():
         raise FkoptError(f"{mechanism} geometry.file: {path} does not exist")
-    size = path.stat().st_size
-    if size > max_bytes:
-        raise FkoptError(f"{mechanism} {path}: {size} bytes, larger than the {max_bytes} bytes accepted for {what}")
+    try:
+        os.close(open_input(path, max_bytes, f"{mechanism} geometry.file"))
+    except FkoptError as err:
+        raise FkoptError(str(err).replace("for this file", f"for {what}")) from None
 
 
 def load_yaml(path: str | Path, max_bytes: int = MAX_YAML_BYTES) -> Any:
@@ -255,6 +421,35 @@ def check_component(value: Any, field: str) -> str:
         raise FkoptError(f"{field}: {shown} is not a single safe folder name: letters, digits and "
                          f"_ . + - only, a letter or digit first, at most {MAX_COMPONENT} characters")
     return value
+
+
+def file_names(names, reserved=(), allowed: str = "A-Za-z0-9_.+-", sep: str = "_") -> dict[str, str]:
+    """A file-name stem for each of ``names``, never the same for two distinct names (nor equal
+    to a ``reserved`` stem), compared ignoring case (a case-insensitive file system).
+
+    A name made only of ``allowed`` characters keeps itself (so existing files keep their
+    names); any other name has each run of other characters replaced by ``sep``, and when that
+    stem is taken -- by a name spelled so (``pso-lm`` beside ``pso+lm``, ``a_b`` beside ``a b``),
+    by a reserved stem (``all``) or by another such name -- gets ``sep`` and 8 hex digits of
+    its SHA-256 (then a counter, should even that be taken). Deterministic: the same set of
+    names gives the same stems."""
+    import hashlib
+    unsafe = re.compile(f"[^{allowed}]+")
+    names = sorted(set(map(str, names)))
+    taken = {r.lower() for r in reserved}
+    out: dict[str, str] = {}
+    owners = [n for n in names if n and not unsafe.search(n) and not n.startswith(".")]
+    for group in (owners, [n for n in names if n not in set(owners)]):
+        for name in group:
+            stem = name if group is owners else (unsafe.sub(sep, name).strip(sep + ".") or "x")[:48]
+            if stem.lower() in taken:
+                stem = f"{stem[:48]}{sep}{hashlib.sha256(name.encode()).hexdigest()[:8]}"
+                base, k = stem, 2
+                while stem.lower() in taken:
+                    stem, k = f"{base}{sep}{k}", k + 1
+            taken.add(stem.lower())
+            out[name] = stem
+    return out
 
 
 def inside(root: str | Path, path: str | Path, option: str = "--out") -> Path:
@@ -376,44 +571,17 @@ def write_atomically(final: str | Path, write: Callable[[Path], Any],
         if check is not None:
             check(final)
         swap_into_place(tmp, final)
+    except OSError as err:
+        shutil.rmtree(tmp, ignore_errors=True)
+        name = Path(err.filename) if err.filename else None
+        if name is not None and (name == tmp or tmp in name.parents):   # the file as the user knows it
+            name = final / name.relative_to(tmp)
+        where = f"{name}: " if name is not None else f"{final}: "
+        raise FkoptError(f"{where}cannot write ({err.strerror or err}); the previous result is kept") from None
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return final
-
-
-#: Largest decompressed ``.csv.gz`` fkopt reads (bytes). The largest it writes, kinbench v2's
-#: ``trace.csv.gz``, unpacks to ~64 MB; the cap keeps a hostile file (a small gzip that unpacks
-#: to gigabytes) from taking the memory: the size is measured by streaming decompression first.
-MAX_UNPACKED = 256 * 1024 ** 2
-
-
-def unpacked_size(path: str | Path, limit: int = MAX_UNPACKED) -> int:
-    """Decompressed size of gzip ``path``, streamed in 1 MiB pieces; stops past ``limit``."""
-    import gzip
-    size = 0
-    with gzip.open(path, "rb") as fh:
-        while chunk := fh.read(1 << 20):
-            size += len(chunk)
-            if size > limit:
-                break
-    return size
-
-
-def check_unpacked(path: str | Path, limit: int | None = None) -> None:
-    """Refuse, with one line, a gzip file that unpacks to more than ``limit`` bytes (default
-    :data:`MAX_UNPACKED`) or is no gzip."""
-    import gzip
-    import zlib
-    limit = MAX_UNPACKED if limit is None else limit
-    try:
-        too_big = unpacked_size(path, limit) > limit
-    except (EOFError, gzip.BadGzipFile, zlib.error) as err:
-        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a valid gzip file ({err})"
-        raise FkoptError(f"{path}: {what}") from None
-    if too_big:
-        raise FkoptError(f"{path}: unpacks to more than {limit // 1024 ** 2} MB; refused (the largest file fkopt "
-                         "writes is far smaller; memory stays bounded)")
 
 
 @contextlib.contextmanager
@@ -457,18 +625,63 @@ def write_file_atomically(path: str | Path, write: Callable[[Path], Any]) -> Non
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
-        write(Path(tmp))
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
+        with naming_the_file(path):
+            write(Path(tmp))
+            with open(tmp, "rb") as fh:
+                os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
 
 
+@contextlib.contextmanager
+def naming_the_file(path: str | Path):
+    """An OSError raised while writing ``path`` without naming a file (a full disk, a quota: the
+    kernel reports ENOSPC at write or close, not at open) is re-raised naming ``path``, so the
+    one line says which file could not be written (the previous result is kept by the swap)."""
+    try:
+        yield
+    except OSError as err:
+        if err.filename:
+            raise
+        raise OSError(err.errno, err.strerror or str(err), str(path)) from None
+
+
 def write_json_atomically(path: str | Path, data: Any, **dump) -> None:
     text = json.dumps(data, **dump)
     write_file_atomically(path, lambda p: p.write_text(text + ("\n" if dump.get("indent") else "")))
+
+
+def strict_json(data: Any, **dump) -> str:
+    """``data`` as strict JSON (RFC 8259: no ``NaN``/``Infinity``, which strict parsers reject),
+    for every ``--json`` output: a number that is not finite becomes ``null`` and the object gets
+    a ``"non_finite"`` mapping from that field's path (``position_error``, ``solutions[0].x``)
+    to ``"inf"``, ``"-inf"`` or ``"nan"`` -- nothing is lost, nothing guessed (docs/cli.md)."""
+    import math
+    flags: dict[str, str] = {}
+
+    def clean(value, path):
+        if isinstance(value, dict):
+            return {k: clean(v, f"{path}.{k}" if path else str(k)) for k, v in value.items()}
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        if isinstance(value, (list, tuple)):
+            return [clean(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        if isinstance(value, np.integer):
+            return int(value)
+        if isinstance(value, (float, np.floating)):
+            value = float(value)
+            if not math.isfinite(value):
+                flags[path] = "nan" if value != value else ("inf" if value > 0 else "-inf")
+                return None
+        return value
+    out = clean(data, "")
+    if flags and isinstance(out, dict):
+        out["non_finite"] = flags
+    return json.dumps(out, allow_nan=False, default=str, **dump)
 
 
 def write_json(path: str | Path, data: Any) -> None:
@@ -491,6 +704,36 @@ def nanmedian(a) -> float:
     a = np.asarray(a, dtype=float)
     ok = ~np.isnan(a)
     return float(np.median(a[ok])) if ok.any() else float("nan")
+
+
+#: Characters that mean something in Markdown tables, links, code or HTML, and their escapes.
+_MD_ESCAPES = {"\\": "\\\\", "`": "\\`", "*": "\\*", "[": "\\[", "]": "\\]", "|": "\\|",
+               "<": "&lt;", ">": "&gt;", "&": "&amp;"}
+
+
+def md_text(value: Any) -> str:
+    """``value`` as literal text inside a Markdown file (a table cell, a heading): HTML (``<script>``,
+    ``<img onerror>``) and entities, link and image brackets, table bars, code ticks and
+    emphasis stars escaped; newlines, terminal escape sequences and other control characters
+    shown as ``\\xNN`` text instead of acting (a title cannot start a new heading or recolour a
+    terminal that shows the file)."""
+    out = []
+    for c in str(value):
+        if c in _MD_ESCAPES:
+            out.append(_MD_ESCAPES[c])
+        elif not c.isprintable():
+            out.append(f"\\\\x{ord(c):02x}" if ord(c) < 256 else f"\\\\u{ord(c):04x}")
+        else:
+            out.append(c)
+    return "".join(out)
+
+
+def short_token(text: Any, limit: int = 40) -> str:
+    """A short, printable excerpt of a hostile file's text for an error line: whitespace runs
+    made one space, non-printable characters ``?``, at most ``limit`` characters."""
+    text = " ".join(str(text).split())
+    text = "".join(c if c.isprintable() else "?" for c in text)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def one_line(text: str, limit: int = 2000) -> str:

@@ -154,7 +154,11 @@ def deterministic_files(folder: Path) -> list[str]:
 
 
 def sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a file's own bytes, read bounded (a regular file: a FIFO or ``/dev/zero`` in a
+    results folder is one line, never a hang)."""
+    from .files import read_stored
+    path = Path(path)
+    return hashlib.sha256(read_stored(path.parent, path.name, unpack=False)).hexdigest()
 
 
 def file_digests(folder: Path) -> dict[str, str]:
@@ -172,7 +176,7 @@ def write_outputs(kind: str, result: Any, folder: str | Path, *, figures: bool =
     """Write every file of ``kind`` for ``result`` into ``folder`` (which must exist); returns
     the names written. ``figures=False`` / ``timing=False`` leave out the figures / the timing
     files (what ``fkopt check`` reruns for: only deterministic files are compared)."""
-    from .files import write_json
+    from .files import naming_the_file, write_json
     from .provenance import environment
 
     folder = Path(folder)
@@ -182,18 +186,21 @@ def write_outputs(kind: str, result: Any, folder: str | Path, *, figures: bool =
         if (out.role == FIGURE and not figures) or (out.role == TIMING and not timing):
             continue
         make = _load(out.make)
-        if out.role == FIGURE:
-            written += make(result, folder, tables)
-            continue
-        df = make(result)
-        if df is None:
-            continue
-        gz = {"compression": {"method": "gzip", "mtime": 0}} if out.file.endswith(".gz") else {}
-        df.to_csv(folder / out.file, index=False, float_format=out.float_format, **gz)
+        with naming_the_file(folder / out.file):
+            if out.role == FIGURE:
+                written += make(result, folder, tables)
+                continue
+            df = make(result)
+            if df is None:
+                continue
+            gz = {"compression": {"method": "gzip", "mtime": 0}} if out.file.endswith(".gz") else {}
+            df.to_csv(folder / out.file, index=False, float_format=out.float_format, **gz)
         tables[out.file] = df
         written.append(out.file)
-    write_json(folder / META_FILE, {**_load(META[kind])(result), "files": file_digests(folder)})
-    write_json(folder / ENV_FILE, environment())
+    with naming_the_file(folder / META_FILE):
+        write_json(folder / META_FILE, {**_load(META[kind])(result), "files": file_digests(folder)})
+    with naming_the_file(folder / ENV_FILE):
+        write_json(folder / ENV_FILE, environment())
     return written + [META_FILE, ENV_FILE]
 
 

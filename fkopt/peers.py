@@ -14,12 +14,15 @@ Success rate is the share of runs below the threshold. Evaluations are the mean 
 """
 from __future__ import annotations
 
-import json
+import io
 import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from .errors import FkoptError
+from .files import parse_json, read_stored
 
 #: Which fkopt algorithm each library algorithm is the counterpart of (by name).
 COUNTERPARTS = {"niapy:ArtificialBeeColonyAlgorithm": "abc", "niapy:ParticleSwarmAlgorithm": "pso",
@@ -44,13 +47,13 @@ def _verdict(a: float, b: float, name_a: str, name_b: str, thr: float | None) ->
 
 
 def paper_section(folder: Path) -> str:
-    meta = json.loads((folder / "meta.json").read_text())
-    summary = pd.read_csv(folder / "summary.csv")
+    meta = parse_json(read_stored(folder, "meta.json"), str(folder / "meta.json"))
+    summary = pd.read_csv(io.BytesIO(read_stored(folder, "summary.csv")))
     config = meta["config"]
     thr = config.get("threshold")
     try:   # library versions are in env.json (fkopt.provenance), beside the timings
-        libs = json.loads((folder / "env.json").read_text()).get("libraries", {})
-    except (OSError, ValueError):
+        libs = parse_json(read_stored(folder, "env.json"), "env.json").get("libraries", {})
+    except (OSError, ValueError, AttributeError, FkoptError):
         libs = {}
     lines = [f"## {config.get('paper')}: {config.get('title', '')}", ""]
     used = sorted({a["name"].split(":")[0] for a in config["algorithms"] if ":" in a["name"]})

@@ -90,6 +90,7 @@ TIERS = {
     "tests/test_hostile.py::test_interrupted_study_rerun_keeps_previous_result": ("external",),
     "tests/test_hostile.py::test_interrupted_experiment_rerun_keeps_previous_result": ("external",),
     "tests/test_hostile.py::test_jobs_10000_starts_no_more_processes_than_cpus": ("external",),
+    "tests/test_hostile.py::test_export_keeps_pso_plus_lm_and_an_outside_pso_minus_lm_apart": ("slow",),
     "tests/test_reproduce.py::test_stored_results_are_reproduced": ("stored",),
     "tests/test_reproduce.py::test_reproduce_in_worker_processes_gives_the_serial_files": ("stored", "slow"),
     "tests/test_reproduce.py::test_report_is_generated_not_edited": ("stored",),

@@ -187,6 +187,17 @@ CORPUS = [
     ("reproduce-out-file", None, ["reproduce", "--configs", "{root}/configs", "--out", "{root}/afile"], ["is a file"]),
     ("reproduce-clash", None, ["reproduce", "--configs", "{root}/clash", "--out", "{out}"], ["paper/name must differ"]),
     ("report-corrupt-meta", None, ["report", "{root}/corrupt"], ["meta.json", "unreadable"]),
+    # -- issue 30: huge finite numbers in configs and geometry (|v| <= 1e9) ----------------------------
+    ("case-joints-1e300", with_(BASE, cases=[{"joints": {"d1": 1e300, "d2": 600, "d3": 600}}]),
+     ["run", "{f}", "--out", "{out}"], ["cases[0].joints", "'d1'", "|value| <= 1e+09"]),
+    ("case-pose-1e300", with_(BASE, cases=[{"pose": {"alpha": 0, "beta": 0, "z": 1e300}}]),
+     ["run", "{f}", "--out", "{out}"], ["cases[0].pose", "'z'", "1e+09"]),
+    ("assembly-joints-1e300", with_(ASSEMBLY, joints={"d1": 1e300, "d2": 1e300, "d3": 1e300}),
+     ["run", "{f}", "--out", "{out}"], ["joints", "'d1'", "1e+09"]),
+    ("geometry-1e300", "ra: 1.0e+300\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
+     ["geometry.ra", "|value| <= 1e+09"]),
+    ("config-geometry-1e300", with_(BASE, mechanism={"name": "3-rps", "geometry": {"rb": 2e9}}),
+     ["run", "{f}", "--out", "{out}"], ["geometry.rb", "1e+09"]),
 ]
 
 
@@ -448,7 +459,8 @@ def test_resume_refuses_corrupt_task_files(finished_study, cli, content):
     assert task.read_text() == content            # nothing wiped: the user decides
 
 
-@pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task"])
+@pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task", "fitness-text", "fitness-nan",
+                                  "fitness-inf", "evaluations-negative", "wall-inf"])
 def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli, edit):
     """Someone who also rewrote manifest.json's digests still cannot slip a malformed record in."""
     import hashlib
@@ -464,6 +476,12 @@ def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli
         rec["fitness"] = rec["fitness"][:1]
     elif edit == "strings":
         rec["x"] = "abc"
+    elif edit.startswith("fitness-"):           # issue 30: a value of the wrong type or range
+        rec["fitness"][0][0] = {"fitness-text": "x", "fitness-nan": float("nan"), "fitness-inf": float("inf")}[edit]
+    elif edit == "evaluations-negative":
+        rec["evaluations"][0][0] = -5
+    elif edit == "wall-inf":
+        rec["wall_s"] = float("inf")
     else:
         rec["task"]["stop"] = 1
     task.write_text(json.dumps(rec))
@@ -983,3 +1001,654 @@ def test_swap_keeps_previous_until_replaced(tmp_path):
     (new / "c.csv").write_text("3\n")
     swap_into_place(new, final)
     assert sorted(p.name for p in final.iterdir()) == ["c.csv"] and not new.exists()
+
+
+# == issue 30: hostile inputs, third round ==========================================================
+# Every file fkopt did not write in this run is read bounded (files.read_input) and validated.
+import gzip as _gzip
+import shutil as _shutil
+
+SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
+MINI_SETS = "my-sets"
+
+
+def mini_suite(root: Path, sets_folder: str = MINI_SETS, **over) -> Path:
+    """A one-problem suite (mao2017-3rps, set uniform, 2 poses, lm) beside a copy of its pose sets
+    under a private version name (so the released-version check does not mask what is tested)."""
+    root.mkdir(parents=True, exist_ok=True)
+    sets = root / sets_folder
+    if not sets.exists():
+        _shutil.copytree(SUITES / "kinbench-v1" / "mao2017-3rps", sets / "mao2017-3rps")
+        manifest = json.loads((SUITES / "kinbench-v1" / "manifest.json").read_text())
+        manifest["problems"] = {"mao2017-3rps": manifest["problems"]["mao2017-3rps"]}
+        manifest["version"] = sets_folder
+        (sets / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+    data = yaml.safe_load((SUITES / "kinbench.yaml").read_text())
+    data.update(name="mini", pose_sets=sets_folder, problems=data["problems"][:1], sets=["uniform"], poses=2,
+                runs=1, solvers=[{"name": "lm"}], budget_per_dim=50, bootstrap=100, quick=None)
+    data.update(over)
+    path = root / "mini.yaml"
+    path.write_text(yaml_of(data))
+    return path
+
+
+def resign(sets: Path, rel: str) -> None:
+    """Update the manifest's SHA-256 of ``rel`` (a forged signature: the file is then 'valid')."""
+    manifest = json.loads((sets / "manifest.json").read_text())
+    name = Path(rel).stem
+    manifest["problems"]["mao2017-3rps"]["sets"][name]["sha256"] = hashlib.sha256((sets / rel).read_bytes()).hexdigest()
+    (sets / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+
+
+def refused(cli, argv, root: Path, *fragments) -> str:
+    """``fkopt argv`` is exit 2, one line holding ``fragments``, and nothing under ``root`` changed."""
+    before = snapshot(root)
+    line = one_line_error(cli(*argv), *fragments)
+    assert snapshot(root) == before, "a refused input wrote or changed a file"
+    return line
+
+
+# -- pose sets: every malformed input is one line (findings 1, 3 and 5) ---------------------------
+UNIFORM = f"{MINI_SETS}/mao2017-3rps/uniform.csv"
+
+
+def _csv(text):
+    def spoil(sets):
+        (sets / "mao2017-3rps" / "uniform.csv").write_bytes(text if isinstance(text, bytes) else text.encode())
+        resign(sets, "mao2017-3rps/uniform.csv")
+    return spoil
+
+
+def _manifest(change):
+    def spoil(sets):
+        m = json.loads((sets / "manifest.json").read_text())
+        m = change(m)
+        (sets / "manifest.json").write_text(json.dumps(m))
+    return spoil
+
+
+def _entry(change):
+    return _manifest(lambda m: (change(m["problems"]["mao2017-3rps"]), m)[1])
+
+
+def _link(target):
+    def spoil(sets):
+        f = sets / "mao2017-3rps" / "uniform.csv"
+        f.unlink()
+        f.symlink_to(target)
+    return spoil
+
+
+def _fifo(sets):
+    f = sets / "mao2017-3rps" / "uniform.csv"
+    f.unlink()
+    os.mkfifo(f)
+
+
+POSESET_CASES = [
+    ("csv-empty", _csv(""), ["uniform.csv", "empty"]),
+    ("csv-non-ascii", _csv("alpha,beta,z\n1,2,caf\u00e9\n"), ["uniform.csv", "not ASCII"]),
+    ("csv-cell-text", _csv("alpha,beta,z\n1,2,<script>\n"), ["uniform.csv", "line 2", "not a number"]),
+    ("csv-ragged", _csv("alpha,beta,z\n1,2,600\n1,2\n"), ["uniform.csv", "line 3", "needs 3"]),
+    ("csv-nan", _csv("alpha,beta,z\n1,2,nan\n"), ["uniform.csv", "finite"]),
+    ("csv-header", _csv("a,b,c\n1,2,600\n"), ["uniform.csv", "header", "alpha,beta,z"]),
+    ("csv-poses-count", _csv("alpha,beta,z\n1,2,600\n"), ["poses", "has 1 poses"]),
+    ("csv-fifo", _fifo, ["uniform.csv", "FIFO", "only regular files"]),
+    ("csv-dev-zero", _link("/dev/zero"), ["uniform.csv", "outside"]),
+    ("csv-folder", lambda s: ((s / "mao2017-3rps" / "uniform.csv").unlink(),
+                              (s / "mao2017-3rps" / "uniform.csv").mkdir()), ["uniform.csv", "a folder"]),
+    ("csv-link-outside", lambda s: _link(s.parent / "elsewhere.csv")(s), ["uniform.csv", "outside"]),
+    ("file-escapes", _entry(lambda e: e["sets"]["uniform"].update(file="../../x.csv")), ["file", "outside"]),
+    ("file-absolute", _entry(lambda e: e["sets"]["uniform"].update(file="/etc/passwd")), ["file", "outside"]),
+    ("file-not-text", _entry(lambda e: e["sets"]["uniform"].update(file=7)), ["sets.uniform.file"]),
+    ("manifest-list", _manifest(lambda m: []), ["manifest.json", "JSON mapping"]),
+    ("manifest-not-json", lambda s: (s / "manifest.json").write_text("{not json"), ["manifest.json", "not valid JSON"]),
+    ("manifest-nan", lambda s: (s / "manifest.json").write_text('{"problems": NaN}'), ["manifest.json", "NaN"]),
+    ("manifest-problems-list", _manifest(lambda m: {**m, "problems": []}), ["problems", "mapping"]),
+    ("manifest-no-mechanism", _entry(lambda e: e.pop("mechanism")), ["problems.mao2017-3rps.mechanism", "missing"]),
+    ("manifest-sets-list", _entry(lambda e: e.update(sets=[])), ["problems.mao2017-3rps.sets", "mapping"]),
+    ("manifest-no-sha", _entry(lambda e: e["sets"]["uniform"].pop("sha256")), ["sets.uniform.sha256", "64"]),
+    ("manifest-no-set", _entry(lambda e: e["sets"].pop("uniform")), ["has no set 'uniform'"]),
+    ("manifest-unknowns", _entry(lambda e: e.update(unknowns="alpha")), ["unknowns", "list"]),
+    ("manifest-poses-text", _entry(lambda e: e["sets"]["uniform"].update(poses="20")), ["poses", "integer"]),
+    ("manifest-huge", lambda s: (s / "manifest.json").write_bytes(b" " * (2 << 20)), ["manifest.json", "larger than"]),
+]
+
+
+@pytest.mark.parametrize("case", POSESET_CASES, ids=[c[0] for c in POSESET_CASES])
+def test_pose_set_inputs_are_one_line(case, tmp_path, cli):
+    ident, spoil, fragments = case
+    path = mini_suite(tmp_path / "s")
+    (tmp_path / "s" / "elsewhere.csv").write_text((SUITES / "kinbench-v1" / "mao2017-3rps" / "uniform.csv").read_text())
+    spoil(tmp_path / "s" / MINI_SETS)
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q"], tmp_path, *fragments)
+    assert "<script>" not in line and "root:" not in line       # no file content quoted
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
+def test_a_swapped_released_set_with_a_resigned_manifest_is_refused(tmp_path, cli):
+    path = mini_suite(tmp_path / "s", sets_folder="kinbench-v1")
+    # the copy trimmed the manifest: a re-signed released version, as an attacker would make it
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q"], tmp_path, "released kinbench-v1")
+    assert "new version" in line or "differs from released" in line
+    # the committed release itself loads (its manifest is the released one, byte for byte)
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.posesets import load_pose_sets
+    assert load_pose_sets(load_suite(SUITES / "kinbench.yaml"))[1]["version"] == "kinbench-v1"
+
+
+def test_a_mini_suite_of_a_private_version_still_validates(tmp_path):
+    from fkopt.experiment.kinds import load_any, validate_any
+    path = mini_suite(tmp_path / "s")
+    assert validate_any(load_any(path), str(path)) == 1
+
+
+# -- outside results: CSV and IOH (findings 1, 4 and 5) ---------------------------------------------
+GOOD_CSV = "problem,set,pose,run,evaluations,best_so_far\n" + "".join(
+    f"mao2017-3rps,uniform,{p},0,{e},{f}\n" for p in (0, 1) for e, f in ((1, 5.0), (6, 1e-12)))
+GOOD_DAT = "evaluations raw_y\n1 5.0\n6 1e-12\n" * 2
+SECRET = "root:x:0:0:SECRET-TOKEN"
+
+
+def ioh_folder(root: Path, index=None, dat=GOOD_DAT) -> Path:
+    """An IOHprofiler folder of one algorithm with both poses of the mini suite."""
+    folder = root / "ioh"
+    (folder / "run" / "data_f1").mkdir(parents=True, exist_ok=True)
+    index = index if index is not None else {
+        "algorithm": {"name": "RS"}, "function_name": "mao2017-3rps__uniform",
+        "scenarios": [{"path": "data_f1/IOHprofiler_f1_DIM3.dat", "runs": [{"instance": 1}, {"instance": 2}]}]}
+    (folder / "run" / "IOHprofiler_f1.json").write_text(index if isinstance(index, str) else json.dumps(index))
+    (folder / "run" / "data_f1" / "IOHprofiler_f1_DIM3.dat").write_text(dat)
+    return folder
+
+
+def _index(**change):
+    data = {"algorithm": {"name": "RS"}, "function_name": "mao2017-3rps__uniform",
+            "scenarios": [{"path": "data_f1/IOHprofiler_f1_DIM3.dat", "runs": [{"instance": 1}, {"instance": 2}]}]}
+    data.update(change)
+    return data
+
+
+def _runs(*instances):
+    return _index(scenarios=[{"path": "data_f1/IOHprofiler_f1_DIM3.dat", "runs": [{"instance": i} for i in instances]}])
+
+
+def _path(p):
+    return _index(scenarios=[{"path": p, "runs": [{"instance": 1}, {"instance": 2}]}])
+
+
+def _write_csv(text):
+    return lambda root: (root / "x.csv").write_text(text)
+
+
+def _gzip_bomb(root):
+    with _gzip.open(root / "x.csv.gz", "wb", compresslevel=1) as fh:
+        fh.write(GOOD_CSV.encode())
+        chunk = b"0" * (1 << 20)
+        for _ in range(65):
+            fh.write(chunk)
+
+
+def _sparse(root):
+    with open(root / "x.csv", "wb") as fh:
+        fh.truncate(65 << 20)         # a size past the cap, without writing 65 MB
+
+
+OUTSIDE_CASES = [   # (id, make the input under root, outside entry, fragments)
+    ("csv-gzip-bomb", _gzip_bomb, {"file": "x.csv.gz"}, ["outside[0].file", "x.csv.gz", "unpacks to more than"]),
+    ("csv-too-large", _sparse, {"file": "x.csv"}, ["outside[0].file", "larger than"]),
+    ("csv-fifo", lambda root: os.mkfifo(root / "x.csv"), {"file": "x.csv"}, ["outside[0].file", "FIFO"]),
+    ("csv-dev-zero", lambda root: (root / "x.csv").symlink_to("/dev/zero"), {"file": "x.csv"},
+     ["outside[0].file", "character device"]),
+    ("csv-folder", lambda root: (root / "x.csv").mkdir(), {"file": "x.csv"}, ["outside[0].file", "a folder"]),
+    ("csv-evaluations-1e300", _write_csv(GOOD_CSV.replace(",6,", ",1e300,")), {"file": "x.csv"},
+     ["column 'evaluations'", "[0, 2^53]"]),
+    ("csv-evaluations-2e53", _write_csv(GOOD_CSV.replace(",6,", f",{2**53 + 2},")), {"file": "x.csv"},
+     ["column 'evaluations'", "[0, 2^53]"]),
+    ("csv-run-1e300", _write_csv(GOOD_CSV.replace(",0,6,", ",1e300,6,")), {"file": "x.csv"}, ["column 'run'"]),
+    ("csv-empty", _write_csv(""), {"file": "x.csv"}, ["outside[0].file", "unreadable CSV"]),
+    ("ioh-no-header", lambda root: ioh_folder(root, dat="1 5.0\n6 1e-12\n"), {"ioh": "ioh"},
+     ["IOHprofiler_f1_DIM3.dat", "line 1", "header"]),
+    ("ioh-dat-text", lambda root: ioh_folder(root, dat=f"evaluations raw_y\n1 {SECRET}\n"), {"ioh": "ioh"},
+     ["line 2", "two numbers"]),
+    ("ioh-dat-1e300", lambda root: ioh_folder(root, dat="evaluations raw_y\n1e300 5\n" * 2), {"ioh": "ioh"},
+     ["evaluations", "[0, 2^53]"]),
+    ("ioh-instance-text", lambda root: ioh_folder(root, _runs("x", 2)), {"ioh": "ioh"},
+     ["scenarios[0].runs[0].instance", "integer >= 1"]),
+    ("ioh-instance-null", lambda root: ioh_folder(root, _runs(None, 2)), {"ioh": "ioh"},
+     ["scenarios[0].runs[0].instance"]),
+    ("ioh-instance-bool", lambda root: ioh_folder(root, _runs(True, 2)), {"ioh": "ioh"}, ["instance"]),
+    ("ioh-function-number", lambda root: ioh_folder(root, _index(function_name=7)), {"ioh": "ioh"},
+     ["function_name", "must be text"]),
+    ("ioh-mixed-function-names", lambda root: (ioh_folder(root), (root / "ioh" / "run2").mkdir(),
+                                               (root / "ioh" / "run2" / "IOHprofiler_f2.json").write_text(
+                                                   json.dumps(_index(function_name=2)))),
+     {"ioh": "ioh"}, ["IOHprofiler_f2.json", "function_name"]),
+    ("ioh-no-algorithm", lambda root: ioh_folder(root, _index(algorithm="RS")), {"ioh": "ioh"}, ["algorithm.name"]),
+    ("ioh-scenarios-map", lambda root: ioh_folder(root, _index(scenarios={})), {"ioh": "ioh"}, ["'scenarios'"]),
+    ("ioh-index-list", lambda root: ioh_folder(root, "[]"), {"ioh": "ioh"}, ["IOHprofiler_f1.json", "mapping"]),
+    ("ioh-index-infinity", lambda root: ioh_folder(root, '{"algorithm": Infinity}'), {"ioh": "ioh"},
+     ["IOHprofiler_f1.json", "Infinity"]),
+    ("ioh-index-deep", lambda root: ioh_folder(root, "[" * 100_000 + "]" * 100_000), {"ioh": "ioh"},
+     ["IOHprofiler_f1.json"]),
+    ("ioh-path-dotdot", lambda root: ioh_folder(root, _path("../../secret.dat")), {"ioh": "ioh"},
+     ["scenarios[0].path", "outside"]),
+    ("ioh-path-absolute", lambda root: ioh_folder(root, _path(str(root / "secret.dat"))), {"ioh": "ioh"},
+     ["scenarios[0].path", "outside"]),
+    ("ioh-path-etc", lambda root: ioh_folder(root, _path("/etc/passwd")), {"ioh": "ioh"},
+     ["scenarios[0].path", "outside"]),
+    ("ioh-path-fifo", lambda root: (ioh_folder(root), (root / "ioh" / "run" / "p").mkdir(),
+                                    os.mkfifo(root / "ioh" / "run" / "p" / "f.dat"),
+                                    ioh_folder(root, _path("p/f.dat"))), {"ioh": "ioh"}, ["FIFO"]),
+    ("ioh-path-number", lambda root: ioh_folder(root, _path(5)), {"ioh": "ioh"}, ["scenarios[0].path"]),
+    ("ioh-stray-link-outside", lambda root: (ioh_folder(root), (root / "ioh" / "run" / "notes.txt").symlink_to(
+        root / "secret.dat")), {"ioh": "ioh"}, ["notes.txt", "outside"]),
+    ("ioh-run-folder-link", lambda root: (ioh_folder(root / "elsewhere"), (root / "ioh").mkdir(),
+                                          (root / "ioh" / "run").symlink_to(root / "elsewhere" / "ioh" / "run")),
+     {"ioh": "ioh"}, ["outside"]),
+]
+
+
+@pytest.mark.parametrize("case", OUTSIDE_CASES, ids=[c[0] for c in OUTSIDE_CASES])
+def test_outside_inputs_are_one_line(case, tmp_path, cli):
+    ident, make, entry, fragments = case
+    root = tmp_path / "s"
+    root.mkdir()
+    (root / "secret.dat").write_text(f"evaluations raw_y\n{SECRET} 1\n")
+    make(root)
+    path = mini_suite(root, outside=[{"solver": "ext", "track": "black-box", **entry}])
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q"], tmp_path, *fragments)
+    assert "SECRET" not in line                              # never a token of a file it reached
+    assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
+
+
+def test_good_outside_csv_gz_and_ioh_still_validate(tmp_path):
+    """The checks above refuse only what is wrong: the same mini suite with well-formed files loads."""
+    from fkopt.experiment.kinds import load_any, validate_any
+    from fkopt.kinbench.outside import logged_runs
+    from fkopt.kinbench.runner import instances_of
+    from fkopt.kinbench.posesets import load_pose_sets
+    root = tmp_path / "s"
+    root.mkdir()
+    with _gzip.open(root / "x.csv.gz", "wt") as fh:
+        fh.write(GOOD_CSV)
+    ioh_folder(root)
+    path = mini_suite(root, outside=[{"solver": "ext", "track": "black-box", "file": "x.csv.gz"},
+                                     {"solver": "ioh", "track": "black-box", "ioh": "ioh"}])
+    cfg = load_any(path)
+    assert validate_any(cfg, str(path)) == 1
+    instances = instances_of(cfg, load_pose_sets(cfg)[0])
+    for k in (0, 1):
+        runs = list(logged_runs(cfg, k, instances))
+        assert [(r[2], list(r[4]), list(r[5])) for r in runs] == [(p, [1.0, 6.0], [5.0, 1e-12]) for p in (0, 1)]
+
+
+# -- --resume: task records checked against the plan, even with a forged digest (finding 2) ------
+def _forge_task(tmp_path, edit):
+    """The mini suite's one task, computed, edited by ``edit`` and kept as a task file of an
+    interrupted run with its digest re-signed in the manifest (what an attacker can do)."""
+    from fkopt.experiment.kinds import load_any
+    from fkopt.kinbench.kind import work_folder
+    from fkopt.kinbench.runner import solve_task, suite_plan
+    path = mini_suite(tmp_path / "s")
+    cfg = load_any(path)
+    plan = suite_plan(cfg, str(path))
+    rec = json.loads(json.dumps(solve_task(plan.tasks[0].payload)))
+    edit(rec)
+    work = work_folder(tmp_path / "out", cfg)
+    (work / "tasks").mkdir(parents=True)
+    task = work / "tasks" / f"{plan.tasks[0].id}.json"
+    task.write_text(json.dumps(rec))
+    (work / "tasks" / "manifest.json").write_text(json.dumps(
+        {"fingerprint": plan.fingerprint, "tasks": {plan.tasks[0].id: hashlib.sha256(task.read_bytes()).hexdigest()}}))
+    return path, task
+
+
+def _row(col, value, i=0):
+    return lambda rec: rec["rows"][col].__setitem__(i, value)
+
+
+RECORD_EDITS = [
+    ("fitness-text", _row("fitness", "x"), ["rows.fitness", "not numbers"]),
+    ("fitness-nan", _row("fitness", float("nan")), ["rows.fitness"]),
+    ("fitness-negative", _row("fitness", -1.0), ["rows.fitness"]),
+    ("solver-relabelled", lambda r: r["rows"].update(solver=["pso"] * len(r["rows"]["solver"])),
+     ["rows.solver", "'pso'", "'lm'"]),
+    ("problem-renamed", _row("problem", "wu2015-3ppr"), ["rows.problem"]),
+    ("set-renamed", _row("set", "boundary"), ["rows.set"]),
+    ("pose-moved", _row("pose", 7), ["rows.pose"]),
+    ("pose-text", _row("pose", "0"), ["rows.pose"]),
+    ("run-renumbered", _row("run", 3), ["rows.run"]),
+    ("track-changed", _row("track", "exact"), ["rows.track"]),
+    ("evaluations-1e300", _row("evaluations", 1e300), ["rows.evaluations"]),
+    ("evaluations-past-budget", _row("evaluations", 10_000.0), ["rows.evaluations"]),
+    ("target-text", _row("evals_to_1e-02", "soon"), ["rows.evals_to_1e-02"]),
+    ("rows-short", lambda r: [v.pop() for v in r["rows"].values()], ["rows", "run rows"]),
+    ("rows-column-missing", lambda r: r["rows"].pop("fitness"), ["rows", "columns"]),
+    ("rows-column-extra", lambda r: r["rows"].update(extra=[0] * 2), ["rows", "columns"]),
+    ("dim-text", lambda r: r.update(dim="3"), ["dim"]),
+    ("trace-row-outside", lambda r: r["trace"]["row"].__setitem__(0, 99), ["trace.row"]),
+    ("trace-ragged", lambda r: r["trace"]["row"].pop(), ["trace", "length"]),
+    ("trace-fitness-text", lambda r: r["trace"]["best_fitness"].__setitem__(0, "x"), ["trace.best_fitness"]),
+    ("solves-changed", lambda r: r.update(solves=99), ["solves"]),
+    ("wall-negative", lambda r: r.update(wall_s=-1), ["wall_s"]),
+]
+
+
+@pytest.mark.parametrize("case", RECORD_EDITS, ids=[c[0] for c in RECORD_EDITS])
+def test_resume_checks_suite_records_against_the_plan(case, tmp_path, cli):
+    ident, edit, fragments = case
+    path, task = _forge_task(tmp_path, edit)
+    line = refused(cli, ["suite", path, "--out", tmp_path / "out", "-q", "--resume"], tmp_path,
+                   task.name, "not a finished task of this run", *fragments)
+    assert "--resume" in line or "delete it" in line
+    assert not (tmp_path / "out" / "kinbench" / "mini").exists()        # nothing published
+
+
+def test_resume_reuses_an_untouched_suite_record(tmp_path, cli):
+    """The check above refuses only edits: the genuine record is reused and published."""
+    path, task = _forge_task(tmp_path, lambda rec: None)
+    code, _, err = cli("suite", path, "--out", tmp_path / "out", "-q", "--resume")
+    assert code == 0, err
+    runs = (tmp_path / "out" / "kinbench" / "mini" / "runs.csv").read_text()
+    assert runs.count("\n") == 3 and ",lm," in runs
+
+
+# -- stored results read back by check: regular files inside the folder only (finding 9) --------
+@pytest.mark.parametrize("how", ["link-outside", "link-dev-zero", "fifo", "link-inside"])
+def test_check_refuses_a_runs_csv_that_is_not_a_regular_file_of_the_folder(finished_study, cli, how):
+    cfg, out, final, outside = finished_study
+    runs = final / "runs.csv"
+    (outside / "runs.csv").write_bytes(runs.read_bytes())     # the same bytes: only the link is wrong
+    if how == "link-inside":
+        (final / "copy.csv").write_bytes(runs.read_bytes())
+    runs.unlink()
+    if how == "fifo":
+        os.mkfifo(runs)
+    else:
+        runs.symlink_to({"link-outside": outside / "runs.csv", "link-dev-zero": Path("/dev/zero"),
+                         "link-inside": final / "copy.csv"}[how])
+    code, _, err = cli("check", out, "-q")                     # returns at once: nothing read through it
+    assert code == 1 and "Traceback" not in err, err
+    assert "runs.csv" in err and ("symbolic link" in err or "FIFO" in err)
+    assert err.strip().splitlines()[-1].startswith("fkopt: check failed:")
+
+
+# -- huge finite numbers and deep chains in URDF and on the command line (findings 6 and 9) -------
+def urdf_chain(n=2, *, axis="0 0 1", xyz="0 0 0.1", rpy="0 0 0", lower="-1", upper="1", mimic=False,
+               multiplier="1") -> str:
+    s = ['<robot name="r">'] + [f'<link name="l{i}"/>' for i in range(n + 1)]
+    for i in range(n):
+        m = f'<mimic joint="j{i - 1}" multiplier="{multiplier}"/>' if mimic and i > 0 else ""
+        s.append(f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+                 f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/><limit lower="{lower}" upper="{upper}"/>'
+                 f'{m}</joint>')
+    return "\n".join(s + ["</robot>"])
+
+
+def _urdf(text):
+    return lambda root: (root / "arm.urdf").write_text(text)
+
+
+URDF_CASES = [   # (id, make root/arm.urdf, fragments)
+    ("axis-1e308", _urdf(urdf_chain(axis="0 0 1e308")), ["arm.urdf", "joint 'j0' axis", "|v| <= 1e+09"]),
+    ("origin-1e308", _urdf(urdf_chain(xyz="1e308 0 0")), ["origin xyz", "|v| <= 1e+09"]),
+    ("origin-negative-huge", _urdf(urdf_chain(xyz="0 -2e9 0")), ["origin xyz", "|v| <= 1e+09"]),
+    ("rpy-1e10", _urdf(urdf_chain(rpy="0 1e10 0")), ["origin rpy", "|v| <= 1e+09"]),
+    ("limit-1e300", _urdf(urdf_chain(lower="-1e300")), ["limit lower", "|v| <= 1e+09"]),
+    ("limit-reversed", _urdf(urdf_chain(lower="1", upper="-1")), ["joint 'j0' <limit>", "lower 1 > upper -1",
+                                                                  "needs lower <= upper"]),
+    ("mimic-multiplier-huge", _urdf(urdf_chain(3, mimic=True, multiplier="1e300")), ["multiplier", "|v| <= 1e+09"]),
+    ("mimic-product-overflow", _urdf(urdf_chain(40, mimic=True, multiplier="1e8")), ["chain of mimics", "1e+09"]),
+    ("mimic-3000-deep", _urdf(urdf_chain(3000, mimic=True)), ["arm.urdf", "3000 joints", "at most 1000"]),
+    ("chain-2000", _urdf(urdf_chain(2000)), ["arm.urdf", "2000 joints", "at most 1000", "geometry.tip"]),
+    ("fifo", lambda root: os.mkfifo(root / "arm.urdf"), ["arm.urdf", "FIFO", "only regular files"]),
+    ("dev-zero", lambda root: (root / "arm.urdf").symlink_to("/dev/zero"), ["arm.urdf", "character device"]),
+    ("folder", lambda root: (root / "arm.urdf").mkdir(), ["arm.urdf", "a folder"]),
+    ("too-large", lambda root: open(root / "arm.urdf", "wb").truncate(5 << 20), ["arm.urdf", "larger than the 4 MB"]),
+]
+
+
+@pytest.mark.parametrize("command", ["fk", "ik"])
+@pytest.mark.parametrize("case", URDF_CASES, ids=[c[0] for c in URDF_CASES])
+def test_urdf_inputs_are_one_line(case, command, tmp_path, cli):
+    ident, make, fragments = case
+    make(tmp_path)
+    geometry = tmp_path / "g.yaml"
+    geometry.write_text(f"file: {tmp_path / 'arm.urdf'}\n")
+    argv = (["fk", "urdf", "--geometry", geometry, "--joints", "j0=0.1"] if command == "fk" else
+            ["ik", "urdf", "--geometry", geometry, "--pose", "x=0,y=0,z=0.2,alpha=0,beta=0,gamma=0"])
+    line = refused(cli, argv, tmp_path, *fragments)
+    assert "e+308" not in line.split("bound")[-1]          # never a result printed from such a number
+
+
+def test_a_500_deep_mimic_chain_and_numbers_within_the_bound_still_work(tmp_path, cli):
+    """No recursion in following mimics, and |v| <= 1e9 is accepted: the refusals above are bounds."""
+    (tmp_path / "arm.urdf").write_text(urdf_chain(500, mimic=True, xyz="0 0 1e-3", lower="-1e9", upper="1e9"))
+    geometry = tmp_path / "g.yaml"
+    geometry.write_text(f"file: {tmp_path / 'arm.urdf'}\n")
+    code, out, err = cli("fk", "urdf", "--geometry", geometry, "--joints", "j0=0", "--json")
+    assert code == 0, err
+    assert json.loads(out)["pose"]["z"] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("argv, fragments", [
+    (["fk", "3-rps", "--joints", "d1=1e300,d2=1e300,d3=1e300", "--all-solutions"], ["--joints", "'d1'", "1e+09"]),
+    (["fk", "3-rps", "--joints", "d1=600,d2=600,d3=-1e300"], ["--joints", "'d3'", "1e+09"]),
+    (["ik", "3-rps", "--pose", "alpha=0,beta=1e200,z=600"], ["--pose", "'beta'", "1e+09"]),
+    (["fk", "6-sps", "--joints", ",".join(f"l{i}=1e300" for i in range(1, 7))], ["--joints", "1e+09"]),
+], ids=["3rps-all-solutions", "3rps-negative", "ik-pose", "6sps"])
+def test_huge_command_line_values_are_one_line(argv, fragments, tmp_path, cli):
+    refused(cli, argv, tmp_path, *fragments)
+
+
+def test_within_the_bound_no_solution_stays_exit_1(cli):
+    code, _, err = cli("fk", "3-rps", "--joints", "d1=1e8,d2=1e8,d3=1e8")
+    assert code == 1 and "no pose" in err and "Traceback" not in err
+
+
+# -- names on disk are collision-free (finding 7) ---------------------------------------------------
+def _crafted(name, sep="-"):
+    """The stem a hash suffix would give ``name``: an attacker's label spelled as it."""
+    import re as _re
+    return _re.sub(r"[^A-Za-z0-9_.-]+", sep, name).strip(sep) + sep + hashlib.sha256(name.encode()).hexdigest()[:8]
+
+
+@pytest.mark.parametrize("names", [
+    ["pso+lm", "pso-lm", "pso lm", "pso--lm", _crafted("pso+lm"), "PSO-LM", "pso/lm", "../pso-lm", ".pso-lm"],
+    ["a b", "a_b", "a__b", "a\nb", "a\x1b[31mb", "A_B", "all", "ALL", "", "x", "\u00e9", "\u00e8"],
+], ids=["labels", "classes"])
+def test_two_distinct_names_never_share_a_file(names, tmp_path):
+    from fkopt.files import file_names
+    for allowed, sep in (("A-Za-z0-9_.-", "-"), ("A-Za-z0-9_.+-", "_")):
+        stems = file_names(names, reserved=("all",), allowed=allowed, sep=sep)
+        assert set(stems) == set(names)
+        assert len({s.lower() for s in stems.values()}) == len(names)          # also case-insensitively
+        assert "all" not in {s.lower() for s in stems.values()}
+        for s in stems.values():           # each a file in the folder, none hidden or outside it
+            assert s and not s.startswith(".") and "/" not in s and (tmp_path / s).resolve().parent == tmp_path
+            (tmp_path / f"{s}.txt").write_text(s)
+        assert len(list(tmp_path.glob("*.txt"))) == len(names)
+        for p in tmp_path.glob("*.txt"):
+            p.unlink()
+    assert file_names(["pso-lm", "abc"]) == {"pso-lm": "pso-lm", "abc": "abc"}    # safe names keep themselves
+
+
+def test_export_keeps_pso_plus_lm_and_an_outside_pso_minus_lm_apart(tmp_path, cli):
+    root = tmp_path / "s"
+    root.mkdir()
+    (root / "x.csv").write_text(GOOD_CSV)
+    path = mini_suite(root, solvers=[{"name": "pso+lm"}], outside=[{"solver": "pso-lm", "track": "black-box",
+                                                                     "file": "x.csv"}])
+    assert cli("suite", path, "--out", tmp_path / "out", "-q")[0] == 0
+    code, _, err = cli("export", tmp_path / "out", "--format", "ioh", "--out", tmp_path / "ioh")
+    assert code == 0, err
+    indexes = sorted((tmp_path / "ioh").glob("*/IOHprofiler_f*.json"))
+    names = {json.loads(p.read_text())["algorithm"]["name"]: p.parent.name for p in indexes}
+    assert set(names) == {"pso+lm", "pso-lm"} and len(set(names.values())) == 2 and len(indexes) == 2
+    assert names["pso-lm"] == "pso-lm"
+
+
+def test_export_writes_one_folder_per_label(tmp_path):
+    """The fast form of the test above: the export's writer, two functions, colliding labels."""
+    import numpy as np
+    from fkopt.export import Function, _write_function, algorithm_folders
+    runs = [(1, np.array([1, 6]), np.array([5.0, 1e-12]), [0.0])]
+    fns = [Function(name=f"p{i}__uniform", dim=1, instances=["0"], attributes=[],
+                    algorithms={"pso+lm": ({}, runs), "pso-lm": ({}, runs), "pso lm": ({}, runs)}) for i in (1, 2)]
+    folders = algorithm_folders(label for fn in fns for label in fn.algorithms)
+    for fid, fn in enumerate(fns, start=1):
+        _write_function(tmp_path, fid, fn, folders)
+    indexes = sorted(tmp_path.glob("*/IOHprofiler_f*.json"))
+    by_folder = {}
+    for p in indexes:
+        by_folder.setdefault(p.parent.name, set()).add(json.loads(p.read_text())["algorithm"]["name"])
+    assert len(indexes) == 6 and len(by_folder) == 3 and all(len(v) == 1 for v in by_folder.values())
+
+
+def test_every_problem_class_gets_its_own_figure(tmp_path):
+    from types import SimpleNamespace
+    import pandas as pd
+    from fkopt.kinbench.reports import ecdf_figures
+    scopes = ["all", "class:all", "class:a b", "class:a_b"]
+    df = pd.DataFrame([{"scope": s, "solver": "lm", "track": "jacobian", "evals_per_dim": 2.0, "reached": 1,
+                        "pairs": 1, "fraction": 1.0} for s in scopes])
+    sr = SimpleNamespace(config=SimpleNamespace(targets=[1e-2], budget_per_dim=50, name="mini"))
+    names = ecdf_figures(sr, tmp_path, {"ecdf.csv": df})
+    pngs = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert len(pngs) == len(scopes) and "ecdf_all.png" in pngs and "ecdf_a_b.png" in pngs
+    assert len([n for n in names if n.endswith(".png")]) == len(scopes)
+
+
+# -- strict JSON and escaped Markdown (finding 8) ---------------------------------------------------
+def _strict_loads(text):
+    def refuse(name):
+        raise ValueError(f"{name} is not strict JSON")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_strict_json_writes_null_and_names_every_non_finite_number():
+    import numpy as np
+    from fkopt.files import strict_json
+    data = {"pose": {"x": float("inf"), "y": np.float64("nan"), "z": 1.5}, "error": -np.inf,
+            "solutions": [{"x": [1.0, float("nan")]}], "n": np.int64(3), "ok": np.bool_(True)}
+    out = _strict_loads(strict_json(data))
+    assert out["pose"] == {"x": None, "y": None, "z": 1.5} and out["error"] is None and out["n"] == 3
+    assert out["non_finite"] == {"pose.x": "inf", "pose.y": "nan", "error": "-inf", "solutions[0].x[1]": "nan"}
+    assert "non_finite" not in _strict_loads(strict_json({"a": 1.0}))       # only when there is one
+
+
+@pytest.mark.parametrize("argv", [["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--json"],
+                                  ["fk", "3-rps", "--joints", "d1=598.85,d2=671.92,d3=629.16", "--json"]],
+                         ids=["ik", "fk"])
+def test_json_outputs_are_strict_even_when_a_number_is_not_finite(argv, cli, monkeypatch):
+    import numpy as np
+    from fkopt.mechanisms.rps3 import ThreeRPS
+    real = ThreeRPS.ik
+    if argv[0] == "ik":      # an answer holding inf and NaN (as a broken plug-in could return)
+        monkeypatch.setattr(ThreeRPS, "ik", lambda self, pose: np.array([np.inf, np.nan, 600.0]))
+    code, out, err = cli(*argv)
+    data = _strict_loads(out.strip().splitlines()[0])          # a strict parser accepts it
+    if argv[0] == "ik":
+        assert data["joints"]["d1"] is None and data["non_finite"] == {"joints.d1": "inf", "joints.d2": "nan"}
+    else:
+        assert code == 0 and data["solved"] is True and "non_finite" not in data
+    monkeypatch.setattr(ThreeRPS, "ik", real)
+
+
+HOSTILE_TEXT = ["<script>alert(1)</script>", "<img src=x onerror=alert(1)>", "\x1b[31mred\x1b[0m\x07",
+                "a\n# injected heading", "a | b | c", "[link](javascript:alert(1))", "![i](http://x/y.png)", "`code`"]
+
+
+def test_leaderboard_md_escapes_what_it_copies(tmp_path):
+    from types import SimpleNamespace
+    import pandas as pd
+    from markdown_it import MarkdownIt
+    from fkopt.kinbench.reports import leaderboard_markdown
+    config = SimpleNamespace(title=" ".join(HOSTILE_TEXT), name="mini", pose_sets="my-sets", problems=[1],
+                             sets=["uniform"], runs=1, budget_per_dim=50, targets=[1e-2], bootstrap=100, alpha=0.05)
+    lb = pd.DataFrame([{"scope": scope, "rank": i + 1, "solver": text, "track": "black-box", "score": 0.5,
+                        "ci_low": 0.4, "ci_high": 0.6, "instances": 2, "better_than": text, "success_1e-02": 1.0}
+                       for scope in ("overall", f"class:{HOSTILE_TEXT[0]}") for i, text in enumerate(HOSTILE_TEXT)])
+    ms = pd.DataFrame([{"problem": HOSTILE_TEXT[1], "set": "uniform", "solver": t, "track": "black-box",
+                        "target": 1e-2, "trials": 1, "success_rate": 1.0, "ert": 6.0} for t in HOSTILE_TEXT])
+    leaderboard_markdown(SimpleNamespace(config=config, timing=None), tmp_path, {"leaderboard.csv": lb,
+                                                                                 "measures.csv": ms})
+    text = (tmp_path / "leaderboard.md").read_text()
+    assert "\x1b" not in text and "\x07" not in text and "<script" not in text and "<img" not in text
+    rendered = MarkdownIt("commonmark").enable("table").render(text)
+    assert "<script" not in rendered and "<img" not in rendered and "<a " not in rendered and "<code>" not in rendered
+    assert rendered.count("<h1>") == 1                       # the newline did not start a heading
+    rows = [ln for ln in text.splitlines() if ln.startswith("| ")]
+    assert all(ln.count(" | ") == rows[0].count(" | ") for ln in rows if ln.count(" | ") >= 7)  # no cell split
+    assert rendered.count("<tr>") == 2 * (len(HOSTILE_TEXT) + 1) + len(HOSTILE_TEXT) + 1
+
+
+# -- a full disk names the file; the previous result stays (finding 9) ------------------------------
+@pytest.mark.parametrize("victim", ["runs.csv", "meta.json"])
+def test_disk_full_names_the_file_and_keeps_the_previous_result(victim, tmp_path, cli, monkeypatch):
+    import errno
+    import pandas as pd
+    import fkopt.files
+    cfg = tmp_path / "e.yaml"
+    cfg.write_text(with_(BASE, name="full", runs=1, iterations=2))
+    out = tmp_path / "out"
+    assert cli("run", cfg, "--out", out, "-q")[0] == 0
+    before = snapshot(out)
+
+    def full(*args, **kwargs):         # what the kernel says at write(): ENOSPC, no file name
+        raise OSError(errno.ENOSPC, "No space left on device")
+    if victim == "runs.csv":
+        real = pd.DataFrame.to_csv
+        monkeypatch.setattr(pd.DataFrame, "to_csv", lambda self, path=None, *a, **k: full() if Path(str(path)).name
+                            == victim else real(self, path, *a, **k))
+    else:
+        monkeypatch.setattr(fkopt.files, "write_json", lambda path, data: full())
+    line = one_line_error(cli("run", cfg, "--out", out, "-q"), "No space left on device", "previous result is kept")
+    assert f"{out / 'test' / 'full' / victim}: cannot write" in line       # the file as the user knows it
+    assert snapshot(out) == before
+    assert not any(".new-" in p.name for p in out.rglob(".*"))
+
+
+# -- configs and geometry YAML are read bounded too (finding 1) --------------------------------------
+def _config_path(how, root):
+    f = root / "c.yaml"
+    if how == "fifo":
+        os.mkfifo(f)
+    elif how == "dev-zero":
+        f.symlink_to("/dev/zero")
+    elif how == "folder":
+        f.mkdir()
+    elif how == "sparse":
+        with open(f, "wb") as fh:
+            fh.truncate(2 << 20)
+    return f
+
+
+CONFIG_READS = [("fifo", "FIFO"), ("dev-zero", "character device"), ("folder", "a folder"), ("sparse", "larger than")]
+
+
+@pytest.mark.parametrize("how, fragment", CONFIG_READS, ids=[c[0] for c in CONFIG_READS])
+@pytest.mark.parametrize("command", ["run", "suite", "geometry"])
+def test_config_and_geometry_files_that_are_not_regular_files_are_one_line(command, how, fragment, tmp_path, cli):
+    f = _config_path(how, tmp_path)
+    argv = {"run": ["run", f, "--out", tmp_path / "out"], "suite": ["suite", f, "--out", tmp_path / "out"],
+            "geometry": ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", f]}[command]
+    refused(cli, argv, tmp_path, "c.yaml", fragment)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("budget", [1, 50], ids=["no-answer-within-budget", "answers"])
+def test_genuine_suite_records_of_every_track_pass_the_resume_check(budget, tmp_path):
+    """The check refuses only what the plan would not produce: every track's own records pass,
+    also a run with no answer within its budget (fitness inf, evaluations = budget)."""
+    from fkopt.experiment.kinds import load_any
+    from fkopt.kinbench.runner import record_problem, solve_task, suite_plan
+    path = mini_suite(tmp_path / "s", solvers=[{"name": "lm"}, {"name": "forward"}, {"name": "pso"},
+                                               {"name": "gabc+lm"}], budget_per_dim=budget)
+    plan = suite_plan(load_any(path), str(path))
+    for task in plan.tasks:
+        rec = json.loads(json.dumps(solve_task(task.payload)))        # as a task file holds it
+        assert record_problem(task, rec) is None, task.label
+        if budget == 1:
+            assert rec["rows"]["fitness"][0] == float("inf")

@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import FkoptError
-from ..files import load_mapping, output_folder, run_lock, write_atomically
+from ..files import load_mapping, output_folder, parse_json, read_stored, run_lock, write_atomically
 from ..outputs import write_outputs
 from ..kinbench.kind import SUITE
 from ..study.kind import STUDY
@@ -128,8 +128,10 @@ def stored_config(folder: Path) -> dict | None:
     (a finished study whose tables were deleted is still fkopt's); None when there is none."""
     from .tasks import TASKS, read_manifest
     try:
-        data = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        data = parse_json(read_stored(folder, "meta.json"), "meta.json") if (folder / "meta.json").exists() else None
+    except FkoptError:
+        data = None
+    if data is None:
         data = read_manifest(folder / TASKS)
     return data["config"] if isinstance(data, dict) and isinstance(data.get("config"), dict) else None
 

@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import FkoptError
-from ..files import inside, write_json_atomically
+from ..files import inside, parse_json, read_stored, write_json_atomically
 from ..progress import listening
 
 TASKS = "tasks"
@@ -116,15 +116,20 @@ def run_remote(item: tuple[Callable[[Any], Any], str, Any]) -> tuple[str, Any]:
 
 
 def sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a task file, read bounded (:func:`fkopt.files.read_stored`: a FIFO or a
+    device where a task file should be is one line, not a hang)."""
+    path = Path(path)
+    return hashlib.sha256(read_stored(path.parent, path.name, unpack=False)).hexdigest()
 
 
 def read_manifest(tasks: Path) -> dict | None:
     """The manifest of a task folder (or an older release's), None when there is none."""
     for name in (MANIFEST, *OLD_MANIFESTS):
+        if not (tasks / name).exists():
+            continue
         try:
-            data = json.loads((tasks / name).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            data = parse_json(read_stored(tasks, name, unpack=False), str(tasks / name))
+        except FkoptError:
             continue
         return data if isinstance(data, dict) else None
     return None
@@ -180,12 +185,13 @@ class TaskStore:
             if path.name in (MANIFEST, *OLD_MANIFESTS):
                 continue
             inside(self.out, path, "--resume")
-            if self.digests.get(path.stem) != sha256(path):
+            data = read_stored(self.tasks, path.name, unpack=False)    # once: the bytes hashed are the bytes read
+            if self.digests.get(path.stem) != hashlib.sha256(data).hexdigest():
                 raise FkoptError(f"{path}: changed since fkopt wrote it (its SHA-256 is not the one recorded in "
                                  f"{MANIFEST}); {REDO}")
             try:
-                rec = json.loads(path.read_text(encoding="utf-8"))
-            except (OSError, ValueError) as err:
+                rec = json.loads(data.decode("utf-8"))
+            except (ValueError, RecursionError) as err:
                 raise FkoptError(f"{path}: unreadable task file ({type(err).__name__}); {REDO}") from None
             if isinstance(rec, dict) and rec.get("fingerprint") not in (None, self.fingerprint):
                 raise FkoptError(f"{path}: belongs to another version of {self.name} (its config or pose sets changed); "

@@ -27,12 +27,13 @@ the same bytes.
 """
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..files import MAX_UNPACKED, check_unpacked
+from ..files import MAX_UNPACKED, read_input
 
 FILE = "trace.csv.gz"
 COLUMNS = ("case", "algorithm", "run", "iteration", "evaluations", "best_fitness")
@@ -106,17 +107,13 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
     (measured before parsing, so memory stays bounded), the ``columns`` (an experiment's
     :data:`COLUMNS` by default; a suite's trace has others), integer counts (evaluations >= 1)
     and numeric fitness values. Anything else is an FkoptError naming the file and what is wrong."""
-    import gzip
-    import zlib
     from ..errors import FkoptError
     path = Path(folder) / FILE
     labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
-    check_unpacked(path, limit)      # size measured by streaming, before parsing
+    # bounded: a regular file inside the folder, unpacked size measured by streaming before parsing
+    data = read_input(path, MAX_UNPACKED, within=folder, unpacked=MAX_UNPACKED if limit is None else limit)
     try:
-        table = pd.read_csv(path, compression="gzip", dtype=dict.fromkeys(labels, "category"))
-    except (EOFError, gzip.BadGzipFile, zlib.error) as err:
-        what = "truncated gzip (ends early)" if isinstance(err, EOFError) else f"not a valid gzip file ({err})"
-        raise FkoptError(f"{path}: {what}") from None
+        table = pd.read_csv(io.BytesIO(data), dtype=dict.fromkeys(labels, "category"))
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as err:
         text = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise FkoptError(f"{path}: not a CSV table ({text})") from None

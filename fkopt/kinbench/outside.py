@@ -35,12 +35,14 @@ have at least one run, so all solvers are ranked on the same instances. The SHA-
 from __future__ import annotations
 
 import hashlib
+import io
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..errors import FkoptError
+from ..files import MAX_INPUT_BYTES, read_input
 from ..record import run_record
 from .budget import at_budget, budget_of
 
@@ -53,22 +55,32 @@ def outside_path(config, entry) -> Path:
     return Path(base) / (entry.file or entry.ioh)
 
 
+#: Largest integer in the pose, run and evaluations columns: every integer up to 2^53 is exact
+#: in a double and fits int64 (1e300 evaluations would wrap to a count of 1 when cast).
+MAX_COUNT = 2 ** 53
+
+
 def digest(config, entry) -> str:
+    """SHA-256 of the file (of every file of the IOH folder, by relative path), read bounded."""
     path = outside_path(config, entry)
     files = [path] if entry.file else sorted(p for p in path.rglob("*") if p.is_file())
     h = hashlib.sha256()
     for f in files:
-        h.update(str(f.relative_to(path) if entry.ioh else f.name).encode() + b"\0" + f.read_bytes())
+        data = read_input(f, MAX_INPUT_BYTES, within=None if entry.file else path, unpack=False)
+        h.update(str(f.relative_to(path) if entry.ioh else f.name).encode() + b"\0" + data)
     return h.hexdigest()
 
 
 def _csv_log(path: Path, where: str) -> pd.DataFrame:
+    """The rows of an outside CSV (``.csv`` or ``.csv.gz``), read with
+    :func:`fkopt.files.read_input`'s bounds (a regular file, size and unpacked size capped)."""
+    if not path.exists() and not path.is_symlink():
+        raise FkoptError(f"{where}: not found")
+    data = read_input(path, MAX_INPUT_BYTES, field=where.partition(": ")[0])
     try:
-        df = pd.read_csv(path, dtype={"problem": str, "set": str})
-    except FileNotFoundError:
-        raise FkoptError(f"{where}: not found") from None
-    except (OSError, ValueError, pd.errors.ParserError) as err:
-        raise FkoptError(f"{where}: unreadable CSV ({err})") from None
+        df = pd.read_csv(io.BytesIO(data), dtype={"problem": str, "set": str})
+    except (OSError, ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
+        raise FkoptError(f"{where}: unreadable CSV ({type(err).__name__})") from None
     missing = [c for c in COLUMNS if c not in df.columns]
     if missing:
         raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {', '.join(COLUMNS)}")
@@ -79,10 +91,7 @@ def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
     from ..iohformat import read_ioh
     if not path.is_dir():
         raise FkoptError(f"{where}: not a folder")
-    try:
-        data = read_ioh(path)
-    except (OSError, ValueError, KeyError, TypeError) as err:
-        raise FkoptError(f"{where}: unreadable IOH data ({type(err).__name__}: {err})") from None
+    data = read_ioh(path)
     algos = sorted({a for a, _, _ in data})
     if not algos:
         raise FkoptError(f"{where}: no IOHprofiler_f*.json index files found")
@@ -99,7 +108,6 @@ def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
         if not sep:
             raise FkoptError(f"{where}: function name '{fname}' is not <problem>{IOH_SEPARATOR}<set>")
         for run, (block, _) in enumerate(runs):
-            block = block.reshape(-1, 2)
             rows += [(problem, name, int(instance) - 1, run, e, y) for e, y in block]
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
@@ -116,10 +124,11 @@ def logged_runs(config, k: int, instances: set[tuple[str, str, int]]):
         vals = pd.to_numeric(df[col], errors="coerce")
         integer = col != "best_so_far"
         bad = vals.isna() | (vals < 0) | (~np.isfinite(vals.fillna(0)))
-        if integer:
-            bad |= vals.fillna(0) % 1 != 0
+        if integer:       # range-checked before any cast to int
+            bad |= (vals.fillna(0) % 1 != 0) | (vals.fillna(0) > MAX_COUNT)
         if bad.any():
-            raise FkoptError(f"{where}: column '{col}' needs non-negative {'integers' if integer else 'finite numbers'} "
+            need = "integers in [0, 2^53]" if integer else "finite numbers"
+            raise FkoptError(f"{where}: column '{col}' needs non-negative {need} "
                              f"(row {int(np.flatnonzero(bad)[0]) + 2})")
         df[col] = vals
     got = set(zip(df["problem"], df["set"], df["pose"].astype(int)))

@@ -43,7 +43,6 @@ CANDIDATES = 4000
 SINGULAR_QUANTILE = 0.95
 BOUNDARY_SHARE = 0.02
 MANIFEST = "manifest.json"
-
 #: The papers' printed poses, in the unknowns' space, by problem name (see the configs/ folders).
 PRINTED: dict[str, list[dict[str, float]]] = {
     "mao2017-3rps": [{"alpha": 9, "beta": 13, "z": 622}, {"alpha": -13, "beta": -19, "z": 574},
@@ -194,45 +193,114 @@ def pose_set_folder(config) -> Path:
     return Path(base) / config.pose_sets
 
 
+#: Largest manifest and pose-set CSV read (bytes); fkopt's own are kilobytes.
+MAX_MANIFEST_BYTES = 1 << 20
+MAX_SET_BYTES = 16 << 20
+
+
+def _manifest_problem(manifest, mpath: Path, problem) -> dict:
+    """The manifest's entry of ``problem``, its shape checked (one line naming the field)."""
+    problems = manifest.get("problems") if isinstance(manifest, dict) else None
+    if not isinstance(problems, dict):
+        raise FkoptError(f"{mpath}: field 'problems' must be a mapping of problem name to its sets")
+    entry = problems.get(problem.name)
+    if entry is None:
+        raise FkoptError(f"{mpath}: no pose sets for problem '{problem.name}' "
+                         f"(has: {', '.join(map(str, problems))[:200]})")
+    where = f"{mpath}: problems.{problem.name}"
+    if not isinstance(entry, dict):
+        raise FkoptError(f"{where}: must be a mapping with mechanism, unknowns and sets")
+    for key, kind, what in (("mechanism", dict, "a mapping (the mechanism spec)"),
+                            ("unknowns", list, "a list of the unknowns' names"),
+                            ("sets", dict, "a mapping of set name to its file, sha256 and poses")):
+        if not isinstance(entry.get(key), kind):
+            raise FkoptError(f"{where}.{key}: {'missing' if key not in entry else 'wrong type'}; must be {what}")
+    if not entry["unknowns"] or not all(isinstance(u, str) for u in entry["unknowns"]):
+        raise FkoptError(f"{where}.unknowns: must be a non-empty list of names")
+    return entry
+
+
+def _set_meta(entry: dict, where: str, name: str) -> dict:
+    meta = entry["sets"].get(name)
+    if meta is None:
+        raise FkoptError(f"{where}: has no set '{name}' (has: {', '.join(map(str, entry['sets']))[:200]})")
+    if not isinstance(meta, dict):
+        raise FkoptError(f"{where}.sets.{name}: must be a mapping with file, sha256 and poses")
+    if not isinstance(meta.get("file"), str) or not meta["file"]:
+        raise FkoptError(f"{where}.sets.{name}.file: must be the set's path inside the pose-set folder")
+    sha = meta.get("sha256")
+    if not isinstance(sha, str) or len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
+        raise FkoptError(f"{where}.sets.{name}.sha256: must be 64 lowercase hex digits (the file's SHA-256)")
+    poses = meta.get("poses")
+    if poses is not None and (not isinstance(poses, int) or isinstance(poses, bool) or poses < 0):
+        raise FkoptError(f"{where}.sets.{name}.poses: must be a non-negative integer")
+    return meta
+
+
+def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
+    """The points of a pose-set CSV: ASCII, a header of exactly ``unknowns``, every row that
+    many finite numbers; anything else one line naming the file, the line and what is allowed
+    (no cell of the file is quoted beyond a short sanitised token)."""
+    from ..files import short_token
+    try:
+        text = data.decode("ascii")
+    except UnicodeDecodeError as err:
+        raise FkoptError(f"{path}: not ASCII text (byte 0x{data[err.start]:02x} at offset {err.start}); a pose set "
+                         "is a CSV of numbers") from None
+    lines = text.splitlines()
+    if not lines:
+        raise FkoptError(f"{path}: empty; needs the header {','.join(unknowns)} and one row per pose")
+    if lines[0].split(",") != unknowns:
+        raise FkoptError(f"{path}: header '{short_token(lines[0])}' differs from the unknowns "
+                         f"{','.join(unknowns)}")
+    pts = np.empty((len(lines) - 1, len(unknowns)))
+    for i, line in enumerate(lines[1:]):
+        cells = line.split(",")
+        if len(cells) != len(unknowns):
+            raise FkoptError(f"{path}: line {i + 2} has {len(cells)} cells, needs {len(unknowns)} "
+                             f"({','.join(unknowns)})")
+        try:
+            pts[i] = [float(c) for c in cells]
+        except ValueError:
+            raise FkoptError(f"{path}: line {i + 2}: not a number (needs {len(unknowns)} finite numbers)") from None
+        if not np.all(np.isfinite(pts[i])):
+            raise FkoptError(f"{path}: line {i + 2}: not a finite number (NaN and inf are not poses)")
+    return pts
+
+
 def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
     """{(problem, set): points} of ``config`` (the first ``config.poses`` of each set), checked
-    against the manifest's SHA-256 and mechanism specs; and the manifest."""
+    against the manifest's SHA-256 and mechanism specs; and the manifest. Every file is read
+    with :func:`fkopt.files.read_input`'s bounds (a set's file must lie inside the set folder);
+    the manifest's shape and every set file's contents are checked (a digest proves a file is
+    the one the manifest names, not that either is well-formed): one line naming the file."""
+    from ..files import parse_json, read_input
     folder = pose_set_folder(config)
     mpath = folder / MANIFEST
-    try:
-        manifest = json.loads(mpath.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    if not mpath.exists() and not mpath.is_symlink():
         raise FkoptError(f"{mpath}: pose-set manifest not found (pose_sets: '{config.pose_sets}' names a "
-                         "folder beside the suite file)") from None
-    except (OSError, ValueError) as err:
-        raise FkoptError(f"{mpath}: unreadable pose-set manifest ({err})") from None
+                         "folder beside the suite file)")
+    raw = read_input(mpath, MAX_MANIFEST_BYTES, within=folder)
+    manifest = parse_json(raw, str(mpath))
+    if not isinstance(manifest, dict):
+        raise FkoptError(f"{mpath}: must be a JSON mapping (version, seed, problems)")
     out = {}
     for problem in config.problems:
-        entry = manifest.get("problems", {}).get(problem.name)
-        if entry is None:
-            raise FkoptError(f"{mpath}: no pose sets for problem '{problem.name}' "
-                             f"(has: {', '.join(manifest.get('problems', {}))})")
+        entry = _manifest_problem(manifest, mpath, problem)
+        where = f"{mpath}: problems.{problem.name}"
         if entry["mechanism"] != problem.mechanism.model_dump(mode="json"):
             raise FkoptError(f"problems[{problem.name}].mechanism: differs from the mechanism its pose sets "
-                             f"in {folder} were generated for ({entry['mechanism']}); a new mechanism needs "
-                             "new pose sets (a new version)")
+                             f"in {folder} were generated for; a new mechanism needs new pose sets (a new version)")
         for name in config.sets:
-            meta = entry["sets"].get(name)
-            if meta is None:
-                raise FkoptError(f"{mpath}: problem '{problem.name}' has no set '{name}'")
+            meta = _set_meta(entry, where, name)
             path = folder / meta["file"]
-            try:
-                data = path.read_bytes()
-            except OSError as err:
-                raise FkoptError(f"{path}: cannot read pose set ({err.strerror or err})") from None
+            data = read_input(path, MAX_SET_BYTES, field=f"{where}.sets.{name}.file", within=folder)
             if sha256_bytes(data) != meta["sha256"]:
                 raise FkoptError(f"{path}: SHA-256 {sha256_bytes(data)[:16]}... differs from the manifest's "
                                  f"{meta['sha256'][:16]}...; the frozen pose set was changed")
-            lines = data.decode("ascii").splitlines()
-            if lines[0].split(",") != entry["unknowns"]:
-                raise FkoptError(f"{path}: columns {lines[0]} differ from {entry['unknowns']}")
-            pts = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=float)
-            pts = pts.reshape(-1, len(entry["unknowns"]))
+            pts = parse_set_csv(data, path, entry["unknowns"])
+            if meta.get("poses") is not None and meta["poses"] != len(pts):
+                raise FkoptError(f"{where}.sets.{name}.poses: {meta['poses']}, but {path} has {len(pts)} poses")
             out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
     from .releases import check_release
     check_release(config, manifest)      # a released version: every file as released, not only as its manifest says

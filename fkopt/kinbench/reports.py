@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .. import record
+from ..files import file_names, md_text
 from . import measures as M
 from .outside import digest
 
@@ -55,10 +55,6 @@ def scaling_target(targets) -> float:
     return sorted(targets, reverse=True)[len(targets) // 2]
 
 
-def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.+-]+", "_", text).strip("_")
-
-
 def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
@@ -71,6 +67,9 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     names = []
     targets = ", ".join(f"{t:.0e}" for t in sr.config.targets)
+    # one file per scope: a class "all" does not overwrite ecdf_all, "a b" and "a_b" differ
+    scopes = [s for s in df["scope"].unique() if s != "all"]
+    stems = file_names((s.removeprefix("class:") for s in scopes), reserved=("all",))
     for scope, g in df.groupby("scope", sort=False):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
         top = float(sr.config.budget_per_dim)
@@ -88,7 +87,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         what = "all problems" if scope == "all" else scope.split(":", 1)[1]
         ax.set_title(f"{sr.config.name}: {what}; targets {targets}", fontsize=8)
         legend_off_data(ax, fontsize=7)
-        stem = "ecdf_all" if scope == "all" else f"ecdf_{_slug(scope.split(':', 1)[1])}"
+        stem = "ecdf_all" if scope == "all" else f"ecdf_{stems[scope.removeprefix('class:')]}"
         names += save(fig, folder / f"{stem}.png")
         pyplot.close(fig)
     return names
@@ -101,12 +100,14 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
     df = tables.get("scaling.csv")
     if df is None or df.empty:
         return []
-    from ..experiment.plotting import plt, save
+    from ..experiment.plotting import legend_off_data, plt, save
     pyplot = plt()
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     target = scaling_target(sr.config.targets)
     names = []
-    for cls, g in df[np.isclose(df["target"], target)].groupby("class", sort=True):
+    shown = df[np.isclose(df["target"], target)]
+    stems = file_names(shown["class"].unique())       # two distinct classes never share a file
+    for cls, g in shown.groupby("class", sort=True):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
         for (solver, track), s in g.groupby(["solver", "track"], sort=False):
             s = s[np.isfinite(s["ert_per_dim"])]
@@ -120,8 +121,8 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
         ax.set_xlabel("dimension (number of joints)")
         ax.set_ylabel(f"log10(ERT / dimension) at {target:.0e}")
         ax.set_title(f"{sr.config.name}: {cls}, cost against dimension", fontsize=8)
-        ax.legend(loc="best", fontsize=7)
-        names += save(fig, folder / f"scaling_{_slug(cls)}.png")
+        legend_off_data(ax, fontsize=7)
+        names += save(fig, folder / f"scaling_{stems[cls]}.png")
         pyplot.close(fig)
     return names
 
@@ -133,7 +134,7 @@ def _md_table(df: pd.DataFrame, cols: list[str]) -> str:
     def fmt(v):
         if isinstance(v, float):
             return "inf" if np.isinf(v) else f"{v:.4g}"
-        return str(v)
+        return md_text(v)        # solver labels, classes, problem names: text of a config file
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     lines += ["| " + " | ".join(fmt(v) for v in row) + " |" for row in df[cols].itertuples(index=False)]
     return "\n".join(lines)
@@ -168,13 +169,13 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
         return []
     c = sr.config
     cols = leaderboard_columns(lb)
-    out = [f"# {c.title or c.name}", "", preamble(c), ""]
+    out = [f"# {md_text(c.title or c.name)}", "", md_text(preamble(c)), ""]
     for title, pred in (("Overall", lambda s: s == "overall"), ("Per track", lambda s: s.startswith("track:")),
                         ("Per problem class", lambda s: s.startswith("class:"))):
         out += [f"## {title}", ""]
         for scope, g in leaderboard_sections(tables):
             if pred(scope):
-                out += [f"### {scope}", "", _md_table(g, cols), ""]
+                out += [f"### {md_text(scope)}", "", _md_table(g, cols), ""]
     sc = tables.get("scaling.csv")
     if sc is not None:
         target = scaling_target(c.targets)
@@ -182,12 +183,12 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
                 "over every problem, set and pose of a dimension, for the classes of several dimensions "
                 "(scaling.csv has every target).", ""]
         for cls, g in sc[np.isclose(sc["target"], target)].groupby("class", sort=True):
-            out += [f"### {cls}", "", _md_table(g.sort_values(["solver", "dim"], kind="stable"), SCALING), ""]
+            out += [f"### {md_text(cls)}", "", _md_table(g.sort_values(["solver", "dim"], kind="stable"), SCALING), ""]
     ms = tables.get("measures.csv")
     if ms is not None:
         out += ["## Per problem", "", "Success rate and ERT (evaluations) per set and target.", ""]
         for problem, g in ms.groupby("problem", sort=False):
-            out += [f"### {problem}", "", _md_table(g, PER_PROBLEM), ""]
+            out += [f"### {md_text(problem)}", "", _md_table(g, PER_PROBLEM), ""]
     tim = tables.get("timing.csv")
     if tim is not None and not tim.empty:
         out += ["## Wall time per solve", "", "Amortised: the batched solve's wall time over its "

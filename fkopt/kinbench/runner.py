@@ -33,9 +33,9 @@ from ..experiment.config import RunConfig
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..experiment.tasks import Plan, Ran, Task, run_tasks
 from ..solve import chunk_size
-from .budget import at_budget, budget_of
+from .budget import at_budget, budget_of, target_column
 from .config import SuiteConfig, suite_from_dict
-from .outside import read_outside
+from .outside import digest, read_outside
 from .posesets import load_pose_sets, problem_mechanism, targets_of
 from .traces import suite_trace, task_trace
 
@@ -112,6 +112,7 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances)
+            digest(config, config.outside[k])   # every file meta.json will hash, read bounded now
     return need
 
 
@@ -166,25 +167,91 @@ def fingerprint(config: SuiteConfig, manifest: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
+def _numbers(values, name: str, lo: float, hi: float, *, nan: bool = False, integer: bool = False,
+             inf: bool = False) -> str | None:
+    """Why ``values`` (a column read back from a task file) is not a list of numbers in [lo, hi]
+    (NaN only when ``nan``, +inf only when ``inf``, whole numbers only when ``integer``)."""
+    if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
+        return f"{name}: not numbers"
+    a = np.asarray(values, dtype=float)
+    bad = np.isnan(a) if not nan else np.zeros(a.shape, bool)
+    ok = np.isnan(a) | ((a >= lo) & (a <= hi)) | (inf & (a == np.inf))
+    bad |= ~ok
+    if integer:
+        bad |= np.isfinite(a) & (a % 1 != 0)
+    if bad.any():
+        allowed = f"{'whole ' if integer else ''}numbers in [{lo:g}, {hi:g}]" + (", NaN" if nan else "") + \
+            (", inf" if inf else "")
+        return f"{name}: row {int(np.flatnonzero(bad)[0])} is not one of {allowed}"
+    return None
+
+
 def record_problem(task, rec) -> str | None:
-    """Why ``rec`` is not the finished record of ``task`` (a task file read back by --resume)."""
+    """Why ``rec`` is not the finished record of ``task`` (a task file read back by --resume):
+    every field is checked against the plan -- the problem, class, solver, track, set and pose
+    names and run numbers of every row, the dimension and budget, each measure's type and range
+    (NaN only where a target was not reached, inf only as the fitness of a run without an answer)
+    and the row counts of the rows and the trace. A digest proves the file is the one written,
+    not that it holds this task's numbers (an edited file with a re-signed manifest)."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
+    payload = task.payload
     try:
-        if (int(rec["problem"]), int(rec["solver"])) != (task.payload["problem"], task.payload["solver"]):
+        if rec["problem"] != payload["problem"] or rec["solver"] != payload["solver"] \
+                or isinstance(rec["problem"], bool) or isinstance(rec["solver"], bool):
             return "its problem/solver are not its file name's"
+        config = suite_from_dict(payload["config"], "suite task")
+        problem, solver = config.problems[payload["problem"]], config.solvers[payload["solver"]]
+        cases = payload["cases"]
+        dim = len(cases[0][2]) if cases else rec["dim"]
+        if rec["dim"] != dim or isinstance(rec["dim"], bool):
+            return f"dim: {str(rec['dim'])[:20]!r}, expected {dim}"
+        budget, runs = budget_of(config, dim), config.runs
+        n = len(cases) * runs
         rows = rec["rows"]
-        n = len(task.payload["cases"]) * int(task.payload["config"]["runs"])
-        if not isinstance(rows, dict) or any(not isinstance(v, list) or len(v) != n for v in rows.values()):
+        measures = ["evaluations", "fitness", *(target_column(t) for t in config.targets)]
+        names = ["kind", "problem", "class", "set", "pose", "solver", "track", "run", "dim", "budget", "task_seed",
+                 *measures]
+        if not isinstance(rows, dict) or sorted(rows) != sorted(names):
+            return f"rows: not the columns {', '.join(names)}"
+        if any(not isinstance(v, list) or len(v) != n for v in rows.values()):
             return f"rows: not a table of {n} run rows"
+        expected = {"kind": ["suite"] * n, "problem": [problem.name] * n, "class": [problem.problem_class] * n,
+                    "set": [c[0] for c in cases for _ in range(runs)],
+                    "pose": [c[1] for c in cases for _ in range(runs)],
+                    "solver": [solver.key] * n, "track": [solver.track] * n,
+                    "run": list(range(runs)) * len(cases), "dim": [dim] * n, "budget": [budget] * n,
+                    "task_seed": [task_seed(config.seed, c[1], f"{problem.name}/{c[0]}/{solver.key}")
+                                  for c in cases for _ in range(runs)]}
+        for col, want in expected.items():
+            got = rows[col]
+            if any(type(g) is not type(w) or g != w for g, w in zip(got, want)):
+                i = next(i for i, (g, w) in enumerate(zip(got, want)) if type(g) is not type(w) or g != w)
+                return f"rows.{col}: row {i} is {str(got[i])[:30]!r}, this task's is {str(want[i])[:30]!r}"
+        why = (_numbers(rows["evaluations"], "rows.evaluations", 0, budget, integer=True)
+               or _numbers(rows["fitness"], "rows.fitness", 0, float(np.finfo(float).max), inf=True)
+               or next(filter(None, (_numbers(rows[c], f"rows.{c}", 0, budget, nan=True, integer=True)
+                                     for c in measures[2:])), None))
+        if why:
+            return why
         trace = rec["trace"]
         if not isinstance(trace, dict) or any(not isinstance(trace.get(k), list)
                                               for k in ("row", "evaluations", "best_fitness")):
             return "trace: not the run traces (row, evaluations, best_fitness)"
-        int(rec["dim"]), float(rec["wall_s"]), int(rec["solves"])
+        if len({len(trace[k]) for k in ("row", "evaluations", "best_fitness")}) != 1:
+            return "trace: row, evaluations and best_fitness differ in length"
+        why = (_numbers(trace["row"], "trace.row", 0, max(n - 1, 0), integer=True)
+               or _numbers(trace["evaluations"], "trace.evaluations", 1, max(budget, 1), integer=True)
+               or _numbers(trace["best_fitness"], "trace.best_fitness", 0, float(np.finfo(float).max), inf=True))
+        if why:
+            return why
+        if rec["solves"] != len(cases) * runs or isinstance(rec["solves"], bool):
+            return f"solves: expected {len(cases) * runs}"
+        if _numbers([rec["wall_s"]], "wall_s", 0, float(np.finfo(float).max)):
+            return "wall_s: not a non-negative finite number"
     except KeyError as err:
-        return f"field {err.args[0]!r} is missing"
-    except (TypeError, ValueError) as err:
+        return f"field {str(err.args[0])[:40]!r} is missing"
+    except (TypeError, ValueError, IndexError, AttributeError) as err:
         return f"{type(err).__name__}: {str(err)[:120]}"
     return None
 

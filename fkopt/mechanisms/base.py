@@ -33,12 +33,31 @@ from ..errors import FkoptError, did_you_mean
 
 
 def _geometry_base():
-    from pydantic import BaseModel, ConfigDict
+    from pydantic import BaseModel, ConfigDict, field_validator
+
+    from ..files import MAX_MAGNITUDE
 
     class Geometry(BaseModel):
-        """Base of every mechanism's geometry model (unknown keys are rejected)."""
+        """Base of every mechanism's geometry model (unknown keys are rejected; every number,
+        also inside lists, within |v| <= :data:`fkopt.files.MAX_MAGNITUDE`, 1e9 in the
+        geometry's units: past it FK and IK overflow to inf instead of failing)."""
 
         model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)   # "1e400" from YAML is inf
+
+        @field_validator("*", mode="after", check_fields=False)
+        @classmethod
+        def _within_magnitude(cls, value):
+            def walk(v):
+                if isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) > MAX_MAGNITUDE:
+                    raise ValueError(f"{v:g} is past the bound |value| <= {MAX_MAGNITUDE:g}")
+                if isinstance(v, (list, tuple)):
+                    for x in v:
+                        walk(x)
+                elif isinstance(v, dict):
+                    for x in v.values():
+                        walk(x)
+            walk(value)
+            return value
 
     Geometry.__module__ = __name__
     return Geometry
@@ -193,7 +212,19 @@ class Mechanism:
         if missing:
             raise FkoptError(f"{self.name} {what}: missing {', '.join(missing)} "
                              f"(needs {', '.join(names)})")
-        return np.array([float(values[n]) for n in names])
+        return self._bounded(np.array([float(values[n]) for n in names]), names, what)
+
+    def _bounded(self, values: np.ndarray, names: tuple[str, ...], what: str) -> np.ndarray:
+        """``values`` after checking |v| <= :data:`fkopt.files.MAX_MAGNITUDE` (1e9 in the
+        mechanism's units; past it a square overflows in FK, IK or a Jacobian): one line naming
+        the variable otherwise."""
+        from ..files import MAX_MAGNITUDE
+        big = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
+        if big.size:
+            i = int(big[0])
+            raise FkoptError(f"{self.name} {what}: '{names[i]}' = {values[i]:g} is past the bound |value| <= "
+                             f"{MAX_MAGNITUDE:g} (in the mechanism's units)")
+        return values
 
     def as_values(self, values, names: tuple[str, ...], what: str) -> np.ndarray:
         """Measured joints or a target pose, given by name (dict) or in order (sequence), as a
@@ -206,7 +237,7 @@ class Mechanism:
                              f"({', '.join(names)}), got shape {values.shape}")
         if not np.all(np.isfinite(values)):
             raise FkoptError(f"{self.name} {what}: values must be finite, got {values.tolist()}")
-        return values
+        return self._bounded(values, names, what)
 
     def angle_mask(self, units: tuple[str, ...]) -> np.ndarray:
         return np.array([u == "deg" for u in units])

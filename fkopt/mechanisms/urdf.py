@@ -40,7 +40,7 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from ..errors import FkoptError, did_you_mean
-from ..files import check_geometry_file
+from ..files import MAX_MAGNITUDE, check_geometry_file, read_input, short_token
 from ..numerics.chain import frame_jacobian1, from_terms
 from .base import FrameArm, Geometry, describe_validation_error
 
@@ -67,8 +67,19 @@ def _floats(text, count: int, default, what: str, path: Path) -> tuple:
     except ValueError:
         values = ()
     if len(values) != count or not all(map(math.isfinite, values)):
-        raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{text}')")
+        raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{short_token(text)}')")
+    if any(abs(v) > MAX_URDF_VALUE for v in values):
+        raise FkoptError(f"urdf {path}: {what}: {short_token(text)} is past the bound |v| <= {MAX_URDF_VALUE:g} "
+                         "(m, rad) accepted for a URDF number")
     return values
+
+
+#: Most joints (moving, fixed and mimic) on the chain base -> tip: real arms have tens; FK, the
+#: Jacobian and IK are linear in the chain's length and a 2000-joint IK took 30 s.
+MAX_CHAIN_JOINTS = 1000
+#: Largest magnitude of a number of a URDF file (lengths in m, angles in rad, factors): the one
+#: bound of :data:`fkopt.files.MAX_MAGNITUDE`.
+MAX_URDF_VALUE = MAX_MAGNITUDE
 
 
 #: Largest URDF file read (bytes): a robot description with meshes referenced, not inlined, is
@@ -83,7 +94,7 @@ def _load(path: Path) -> SimpleNamespace:
     import xml.etree.ElementTree as ET
     check_geometry_file(path, "urdf", MAX_URDF_BYTES, "a URDF file")
     try:
-        root = ET.parse(str(path)).getroot()
+        root = ET.fromstring(read_input(path, MAX_URDF_BYTES, field="urdf geometry.file"))
     except ET.ParseError as err:
         raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
     links = {e.get("name"): e for e in root.findall("link")}
@@ -111,6 +122,9 @@ def _load(path: Path) -> SimpleNamespace:
         if lim is not None and lim.get("lower") is not None and lim.get("upper") is not None:
             limit = SimpleNamespace(lower=_floats(lim.get("lower"), 1, None, f"joint '{name}' limit lower", path)[0],
                                     upper=_floats(lim.get("upper"), 1, None, f"joint '{name}' limit upper", path)[0])
+            if limit.lower > limit.upper:     # not swapped: a reversed pair is a mistake in the file
+                raise FkoptError(f"urdf {path}: joint '{name}' <limit>: lower {limit.lower:g} > upper "
+                                 f"{limit.upper:g}; needs lower <= upper")
         mi = e.find("mimic")
         mimic = None
         if mi is not None:
@@ -155,6 +169,9 @@ def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
         if len(chain) > len(robot.joint_map):
             raise FkoptError(f"urdf {path}: the joints form a loop")
     chain.reverse()
+    if len(chain) > MAX_CHAIN_JOINTS:
+        raise FkoptError(f"urdf {path}: the chain '{base}' -> '{tip}' has {len(chain)} joints; at most "
+                         f"{MAX_CHAIN_JOINTS} are accepted (geometry.base, geometry.tip pick a shorter chain)")
     for j in chain:
         if j.type not in (*MOVING, "fixed"):
             raise FkoptError(f"urdf {path}: joint '{j.name}' has type '{j.type}'; the chain may hold "
@@ -262,19 +279,29 @@ class URDFArm(FrameArm):
         index = {n: i for i, n in enumerate(names)}
         to_si = [math.pi / 180.0 if u == "deg" else 1.0 for u in units]
 
-        def source(j, seen=()):
-            """(unknown index, multiplier, offset) of joint j in SI units: q_j = m q_src + o."""
-            if j.mimic is None:
-                return index[j.name], 1.0, 0.0
-            master = on_chain.get(j.mimic.joint)
-            if master is None or j.name in seen:
-                why = "is not on the chain" if master is None else "mimics in a loop"
-                raise FkoptError(f"{self.name} {path}: joint '{j.name}' mimics '{j.mimic.joint}', which {why} "
-                                 f"between '{chain[0].parent}' and '{chain[-1].child}'")
-            var, mult, off = source(master, seen + (j.name,))
-            a = 1.0 if j.mimic.multiplier is None else float(j.mimic.multiplier)
-            b = 0.0 if j.mimic.offset is None else float(j.mimic.offset)
-            return var, a * mult, a * off + b
+        def source(j):
+            """(unknown index, multiplier, offset) of joint j in SI units: q_j = m q_src + o,
+            following the chain of mimics iteratively (a 3000-deep chain is no recursion)."""
+            steps, seen, start = [], set(), j
+            while j.mimic is not None:
+                master = on_chain.get(j.mimic.joint)
+                if master is None or j.name in seen:
+                    why = "is not on the chain" if master is None else "mimics in a loop"
+                    raise FkoptError(f"{self.name} {path}: joint '{j.name}' mimics '{j.mimic.joint}', which {why} "
+                                     f"between '{chain[0].parent}' and '{chain[-1].child}'")
+                seen.add(j.name)
+                steps.append(j.mimic)
+                j = master
+            var, mult, off = index[j.name], 1.0, 0.0
+            for m in reversed(steps):      # q = a (m_master q_src + o_master) + b, innermost first
+                a = 1.0 if m.multiplier is None else float(m.multiplier)
+                b = 0.0 if m.offset is None else float(m.offset)
+                mult, off = a * mult, a * off + b
+            if not (math.isfinite(mult) and math.isfinite(off)) or abs(mult) > MAX_URDF_VALUE \
+                    or abs(off) > MAX_URDF_VALUE:
+                raise FkoptError(f"{self.name} {path}: joint '{start.name}': its chain of mimics multiplies to "
+                                 f"{mult:g} q + {off:g}, past the bound |v| <= {MAX_URDF_VALUE:g}")
+            return var, mult, off
 
         for j in moving:
             lim = j.limit

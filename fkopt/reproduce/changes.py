@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..files import read_stored
 from ..outputs import deterministic_files, sha256
 from .claims import CLAIMS_FILE
 from .store import Store
@@ -52,11 +53,11 @@ def snapshot(root: str | Path, keep: Path | None = None) -> Snapshot:
             for f in names:
                 shutil.copyfile(exp.folder / f, keep / label / f)
         if (exp.folder / "summary.csv").is_file():
-            snap.summaries[label] = (exp.folder / "summary.csv").read_text(encoding="utf-8", errors="replace")
+            snap.summaries[label] = read_stored(exp.folder, "summary.csv").decode("utf-8", errors="replace")
     for paper in store.papers():
         file = root / paper / CLAIMS_FILE
         if file.is_file():
-            snap.claims[paper] = file.read_text(encoding="utf-8", errors="replace")
+            snap.claims[paper] = read_stored(file.parent, file.name).decode("utf-8", errors="replace")
     return snap
 
 

@@ -28,7 +28,7 @@ not compared (they depend on the plotting library's version).
 """
 from __future__ import annotations
 
-import json
+import io
 import shutil
 import tempfile
 from pathlib import Path
@@ -38,6 +38,7 @@ import pandas as pd
 
 from ..compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
 from ..errors import FkoptError
+from ..files import odd_entries, parse_json, read_stored
 from ..experiment.kinds import from_dict, rerun_files
 from ..numerics import path as numerics_path
 from ..provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
@@ -76,8 +77,8 @@ def integrity(exp: Experiment) -> list[Mismatch]:
 def stored_tier(exp: Experiment) -> str:
     """The platform tier of a stored result on this machine (from its env.json's fingerprint)."""
     try:
-        stored = json.loads((exp.folder / ENV_FILE).read_text(encoding="utf-8")).get("fingerprint")
-    except (OSError, ValueError, AttributeError):
+        stored = parse_json(read_stored(exp.folder, ENV_FILE), ENV_FILE).get("fingerprint")
+    except (OSError, ValueError, AttributeError, FkoptError):
         return ANY
     return platform_tier(stored)
 
@@ -86,8 +87,8 @@ def stored_numerics(exp: Experiment) -> str:
     """The ``FKOPT_NUMERICS`` mode a stored result ran under (its env.json's ``numerics.mode``;
     'auto' for results stored before the record existed: :func:`fkopt.numerics.path.recorded`)."""
     try:
-        env = json.loads((exp.folder / ENV_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        env = parse_json(read_stored(exp.folder, ENV_FILE), ENV_FILE)
+    except (OSError, ValueError, FkoptError):
         env = None
     return numerics_path.recorded(env)
 
@@ -133,8 +134,8 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     from ..experiment.runner import build_cases, build_mechanism, build_problem, make_problem
     label = _label(exp)
     try:
-        runs = pd.read_csv(exp.folder / "runs.csv")
-    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        runs = pd.read_csv(io.BytesIO(read_stored(exp.folder, "runs.csv")))
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(label, "runs.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
     mech = build_mechanism(config)
     if kind == "experiment":
@@ -200,6 +201,10 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
     if problem:
         return [Mismatch(label, "meta.json", "-", "file", problem, "a readable meta.json with the config",
                          "present and readable")]
+    odd = odd_entries(exp.folder)
+    if odd:       # nothing of the folder is read through a link or from a FIFO or device
+        return [Mismatch(label, name, "-", "file", what, "a regular file of the folder", "regular files only")
+                for name, what in odd]
     out = integrity(exp)
     from ..experiment.tasks import task_file_problems     # kept task files: digests of tasks/manifest.json
     out += [Mismatch(label, name, "-", "sha256", why, "recorded in tasks/manifest.json", "unchanged since written")
@@ -259,9 +264,9 @@ def timing_verdicts(exp: Experiment) -> list[Mismatch]:
     if not file.is_file():
         return []
     try:
-        stored = pd.read_csv(file, keep_default_na=False)
+        stored = pd.read_csv(io.BytesIO(read_stored(file.parent, file.name)), keep_default_na=False)
         judged = judge_paper(exp.paper, Store(exp.folder.parents[1]), timing_only=True)
-    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
+    except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, "-", "file", f"unreadable ({err})", "readable",
                          "readable CSV")]
     if judged is None:

@@ -1,14 +1,15 @@
 """Read access to a results tree ``RESULTS/<paper>/<experiment>/``."""
 from __future__ import annotations
 
-import json
+import io
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
 import pandas as pd
 
-from ..files import check_unpacked
+from ..errors import FkoptError
+from ..files import parse_json, read_stored
 
 
 @dataclass
@@ -25,7 +26,9 @@ class Experiment:
 
     @cached_property
     def meta(self) -> dict:
-        data = json.loads((self.folder / "meta.json").read_text(encoding="utf-8"))
+        if not (self.folder / "meta.json").exists():
+            raise FileNotFoundError(self.folder / "meta.json")
+        data = parse_json(read_stored(self.folder, "meta.json"), "meta.json")
         if not isinstance(data, dict) or not isinstance(data.get("config"), dict):
             raise ValueError("no 'config' mapping")
         return data
@@ -36,6 +39,8 @@ class Experiment:
             self.meta
         except FileNotFoundError:
             return "missing"
+        except FkoptError as err:
+            return f"unreadable ({str(err)[:120]})"
         except (OSError, UnicodeDecodeError, ValueError) as err:
             return f"unreadable ({type(err).__name__}: {str(err)[:80]})"
         return None
@@ -56,9 +61,8 @@ class Experiment:
         file = name if name.endswith((".csv", ".csv.gz")) else f"{name}.csv"
         if not (self.folder / file).exists() and (self.folder / f"{file}.gz").exists():
             file += ".gz"      # trace.csv.gz (fkopt.experiment.traces)
-        if file.endswith(".gz"):
-            check_unpacked(self.folder / file)      # a gzip bomb is one line, not the memory
-        return pd.read_csv(self.folder / file, keep_default_na=True)
+        # bounded: inside the folder, a regular file, a gzip bomb one line, not the memory
+        return pd.read_csv(io.BytesIO(read_stored(self.folder, file)), keep_default_na=True)
 
     def figures(self) -> list[str]:
         return sorted(p.name for p in self.folder.glob("*.png"))
@@ -88,7 +92,6 @@ class Store:
 
     def require_readable(self) -> None:
         """One-line error unless the root is a folder whose results all have a readable meta.json."""
-        from ..errors import FkoptError
         if not self.root.is_dir():
             raise FkoptError(f"{self.root}: no such results folder")
         exps = self.folders()

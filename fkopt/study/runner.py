@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import time
@@ -220,11 +221,19 @@ def record_problem(rec, ident: str, task: Task, config: StudyConfig, dim: int) -
         shapes["seeds"] = (rows,)
         if config.mode == "tracking":
             shapes["start"] = (rows, config.runs, dim)
+        #: NaN only where a run never reached the threshold; every other number finite
+        may_be_nan = {"iterations_to", "evaluations_to", "start"}
         for key, shape in shapes.items():
+            if any(isinstance(v, (str, bool)) for v in np.asarray(rec[key], dtype=object).ravel()):
+                return f"{key}: not numbers"
             value = np.asarray(rec[key], dtype=float)
             if value.shape != shape:
                 return f"{key}: shape {value.shape}, expected {shape}"
-        float(rec["wall_s"])
+            finite = np.isfinite(value) | (np.isnan(value) if key in may_be_nan else False)
+            if not finite.all() or (key != "x" and key != "start" and (value[np.isfinite(value)] < 0).any()):
+                return f"{key}: not non-negative finite numbers" + (" (or NaN)" if key in may_be_nan else "")
+        if not math.isfinite(float(rec["wall_s"])) or float(rec["wall_s"]) < 0:
+            return "wall_s: not a non-negative finite number"
     except KeyError as err:
         return f"field {err.args[0]!r} is missing"
     except (TypeError, ValueError):

@@ -35,7 +35,9 @@ def chain_ets(path: Path, base: str, tip: str):
         warnings.simplefilter("ignore")
         import roboticstoolbox as rtb
         from roboticstoolbox.models.URDF.URDFRobot import URDF_file
-    tree = ET.parse(str(path))
+    from ...files import read_input
+    from ...mechanisms.urdf import MAX_URDF_BYTES
+    tree = ET.ElementTree(ET.fromstring(read_input(path, MAX_URDF_BYTES, field="urdf geometry.file")))
     for parent in list(tree.getroot().iter()):
         for e in list(parent):
             if e.tag in ("visual", "collision", "transmission", "gazebo"):

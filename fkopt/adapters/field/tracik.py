@@ -28,8 +28,11 @@ class TracIK(FieldIK):
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
         import pytracik
+
+        from ...files import read_text
+        from ...mechanisms.urdf import MAX_URDF_BYTES
         self._pt = pytracik
-        self._solver = pytracik.TRAC_IK(arm.base_link, arm.tip_link, arm.path.read_text(), self.timeout,
+        self._solver = pytracik.TRAC_IK(arm.base_link, arm.tip_link, read_text(arm.path, MAX_URDF_BYTES, field="urdf geometry.file"), self.timeout,
                                         self.EPS, pytracik.Speed)
         if pytracik.get_num_joints(self._solver) != arm.dof:
             from ...errors import FkoptError
