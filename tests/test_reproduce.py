@@ -328,12 +328,16 @@ def test_changes_say_what_a_regeneration_moved(tmp_path):
     before = snapshot(tmp_path / "results")
     assert "Unchanged (every deterministic file byte-identical): mao2017/tab6." in describe(before, tmp_path / "results")
     _edit_csv(folder, "summary.csv", 0, "mean_evaluations", lambda v: v + 20)
-    claims = (folder.parent / "claims.csv").read_text().splitlines()
-    claims[1] = claims[1].rsplit(",", 1)[0] + ",not held" if claims[1].endswith(",held") else claims[1].rsplit(",", 1)[0] + ",held"
-    (folder.parent / "claims.csv").write_text("\n".join(claims) + "\n")
+    import pandas as pd
+    claims = pd.read_csv(folder.parent / "claims.csv", keep_default_na=False)
+    first = claims.loc[0, "verdict"]
+    claims.loc[0, "verdict"] = "not held" if first != "not held" else "held"
+    claims.loc[1, "condition"] = "a reworded condition"    # keyed by id: a rewording is no move
+    claims.to_csv(folder.parent / "claims.csv", index=False)
     text = describe(before, tmp_path / "results")
     assert "## mao2017/tab6" in text and "`summary.csv`" in text and "mean_evaluations" in text and "→" in text
-    assert "## Verdicts that changed" in text and "mao2017:" in text
+    assert "## Verdicts that changed" in text and f"mao2017: {claims.loc[0, 'id']} (" in text
+    assert f"{claims.loc[1, 'id']} (" not in text
 
 
 def test_an_edited_timing_verdict_is_caught_on_any_platform(tmp_path):

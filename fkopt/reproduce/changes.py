@@ -130,15 +130,22 @@ def _claim_moves(before: str | None, after: str | None) -> list[str]:
     a, b = _table(before), _table(after)
     if a is None or b is None or "claim" not in a.columns or "claim" not in b.columns:
         return []
-    def keyed(df: pd.DataFrame) -> dict[str, str]:   # one row per reading: the condition tells them apart
+    by_id = all("id" in df.columns and df["id"].notna().all() and (df["id"].astype(str) != "").all() for df in (a, b))
+
+    def keyed(df: pd.DataFrame) -> dict[str, str]:
+        if by_id:   # the stable id (one per reading): a reworded claim or condition is no move
+            return {str(i): str(v) for i, v in zip(df["id"], df["verdict"])}
+        # older files without ids: one row per reading, the condition tells them apart
         cond = df["condition"].fillna("").astype(str) if "condition" in df.columns else pd.Series([""] * len(df))
         return {str(c) + (f" [under: {k}]" if k else ""): str(v)
                 for c, k, v in zip(df["claim"], cond, df["verdict"])}
     old, new = keyed(a), keyed(b)
+    texts = {**dict(zip(a["id"].astype(str), a["claim"])), **dict(zip(b["id"].astype(str), b["claim"]))} if by_id else {}
     out = []
-    for text in sorted(set(old) | set(new)):
-        if old.get(text) != new.get(text):
-            out.append(f"{text[:110]}: {old.get(text, '(new claim)')} → {new.get(text, '(claim removed)')}")
+    for key in sorted(set(old) | set(new)):
+        if old.get(key) != new.get(key):
+            label = f"{key} ({str(texts[key])[:80]})" if by_id else key[:110]
+            out.append(f"{label}: {old.get(key, '(new claim)')} → {new.get(key, '(claim removed)')}")
     return out
 
 

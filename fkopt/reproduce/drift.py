@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .claims import CLAIMS_FILE, TIMING_CLAIMS_FILE, _key, claims_frame, read_claims
-from .engine import judge_paper
+from .engine import judge_paper, load
 from .store import Store
 
 
@@ -56,6 +56,9 @@ def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
         shutil.copytree(exp.folder.parent, tmp / exp.paper)
         shutil.rmtree(tmp / exp.paper / exp.name)
         shutil.copytree(rerun_folder, tmp / exp.paper / exp.name)
+        for other in _other_papers_experiments(exp.paper):   # a claim judged on another paper's runs
+            if (exp.folder.parents[1] / other).is_dir() and not (tmp / other).exists():
+                shutil.copytree(exp.folder.parents[1] / other, tmp / other)   # without that paper's claims.csv
         from ..compare import TIMING_FILES   # check's rerun measures no time: the stored timings stand in,
         for name in TIMING_FILES:            # so judging the paper (timing claims included) can read them
             if (exp.folder / name).is_file() and not (tmp / exp.paper / exp.name / name).exists():
@@ -65,3 +68,9 @@ def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
         shutil.rmtree(tmp, ignore_errors=True)
     return [Mismatch(f"{exp.paper}/{exp.name}", CLAIMS_FILE, text[:90], "verdict", a, b, "same verdict")
             for _, text, a, b in changes]
+
+
+def _other_papers_experiments(paper: str) -> list[str]:
+    """``other_paper/name`` of every experiment of another paper that ``paper``'s claims are judged on."""
+    specs = (load(paper) or {}).get("claims") or []
+    return sorted({str(c["experiment"]) for c in specs if "/" in str(c.get("experiment", ""))})
