@@ -655,9 +655,9 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
 
 
 @app.command()
-def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~30 s on a busy 2-core machine: "
-                                     "27-29 s measured; the first run after installing also compiles the "
-                                     "numerics, ~25 s more)"),
+def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s on an idle 2-core machine, "
+                                     "20.5 s measured; 27-29 s under load; the first run after installing "
+                                     "also compiles the numerics, ~25 s more)"),
           peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
                                    "(the committed measurements are rewritten only with --out bench)"),
