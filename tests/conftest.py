@@ -70,6 +70,8 @@ def cli(monkeypatch, capsys):
 # that no longer exists in its (collected) file is a usage error, not a silent no-op.
 FAST_TIER = "not slow and not stored and not external and not browser"
 TIERS = {
+    "tests/test_bench_ik.py::test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones": ("external",),
+    "tests/test_bench_ik.py::test_ik_sections_report_every_arm_ratios_and_verified_counts": ("external",),
     "tests/test_bench.py::test_quick_run_writes_csv_and_plot": ("slow",),
     "tests/test_kinbench.py::test_fkopt_check_passes_on_the_v2_quick_tier_and_fails_on_an_edited_number":
         ("slow", "stored"),

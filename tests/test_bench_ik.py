@@ -3,7 +3,6 @@ of example-robot-data (no timing is asserted)."""
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.external
 
 
 @pytest.fixture(scope="module")
