@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FkoptError
+from ..experiment.config import files_folder
 
 VERSION = "kinbench-v1"
 #: Poses per generated set.
@@ -73,8 +74,7 @@ def problem_mechanism(problem, folder: Path | None = None):
     from ..experiment.runner import build_mechanism
     cfg = RunConfig(name="pose-set", mechanism=problem.mechanism, objective=problem.objective,
                     algorithms=[{"name": "lm"}])
-    cfg._folder = folder
-    return build_mechanism(cfg), cfg
+    return build_mechanism(cfg, folder), cfg
 
 
 def targets_of(mech, points: np.ndarray) -> np.ndarray:
@@ -156,8 +156,8 @@ def write_pose_sets(config, folder: Path) -> Path:
     manifest = {"version": folder.name, "seed": config.seed, "poses_per_set": POSES,
                 "generator": "fkopt.kinbench.posesets.generate", "problems": {}}
     for problem in config.problems:
-        sets, info = generate(problem, config.seed, POSES, config._folder)
-        mech, _ = problem_mechanism(problem, config._folder)
+        sets, info = generate(problem, config.seed, POSES, files_folder(config))
+        mech, _ = problem_mechanism(problem, files_folder(config))
         entry = {"mechanism": problem.mechanism.model_dump(mode="json"), "unknowns": list(mech.unknown_names),
                  "sets": {}}
         (folder / problem.name).mkdir(parents=True, exist_ok=True)
@@ -171,15 +171,18 @@ def write_pose_sets(config, folder: Path) -> Path:
     return folder
 
 
-def pose_set_folder(config) -> Path:
-    base = config._folder if config._folder is not None else Path(".")
-    return Path(base) / config.pose_sets
+def pose_set_folder(config, files: Path | None = None) -> Path:
+    """The suite's pose-set folder, in ``files`` (default: the suite file's folder,
+    :func:`fkopt.experiment.config.files_folder`)."""
+    base = files if files is not None else files_folder(config)
+    return Path(base if base is not None else ".") / config.pose_sets
 
 
-def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
+def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
     """{(problem, set): points} of ``config`` (the first ``config.poses`` of each set), checked
-    against the manifest's SHA-256 and mechanism specs; and the manifest."""
-    folder = pose_set_folder(config)
+    against the manifest's SHA-256 and mechanism specs; and the manifest. ``files``: where the
+    suite's relative files are (:func:`pose_set_folder`)."""
+    folder = pose_set_folder(config, files)
     mpath = folder / MANIFEST
     try:
         manifest = json.loads(mpath.read_text(encoding="utf-8"))
