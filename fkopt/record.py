@@ -42,7 +42,16 @@ Index columns count from 0 everywhere (``pose``, ``run``, ``trajectory``, ``step
 ``iteration``); labels (``case-1``, ``pose-1``) are names, not indices.
 
 ``runs.csv`` is the record with the columns its folder fixes left out (:data:`NOT_IN_RUNS`)
-and ``solver`` under the name its kind's readers know (:data:`FILE_NAMES`).
+and ``solver`` under the name its kind's readers know (:data:`FILE_NAMES`); ``summary.csv``
+(experiments, studies) is :func:`summary_table` over it; a study's ``ecdf.csv`` and
+``stats.csv`` pool its columns per solver, a suite's measures, ECDF and leaderboard are computed
+from it (:mod:`fkopt.kinbench.measures`). Measured times are a second table next to it, the
+timing record (:data:`TIMING_COLUMNS`), which :func:`timing_table` and
+:func:`timing_runs_table` write for every kind.
+
+Still read from a kind's own arrays: an experiment's values, inputs, convergence and trace
+files and its figures (per-iteration histories, which the flat record does not hold), a study's
+poses/heatmap/tracking tables and figures (per-pose medians), an assembly's solutions.
 """
 from __future__ import annotations
 

@@ -25,7 +25,7 @@ from ..errors import FkoptError
 from ..files import error_line
 from ..record import BATCH, timing_record, timing_table as record_timing_table
 from .tasks import Kind, Plan, Task
-from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed
+from .config import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed, files_folder
 
 KIND = "assembly"
 
@@ -66,10 +66,11 @@ class AssemblyResult:
 
 
 def run_assembly(config: AssemblyConfig, source: str | None = None, mech=None) -> AssemblyResult:
-    """The search; ``mech``: the config's mechanism, already built (else built here)."""
+    """The search; ``mech``: the config's mechanism, already built (else built here, its
+    relative files beside ``source``)."""
     from ..assembly import all_solutions
     from .runner import build_mechanism
-    mech = build_mechanism(config) if mech is None else mech
+    mech = build_mechanism(config, files_folder(config, source)) if mech is None else mech
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
                          tol=config.tol, dedup=config.dedup, iterations=config.iterations)
@@ -133,7 +134,7 @@ def _validate(config: AssemblyConfig, plan) -> int:
 def _plan(config: AssemblyConfig, source: str | None, timing: bool = True):
     """One task: the search (timed, so it runs in this process; its time is part of the result)."""
     from .runner import build_mechanism
-    mech = build_mechanism(config)
+    mech = build_mechanism(config, files_folder(config, source))
     payload = {"config": config.model_dump(mode="json"), "source": source}
     return Plan([Task("search", payload, "all solutions")], solve_task,
                 local=lambda _: run_assembly(config, source, mech), context=mech, name=config.name)

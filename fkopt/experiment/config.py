@@ -241,6 +241,15 @@ def experiment_from_dict(data: dict, where: str) -> ExperimentConfig:
         raise FkoptError(f"{where}: {_one_line(err, data)}") from None
 
 
+def files_folder(config, source: str | Path | None = None) -> Path | None:
+    """Where ``config``'s relative files (a URDF's ``geometry.file``, a suite's pose sets and
+    outside logs) resolve: the folder of the file it was read from (set once, by its loader),
+    else the folder of ``source``, else None (the working directory). A run passes the answer
+    down; nothing sets it on the config afterwards."""
+    folder = getattr(config, "_folder", None)
+    return Path(folder) if folder is not None else (Path(source).parent if source else None)
+
+
 def load_config(path: str | Path) -> ExperimentConfig:
     """Read and validate an experiment file; errors name the file, line or field."""
     data = load_mapping(path, "experiment fields")

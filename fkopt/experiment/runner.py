@@ -24,7 +24,7 @@ from ..record import ALONE, BATCH, concat, run_record, timing_record
 from ..problems import fk_problem, ik_problem
 from ..rotations import wrap_degrees
 from ..solve import Result, chunk_size, make_algorithm, solve
-from .config import AlgorithmSpec, ExperimentConfig, RandomCases, RunConfig
+from .config import AlgorithmSpec, ExperimentConfig, RandomCases, RunConfig, files_folder
 from .tasks import Plan, Ran, Task, run_tasks
 from .timing import sample_plan, time_case
 
@@ -83,16 +83,18 @@ def task_seed(seed: int, case_index: int, label: str) -> int:
     return int(state[0])
 
 
-def build_mechanism(config: ExperimentConfig):
+def build_mechanism(config: ExperimentConfig, folder: Path | None = None):
     """The config's mechanism, checked before any work: its bounds finite with a finite width
     (:func:`fkopt.mechanisms.base.check_bounds`), and its closed form giving finite values of
     the right shape at the centre of the bounds. A plug-in mechanism that raises or returns
-    something else is one line naming it."""
+    something else is one line naming it. Relative files resolve in ``folder`` (default:
+    :func:`~fkopt.experiment.config.files_folder`)."""
     from ..mechanisms.base import check_bounds
     from ..solve import contained, plugin_of
     cls = registry.mechanism_class(config.mechanism.name)
     who = f"mechanism plug-in '{config.mechanism.name}' ({plugin_of(cls)})" if plugin_of(cls) else None
-    geometry = registry.resolve_files(cls, config.mechanism.geometry, getattr(config, "_folder", None))
+    geometry = registry.resolve_files(cls, config.mechanism.geometry,
+                                      folder if folder is not None else files_folder(config))
     mech = contained(who, lambda: cls(bounds=dict(config.mechanism.bounds), **geometry))
     name = who or config.mechanism.name
     names = contained(who, lambda: tuple(mech.unknown_names))
@@ -186,9 +188,10 @@ def pose_error(mech, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.abs(np.where(angle, wrap_degrees(d), d))
 
 
-def validate_experiment(config: ExperimentConfig):
-    """Build everything a run needs without running it (so bad input fails before any work)."""
-    mech = build_mechanism(config)
+def validate_experiment(config: ExperimentConfig, folder: Path | None = None):
+    """Build everything a run needs without running it (so bad input fails before any work);
+    relative files resolve in ``folder`` (:func:`build_mechanism`)."""
+    mech = build_mechanism(config, folder)
     cases = build_cases(config, mech)
     for spec in config.algorithms:
         make_algorithm(spec.name, spec.params)   # unknown names/parameters fail here
@@ -253,10 +256,8 @@ class Solved:
     wall_s: float
 
 
-def _prepare(config: ExperimentConfig, source: str | None):
-    if source and getattr(config, "_folder", None) is None:   # relative files resolve beside the config
-        config._folder = Path(source).parent
-    mech, cases, problems = validate_experiment(config)
+def _prepare(config: ExperimentConfig, folder: Path | None):
+    mech, cases, problems = validate_experiment(config, folder)
     one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
     batched = problems[0] if one else batched_problem(config, mech, cases)
     return mech, cases, problems, batched
@@ -292,10 +293,11 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None, timing:
     and cases; a worker process rebuilds them from the payload (:func:`solve_task`), with the
     same numbers."""
     started = time.perf_counter()
-    mech, cases, problems, batched = _prepare(config, source)
+    folder = files_folder(config, source)        # relative files resolve beside the config
+    mech, cases, problems, batched = _prepare(config, folder)
     data = config.model_dump_json()
-    folder = str(config._folder) if getattr(config, "_folder", None) is not None else None
-    tasks = [Task(f"a{a:02d}", {"config": data, "folder": folder, "algorithm": a}, spec.key)
+    tasks = [Task(f"a{a:02d}", {"config": data, "folder": None if folder is None else str(folder), "algorithm": a},
+                  spec.key)
              for a, spec in enumerate(config.algorithms)]
     timed_cases, per = sample_plan(len(cases), config.runs)
     timed = [Task(f"t{c:02d}", {"timing": c, "runs": per}, f"timing · {cases[c].label}")
@@ -316,9 +318,7 @@ def solve_task(payload: dict) -> Solved:
     """Worker: one algorithm of an experiment on all its cases, rebuilt from the payload."""
     from .config import experiment_from_dict
     config = experiment_from_dict(json.loads(payload["config"]), "experiment task")
-    if payload.get("folder"):
-        config._folder = Path(payload["folder"])
-    mech, cases, _, batched = _prepare(config, None)
+    mech, cases, _, batched = _prepare(config, Path(payload["folder"]) if payload.get("folder") else None)
     return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
 
 

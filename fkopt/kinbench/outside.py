@@ -43,6 +43,7 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..files import MAX_INPUT_BYTES, read_input
+from ..experiment.config import files_folder
 from ..record import run_record
 from .budget import at_budget, budget_of
 
@@ -50,9 +51,11 @@ COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
 IOH_SEPARATOR = "__"
 
 
-def outside_path(config, entry) -> Path:
-    base = config._folder if config._folder is not None else Path(".")
-    return Path(base) / (entry.file or entry.ioh)
+def outside_path(config, entry, files: Path | None = None) -> Path:
+    """An outside entry's file or folder, in ``files`` (default: the suite file's folder,
+    :func:`fkopt.experiment.config.files_folder`)."""
+    base = files if files is not None else files_folder(config)
+    return Path(base if base is not None else ".") / (entry.file or entry.ioh)
 
 
 #: Largest integer in the pose, run and evaluations columns: every integer up to 2^53 is exact
@@ -60,9 +63,9 @@ def outside_path(config, entry) -> Path:
 MAX_COUNT = 2 ** 53
 
 
-def digest(config, entry) -> str:
+def digest(config, entry, files: Path | None = None) -> str:
     """SHA-256 of the file (of every file of the IOH folder, by relative path), read bounded."""
-    path = outside_path(config, entry)
+    path = outside_path(config, entry, files)
     files = [path] if entry.file else sorted(p for p in path.rglob("*") if p.is_file())
     h = hashlib.sha256()
     for f in files:
@@ -112,12 +115,12 @@ def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
 
-def logged_runs(config, k: int, instances: set[tuple[str, str, int]]):
+def logged_runs(config, k: int, instances: set[tuple[str, str, int]], files: Path | None = None):
     """``config.outside[k]``'s file, checked, as one (problem, set, pose, run, evaluations,
     best-so-far) tuple per run of a selected instance (sorted keys; evaluations sorted, the
     best-so-far accumulated)."""
     entry = config.outside[k]
-    path = outside_path(config, entry)
+    path = outside_path(config, entry, files)
     where = f"outside[{k}].{'file' if entry.file else 'ioh'}: {path}"
     df = _csv_log(path, where) if entry.file else _ioh_log(path, where, entry.algorithm)
     for col in ("pose", "run", "evaluations", "best_so_far"):
@@ -151,12 +154,13 @@ def in_suite_order(config, out: pd.DataFrame) -> pd.DataFrame:
     return out.sort_values(keys, kind="stable").drop(columns="_o").reset_index(drop=True)
 
 
-def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]]) -> pd.DataFrame:
+def read_outside(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]],
+                 files: Path | None = None) -> pd.DataFrame:
     """The run rows (as :func:`fkopt.kinbench.runner.run_rows` makes them) of ``config.outside[k]``."""
     entry = config.outside[k]
     frames = []
     classes = {p.name: p.problem_class for p in config.problems}
-    for problem, name, pose, run, ev, hist in logged_runs(config, k, instances):
+    for problem, name, pose, run, ev, hist in logged_runs(config, k, instances, files):
         dim = dims[problem]
         m = at_budget(hist[None], ev[None], budget_of(config, dim), config.targets)
         frames.append({"problem": problem, "class": classes[problem], "set": name, "pose": pose,

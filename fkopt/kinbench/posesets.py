@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FkoptError
+from ..experiment.config import files_folder
 
 VERSION = "kinbench-v1"
 #: Poses per generated set.
@@ -71,8 +72,7 @@ def problem_mechanism(problem, folder: Path | None = None):
     from ..experiment.runner import build_mechanism
     cfg = RunConfig(name="pose-set", mechanism=problem.mechanism, objective=problem.objective,
                     algorithms=[{"name": "lm"}])
-    cfg._folder = folder
-    return build_mechanism(cfg), cfg
+    return build_mechanism(cfg, folder), cfg
 
 
 def targets_of(mech, points: np.ndarray) -> np.ndarray:
@@ -173,8 +173,8 @@ def write_pose_sets(config, folder: Path, poses: int = POSES, measure: str = "co
     if measure != "condition":
         manifest["near_singular_measure"] = measure
     for problem in config.problems:
-        sets, info = generate(problem, config.seed, poses, config._folder, measure)
-        mech, _ = problem_mechanism(problem, config._folder)
+        sets, info = generate(problem, config.seed, poses, files_folder(config), measure)
+        mech, _ = problem_mechanism(problem, files_folder(config))
         entry = {"mechanism": problem.mechanism.model_dump(mode="json"), "unknowns": list(mech.unknown_names),
                  "sets": {}}
         (folder / problem.name).mkdir(parents=True, exist_ok=True)
@@ -188,9 +188,11 @@ def write_pose_sets(config, folder: Path, poses: int = POSES, measure: str = "co
     return folder
 
 
-def pose_set_folder(config) -> Path:
-    base = config._folder if config._folder is not None else Path(".")
-    return Path(base) / config.pose_sets
+def pose_set_folder(config, files: Path | None = None) -> Path:
+    """The suite's pose-set folder, in ``files`` (default: the suite file's folder,
+    :func:`fkopt.experiment.config.files_folder`)."""
+    base = files if files is not None else files_folder(config)
+    return Path(base if base is not None else ".") / config.pose_sets
 
 
 #: Largest manifest and pose-set CSV read (bytes); fkopt's own are kilobytes.
@@ -268,14 +270,15 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     return pts
 
 
-def load_pose_sets(config) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
+def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, str], np.ndarray], dict]:
     """{(problem, set): points} of ``config`` (the first ``config.poses`` of each set), checked
     against the manifest's SHA-256 and mechanism specs; and the manifest. Every file is read
     with :func:`fkopt.files.read_input`'s bounds (a set's file must lie inside the set folder);
     the manifest's shape and every set file's contents are checked (a digest proves a file is
-    the one the manifest names, not that either is well-formed): one line naming the file."""
+    the one the manifest names, not that either is well-formed): one line naming the file.
+    ``files``: where the suite's relative files are (:func:`pose_set_folder`)."""
     from ..files import parse_json, read_input
-    folder = pose_set_folder(config)
+    folder = pose_set_folder(config, files)
     mpath = folder / MANIFEST
     if not mpath.exists() and not mpath.is_symlink():
         raise FkoptError(f"{mpath}: pose-set manifest not found (pose_sets: '{config.pose_sets}' names a "

@@ -237,5 +237,5 @@ def meta(sr) -> dict:
     return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json"),
             "config_file": sr.source,
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
-            "outside": {o.solver: digest(c, o) for o in c.outside},
+            "outside": {o.solver: digest(c, o, sr.files) for o in c.outside},
             "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)"}

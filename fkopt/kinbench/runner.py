@@ -29,7 +29,7 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..record import BATCH, concat, run_record, timing_record
-from ..experiment.config import RunConfig
+from ..experiment.config import RunConfig, files_folder
 from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
 from ..experiment.tasks import Plan, Ran, Task, run_tasks
 from ..solve import chunk_size
@@ -48,7 +48,6 @@ def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
                     algorithms=[solver.model_dump(exclude={"track"})], population=config.population,
                     iterations=solver.iterations or max(1, math.ceil(budget / pop)), runs=config.runs,
                     seed=config.seed, threshold=min(config.targets), stop_at_threshold=True)
-    cfg._folder = config._folder
     return cfg
 
 
@@ -61,6 +60,7 @@ class SuiteResult:
     wall_s: float
     source: str | None = None
     trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
+    files: Path | None = None            # where its relative files are (pose sets, outside logs)
 
     @property
     def runs(self) -> pd.DataFrame:
@@ -81,11 +81,12 @@ def instances_of(config: SuiteConfig, sets: dict) -> set[tuple[str, str, int]]:
 def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
     """Everything a suite needs, built without solving (the pose sets its plan loaded, else
     loaded here); the estimated bytes of the run."""
-    sets = plan.context.sets if plan is not None else load_pose_sets(config)[0]
+    files = plan.context.files if plan is not None else files_folder(config)
+    sets = plan.context.sets if plan is not None else load_pose_sets(config, files)[0]
     need = 0
     dims: dict[str, int] = {}
     for problem in config.problems:
-        mech, _ = problem_mechanism(problem, config._folder)
+        mech, _ = problem_mechanism(problem, files)
         cases = _cases(config, sets, problem)
         if not cases:
             raise FkoptError(f"problems[{problem.name}]: no poses in sets {', '.join(config.sets)}")
@@ -111,8 +112,8 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
     if config.outside:            # read and checked now, so a bad file fails before any solve
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
-            read_outside(config, k, dims, instances)
-            digest(config, config.outside[k])   # every file meta.json will hash, read bounded now
+            read_outside(config, k, dims, instances, files)
+            digest(config, config.outside[k], files)   # every file meta.json will hash, read bounded now
     return need
 
 
@@ -120,11 +121,10 @@ def solve_task(payload: dict) -> dict:
     """Worker: one (problem, solver) task on the cases (checked poses) the payload carries;
     returns its record, JSON-able (a task file): run rows as columns of lists, wall time."""
     config = suite_from_dict(payload["config"], "suite task")
-    config._folder = Path(payload["folder"]) if payload["folder"] else None
     problem = config.problems[payload["problem"]]
     solver = config.solvers[payload["solver"]]
     cases = payload["cases"]
-    mech, _ = problem_mechanism(problem, config._folder)
+    mech, _ = problem_mechanism(problem, Path(payload["folder"]) if payload["folder"] else None)
     dim = len(mech.unknown_names)
     cfg = task_config(config, problem, solver, dim)
     points = np.stack([c[2] for c in cases])
@@ -261,6 +261,7 @@ class _Context:
     sets: dict
     manifest: dict
     prepared_s: float     # building the plan (validation)
+    files: Path | None    # where the suite's relative files are (pose sets, outside logs)
 
 
 def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = True) -> Plan:
@@ -268,17 +269,16 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
     problem's selected sets a case of one batched solve; kept as task files while the suite runs
     (``--resume``), not in the published folder (its run rows are)."""
     started = time.perf_counter()
-    if source and config._folder is None:
-        config._folder = Path(source).parent
-    sets, manifest = load_pose_sets(config)
+    files = files_folder(config, source)          # relative files resolve beside the suite file
+    sets, manifest = load_pose_sets(config, files)
     fp = fingerprint(config, manifest)
     data = config.model_dump(mode="json")
-    folder = str(config._folder) if config._folder is not None else ""
+    folder = str(files) if files is not None else ""
     tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
-                context=_Context(sets, manifest, time.perf_counter() - started), name=f"suite '{config.name}'")
+                context=_Context(sets, manifest, time.perf_counter() - started, files), name=f"suite '{config.name}'")
 
 
 def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
@@ -290,14 +290,14 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
         instances = instances_of(config, ctx.sets)
-        frames += [read_outside(config, k, dims, instances) for k in range(len(config.outside))]
+        frames += [read_outside(config, k, dims, instances, ctx.files) for k in range(len(config.outside))]
     runs = concat(frames)
     tim = concat([timing_record("suite", {"problem": config.problems[r["problem"]].name,
                                           "solver": config.solvers[r["solver"]].key, "runs": r["solves"],
                                           "seconds": r["wall_s"], "mode": BATCH}) for r in done])
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
     return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
-                       suite_trace(config, done, runs))
+                       suite_trace(config, done, runs, ctx.files), ctx.files)
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,

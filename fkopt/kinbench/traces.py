@@ -79,13 +79,14 @@ def task_trace(result, budget: int) -> dict:
     return {"row": r.tolist(), "evaluations": e.tolist(), "best_fitness": f.tolist()}
 
 
-def outside_trace(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]]) -> pd.DataFrame:
+def outside_trace(config, k: int, dims: dict[str, int], instances: set[tuple[str, str, int]],
+                  files=None) -> pd.DataFrame:
     """The trace rows (:mod:`fkopt.kinbench.traces`) of ``config.outside[k]``'s runs, cut at the
     budget as :func:`~fkopt.kinbench.outside.read_outside`'s measures are."""
     from .outside import in_suite_order, logged_runs
     entry = config.outside[k]
     frames = []
-    for problem, name, pose, run, ev, hist in logged_runs(config, k, instances):
+    for problem, name, pose, run, ev, hist in logged_runs(config, k, instances, files):
         keep = np.r_[True, hist[1:] < hist[:-1]]            # the improvements, at their logged counts
         events = (np.zeros(int(keep.sum()), np.intp), ev[keep].astype(np.int64), hist[keep])
         _, e, f = budget_trace(events, ev[None], budget_of(config, dims[problem]))
@@ -94,9 +95,10 @@ def outside_trace(config, k: int, dims: dict[str, int], instances: set[tuple[str
     return in_suite_order(config, pd.concat(frames, ignore_index=True))[list(COLUMNS)]
 
 
-def suite_trace(config, done: list[dict], runs: pd.DataFrame) -> pd.DataFrame:
+def suite_trace(config, done: list[dict], runs: pd.DataFrame, files=None) -> pd.DataFrame:
     """The trace table of a suite: its tasks' traces (``done``: the task records, in the order
-    of their run rows in ``runs``) and the outside results' (read again from their files)."""
+    of their run rows in ``runs``) and the outside results' (read again from their files, in
+    ``files``: the suite file's folder)."""
     frames = []
     for rec in done:
         t = rec["trace"]
@@ -111,7 +113,7 @@ def suite_trace(config, done: list[dict], runs: pd.DataFrame) -> pd.DataFrame:
     if config.outside:
         dims = dict(zip(runs["problem"], runs["dim"]))
         instances = set(zip(runs["problem"], runs["set"], runs["pose"]))
-        frames += [outside_trace(config, k, dims, instances) for k in range(len(config.outside))]
+        frames += [outside_trace(config, k, dims, instances, files) for k in range(len(config.outside))]
     if not frames:
         return pd.DataFrame(columns=list(COLUMNS))
     return pd.concat(frames, ignore_index=True)[list(COLUMNS)]

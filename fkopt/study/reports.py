@@ -95,13 +95,19 @@ def timing_table(sr: StudyResult) -> pd.DataFrame:
     return record.timing_table(sr.timing, settings, names=record.FILE_NAMES["study"])
 
 
+def _per_algorithm(sr: StudyResult, column: str) -> dict[str, np.ndarray]:
+    """A run-record column pooled over every (pose, run) of each algorithm, in config order."""
+    return {key: g[column].to_numpy(float) for key, g in sr.record.groupby("solver", sort=False)}
+
+
 def ecdf_of(sr: StudyResult) -> pd.DataFrame:
-    return ecdf_table({ar.key: ar.evaluations_to for ar in sr.algorithms})
+    """Fraction of (pose, run) pairs solved vs evaluations, from the run record."""
+    return ecdf_table(_per_algorithm(sr, "evaluations_to_threshold"))
 
 
 def stats_of(sr: StudyResult) -> pd.DataFrame:
-    samples = {"final_fitness": {ar.key: ar.fitness for ar in sr.algorithms},
-               "evaluations_to_threshold": {ar.key: ar.evaluations_to for ar in sr.algorithms}}
+    """Pairwise rank tests over the run record's (pose, run) samples (Holm per metric)."""
+    samples = {metric: _per_algorithm(sr, metric) for metric in ("final_fitness", "evaluations_to_threshold")}
     return pairwise_tests(samples, sr.config.alpha)
 
 

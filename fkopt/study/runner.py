@@ -28,6 +28,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..experiment.config import files_folder
 from ..experiment.runner import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from ..problems import BoxedProblem
 from ..record import BATCH, concat, run_record, timing_record
@@ -64,9 +65,10 @@ def plan_tasks(config: StudyConfig, n_poses: int) -> list[Task]:
     return out
 
 
-def validate_study(config: StudyConfig):
-    """Build everything a run needs without running it (bad input fails before any work)."""
-    mech = build_mechanism(config)
+def validate_study(config: StudyConfig, folder: Path | None = None):
+    """Build everything a run needs without running it (bad input fails before any work);
+    relative files resolve in ``folder`` (:func:`fkopt.experiment.runner.build_mechanism`)."""
+    mech = build_mechanism(config, folder)
     poses = build_poses(config, mech)
     for spec in config.algorithms:
         make_algorithm(spec.name, spec.params)
@@ -76,19 +78,20 @@ def validate_study(config: StudyConfig):
 
 
 @lru_cache(maxsize=4)
-def _context(config_json: str):
+def _context(config_json: str, folder: str | None = None):
     config = StudyConfig(**json.loads(config_json))
-    mech, poses = validate_study(config)
+    mech, poses = validate_study(config, Path(folder) if folder else None)
     return config, mech, poses
 
 
-def payload(config: StudyConfig, task: Task) -> dict:
-    return {"config": config.model_dump_json(), "task": task.__dict__.copy()}
+def payload(config: StudyConfig, task: Task, folder: Path | None = None) -> dict:
+    return {"config": config.model_dump_json(), "task": task.__dict__.copy(),
+            "folder": None if folder is None else str(folder)}
 
 
 def run_task(payload: dict) -> dict:
     """Compute one task (in any process); returns a JSON-able record."""
-    config, mech, poses = _context(payload["config"])
+    config, mech, poses = _context(payload["config"], payload.get("folder"))
     task = Task(**payload["task"])
     spec = config.algorithms[task.algorithm]
     start = time.perf_counter()
@@ -343,11 +346,12 @@ def study_plan(config: StudyConfig, source: str | None = None, timing: bool = Tr
     """A study as tasks of the one runner: kept as task files (resume), published in ``tasks/``
     (its times are each task's own wall time: no separate timing tasks)."""
     started = time.perf_counter()
-    mech, poses = validate_study(config)
+    folder = files_folder(config, source)        # relative files resolve beside the config
+    mech, poses = validate_study(config, folder)
     tasks = plan_tasks(config, len(poses))
     by_id = {t.id: t for t in tasks}
     dim = len(mech.unknown_names)
-    return Plan([RunnerTask(t.id, payload(config, t), _label(config, t)) for t in tasks],
+    return Plan([RunnerTask(t.id, payload(config, t, folder), _label(config, t)) for t in tasks],
                 run_task, fingerprint=config.fingerprint(), stored=True, keep=True,
                 check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, dim),
                 context=_Context(mech, poses, time.perf_counter() - started), name=f"study '{config.name}'")
