@@ -209,8 +209,10 @@ def agreement(before: Snapshot, root: str | Path) -> str:
         if files:
             moved[label] = files
     count = sum(len(f) for f in moved.values())
+    added = len(set(after.files) - set(before.files))
+    new = f" ({added} results are new)" if added else ""
     if not count:
-        return "reproduce: every deterministic file is byte-identical to the stored one"
+        return "reproduce: every deterministic file is byte-identical to the stored one" + new
     if before.copies is None:
         return f"reproduce: {count} deterministic files in {len(moved)} results moved"
     store = {f"{e.paper}/{e.name}": e for e in Store(root).folders(None)}
@@ -221,7 +223,7 @@ def agreement(before: Snapshot, root: str | Path) -> str:
                                        and (root / label / f).exists()])
         if found:
             refused[label] = found
-    head = f"reproduce: {count} deterministic files in {len(moved)} results moved from the stored ones; "
+    head = f"reproduce: {count} deterministic files in {len(moved)} results moved from the stored ones{new}; "
     if not refused:
         return head + ("fkopt check's cross-platform rules accept all of them (another CPU moves the last "
                        "digits of path-dependent runs: docs/reproducing.md)")
