@@ -132,3 +132,20 @@ def test_least_squares_fk_answers_are_judged_in_both_assembly_modes():
     assert v["success"][:, 2].any() and v["other_mode"][:, 2].any()
     exact = fk_verdicts(m, x, x, legs)
     assert exact["success"].all() and not exact["other_mode"].any()
+
+
+def test_clock_track_with_the_field_reference():
+    """The clock track on the Panda with rtb ik_LM as the reference: one run per timeout for
+    TRAC-IK (wall-clock limit), one run for fkopt.inverse and rtb (none), ratios to rtb's time."""
+    _needs("tracik")
+    _needs("rtb-ik_LM")
+    from fkopt.kinbench.clock import clock_board, run_clock
+    m = arm("panda")
+    q, _ = targets(m, 5, 8)
+    a = run_clock(m, "panda", q, ["fkopt.inverse", "tracik"], seed=2)
+    assert sorted(a.groupby("solver").size().items()) == [("fkopt.inverse", 5), ("rtb-ik_LM", 5), ("tracik", 15)]
+    assert sorted(a.loc[a.solver == "tracik", "given_timeout_ms"].unique()) == [1.0, 5.0, 20.0]
+    b = clock_board(a)
+    assert len(b) == 9 and set(b["entry"]) == {"organiser", "outside"}
+    assert (b.loc[b.solver == "rtb-ik_LM", "time_ratio_median"] == 1.0).all()
+    assert (b.loc[b.solver == "fkopt.inverse", "success_1e-05m_1e-05rad"] == 1.0).all()

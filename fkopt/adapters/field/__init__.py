@@ -15,7 +15,7 @@ given (no global RNG); a package whose internal restarts draw from its own RNG s
 ``timeout`` (s) is each query's wall-clock allowance: packages with a wall-clock limit get it
 (TRAC-IK), restart loops written here stop starting new searches once it has passed, and
 packages with only iteration limits (roboticstoolbox) run to their limits -- the clock track
-(:mod:`fkopt.kinbench.v3`) counts any answer later than the timeout as a failure at the timeout.
+(:mod:`fkopt.kinbench.clock`) counts any answer later than the timeout as a failure at the timeout.
 
 Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
 (roboticstoolbox-python ``ik_LM``, ``ik_NR``), :mod:`.pin` (pinocchio's CLIK), :mod:`.ikpy`;

@@ -1,0 +1,82 @@
+"""kinbench v3's clock/throughput tracks, boards and outside submissions: the logic, fast and
+without the field's packages (fkopt.inverse is the reference here; tests/test_field.py runs the
+outside solvers)."""
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fkopt.kinbench.clock import clock_board, run_clock, run_throughput
+from fkopt.kinbench.physical import LADDER, rung_label
+
+ROBOTS = Path(__file__).resolve().parents[1] / "configs" / "suites" / "robots"
+
+
+def ur5():
+    from fkopt.mechanisms.urdf import URDFArm
+    return URDFArm(file=str(ROBOTS / "ur5.urdf"), base="base_link", tip="tool0")
+
+
+def queries(m, n, seed=0):
+    rng = np.random.default_rng(seed)
+    return m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
+
+
+def answers_frame(seconds, ok, solver="s", timeout=None, robot="r"):
+    n = len(seconds)
+    return pd.DataFrame({"robot": robot, "query": np.arange(n), "solver": solver, "entry": "outside",
+                         "given_timeout_ms": np.nan if timeout is None else timeout, "seconds": seconds,
+                         "claimed": True, "position_m": np.where(ok, 0.0, 1.0), "rotation_rad": 0.0,
+                         "in_limits": True})
+
+
+def test_board_counts_failures_and_late_answers_at_the_timeout_and_divides_query_by_query():
+    ref = answers_frame([1e-3, 2e-3, 4e-3, 1e-3], [True] * 4, solver="ref")
+    # query 0: 0.5 ms, right; 1: 3 ms, right; 2: wrong in 0.1 ms; 3: right but at 30 ms
+    s = answers_frame([0.5e-3, 3e-3, 1e-4, 30e-3], [True, True, False, True])
+    board = clock_board(pd.concat([ref, s]), timeouts_ms=(1.0, 5.0, 20.0), reference="ref")
+    row = board[(board.solver == "s") & (board.timeout_ms == 5.0)].iloc[0]
+    assert row["success_5mm_0.05rad"] == 0.5                      # the late and the wrong answers fail
+    tta = np.array([0.5e-3, 3e-3, 5e-3, 5e-3])                      # failures at the 5 ms timeout
+    assert row["time_ms_median"] == pytest.approx(1e3 * np.median(tta))
+    assert row["time_ratio_median"] == pytest.approx(np.median(tta / [1e-3, 2e-3, 4e-3, 1e-3]))
+    assert row["time_ratio_p95"] == pytest.approx(np.percentile(tta / [1e-3, 2e-3, 4e-3, 1e-3], 95))
+    one = board[(board.solver == "s") & (board.timeout_ms == 1.0)].iloc[0]
+    assert one["success_5mm_0.05rad"] == 0.25
+    ref_row = board[(board.solver == "ref") & (board.timeout_ms == 20.0)].iloc[0]
+    assert ref_row["time_ratio_median"] == 1.0 and ref_row["success_1e-08m_1e-08rad"] == 1.0
+    assert [c for c in board if c.startswith("success_")] == [f"success_{rung_label(r)}" for r in LADDER]
+
+
+def test_a_solver_with_a_wall_clock_limit_is_judged_by_its_own_run_at_each_timeout():
+    ref = answers_frame([1e-3] * 2, [True] * 2, solver="ref")
+    fast = answers_frame([0.5e-3, 0.5e-3], [False, False], timeout=1.0)          # given 1 ms: wrong
+    slow = answers_frame([4e-3, 4e-3], [True, True], timeout=5.0)                # given 5 ms: right
+    board = clock_board(pd.concat([ref, fast, slow]), timeouts_ms=(1.0, 5.0), reference="ref")
+    s = board[board.solver == "s"].set_index("timeout_ms")
+    assert s.loc[1.0, "success_5mm_0.05rad"] == 0.0 and s.loc[5.0, "success_5mm_0.05rad"] == 1.0
+    assert s.loc[1.0, "queries"] == 2 and s.loc[5.0, "queries"] == 2
+
+
+def test_clock_track_stores_every_answer_verified_by_fkopt_fk():
+    m = ur5()
+    q = queries(m, 4)
+    a = run_clock(m, "ur5", q, ["fkopt.inverse"], timeouts_ms=(5.0, 20.0), reference="fkopt.inverse", seed=1)
+    assert len(a) == 4 and set(a["solver"]) == {"fkopt.inverse"} and a["given_timeout_ms"].isna().all()
+    J = a[[f"q{d}" for d in range(m.dof)]].to_numpy()
+    F = m.fk_matrix(J)
+    assert np.allclose(a["position_m"], np.linalg.norm(F[:, :3, 3] - m.fk_matrix(q)[:, :3, 3], axis=-1))
+    assert (a["position_m"] < 1e-8).all() and a["in_limits"].all() and (a["seconds"] > 0).all()
+    assert (a["entry"] == "organiser").all()
+    b = clock_board(a, timeouts_ms=(5.0, 20.0), reference="fkopt.inverse")
+    assert len(b) == 2 and (b["time_ratio_median"] == 1.0).all()
+
+
+def test_throughput_track_measures_batches_against_the_reference_rate():
+    m = ur5()
+    tp = run_throughput(m, "ur5", queries(m, 5), ["fkopt.inverse"], batches=(1, 10), repeats=1,
+                        reference="fkopt.inverse", seed=1, reference_queries=5)
+    assert list(tp["batch"]) == [1, 10] and (tp["queries_per_s"] > 0).all()
+    assert np.allclose(tp["ratio"], tp["queries_per_s"] / tp["reference_queries_per_s"])
+    assert (tp["success_1e-08m_1e-08rad"] == 1.0).all()
