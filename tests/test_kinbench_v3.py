@@ -80,3 +80,59 @@ def test_throughput_track_measures_batches_against_the_reference_rate():
     assert list(tp["batch"]) == [1, 10] and (tp["queries_per_s"] > 0).all()
     assert np.allclose(tp["ratio"], tp["queries_per_s"] / tp["reference_queries_per_s"])
     assert (tp["success_1e-08m_1e-08rad"] == 1.0).all()
+
+
+# -- the tracks in a suite ------------------------------------------------------------------------
+TINY = Path(__file__).resolve().parent / "kinbench-v3-tiny.yaml"
+
+
+def tiny_v3(tmp_path, **clock):
+    """tests/kinbench-v3-tiny.yaml with fkopt.inverse alone (its own reference: no outside
+    package needed), 3 queries, batches 1 and 10; run in tmp_path (pose sets copied beside)."""
+    import shutil
+    import yaml
+    shutil.copytree(TINY.parent / "kinbench-v3-tiny", tmp_path / "tests" / "kinbench-v3-tiny")
+    shutil.copytree(ROBOTS, tmp_path / "configs" / "suites" / "robots")
+    data = yaml.safe_load(TINY.read_text())
+    data["tracks"]["clock"].update({"solvers": ["fkopt.inverse"], "reference": "fkopt.inverse", "queries": 3, **clock})
+    data["tracks"]["throughput"] = {"batches": [1, 10], "repeats": 1}
+    path = tmp_path / "tests" / "tiny.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
+    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinbench.reports import board_top_lines
+    path = tiny_v3(tmp_path)
+    folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    assert list(board.columns[:4]) == ["solver", "robot", "timeout_ms", "entry"]
+    assert [c for c in board if c.startswith("success_")] == [f"success_{rung_label(r)}" for r in LADDER]
+    assert set(board["robot"]) == {"ur5", "panda"} and (board["entry"] == "organiser").all()
+    assert len(board) == 2 * 3 and (board["throughput_batch"] == 10).all()
+    answers = pd.read_csv(folder / "answers.csv.gz")
+    assert len(answers) == 2 * 3 and set(answers["set"]) == {"uniform"}
+    assert set(pd.read_csv(folder / "throughput.csv")["batch"]) == {1, 10}
+    lines = board_top_lines(folder)
+    assert lines[0].startswith("track:exact") and any(line.startswith("ur5 (timeout 20 ms") for line in lines)
+    assert any("fkopt.inverse" in line and "success 100 / 100 / 100 / 100 %" in line for line in lines)
+    assert "Per robot, on the clock" in (folder / "leaderboard.md").read_text()
+    page = (folder / "index.html").read_text()
+    assert page.index("Per robot, on the clock") < page.index("<h2>overall")
+
+
+@pytest.mark.parametrize("clock, message", [
+    ({"solvers": ["trac-ik"]}, "solver 'trac-ik' is not a clock-track solver (allowed: fkopt.inverse, tracik"),
+    ({"problems": ["ur10"]}, "tracks.clock.problems: 'ur10' is not one of the suite's problems"),
+    ({"timeouts_ms": [5, 1]}, "timeouts_ms: distinct, increasing"),
+])
+def test_a_bad_tracks_section_is_one_line_naming_the_field(tmp_path, clock, message):
+    import subprocess
+    import sys
+    path = tiny_v3(tmp_path, **clock)
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-m", "fkopt.cli", "suite", str(path), "--out", str(out)],
+                       capture_output=True, text=True, env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
+    assert r.returncode == 2 and message in r.stderr + r.stdout and "Traceback" not in r.stderr
+    assert not out.exists()

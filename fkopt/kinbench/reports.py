@@ -40,6 +40,84 @@ def timing_table(sr) -> pd.DataFrame:
     return sr.timing
 
 
+def answers_table(sr) -> pd.DataFrame | None:
+    """answers.csv.gz: every answer of the clock track (joints q0.., wall time, claim, and
+    fkopt's verdict), so anyone can re-verify the board."""
+    return getattr(sr, "answers", None)
+
+
+def throughput_table(sr) -> pd.DataFrame | None:
+    return getattr(sr, "throughput", None)
+
+
+def robots_board_table(sr) -> pd.DataFrame | None:
+    """leaderboard-robots.csv: per (solver, robot, timeout) the success share at every rung of
+    the ladder within the timeout, the time to an answer at the track's rung (median/p95, ms
+    and as a ratio to the reference on the same query), the throughput at the largest batch
+    (queries/s and its ratio to the reference's rate; empty for solvers that take no batches)
+    and the entry (organiser / outside). Sorted per robot and timeout by success at the rung,
+    then by median ratio."""
+    from .clock import clock_board
+    from .physical import LADDER, rung_label
+    answers = getattr(sr, "answers", None)
+    if answers is None or answers.empty:
+        return None
+    clock = sr.config.tracks.clock
+    board = clock_board(answers, timeouts_ms=tuple(clock.timeouts_ms), reference=clock.reference, rung=clock.rung)
+    tp = getattr(sr, "throughput", None)
+    board["throughput_batch"], board["throughput_qps"], board["throughput_ratio"] = np.nan, np.nan, np.nan
+    if tp is not None and not tp.empty:
+        top = tp.sort_values("batch").groupby(["solver", "robot"], sort=False).last()
+        for (solver, robot), row in top.iterrows():
+            at = (board["solver"] == solver) & (board["robot"] == robot)
+            board.loc[at, ["throughput_batch", "throughput_qps", "throughput_ratio"]] = \
+                [row["batch"], row["queries_per_s"], row["ratio"]]
+    key = f"success_{rung_label(LADDER[clock.rung])}"
+    board["rung"] = rung_label(LADDER[clock.rung])
+    order = {r: k for k, r in enumerate(dict.fromkeys(board["robot"]))}
+    board = board.assign(_r=board["robot"].map(order), _s=-board[key])
+    board = board.sort_values(["_r", "timeout_ms", "_s", "time_ratio_median"], kind="stable").drop(columns=["_r", "_s"])
+    lead = ["solver", "robot", "timeout_ms", "entry"]
+    return board[lead + [c for c in board.columns if c not in lead]].reset_index(drop=True)
+
+
+def board_top_lines(folder: Path, top: int = 3) -> list[str]:
+    """What ``fkopt suite`` prints when it ends: the first ``top`` rows of each track's overall
+    ranking (leaderboard.csv) and the top of the per-robot board (leaderboard-robots.csv)."""
+    folder = Path(folder)
+    lines = []
+    lb_path = folder / "leaderboard.csv"
+    if lb_path.exists():
+        lb = pd.read_csv(lb_path)
+        for scope, g in lb.groupby("scope", sort=False):
+            if scope.startswith("track:"):
+                best = ", ".join(f"{r.solver} {r.score:.3f}" for r in g.head(top).itertuples())
+                lines.append(f"{scope} (score, evaluations): {best}")
+    robots = folder / "leaderboard-robots.csv"
+    if robots.exists():
+        lines += robots_top_lines(pd.read_csv(robots), top)
+    return lines
+
+
+def robots_top_lines(board: pd.DataFrame, top: int = 3) -> list[str]:
+    """The top of the per-robot board in physical units: per robot, at the largest timeout,
+    the first ``top`` solvers with success at every rung (%) and the median time (ms, and as a
+    ratio to the reference)."""
+    success = [c for c in board.columns if c.startswith("success_")]
+    lines = []
+    t = board["timeout_ms"].max()
+    for robot, g in board[board["timeout_ms"] == t].groupby("robot", sort=False):
+        ref = g["reference"].iloc[0]
+        lines.append(f"{robot} (timeout {t:g} ms; time to an answer at {g['rung'].iloc[0]}, ratio to {ref}; "
+                     f"success at {', '.join(c[len('success_'):] for c in success)}):")
+        for _, row in g.head(top).iterrows():
+            pct = " / ".join(f"{100 * row[c]:.0f}" for c in success)
+            qps = "" if np.isnan(row["throughput_qps"]) else f", {row['throughput_qps']:.0f} queries/s at batch {row['throughput_batch']:.0f}"
+            lines.append(f"  {row['solver']:<16} [{row['entry']}] success {pct} %, median {row['time_ms_median']:.3g} ms "
+                         f"(x{row['time_ratio_median']:.3g}), p95 {row['time_ms_p95']:.3g} ms (x{row['time_ratio_p95']:.3g}){qps}")
+    return lines
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.+-]+", "_", text).strip("_")
 
@@ -109,6 +187,18 @@ def preamble(c) -> str:
             "Tracks are ranked separately; 'overall' mixes them for reference only (docs/kinbench.md).")
 
 
+ROBOTS_PREAMBLE = ("IK of real arms, every answer checked by fkopt's FK (position m, geodesic rotation rad, "
+                   "joint limits), whatever the solver claims; success within the timeout at each rung; time to "
+                   "an answer (a failure counted at the timeout) in ms and as a ratio to the reference solver "
+                   "measured in the same job on the same query; entry: organiser (fkopt's own) or outside "
+                   "(docs/kinbench.md, v3).")
+
+
+def robot_columns(board: pd.DataFrame) -> list[str]:
+    return (["solver", "robot", "timeout_ms", "entry"] + [c for c in board.columns if c.startswith("success_")]
+            + ["time_ms_median", "time_ratio_median", "time_ratio_p95", "throughput_qps"])
+
+
 PER_PROBLEM = ["set", "solver", "track", "target", "trials", "success_rate", "ert"]
 
 
@@ -119,6 +209,9 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
     c = sr.config
     cols = leaderboard_columns(lb)
     out = [f"# {c.title or c.name}", "", preamble(c), ""]
+    robots = tables.get("leaderboard-robots.csv")
+    if robots is not None:
+        out += ["## Per robot, on the clock", "", ROBOTS_PREAMBLE, "", _md_table(robots, robot_columns(robots)), ""]
     for title, pred in (("Overall", lambda s: s == "overall"), ("Per track", lambda s: s.startswith("track:")),
                         ("Per problem class", lambda s: s.startswith("class:"))):
         out += [f"## {title}", ""]
@@ -150,6 +243,10 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
     cols = leaderboard_columns(lb)
     body = [f"<h1>{html.escape(c.title or c.name)}</h1>",
             f"<p>{html.escape(preamble(c))} Click a column header to sort.</p>"]
+    robots = tables.get("leaderboard-robots.csv")
+    if robots is not None:
+        body += ["<h2>Per robot, on the clock</h2>", f"<p>{html.escape(ROBOTS_PREAMBLE)}</p>",
+                 table_html(robots, robot_columns(robots), "robots")]
     for k, (scope, g) in enumerate(leaderboard_sections(tables)):
         body += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
     figs = sorted(folder.glob("ecdf_*.png"))

@@ -60,6 +60,8 @@ class SuiteResult:
     wall_s: float
     source: str | None = None
     trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
+    answers: pd.DataFrame | None = None  # answers.csv.gz: every answer of the clock track (v3)
+    throughput: pd.DataFrame | None = None   # throughput.csv: queries/s per batch size (v3)
 
 
 def _cases(config: SuiteConfig, sets: dict, problem):
@@ -105,12 +107,76 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances)
-    return len(config.problems) * len(config.solvers), need
+    tracks = track_cases(config, sets)
+    for p, _ in tracks:
+        validate_track(config, p)
+    return len(config.problems) * len(config.solvers) + len(tracks), need
+
+
+def track_cases(config: SuiteConfig, sets: dict) -> list[tuple[int, np.ndarray]]:
+    """(problem index, queries: joints of the clock set's first ``queries`` poses) of every
+    clock-track arm; the suite's ``poses`` (how many poses the swarms get) does not cut them."""
+    clock = config.tracks.clock if config.tracks is not None else None
+    if clock is None:
+        return []
+    if config.poses is not None:
+        full = config.model_copy(update={"poses": None})
+        full._folder = config._folder
+        sets, _ = load_pose_sets(full)
+    index = {p.name: k for k, p in enumerate(config.problems)}
+    return [(index[name], np.asarray(sets[(name, clock.set)][:clock.queries], dtype=float)) for name in clock.problems]
+
+
+def track_arm(config: SuiteConfig, p: int):
+    """The URDF arm of clock-track problem ``p`` (the field's packages read URDF only)."""
+    problem = config.problems[p]
+    mech, _ = problem_mechanism(problem, config._folder)
+    if getattr(mech, "kind", None) != "serial" or not hasattr(mech, "path") or not hasattr(mech, "tip_link"):
+        raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf); "
+                         "the clock track's solvers read URDF files")
+    return mech
+
+
+def validate_track(config: SuiteConfig, p: int) -> None:
+    """Every clock-track solver built once on arm ``p``: a missing package or an arm a package
+    misreads is one line before any work."""
+    from .clock import make_solver
+    arm = track_arm(config, p)
+    clock = config.tracks.clock
+    for name in dict.fromkeys([clock.reference, *clock.solvers]):
+        try:
+            make_solver(name, arm, timeout=max(clock.timeouts_ms) / 1e3, rng=np.random.default_rng(0))
+        except FkoptError as err:
+            raise FkoptError(f"tracks.clock.solvers[{name}] on problems[{config.problems[p].name}]: {err}") from None
+
+
+def solve_track(payload: dict) -> dict:
+    """Worker: the clock (and throughput) track on one arm; returns every answer, JSON-able."""
+    from .clock import run_clock, run_throughput
+    config = suite_from_dict(payload["config"], "suite task")
+    config._folder = Path(payload["folder"]) if payload["folder"] else None
+    p, clock, tp = payload["problem"], config.tracks.clock, config.tracks.throughput
+    arm = track_arm(config, p)
+    name = config.problems[p].name
+    queries = np.asarray(payload["queries"], dtype=float)
+    start = time.perf_counter()
+    answers = run_clock(arm, name, queries, clock.solvers, timeouts_ms=tuple(clock.timeouts_ms),
+                        reference=clock.reference, seed=config.seed)
+    answers.insert(1, "set", clock.set)
+    rate = None
+    if tp is not None:
+        rate = run_throughput(arm, name, queries, clock.solvers, batches=tuple(tp.batches), repeats=tp.repeats,
+                              reference=clock.reference, seed=config.seed).to_dict(orient="list")
+    return {"fingerprint": payload["fingerprint"], "track": "clock", "problem": p,
+            "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start}
 
 
 def solve_task(payload: dict) -> dict:
     """Worker: one (problem, solver) task on the cases (checked poses) the payload carries;
-    returns its record, JSON-able (a task file): run rows as columns of lists, wall time."""
+    returns its record, JSON-able (a task file): run rows as columns of lists, wall time. A
+    track task (``payload["track"]``) goes to :func:`solve_track`."""
+    if payload.get("track"):
+        return solve_track(payload)
     config = suite_from_dict(payload["config"], "suite task")
     config._folder = Path(payload["folder"]) if payload["folder"] else None
     problem = config.problems[payload["problem"]]
@@ -156,6 +222,18 @@ def record_problem(task, rec) -> str | None:
     """Why ``rec`` is not the finished record of ``task`` (a task file read back by --resume)."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
+    if task.payload.get("track"):
+        try:
+            if int(rec["problem"]) != task.payload["problem"] or rec["track"] != task.payload["track"]:
+                return "its problem/track are not its file name's"
+            if not isinstance(rec["answers"], dict) or not all(isinstance(v, list) for v in rec["answers"].values()):
+                return "answers: not a table of answers"
+            float(rec["wall_s"])
+        except KeyError as err:
+            return f"field {err.args[0]!r} is missing"
+        except (TypeError, ValueError) as err:
+            return f"{type(err).__name__}: {str(err)[:120]}"
+        return None
     try:
         if (int(rec["problem"]), int(rec["solver"])) != (task.payload["problem"], task.payload["solver"]):
             return "its problem/solver are not its file name's"
@@ -196,6 +274,9 @@ def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
     tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
+    tasks += [Task(f"t{p}", {"config": data, "folder": folder, "problem": p, "track": "clock", "fingerprint": fp,
+                             "queries": queries.tolist()}, f"{config.problems[p].name} / clock track")
+              for p, queries in track_cases(config, sets)]
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
                 context=_Context(sets, manifest, started), name=f"suite '{config.name}'")
 
@@ -203,7 +284,12 @@ def suite_plan(config: SuiteConfig, source: str | None = None) -> Plan:
 def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
     """The run rows of every task, then the imported outside results, and the timing table."""
     ctx: _Context = plan.context
-    done = [{**ran.records[t.id], "rows": pd.DataFrame(ran.records[t.id]["rows"])} for t in plan.tasks]
+    done = [{**ran.records[t.id], "rows": pd.DataFrame(ran.records[t.id]["rows"])} for t in plan.tasks
+            if not t.payload.get("track")]
+    tracked = [ran.records[t.id] for t in plan.tasks if t.payload.get("track")]
+    answers = pd.concat([pd.DataFrame(r["answers"]) for r in tracked], ignore_index=True) if tracked else None
+    rates = [pd.DataFrame(r["throughput"]) for r in tracked if r.get("throughput")]
+    throughput = pd.concat(rates, ignore_index=True) if rates else None
     frames = [r["rows"] for r in done]
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
@@ -214,7 +300,7 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
                          "solves": r["solves"], "wall_s": r["wall_s"], "ms_per_solve": 1e3 * r["wall_s"] / r["solves"]}
                         for r in done])
     return SuiteResult(config, runs, tim, ctx.manifest, time.perf_counter() - ctx.started, source,
-                       suite_trace(config, done, runs))
+                       suite_trace(config, done, runs), answers, throughput)
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,

@@ -38,6 +38,8 @@ class NGOpt(BlackBoxIK):
             warnings.simplefilter("ignore")
             import nevergrad as ng
         self._ng = ng
+        # NGOpt's Cobyla runs scipy in nevergrad's worker thread, outside any catch_warnings here
+        warnings.filterwarnings("ignore", message="COBYLA: Invalid RHOEND")
         self.settings.update(version=ng.__version__, budget=f"{self.BUDGET_PER_DOF} x dof per start", num_workers=1)
 
     def search(self, f, x0, deadline):
