@@ -233,6 +233,34 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
                   "poses, runs or a smaller budget.", "", {"solvers": ["gabc", "lm"], "poses": 3, "runs": 3}),
         "check": ("`ci`: the test suite reruns the stored result; `full`: only `fkopt check --subset all`.",
                   "", "full"),
+        "tracks": ("kinbench v3's tracks on the clock: IK of the suite's URDF arms by fkopt.inverse and "
+                   "the field's solvers, ranked by wall time as ratios to a reference solver "
+                   "(docs/kinbench.md).", "", {"clock": {"problems": ["ur5"], "solvers": ["fkopt.inverse", "tracik"]}}),
+    },
+    "Tracks": {
+        "clock": ("The clock track: every solver at every timeout on every query, interleaved with the "
+                  "reference.", "", {"problems": ["ur5"], "solvers": ["fkopt.inverse", "tracik"]}),
+        "throughput": ("Queries per second at each batch size, for the clock's solvers that take batches "
+                       "(fkopt.inverse).", "", {"batches": [1, 10, 100, 1000]}),
+    },
+    "ClockTrack": {
+        "problems": ("The suite's problems the track runs on (URDF arms: the field's packages read URDF).",
+                     "", ["ur5", "panda"]),
+        "solvers": ("fkopt.inverse (the organiser's) and the field's wrappers (fkopt.adapters.field).", "",
+                    ["fkopt.inverse", "tracik", "rtb-ik_NR", "pin-clik", "ikpy"]),
+        "reference": ("The solver every time is divided by, measured in the same job, query by query.", "",
+                      "rtb-ik_LM"),
+        "timeouts_ms": ("Timeouts; an answer later than the timeout is a failure counted at the timeout.",
+                        "ms", [1, 5, 20]),
+        "set": ("The pose set whose frozen poses are the queries.", "", "uniform"),
+        "queries": ("Queries per arm: the set's first N poses (the suite's `poses` does not cut them); "
+                    "default all.", "poses", 20),
+        "rung": ("The ladder rung (0: 5 mm/0.05 rad, 1: 1 mm/0.01 rad, 2: 1e-5 m/1e-5 rad, 3: 1e-8 m/1e-8 "
+                 "rad) the time to an answer is judged at.", "", 2),
+    },
+    "ThroughputTrack": {
+        "batches": ("Batch sizes (the queries repeated when fewer).", "queries per call", [1, 10, 100, 1000]),
+        "repeats": ("Calls per batch size; the fastest counts.", "calls", 3),
     },
     "SuiteProblem": {
         "name": ("Name of the problem in the tables.", "", "mao2017-3rps"),
@@ -261,6 +289,7 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "poses": ("Poses per set.", "poses", 3),
         "runs": ("Runs per pose.", "runs", 3),
         "budget_per_dim": ("Budget per dimension.", "evaluations per dimension", 500),
+        "queries": ("Queries per arm of the clock track.", "poses", 5),
     },
 }
 #: Fields documented once for every model that inherits them.
