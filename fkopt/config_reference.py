@@ -255,8 +255,19 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "set": ("The pose set whose frozen poses are the queries.", "", "uniform"),
         "queries": ("Queries per arm: the set's first N poses (the suite's `poses` does not cut them); "
                     "default all.", "poses", 20),
+        "submissions": ("Solvers run elsewhere: per query their joints and wall time beside the reference's, "
+                        "verified by fkopt's FK (fkopt.kinbench.submissions).", "",
+                        [{"solver": "my-ik", "file": "my-ik.csv", "machine": "i7-1185G7, 1 thread"}]),
         "rung": ("The ladder rung (0: 5 mm/0.05 rad, 1: 1 mm/0.01 rad, 2: 1e-5 m/1e-5 rad, 3: 1e-8 m/1e-8 "
                  "rad) the time to an answer is judged at.", "", 2),
+    },
+    "ClockSubmission": {
+        "solver": ("Name of the submitted solver on the board.", "", "my-ik"),
+        "file": ("CSV of its answers per query (robot, query, q0.., seconds, reference_seconds), relative to "
+                 "the suite file.", "", "my-ik.csv"),
+        "machine": ("The machine it ran on (CPU, threads, OS).", "", "i7-1185G7, 1 thread, Ubuntu 24.04"),
+        "reference": ("The reference solver timed beside it; must be the track's.", "", "rtb-ik_LM"),
+        "description": ("Free text: what the solver is and how it was run.", "", "my-ik 0.3, default options"),
     },
     "ThroughputTrack": {
         "batches": ("Batch sizes (the queries repeated when fewer).", "queries per call", [1, 10, 100, 1000]),

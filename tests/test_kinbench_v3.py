@@ -23,10 +23,12 @@ def queries(m, n, seed=0):
     return m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
 
 
-def answers_frame(seconds, ok, solver="s", timeout=None, robot="r"):
+def answers_frame(seconds, ok, solver="s", timeout=None, robot="r", ref=None):
     n = len(seconds)
+    ref = seconds if ref is None else ref
     return pd.DataFrame({"robot": robot, "query": np.arange(n), "solver": solver, "entry": "outside",
                          "given_timeout_ms": np.nan if timeout is None else timeout, "seconds": seconds,
+                         "reference_seconds": ref, "source": "run",
                          "claimed": True, "position_m": np.where(ok, 0.0, 1.0), "rotation_rad": 0.0,
                          "in_limits": True})
 
@@ -34,7 +36,7 @@ def answers_frame(seconds, ok, solver="s", timeout=None, robot="r"):
 def test_board_counts_failures_and_late_answers_at_the_timeout_and_divides_query_by_query():
     ref = answers_frame([1e-3, 2e-3, 4e-3, 1e-3], [True] * 4, solver="ref")
     # query 0: 0.5 ms, right; 1: 3 ms, right; 2: wrong in 0.1 ms; 3: right but at 30 ms
-    s = answers_frame([0.5e-3, 3e-3, 1e-4, 30e-3], [True, True, False, True])
+    s = answers_frame([0.5e-3, 3e-3, 1e-4, 30e-3], [True, True, False, True], ref=[1e-3, 2e-3, 4e-3, 1e-3])
     board = clock_board(pd.concat([ref, s]), timeouts_ms=(1.0, 5.0, 20.0), reference="ref")
     row = board[(board.solver == "s") & (board.timeout_ms == 5.0)].iloc[0]
     assert row["success_5mm_0.05rad"] == 0.5                      # the late and the wrong answers fail
@@ -51,8 +53,8 @@ def test_board_counts_failures_and_late_answers_at_the_timeout_and_divides_query
 
 def test_a_solver_with_a_wall_clock_limit_is_judged_by_its_own_run_at_each_timeout():
     ref = answers_frame([1e-3] * 2, [True] * 2, solver="ref")
-    fast = answers_frame([0.5e-3, 0.5e-3], [False, False], timeout=1.0)          # given 1 ms: wrong
-    slow = answers_frame([4e-3, 4e-3], [True, True], timeout=5.0)                # given 5 ms: right
+    fast = answers_frame([0.5e-3, 0.5e-3], [False, False], timeout=1.0, ref=[1e-3] * 2)   # given 1 ms: wrong
+    slow = answers_frame([4e-3, 4e-3], [True, True], timeout=5.0, ref=[1e-3] * 2)         # given 5 ms: right
     board = clock_board(pd.concat([ref, fast, slow]), timeouts_ms=(1.0, 5.0), reference="ref")
     s = board[board.solver == "s"].set_index("timeout_ms")
     assert s.loc[1.0, "success_5mm_0.05rad"] == 0.0 and s.loc[5.0, "success_5mm_0.05rad"] == 1.0
@@ -135,4 +137,76 @@ def test_a_bad_tracks_section_is_one_line_naming_the_field(tmp_path, clock, mess
     r = subprocess.run([sys.executable, "-m", "fkopt.cli", "suite", str(path), "--out", str(out)],
                        capture_output=True, text=True, env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
     assert r.returncode == 2 and message in r.stderr + r.stdout and "Traceback" not in r.stderr
+    assert not out.exists()
+
+
+# -- outside submissions --------------------------------------------------------------------------
+def submission(tmp_path, rows=None, **entry):
+    """A submission for the UR5 and Panda queries of tiny_v3: the frozen joints themselves
+    (exact answers) except where ``rows`` changes them."""
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.runner import track_arm, track_cases
+    from fkopt.kinbench.posesets import load_pose_sets
+    import yaml
+    path = tiny_v3(tmp_path)
+    cfg = load_suite(path)
+    sets, _ = load_pose_sets(cfg)
+    out = []
+    for p, queries in track_cases(cfg, sets):
+        arm = track_arm(cfg, p)
+        for i, q in enumerate(queries):
+            row = {"robot": cfg.problems[p].name, "query": i, "seconds": 2e-3, "reference_seconds": 1e-3,
+                   "claimed": True, **{f"q{d}": v for d, v in enumerate(q)}}
+            out.append(row)
+    df = pd.DataFrame(out)
+    if rows is not None:
+        df = rows(df)
+    df.to_csv(path.parent / "my-ik.csv", index=False)
+    data = yaml.safe_load(path.read_text())
+    data["tracks"]["clock"]["submissions"] = [{"solver": "my-ik", "file": "my-ik.csv",
+                                               "machine": "test machine", **entry}]
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_a_submission_claiming_success_on_wrong_answers_gets_failures(tmp_path):
+    from fkopt.experiment.kinds import load_any, run_config
+
+    def spoil(df):
+        ur5 = df.index[df.robot == "ur5"]
+        df.loc[ur5[0], "q0"] += 1.0                     # 1 deg off: wrong, but claimed
+        df.loc[ur5[1], [f"q{d}" for d in range(6)]] = np.nan   # no answer
+        df.loc[ur5[2], "seconds"] = 30e-3               # right, but later than every timeout
+        return df
+    path = submission(tmp_path, spoil)
+    folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    mine = board[board.solver == "my-ik"].set_index(["robot", "timeout_ms"])
+    assert (mine["entry"] == "outside").all() and (mine["source"] == "submitted").all()
+    assert mine.loc[("ur5", 20.0), "success_5mm_0.05rad"] == 0.0        # 3 queries, each spoilt
+    assert mine.loc[("panda", 20.0), "success_1e-08m_1e-08rad"] == 1.0
+    assert mine.loc[("panda", 5.0), "time_ratio_median"] == pytest.approx(2.0)   # 2 ms / 1 ms beside it
+    answers = pd.read_csv(folder / "answers.csv.gz")
+    sub = answers[answers.solver == "my-ik"]
+    assert len(sub) == 6 and sub["claimed"].iloc[0] and sub["position_m"].iloc[0] > 1e-3
+    import json
+    meta = json.loads((folder / "meta.json").read_text())
+    assert meta["submissions"]["my-ik"]["machine"] == "test machine"
+
+
+@pytest.mark.parametrize("rows, entry, message", [
+    (lambda df: df.drop(index=1), {}, "robot ur5: no row for query 1"),
+    (lambda df: df.assign(seconds=-1.0), {}, "line 2: seconds = -1.0; allowed: a positive number"),
+    (lambda df: df.drop(columns=["reference_seconds"]), {}, "missing column 'reference_seconds'"),
+    (lambda df: df.assign(robot="ur10"), {}, "robot 'ur10' is not one of tracks.clock.problems"),
+    (None, {"reference": "tracik"}, "is not the track's reference"),
+])
+def test_a_malformed_submission_is_one_line_naming_file_row_and_field(tmp_path, rows, entry, message):
+    import subprocess
+    import sys
+    path = submission(tmp_path, rows, **entry)
+    out = tmp_path / "out"
+    r = subprocess.run([sys.executable, "-m", "fkopt.cli", "suite", str(path), "--out", str(out)],
+                       capture_output=True, text=True, env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
+    assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr, r.stderr
     assert not out.exists()

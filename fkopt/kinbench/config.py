@@ -133,6 +133,17 @@ def clock_solvers() -> tuple[str, ...]:
     return ("fkopt.inverse", *IK_SOLVERS)
 
 
+class ClockSubmission(Strict):
+    """A solver run elsewhere on the clock track (:mod:`fkopt.kinbench.submissions`): a CSV of
+    its answers and wall times per query, the machine, and the reference timed beside it."""
+
+    solver: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+:-]{0,63}$")
+    file: str = Field(min_length=1)
+    machine: str = Field(min_length=1, max_length=200)
+    reference: str | None = None
+    description: str = ""
+
+
 class ClockTrack(Strict):
     """The clock track (:mod:`fkopt.kinbench.clock`): IK of the suite's URDF arms, every solver
     at every timeout, times as ratios to ``reference`` measured in the same job."""
@@ -144,6 +155,7 @@ class ClockTrack(Strict):
     set: Literal["uniform", "near-singular", "boundary", "printed"] = "uniform"
     queries: int | None = Field(None, ge=1, le=100_000)
     rung: int = Field(2, ge=0, le=3)
+    submissions: list[ClockSubmission] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _names(self):
@@ -155,6 +167,12 @@ class ClockTrack(Strict):
             raise ValueError("problems and solvers must not repeat")
         if any(t <= 0 or t > 10_000 for t in self.timeouts_ms) or sorted(set(self.timeouts_ms)) != self.timeouts_ms:
             raise ValueError("timeouts_ms: distinct, increasing, in (0, 10000] ms")
+        for sub in self.submissions:
+            if sub.solver in [*self.solvers, self.reference] or [s.solver for s in self.submissions].count(sub.solver) > 1:
+                raise ValueError(f"submissions: solver '{sub.solver}' repeats a solver of the track")
+            if sub.reference is not None and sub.reference != self.reference:
+                raise ValueError(f"submissions[{sub.solver}].reference: '{sub.reference}' is not the track's "
+                                 f"reference ({self.reference}); its times would not be ratios to the same solver")
         return self
 
 
@@ -272,6 +290,16 @@ class SuiteConfig(Located):
             if clock.set not in self.sets:
                 raise ValueError(f"tracks.clock.set: '{clock.set}' is not one of the suite's sets ({', '.join(self.sets)})")
         return self
+
+    def stored_dump(self) -> dict:
+        """The config as meta.json records it: v3's fields (``tracks``, ``quick.queries``) only
+        when set, so a v1/v2 suite's stored meta.json is what a rerun writes."""
+        data = self.model_dump(mode="json")
+        if data.get("tracks") is None:
+            data.pop("tracks", None)
+        if isinstance(data.get("quick"), dict) and data["quick"].get("queries") is None:
+            data["quick"].pop("queries", None)
+        return data
 
     def quick_tier(self, where: str = "suite") -> "SuiteConfig":
         """The ``--quick`` subset as a config of its own (name ``<name>-quick``, no quick block)."""

@@ -16,6 +16,7 @@ import pandas as pd
 
 from . import measures as M
 from .outside import digest
+from .submissions import submission_digest
 
 
 def runs_table(sr) -> pd.DataFrame:
@@ -265,8 +266,18 @@ def meta(sr) -> dict:
     c = sr.config
     manifest = sr.manifest or {}
     canonical = hashlib.sha256(json.dumps(manifest, sort_keys=True).encode()).hexdigest()
-    return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json"),
+    return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.stored_dump(),
             "config_file": sr.source,
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
             "outside": {o.solver: digest(c, o) for o in c.outside},
-            "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)"}
+            "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)",
+            **submissions_meta(c)}
+
+
+def submissions_meta(c) -> dict:
+    """meta.json's record of the clock track's outside submissions (only when there are any)."""
+    subs = c.tracks.clock.submissions if c.tracks is not None and c.tracks.clock is not None else []
+    if not subs:
+        return {}
+    return {"submissions": {s.solver: {"sha256": submission_digest(c, s), "machine": s.machine, "file": s.file,
+                                       "description": s.description} for s in subs}}

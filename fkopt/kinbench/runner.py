@@ -110,6 +110,7 @@ def validate_suite(config: SuiteConfig) -> tuple[int, int]:
     tracks = track_cases(config, sets)
     for p, _ in tracks:
         validate_track(config, p)
+    read_submissions(config, tracks)
     return len(config.problems) * len(config.solvers) + len(tracks), need
 
 
@@ -135,6 +136,16 @@ def track_arm(config: SuiteConfig, p: int):
         raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf); "
                          "the clock track's solvers read URDF files")
     return mech
+
+
+def read_submissions(config: SuiteConfig, tracks) -> pd.DataFrame | None:
+    """Every outside submission of the clock track, verified by fkopt's FK (answers rows)."""
+    if not tracks or not config.tracks.clock.submissions:
+        return None
+    from .submissions import read_submission
+    arms = {config.problems[p].name: (track_arm(config, p), queries) for p, queries in tracks}
+    return pd.concat([read_submission(config, k, arms) for k in range(len(config.tracks.clock.submissions))],
+                     ignore_index=True)
 
 
 def validate_track(config: SuiteConfig, p: int) -> None:
@@ -288,6 +299,9 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
             if not t.payload.get("track")]
     tracked = [ran.records[t.id] for t in plan.tasks if t.payload.get("track")]
     answers = pd.concat([pd.DataFrame(r["answers"]) for r in tracked], ignore_index=True) if tracked else None
+    submitted = read_submissions(config, track_cases(config, ctx.sets)) if tracked else None
+    if submitted is not None:
+        answers = pd.concat([answers, submitted], ignore_index=True)
     rates = [pd.DataFrame(r["throughput"]) for r in tracked if r.get("throughput")]
     throughput = pd.concat(rates, ignore_index=True) if rates else None
     frames = [r["rows"] for r in done]
