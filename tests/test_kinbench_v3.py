@@ -210,3 +210,14 @@ def test_a_malformed_submission_is_one_line_naming_file_row_and_field(tmp_path, 
                        capture_output=True, text=True, env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
     assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr, r.stderr
     assert not out.exists()
+
+
+def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
+    import sys
+    from fkopt.adapters.field import make_ik
+    from fkopt.errors import FkoptError
+    monkeypatch.setitem(sys.modules, "pytracik", None)          # import pytracik -> ImportError
+    with pytest.raises(FkoptError, match=r"field solver 'tracik' needs pytracik \(pip install -e \"\.\[field\]\"\)"):
+        make_ik("tracik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
+    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: tracik, rtb-ik_LM"):
+        make_ik("trac-ik", ur5(), timeout=0.005, rng=np.random.default_rng(0))

@@ -61,17 +61,23 @@ def digest(config, entry) -> str:
     return h.hexdigest()
 
 
-def _csv_log(path: Path, where: str) -> pd.DataFrame:
+def read_csv_columns(path: Path, where: str, columns, dtype: dict, needs: str | None = None) -> pd.DataFrame:
+    """A submitted CSV with the ``columns`` it must have; a missing file, an unreadable one or a
+    missing column is one line (``needs``: how the message lists what is needed)."""
     try:
-        df = pd.read_csv(path, dtype={"problem": str, "set": str})
+        df = pd.read_csv(path, dtype=dtype)
     except FileNotFoundError:
         raise FkoptError(f"{where}: not found") from None
     except (OSError, ValueError, pd.errors.ParserError) as err:
         raise FkoptError(f"{where}: unreadable CSV ({err})") from None
-    missing = [c for c in COLUMNS if c not in df.columns]
+    missing = [c for c in columns if c not in df.columns]
     if missing:
-        raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {', '.join(COLUMNS)}")
+        raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {needs or ', '.join(columns)}")
     return df
+
+
+def _csv_log(path: Path, where: str) -> pd.DataFrame:
+    return read_csv_columns(path, where, COLUMNS, {"problem": str, "set": str})
 
 
 def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:

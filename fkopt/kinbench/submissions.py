@@ -42,6 +42,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import FkoptError
+from .outside import read_csv_columns
 from .physical import ik_verdicts
 
 REQUIRED = ("robot", "query", "seconds", "reference_seconds")
@@ -65,15 +66,7 @@ def read_submission(config, k: int, arms: dict) -> pd.DataFrame:
     entry = clock.submissions[k]
     path = submission_path(config, entry)
     where = f"tracks.clock.submissions[{entry.solver}]: {path}"
-    try:
-        df = pd.read_csv(path, dtype={"robot": str})
-    except FileNotFoundError:
-        raise FkoptError(f"{where}: not found") from None
-    except (OSError, ValueError, pd.errors.ParserError) as err:
-        raise FkoptError(f"{where}: unreadable CSV ({err})") from None
-    missing = [c for c in REQUIRED if c not in df.columns]
-    if missing:
-        raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {', '.join(REQUIRED)}, q0, q1, ...")
+    df = read_csv_columns(path, where, REQUIRED, {"robot": str}, f"{', '.join(REQUIRED)}, q0, q1, ...")
     timeouts = clock.timeouts_ms
     timed = "given_timeout_ms" in df.columns
     frames = []
