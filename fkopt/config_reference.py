@@ -258,6 +258,9 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "submissions": ("Solvers run elsewhere: per query their joints and wall time beside the reference's, "
                         "verified by fkopt's FK (fkopt.kinbench.submissions).", "",
                         [{"solver": "my-ik", "file": "my-ik.csv", "machine": "i7-1185G7, 1 thread"}]),
+        "fk_solvers": ("Solvers of FK on the track's 6-DOF parallel mechanisms.", "", ["fkopt.forward"]),
+        "fk_reference": ("The reference of FK: scipy least_squares from random starts.", "", "scipy-least_squares"),
+        "fk_timeouts_ms": ("Timeouts of FK.", "ms", [20, 100, 500]),
         "rung": ("The ladder rung (0: 5 mm/0.05 rad, 1: 1 mm/0.01 rad, 2: 1e-5 m/1e-5 rad, 3: 1e-8 m/1e-8 "
                  "rad) the time to an answer is judged at.", "", 2),
     },
@@ -272,6 +275,7 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
     "ThroughputTrack": {
         "batches": ("Batch sizes (the queries repeated when fewer).", "queries per call", [1, 10, 100, 1000]),
         "repeats": ("Calls per batch size; the fastest counts.", "calls", 3),
+        "fk_batches": ("Batch sizes for FK of parallel mechanisms.", "queries per call", [1, 10, 100]),
     },
     "SuiteProblem": {
         "name": ("Name of the problem in the tables.", "", "mao2017-3rps"),

@@ -89,15 +89,18 @@ TINY = Path(__file__).resolve().parent / "kinbench-v3-tiny.yaml"
 
 
 def tiny_v3(tmp_path, **clock):
-    """tests/kinbench-v3-tiny.yaml with fkopt.inverse alone (its own reference: no outside
-    package needed), 3 queries, batches 1 and 10; run in tmp_path (pose sets copied beside)."""
+    """tests/kinbench-v3-tiny.yaml with fkopt.inverse alone on the two arms (its own reference:
+    no outside package needed), 3 queries, batches 1 and 10; run in tmp_path (pose sets copied
+    beside). Dietmaier's platform stays only when ``clock`` sets fk_solvers."""
     import shutil
     import yaml
     shutil.copytree(TINY.parent / "kinbench-v3-tiny", tmp_path / "tests" / "kinbench-v3-tiny")
     shutil.copytree(ROBOTS, tmp_path / "configs" / "suites" / "robots")
     data = yaml.safe_load(TINY.read_text())
-    data["tracks"]["clock"].update({"solvers": ["fkopt.inverse"], "reference": "fkopt.inverse", "queries": 3, **clock})
-    data["tracks"]["throughput"] = {"batches": [1, 10], "repeats": 1}
+    data["problems"] = [p for p in data["problems"] if p["name"] in ("ur5", "panda") or "fk_solvers" in clock]
+    data["tracks"]["clock"].update({"problems": ["ur5", "panda"], "solvers": ["fkopt.inverse"],
+                                    "reference": "fkopt.inverse", "queries": 3, **clock})
+    data["tracks"]["throughput"] = {"batches": [1, 10], "fk_batches": [1, 2], "repeats": 1}
     path = tmp_path / "tests" / "tiny.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path
@@ -130,14 +133,22 @@ def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
     ({"timeouts_ms": [5, 1]}, "timeouts_ms: distinct, increasing"),
 ])
 def test_a_bad_tracks_section_is_one_line_naming_the_field(tmp_path, clock, message):
+    from fkopt.errors import FkoptError
+    from fkopt.experiment.kinds import load_any
+    with pytest.raises(FkoptError) as err:
+        load_any(tiny_v3(tmp_path, **clock))
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_fkopt_suite_exits_2_with_one_line_and_writes_nothing_on_a_bad_submission(tmp_path):
     import subprocess
     import sys
-    path = tiny_v3(tmp_path, **clock)
+    path = submission(tmp_path, lambda df: df.drop(index=1))
     out = tmp_path / "out"
     r = subprocess.run([sys.executable, "-m", "fkopt.cli", "suite", str(path), "--out", str(out)],
                        capture_output=True, text=True, env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
-    assert r.returncode == 2 and message in r.stderr + r.stdout and "Traceback" not in r.stderr
-    assert not out.exists()
+    assert r.returncode == 2 and "robot ur5: no row for query 1" in r.stderr and "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not out.exists()
 
 
 # -- outside submissions --------------------------------------------------------------------------
@@ -202,14 +213,13 @@ def test_a_submission_claiming_success_on_wrong_answers_gets_failures(tmp_path):
     (None, {"reference": "tracik"}, "is not the track's reference"),
 ])
 def test_a_malformed_submission_is_one_line_naming_file_row_and_field(tmp_path, rows, entry, message):
-    import subprocess
-    import sys
+    from fkopt.errors import FkoptError
+    from fkopt.experiment.kinds import load_any, run_config
     path = submission(tmp_path, rows, **entry)
-    out = tmp_path / "out"
-    r = subprocess.run([sys.executable, "-m", "fkopt.cli", "suite", str(path), "--out", str(out)],
-                       capture_output=True, text=True, env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
-    assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr, r.stderr
-    assert not out.exists()
+    with pytest.raises(FkoptError) as err:
+        run_config(load_any(path), tmp_path / "out", source=str(path))
+    assert message in str(err.value) and "\n" not in str(err.value)
+    assert not (tmp_path / "out" / "kinbench").exists()
 
 
 def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
@@ -221,3 +231,30 @@ def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
         make_ik("tracik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
     with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: tracik, rtb-ik_LM"):
         make_ik("trac-ik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
+
+
+def test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apart(tmp_path):
+    """Dietmaier's 6-6 platform (up to 40 assembly modes): fkopt.forward beside scipy
+    least_squares, judged against the generating pose, answers whose legs solve the equations
+    in another mode counted as other_mode, poses stored as x0..x5."""
+    from fkopt.experiment.kinds import load_any, run_config
+    path = tiny_v3(tmp_path, problems=["dietmaier-6sps"], fk_solvers=["fkopt.forward"],
+                   fk_reference="scipy-least_squares", fk_timeouts_ms=[20, 500], queries=2)
+    folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    assert set(board["robot"]) == {"dietmaier-6sps"} and set(board["timeout_ms"]) == {20, 500}
+    assert set(board["solver"]) == {"fkopt.forward", "scipy-least_squares"}
+    assert (board["reference"] == "scipy-least_squares").all()
+    assert ((board["other_mode"] >= 0) & (board["other_mode"] + board["success_1e-05m_1e-05rad"] <= 1)).all()
+    answers = pd.read_csv(folder / "answers.csv.gz")
+    assert {f"x{d}" for d in range(6)} <= set(answers.columns) and answers["leg_residual"].notna().all()
+    from fkopt import mechanism
+    m = mechanism("6-sps")
+    fwd = answers[answers.solver == "fkopt.forward"]
+    X = fwd[[f"x{d}" for d in range(6)]].to_numpy()
+    from fkopt.kinbench.posesets import load_pose_sets
+    from fkopt.kinbench.config import load_suite
+    sets, _ = load_pose_sets(load_suite(path).model_copy(update={"poses": None}))
+    L = m.ik(sets[("dietmaier-6sps", "uniform")][:2])
+    assert np.allclose(fwd["leg_residual"], np.max(np.abs(m.ik(X) - L) / L, axis=-1))
+    assert set(pd.read_csv(folder / "throughput.csv")["batch"]) == {1, 2}

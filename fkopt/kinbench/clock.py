@@ -37,16 +37,19 @@ import zlib
 import numpy as np
 import pandas as pd
 
-from .physical import LADDER, ik_verdicts, rung_label
+from .physical import LADDER, fk_verdicts, ik_verdicts, rung_label
 
-#: Timeouts of the clock track (ms).
+#: Timeouts of the clock track (ms): IK of serial arms, FK of parallel mechanisms.
 TIMEOUTS_MS = (1.0, 5.0, 20.0)
+FK_TIMEOUTS_MS = (20.0, 100.0, 500.0)
 #: Batch sizes of the throughput track.
 BATCHES = (1, 10, 100, 1000)
 #: The IK solver every time is divided by (measured in the same job, query by query).
 REFERENCE = "rtb-ik_LM"
+#: The reference of FK of parallel mechanisms: scipy's least_squares from random starts.
+FK_REFERENCE = "scipy-least_squares"
 #: fkopt's own solvers: the organiser's entries on a board; everything else is an outside entry.
-ORGANISER = ("fkopt.inverse",)
+ORGANISER = ("fkopt.inverse", "fkopt.forward")
 
 
 class FkoptInverse:
@@ -82,12 +85,82 @@ class FkoptInverse:
         return np.asarray(r.joints, dtype=float)
 
 
-def make_solver(name: str, arm, *, timeout: float, rng: np.random.Generator):
-    """The organiser's solver or a field wrapper (:func:`fkopt.adapters.field.make_ik`)."""
+class FkoptForward:
+    """The organiser's FK entry: :func:`fkopt.kinematics.forward` (local Newton, deterministic
+    restarts, global search) with ``tol`` = 1e-10 on max |ik(pose) - legs| (joint units); its
+    seed per query from the wrapper's generator; no wall-clock limit. One call before the clock
+    (imports, first-call set-up)."""
+
+    name = "fkopt.forward"
+    package = "fkopt"
+    TOL = 1e-10
+
+    def __init__(self, mechanism, *, timeout: float, rng: np.random.Generator):
+        from ..kinematics import forward
+        self.mechanism, self.timeout, self.rng, self._forward = mechanism, float(timeout), rng, forward
+        forward(mechanism, mechanism.ik(mechanism.bounds.mean(axis=1)[None])[0], tol=self.TOL)
+        self.settings = {"timeout_s": self.timeout, "tol": self.TOL, "wall_clock_limit": False,
+                         "seed": "per query from the wrapper's generator", "defaults": "fkopt.forward's"}
+
+    def solve1(self, legs):
+        r = self._forward(self.mechanism, legs, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        return np.asarray(r.pose, dtype=float), bool(r.solved)
+
+    def solve_batch(self, legs: np.ndarray) -> np.ndarray:
+        r = self._forward(self.mechanism, legs, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        return np.asarray(r.pose, dtype=float)
+
+
+#: Solvers of FK of parallel mechanisms on the clock.
+FK_SOLVERS = (FkoptForward.name, FK_REFERENCE)
+
+
+def is_ik(mechanism) -> bool:
+    """IK of a serial arm (targets: tip frames) or FK of a parallel mechanism (targets: legs)."""
+    return getattr(mechanism, "kind", None) == "serial"
+
+
+def make_solver(name: str, mechanism, *, timeout: float, rng: np.random.Generator):
+    """The organiser's solver or a field wrapper (:func:`fkopt.adapters.field.make_ik`; for
+    FK, :class:`fkopt.adapters.field.scipy_fk.LeastSquaresFK`)."""
     if name == FkoptInverse.name:
-        return FkoptInverse(arm, timeout=timeout, rng=rng)
+        return FkoptInverse(mechanism, timeout=timeout, rng=rng)
+    if name == FkoptForward.name:
+        return FkoptForward(mechanism, timeout=timeout, rng=rng)
+    if name == FK_REFERENCE:
+        from ..adapters.field.scipy_fk import LeastSquaresFK
+        return LeastSquaresFK(mechanism, timeout=timeout, rng=rng)
     from ..adapters.field import make_ik
-    return make_ik(name, arm, timeout=timeout, rng=rng)
+    return make_ik(name, mechanism, timeout=timeout, rng=rng)
+
+
+def track_settings(clock, mechanism) -> tuple[list[str], str, tuple[float, ...]]:
+    """(solvers, reference, timeouts in ms) of the clock-track config ``clock`` on ``mechanism``:
+    the IK ones for a serial arm, the ``fk_`` ones for a parallel mechanism."""
+    if is_ik(mechanism):
+        return list(clock.solvers), clock.reference, tuple(clock.timeouts_ms)
+    return list(clock.fk_solvers), clock.fk_reference, tuple(clock.fk_timeouts_ms)
+
+
+def targets_of(mechanism, queries: np.ndarray) -> np.ndarray:
+    """What the solvers get per query: the tip frame (IK) or the leg lengths (FK)."""
+    return mechanism.fk_matrix(queries) if is_ik(mechanism) else mechanism.ik(queries)
+
+
+def verdicts(mechanism, answers: np.ndarray, queries: np.ndarray, targets: np.ndarray) -> dict:
+    """kinbench's verdict on answers (n, dim): ``position_m``, ``rotation_rad``, ``in_limits``
+    (IK: joints inside the limits; FK: answered), ``leg_residual`` (FK; NaN for IK) and
+    ``success`` (n, rungs) (:mod:`fkopt.kinbench.physical`)."""
+    if is_ik(mechanism):
+        v = ik_verdicts(mechanism, answers, targets)
+        return {**v, "leg_residual": np.full(len(answers), np.nan)}
+    v = fk_verdicts(mechanism, answers, queries, targets)
+    return {**v, "in_limits": np.all(np.isfinite(answers), axis=-1)}
+
+
+def answer_prefix(mechanism) -> str:
+    """Column prefix of an answer's components: q (joints) for IK, x (pose) for FK."""
+    return "q" if is_ik(mechanism) else "x"
 
 
 def entry_of(name: str) -> str:
@@ -103,24 +176,25 @@ def _uses_timeout(solver) -> bool:
     return solver.settings.get("wall_clock_limit", True) is not False
 
 
-def run_clock(arm, robot: str, queries: np.ndarray, solvers: list[str], *, timeouts_ms=TIMEOUTS_MS,
+def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *, timeouts_ms=TIMEOUTS_MS,
               reference: str = REFERENCE, seed: int = 0) -> pd.DataFrame:
-    """Every answer of the clock track on one robot: one row per (query, solver, timeout given)
-    with the joints, the wall time, the reference's wall time on the same query
-    (``reference_seconds``), the claim and the verdict (``position_m``, ``rotation_rad``,
-    ``in_limits``). ``queries``: joints (n, dof) in public units (deg, m) inside the limits;
+    """Every answer of the clock track on one arm (IK) or parallel mechanism (FK): one row per
+    (query, solver, timeout given) with the answer (joints ``q0..`` or pose ``x0..``), the wall
+    time, the reference's wall time on the same query (``reference_seconds``), the claim and the
+    verdict (``position_m``, ``rotation_rad``, ``in_limits``, ``leg_residual``). ``queries``:
+    joints (IK) or poses (FK) in public units, the frozen pose set's points;
     ``given_timeout_ms`` is NaN for a solver without a wall-clock limit (run once)."""
-    targets = arm.fk_matrix(queries)
+    targets = targets_of(mechanism, queries)
     runs: list[tuple[str, float | None, object]] = []         # (solver name, timeout given, wrapper)
     for name in dict.fromkeys([reference, *solvers]):
-        first = make_solver(name, arm, timeout=max(timeouts_ms) / 1e3, rng=np.random.default_rng(0))
+        first = make_solver(name, mechanism, timeout=max(timeouts_ms) / 1e3, rng=np.random.default_rng(0))
         if _uses_timeout(first):
-            runs += [(name, t, make_solver(name, arm, timeout=t / 1e3, rng=np.random.default_rng(0)))
+            runs += [(name, t, make_solver(name, mechanism, timeout=t / 1e3, rng=np.random.default_rng(0)))
                      for t in timeouts_ms]
         else:
             runs.append((name, None, first))
-    n, k = len(queries), len(runs)
-    joints = np.full((n, k, arm.dof), np.nan)
+    n, k, dim = len(queries), len(runs), queries.shape[1]
+    answers = np.full((n, k, dim), np.nan)
     seconds, claimed = np.zeros((n, k)), np.zeros((n, k), bool)
     for i in range(n):
         for j in np.roll(np.arange(k), -(i % k)):                          # interleaved, rotated
@@ -131,18 +205,21 @@ def run_clock(arm, robot: str, queries: np.ndarray, solvers: list[str], *, timeo
             seconds[i, j] = time.perf_counter() - t0
             claimed[i, j] = bool(ok)
             if q is not None:
-                joints[i, j] = q
+                answers[i, j] = q
     frames = []
-    ref_seconds = seconds[:, [j for j, r in enumerate(runs) if r[0] == reference][0]]
+    # a reference with a wall-clock limit is timed by its run at the largest timeout
+    ref_seconds = seconds[:, [j for j, r in enumerate(runs) if r[0] == reference][-1]]
+    prefix = answer_prefix(mechanism)
     for j, (name, t, solver) in enumerate(runs):
-        v = ik_verdicts(arm, joints[:, j], targets)
+        v = verdicts(mechanism, answers[:, j], queries, targets)
         frame = pd.DataFrame({"robot": robot, "query": np.arange(n), "solver": name, "entry": entry_of(name),
                               "source": "run", "given_timeout_ms": np.nan if t is None else t,
                               "seconds": seconds[:, j], "reference_seconds": ref_seconds,
                               "claimed": claimed[:, j], "position_m": v["position_m"],
-                              "rotation_rad": v["rotation_rad"], "in_limits": v["in_limits"]})
-        for d in range(arm.dof):
-            frame[f"q{d}"] = joints[:, j, d]
+                              "rotation_rad": v["rotation_rad"], "in_limits": v["in_limits"],
+                              "leg_residual": v["leg_residual"]})
+        for d in range(dim):
+            frame[f"{prefix}{d}"] = answers[:, j, d]
         frames.append(frame)
     return pd.concat(frames, ignore_index=True)
 
@@ -154,16 +231,20 @@ def rung_success(answers: pd.DataFrame, ladder=LADDER) -> np.ndarray:
     return np.stack([(pe <= p) & (re <= r) & lim for p, r in ladder], axis=-1)
 
 
-def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: str = REFERENCE,
+def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: str | dict = REFERENCE,
                 rung: int = 2, ladder=LADDER) -> pd.DataFrame:
     """Per (robot, solver, timeout): success share at every rung within the timeout, and the
     time to an answer at rung ``rung`` (ms and as a ratio to the reference's time on the same
     query, each row's ``reference_seconds``: measured in this job for the solvers run here, on
     the submitter's machine for a submission): median and p95, a failure counted at the
-    timeout. ``reference_ms_median``: the reference's own median here."""
+    timeout. ``reference_ms_median``: the reference's own median here. ``reference``: one name,
+    or robot -> name (IK arms and parallel mechanisms have different references). FK rows (a
+    ``leg_residual``) also get ``other_mode``: the share of answers within the timeout whose legs
+    solve the equations to the rung's tolerance in another assembly mode."""
     rows = []
     for robot, a in answers.groupby("robot", sort=False):
-        ref = a[a["solver"] == reference]
+        ref_name = reference.get(robot, REFERENCE) if isinstance(reference, dict) else reference
+        ref = a[a["solver"] == ref_name]
         ref_ms = 1e3 * float(ref.groupby("query")["seconds"].first().median()) if len(ref) else np.nan
         for name, s in a.groupby("solver", sort=False):
             for t in timeouts_ms:
@@ -173,10 +254,14 @@ def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: st
                 ratio = tta / g["reference_seconds"].to_numpy()
                 row = {"solver": name, "robot": robot, "timeout_ms": t, "entry": entry_of(name),
                        "queries": len(g)}
+                leg = g["leg_residual"].to_numpy(float) if "leg_residual" in g else np.full(len(g), np.nan)
+                if (~np.isnan(leg)).any():
+                    solved = (leg <= ladder[rung][0]) & (g["seconds"].to_numpy() <= t / 1e3)
+                    row["other_mode"] = float((solved & ~ok[:, rung]).mean())
                 row.update({f"success_{rung_label(r)}": float(ok[:, k].mean()) for k, r in enumerate(ladder)})
                 row.update({"time_ms_median": 1e3 * float(np.median(tta)), "time_ms_p95": 1e3 * float(np.percentile(tta, 95)),
                             "time_ratio_median": float(np.median(ratio)), "time_ratio_p95": float(np.percentile(ratio, 95)),
-                            "reference": reference, "reference_ms_median": ref_ms,
+                            "reference": ref_name, "reference_ms_median": ref_ms,
                             "source": g["source"].iloc[0] if "source" in g else "run"})
                 rows.append(row)
     return pd.DataFrame(rows)
@@ -188,7 +273,7 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
     calls), beside the reference's rate one query per call on the first ``reference_queries``
     queries (timed right after each batch size), and the share of answers passing each
     rung (fkopt's verdict)."""
-    targets = arm.fk_matrix(queries)
+    targets = targets_of(arm, queries)
     ref = make_solver(reference, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, reference, -1, 0))
     rows = []
     m = min(reference_queries, len(targets))
@@ -207,7 +292,7 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
             for i in range(m):
                 ref.solve1(targets[i])
             ref_qps = m / (time.perf_counter() - t0)
-            v = ik_verdicts(arm, q, targets[idx])
+            v = verdicts(arm, q, queries[idx], targets[idx])
             row = {"solver": name, "robot": robot, "entry": entry_of(name), "batch": b, "queries_per_s": b / best,
                    "reference": reference, "reference_queries_per_s": ref_qps, "ratio": (b / best) / ref_qps}
             row.update({f"success_{rung_label(r)}": float(v["success"][:, k].mean()) for k, r in enumerate(LADDER)})

@@ -156,6 +156,10 @@ class ClockTrack(Strict):
     queries: int | None = Field(None, ge=1, le=100_000)
     rung: int = Field(2, ge=0, le=3)
     submissions: list[ClockSubmission] = Field(default_factory=list)
+    #: FK of the suite's 6-DOF parallel mechanisms among ``problems``: solvers, reference, timeouts
+    fk_solvers: list[str] = Field(default_factory=lambda: ["fkopt.forward"], min_length=1)
+    fk_reference: str = "scipy-least_squares"
+    fk_timeouts_ms: list[float] = Field(default_factory=lambda: [20.0, 100.0, 500.0], min_length=1)
 
     @model_validator(mode="after")
     def _names(self):
@@ -165,8 +169,14 @@ class ClockTrack(Strict):
                 raise ValueError(f"solver '{name}' is not a clock-track solver (allowed: {', '.join(known)})")
         if len(set(self.solvers)) != len(self.solvers) or len(set(self.problems)) != len(self.problems):
             raise ValueError("problems and solvers must not repeat")
-        if any(t <= 0 or t > 10_000 for t in self.timeouts_ms) or sorted(set(self.timeouts_ms)) != self.timeouts_ms:
-            raise ValueError("timeouts_ms: distinct, increasing, in (0, 10000] ms")
+        for field in ("timeouts_ms", "fk_timeouts_ms"):
+            ts = getattr(self, field)
+            if any(t <= 0 or t > 10_000 for t in ts) or sorted(set(ts)) != ts:
+                raise ValueError(f"{field}: distinct, increasing, in (0, 10000] ms")
+        fk_known = ("fkopt.forward", "scipy-least_squares")
+        for name in [*self.fk_solvers, self.fk_reference]:
+            if name not in fk_known:
+                raise ValueError(f"fk solver '{name}' is not a clock-track FK solver (allowed: {', '.join(fk_known)})")
         for sub in self.submissions:
             if sub.solver in [*self.solvers, self.reference] or [s.solver for s in self.submissions].count(sub.solver) > 1:
                 raise ValueError(f"submissions: solver '{sub.solver}' repeats a solver of the track")
@@ -180,9 +190,11 @@ class ThroughputTrack(Strict):
     """Queries per second at each batch size, for the clock's solvers that take batches."""
 
     batches: list[int] = Field(default_factory=lambda: [1, 10, 100, 1000], min_length=1)
+    #: batch sizes for FK of parallel mechanisms (fkopt.forward: ~0.1 s per pose on Dietmaier's platform)
+    fk_batches: list[int] = Field(default_factory=lambda: [1, 10, 100], min_length=1)
     repeats: int = Field(3, ge=1, le=100)
 
-    @field_validator("batches")
+    @field_validator("batches", "fk_batches")
     @classmethod
     def _batches(cls, batches):
         if any(b < 1 or b > 100_000 for b in batches) or sorted(set(batches)) != batches:

@@ -64,7 +64,15 @@ def robots_board_table(sr) -> pd.DataFrame | None:
     if answers is None or answers.empty:
         return None
     clock = sr.config.tracks.clock
-    board = clock_board(answers, timeouts_ms=tuple(clock.timeouts_ms), reference=clock.reference, rung=clock.rung)
+    fk = answers.groupby("robot", sort=False)["leg_residual"].apply(lambda v: v.notna().any())
+    parts = []
+    for is_fk, timeouts, reference in ((False, clock.timeouts_ms, clock.reference),
+                                       (True, clock.fk_timeouts_ms, clock.fk_reference)):
+        robots = [r for r, f in fk.items() if bool(f) == is_fk]
+        if robots:
+            parts.append(clock_board(answers[answers["robot"].isin(robots)], timeouts_ms=tuple(timeouts),
+                                     reference=reference, rung=clock.rung))
+    board = pd.concat(parts, ignore_index=True)
     tp = getattr(sr, "throughput", None)
     board["throughput_batch"], board["throughput_qps"], board["throughput_ratio"] = np.nan, np.nan, np.nan
     if tp is not None and not tp.empty:
@@ -106,15 +114,18 @@ def robots_top_lines(board: pd.DataFrame, top: int = 3) -> list[str]:
     ratio to the reference)."""
     success = [c for c in board.columns if c.startswith("success_")]
     lines = []
-    t = board["timeout_ms"].max()
-    for robot, g in board[board["timeout_ms"] == t].groupby("robot", sort=False):
+    for robot, g in board.groupby("robot", sort=False):
+        t = g["timeout_ms"].max()
+        g = g[g["timeout_ms"] == t]
         ref = g["reference"].iloc[0]
         lines.append(f"{robot} (timeout {t:g} ms; time to an answer at {g['rung'].iloc[0]}, ratio to {ref}; "
                      f"success at {', '.join(c[len('success_'):] for c in success)}):")
         for _, row in g.head(top).iterrows():
             pct = " / ".join(f"{100 * row[c]:.0f}" for c in success)
             qps = "" if np.isnan(row["throughput_qps"]) else f", {row['throughput_qps']:.0f} queries/s at batch {row['throughput_batch']:.0f}"
-            lines.append(f"  {row['solver']:<16} [{row['entry']}] success {pct} %, median {row['time_ms_median']:.3g} ms "
+            other = "" if "other_mode" not in row or pd.isna(row["other_mode"]) else \
+                f", another assembly mode {100 * row['other_mode']:.0f} %"
+            lines.append(f"  {row['solver']:<16} [{row['entry']}] success {pct} %{other}, median {row['time_ms_median']:.3g} ms "
                          f"(x{row['time_ratio_median']:.3g}), p95 {row['time_ms_p95']:.3g} ms (x{row['time_ratio_p95']:.3g}){qps}")
     return lines
 

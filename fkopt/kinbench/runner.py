@@ -132,9 +132,14 @@ def track_arm(config: SuiteConfig, p: int):
     """The URDF arm of clock-track problem ``p`` (the field's packages read URDF only)."""
     problem = config.problems[p]
     mech, _ = problem_mechanism(problem, config._folder)
+    if getattr(mech, "kind", None) == "parallel":
+        if len(mech.unknown_names) != 6 or tuple(mech.pose_units[3:]) != ("deg",) * 3:
+            raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a 6-DOF parallel mechanism "
+                             "(x, y, z, three angles): the FK clock judges poses in m and rad")
+        return mech
     if getattr(mech, "kind", None) != "serial" or not hasattr(mech, "path") or not hasattr(mech, "tip_link"):
-        raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf); "
-                         "the clock track's solvers read URDF files")
+        raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf) or a "
+                         "6-DOF parallel mechanism; the clock track's IK solvers read URDF files")
     return mech
 
 
@@ -143,7 +148,9 @@ def read_submissions(config: SuiteConfig, tracks) -> pd.DataFrame | None:
     if not tracks or not config.tracks.clock.submissions:
         return None
     from .submissions import read_submission
+    from .clock import is_ik
     arms = {config.problems[p].name: (track_arm(config, p), queries) for p, queries in tracks}
+    arms = {name: v for name, v in arms.items() if is_ik(v[0])}       # submissions: IK answers
     return pd.concat([read_submission(config, k, arms) for k in range(len(config.tracks.clock.submissions))],
                      ignore_index=True)
 
@@ -151,19 +158,19 @@ def read_submissions(config: SuiteConfig, tracks) -> pd.DataFrame | None:
 def validate_track(config: SuiteConfig, p: int) -> None:
     """Every clock-track solver built once on arm ``p``: a missing package or an arm a package
     misreads is one line before any work."""
-    from .clock import make_solver
+    from .clock import make_solver, track_settings
     arm = track_arm(config, p)
-    clock = config.tracks.clock
-    for name in dict.fromkeys([clock.reference, *clock.solvers]):
+    solvers, reference, timeouts = track_settings(config.tracks.clock, arm)
+    for name in dict.fromkeys([reference, *solvers]):
         try:
-            make_solver(name, arm, timeout=max(clock.timeouts_ms) / 1e3, rng=np.random.default_rng(0))
+            make_solver(name, arm, timeout=max(timeouts) / 1e3, rng=np.random.default_rng(0))
         except FkoptError as err:
             raise FkoptError(f"tracks.clock.solvers[{name}] on problems[{config.problems[p].name}]: {err}") from None
 
 
 def solve_track(payload: dict) -> dict:
     """Worker: the clock (and throughput) track on one arm; returns every answer, JSON-able."""
-    from .clock import run_clock, run_throughput
+    from .clock import run_clock, run_throughput, track_settings
     config = suite_from_dict(payload["config"], "suite task")
     config._folder = Path(payload["folder"]) if payload["folder"] else None
     p, clock, tp = payload["problem"], config.tracks.clock, config.tracks.throughput
@@ -171,13 +178,15 @@ def solve_track(payload: dict) -> dict:
     name = config.problems[p].name
     queries = np.asarray(payload["queries"], dtype=float)
     start = time.perf_counter()
-    answers = run_clock(arm, name, queries, clock.solvers, timeouts_ms=tuple(clock.timeouts_ms),
-                        reference=clock.reference, seed=config.seed)
+    solvers, reference, timeouts = track_settings(clock, arm)
+    answers = run_clock(arm, name, queries, solvers, timeouts_ms=timeouts, reference=reference, seed=config.seed)
     answers.insert(1, "set", clock.set)
     rate = None
     if tp is not None:
-        rate = run_throughput(arm, name, queries, clock.solvers, batches=tuple(tp.batches), repeats=tp.repeats,
-                              reference=clock.reference, seed=config.seed).to_dict(orient="list")
+        from .clock import is_ik
+        batches = tp.batches if is_ik(arm) else tp.fk_batches
+        rate = run_throughput(arm, name, queries, solvers, batches=tuple(batches), repeats=tp.repeats,
+                              reference=reference, seed=config.seed).to_dict(orient="list")
     return {"fingerprint": payload["fingerprint"], "track": "clock", "problem": p,
             "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start}
 
