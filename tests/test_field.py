@@ -147,5 +147,5 @@ def test_clock_track_with_the_field_reference():
     assert sorted(a.loc[a.solver == "tracik", "given_timeout_ms"].unique()) == [1.0, 5.0, 20.0]
     b = clock_board(a)
     assert len(b) == 9 and set(b["entry"]) == {"organiser", "outside"}
-    assert (b.loc[b.solver == "rtb-ik_LM", "time_ratio_median"] == 1.0).all()
+    assert (b.loc[b.solver == "rtb-ik_LM", "time_ratio_median"] >= 1.0).all()     # first call / best of 3
     assert (b.loc[b.solver == "fkopt.inverse", "success_1e-05m_1e-05rad"] == 1.0).all()

@@ -72,7 +72,8 @@ def test_clock_track_stores_every_answer_verified_by_fkopt_fk():
     assert (a["position_m"] < 1e-8).all() and a["in_limits"].all() and (a["seconds"] > 0).all()
     assert (a["entry"] == "organiser").all()
     b = clock_board(a, timeouts_ms=(5.0, 20.0), reference="fkopt.inverse")
-    assert len(b) == 2 and (b["time_ratio_median"] == 1.0).all()
+    assert len(b) == 2 and (b["time_ratio_median"] >= 1.0).all()    # one call against the best of three
+    assert (a["reference_seconds"] <= a["seconds"]).all()
 
 
 def test_throughput_track_measures_batches_against_the_reference_rate():

@@ -13,9 +13,9 @@ Every answer is judged by :func:`fkopt.kinbench.physical.ik_verdicts` (fkopt's F
 limits), never by what the solver claims; at timeout t an answer is a success at a rung when
 the verdict says so *and* it came within t. Time to an answer at rung r and timeout t: the
 query's wall time when it is a success there, t otherwise (a failure counted at the timeout).
-Its ratio to the reference's wall time on the same query (whatever the reference's outcome)
-is what the board ranks: median and p95 over the queries, so that it means the same on
-another machine.
+Its ratio to the reference's wall time on the same query (whatever the reference's outcome;
+the fastest of :data:`REFERENCE_REPEATS` calls from the same start) is what the board ranks:
+median and p95 over the queries, so that it means the same on another machine.
 
 **Throughput track** (:func:`run_throughput`). Solvers that take batches (``solve_batch``:
 ``fkopt.inverse``) answer the first b queries (repeated when fewer) in one call at each batch
@@ -48,6 +48,11 @@ BATCHES = (1, 10, 100, 1000)
 REFERENCE = "rtb-ik_LM"
 #: The reference of FK of parallel mechanisms: scipy's least_squares from random starts.
 FK_REFERENCE = "scipy-least_squares"
+#: The reference's time on a query (the ratios' denominator) is the fastest of this many calls
+#: with the same start: measured here, the same rtb call (same answer, same search) took 0.19 ms
+#: in one run and 1.35 ms in another on this shared 2-core machine; the best of three is the
+#: machine's speed on that query, not its momentary load. Its board row keeps the first call.
+REFERENCE_REPEATS = 3
 #: fkopt's own solvers: the organiser's entries on a board; everything else is an outside entry.
 ORGANISER = ("fkopt.inverse", "fkopt.forward")
 
@@ -177,7 +182,7 @@ def _uses_timeout(solver) -> bool:
 
 
 def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *, timeouts_ms=TIMEOUTS_MS,
-              reference: str = REFERENCE, seed: int = 0) -> pd.DataFrame:
+              reference: str = REFERENCE, seed: int = 0, reference_repeats: int = REFERENCE_REPEATS) -> pd.DataFrame:
     """Every answer of the clock track on one arm (IK) or parallel mechanism (FK): one row per
     (query, solver, timeout given) with the answer (joints ``q0..`` or pose ``x0..``), the wall
     time, the reference's wall time on the same query (``reference_seconds``), the claim and the
@@ -196,19 +201,24 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
     n, k, dim = len(queries), len(runs), queries.shape[1]
     answers = np.full((n, k, dim), np.nan)
     seconds, claimed = np.zeros((n, k)), np.zeros((n, k), bool)
+    # a reference with a wall-clock limit is timed by its run at the largest timeout
+    j_ref = [j for j, r in enumerate(runs) if r[0] == reference][-1]
+    ref_seconds = np.full(n, np.inf)
     for i in range(n):
         for j in np.roll(np.arange(k), -(i % k)):                          # interleaved, rotated
             name, t, solver = runs[j]
-            solver.rng = query_rng(seed, robot, name, t, i)
-            t0 = time.perf_counter()
-            q, ok = solver.solve1(targets[i])
-            seconds[i, j] = time.perf_counter() - t0
-            claimed[i, j] = bool(ok)
-            if q is not None:
-                answers[i, j] = q
+            for rep in range(reference_repeats if j == j_ref else 1):
+                solver.rng = query_rng(seed, robot, name, t, i)            # the same start each time
+                t0 = time.perf_counter()
+                q, ok = solver.solve1(targets[i])
+                dt = time.perf_counter() - t0
+                if rep == 0:
+                    seconds[i, j], claimed[i, j] = dt, bool(ok)
+                    if q is not None:
+                        answers[i, j] = q
+                if j == j_ref:
+                    ref_seconds[i] = min(ref_seconds[i], dt)
     frames = []
-    # a reference with a wall-clock limit is timed by its run at the largest timeout
-    ref_seconds = seconds[:, [j for j, r in enumerate(runs) if r[0] == reference][-1]]
     prefix = answer_prefix(mechanism)
     for j, (name, t, solver) in enumerate(runs):
         v = verdicts(mechanism, answers[:, j], queries, targets)
