@@ -49,9 +49,10 @@ REFERENCE = "rtb-ik_LM"
 #: The reference of FK of parallel mechanisms: scipy's least_squares from random starts.
 FK_REFERENCE = "scipy-least_squares"
 #: The reference's time on a query (the ratios' denominator) is the fastest of this many calls
-#: with the same start: measured here, the same rtb call (same answer, same search) took 0.19 ms
-#: in one run and 1.35 ms in another on this shared 2-core machine; the best of three is the
-#: machine's speed on that query, not its momentary load. Its board row keeps the first call.
+#: with the same start, spread over the query's rotation of solvers (so none is a warm repeat
+#: of the one before: back to back, rtb's second call was ~3x faster than its first): measured
+#: here, the same rtb call (same answer, same search) took 0.19 ms in one run and 1.35 ms in
+#: another on this shared 2-core machine. Its board row keeps its first call.
 REFERENCE_REPEATS = 3
 #: fkopt's own solvers: the organiser's entries on a board; everything else is an outside entry.
 ORGANISER = ("fkopt.inverse", "fkopt.forward")
@@ -205,19 +206,22 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
     j_ref = [j for j, r in enumerate(runs) if r[0] == reference][-1]
     ref_seconds = np.full(n, np.inf)
     for i in range(n):
-        for j in np.roll(np.arange(k), -(i % k)):                          # interleaved, rotated
+        order = [(int(j), 0) for j in np.roll(np.arange(k), -(i % k))]     # interleaved, rotated
+        at = order.index((j_ref, 0))
+        for rep in range(1, reference_repeats):       # the reference's repeats spread over the rotation
+            order.insert((at + rep * (k + rep) // reference_repeats) % (len(order) + 1), (j_ref, rep))
+        for j, rep in order:
             name, t, solver = runs[j]
-            for rep in range(reference_repeats if j == j_ref else 1):
-                solver.rng = query_rng(seed, robot, name, t, i)            # the same start each time
-                t0 = time.perf_counter()
-                q, ok = solver.solve1(targets[i])
-                dt = time.perf_counter() - t0
-                if rep == 0:
-                    seconds[i, j], claimed[i, j] = dt, bool(ok)
-                    if q is not None:
-                        answers[i, j] = q
-                if j == j_ref:
-                    ref_seconds[i] = min(ref_seconds[i], dt)
+            solver.rng = query_rng(seed, robot, name, t, i)                # the reference: the same start
+            t0 = time.perf_counter()
+            q, ok = solver.solve1(targets[i])
+            dt = time.perf_counter() - t0
+            if rep == 0:
+                seconds[i, j], claimed[i, j] = dt, bool(ok)
+                if q is not None:
+                    answers[i, j] = q
+            if j == j_ref:
+                ref_seconds[i] = min(ref_seconds[i], dt)
     frames = []
     prefix = answer_prefix(mechanism)
     for j, (name, t, solver) in enumerate(runs):
