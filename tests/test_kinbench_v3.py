@@ -259,3 +259,44 @@ def test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apa
     L = m.ik(sets[("dietmaier-6sps", "uniform")][:2])
     assert np.allclose(fwd["leg_residual"], np.max(np.abs(m.ik(X) - L) / L, axis=-1))
     assert set(pd.read_csv(folder / "throughput.csv")["batch"]) == {1, 2}
+
+
+def test_every_field_wrapper_is_importable_without_its_package_and_documents_settings_and_quirks():
+    """Each wrapper module imports its outside package only when built (so fkopt imports without
+    the [field] extra) and its docstring states the settings it uses and the quirks it handles."""
+    import importlib
+    from fkopt.adapters.field import BLACK_BOX, IK_SOLVERS, PACKAGES, BlackBoxIK, FieldIK
+    assert set(IK_SOLVERS) == set(PACKAGES) and set(BLACK_BOX) <= set(IK_SOLVERS)
+    modules = {m for m, _ in IK_SOLVERS.values()} | {"scipy_fk"}
+    for module in modules:
+        mod = importlib.import_module(f"fkopt.adapters.field.{module}")
+        doc = mod.__doc__ or ""
+        assert "Settings" in doc and ("Quirk" in doc or "quirk" in doc or module in ("lbfgsb", "scipy_fk")), module
+    for name, (module, cls) in IK_SOLVERS.items():
+        klass = getattr(importlib.import_module(f"fkopt.adapters.field.{module}"), cls)
+        assert issubclass(klass, BlackBoxIK if name in BLACK_BOX else FieldIK) and klass.name == name
+
+
+def test_the_black_box_objective_is_zero_at_the_answer_and_grows_with_the_error():
+    from fkopt.adapters.field import pose_objective
+    m = ur5()
+    q = queries(m, 1, 4)
+    f = pose_objective(m, m.fk_matrix(q)[0])
+    x = np.radians(q)
+    near, far = x + 1e-4, x + 1e-2
+    values = f(np.vstack([x, near, far]))
+    assert values[0] < 1e-24 and 0 < values[1] < values[2]
+
+
+def test_least_squares_fk_reference_returns_poses_fkopt_judges():
+    import fkopt
+    from fkopt.adapters.field.scipy_fk import LeastSquaresFK
+    from fkopt.kinbench.physical import fk_verdicts
+    m = fkopt.mechanism("6-sps")
+    x = m.bounds.mean(1) + np.random.default_rng(0).normal(0, 1, (2, 6)) * 0.02 * (m.bounds[:, 1] - m.bounds[:, 0])
+    legs = m.ik(x)
+    s = LeastSquaresFK(m, timeout=0.05, rng=np.random.default_rng(1))
+    poses = np.array([s.solve1(L)[0] for L in legs])
+    v = fk_verdicts(m, poses, x, legs)
+    assert poses.shape == (2, 6) and np.isfinite(v["leg_residual"]).all()
+    assert s.settings["jac"] == "2-point" and s.settings["timeout_s"] == 0.05
