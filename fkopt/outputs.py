@@ -121,6 +121,7 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
         Output("throughput.csv", f"{_SUITE}:throughput_table", TIMING),
         Output("leaderboard-robots.csv", f"{_SUITE}:robots_board_table", TIMING),
         Output("ecdf", f"{_SUITE}:ecdf_figures", FIGURE),
+        Output("clock", f"{_SUITE}:clock_figures", FIGURE),
         Output("leaderboard.md", f"{_SUITE}:leaderboard_markdown", FIGURE),   # never compared
         Output("index.html", f"{_SUITE}:html_page", FIGURE),                  # inlines the figures
     ),

@@ -125,7 +125,8 @@ def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
     assert any("fkopt.inverse" in line and "success 100 / 100 / 100 / 100 %" in line for line in lines)
     assert "Per robot, on the clock" in (folder / "leaderboard.md").read_text()
     page = (folder / "index.html").read_text()
-    assert page.index("Per robot, on the clock") < page.index("<h2>overall")
+    assert page.index("Per robot, on the clock") < page.index('alt="clock_ur5"') < page.index("<h2>overall")
+    assert (folder / "clock_panda.png").exists() and (folder / "clock_panda.pdf").exists()
 
 
 @pytest.mark.parametrize("clock, message", [
@@ -300,3 +301,10 @@ def test_least_squares_fk_reference_returns_poses_fkopt_judges():
     v = fk_verdicts(m, poses, x, legs)
     assert poses.shape == (2, 6) and np.isfinite(v["leg_residual"]).all()
     assert s.settings["jac"] == "2-point" and s.settings["timeout_s"] == 0.05
+
+
+def test_labels_at_the_end_of_ecdf_lines_are_spread_apart():
+    from fkopt.kinbench.reports import spread_labels
+    ys = spread_labels([1.0, 1.0, 0.2, 1.0, 0.21], 0.05)
+    assert sorted(np.round(np.diff(sorted(ys)), 9)) [0] >= 0.05
+    assert ys[2] == 0.2 and min(ys) == 0.2

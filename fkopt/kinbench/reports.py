@@ -90,6 +90,66 @@ def robots_board_table(sr) -> pd.DataFrame | None:
     return board[lead + [c for c in board.columns if c not in lead]].reset_index(drop=True)
 
 
+def spread_labels(ys, gap: float) -> list[float]:
+    """Label heights near ``ys`` at least ``gap`` apart (in the order of ``ys``), so that the
+    names at the right end of ECDF lines that end together do not overlap."""
+    order = np.argsort(ys, kind="stable")
+    out = np.asarray(ys, dtype=float).copy()
+    for a, b in zip(order[:-1], order[1:]):
+        out[b] = max(out[b], out[a] + gap)
+    return out.tolist()
+
+
+def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
+    """One ECDF per robot of the clock track at its largest timeout: the share of queries
+    answered at the track's rung (kinbench's verdict) against the time to the answer (ms, log),
+    one step line per solver and the virtual best solver (per query the fastest right answer of
+    any solver run here), the timeout marked; names at the right end, spread apart."""
+    from ..experiment.plotting import plt, save
+    from .clock import rung_success
+    from .physical import LADDER, rung_label
+    answers = tables.get("answers.csv.gz")
+    if answers is None or answers.empty:
+        return []
+    clock = sr.config.tracks.clock
+    pyplot = plt()
+    names = []
+    for robot, a in answers.groupby("robot", sort=False):
+        fk = a["leg_residual"].notna().any()
+        t = max(clock.fk_timeouts_ms if fk else clock.timeouts_ms)
+        a = a[(a["given_timeout_ms"].isna() | (a["given_timeout_ms"] == t)) & (a["source"] == "run")]
+        n = a["query"].nunique()
+        ok = rung_success(a)[:, clock.rung] & (a["seconds"].to_numpy() <= t / 1e3)
+        ms = np.where(ok, 1e3 * a["seconds"].to_numpy(), np.inf)
+        a = a.assign(_ms=ms)
+        fig, ax = pyplot.subplots(figsize=(5.6, 3.6))
+        ends = []
+        curves = [(solver, g.groupby("query")["_ms"].min()) for solver, g in a.groupby("solver", sort=False)]
+        curves.append(("virtual best", a.groupby("query")["_ms"].min()))
+        for solver, per_query in curves:
+            x = np.sort(per_query.to_numpy())
+            x = x[np.isfinite(x)]
+            y = np.arange(1, len(x) + 1) / n
+            xs, ys = np.concatenate([[1e-3], x, [t]]), np.concatenate([[0.0], y, [y[-1] if len(y) else 0.0]])
+            style = {"color": "black", "linestyle": ":"} if solver == "virtual best" else {}
+            line, = ax.step(xs, ys, where="post", **style)
+            ends.append((solver, ys[-1], line.get_color()))
+        for (solver, _, color), y in zip(ends, spread_labels([e[1] for e in ends], 0.045)):
+            ax.annotate(solver, (t, y), xytext=(4, 0), textcoords="offset points", fontsize=7, color=color,
+                        va="center", annotation_clip=False)
+        ax.axvline(t, color="grey", linewidth=0.8)
+        ax.set_xscale("log")
+        ax.set_xlim(1e-2, t * 1.05)
+        ax.set_ylim(-0.02, 1.02)
+        ax.set_xlabel(f"time to an answer (ms); timeout {t:g} ms marked")
+        ax.set_ylabel(f"share of {n} queries")
+        ax.set_title(f"{sr.config.name}: {robot}, answers at {rung_label(LADDER[clock.rung])} (kinbench's FK)",
+                     fontsize=8)
+        names += save(fig, folder / f"clock_{_slug(robot)}.png")
+        pyplot.close(fig)
+    return names
+
+
 def board_top_lines(folder: Path, top: int = 3) -> list[str]:
     """What ``fkopt suite`` prints when it ends: the first ``top`` rows of each track's overall
     ranking (leaderboard.csv) and the top of the per-robot board (leaderboard-robots.csv)."""
@@ -259,6 +319,7 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
     if robots is not None:
         body += ["<h2>Per robot, on the clock</h2>", f"<p>{html.escape(ROBOTS_PREAMBLE)}</p>",
                  table_html(robots, robot_columns(robots), "robots")]
+        body += [img(p) for p in sorted(folder.glob("clock_*.png"))]
     for k, (scope, g) in enumerate(leaderboard_sections(tables)):
         body += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
     figs = sorted(folder.glob("ecdf_*.png"))
