@@ -70,6 +70,7 @@ def cli(monkeypatch, capsys):
 # that no longer exists in its (collected) file is a usage error, not a silent no-op.
 FAST_TIER = "not slow and not stored and not external and not browser"
 TIERS = {
+    "tests/test_kinbench_v3.py::test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board": ("slow",),
     "tests/test_kinbench_v3.py::test_a_suite_with_tracks_writes_the_robot_board_and_every_answer": ("slow",),
     "tests/test_kinbench_v3.py::test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apart":
         ("slow",),

@@ -308,3 +308,40 @@ def test_labels_at_the_end_of_ecdf_lines_are_spread_apart():
     ys = spread_labels([1.0, 1.0, 0.2, 1.0, 0.21], 0.05)
     assert sorted(np.round(np.diff(sorted(ys)), 9)) [0] >= 0.05
     assert ys[2] == 0.2 and min(ys) == 0.2
+
+
+def test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board(tmp_path):
+    """The clock files vary run to run; check re-verifies them instead: an edited answer (a
+    better-looking verdict) or an edited board number is caught, an untouched folder passes."""
+    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.verify import reverify
+    path = tiny_v3(tmp_path)
+    folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
+    cfg = load_suite(path)
+    assert reverify(folder, cfg) == []
+    answers = pd.read_csv(folder / "answers.csv.gz")
+    answers.loc[0, "q0"] += 0.5                                 # a wrong answer, its verdict left as it was
+    answers.to_csv(folder / "answers.csv.gz", index=False, float_format="%.17g")
+    bad = reverify(folder, cfg)
+    assert bad and bad[0][0] == "answers.csv.gz" and bad[0][2] == "position_m"
+    answers.loc[0, "q0"] -= 0.5
+    answers.to_csv(folder / "answers.csv.gz", index=False, float_format="%.17g")
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    board.loc[0, "time_ratio_median"] *= 0.5                    # a faster-looking entry
+    board.to_csv(folder / "leaderboard-robots.csv", index=False)
+    bad = reverify(folder, cfg)
+    assert [(b[0], b[2]) for b in bad] == [("leaderboard-robots.csv", "time_ratio_median")]
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "fkopt.cli", "check", str(folder)], capture_output=True, text=True,
+                       env={"PYTHONPATH": str(TINY.parents[1]), "PATH": "/usr/bin:/bin"})
+    assert r.returncode == 1 and "leaderboard-robots.csv" in r.stdout + r.stderr
+
+
+def test_reverify_compares_infinities_and_skips_suites_without_tracks(tmp_path):
+    from types import SimpleNamespace
+    from fkopt.kinbench.verify import _close, reverify
+    assert _close([np.inf, 1.0, np.nan], [np.inf, 1.0 + 1e-12, np.nan]).all()
+    assert not _close([np.inf, 1.0], [-np.inf, 1.1]).any()
+    assert reverify(tmp_path, SimpleNamespace(tracks=None)) == []
