@@ -140,7 +140,9 @@ def check_overwrite(folder: Path, config, force: bool) -> None:
         return
     if force:
         return
-    if numeric_fields(stored) != numeric_fields(config.model_dump(mode="json")):
+    # a kind may record its config without fields left at defaults newer than its stored results
+    dump = config.stored_dump() if hasattr(config, "stored_dump") else config.model_dump(mode="json")
+    if numeric_fields(stored) != numeric_fields(dump):
         raise FkoptError(f"{folder}: holds a result of a different config (its result-changing fields "
                          "differ); rerun with --force to replace it")
 

@@ -234,7 +234,7 @@ def fingerprint(config: SuiteConfig, manifest: dict) -> str:
     """Hash of everything that changes a task's numbers: the config's result-changing fields and
     the pose sets (a resumed suite must match it)."""
     from ..experiment.config import numeric_fields
-    text = json.dumps([numeric_fields(config.model_dump(mode="json")), manifest], sort_keys=True)
+    text = json.dumps([numeric_fields(config.stored_dump()), manifest], sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
