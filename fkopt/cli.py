@@ -385,7 +385,10 @@ def _print_outcome(con, outcome, tasks: int) -> None:
         from .study.reports import summary_table
         _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
     elif getattr(result.config, "kind", None) == "suite":
+        from .kinbench.reports import board_top_lines
         con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
+        for line in board_top_lines(outcome.folder):
+            con.print(line, markup=False, highlight=False, soft_wrap=True)
     else:
         con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s)")
     reused = tasks - len(outcome.computed)

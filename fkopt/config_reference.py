@@ -233,6 +233,49 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
                   "poses, runs or a smaller budget.", "", {"solvers": ["gabc", "lm"], "poses": 3, "runs": 3}),
         "check": ("`ci`: the test suite reruns the stored result; `full`: only `fkopt check --subset all`.",
                   "", "full"),
+        "tracks": ("kinbench v3's tracks on the clock: IK of the suite's URDF arms by fkopt.inverse and "
+                   "the field's solvers, ranked by wall time as ratios to a reference solver "
+                   "(docs/kinbench.md).", "", {"clock": {"problems": ["ur5"], "solvers": ["fkopt.inverse", "tracik"]}}),
+    },
+    "Tracks": {
+        "clock": ("The clock track: every solver at every timeout on every query, interleaved with the "
+                  "reference.", "", {"problems": ["ur5"], "solvers": ["fkopt.inverse", "tracik"]}),
+        "throughput": ("Queries per second at each batch size, for the clock's solvers that take batches "
+                       "(fkopt.inverse).", "", {"batches": [1, 10, 100, 1000]}),
+    },
+    "ClockTrack": {
+        "problems": ("The suite's problems the track runs on (URDF arms: the field's packages read URDF).",
+                     "", ["ur5", "panda"]),
+        "solvers": ("fkopt.inverse (the organiser's) and the field's wrappers (fkopt.adapters.field).", "",
+                    ["fkopt.inverse", "tracik", "rtb-ik_NR", "pin-clik", "ikpy"]),
+        "reference": ("The solver every time is divided by, measured in the same job, query by query.", "",
+                      "rtb-ik_LM"),
+        "timeouts_ms": ("Timeouts; an answer later than the timeout is a failure counted at the timeout.",
+                        "ms", [1, 5, 20]),
+        "set": ("The pose set whose frozen poses are the queries.", "", "uniform"),
+        "queries": ("Queries per arm: the set's first N poses (the suite's `poses` does not cut them); "
+                    "default all.", "poses", 20),
+        "submissions": ("Solvers run elsewhere: per query their joints and wall time beside the reference's, "
+                        "verified by fkopt's FK (fkopt.kinbench.submissions).", "",
+                        [{"solver": "my-ik", "file": "my-ik.csv", "machine": "i7-1185G7, 1 thread"}]),
+        "fk_solvers": ("Solvers of FK on the track's 6-DOF parallel mechanisms.", "", ["fkopt.forward"]),
+        "fk_reference": ("The reference of FK: scipy least_squares from random starts.", "", "scipy-least_squares"),
+        "fk_timeouts_ms": ("Timeouts of FK.", "ms", [20, 100, 500]),
+        "rung": ("The ladder rung (0: 5 mm/0.05 rad, 1: 1 mm/0.01 rad, 2: 1e-5 m/1e-5 rad, 3: 1e-8 m/1e-8 "
+                 "rad) the time to an answer is judged at.", "", 2),
+    },
+    "ClockSubmission": {
+        "solver": ("Name of the submitted solver on the board.", "", "my-ik"),
+        "file": ("CSV of its answers per query (robot, query, q0.., seconds, reference_seconds), relative to "
+                 "the suite file.", "", "my-ik.csv"),
+        "machine": ("The machine it ran on (CPU, threads, OS).", "", "i7-1185G7, 1 thread, Ubuntu 24.04"),
+        "reference": ("The reference solver timed beside it; must be the track's.", "", "rtb-ik_LM"),
+        "description": ("Free text: what the solver is and how it was run.", "", "my-ik 0.3, default options"),
+    },
+    "ThroughputTrack": {
+        "batches": ("Batch sizes (the queries repeated when fewer).", "queries per call", [1, 10, 100, 1000]),
+        "repeats": ("Calls per batch size; the fastest counts.", "calls", 3),
+        "fk_batches": ("Batch sizes for FK of parallel mechanisms.", "queries per call", [1, 10, 100]),
     },
     "SuiteProblem": {
         "name": ("Name of the problem in the tables.", "", "mao2017-3rps"),
@@ -264,6 +307,7 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "poses": ("Poses per set.", "poses", 3),
         "runs": ("Runs per pose.", "runs", 3),
         "budget_per_dim": ("Budget per dimension.", "evaluations per dimension", 500),
+        "queries": ("Queries per arm of the clock track.", "poses", 5),
     },
 }
 #: Fields documented once for every model that inherits them.

@@ -72,6 +72,13 @@ FAST_TIER = "not slow and not stored and not external and not browser"
 TIERS = {
     "tests/test_bench_ik.py::test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones": ("external",),
     "tests/test_bench_ik.py::test_ik_sections_report_every_arm_ratios_and_verified_counts": ("external",),
+    "tests/test_kinbench_v3.py::test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board": ("slow",),
+    "tests/test_kinbench_v3.py::test_a_suite_with_tracks_writes_the_robot_board_and_every_answer": ("slow",),
+    "tests/test_kinbench_v3.py::test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apart":
+        ("slow",),
+    "tests/test_kinbench_v3.py::test_a_submission_claiming_success_on_wrong_answers_gets_failures": ("slow",),
+    "tests/test_kinbench_v3.py::test_fkopt_suite_exits_2_with_one_line_and_writes_nothing_on_a_bad_submission":
+        ("slow",),
     "tests/test_bench.py::test_quick_run_writes_csv_and_plot": ("slow",),
     "tests/test_kinbench.py::test_fkopt_check_passes_on_the_v2_quick_tier_and_fails_on_an_edited_number":
         ("slow", "stored"),

@@ -154,7 +154,9 @@ def check_overwrite(folder: Path, config, force: bool) -> None:
         return
     if force:
         return
-    old, new = numeric_fields(stored), numeric_fields(config.model_dump(mode="json"))
+    # a kind may record its config without fields left at defaults newer than its stored results
+    dump = config.stored_dump() if hasattr(config, "stored_dump") else config.model_dump(mode="json")
+    old, new = numeric_fields(stored), numeric_fields(dump)
     if old != new:
         changed = changed_fields(old, new)
         shown = "; ".join(changed[:3]) + (f"; and {len(changed) - 3} more" if len(changed) > 3 else "")

@@ -20,7 +20,17 @@
     runs: 5
     seed: 2026
     targets: [1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8, 1.0e-10]
-    quick: {problems: [...], solvers: [...], poses: 3, runs: 2, budget_per_dim: 300}
+    quick: {problems: [...], solvers: [...], poses: 3, runs: 2, budget_per_dim: 300, queries: 5}
+    tracks:                         # kinbench v3: IK solvers on the clock (fkopt.kinbench.clock)
+      clock:
+        problems: [ur5, panda]      # the suite's URDF arms; queries: their frozen poses of `set`
+        solvers: [fkopt.inverse, tracik, rtb-ik_NR, pin-clik, ikpy]   # fkopt.adapters.field names
+        reference: rtb-ik_LM        # every time is a ratio to this solver's, query by query
+        timeouts_ms: [1, 5, 20]
+        set: uniform
+        queries: 50                 # the set's first N poses (all when omitted)
+        rung: 2                     # the ladder rung (0..3) the time to an answer is judged at
+      throughput: {batches: [1, 10, 100, 1000], repeats: 3}   # the clock's arms and batch solvers
 
 A solver's iterations are chosen so its swarm can spend the budget
 (``ceil(budget / population)``); every measure is taken at the budget, from the cumulative
@@ -116,6 +126,94 @@ class QuickTier(Strict):
     poses: int | None = Field(None, ge=1)
     runs: int | None = Field(None, ge=1, le=MAX_RUNS)
     budget_per_dim: int | None = Field(None, ge=1, le=MAX_BUDGET_PER_DIM)
+    #: queries per arm of the clock track (its arms: those of tracks.clock.problems kept here)
+    queries: int | None = Field(None, ge=1)
+
+
+#: Solvers the clock track knows: the organiser's and the field's (fkopt.adapters.field).
+def clock_solvers() -> tuple[str, ...]:
+    from ..adapters.field import IK_SOLVERS
+    return ("fkopt.inverse", *IK_SOLVERS)
+
+
+class ClockSubmission(Strict):
+    """A solver run elsewhere on the clock track (:mod:`fkopt.kinbench.submissions`): a CSV of
+    its answers and wall times per query, the machine, and the reference timed beside it."""
+
+    solver: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+:-]{0,63}$")
+    file: str = Field(min_length=1)
+    machine: str = Field(min_length=1, max_length=200)
+    reference: str | None = None
+    description: str = ""
+
+
+class ClockTrack(Strict):
+    """The clock track (:mod:`fkopt.kinbench.clock`): IK of the suite's URDF arms, every solver
+    at every timeout, times as ratios to ``reference`` measured in the same job."""
+
+    problems: list[str] = Field(min_length=1)
+    solvers: list[str] = Field(min_length=1)
+    reference: str = "rtb-ik_LM"
+    timeouts_ms: list[float] = Field(default_factory=lambda: [1.0, 5.0, 20.0], min_length=1)
+    set: Literal["uniform", "near-singular", "boundary", "printed"] = "uniform"
+    queries: int | None = Field(None, ge=1, le=100_000)
+    rung: int = Field(2, ge=0, le=3)
+    submissions: list[ClockSubmission] = Field(default_factory=list)
+    #: FK of the suite's 6-DOF parallel mechanisms among ``problems``: solvers, reference, timeouts
+    fk_solvers: list[str] = Field(default_factory=lambda: ["fkopt.forward"], min_length=1)
+    fk_reference: str = "scipy-least_squares"
+    fk_timeouts_ms: list[float] = Field(default_factory=lambda: [20.0, 100.0, 500.0], min_length=1)
+
+    @model_validator(mode="after")
+    def _names(self):
+        known = clock_solvers()
+        for name in [*self.solvers, self.reference]:
+            if name not in known:
+                raise ValueError(f"solver '{name}' is not a clock-track solver (allowed: {', '.join(known)})")
+        if len(set(self.solvers)) != len(self.solvers) or len(set(self.problems)) != len(self.problems):
+            raise ValueError("problems and solvers must not repeat")
+        for field in ("timeouts_ms", "fk_timeouts_ms"):
+            ts = getattr(self, field)
+            if any(t <= 0 or t > 10_000 for t in ts) or sorted(set(ts)) != ts:
+                raise ValueError(f"{field}: distinct, increasing, in (0, 10000] ms")
+        fk_known = ("fkopt.forward", "scipy-least_squares")
+        for name in [*self.fk_solvers, self.fk_reference]:
+            if name not in fk_known:
+                raise ValueError(f"fk solver '{name}' is not a clock-track FK solver (allowed: {', '.join(fk_known)})")
+        for sub in self.submissions:
+            if sub.solver in [*self.solvers, self.reference] or [s.solver for s in self.submissions].count(sub.solver) > 1:
+                raise ValueError(f"submissions: solver '{sub.solver}' repeats a solver of the track")
+            if sub.reference is not None and sub.reference != self.reference:
+                raise ValueError(f"submissions[{sub.solver}].reference: '{sub.reference}' is not the track's "
+                                 f"reference ({self.reference}); its times would not be ratios to the same solver")
+        return self
+
+
+class ThroughputTrack(Strict):
+    """Queries per second at each batch size, for the clock's solvers that take batches."""
+
+    batches: list[int] = Field(default_factory=lambda: [1, 10, 100, 1000], min_length=1)
+    #: batch sizes for FK of parallel mechanisms (fkopt.forward: ~0.1 s per pose on Dietmaier's platform)
+    fk_batches: list[int] = Field(default_factory=lambda: [1, 10, 100], min_length=1)
+    repeats: int = Field(3, ge=1, le=100)
+
+    @field_validator("batches", "fk_batches")
+    @classmethod
+    def _batches(cls, batches):
+        if any(b < 1 or b > 100_000 for b in batches) or sorted(set(batches)) != batches:
+            raise ValueError("batches: distinct, increasing, 1 to 100000")
+        return batches
+
+
+class Tracks(Strict):
+    clock: ClockTrack | None = None
+    throughput: ThroughputTrack | None = None
+
+    @model_validator(mode="after")
+    def _needs_clock(self):
+        if self.throughput is not None and self.clock is None:
+            raise ValueError("throughput runs on the clock track's arms and solvers: give tracks.clock too")
+        return self
 
 
 class SuiteConfig(Located):
@@ -137,6 +235,8 @@ class SuiteConfig(Located):
     #: Solvers run elsewhere, imported from CSV files of evaluations and best-so-far per run.
     outside: list[OutsideSolver] = Field(default_factory=list)
     quick: QuickTier | None = None
+    #: kinbench v3's tracks on the clock (IK of the suite's URDF arms); None: none.
+    tracks: Tracks | None = None
     check: Literal["ci", "full"] = "full"
     _folder: Path | None = PrivateAttr(None)
 
@@ -221,6 +321,29 @@ class SuiteConfig(Located):
                                      f"({', '.join(known)})")
         return self
 
+    @model_validator(mode="after")
+    def _track_problems(self):
+        clock = self.tracks.clock if self.tracks is not None else None
+        if clock is not None:
+            known = [p.name for p in self.problems]
+            for name in clock.problems:
+                if name not in known:
+                    raise ValueError(f"tracks.clock.problems: '{name}' is not one of the suite's problems "
+                                     f"({', '.join(known)})")
+            if clock.set not in self.sets:
+                raise ValueError(f"tracks.clock.set: '{clock.set}' is not one of the suite's sets ({', '.join(self.sets)})")
+        return self
+
+    def stored_dump(self) -> dict:
+        """The config as meta.json records it: v3's fields (``tracks``, ``quick.queries``) only
+        when set, so a v1/v2 suite's stored meta.json is what a rerun writes."""
+        data = self.model_dump(mode="json")
+        if data.get("tracks") is None:
+            data.pop("tracks", None)
+        if isinstance(data.get("quick"), dict) and data["quick"].get("queries") is None:
+            data["quick"].pop("queries", None)
+        return data
+
     def quick_tier(self, where: str = "suite") -> "SuiteConfig":
         """The ``--quick`` subset as a config of its own (name ``<name>-quick``, no quick block)."""
         if self.quick is None:
@@ -236,6 +359,14 @@ class SuiteConfig(Located):
         for key in ("sets", "poses", "runs", "budget_per_dim"):
             if getattr(q, key) is not None:
                 data[key] = getattr(q, key)
+        clock = (data.get("tracks") or {}).get("clock")
+        if clock is not None:
+            kept = {p["name"] for p in data["problems"]}
+            clock["problems"] = [p for p in clock["problems"] if p in kept]
+            if q.queries is not None:
+                clock["queries"] = q.queries
+            if not clock["problems"] or clock["set"] not in data["sets"]:
+                data["tracks"] = None
         out = SuiteConfig(**data)
         out._folder = self._folder
         return out

@@ -74,20 +74,26 @@ def digest(config, entry, files: Path | None = None) -> str:
     return h.hexdigest()
 
 
-def _csv_log(path: Path, where: str) -> pd.DataFrame:
-    """The rows of an outside CSV (``.csv`` or ``.csv.gz``), read with
-    :func:`fkopt.files.read_input`'s bounds (a regular file, size and unpacked size capped)."""
+def read_csv_columns(path: Path, where: str, columns, dtype: dict, needs: str | None = None) -> pd.DataFrame:
+    """A submitted CSV (``.csv`` or ``.csv.gz``) with the ``columns`` it must have, read with
+    :func:`fkopt.files.read_input`'s bounds (a regular file, size and unpacked size capped); a
+    missing file, an unreadable one or a missing column is one line (``needs``: how the message
+    lists what is needed)."""
     if not path.exists() and not path.is_symlink():
         raise FkoptError(f"{where}: not found")
     data = read_input(path, MAX_INPUT_BYTES, field=where.partition(": ")[0])
     try:
-        df = pd.read_csv(io.BytesIO(data), dtype={"problem": str, "set": str})
+        df = pd.read_csv(io.BytesIO(data), dtype=dtype)         # read_input unpacked a .gz
     except (OSError, ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise FkoptError(f"{where}: unreadable CSV ({type(err).__name__})") from None
-    missing = [c for c in COLUMNS if c not in df.columns]
+    missing = [c for c in columns if c not in df.columns]
     if missing:
-        raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {', '.join(COLUMNS)}")
+        raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {needs or ', '.join(columns)}")
     return df
+
+
+def _csv_log(path: Path, where: str) -> pd.DataFrame:
+    return read_csv_columns(path, where, COLUMNS, {"problem": str, "set": str})
 
 
 def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:

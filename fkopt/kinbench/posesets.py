@@ -306,5 +306,5 @@ def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, s
                 raise FkoptError(f"{where}.sets.{name}.poses: {meta['poses']}, but {path} has {len(pts)} poses")
             out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
     from .releases import check_release
-    check_release(config, manifest)      # a released version: every file as released, not only as its manifest says
+    check_release(config, manifest, files)      # a released version: every file as released, not only as its manifest says
     return out, manifest

@@ -106,7 +106,16 @@ RELEASES: dict[str, Release] = {
 
 
 def sha256_file(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a file as it is on disk, read bounded (:func:`fkopt.files.read_input`)."""
+    from ..files import read_input
+    return hashlib.sha256(read_input(path, 64 << 20, unpack=False)).hexdigest()
+
+
+def _base(config, files) -> Path:
+    """Where the suite's relative files are: ``files``, else the suite file's folder."""
+    from ..experiment.config import files_folder
+    base = files if files is not None else files_folder(config)
+    return Path(base if base is not None else ".")
 
 
 def problem_files(config) -> list[str]:
@@ -122,9 +131,9 @@ def problem_files(config) -> list[str]:
     return sorted(set(out))
 
 
-def release_files(config) -> dict[str, str]:
+def release_files(config, files: Path | None = None) -> dict[str, str]:
     """path -> SHA-256 of every file of ``config``'s version: the pose-set folder and the problem files."""
-    base = Path(config._folder if config._folder is not None else ".")
+    base = _base(config, files)
     folder = base / config.pose_sets
     names = sorted(p.relative_to(base).as_posix() for p in folder.rglob("*") if p.is_file())
     return {name: sha256_file(base / name) for name in names + problem_files(config)}
@@ -138,8 +147,9 @@ def released_name(config, manifest: dict) -> str | None:
     return None
 
 
-def check_release(config, manifest: dict) -> None:
-    """Refuse (one line) a suite naming a released version whose files or fitness differ from it."""
+def check_release(config, manifest: dict, files: Path | None = None) -> None:
+    """Refuse (one line) a suite naming a released version whose files or fitness differ from it
+    (``files``: where the suite's relative files are, default the suite file's folder)."""
     name = released_name(config, manifest)
     if name is None:
         return
@@ -148,7 +158,7 @@ def check_release(config, manifest: dict) -> None:
     if release.fitness != FITNESS_VERSION:
         raise FkoptError(f"pose_sets: {name} was released with fitness definitions version {release.fitness}, "
                          f"this fkopt has version {FITNESS_VERSION} (CHANGES.md){new}")
-    base = Path(config._folder if config._folder is not None else ".")
+    base = _base(config, files)
     folder = base / config.pose_sets
     # the release's pose sets are in the folder named as the version; a copy may be named otherwise
     expected = {(f"{config.pose_sets}/{k.split('/', 1)[1]}" if k.startswith(name + "/") else k): v

@@ -17,6 +17,7 @@ from .. import record
 from ..files import file_names, md_text
 from . import measures as M
 from .outside import digest
+from .submissions import submission_digest
 
 
 def runs_table(sr) -> pd.DataFrame:
@@ -53,6 +54,156 @@ def scaling_table(sr) -> pd.DataFrame | None:
 def scaling_target(targets) -> float:
     """The target the scaling figure and section show: the middle of the ladder (1e-6 of v1-v3's)."""
     return sorted(targets, reverse=True)[len(targets) // 2]
+
+
+def answers_table(sr) -> pd.DataFrame | None:
+    """answers.csv.gz: every answer of the clock track (joints q0.., wall time, claim, and
+    fkopt's verdict), so anyone can re-verify the board."""
+    return getattr(sr, "answers", None)
+
+
+def throughput_table(sr) -> pd.DataFrame | None:
+    return getattr(sr, "throughput", None)
+
+
+def robots_board_table(sr) -> pd.DataFrame | None:
+    """leaderboard-robots.csv: per (solver, robot, timeout) the success share at every rung of
+    the ladder within the timeout, the time to an answer at the track's rung (median/p95, ms
+    and as a ratio to the reference on the same query), the throughput at the largest batch
+    (queries/s and its ratio to the reference's rate; empty for solvers that take no batches)
+    and the entry (organiser / outside). Sorted per robot and timeout by success at the rung,
+    then by median ratio."""
+    from .clock import clock_board
+    from .physical import LADDER, rung_label
+    answers = getattr(sr, "answers", None)
+    if answers is None or answers.empty:
+        return None
+    clock = sr.config.tracks.clock
+    fk = answers.groupby("robot", sort=False)["leg_residual"].apply(lambda v: v.notna().any())
+    parts = []
+    for is_fk, timeouts, reference in ((False, clock.timeouts_ms, clock.reference),
+                                       (True, clock.fk_timeouts_ms, clock.fk_reference)):
+        robots = [r for r, f in fk.items() if bool(f) == is_fk]
+        if robots:
+            parts.append(clock_board(answers[answers["robot"].isin(robots)], timeouts_ms=tuple(timeouts),
+                                     reference=reference, rung=clock.rung))
+    board = pd.concat(parts, ignore_index=True)
+    tp = getattr(sr, "throughput", None)
+    board["throughput_batch"], board["throughput_qps"], board["throughput_ratio"] = np.nan, np.nan, np.nan
+    if tp is not None and not tp.empty:
+        top = tp.sort_values("batch").groupby(["solver", "robot"], sort=False).last()
+        for (solver, robot), row in top.iterrows():
+            at = (board["solver"] == solver) & (board["robot"] == robot)
+            board.loc[at, ["throughput_batch", "throughput_qps", "throughput_ratio"]] = \
+                [row["batch"], row["queries_per_s"], row["ratio"]]
+    key = f"success_{rung_label(LADDER[clock.rung])}"
+    board["rung"] = rung_label(LADDER[clock.rung])
+    order = {r: k for k, r in enumerate(dict.fromkeys(board["robot"]))}
+    board = board.assign(_r=board["robot"].map(order), _s=-board[key])
+    board = board.sort_values(["_r", "timeout_ms", "_s", "time_ratio_median"], kind="stable").drop(columns=["_r", "_s"])
+    lead = ["solver", "robot", "timeout_ms", "entry"]
+    return board[lead + [c for c in board.columns if c not in lead]].reset_index(drop=True)
+
+
+def spread_labels(ys, gap: float) -> list[float]:
+    """Label heights near ``ys`` at least ``gap`` apart (in the order of ``ys``), so that the
+    names at the right end of ECDF lines that end together do not overlap."""
+    order = np.argsort(ys, kind="stable")
+    out = np.asarray(ys, dtype=float).copy()
+    for a, b in zip(order[:-1], order[1:]):
+        out[b] = max(out[b], out[a] + gap)
+    return out.tolist()
+
+
+def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
+    """One ECDF per robot of the clock track at its largest timeout: the share of queries
+    answered at the track's rung (kinbench's verdict) against the time to the answer (ms, log),
+    one step line per solver and the virtual best solver (per query the fastest right answer of
+    any solver run here), the timeout marked; names at the right end, spread apart."""
+    from ..experiment.plotting import plt, save
+    from .clock import rung_success
+    from .physical import LADDER, rung_label
+    answers = tables.get("answers.csv.gz")
+    if answers is None or answers.empty:
+        return []
+    clock = sr.config.tracks.clock
+    pyplot = plt()
+    names = []
+    stems = file_names(answers["robot"].unique())        # two distinct robots never share a file
+    for robot, a in answers.groupby("robot", sort=False):
+        fk = a["leg_residual"].notna().any()
+        t = max(clock.fk_timeouts_ms if fk else clock.timeouts_ms)
+        a = a[(a["given_timeout_ms"].isna() | (a["given_timeout_ms"] == t)) & (a["source"] == "run")]
+        n = a["query"].nunique()
+        ok = rung_success(a)[:, clock.rung] & (a["seconds"].to_numpy() <= t / 1e3)
+        ms = np.where(ok, 1e3 * a["seconds"].to_numpy(), np.inf)
+        a = a.assign(_ms=ms)
+        fig, ax = pyplot.subplots(figsize=(5.6, 3.6))
+        ends = []
+        curves = [(solver, g.groupby("query")["_ms"].min()) for solver, g in a.groupby("solver", sort=False)]
+        curves.append(("virtual best", a.groupby("query")["_ms"].min()))
+        for solver, per_query in curves:
+            x = np.sort(per_query.to_numpy())
+            x = x[np.isfinite(x)]
+            y = np.arange(1, len(x) + 1) / n
+            xs, ys = np.concatenate([[1e-3], x, [t]]), np.concatenate([[0.0], y, [y[-1] if len(y) else 0.0]])
+            style = {"color": "black", "linestyle": ":"} if solver == "virtual best" else {}
+            line, = ax.step(xs, ys, where="post", **style)
+            ends.append((solver, ys[-1], line.get_color()))
+        for (solver, _, color), y in zip(ends, spread_labels([e[1] for e in ends], 0.045)):
+            ax.annotate(solver, (t, y), xytext=(4, 0), textcoords="offset points", fontsize=7, color=color,
+                        va="center", annotation_clip=False)
+        ax.axvline(t, color="grey", linewidth=0.8)
+        ax.set_xscale("log")
+        ax.set_xlim(1e-2, t * 1.05)
+        ax.set_ylim(-0.02, 1.02)
+        ax.set_xlabel(f"time to an answer (ms); timeout {t:g} ms marked")
+        ax.set_ylabel(f"share of {n} queries")
+        ax.set_title(f"{sr.config.name}: {robot}, answers at {rung_label(LADDER[clock.rung])} (kinbench's FK)",
+                     fontsize=8)
+        names += save(fig, folder / f"clock_{stems[robot]}.png")
+        pyplot.close(fig)
+    return names
+
+
+def board_top_lines(folder: Path, top: int = 3) -> list[str]:
+    """What ``fkopt suite`` prints when it ends: the first ``top`` rows of each track's overall
+    ranking (leaderboard.csv) and the top of the per-robot board (leaderboard-robots.csv)."""
+    folder = Path(folder)
+    lines = []
+    lb_path = folder / "leaderboard.csv"
+    if lb_path.exists():
+        lb = pd.read_csv(lb_path)
+        for scope, g in lb.groupby("scope", sort=False):
+            if scope.startswith("track:"):
+                best = ", ".join(f"{r.solver} {r.score:.3f}" for r in g.head(top).itertuples())
+                lines.append(f"{scope} (score, evaluations): {best}")
+    robots = folder / "leaderboard-robots.csv"
+    if robots.exists():
+        lines += robots_top_lines(pd.read_csv(robots), top)
+    return lines
+
+
+def robots_top_lines(board: pd.DataFrame, top: int = 3) -> list[str]:
+    """The top of the per-robot board in physical units: per robot, at the largest timeout,
+    the first ``top`` solvers with success at every rung (%) and the median time (ms, and as a
+    ratio to the reference)."""
+    success = [c for c in board.columns if c.startswith("success_")]
+    lines = []
+    for robot, g in board.groupby("robot", sort=False):
+        t = g["timeout_ms"].max()
+        g = g[g["timeout_ms"] == t]
+        ref = g["reference"].iloc[0]
+        lines.append(f"{robot} (timeout {t:g} ms; time to an answer at {g['rung'].iloc[0]}, ratio to {ref}; "
+                     f"success at {', '.join(c[len('success_'):] for c in success)}):")
+        for _, row in g.head(top).iterrows():
+            pct = " / ".join(f"{100 * row[c]:.0f}" for c in success)
+            qps = "" if np.isnan(row["throughput_qps"]) else f", {row['throughput_qps']:.0f} queries/s at batch {row['throughput_batch']:.0f}"
+            other = "" if "other_mode" not in row or pd.isna(row["other_mode"]) else \
+                f", another assembly mode {100 * row['other_mode']:.0f} %"
+            lines.append(f"  {row['solver']:<16} [{row['entry']}] success {pct} %{other}, median {row['time_ms_median']:.3g} ms "
+                         f"(x{row['time_ratio_median']:.3g}), p95 {row['time_ms_p95']:.3g} ms (x{row['time_ratio_p95']:.3g}){qps}")
+    return lines
 
 
 def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
@@ -160,6 +311,18 @@ def preamble(c) -> str:
             "Tracks are ranked separately; 'overall' mixes them for reference only (docs/kinbench.md).")
 
 
+ROBOTS_PREAMBLE = ("IK of real arms, every answer checked by fkopt's FK (position m, geodesic rotation rad, "
+                   "joint limits), whatever the solver claims; success within the timeout at each rung; time to "
+                   "an answer (a failure counted at the timeout) in ms and as a ratio to the reference solver "
+                   "measured in the same job on the same query; entry: organiser (fkopt's own) or outside "
+                   "(docs/kinbench.md, v3).")
+
+
+def robot_columns(board: pd.DataFrame) -> list[str]:
+    return (["solver", "robot", "timeout_ms", "entry"] + [c for c in board.columns if c.startswith("success_")]
+            + ["time_ms_median", "time_ratio_median", "time_ratio_p95", "throughput_qps"])
+
+
 PER_PROBLEM = ["set", "solver", "track", "target", "trials", "success_rate", "ert"]
 
 
@@ -170,6 +333,9 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
     c = sr.config
     cols = leaderboard_columns(lb)
     out = [f"# {md_text(c.title or c.name)}", "", md_text(preamble(c)), ""]
+    robots = tables.get("leaderboard-robots.csv")
+    if robots is not None:
+        out += ["## Per robot, on the clock", "", ROBOTS_PREAMBLE, "", _md_table(robots, robot_columns(robots)), ""]
     for title, pred in (("Overall", lambda s: s == "overall"), ("Per track", lambda s: s.startswith("track:")),
                         ("Per problem class", lambda s: s.startswith("class:"))):
         out += [f"## {title}", ""]
@@ -209,6 +375,11 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
     cols = leaderboard_columns(lb)
     body = [f"<h1>{html.escape(c.title or c.name)}</h1>",
             f"<p>{html.escape(preamble(c))} Click a column header to sort.</p>"]
+    robots = tables.get("leaderboard-robots.csv")
+    if robots is not None:
+        body += ["<h2>Per robot, on the clock</h2>", f"<p>{html.escape(ROBOTS_PREAMBLE)}</p>",
+                 table_html(robots, robot_columns(robots), "robots")]
+        body += [img(p) for p in sorted(folder.glob("clock_*.png"))]
     for k, (scope, g) in enumerate(leaderboard_sections(tables)):
         body += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
     figs = sorted(folder.glob("ecdf_*.png"))
@@ -234,8 +405,18 @@ def meta(sr) -> dict:
     c = sr.config
     manifest = sr.manifest or {}
     canonical = hashlib.sha256(json.dumps(manifest, sort_keys=True).encode()).hexdigest()
-    return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.model_dump(mode="json"),
+    return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.stored_dump(),
             "config_file": sr.source,
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
             "outside": {o.solver: digest(c, o, sr.files) for o in c.outside},
-            "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)"}
+            "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)",
+            **submissions_meta(c, sr.files)}
+
+
+def submissions_meta(c, files=None) -> dict:
+    """meta.json's record of the clock track's outside submissions (only when there are any)."""
+    subs = c.tracks.clock.submissions if c.tracks is not None and c.tracks.clock is not None else []
+    if not subs:
+        return {}
+    return {"submissions": {s.solver: {"sha256": submission_digest(c, s, files), "machine": s.machine, "file": s.file,
+                                       "description": s.description} for s in subs}}

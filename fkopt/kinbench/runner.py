@@ -61,6 +61,8 @@ class SuiteResult:
     source: str | None = None
     trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
     files: Path | None = None            # where its relative files are (pose sets, outside logs)
+    answers: pd.DataFrame | None = None  # answers.csv.gz: every answer of the clock track (v3)
+    throughput: pd.DataFrame | None = None   # throughput.csv: queries/s per batch size (v3)
 
     @property
     def runs(self) -> pd.DataFrame:
@@ -114,12 +116,94 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances, files)
             digest(config, config.outside[k], files)   # every file meta.json will hash, read bounded now
+    tracks = track_cases(config, sets, files)
+    for p, _ in tracks:
+        validate_track(config, p, files)
+    read_submissions(config, tracks, files)
     return need
+
+
+def track_cases(config: SuiteConfig, sets: dict, files: Path | None = None) -> list[tuple[int, np.ndarray]]:
+    """(problem index, queries: joints of the clock set's first ``queries`` poses) of every
+    clock-track arm; the suite's ``poses`` (how many poses the swarms get) does not cut them."""
+    clock = config.tracks.clock if config.tracks is not None else None
+    if clock is None:
+        return []
+    if config.poses is not None:
+        sets, _ = load_pose_sets(config.model_copy(update={"poses": None}), files)
+    index = {p.name: k for k, p in enumerate(config.problems)}
+    return [(index[name], np.asarray(sets[(name, clock.set)][:clock.queries], dtype=float)) for name in clock.problems]
+
+
+def track_arm(config: SuiteConfig, p: int, files: Path | None = None):
+    """The URDF arm of clock-track problem ``p`` (the field's packages read URDF only)."""
+    problem = config.problems[p]
+    mech, _ = problem_mechanism(problem, files if files is not None else files_folder(config))
+    if getattr(mech, "kind", None) == "parallel":
+        if len(mech.unknown_names) != 6 or tuple(mech.pose_units[3:]) != ("deg",) * 3:
+            raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a 6-DOF parallel mechanism "
+                             "(x, y, z, three angles): the FK clock judges poses in m and rad")
+        return mech
+    if getattr(mech, "kind", None) != "serial" or not hasattr(mech, "path") or not hasattr(mech, "tip_link"):
+        raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf) or a "
+                         "6-DOF parallel mechanism; the clock track's IK solvers read URDF files")
+    return mech
+
+
+def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> pd.DataFrame | None:
+    """Every outside submission of the clock track, verified by fkopt's FK (answers rows)."""
+    if not tracks or not config.tracks.clock.submissions:
+        return None
+    from .submissions import read_submission
+    from .clock import is_ik
+    arms = {config.problems[p].name: (track_arm(config, p, files), queries) for p, queries in tracks}
+    arms = {name: v for name, v in arms.items() if is_ik(v[0])}       # submissions: IK answers
+    return pd.concat([read_submission(config, k, arms, files) for k in range(len(config.tracks.clock.submissions))],
+                     ignore_index=True)
+
+
+def validate_track(config: SuiteConfig, p: int, files: Path | None = None) -> None:
+    """Every clock-track solver built once on arm ``p``: a missing package or an arm a package
+    misreads is one line before any work."""
+    from .clock import make_solver, track_settings
+    arm = track_arm(config, p, files)
+    solvers, reference, timeouts = track_settings(config.tracks.clock, arm)
+    for name in dict.fromkeys([reference, *solvers]):
+        try:
+            make_solver(name, arm, timeout=max(timeouts) / 1e3, rng=np.random.default_rng(0))
+        except FkoptError as err:
+            raise FkoptError(f"tracks.clock.solvers[{name}] on problems[{config.problems[p].name}]: {err}") from None
+
+
+def solve_track(payload: dict) -> dict:
+    """Worker: the clock (and throughput) track on one arm; returns every answer, JSON-able."""
+    from .clock import run_clock, run_throughput, track_settings
+    config = suite_from_dict(payload["config"], "suite task")
+    files = Path(payload["folder"]) if payload["folder"] else None
+    p, clock, tp = payload["problem"], config.tracks.clock, config.tracks.throughput
+    arm = track_arm(config, p, files)
+    name = config.problems[p].name
+    queries = np.asarray(payload["queries"], dtype=float)
+    start = time.perf_counter()
+    solvers, reference, timeouts = track_settings(clock, arm)
+    answers = run_clock(arm, name, queries, solvers, timeouts_ms=timeouts, reference=reference, seed=config.seed)
+    answers.insert(1, "set", clock.set)
+    rate = None
+    if tp is not None:
+        from .clock import is_ik
+        batches = tp.batches if is_ik(arm) else tp.fk_batches
+        rate = run_throughput(arm, name, queries, solvers, batches=tuple(batches), repeats=tp.repeats,
+                              reference=reference, seed=config.seed).to_dict(orient="list")
+    return {"fingerprint": payload["fingerprint"], "track": "clock", "problem": p,
+            "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start}
 
 
 def solve_task(payload: dict) -> dict:
     """Worker: one (problem, solver) task on the cases (checked poses) the payload carries;
-    returns its record, JSON-able (a task file): run rows as columns of lists, wall time."""
+    returns its record, JSON-able (a task file): run rows as columns of lists, wall time. A
+    track task (``payload["track"]``) goes to :func:`solve_track`."""
+    if payload.get("track"):
+        return solve_track(payload)
     config = suite_from_dict(payload["config"], "suite task")
     problem = config.problems[payload["problem"]]
     solver = config.solvers[payload["solver"]]
@@ -163,7 +247,7 @@ def fingerprint(config: SuiteConfig, manifest: dict) -> str:
     """Hash of everything that changes a task's numbers: the config's result-changing fields and
     the pose sets (a resumed suite must match it)."""
     from ..experiment.config import numeric_fields
-    text = json.dumps([numeric_fields(config.model_dump(mode="json")), manifest], sort_keys=True)
+    text = json.dumps([numeric_fields(config.stored_dump()), manifest], sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -195,6 +279,18 @@ def record_problem(task, rec) -> str | None:
     not that it holds this task's numbers (an edited file with a re-signed manifest)."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
+    if task.payload.get("track"):
+        try:
+            if int(rec["problem"]) != task.payload["problem"] or rec["track"] != task.payload["track"]:
+                return "its problem/track are not its file name's"
+            if not isinstance(rec["answers"], dict) or not all(isinstance(v, list) for v in rec["answers"].values()):
+                return "answers: not a table of answers"
+            float(rec["wall_s"])
+        except KeyError as err:
+            return f"field {err.args[0]!r} is missing"
+        except (TypeError, ValueError) as err:
+            return f"{type(err).__name__}: {str(err)[:120]}"
+        return None
     payload = task.payload
     try:
         if rec["problem"] != payload["problem"] or rec["solver"] != payload["solver"] \
@@ -277,6 +373,9 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
     tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
+    tasks += [Task(f"t{p}", {"config": data, "folder": folder, "problem": p, "track": "clock", "fingerprint": fp,
+                             "queries": queries.tolist()}, f"{config.problems[p].name} / clock track")
+              for p, queries in track_cases(config, sets, files)]
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
                 context=_Context(sets, manifest, time.perf_counter() - started, files), name=f"suite '{config.name}'")
 
@@ -285,7 +384,15 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     """The run rows of every task, then the imported outside results, and the timing table."""
     merging = time.perf_counter()
     ctx: _Context = plan.context
-    done = [{**ran.records[t.id], "rows": rows_of(ran.records[t.id])} for t in plan.tasks]
+    done = [{**ran.records[t.id], "rows": rows_of(ran.records[t.id])} for t in plan.tasks
+            if not t.payload.get("track")]
+    tracked = [ran.records[t.id] for t in plan.tasks if t.payload.get("track")]
+    answers = pd.concat([pd.DataFrame(r["answers"]) for r in tracked], ignore_index=True) if tracked else None
+    submitted = read_submissions(config, track_cases(config, ctx.sets, ctx.files), ctx.files) if tracked else None
+    if submitted is not None:
+        answers = pd.concat([answers, submitted], ignore_index=True)
+    rates = [pd.DataFrame(r["throughput"]) for r in tracked if r.get("throughput")]
+    throughput = pd.concat(rates, ignore_index=True) if rates else None
     frames = [r["rows"] for r in done]
     if config.outside:
         dims = {config.problems[r["problem"]].name: r["dim"] for r in done}
@@ -297,7 +404,7 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
                                           "seconds": r["wall_s"], "mode": BATCH}) for r in done])
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
     return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
-                       suite_trace(config, done, runs, ctx.files), ctx.files)
+                       suite_trace(config, done, runs, ctx.files), ctx.files, answers, throughput)
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,

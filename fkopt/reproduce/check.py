@@ -222,6 +222,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
     out += recomputed_fitness(exp, config)
     out += missing_claims(exp)
     out += timing_verdicts(exp)
+    out += board_from_answers(label, exp, config)
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-check-"))
     try:
         with numerics_path.forced(stored_numerics(exp)):          # the path that made it
@@ -235,6 +236,18 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return out
+
+
+def board_from_answers(label: str, exp: Experiment, config) -> list[Mismatch]:
+    """A kinbench v3 suite: every stored answer judged again with fkopt's FK and the per-robot
+    board recomputed from them (:func:`fkopt.kinbench.verify.reverify`); the timing files
+    themselves are never compared with a rerun's."""
+    if getattr(config, "kind", None) != "suite" or getattr(config, "tracks", None) is None:
+        return []
+    from ..kinbench.verify import reverify
+    if config._folder is None and exp.meta.get("config_file"):
+        config._folder = Path(exp.meta["config_file"]).parent
+    return [Mismatch(label, *row) for row in reverify(exp.folder, config)]
 
 
 def missing_claims(exp: Experiment) -> list[Mismatch]:

@@ -15,12 +15,14 @@ given (no global RNG); a package whose internal restarts draw from its own RNG s
 ``timeout`` (s) is each query's wall-clock allowance: packages with a wall-clock limit get it
 (TRAC-IK), restart loops written here stop starting new searches once it has passed, and
 packages with only iteration limits (roboticstoolbox) run to their limits -- the clock track
-(:mod:`fkopt.kinbench.v3`) counts any answer later than the timeout as a failure at the timeout.
+(:mod:`fkopt.kinbench.clock`) counts any answer later than the timeout as a failure at the timeout.
 
 Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
-(roboticstoolbox-python ``ik_LM``, ``ik_NR``). Not yet written (issue 27): pinocchio CLIK, ikpy,
-CMA-ES, Nevergrad NGOpt, scipy L-BFGS-B, scipy ``least_squares`` for parallel FK;
-:func:`pose_objective` is the black-box objective they are meant to minimise.
+(roboticstoolbox-python ``ik_LM``, ``ik_NR``), :mod:`.pin` (pinocchio's CLIK), :mod:`.ikpy`;
+black-box optimisers on :func:`pose_objective` (:class:`BlackBoxIK`, restarts until the
+timeout): :mod:`.cmaes` (pycma, IPOP), :mod:`.lbfgsb` (scipy L-BFGS-B from random starts),
+:mod:`.nevergrad_ngopt` (NGOpt); FK of parallel mechanisms: :mod:`.scipy_fk` (scipy
+``least_squares`` from random starts, :class:`~.scipy_fk.LeastSquaresFK`).
 """
 from __future__ import annotations
 
@@ -38,10 +40,18 @@ IK_SOLVERS = {
     "tracik": ("tracik", "TracIK"),
     "rtb-ik_LM": ("rtb", "RtbLM"),
     "rtb-ik_NR": ("rtb", "RtbNR"),
+    "pin-clik": ("pin", "PinCLIK"),
+    "ikpy": ("ikpy", "IkPy"),
+    "cma-es": ("cmaes", "CmaES"),
+    "scipy-lbfgsb": ("lbfgsb", "LBFGSB"),
+    "nevergrad-ngopt": ("nevergrad_ngopt", "NGOpt"),
 }
 #: The outside package each wrapper needs (for the one-line message when it is missing).
 PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
-}
+            "pin-clik": "pin", "ikpy": "ikpy", "cma-es": "cma", "scipy-lbfgsb": "scipy",
+            "nevergrad-ngopt": "nevergrad"}
+#: Wrappers that only see the objective (the black-box track); the others use Jacobians.
+BLACK_BOX = ("cma-es", "scipy-lbfgsb", "nevergrad-ngopt")
 
 
 class FieldIK:
@@ -131,6 +141,36 @@ def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
 def soa(R: np.ndarray):
     """A (..., 3, 3) stack as :data:`fkopt.rotations.Matrix` (nested tuples of arrays)."""
     return tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3))
+
+
+class BlackBoxIK(FieldIK):
+    """A black-box optimiser on :func:`pose_objective` (fkopt's FK as the black box), restarted
+    from random in-limit starts until the objective is below ``FTARGET`` or the wall-clock
+    ``timeout`` has passed; subclasses supply :meth:`search` (one start, stopping by itself at
+    the deadline). FTARGET = 1e-17 m^2 puts both errors within 3.2e-9 (m, rad): every rung of
+    the ladder."""
+
+    FTARGET = 1e-17
+
+    def __init__(self, arm, *, timeout, rng):
+        super().__init__(arm, timeout=timeout, rng=rng)
+        self.settings.update(objective="|dp|^2 (m^2) + angle^2 (rad^2) on fkopt's FK", ftarget=self.FTARGET,
+                             start="uniform in limits (wrapper's generator), restarts until the timeout",
+                             wall_clock_limit=True)
+
+    def search(self, f, x0: np.ndarray, deadline: float) -> tuple[np.ndarray, float]:
+        raise NotImplementedError
+
+    def solve1(self, T):
+        f = pose_objective(self.arm, T)
+        deadline = time.perf_counter() + self.timeout
+        best_x, best_f = None, np.inf
+        while True:
+            x, fx = self.search(f, self.random_start(), deadline)
+            if fx < best_f:
+                best_x, best_f = np.clip(x, self.lo_rad, self.hi_rad), fx
+            if best_f <= self.FTARGET or time.perf_counter() > deadline:
+                return self.public(best_x), bool(best_f <= self.FTARGET)
 
 
 def pose_objective(arm, T: np.ndarray):

@@ -1,0 +1,314 @@
+"""kinbench v3's clock and throughput tracks: IK solvers ranked on wall time, in ratios to a
+reference solver measured in the same job.
+
+**Clock track** (:func:`run_clock`). Per robot, every query (a frozen in-limit configuration
+of the suite's pose set; the target is its tip frame by fkopt's FK) goes through every solver
+at every timeout of :data:`TIMEOUTS_MS`, and through the reference solver (roboticstoolbox's
+``ik_LM``, :data:`REFERENCE`), *interleaved*: query by query, the solvers in an order rotated by
+one per query, so slow drifts of the machine's load reach every solver alike. A solver with a
+wall-clock limit (its ``settings["wall_clock_limit"]`` is not False: TRAC-IK, pinocchio's
+CLIK, ikpy, the black-box optimisers) runs once per timeout with that timeout; one without
+(rtb, ``fkopt.inverse``) runs once per query and is judged at each timeout by its one time.
+Every answer is judged by :func:`fkopt.kinbench.physical.ik_verdicts` (fkopt's FK, joint
+limits), never by what the solver claims; at timeout t an answer is a success at a rung when
+the verdict says so *and* it came within t. Time to an answer at rung r and timeout t: the
+query's wall time when it is a success there, t otherwise (a failure counted at the timeout).
+Its ratio to the reference's wall time on the same query (whatever the reference's outcome;
+the fastest of :data:`REFERENCE_REPEATS` calls from the same start) is what the board ranks:
+median and p95 over the queries, so that it means the same on another machine.
+
+**Throughput track** (:func:`run_throughput`). Solvers that take batches (``solve_batch``:
+``fkopt.inverse``) answer the first b queries (repeated when fewer) in one call at each batch
+size of :data:`BATCHES`, best of ``repeats`` calls; queries per second, beside the reference's
+one-query-per-call rate over (at most 100 of) the same queries, timed right after each batch
+size (``ratio``), and the share of
+answers that pass each rung.
+
+Seeds: each (robot, solver, timeout, query) draws its starts from its own generator,
+``SeedSequence([seed, crc32("robot/solver/timeout"), query])``; no global RNG. TRAC-IK's and
+rtb's internal restarts use their own unseeded RNGs and every timing varies, so these files are
+timing files (never compared byte for byte by ``fkopt check``).
+"""
+from __future__ import annotations
+
+import time
+import zlib
+
+import numpy as np
+import pandas as pd
+
+from .physical import LADDER, fk_verdicts, ik_verdicts, rung_label
+
+#: Timeouts of the clock track (ms): IK of serial arms, FK of parallel mechanisms.
+TIMEOUTS_MS = (1.0, 5.0, 20.0)
+FK_TIMEOUTS_MS = (20.0, 100.0, 500.0)
+#: Batch sizes of the throughput track.
+BATCHES = (1, 10, 100, 1000)
+#: The IK solver every time is divided by (measured in the same job, query by query).
+REFERENCE = "rtb-ik_LM"
+#: The reference of FK of parallel mechanisms: scipy's least_squares from random starts.
+FK_REFERENCE = "scipy-least_squares"
+#: The reference's time on a query (the ratios' denominator) is the fastest of this many calls
+#: with the same start, spread over the query's rotation of solvers (so none is a warm repeat
+#: of the one before: back to back, rtb's second call was ~3x faster than its first): measured
+#: here, the same rtb call (same answer, same search) took 0.19 ms in one run and 1.35 ms in
+#: another on this shared 2-core machine. Its board row keeps its first call.
+REFERENCE_REPEATS = 3
+#: fkopt's own solvers: the organiser's entries on a board; everything else is an outside entry.
+ORGANISER = ("fkopt.inverse", "fkopt.forward")
+
+
+class FkoptInverse:
+    """The organiser's entry: :func:`fkopt.kinematics.inverse` with its defaults and
+    ``tol`` = (1e-9 m, 1e-9 rad), tight enough for every rung of the ladder. The start table
+    (4096 FK evaluations and its k-d tree) is built when the wrapper is made, outside the clock,
+    as the field's packages parse their URDF outside it. No wall-clock limit (it runs to its
+    restart limit); its seed per query comes from the wrapper's generator."""
+
+    name = "fkopt.inverse"
+    package = "fkopt"
+    TOL = (1e-9, 1e-9)
+
+    def __init__(self, arm, *, timeout: float, rng: np.random.Generator):
+        from ..kinematics import inverse
+        self.arm, self.timeout, self.rng, self._inverse = arm, float(timeout), rng, inverse
+        inverse(arm, arm.fk(arm.bounds.mean(axis=1)), tol=self.TOL)          # start table, outside the clock
+        self.settings = {"timeout_s": self.timeout, "tol": list(self.TOL), "wall_clock_limit": False,
+                         "seed": "per query from the wrapper's generator", "defaults": "fkopt.inverse's"}
+
+    def _poses(self, T: np.ndarray) -> np.ndarray:
+        from ..rotations import zyz_angles
+        R = T[..., :3, :3]
+        a, b, g = zyz_angles(tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3)))
+        return np.concatenate([T[..., :3, 3], np.degrees(np.stack([a, b, g], axis=-1))], axis=-1)
+
+    def solve1(self, T):
+        r = self._inverse(self.arm, self._poses(T), tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        return np.asarray(r.joints, dtype=float), bool(r.solved)
+
+    def solve_batch(self, T: np.ndarray) -> np.ndarray:
+        r = self._inverse(self.arm, self._poses(T), tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        return np.asarray(r.joints, dtype=float)
+
+
+class FkoptForward:
+    """The organiser's FK entry: :func:`fkopt.kinematics.forward` (local Newton, deterministic
+    restarts, global search) with ``tol`` = 1e-10 on max |ik(pose) - legs| (joint units); its
+    seed per query from the wrapper's generator; no wall-clock limit. One call before the clock
+    (imports, first-call set-up)."""
+
+    name = "fkopt.forward"
+    package = "fkopt"
+    TOL = 1e-10
+
+    def __init__(self, mechanism, *, timeout: float, rng: np.random.Generator):
+        from ..kinematics import forward
+        self.mechanism, self.timeout, self.rng, self._forward = mechanism, float(timeout), rng, forward
+        forward(mechanism, mechanism.ik(mechanism.bounds.mean(axis=1)[None])[0], tol=self.TOL)
+        self.settings = {"timeout_s": self.timeout, "tol": self.TOL, "wall_clock_limit": False,
+                         "seed": "per query from the wrapper's generator", "defaults": "fkopt.forward's"}
+
+    def solve1(self, legs):
+        r = self._forward(self.mechanism, legs, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        return np.asarray(r.pose, dtype=float), bool(r.solved)
+
+    def solve_batch(self, legs: np.ndarray) -> np.ndarray:
+        r = self._forward(self.mechanism, legs, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        return np.asarray(r.pose, dtype=float)
+
+
+#: Solvers of FK of parallel mechanisms on the clock.
+FK_SOLVERS = (FkoptForward.name, FK_REFERENCE)
+
+
+def is_ik(mechanism) -> bool:
+    """IK of a serial arm (targets: tip frames) or FK of a parallel mechanism (targets: legs)."""
+    return getattr(mechanism, "kind", None) == "serial"
+
+
+def make_solver(name: str, mechanism, *, timeout: float, rng: np.random.Generator):
+    """The organiser's solver or a field wrapper (:func:`fkopt.adapters.field.make_ik`; for
+    FK, :class:`fkopt.adapters.field.scipy_fk.LeastSquaresFK`)."""
+    if name == FkoptInverse.name:
+        return FkoptInverse(mechanism, timeout=timeout, rng=rng)
+    if name == FkoptForward.name:
+        return FkoptForward(mechanism, timeout=timeout, rng=rng)
+    if name == FK_REFERENCE:
+        from ..adapters.field.scipy_fk import LeastSquaresFK
+        return LeastSquaresFK(mechanism, timeout=timeout, rng=rng)
+    from ..adapters.field import make_ik
+    return make_ik(name, mechanism, timeout=timeout, rng=rng)
+
+
+def track_settings(clock, mechanism) -> tuple[list[str], str, tuple[float, ...]]:
+    """(solvers, reference, timeouts in ms) of the clock-track config ``clock`` on ``mechanism``:
+    the IK ones for a serial arm, the ``fk_`` ones for a parallel mechanism."""
+    if is_ik(mechanism):
+        return list(clock.solvers), clock.reference, tuple(clock.timeouts_ms)
+    return list(clock.fk_solvers), clock.fk_reference, tuple(clock.fk_timeouts_ms)
+
+
+def targets_of(mechanism, queries: np.ndarray) -> np.ndarray:
+    """What the solvers get per query: the tip frame (IK) or the leg lengths (FK)."""
+    return mechanism.fk_matrix(queries) if is_ik(mechanism) else mechanism.ik(queries)
+
+
+def verdicts(mechanism, answers: np.ndarray, queries: np.ndarray, targets: np.ndarray) -> dict:
+    """kinbench's verdict on answers (n, dim): ``position_m``, ``rotation_rad``, ``in_limits``
+    (IK: joints inside the limits; FK: answered), ``leg_residual`` (FK; NaN for IK) and
+    ``success`` (n, rungs) (:mod:`fkopt.kinbench.physical`)."""
+    if is_ik(mechanism):
+        v = ik_verdicts(mechanism, answers, targets)
+        return {**v, "leg_residual": np.full(len(answers), np.nan)}
+    v = fk_verdicts(mechanism, answers, queries, targets)
+    return {**v, "in_limits": np.all(np.isfinite(answers), axis=-1)}
+
+
+def answer_prefix(mechanism) -> str:
+    """Column prefix of an answer's components: q (joints) for IK, x (pose) for FK."""
+    return "q" if is_ik(mechanism) else "x"
+
+
+def entry_of(name: str) -> str:
+    return "organiser" if name in ORGANISER else "outside"
+
+
+def query_rng(seed: int, robot: str, solver: str, timeout_ms: float | None, query: int) -> np.random.Generator:
+    key = zlib.crc32(f"{robot}/{solver}/{timeout_ms}".encode())
+    return np.random.default_rng(np.random.SeedSequence([int(seed), key, int(query)]))
+
+
+def _uses_timeout(solver) -> bool:
+    return solver.settings.get("wall_clock_limit", True) is not False
+
+
+def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *, timeouts_ms=TIMEOUTS_MS,
+              reference: str = REFERENCE, seed: int = 0, reference_repeats: int = REFERENCE_REPEATS) -> pd.DataFrame:
+    """Every answer of the clock track on one arm (IK) or parallel mechanism (FK): one row per
+    (query, solver, timeout given) with the answer (joints ``q0..`` or pose ``x0..``), the wall
+    time, the reference's wall time on the same query (``reference_seconds``), the claim and the
+    verdict (``position_m``, ``rotation_rad``, ``in_limits``, ``leg_residual``). ``queries``:
+    joints (IK) or poses (FK) in public units, the frozen pose set's points;
+    ``given_timeout_ms`` is NaN for a solver without a wall-clock limit (run once)."""
+    targets = targets_of(mechanism, queries)
+    runs: list[tuple[str, float | None, object]] = []         # (solver name, timeout given, wrapper)
+    for name in dict.fromkeys([reference, *solvers]):
+        first = make_solver(name, mechanism, timeout=max(timeouts_ms) / 1e3, rng=np.random.default_rng(0))
+        if _uses_timeout(first):
+            runs += [(name, t, make_solver(name, mechanism, timeout=t / 1e3, rng=np.random.default_rng(0)))
+                     for t in timeouts_ms]
+        else:
+            runs.append((name, None, first))
+    n, k, dim = len(queries), len(runs), queries.shape[1]
+    answers = np.full((n, k, dim), np.nan)
+    seconds, claimed = np.zeros((n, k)), np.zeros((n, k), bool)
+    # a reference with a wall-clock limit is timed by its run at the largest timeout
+    j_ref = [j for j, r in enumerate(runs) if r[0] == reference][-1]
+    ref_seconds = np.full(n, np.inf)
+    for i in range(n):
+        order = [(int(j), 0) for j in np.roll(np.arange(k), -(i % k))]     # interleaved, rotated
+        at = order.index((j_ref, 0))
+        for rep in range(1, reference_repeats):       # the reference's repeats spread over the rotation
+            order.insert((at + rep * (k + rep) // reference_repeats) % (len(order) + 1), (j_ref, rep))
+        for j, rep in order:
+            name, t, solver = runs[j]
+            solver.rng = query_rng(seed, robot, name, t, i)                # the reference: the same start
+            t0 = time.perf_counter()
+            q, ok = solver.solve1(targets[i])
+            dt = time.perf_counter() - t0
+            if rep == 0:
+                seconds[i, j], claimed[i, j] = dt, bool(ok)
+                if q is not None:
+                    answers[i, j] = q
+            if j == j_ref:
+                ref_seconds[i] = min(ref_seconds[i], dt)
+    frames = []
+    prefix = answer_prefix(mechanism)
+    for j, (name, t, solver) in enumerate(runs):
+        v = verdicts(mechanism, answers[:, j], queries, targets)
+        frame = pd.DataFrame({"robot": robot, "query": np.arange(n), "solver": name, "entry": entry_of(name),
+                              "source": "run", "given_timeout_ms": np.nan if t is None else t,
+                              "seconds": seconds[:, j], "reference_seconds": ref_seconds,
+                              "claimed": claimed[:, j], "position_m": v["position_m"],
+                              "rotation_rad": v["rotation_rad"], "in_limits": v["in_limits"],
+                              "leg_residual": v["leg_residual"]})
+        for d in range(dim):
+            frame[f"{prefix}{d}"] = answers[:, j, d]
+        frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
+
+
+def rung_success(answers: pd.DataFrame, ladder=LADDER) -> np.ndarray:
+    """(rows, rungs): the verdict at each rung of the ladder (errors within it, in limits)."""
+    pe, re = answers["position_m"].to_numpy(), answers["rotation_rad"].to_numpy()
+    lim = answers["in_limits"].to_numpy(bool)
+    return np.stack([(pe <= p) & (re <= r) & lim for p, r in ladder], axis=-1)
+
+
+def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: str | dict = REFERENCE,
+                rung: int = 2, ladder=LADDER) -> pd.DataFrame:
+    """Per (robot, solver, timeout): success share at every rung within the timeout, and the
+    time to an answer at rung ``rung`` (ms and as a ratio to the reference's time on the same
+    query, each row's ``reference_seconds``: measured in this job for the solvers run here, on
+    the submitter's machine for a submission): median and p95, a failure counted at the
+    timeout. ``reference_ms_median``: the reference's own median here. ``reference``: one name,
+    or robot -> name (IK arms and parallel mechanisms have different references). FK rows (a
+    ``leg_residual``) also get ``other_mode``: the share of answers within the timeout whose legs
+    solve the equations to the rung's tolerance in another assembly mode."""
+    rows = []
+    for robot, a in answers.groupby("robot", sort=False):
+        ref_name = reference.get(robot, REFERENCE) if isinstance(reference, dict) else reference
+        ref = a[a["solver"] == ref_name]
+        ref_ms = 1e3 * float(ref.groupby("query")["seconds"].first().median()) if len(ref) else np.nan
+        for name, s in a.groupby("solver", sort=False):
+            for t in timeouts_ms:
+                g = s[s["given_timeout_ms"].isna() | (s["given_timeout_ms"] == t)].sort_values("query")
+                ok = rung_success(g, ladder) & (g["seconds"].to_numpy() <= t / 1e3)[:, None]
+                tta = np.where(ok[:, rung], g["seconds"].to_numpy(), t / 1e3)
+                ratio = tta / g["reference_seconds"].to_numpy()
+                row = {"solver": name, "robot": robot, "timeout_ms": t, "entry": entry_of(name),
+                       "queries": len(g)}
+                leg = g["leg_residual"].to_numpy(float) if "leg_residual" in g else np.full(len(g), np.nan)
+                if (~np.isnan(leg)).any():
+                    solved = (leg <= ladder[rung][0]) & (g["seconds"].to_numpy() <= t / 1e3)
+                    row["other_mode"] = float((solved & ~ok[:, rung]).mean())
+                row.update({f"success_{rung_label(r)}": float(ok[:, k].mean()) for k, r in enumerate(ladder)})
+                row.update({"time_ms_median": 1e3 * float(np.median(tta)), "time_ms_p95": 1e3 * float(np.percentile(tta, 95)),
+                            "time_ratio_median": float(np.median(ratio)), "time_ratio_p95": float(np.percentile(ratio, 95)),
+                            "reference": ref_name, "reference_ms_median": ref_ms,
+                            "source": g["source"].iloc[0] if "source" in g else "run"})
+                rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, batches=BATCHES, repeats: int = 3,
+                   reference: str = REFERENCE, seed: int = 0, reference_queries: int = 100) -> pd.DataFrame:
+    """Queries per second of every batch-taking solver at each batch size (best of ``repeats``
+    calls), beside the reference's rate one query per call on the first ``reference_queries``
+    queries (timed right after each batch size), and the share of answers passing each
+    rung (fkopt's verdict)."""
+    targets = targets_of(arm, queries)
+    ref = make_solver(reference, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, reference, -1, 0))
+    rows = []
+    m = min(reference_queries, len(targets))
+    for name in solvers:
+        solver = make_solver(name, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, name, -1, 0))
+        if not hasattr(solver, "solve_batch"):
+            continue
+        for b in batches:
+            idx = np.arange(b) % len(targets)
+            best = np.inf
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                q = solver.solve_batch(targets[idx])
+                best = min(best, time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            for i in range(m):
+                ref.solve1(targets[i])
+            ref_qps = m / (time.perf_counter() - t0)
+            v = verdicts(arm, q, queries[idx], targets[idx])
+            row = {"solver": name, "robot": robot, "entry": entry_of(name), "batch": b, "queries_per_s": b / best,
+                   "reference": reference, "reference_queries_per_s": ref_qps, "ratio": (b / best) / ref_qps}
+            row.update({f"success_{rung_label(r)}": float(v["success"][:, k].mean()) for k, r in enumerate(LADDER)})
+            rows.append(row)
+    return pd.DataFrame(rows)
