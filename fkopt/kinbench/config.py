@@ -335,13 +335,16 @@ class SuiteConfig(Located):
         return self
 
     def stored_dump(self) -> dict:
-        """The config as meta.json records it: v3's fields (``tracks``, ``quick.queries``) only
-        when set, so a v1/v2 suite's stored meta.json is what a rerun writes."""
+        """The config as meta.json records it: v3's fields (``tracks``, ``quick.queries``,
+        a problem's ``instances``) only when set, so a v1/v2 suite's stored meta.json is what a rerun writes."""
         data = self.model_dump(mode="json")
         if data.get("tracks") is None:
             data.pop("tracks", None)
         if isinstance(data.get("quick"), dict) and data["quick"].get("queries") is None:
             data["quick"].pop("queries", None)
+        for problem in data.get("problems") or []:      # v3's geometry instances, only when asked for
+            if isinstance(problem, dict) and problem.get("instances") is None:
+                problem.pop("instances", None)
         return data
 
     def quick_tier(self, where: str = "suite") -> "SuiteConfig":
