@@ -34,14 +34,17 @@ reproduce-peers:
 	$(FKOPT) reproduce --configs peers --out results/peers
 	$(PYTHON) -m fkopt.peers results/peers
 
-# kinbench (docs/kinbench.md): v1 and v2 in full, their quick tiers (which CI's check reruns) and
-# the libraries subset into results/kinbench/, then the report (~15 min on 2 cores, 7-8 of them the
-# libraries subset). Not part of `make reproduce`.
+# kinbench (docs/kinbench.md): v1 and v2 in full, v3's per-robot board on the clock (one process:
+# its times are ratios measured side by side), the quick tiers (which CI's check reruns: v1, v2, v3
+# and v3's board) and the libraries subset into results/kinbench/, then the report (~25 min on 2
+# cores). v3's evaluations track in full (kinbench-v3.yaml, 92 problems) is not part of it: about
+# 10 CPU-hours (docs/kinbench.md). Not part of `make reproduce`.
 bench-suite:
 	$(FKOPT) report results --snapshot-to .bench-suite-before.json
 	for s in kinbench kinbench-v2 kinbench-v2-libraries; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --jobs 2 -q || exit 1; done
-	for s in kinbench kinbench-v2; do \
+	$(FKOPT) suite configs/suites/kinbench-v3-robots.yaml --out results --force -q
+	for s in kinbench kinbench-v2 kinbench-v3 kinbench-v3-robots; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --quick -q || exit 1; done
 	$(FKOPT) report results --changes-since .bench-suite-before.json   # CHANGES.md: what the suites moved
 	rm -f .bench-suite-before.json

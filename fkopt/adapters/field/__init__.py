@@ -109,6 +109,11 @@ def make_ik(name: str, arm, *, timeout: float, rng: np.random.Generator) -> Fiel
     except ImportError as err:
         raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[field]\"): "
                          f"{err}") from None
+    except FkoptError:
+        raise
+    except Exception as err:     # the outside package refused this arm: one line, not its traceback
+        raise FkoptError(f"field solver '{name}' ({PACKAGES[name]}) cannot read {getattr(arm, 'path', 'this arm')}: "
+                         f"{type(err).__name__}: {str(err).splitlines()[0][:160] if str(err) else ''}") from None
 
 
 def timed1(solver: FieldIK, T: np.ndarray) -> tuple[np.ndarray, float, bool]:

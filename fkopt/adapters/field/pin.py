@@ -46,8 +46,9 @@ class PinCLIK(FieldIK):
         lock = [full.getJointId(n) for n in full.names[1:] if n not in keep]
         model = pin.buildReducedModel(full, lock, pin.neutral(full)) if lock else full
         self.model, self.data = model, model.createData()
-        self._tip = model.getFrameId(arm.tip_link)
-        self._base = model.getFrameId(arm.base_link)
+        # links are BODY frames; a joint may share a link's name (z1's gripperStator), so ask for the body
+        self._tip = model.getFrameId(arm.tip_link, pin.FrameType.BODY)
+        self._base = model.getFrameId(arm.base_link, pin.FrameType.BODY)
         if self._tip >= model.nframes or self._base >= model.nframes:
             raise FkoptError(f"pin-clik: pinocchio's model of {arm.path} lacks frame {arm.base_link} or {arm.tip_link}")
         joints = [model.joints[model.getJointId(n)] for n in arm.joint_names]
