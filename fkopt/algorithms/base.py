@@ -173,6 +173,22 @@ def rows_of(problem, rows: np.ndarray):
     return problem if getattr(problem, "cases", None) is None else problem.take(rows)
 
 
+def compiled_step(problem, kind: str):
+    """(compiled iteration, absolute objective) when the problem's mechanism offers one for the
+    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness under
+    ``FKOPT_NUMERICS=compiled``) and the problem is a plain FK problem of three variables without
+    angle-valued joints, else None. The same operations as the numpy iteration; the fitness'
+    ``tan`` may be an ulp from numpy's (tests/test_numerics.py)."""
+    make = getattr(getattr(problem, "mechanism", None), f"compiled_{kind}_step", None)
+    rows = getattr(problem, "_joint_rows", None)
+    if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
+        return None
+    step = make()
+    if step is None:
+        return None
+    return step, problem.objective == "absolute"
+
+
 def clip(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:
     """Project onto the box (the bound handling of every swarm in fkopt unless it says otherwise)."""
     return np.clip(x, bounds[:, 0], bounds[:, 1])

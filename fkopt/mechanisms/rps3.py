@@ -238,6 +238,20 @@ class ThreeRPS(ParallelMechanism):
             return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute)
         return step
 
+    def compiled_abc_step(self):
+        """A function (state arrays, ...) -> the fitness the log reads, running one ABC or GABC
+        iteration with this fitness compiled (:func:`fkopt.numerics.compiled.abc_rps3`, same
+        arguments after the fitness' leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as
+        :meth:`compiled_fitness`)."""
+        if numerics_path.requested() != "compiled":
+            return None
+        mod = numerics_path.compiled(True)
+        ra, rb = self.geometry.ra, self.geometry.rb
+
+        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute):
+            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute)
+        return step
+
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.
 

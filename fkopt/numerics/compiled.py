@@ -564,3 +564,167 @@ def rps3_fitness(P, J, ra, rb, absolute):
     _rps3_fitness(np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(J, dtype=float), float(ra), float(rb),
                   bool(absolute), out)
     return out
+
+
+@njit(cache=True)
+def _abc_move(xs, xk, xb, phi, psi, rule):
+    """The neighbour move of :meth:`fkopt.algorithms.abc.ABC.move` (rule 0) and
+    :meth:`fkopt.algorithms.gabc.GABC.move` (1: mao2017 eq. 19, 2: zhu2010 with psi = C u) on one
+    coordinate, numpy's operations in their order, before clipping."""
+    out = (xs - xk) * phi
+    if rule == 1:
+        out = out + (xb - xk) * phi
+    elif rule == 2:
+        out = out + (xb - xs) * psi
+    return xs + out
+
+
+@njit(cache=True)
+def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb, absolute, fe, fs, scout, fo):
+    """One iteration of :meth:`fkopt.algorithms.abc.ABC.iterate` (scout, employed, onlooker;
+    GABC's best-so-far refreshed between the phases, rules 1 and 2) on a 3-RPS FK problem, run by
+    run, with the fitness :func:`_rps3_point` (NaN read as +inf, as ``np.fmin(f, inf)``).
+
+    ``u`` (runs, D): the iteration's uniforms of each run in the order of the abc module's
+    docstring (scout dim, employed 3 SN [+ SN psi], onlooker SN roulette, 3 SN [+ SN psi]).
+    Updates x, f, trial and (rules 1, 2) best_x, best_f in place; writes the employed candidates'
+    fitness fe (runs, SN), the scout's fresh fitness fs (runs,) with scout (runs,) 1 where one
+    flew, and the onlooker candidates' fitness fo (runs, SN) -- what the evaluation log reads."""
+    runs, pop, dim = x.shape
+    one = J.shape[1] == 1
+    zhu = rule == 2
+    block = (4 if zhu else 3) * pop
+    v = np.empty(dim)
+    src = np.empty(pop, dtype=np.int64)
+    jj = np.empty(pop, dtype=np.int64)
+    mv = np.empty(pop)
+    bs = np.empty(pop)
+    first = np.empty(pop, dtype=np.int64)
+    cdf = np.empty(pop)
+    for a in range(runs):
+        c = 0 if one else a * pop
+        j0, j1, j2 = J[0, c], J[1, c], J[2, c]
+        # -- scout: the source with the most trials (first of equals) if they exceed limit
+        scout[a] = 0
+        s = 0
+        over = False
+        for i in range(pop):
+            if trial[a, i] > limit:
+                over = True
+            if trial[a, i] > trial[a, s]:
+                s = i
+        if over:
+            for d in range(dim):
+                x[a, s, d] = lo[d] + u[a, d] * (hi[d] - lo[d])
+            trial[a, s] = 0
+            g = _rps3_point(x[a, s, 0], x[a, s, 1], x[a, s, 2], j0, j1, j2, ra, rb, absolute)
+            if g != g:
+                g = np.inf
+            fs[a] = g
+            scout[a] = 1
+        # -- employed: bee i moves coordinate j of source i against neighbour k != i (all
+        # candidates from the sources as they stand, the scout's fresh one included)
+        o = dim
+        for i in range(pop):
+            j = int(u[a, o + i] * dim)
+            k = int(u[a, o + pop + i] * (pop - 1))
+            if k >= i:
+                k += 1
+            phi = u[a, o + 2 * pop + i] * 2.0 - 1.0
+            psi = C * u[a, o + 3 * pop + i] if zhu else 0.0
+            m = _abc_move(x[a, i, j], x[a, k, j], best_x[a, j], phi, psi, rule)
+            m = min(max(m, lo[j]), hi[j])
+            jj[i] = j
+            mv[i] = m
+        if over:
+            f[a, s] = fs[a]
+        for i in range(pop):
+            for d in range(dim):
+                v[d] = x[a, i, d]
+            v[jj[i]] = mv[i]
+            g = _rps3_point(v[0], v[1], v[2], j0, j1, j2, ra, rb, absolute)
+            if g != g:
+                g = np.inf
+            fe[a, i] = g
+        for i in range(pop):
+            if fe[a, i] < f[a, i]:
+                f[a, i] = fe[a, i]
+                x[a, i, jj[i]] = mv[i]
+                trial[a, i] = 0
+            else:
+                trial[a, i] += 1
+        if rule != 0:     # Algorithm.update_best: the first minimum, if it beats the best so far
+            b = 0
+            for i in range(1, pop):
+                if f[a, i] < f[a, b]:
+                    b = i
+            if f[a, b] < best_f[a]:
+                best_f[a] = f[a, b]
+                for d in range(dim):
+                    best_x[a, d] = x[a, b, d]
+        # -- onlookers: roulette on the qualities 1/(1+f) (1-f below 0), cumulated in order
+        o = dim + block
+        acc = 0.0
+        for i in range(pop):
+            q = 1.0 / (1.0 + f[a, i]) if f[a, i] >= 0 else 1.0 - f[a, i]
+            acc = acc + q
+            cdf[i] = acc
+        for i in range(pop):
+            w = u[a, o + i] * cdf[pop - 1]
+            lo_i, hi_i = 0, pop                     # first index with cdf > w (cdf is sorted)
+            while lo_i < hi_i:
+                mid = (lo_i + hi_i) // 2
+                if cdf[mid] <= w:
+                    lo_i = mid + 1
+                else:
+                    hi_i = mid
+            src[i] = 0 if lo_i == pop else lo_i
+        o += pop
+        for i in range(pop):
+            s = src[i]
+            j = int(u[a, o + i] * dim)
+            k = int(u[a, o + pop + i] * (pop - 1))
+            if k >= s:
+                k += 1
+            phi = u[a, o + 2 * pop + i] * 2.0 - 1.0
+            psi = C * u[a, o + 3 * pop + i] if zhu else 0.0
+            m = _abc_move(x[a, s, j], x[a, k, j], best_x[a, j], phi, psi, rule)
+            m = min(max(m, lo[j]), hi[j])
+            jj[i] = j
+            mv[i] = m
+            for d in range(dim):
+                v[d] = x[a, s, d]
+            v[j] = m
+            g = _rps3_point(v[0], v[1], v[2], j0, j1, j2, ra, rb, absolute)
+            if g != g:
+                g = np.inf
+            fo[a, i] = g
+        # synchronous onlookers: per source the lowest candidate, the first onlooker reaching it
+        for i in range(pop):
+            bs[i] = np.inf
+            first[i] = pop
+        for i in range(pop):
+            if fo[a, i] < bs[src[i]]:
+                bs[src[i]] = fo[a, i]
+        for i in range(pop):
+            s = src[i]
+            if fo[a, i] == bs[s] and first[s] == pop:
+                first[s] = i
+            trial[a, s] += 1
+        for s in range(pop):
+            if bs[s] < f[a, s]:
+                w_ = first[s]
+                x[a, s, jj[w_]] = mv[w_]
+                f[a, s] = bs[s]
+                trial[a, s] = 0
+
+
+def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute):
+    """:func:`_abc_rps3` on the state arrays x, f, trial (C-contiguous, updated in place) and
+    best_x, best_f (updated in place: pass copies); returns (fe, fs, scout, fo)."""
+    runs, pop = f.shape
+    fe, fs, scout, fo = np.empty((runs, pop)), np.empty(runs), np.empty(runs, dtype=np.uint8), np.empty((runs, pop))
+    _abc_rps3(x, f, trial, best_x, best_f, u, int(limit), int(rule), float(C),
+              np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float),
+              np.ascontiguousarray(J, dtype=float), float(ra), float(rb), bool(absolute), fe, fs, scout, fo)
+    return fe, fs, scout, fo
