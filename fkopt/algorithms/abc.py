@@ -254,14 +254,18 @@ class ABC(Algorithm):
         # GABC refreshes the best-so-far between the phases: new arrays, as update_best makes
         best_x, best_f = (state.best_x, state.best_f) if rule == 0 else (state.best_x.copy(), state.best_f.copy())
         C = getattr(self.params, "C", 0.0)
-        fe, fs, scout, fo = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
-                                 problem.bounds, J, absolute)
+        log = state.log
+        if log is not None and log.first:          # never in minimize: its initial report comes first
+            raise RuntimeError("the compiled ABC iteration needs the log's initial report first")
+        # The evaluation log's bookkeeping runs in the same pass (EvaluationLog.add, value by
+        # value); outside Algorithm.minimize, scratch arrays stand in for it.
+        arrays = (log.best, log.count, log.active) if log is not None else \
+            (np.full(runs, np.inf), np.zeros(runs, dtype=np.int64), np.zeros(runs, dtype=bool))
+        scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
+                           problem.bounds, J, absolute, arrays)
+        if log is not None:
+            log._keep(*kept)
         state.best_x, state.best_f = best_x, best_f
-        evaluated(state, fe)
-        rows = scout.nonzero()[0]
-        if rows.size:
-            evaluated(state, fs[rows], rows)
-        evaluated(state, fo)
         state.evaluations = state.evaluations + (2 * population + scout)
 
     def step(self, state, xs, xk, phi, streams):

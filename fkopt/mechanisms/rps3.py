@@ -239,8 +239,8 @@ class ThreeRPS(ParallelMechanism):
         return step
 
     def compiled_abc_step(self):
-        """A function (state arrays, ...) -> the fitness the log reads, running one ABC or GABC
-        iteration with this fitness compiled (:func:`fkopt.numerics.compiled.abc_rps3`, same
+        """A function (state arrays, ..., log arrays) -> (scouts, log improvements), running one
+        ABC or GABC iteration with this fitness compiled (:func:`fkopt.numerics.compiled.abc_rps3`, same
         arguments after the fitness' leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as
         :meth:`compiled_fitness`)."""
         if numerics_path.requested() != "compiled":
@@ -248,8 +248,8 @@ class ThreeRPS(ParallelMechanism):
         mod = numerics_path.compiled(True)
         ra, rb = self.geometry.ra, self.geometry.rb
 
-        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute):
-            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute)
+        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log):
+            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log)
         return step
 
     def jacobian(self, poses) -> np.ndarray:

@@ -580,7 +580,29 @@ def _abc_move(xs, xk, xb, phi, psi, rule):
 
 
 @njit(cache=True)
-def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb, absolute, fe, fs, scout, fo):
+def _log_points(a, vals, lbest, lcount, lactive, hr, he, hf, nh):
+    """:meth:`fkopt.algorithms.base.EvaluationLog.add` of the values ``vals`` (k,) that run ``a``
+    just evaluated, in order: an improvement of the running best is kept as (row, evaluation
+    number, value) in hr, he, hf from position nh while the run is active; the log's best and
+    count advance either way. Returns the new nh."""
+    run_best = lbest[a]
+    for c in range(vals.shape[0]):
+        g = vals[c]
+        if g < run_best:
+            if lactive[a]:
+                hr[nh] = a
+                he[nh] = lcount[a] + c + 1
+                hf[nh] = g
+                nh += 1
+            run_best = g
+    lbest[a] = run_best
+    lcount[a] += vals.shape[0]
+    return nh
+
+
+@njit(cache=True)
+def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb, absolute, fe, fs, scout, fo,
+              lbest, lcount, lactive, hr, he, hf):
     """One iteration of :meth:`fkopt.algorithms.abc.ABC.iterate` (scout, employed, onlooker;
     GABC's best-so-far refreshed between the phases, rules 1 and 2) on a 3-RPS FK problem, run by
     run, with the fitness :func:`_rps3_point` (NaN read as +inf, as ``np.fmin(f, inf)``).
@@ -589,7 +611,9 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
     docstring (scout dim, employed 3 SN [+ SN psi], onlooker SN roulette, 3 SN [+ SN psi]).
     Updates x, f, trial and (rules 1, 2) best_x, best_f in place; writes the employed candidates'
     fitness fe (runs, SN), the scout's fresh fitness fs (runs,) with scout (runs,) 1 where one
-    flew, and the onlooker candidates' fitness fo (runs, SN) -- what the evaluation log reads."""
+    flew, and the onlooker candidates' fitness fo (runs, SN); and reports them, in that order, to
+    the evaluation log held as arrays (:func:`_log_points`; the log's best lbest, count lcount,
+    active runs lactive, improvements into hr, he, hf). Returns the number of improvements."""
     runs, pop, dim = x.shape
     one = J.shape[1] == 1
     zhu = rule == 2
@@ -601,6 +625,7 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
     bs = np.empty(pop)
     first = np.empty(pop, dtype=np.int64)
     cdf = np.empty(pop)
+    nh = 0
     for a in range(runs):
         c = 0 if one else a * pop
         j0, j1, j2 = J[0, c], J[1, c], J[2, c]
@@ -646,6 +671,9 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
             if g != g:
                 g = np.inf
             fe[a, i] = g
+        nh = _log_points(a, fe[a], lbest, lcount, lactive, hr, he, hf, nh)
+        if over:
+            nh = _log_points(a, fs[a:a + 1], lbest, lcount, lactive, hr, he, hf, nh)
         for i in range(pop):
             if fe[a, i] < f[a, i]:
                 f[a, i] = fe[a, i]
@@ -699,6 +727,7 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
             if g != g:
                 g = np.inf
             fo[a, i] = g
+        nh = _log_points(a, fo[a], lbest, lcount, lactive, hr, he, hf, nh)
         # synchronous onlookers: per source the lowest candidate, the first onlooker reaching it
         for i in range(pop):
             bs[i] = np.inf
@@ -717,14 +746,21 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
                 x[a, s, jj[w_]] = mv[w_]
                 f[a, s] = bs[s]
                 trial[a, s] = 0
+    return nh
 
 
-def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute):
+def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log):
     """:func:`_abc_rps3` on the state arrays x, f, trial (C-contiguous, updated in place) and
-    best_x, best_f (updated in place: pass copies); returns (fe, fs, scout, fo)."""
+    best_x, best_f (updated in place: pass copies), reporting to ``log`` (best (runs,) float,
+    count (runs,) int64, active (runs,) bool, updated in place). Returns (scout (runs,) 0/1,
+    (rows, evaluation numbers, values) of the improvements the log keeps)."""
     runs, pop = f.shape
     fe, fs, scout, fo = np.empty((runs, pop)), np.empty(runs), np.empty(runs, dtype=np.uint8), np.empty((runs, pop))
-    _abc_rps3(x, f, trial, best_x, best_f, u, int(limit), int(rule), float(C),
-              np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float),
-              np.ascontiguousarray(J, dtype=float), float(ra), float(rb), bool(absolute), fe, fs, scout, fo)
-    return fe, fs, scout, fo
+    most = runs * (2 * pop + 1)
+    hr, he, hf = np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most)
+    best, count, active = log
+    nh = _abc_rps3(x, f, trial, best_x, best_f, u, int(limit), int(rule), float(C),
+                   np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float),
+                   np.ascontiguousarray(J, dtype=float), float(ra), float(rb), bool(absolute), fe, fs, scout, fo,
+                   best, count, active, hr, he, hf)
+    return scout, (hr[:nh], he[:nh], hf[:nh])
