@@ -10,6 +10,11 @@ overrides both). The first call after installing compiles (several seconds); lat
 load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
+* :func:`rps3_fitness`, :func:`pso_rps3`, :func:`abc_rps3` -- the 3-RPS swarm fitness and the PSO
+  and ABC/GABC iterations on it (``FKOPT_NUMERICS=compiled``). These compile with
+  ``error_model="numpy"``: a float division by zero gives numpy's inf/NaN instead of a Python
+  exception, so no check guards each division (half of the fitness' time, measured: 57 -> 29 ns
+  per point); the values are the same wherever the divisor is not zero;
 * :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
 """
@@ -464,7 +469,7 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
     return out, info
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
     """Fitness of one 3-RPS pose (alpha, beta in deg, z) against legs (j0, j1, j2): the operations
     of :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` in their order, then
@@ -505,7 +510,7 @@ def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
     return (r1 * r1 + r2 * r2) + r3 * r3
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rps3_fitness(P, J, ra, rb, absolute, out):
     """:func:`_rps3_point` of poses P (n, 3) against leg rows J (3, 1) or (3, n) into out (n,)."""
     one = J.shape[1] == 1
@@ -514,7 +519,7 @@ def _rps3_fitness(P, J, ra, rb, absolute, out):
         out[i] = _rps3_point(P[i, 0], P[i, 1], P[i, 2], J[0, c], J[1, c], J[2, c], ra, rb, absolute)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolute, nx, nf, npos, nvel, fout):
     """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem, every run
     and particle in one pass: velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations
@@ -566,7 +571,7 @@ def rps3_fitness(P, J, ra, rb, absolute):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _abc_move(xs, xk, xb, phi, psi, rule):
     """The neighbour move of :meth:`fkopt.algorithms.abc.ABC.move` (rule 0) and
     :meth:`fkopt.algorithms.gabc.GABC.move` (1: mao2017 eq. 19, 2: zhu2010 with psi = C u) on one
@@ -579,7 +584,7 @@ def _abc_move(xs, xk, xb, phi, psi, rule):
     return xs + out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _log_points(a, vals, lbest, lcount, lactive, hr, he, hf, nh):
     """:meth:`fkopt.algorithms.base.EvaluationLog.add` of the values ``vals`` (k,) that run ``a``
     just evaluated, in order: an improvement of the running best is kept as (row, evaluation
@@ -600,7 +605,7 @@ def _log_points(a, vals, lbest, lcount, lactive, hr, he, hf, nh):
     return nh
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb, absolute, fe, fs, scout, fo,
               lbest, lcount, lactive, hr, he, hf):
     """One iteration of :meth:`fkopt.algorithms.abc.ABC.iterate` (scout, employed, onlooker;
