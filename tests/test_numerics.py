@@ -194,13 +194,15 @@ def test_compiled_pso_step_is_the_numpy_step_up_to_the_fitness_tolerance(monkeyp
     assert PSO._compiled_step(p) is None                  # the default keeps numpy's bits
 
 
-ABC_CASES = [("abc", {}), ("abc", {"limit": 3}), ("gabc", {}), ("gabc", {"rule": "zhu2010", "limit": 4})]
+ABC_CASES = [("abc", {}, 10), ("abc", {"limit": 3}, 10), ("gabc", {}, 10), ("gabc", {"rule": "zhu2010", "limit": 4}, 10),
+             ("gabc", {}, 40)]     # 40 > 32 bees: the roulette's binary search (abc.DENSE_ROULETTE)
 
 
-@pytest.mark.parametrize("algorithm,params", ABC_CASES, ids=lambda v: v if isinstance(v, str) else str(v))
+@pytest.mark.parametrize("algorithm,params,population", ABC_CASES,
+                         ids=lambda v: v if isinstance(v, str) else str(v))
 @pytest.mark.parametrize("cases", [1, 3])
 def test_compiled_abc_iteration_is_the_numpy_iteration_on_the_compiled_fitness(monkeypatch, algorithm, params,
-                                                                                 cases):
+                                                                                 population, cases):
     """FKOPT_NUMERICS=compiled runs an ABC/GABC iteration on a 3-RPS FK problem in one compiled
     pass (fkopt.numerics.compiled.abc_rps3): the same draws, the same operations and the same
     fitness function as the numpy phases on the compiled fitness, so every record is equal bit
@@ -216,9 +218,9 @@ def test_compiled_abc_iteration_is_the_numpy_iteration_on_the_compiled_fitness(m
     seen = []
     run_compiled = ABC._iterate_compiled
     monkeypatch.setattr(ABC, "_iterate_compiled", lambda self, *a: seen.append(1) or run_compiled(self, *a))
-    fused = fkopt.solve(p, algorithm, population=10, iterations=120, runs=6, seed=3, params=params)
+    fused = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params)
     monkeypatch.setattr(ABC, "_compiled_iteration", lambda self, problem: None)
-    steps = fkopt.solve(p, algorithm, population=10, iterations=120, runs=6, seed=3, params=params)
+    steps = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params)
     for name in ("x", "fitness", "history", "evaluation_history"):
         assert np.array_equal(getattr(fused, name), getattr(steps, name)), name
     for a, b in zip(fused.events, steps.events):

@@ -704,14 +704,22 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
             cdf[i] = acc
         for i in range(pop):
             w = u[a, o + i] * cdf[pop - 1]
-            lo_i, hi_i = 0, pop                     # first index with cdf > w (cdf is sorted)
-            while lo_i < hi_i:
-                mid = (lo_i + hi_i) // 2
-                if cdf[mid] <= w:
-                    lo_i = mid + 1
-                else:
-                    hi_i = mid
-            src[i] = 0 if lo_i == pop else lo_i
+            # the first index with cdf > w = the count of cdf <= w (cdf is sorted): a branch-free
+            # count for small colonies (a binary search mispredicts a branch per level), a binary
+            # search for large ones, as abc.roulette
+            if pop <= 32:
+                n_le = 0
+                for q_i in range(pop):
+                    n_le += cdf[q_i] <= w
+            else:
+                n_le, hi_i = 0, pop
+                while n_le < hi_i:
+                    mid = (n_le + hi_i) // 2
+                    if cdf[mid] <= w:
+                        n_le = mid + 1
+                    else:
+                        hi_i = mid
+            src[i] = 0 if n_le == pop else n_le
         o += pop
         for i in range(pop):
             s = src[i]
