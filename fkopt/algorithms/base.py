@@ -107,6 +107,12 @@ class EvaluationLog:
             self.count[rows] += step
             return
         runs, k = f.shape
+        if not self.first and k:
+            # Most calls improve no run: then nothing is kept and the best stays (a hit needs a
+            # value below the run's best; fmin ignores NaN as the accumulation does).
+            if not (np.fmin.reduce(f, axis=1) < self.best).any():
+                self.count = self.count + k * np.asarray(step, dtype=np.int64)
+                return
         acc = np.fmin.accumulate(f, axis=1)
         prev = np.empty_like(f)
         prev[:, 0] = self.best
