@@ -245,3 +245,23 @@ def test_compiled_abc_iteration_only_where_it_is_the_same_algorithm(monkeypatch)
     assert Mine()._compiled_iteration(p) is None
     monkeypatch.setenv(numerics_path.ENV, "auto")
     assert ABC()._compiled_iteration(p) is None
+
+
+@pytest.mark.parametrize("cases", [1, 3])
+def test_compiled_pso_iteration_is_the_numpy_iteration_on_the_compiled_fitness(monkeypatch, cases):
+    """The compiled PSO iteration (with its evaluation-log bookkeeping) against the numpy
+    iteration on the compiled fitness: every record equal bit for bit, the log included."""
+    from fkopt.algorithms.pso import PSO
+    m = fkopt.mechanism("3-rps")
+    targets = m.bounds[:, 0] + np.random.default_rng(12).random((cases, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    joints = m.ik(targets)
+    p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints)
+    monkeypatch.setenv(numerics_path.ENV, "compiled")
+    assert PSO._compiled_step(p) is not None
+    fused = fkopt.solve(p, "pso", population=10, iterations=150, runs=6, seed=4)
+    monkeypatch.setattr(PSO, "_compiled_step", staticmethod(lambda problem: None))
+    steps = fkopt.solve(p, "pso", population=10, iterations=150, runs=6, seed=4)
+    for name in ("x", "fitness", "history", "evaluation_history"):
+        assert np.array_equal(getattr(fused, name), getattr(steps, name)), name
+    for a, b in zip(fused.events, steps.events):
+        assert np.array_equal(a, b)

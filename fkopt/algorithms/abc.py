@@ -66,7 +66,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, compiled_step, evaluated, row_offsets, rows_of, uniform_in
+from .base import (Algorithm, Params, State, compiled_step, evaluated, log_arrays, log_kept, row_offsets, rows_of,
+                   uniform_in)
 
 
 class ABCParams(Params):
@@ -254,17 +255,10 @@ class ABC(Algorithm):
         # GABC refreshes the best-so-far between the phases: new arrays, as update_best makes
         best_x, best_f = (state.best_x, state.best_f) if rule == 0 else (state.best_x.copy(), state.best_f.copy())
         C = getattr(self.params, "C", 0.0)
-        log = state.log
-        if log is not None and log.first:          # never in minimize: its initial report comes first
-            raise RuntimeError("the compiled ABC iteration needs the log's initial report first")
-        # The evaluation log's bookkeeping runs in the same pass (EvaluationLog.add, value by
-        # value); outside Algorithm.minimize, scratch arrays stand in for it.
-        arrays = (log.best, log.count, log.active) if log is not None else \
-            (np.full(runs, np.inf), np.zeros(runs, dtype=np.int64), np.zeros(runs, dtype=bool))
+        # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
         scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
-                           problem.bounds, J, absolute, arrays)
-        if log is not None:
-            log._keep(*kept)
+                           problem.bounds, J, absolute, log_arrays(state, runs))
+        log_kept(state, kept)
         state.best_x, state.best_f = best_x, best_f
         state.evaluations = state.evaluations + (2 * population + scout)
 

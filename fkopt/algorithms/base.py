@@ -160,6 +160,26 @@ def evaluated(state, f: np.ndarray, rows: np.ndarray | None = None) -> None:
         log.add(f, rows)
 
 
+def log_arrays(state, runs: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The run's :class:`EvaluationLog` as the arrays a compiled iteration updates in place while
+    it reports its values (best, count, active: :func:`fkopt.numerics.compiled._log_points`, the
+    same rule as :meth:`EvaluationLog.add`); scratch arrays outside :meth:`Algorithm.minimize`.
+    Hand the improvements it returns to :func:`log_kept`."""
+    log = getattr(state, "log", None)
+    if log is None:
+        return np.full(runs, np.inf), np.zeros(runs, dtype=np.int64), np.zeros(runs, dtype=bool)
+    if log.first:               # never in minimize: the initial population is reported first
+        raise RuntimeError("a compiled iteration needs the log's initial report first")
+    return log.best, log.count, log.active
+
+
+def log_kept(state, kept) -> None:
+    """Store the improvements (rows, evaluation numbers, values) a compiled iteration found."""
+    log = getattr(state, "log", None)
+    if log is not None:
+        log._keep(*kept)
+
+
 @lru_cache(maxsize=64)
 def row_offsets(runs: int, population: int) -> np.ndarray:
     """``arange(runs) * population`` (read-only, cached): flat index of each run's first agent.

@@ -36,7 +36,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, compiled_step, evaluated, uniform_in
+from .base import Algorithm, Params, State, clip, compiled_step, evaluated, log_arrays, log_kept, uniform_in
 
 
 class PSOParams(Params):
@@ -108,10 +108,11 @@ class PSO(Algorithm):
             if problem.cases is not None:
                 problem._check_cases(state.pos)
             J = problem._joint_rows(state.pos.shape[:-1])     # the fitness' target rows
-            state.x, state.f, state.pos, state.vel, f = step(
+            # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
+            state.x, state.f, state.pos, state.vel, _, kept = step(
                 state.x, state.f, state.pos, state.vel, state.best_x, r, self.inertia_weight(state), p.c1, p.c2,
-                self.velocity_limit(problem.bounds), problem.bounds, J, absolute)
-            evaluated(state, f)
+                self.velocity_limit(problem.bounds), problem.bounds, J, absolute, log_arrays(state, runs))
+            log_kept(state, kept)
             state.evaluations = state.evaluations + population
             return
         g = state.best_x[:, None, :]

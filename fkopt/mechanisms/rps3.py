@@ -234,8 +234,8 @@ class ThreeRPS(ParallelMechanism):
         mod = numerics_path.compiled(True)
         ra, rb = self.geometry.ra, self.geometry.rb
 
-        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute):
-            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute)
+        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute, log):
+            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log)
         return step
 
     def compiled_abc_step(self):

@@ -520,13 +520,17 @@ def _rps3_fitness(P, J, ra, rb, absolute, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolute, nx, nf, npos, nvel, fout):
+def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolute, nx, nf, npos, nvel, fout,
+              lbest, lcount, lactive, hr, he, hf):
     """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem, every run
     and particle in one pass: velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations
     in their order), clamp, move, clip onto the box (velocity zeroed where clipped), the
-    fitness (:func:`_rps3_point`) and the personal best; new arrays nx, nf, npos, nvel, fout."""
+    fitness (:func:`_rps3_point`) and the personal best; new arrays nx, nf, npos, nvel, fout; the
+    fitness reported to the evaluation log held as arrays (:func:`_log_points`). Returns the
+    number of improvements the log keeps."""
     runs, pop, dim = pos.shape
     one = J.shape[1] == 1
+    nh = 0
     for a in range(runs):
         for i in range(pop):
             for d in range(dim):
@@ -549,18 +553,24 @@ def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolu
                 nf[a, i] = fb[a, i]
                 for d in range(dim):
                     nx[a, i, d] = x[a, i, d]
+        nh = _log_points(a, fout[a], lbest, lcount, lactive, hr, he, hf, nh)
+    return nh
 
 
-def pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute):
+def pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log):
     """:func:`_pso_rps3`: (personal bests x, their fitness, positions, velocities, fitness of the
-    positions), all new arrays."""
+    positions), all new arrays, and (rows, evaluation numbers, values) of the improvements kept
+    by ``log`` (best, count, active arrays updated in place, as :func:`abc_rps3`)."""
     nx, nf, npos, nvel, fout = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel), \
         np.empty_like(fb)
-    _pso_rps3(x, fb, pos, vel, np.ascontiguousarray(g), r, float(w), float(c1), float(c2),
-              np.ascontiguousarray(limit, dtype=float), np.ascontiguousarray(bounds[:, 0], dtype=float),
-              np.ascontiguousarray(bounds[:, 1], dtype=float), np.ascontiguousarray(J, dtype=float), float(ra),
-              float(rb), bool(absolute), nx, nf, npos, nvel, fout)
-    return nx, nf, npos, nvel, fout
+    most = fb.size
+    hr, he, hf = np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most)
+    best, count, active = log
+    nh = _pso_rps3(x, fb, pos, vel, np.ascontiguousarray(g), r, float(w), float(c1), float(c2),
+                   np.ascontiguousarray(limit, dtype=float), np.ascontiguousarray(bounds[:, 0], dtype=float),
+                   np.ascontiguousarray(bounds[:, 1], dtype=float), np.ascontiguousarray(J, dtype=float), float(ra),
+                   float(rb), bool(absolute), nx, nf, npos, nvel, fout, best, count, active, hr, he, hf)
+    return nx, nf, npos, nvel, fout, (hr[:nh], he[:nh], hf[:nh])
 
 
 def rps3_fitness(P, J, ra, rb, absolute):
