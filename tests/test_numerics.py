@@ -194,15 +194,18 @@ def test_compiled_pso_step_is_the_numpy_step_up_to_the_fitness_tolerance(monkeyp
     assert PSO._compiled_step(p) is None                  # the default keeps numpy's bits
 
 
-ABC_CASES = [("abc", {}, 10), ("abc", {"limit": 3}, 10), ("gabc", {}, 10), ("gabc", {"rule": "zhu2010", "limit": 4}, 10),
-             ("gabc", {}, 40)]     # 40 > 32 bees: the roulette's binary search (abc.DENSE_ROULETTE)
+ABC_CASES = [("abc", {}, 10, {}), ("abc", {"limit": 3}, 10, {}), ("gabc", {}, 10, {}),
+             ("gabc", {"rule": "zhu2010", "limit": 4}, 10, {}),
+             ("gabc", {}, 40, {}),        # 40 > 32 bees: the roulette's binary search (abc.DENSE_ROULETTE)
+             ("abc", {}, 10, {"objective": "absolute"}),
+             ("gabc", {}, 10, {"target": 1e-6, "stop_at_target": True})]   # frozen runs: the log's active mask
 
 
-@pytest.mark.parametrize("algorithm,params,population", ABC_CASES,
+@pytest.mark.parametrize("algorithm,params,population,options", ABC_CASES,
                          ids=lambda v: v if isinstance(v, str) else str(v))
 @pytest.mark.parametrize("cases", [1, 3])
 def test_compiled_abc_iteration_is_the_numpy_iteration_on_the_compiled_fitness(monkeypatch, algorithm, params,
-                                                                                 population, cases):
+                                                                                 population, options, cases):
     """FKOPT_NUMERICS=compiled runs an ABC/GABC iteration on a 3-RPS FK problem in one compiled
     pass (fkopt.numerics.compiled.abc_rps3): the same draws, the same operations and the same
     fitness function as the numpy phases on the compiled fitness, so every record is equal bit
@@ -213,19 +216,24 @@ def test_compiled_abc_iteration_is_the_numpy_iteration_on_the_compiled_fitness(m
     m = fkopt.mechanism("3-rps")
     targets = m.bounds[:, 0] + np.random.default_rng(11).random((cases, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
     joints = m.ik(targets)
-    p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints)
+    options = dict(options)
+    p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints, objective=options.pop("objective", "squared"))
     monkeypatch.setenv(numerics_path.ENV, "compiled")
     seen = []
     run_compiled = ABC._iterate_compiled
     monkeypatch.setattr(ABC, "_iterate_compiled", lambda self, *a: seen.append(1) or run_compiled(self, *a))
-    fused = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params)
+    fused = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params,
+                        **options)
     monkeypatch.setattr(ABC, "_compiled_iteration", lambda self, problem: None)
-    steps = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params)
+    steps = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params,
+                        **options)
     for name in ("x", "fitness", "history", "evaluation_history"):
         assert np.array_equal(getattr(fused, name), getattr(steps, name)), name
     for a, b in zip(fused.events, steps.events):
         assert np.array_equal(a, b)
-    assert len(seen) == 120                                # the fused run took the compiled pass
+    assert seen and (len(seen) == 120 or "target" in options)    # the compiled pass ran every iteration
+    if "target" in options:                                # some runs froze at the target on the way
+        assert (fused.iterations_done < 120).any()
 
 
 def test_compiled_abc_iteration_only_where_it_is_the_same_algorithm(monkeypatch):
