@@ -678,6 +678,9 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
             mv[i] = m
         if over:
             f[a, s] = fs[a]
+        # candidate i is source i with coordinate jj[i] moved; the greedy step of bee i changes
+        # source i only, so each bee is evaluated and selected in one pass (the moves above read
+        # the sources before any of them changed, as numpy's vectorised phase)
         for i in range(pop):
             for d in range(dim):
                 v[d] = x[a, i, d]
@@ -686,16 +689,15 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
             if g != g:
                 g = np.inf
             fe[a, i] = g
-        nh = _log_points(a, fe[a], lbest, lcount, lactive, hr, he, hf, nh)
-        if over:
-            nh = _log_points(a, fs[a:a + 1], lbest, lcount, lactive, hr, he, hf, nh)
-        for i in range(pop):
-            if fe[a, i] < f[a, i]:
-                f[a, i] = fe[a, i]
+            if g < f[a, i]:
+                f[a, i] = g
                 x[a, i, jj[i]] = mv[i]
                 trial[a, i] = 0
             else:
                 trial[a, i] += 1
+        nh = _log_points(a, fe[a], lbest, lcount, lactive, hr, he, hf, nh)
+        if over:
+            nh = _log_points(a, fs[a:a + 1], lbest, lcount, lactive, hr, he, hf, nh)
         if rule != 0:     # Algorithm.update_best: the first minimum, if it beats the best so far
             b = 0
             for i in range(1, pop):
