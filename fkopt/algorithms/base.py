@@ -16,6 +16,7 @@ iteration on, so its numbers do not depend on the other runs of the batch.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, ClassVar
@@ -24,6 +25,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..errors import FkoptError
+from ..numerics.path import ENV as _NUMERICS_ENV
 from ..progress import tick
 from ..streams import RunStreams
 
@@ -205,14 +207,26 @@ def compiled_step(problem, kind: str):
     ``FKOPT_NUMERICS=compiled``) and the problem is a plain FK problem of three variables without
     angle-valued joints, else None. The same operations as the numpy iteration; the fitness'
     ``tan`` may be an ulp from numpy's (tests/test_numerics.py)."""
+    # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
+    # or a caller may change the variable between iterations).
+    key = (kind, os.environ.get(_NUMERICS_ENV))
+    cache = getattr(problem, "_compiled_steps", None)
+    if cache is not None and key in cache:
+        return cache[key]
     make = getattr(getattr(problem, "mechanism", None), f"compiled_{kind}_step", None)
     rows = getattr(problem, "_joint_rows", None)
     if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
-        return None
-    step = make()
-    if step is None:
-        return None
-    return step, problem.objective == "absolute"
+        got = None
+    else:
+        step = make()
+        got = None if step is None else (step, problem.objective == "absolute")
+    if cache is None:
+        try:
+            cache = problem._compiled_steps = {}
+        except AttributeError:          # a problem that takes no attributes: ask every time
+            return got
+    cache[key] = got
+    return got
 
 
 def clip(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:
