@@ -57,6 +57,11 @@ element); the onlooker duplicates resolved by two ``np.minimum.at`` scatters (no
 winner written back as its one moved coordinate; the roulette as a dense count on bee-major
 (SN, runs) arrays for small colonies or a vectorised binary search for large ones (the same
 integers either way). ``fkopt bench`` measures what an evaluation costs.
+
+Under ``FKOPT_NUMERICS=compiled`` on a 3-RPS FK problem, fkopt's own ABC and GABC (raw selection)
+run each iteration as one compiled pass instead (:func:`fkopt.numerics.compiled.abc_rps3`: the same
+draws in one block per iteration, the same operations, the evaluation log's bookkeeping inside);
+its records equal these phases on the compiled fitness bit for bit (tests/test_numerics.py).
 """
 from __future__ import annotations
 
