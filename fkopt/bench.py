@@ -42,7 +42,9 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    size (rows per chunk) that :data:`fkopt.solve.CHUNK_POINTS` was chosen from.
 4f. ``swarms`` -- GABC, ABC and PSO on 3-RPS at 1 case and 100 cases x 30 runs beside the same
    algorithm as the C loop of ``fkopt/bench_ref/gabc_3rps.c``, alternating: ns per evaluation and
-   the ratio (issue 29's targets: <= 3 at 1 case, <= 1.5 at 100 cases).
+   the ratio (issue 29's targets: <= 3 at 1 case, <= 1.5 at 100 cases); and pygmo's C++
+   ``bee_colony`` with a numba-compiled fitness beside fkopt's batched ABC (population 10, 600
+   iterations, 30 runs), the ratio per run (target >= 10; the row needs pygmo and numba).
 5. ``scaling`` -- GABC on the 3-RPS case with population 10..1000 (30 runs) and runs 1..1000
    (population 10): wall time and ns per evaluation; plotted into ``scaling.png``.
 
@@ -203,23 +205,31 @@ def _peer_mealpy(problem, runs: int):
     return out, "mealpy OriginalABC(epoch=600, pop_size=10, n_limits=30)"
 
 
-def _peer_pygmo(problem, runs: int):
+def _pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population: int = 10, limit: int = 30):
+    """pygmo's C++ ``bee_colony`` on ``fitness_one`` (one point -> float), run ``runs`` times
+    (seed k for run k): per run (seconds of ``evolve``, evaluations, final fitness)."""
     import pygmo as pg
+    lo, hi = np.asarray(bounds)[:, 0].tolist(), np.asarray(bounds)[:, 1].tolist()
 
     class UDP:
         def fitness(self, x):
-            return [float(problem.fitness(np.asarray(x)))]
+            return [float(fitness_one(x))]
 
         def get_bounds(self):
-            return (problem.bounds[:, 0].tolist(), problem.bounds[:, 1].tolist())
+            return (lo, hi)
 
     out = []
     for k in range(runs):
         prob = pg.problem(UDP())
-        algo = pg.algorithm(pg.bee_colony(gen=600, limit=30, seed=k))
+        algo = pg.algorithm(pg.bee_colony(gen=gen, limit=limit, seed=k))
         t = time.perf_counter()
-        pop = algo.evolve(pg.population(prob, 10, seed=k))
+        pop = algo.evolve(pg.population(prob, population, seed=k))
         out.append((time.perf_counter() - t, pop.problem.get_fevals(), float(pop.champion_f[0])))
+    return out
+
+
+def _peer_pygmo(problem, runs: int):
+    out = _pygmo_bee_colony(lambda x: problem.fitness(np.asarray(x)), problem.bounds, runs)
     return out, "pygmo bee_colony(gen=600, limit=30), population 10"
 
 
@@ -773,7 +783,8 @@ def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
     :data:`REFERENCE_C` on the same cases; alternating fkopt solve, C run (best of 2 each; 1 in
     quick mode). Rows: ns per evaluation of each and the ratio fkopt / C, against
     :data:`SWARM_TARGETS`, for the default path and, with numba, ``FKOPT_NUMERICS=compiled``
-    (the 3-RPS fitness compiled; PSO's whole iteration; ABC's and GABC's steps stay numpy). Skipped with a message when there
+    (the 3-RPS fitness and the whole iteration compiled: :func:`fkopt.numerics.compiled.abc_rps3`,
+    ``pso_rps3``). Skipped with a message when there
     is no C compiler."""
     import tempfile
     from . import mechanism
@@ -818,11 +829,71 @@ def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
                          f"{float(np.median(res.fitness)):.2g}, C {ref['median']:.2g}; target <= {target:g}: "
                          f"{'met' if ratio <= target else 'NOT met'}")
                 if fast:
-                    what = "the whole iteration" if alg == "pso" else "the 3-RPS fitness; the steps numpy"
+                    what = "the whole iteration and its evaluation log"
                     rows.add("swarms", label + ", FKOPT_NUMERICS=compiled", k_ns / c_ns, "x C loop",
                              f"compiled: {what}; {k_ns:.0f} ns/eval; "
                              f"median final fitness {float(np.median(rk.fitness)):.2g}; target <= {target:g}: "
                              f"{'met' if k_ns <= target * c_ns else 'NOT met'}")
+
+
+#: Issue 29: pygmo's bee_colony with a compiled fitness at least this many times fkopt's batched
+#: ABC's time per run (population 10, 600 iterations, 30 runs).
+PYGMO_TARGET = 10.0
+
+
+def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
+    """pygmo's C++ ``bee_colony`` (gen 600, limit 30 = fkopt's default SN * dim, population 10)
+    on mao2017's 3-RPS case with the fitness compiled by numba (the 3-RPS point of
+    :func:`fkopt.numerics.compiled._rps3_point`, called once per point as pygmo asks), beside
+    fkopt's ABC solving the 30 runs in one batch (default path and ``FKOPT_NUMERICS=compiled``);
+    alternating, best of 2 for fkopt, pygmo's median run; ratio pygmo / fkopt per run against
+    :data:`PYGMO_TARGET`. Quick mode: 100 iterations, 10 pygmo runs. Skipped with a message
+    without pygmo or numba."""
+    try:
+        import pygmo  # noqa: F401
+        from .numerics import compiled as numerics_compiled
+    except Exception as err:                        # pragma: no cover - depends on the machine
+        messages.append(f"swarms: pygmo bee_colony row skipped: {err}; pip install 'fkopt[bench,fast]'")
+        return
+    from . import mechanism
+    from .numerics import path as numerics_path
+    from .solve import solve
+    m = mechanism("3-rps")
+    problem = mao_problem()
+    j0, j1, j2 = (float(v) for v in problem.joints)
+    ra, rb = float(m.geometry.ra), float(m.geometry.rb)
+    point = numerics_compiled._rps3_point
+
+    def fitness_one(x):                             # numba-compiled; one call per point
+        return point(x[0], x[1], x[2], j0, j1, j2, ra, rb, False)
+    iterations = 100 if quick else 600
+    peer_runs = 10 if quick else 30
+    fitness_one(problem.bounds.mean(axis=1))        # compile / load numba's cache before timing
+    best = {"numpy": np.inf, "compiled": np.inf}
+    fk = {}
+    peer = []
+    for rep in range(2):
+        for mode in ("numpy", "compiled"):
+            with numerics_path.forced(mode):
+                t = time.perf_counter()
+                res = solve(problem, "abc", population=10, iterations=iterations, runs=30, seed=1)
+                per_run = (time.perf_counter() - t) / 30
+            if per_run < best[mode]:
+                best[mode], fk[mode] = per_run, res
+        if rep == 0:
+            peer = _pygmo_bee_colony(fitness_one, problem.bounds, peer_runs, gen=iterations)
+    p_run = float(np.median([r[0] for r in peer]))
+    p_evals = float(np.median([r[1] for r in peer]))
+    p_fit = float(np.median([r[2] for r in peer]))
+    for mode, label in (("numpy", "default path"), ("compiled", "FKOPT_NUMERICS=compiled")):
+        ratio = p_run / best[mode]
+        res = fk[mode]
+        rows.add("swarms", f"pygmo bee_colony (numba fitness) / fkopt abc per run, {label}", ratio, "x",
+                 f"pygmo {p_run * 1e3:.2f} ms/run (median of {peer_runs}, {p_evals:.0f} evaluations, median final "
+                 f"fitness {p_fit:.2g}); fkopt {best[mode] * 1e3:.3f} ms/run (30 runs in one batch, best of 2, "
+                 f"{float(res.evaluations.mean()):.0f} evaluations, median final fitness "
+                 f"{float(np.median(res.fitness)):.2g}); {iterations} it, population 10, limit 30; "
+                 f"target >= {PYGMO_TARGET:g}: {'met' if ratio >= PYGMO_TARGET else 'NOT met'}")
 
 
 def bench_scaling(rows: _Rows, quick: bool) -> dict[str, list[tuple[int, float, float]]]:
@@ -952,6 +1023,7 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
         timed("cases", bench_cases, rows, quick, rng, messages)
     if "swarms" in want:
         timed("swarms", bench_swarms, rows, quick, np.random.default_rng(29), messages)
+        timed("swarms", bench_pygmo_abc, rows, quick, messages)
     if "scaling" in want:
         curves = timed("scaling", bench_scaling, rows, quick)
         plot_scaling(curves, out / "scaling.png", 50 if quick else 200)

@@ -679,8 +679,9 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     ik_LM, if installed), ik-one-pose and ik-batch (fkopt.inverse on 14 example-robot-data arms beside
     rtb's ik_LM at 1e-6 m / 1e-6 rad, one pose per call and 1000 poses in one call, answers checked
     by pinocchio's FK), cases (N cases x 30 runs solved together, beside a compiled C loop when a C
-    compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop), scaling
-    (population and runs; draws scaling.png). The last line gives the seconds per section."""
+    compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop; pygmo's
+    bee_colony with a numba fitness beside the batched ABC), scaling (population and runs; draws
+    scaling.png). The last line gives the seconds per section."""
     from .bench import SECTIONS, run as run_bench
     from .files import output_folder
     bad = [s for s in section if s not in SECTIONS]

@@ -204,13 +204,13 @@ class FKProblem(Problem):
             self._check_cases(x)
         lead = x.shape[:-1]
         compiled = getattr(self.mechanism, "compiled_fitness", None)
-        if compiled is not None and not self._angle.any():   # FKOPT_NUMERICS=compiled only
+        if compiled is not None and not self._angle_idx.size:   # FKOPT_NUMERICS=compiled only
             got = compiled(x.reshape(-1, x.shape[-1]), self._joint_rows(lead), self.objective == "absolute")
             if got is not None:
                 return got.reshape(lead)
         r = columns(x)
         np.subtract(r, self._joint_rows(lead), out=r)
-        if self._angle.any():
+        if self._angle_idx.size:
             r[self._angle_idx] = wrap_degrees(r[self._angle_idx])
         if self.objective == "absolute":
             np.abs(r, out=r)

@@ -100,3 +100,21 @@ def test_compiled_reference_abc_and_pso_loops_solve_the_same_problem(tmp_path):
         if alg == "pso":
             assert per_run == 10 * (iterations + 1)
         assert out["median"] < 1e-6 and np.median(r.fitness) < 1e-6, (alg, out["median"], np.median(r.fitness))
+
+
+def test_swarms_pygmo_row_compares_bee_colony_with_the_batched_abc():
+    """The swarms section's pygmo row (quick): pygmo's bee_colony on the numba-compiled 3-RPS
+    fitness beside fkopt's batched ABC, both paths, ratio per run with the target verdict; both
+    solve mao2017's case (no timing asserted)."""
+    import pytest
+    pytest.importorskip("pygmo")
+    pytest.importorskip("numba")
+    rows = bench._Rows()
+    messages = []
+    bench.bench_pygmo_abc(rows, True, messages)
+    df = pd.DataFrame(rows.rows)
+    got = df[df.item.str.startswith("pygmo bee_colony")]
+    assert len(got) == 2 and not messages
+    assert np.all(np.isfinite(got.value)) and np.all(got.value > 0)
+    for note in got.note:
+        assert "target >= 10:" in note and "2010 evaluations" in note    # gen 100: 10 + 100 * 20

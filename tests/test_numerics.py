@@ -192,3 +192,84 @@ def test_compiled_pso_step_is_the_numpy_step_up_to_the_fitness_tolerance(monkeyp
     assert np.array_equal(a.x[same], b.x[same])
     monkeypatch.setenv(numerics_path.ENV, "auto")
     assert PSO._compiled_step(p) is None                  # the default keeps numpy's bits
+
+
+ABC_CASES = [("abc", {}, 10, {}), ("abc", {"limit": 3}, 10, {}), ("gabc", {}, 10, {}),
+             ("gabc", {"rule": "zhu2010", "limit": 4}, 10, {}),
+             ("gabc", {}, 40, {}),        # 40 > 32 bees: the roulette's binary search (abc.DENSE_ROULETTE)
+             ("abc", {}, 10, {"objective": "absolute"}),
+             ("gabc", {}, 10, {"target": 1e-6, "stop_at_target": True})]   # frozen runs: the log's active mask
+
+
+@pytest.mark.parametrize("algorithm,params,population,options", ABC_CASES,
+                         ids=lambda v: v if isinstance(v, str) else str(v))
+@pytest.mark.parametrize("cases", [1, 3])
+def test_compiled_abc_iteration_is_the_numpy_iteration_on_the_compiled_fitness(monkeypatch, algorithm, params,
+                                                                                 population, options, cases):
+    """FKOPT_NUMERICS=compiled runs an ABC/GABC iteration on a 3-RPS FK problem in one compiled
+    pass (fkopt.numerics.compiled.abc_rps3): the same draws, the same operations and the same
+    fitness function as the numpy phases on the compiled fitness, so every record is equal bit
+    for bit -- histories, points, evaluation counts and the evaluation log -- scouts included
+    (small limits make them fly); against the numpy fitness the tolerance is the outcome one
+    (test above)."""
+    from fkopt.algorithms.abc import ABC
+    m = fkopt.mechanism("3-rps")
+    targets = m.bounds[:, 0] + np.random.default_rng(11).random((cases, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    joints = m.ik(targets)
+    options = dict(options)
+    p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints, objective=options.pop("objective", "squared"))
+    monkeypatch.setenv(numerics_path.ENV, "compiled")
+    seen = []
+    run_compiled = ABC._iterate_compiled
+    monkeypatch.setattr(ABC, "_iterate_compiled", lambda self, *a: seen.append(1) or run_compiled(self, *a))
+    fused = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params,
+                        **options)
+    monkeypatch.setattr(ABC, "_compiled_iteration", lambda self, problem: None)
+    steps = fkopt.solve(p, algorithm, population=population, iterations=120, runs=6, seed=3, params=params,
+                        **options)
+    for name in ("x", "fitness", "history", "evaluation_history"):
+        assert np.array_equal(getattr(fused, name), getattr(steps, name)), name
+    for a, b in zip(fused.events, steps.events):
+        assert np.array_equal(a, b)
+    assert seen and (len(seen) == 120 or "target" in options)    # the compiled pass ran every iteration
+    if "target" in options:                                # some runs froze at the target on the way
+        assert (fused.iterations_done < 120).any()
+
+
+def test_compiled_abc_iteration_only_where_it_is_the_same_algorithm(monkeypatch):
+    """The compiled ABC iteration runs for fkopt's own ABC and GABC with raw selection under
+    FKOPT_NUMERICS=compiled; a subclass, ``selection: karaboga`` or the default mode stay numpy."""
+    from fkopt.algorithms.abc import ABC
+    from fkopt.algorithms.gabc import GABC
+    m = fkopt.mechanism("3-rps")
+    p = fkopt.fk_problem(m, m.ik(np.array([9.0, 13.0, 622.0])))
+
+    class Mine(ABC):
+        name = "mine"
+    monkeypatch.setenv(numerics_path.ENV, "compiled")
+    assert ABC()._compiled_iteration(p)[2] == 0
+    assert GABC()._compiled_iteration(p)[2] == 1 and GABC(rule="zhu2010")._compiled_iteration(p)[2] == 2
+    assert ABC(selection="karaboga")._compiled_iteration(p) is None
+    assert Mine()._compiled_iteration(p) is None
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    assert ABC()._compiled_iteration(p) is None
+
+
+@pytest.mark.parametrize("cases", [1, 3])
+def test_compiled_pso_iteration_is_the_numpy_iteration_on_the_compiled_fitness(monkeypatch, cases):
+    """The compiled PSO iteration (with its evaluation-log bookkeeping) against the numpy
+    iteration on the compiled fitness: every record equal bit for bit, the log included."""
+    from fkopt.algorithms.pso import PSO
+    m = fkopt.mechanism("3-rps")
+    targets = m.bounds[:, 0] + np.random.default_rng(12).random((cases, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    joints = m.ik(targets)
+    p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints)
+    monkeypatch.setenv(numerics_path.ENV, "compiled")
+    assert PSO._compiled_step(p) is not None
+    fused = fkopt.solve(p, "pso", population=10, iterations=150, runs=6, seed=4)
+    monkeypatch.setattr(PSO, "_compiled_step", staticmethod(lambda problem: None))
+    steps = fkopt.solve(p, "pso", population=10, iterations=150, runs=6, seed=4)
+    for name in ("x", "fitness", "history", "evaluation_history"):
+        assert np.array_equal(getattr(fused, name), getattr(steps, name)), name
+    for a, b in zip(fused.events, steps.events):
+        assert np.array_equal(a, b)

@@ -57,6 +57,11 @@ element); the onlooker duplicates resolved by two ``np.minimum.at`` scatters (no
 winner written back as its one moved coordinate; the roulette as a dense count on bee-major
 (SN, runs) arrays for small colonies or a vectorised binary search for large ones (the same
 integers either way). ``fkopt bench`` measures what an evaluation costs.
+
+Under ``FKOPT_NUMERICS=compiled`` on a 3-RPS FK problem, fkopt's own ABC and GABC (raw selection)
+run each iteration as one compiled pass instead (:func:`fkopt.numerics.compiled.abc_rps3`: the same
+draws in one block per iteration, the same operations, the evaluation log's bookkeeping inside);
+its records equal these phases on the compiled fitness bit for bit (tests/test_numerics.py).
 """
 from __future__ import annotations
 
@@ -66,7 +71,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, evaluated, row_offsets, rows_of, uniform_in
+from .base import (Algorithm, Params, State, compiled_step, evaluated, log_arrays, log_kept, row_offsets, rows_of,
+                   uniform_in)
 
 
 class ABCParams(Params):
@@ -217,6 +223,9 @@ class ABC(Algorithm):
     uses_best = False
 
     def iterate(self, state, problem, streams):
+        fused = self._compiled_iteration(problem)
+        if fused is not None:                      # FKOPT_NUMERICS=compiled on a built-in fitness
+            return self._iterate_compiled(state, problem, streams, *fused)
         # The scout of the previous iteration's trials flies first; its fresh source is
         # evaluated together with the employed candidates (one fitness call, not two).
         self.scout_phase(state, problem, streams, evaluate=False)
@@ -224,6 +233,39 @@ class ABC(Algorithm):
         if self.uses_best:
             self.update_best(state)
         self.onlooker_phase(state, problem, streams)
+
+    def compiled_rule(self) -> int | None:
+        """The move as the compiled iteration knows it (0: ABC's; GABC: 1 mao2017, 2 zhu2010),
+        or None when it must run on numpy: a subclass (its own phases or moves), or
+        ``selection: karaboga``."""
+        return 0 if type(self) is ABC and self.params.selection == "raw" else None
+
+    def _compiled_iteration(self, problem):
+        """(compiled iteration, absolute objective, rule) or None (:func:`compiled_step`)."""
+        rule = self.compiled_rule()
+        fused = None if rule is None else compiled_step(problem, "abc")
+        return None if fused is None else (*fused, rule)
+
+    def _iterate_compiled(self, state, problem, streams, step, absolute, rule):
+        """:meth:`iterate` in one compiled pass (:func:`fkopt.numerics.compiled.abc_rps3`): the
+        same draws (one block per iteration holding the phases' draws in their order), the same
+        operations, the same log reports; the fitness' ``tan`` may be an ulp from numpy's."""
+        _aux(state, problem)                        # x, f, trial: C-contiguous arrays of our own
+        runs, population, dim = state.x.shape
+        per_phase = (4 if rule == 2 else 3) * population
+        u = streams.uniform(dim + 2 * per_phase + population)
+        if problem.cases is not None:
+            problem._check_cases(state.x)
+        J = problem._joint_rows(state.x.shape[:-1])
+        # GABC refreshes the best-so-far between the phases: new arrays, as update_best makes
+        best_x, best_f = (state.best_x, state.best_f) if rule == 0 else (state.best_x.copy(), state.best_f.copy())
+        C = getattr(self.params, "C", 0.0)
+        # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
+        scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
+                           problem.bounds, J, absolute, log_arrays(state, runs))
+        log_kept(state, kept)
+        state.best_x, state.best_f = best_x, best_f
+        state.evaluations = state.evaluations + (2 * population + scout)
 
     def step(self, state, xs, xk, phi, streams):
         """The move added to the chosen coordinate, on whole rows (overridden by GABC).

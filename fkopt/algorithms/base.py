@@ -16,6 +16,7 @@ iteration on, so its numbers do not depend on the other runs of the batch.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, ClassVar
@@ -24,6 +25,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from ..errors import FkoptError
+from ..numerics.path import ENV as _NUMERICS_ENV
 from ..progress import tick
 from ..streams import RunStreams
 
@@ -107,6 +109,12 @@ class EvaluationLog:
             self.count[rows] += step
             return
         runs, k = f.shape
+        if not self.first and k:
+            # Most calls improve no run: then nothing is kept and the best stays (a hit needs a
+            # value below the run's best; fmin ignores NaN as the accumulation does).
+            if not (np.fmin.reduce(f, axis=1) < self.best).any():
+                self.count = self.count + k * np.asarray(step, dtype=np.int64)
+                return
         acc = np.fmin.accumulate(f, axis=1)
         prev = np.empty_like(f)
         prev[:, 0] = self.best
@@ -154,6 +162,26 @@ def evaluated(state, f: np.ndarray, rows: np.ndarray | None = None) -> None:
         log.add(f, rows)
 
 
+def log_arrays(state, runs: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The run's :class:`EvaluationLog` as the arrays a compiled iteration updates in place while
+    it reports its values (best, count, active: :func:`fkopt.numerics.compiled._log_points`, the
+    same rule as :meth:`EvaluationLog.add`); scratch arrays outside :meth:`Algorithm.minimize`.
+    Hand the improvements it returns to :func:`log_kept`."""
+    log = getattr(state, "log", None)
+    if log is None:
+        return np.full(runs, np.inf), np.zeros(runs, dtype=np.int64), np.zeros(runs, dtype=bool)
+    if log.first:               # never in minimize: the initial population is reported first
+        raise RuntimeError("a compiled iteration needs the log's initial report first")
+    return log.best, log.count, log.active
+
+
+def log_kept(state, kept) -> None:
+    """Store the improvements (rows, evaluation numbers, values) a compiled iteration found."""
+    log = getattr(state, "log", None)
+    if log is not None:
+        log._keep(*kept)
+
+
 @lru_cache(maxsize=64)
 def row_offsets(runs: int, population: int) -> np.ndarray:
     """``arange(runs) * population`` (read-only, cached): flat index of each run's first agent.
@@ -171,6 +199,34 @@ def rows_of(problem, rows: np.ndarray):
     points of a local method: ``problem.take(rows)`` when the problem's first axis is per row
     (:func:`fkopt.solve` batching several targets), the problem itself otherwise."""
     return problem if getattr(problem, "cases", None) is None else problem.take(rows)
+
+
+def compiled_step(problem, kind: str):
+    """(compiled iteration, absolute objective) when the problem's mechanism offers one for the
+    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness under
+    ``FKOPT_NUMERICS=compiled``) and the problem is a plain FK problem of three variables without
+    angle-valued joints, else None. The same operations as the numpy iteration; the fitness'
+    ``tan`` may be an ulp from numpy's (tests/test_numerics.py)."""
+    # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
+    # or a caller may change the variable between iterations).
+    key = (kind, os.environ.get(_NUMERICS_ENV))
+    cache = getattr(problem, "_compiled_steps", None)
+    if cache is not None and key in cache:
+        return cache[key]
+    make = getattr(getattr(problem, "mechanism", None), f"compiled_{kind}_step", None)
+    rows = getattr(problem, "_joint_rows", None)
+    if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
+        got = None
+    else:
+        step = make()
+        got = None if step is None else (step, problem.objective == "absolute")
+    if cache is None:
+        try:
+            cache = problem._compiled_steps = {}
+        except AttributeError:          # a problem that takes no attributes: ask every time
+            return got
+    cache[key] = got
+    return got
 
 
 def clip(x: np.ndarray, bounds: np.ndarray) -> np.ndarray:

@@ -32,6 +32,11 @@ class GABC(ABC):
     Params = GABCParams
     uses_best = True
 
+    def compiled_rule(self) -> int | None:
+        if type(self) is not GABC or self.params.selection != "raw":
+            return None
+        return 1 if self.params.rule == "mao2017" else 2
+
     def step(self, state, xs, xk, phi, streams):
         best = state.best_x[:, None, :]
         if self.params.rule == "mao2017":

@@ -36,7 +36,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, evaluated, uniform_in
+from .base import Algorithm, Params, State, clip, compiled_step, evaluated, log_arrays, log_kept, uniform_in
 
 
 class PSOParams(Params):
@@ -94,18 +94,8 @@ class PSO(Algorithm):
 
     @staticmethod
     def _compiled_step(problem):
-        """(compiled iteration, absolute objective) when the problem's mechanism offers one
-        (``compiled_pso_step``: the 3-RPS FK fitness under ``FKOPT_NUMERICS=compiled``), else None.
-        The same operations as below; the fitness' ``tan`` may be an ulp from numpy's."""
-        mech = getattr(problem, "mechanism", None)
-        make = getattr(mech, "compiled_pso_step", None)
-        rows = getattr(problem, "_joint_rows", None)
-        if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
-            return None
-        step = make()
-        if step is None:
-            return None
-        return step, problem.objective == "absolute"
+        """:func:`fkopt.algorithms.base.compiled_step` for PSO (``compiled_pso_step``)."""
+        return compiled_step(problem, "pso")
 
     def iterate(self, state, problem, streams):
         p = self.params
@@ -118,10 +108,11 @@ class PSO(Algorithm):
             if problem.cases is not None:
                 problem._check_cases(state.pos)
             J = problem._joint_rows(state.pos.shape[:-1])     # the fitness' target rows
-            state.x, state.f, state.pos, state.vel, f = step(
+            # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
+            state.x, state.f, state.pos, state.vel, _, kept = step(
                 state.x, state.f, state.pos, state.vel, state.best_x, r, self.inertia_weight(state), p.c1, p.c2,
-                self.velocity_limit(problem.bounds), problem.bounds, J, absolute)
-            evaluated(state, f)
+                self.velocity_limit(problem.bounds), problem.bounds, J, absolute, log_arrays(state, runs))
+            log_kept(state, kept)
             state.evaluations = state.evaluations + population
             return
         g = state.best_x[:, None, :]

@@ -234,8 +234,22 @@ class ThreeRPS(ParallelMechanism):
         mod = numerics_path.compiled(True)
         ra, rb = self.geometry.ra, self.geometry.rb
 
-        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute):
-            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute)
+        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute, log):
+            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log)
+        return step
+
+    def compiled_abc_step(self):
+        """A function (state arrays, ..., log arrays) -> (scouts, log improvements), running one
+        ABC or GABC iteration with this fitness compiled (:func:`fkopt.numerics.compiled.abc_rps3`, same
+        arguments after the fitness' leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as
+        :meth:`compiled_fitness`)."""
+        if numerics_path.requested() != "compiled":
+            return None
+        mod = numerics_path.compiled(True)
+        ra, rb = self.geometry.ra, self.geometry.rb
+
+        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log):
+            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log)
         return step
 
     def jacobian(self, poses) -> np.ndarray:

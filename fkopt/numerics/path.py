@@ -54,7 +54,8 @@ def describe() -> dict:
     """What ``env.json`` records (its ``numerics``): ``path``, the path a default ``fkopt.inverse``
     call takes in this process ('compiled' with numba, else 'numpy'); ``mode``, the
     ``FKOPT_NUMERICS`` setting it ran under ('auto', 'numpy' or 'compiled': with 'compiled' the
-    3-RPS swarm fitness is compiled too, ``compiled_fitness``); numba's version; the raw variable."""
+    3-RPS swarm fitness is compiled too, ``compiled_fitness``, and with it the whole PSO, ABC and
+    GABC iterations on it); numba's version; the raw variable."""
     try:
         from importlib.metadata import PackageNotFoundError, version
         try:
