@@ -65,3 +65,9 @@ def test_mechanism_docs_do_not_contradict_the_robots_page():
     text = (ROOT / "docs" / "mechanisms-and-algorithms.md").read_text(encoding="utf-8")
     for stale in ("yourdfpy parses", "no analytic Jacobian for URDF", "w_p: 1000"):
         assert stale not in text
+
+
+def test_readme_quotes_the_stored_v3_robot_board():
+    from fkopt.kinbench.advice import robots_markdown, robots_summary
+    table = robots_markdown(robots_summary(ROOT / "results" / "kinbench" / "kinbench-v3-robots"))
+    assert table in (ROOT / "README.md").read_text(encoding="utf-8")

@@ -40,3 +40,37 @@ def advice_markdown(table: pd.DataFrame) -> str:
         cells = [f"{r.solver} {100 * r.success:.0f} %, {r.ms_per_solve:.3g} ms" for r in rows.itertuples()]
         lines.append(f"| {problem} | {cls} | " + " | ".join(cells + [""] * (3 - len(cells))) + " |")
     return "\n".join(lines)
+
+
+def robots_summary(folder: str | Path, timeout_ms: float = 20.0) -> pd.DataFrame:
+    """Per IK solver of a stored per-robot board (``leaderboard-robots.csv``) at ``timeout_ms``:
+    the arms it ran on, its success at each rung of the ladder (mean over arms, and the worst
+    arm at the board's rung) and its median time and median time ratio to the reference (median
+    over arms); best first (mean success at the rung, then ratio). FK rows (the parallel
+    mechanisms, another timeout ladder) are left out."""
+    board = pd.read_csv(Path(folder) / "leaderboard-robots.csv")
+    fk_robots = set(board.loc[board["other_mode"].notna(), "robot"])      # FK rows count other modes
+    board = board[np.isclose(board["timeout_ms"], timeout_ms) & ~board["robot"].isin(fk_robots)]
+    success = [c for c in board.columns if c.startswith("success_")]
+    rung = f"success_{board['rung'].iloc[0]}"
+    g = board.groupby(["solver", "entry"], sort=False)
+    out = g[success].mean().mul(100)
+    out["worst_arm"] = g[rung].min().mul(100)
+    out["arms"] = g["robot"].nunique()
+    out["median_ms"] = g["time_ms_median"].median()
+    out["median_ratio"] = g["time_ratio_median"].median()
+    out = out.reset_index().sort_values([rung, "median_ratio"], ascending=[False, True], kind="stable")
+    return out.reset_index(drop=True)
+
+
+def robots_markdown(table: pd.DataFrame, timeout_ms: float = 20.0) -> str:
+    """The summary as README prints it."""
+    success = [c for c in table.columns if c.startswith("success_")]
+    rungs = " / ".join(c.removeprefix("success_").replace("_", ", ") for c in success)
+    lines = [f"| solver | entry | arms | success % at {rungs} (mean over arms) | worst arm % | median ms | "
+             "median ratio to rtb `ik_LM` |", "|---|---|---|---|---|---|---|"]
+    for _, r in table.iterrows():
+        pct = " / ".join(f"{r[c]:.0f}" for c in success)
+        lines.append(f"| {r['solver']} | {r['entry']} | {r['arms']} | {pct} | {r['worst_arm']:.0f} | "
+                     f"{r['median_ms']:.3g} | {r['median_ratio']:.3g} |")
+    return "\n".join(lines)
