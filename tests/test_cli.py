@@ -157,8 +157,9 @@ def test_stored_configs_validate():
     for f in files:   # experiments, studies (kind: study), assembly modes and suites
         cfg = load_any(f)
         tasks = validate_any(cfg)
-        if isinstance(cfg, SuiteConfig):     # one task per (problem, solver)
-            assert tasks == len(cfg.problems) * len(cfg.solvers), f
+        if isinstance(cfg, SuiteConfig):     # one task per (problem, solver), and one per clock-track arm
+            clock = cfg.tracks.clock if cfg.tracks is not None else None
+            assert tasks == len(cfg.problems) * len(cfg.solvers) + (len(clock.problems) if clock else 0), f
         elif isinstance(cfg, AssemblyConfig):
             assert tasks == 1, f
         elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block

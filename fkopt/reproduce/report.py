@@ -72,7 +72,7 @@ def suite_section(exp: Experiment, root: Path) -> str:
         overall = board[board["scope"] == "overall"] if "scope" in board.columns else board
         cols = [c for c in ("rank", "solver", "track", "score", "ci_low", "ci_high", "better_than") if c in board.columns]
         lines += ["Overall (tracks mixed, for reference; each track is ranked on its own in the leaderboard):", "",
-                  md_table(overall[cols].fillna("")), ""]
+                  md_table(overall[cols].astype(object).fillna("")), ""]
     return "\n".join(lines)
 
 
