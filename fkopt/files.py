@@ -276,6 +276,16 @@ def read_stored(folder: str | Path, name: str | Path, unpack: bool = True) -> by
     return read_input(Path(folder) / name, MAX_UNPACKED, within=folder, unpacked=MAX_UNPACKED, unpack=unpack)
 
 
+def stored_sha256(path: str | Path, max_bytes: int = MAX_UNPACKED) -> str:
+    """SHA-256 of a stored file's own bytes (not unpacked), read bounded: a regular file inside
+    its folder, at most ``max_bytes`` (default :func:`read_stored`'s); a FIFO or ``/dev/zero``
+    there is one line, never a hang. The one file digest of results folders, task files and
+    released kinbench files."""
+    import hashlib
+    path = Path(path)
+    return hashlib.sha256(read_input(path, max_bytes, within=path.parent, unpack=False)).hexdigest()
+
+
 def odd_entries(folder: str | Path) -> list[tuple[str, str]]:
     """(relative path, what it is) of every entry below ``folder`` that is not a plain file or
     folder: symbolic links (wherever they point), FIFOs, devices, sockets. A results folder

@@ -43,7 +43,6 @@ Adding an output is one maker function in the kind's report module plus one line
 """
 from __future__ import annotations
 
-import hashlib
 import importlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -159,11 +158,9 @@ def deterministic_files(folder: Path) -> list[str]:
 
 
 def sha256(path: Path) -> str:
-    """SHA-256 of a file's own bytes, read bounded (a regular file: a FIFO or ``/dev/zero`` in a
-    results folder is one line, never a hang)."""
-    from .files import read_stored
-    path = Path(path)
-    return hashlib.sha256(read_stored(path.parent, path.name, unpack=False)).hexdigest()
+    """SHA-256 of a results file, read bounded (:func:`fkopt.files.stored_sha256`)."""
+    from .files import stored_sha256
+    return stored_sha256(path)
 
 
 def file_digests(folder: Path) -> dict[str, str]:

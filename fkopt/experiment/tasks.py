@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import FkoptError
-from ..files import inside, parse_json, read_stored, write_json_atomically
+from ..files import inside, parse_json, read_stored, stored_sha256, write_json_atomically
 from ..progress import listening
 
 TASKS = "tasks"
@@ -115,11 +115,8 @@ def run_remote(item: tuple[Callable[[Any], Any], str, Any]) -> tuple[str, Any]:
     return ident, solve(payload)
 
 
-def sha256(path: Path) -> str:
-    """SHA-256 of a task file, read bounded (:func:`fkopt.files.read_stored`: a FIFO or a
-    device where a task file should be is one line, not a hang)."""
-    path = Path(path)
-    return hashlib.sha256(read_stored(path.parent, path.name, unpack=False)).hexdigest()
+#: SHA-256 of a task file, read bounded (a FIFO or a device where a task file should be is one line).
+sha256 = stored_sha256
 
 
 def read_manifest(tasks: Path) -> dict | None:

@@ -21,11 +21,11 @@ name itself a new version (a new ``pose_sets`` folder whose manifest says that n
 """
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import FkoptError
+from ..files import MAX_INPUT_BYTES, stored_sha256
 from ..problems import FITNESS_VERSION
 
 
@@ -105,10 +105,6 @@ RELEASES: dict[str, Release] = {
 }
 
 
-def sha256_file(path: Path) -> str:
-    """SHA-256 of a file as it is on disk, read bounded (:func:`fkopt.files.read_input`)."""
-    from ..files import read_input
-    return hashlib.sha256(read_input(path, 64 << 20, unpack=False)).hexdigest()
 
 
 def _base(config, files) -> Path:
@@ -136,7 +132,7 @@ def release_files(config, files: Path | None = None) -> dict[str, str]:
     base = _base(config, files)
     folder = base / config.pose_sets
     names = sorted(p.relative_to(base).as_posix() for p in folder.rglob("*") if p.is_file())
-    return {name: sha256_file(base / name) for name in names + problem_files(config)}
+    return {name: stored_sha256(base / name, MAX_INPUT_BYTES) for name in names + problem_files(config)}
 
 
 def released_name(config, manifest: dict) -> str | None:
@@ -167,8 +163,9 @@ def check_release(config, manifest: dict, files: Path | None = None) -> None:
         path = base / rel
         if not path.is_file():
             raise FkoptError(f"{path}: missing; it is part of released {name}{new}")
-        if sha256_file(path) != digest:
-            raise FkoptError(f"{path}: differs from released {name} (SHA-256 {sha256_file(path)[:16]}..., "
+        found = stored_sha256(path, MAX_INPUT_BYTES)
+        if found != digest:
+            raise FkoptError(f"{path}: differs from released {name} (SHA-256 {found[:16]}..., "
                              f"released {digest[:16]}...){new}")
     for path in sorted(folder.rglob("*")):
         if path.is_file() and path.relative_to(base).as_posix() not in expected:
