@@ -325,11 +325,11 @@ class _Heartbeat:
     """Plain progress lines for a stdout that is not a terminal (a log, CI, a pipe): one line at
     most every ``every`` seconds, so a long run shows it is alive without a bar's escape codes."""
 
-    def __init__(self, con, every: float | None = None):
+    def __init__(self, con, every: float | None = None, quiet: bool = False):
         import time
         self.con, self.every, self.clock = con, HEARTBEAT_S if every is None else every, time.perf_counter
         self.start = self.last = self.clock()
-        self.on = not con.is_terminal
+        self.on = not (quiet or con.is_terminal)
 
     def beat(self, text) -> None:
         now = self.clock()
@@ -718,7 +718,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     before = snapshot(out, keep=Path(kept.name))    # what the tree held, for CHANGES.md
     con = _console()
     start = time.perf_counter()
-    heart = _Heartbeat(con)
+    heart = _Heartbeat(con, quiet=quiet)
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.description}"), TimeElapsedColumn(), console=con,
                   disable=quiet or not con.is_terminal) as bar:
@@ -737,8 +737,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
             def __call__(self, label, d, t):
                 bar.update(self.task, completed=d, description=label)
                 current["now"] = f"{self.name}: {d:.1f}/{t} tasks ({label})"
-                if not quiet:
-                    heart.beat(status)
+                heart.beat(status)
             running = __call__
 
         def started(p):
@@ -750,16 +749,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
             bar.advance(overall)
             current["done"] += 1
             current["now"] = ""
-            if not quiet:
-                heart.beat(status)
+            heart.beat(status)
 
         def solving(n, total):
             if "solving" not in current:
                 current["solving"] = bar.add_task("", total=total, name="  solving experiments in parallel")
             bar.update(current["solving"], completed=n)
             current["now"] = f"solving experiments in parallel: {n}/{total}"
-            if not quiet:
-                heart.beat(status)
+            heart.beat(status)
             if n == total:
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
