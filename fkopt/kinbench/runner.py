@@ -21,7 +21,7 @@ import hashlib
 import json
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -116,7 +116,7 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
         for k in range(len(config.outside)):
             read_outside(config, k, dims, instances, files)
             digest(config, config.outside[k], files)   # every file meta.json will hash, read bounded now
-    tracks = track_cases(config, sets, files)
+    tracks = plan.context.tracks if plan is not None else track_cases(config, sets, files)
     for p, _ in tracks:
         validate_track(config, p, files)
     read_submissions(config, tracks, files)
@@ -358,6 +358,7 @@ class _Context:
     manifest: dict
     prepared_s: float     # building the plan (validation)
     files: Path | None    # where the suite's relative files are (pose sets, outside logs)
+    tracks: list = field(default_factory=list)   # (problem index, queries) of the clock track's arms
 
 
 def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = True) -> Plan:
@@ -373,11 +374,13 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
     tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
                                  "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
              for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
+    tracks = track_cases(config, sets, files)      # the clock track's queries, loaded once per run
     tasks += [Task(f"t{p}", {"config": data, "folder": folder, "problem": p, "track": "clock", "fingerprint": fp,
                              "queries": queries.tolist()}, f"{config.problems[p].name} / clock track")
-              for p, queries in track_cases(config, sets, files)]
+              for p, queries in tracks]
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
-                context=_Context(sets, manifest, time.perf_counter() - started, files), name=f"suite '{config.name}'")
+                context=_Context(sets, manifest, time.perf_counter() - started, files, tracks),
+                name=f"suite '{config.name}'")
 
 
 def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
@@ -388,7 +391,7 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
             if not t.payload.get("track")]
     tracked = [ran.records[t.id] for t in plan.tasks if t.payload.get("track")]
     answers = pd.concat([pd.DataFrame(r["answers"]) for r in tracked], ignore_index=True) if tracked else None
-    submitted = read_submissions(config, track_cases(config, ctx.sets, ctx.files), ctx.files) if tracked else None
+    submitted = read_submissions(config, ctx.tracks, ctx.files) if tracked else None
     if submitted is not None:
         answers = pd.concat([answers, submitted], ignore_index=True)
     rates = [pd.DataFrame(r["throughput"]) for r in tracked if r.get("throughput")]
