@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import FkoptError
-from ..files import load_mapping, output_folder, parse_json, read_stored, run_lock, write_atomically
+from ..files import load_mapping, output_folder, parse_json, read_stored, run_lock, short_token, write_atomically
 from ..outputs import write_outputs
 from ..kinbench.kind import SUITE
 from ..study.kind import STUDY
@@ -165,8 +165,7 @@ def check_overwrite(folder: Path, config, force: bool) -> None:
 
 
 def _short(value) -> str:
-    text = json.dumps(value, sort_keys=True, default=str)
-    return text if len(text) <= 40 else text[:37] + "..."
+    return short_token(json.dumps(value, sort_keys=True, default=str))
 
 
 def changed_fields(old, new, path: str = "") -> list[str]:
