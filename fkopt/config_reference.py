@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any, Literal, get_args, get_origin
 
 from .errors import FkoptError
+from .files import models_in
 
 #: kind -> "module:Class" of the model that validates a file of that kind (imported on first use).
 MODELS: dict[str, str] = {
@@ -337,13 +338,6 @@ def field_doc(model_name: str, field: str) -> tuple[str, str, Any] | None:
     return None
 
 
-def _models_in(annotation) -> list:
-    from pydantic import BaseModel
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return [annotation]
-    return [m for arg in get_args(annotation) for m in _models_in(arg)]
-
-
 def models_of(kind: str) -> list:
     """Every model a file of ``kind`` can contain, the top-level one first (no repeats)."""
     seen, todo = [], [model(kind)]
@@ -353,7 +347,7 @@ def models_of(kind: str) -> list:
             continue
         seen.append(m)
         for f in m.model_fields.values():
-            todo += _models_in(f.annotation)
+            todo += models_in(f.annotation)
     return seen
 
 

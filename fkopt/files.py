@@ -344,20 +344,20 @@ def load_mapping(path: str | Path, what: str) -> dict:
 
 
 # -- pydantic errors -------------------------------------------------------------------------------
-def _models_in(annotation) -> list:
+def models_in(annotation) -> list:
     """The pydantic models an annotation can hold (through Optional/Union, list, dict, Annotated)."""
     import typing
 
     from pydantic import BaseModel
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
         return [annotation]
-    return [m for arg in typing.get_args(annotation) for m in _models_in(arg)]
+    return [m for arg in typing.get_args(annotation) for m in models_in(arg)]
 
 
 def field_names_at(model, loc: list[str]) -> list[str]:
     """The field names (and aliases) a mapping at ``loc`` (an error's location without its last
     part) may have, walking ``model``'s annotations; [] where that is not known."""
-    current = _models_in(model)
+    current = models_in(model)
     for part in loc:
         if part.isdigit() or part.startswith(("list[", "function-", "literal[", "dict[")):
             continue                         # list items and validator frames: same models
@@ -365,7 +365,7 @@ def field_names_at(model, loc: list[str]) -> list[str]:
         if tagged:                           # a union branch pydantic tried
             current = tagged
             continue
-        current = [m for c in current if part in c.model_fields for m in _models_in(c.model_fields[part].annotation)]
+        current = [m for c in current if part in c.model_fields for m in models_in(c.model_fields[part].annotation)]
     names = []
     for c in current:
         for key, info in c.model_fields.items():
