@@ -665,7 +665,7 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
-                                            "throughput, mao2017, peers, adapters, exact, kinematics, robots, "
+                                            "throughput, mao2017, peers, adapters, exact, kinematics, "
                                             "ik-one-pose, ik-batch, cases, swarms, scaling (default: all but peers "
                                             "and adapters)")):
     """Measure fkopt's speed (and peers') on this machine.
@@ -675,10 +675,9 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     (scipy's, pymoo's and NiaPy's DE through fkopt's adapters beside gabc, abc and the plug-in DE
     on kinbench's problems; with --peers or named), exact (batched
     lm), kinematics (fkopt.forward, fkopt.inverse, all assembly modes, the fk process),
-    robots (fkopt.inverse on URDF arms from example-robot-data beside roboticstoolbox's ETS
-    ik_LM, if installed), ik-one-pose and ik-batch (fkopt.inverse on 14 example-robot-data arms beside
-    rtb's ik_LM at 1e-6 m / 1e-6 rad, one pose per call and 1000 poses in one call, answers checked
-    by pinocchio's FK), cases (N cases x 30 runs solved together, beside a compiled C loop when a C
+    ik-one-pose and ik-batch (fkopt.inverse on 14 example-robot-data arms and the wang7dof DH arm
+    beside rtb's ik_LM at 1e-6 m / 1e-6 rad, one pose per call and 1000 poses in one call, answers
+    checked by pinocchio's FK, the DH arm's by rtb's DHRobot), cases (N cases x 30 runs solved together, beside a compiled C loop when a C
     compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop; pygmo's
     bee_colony with a numba fitness beside the batched ABC), scaling (population and runs; draws
     scaling.png). The last line gives the seconds per section."""

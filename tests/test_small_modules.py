@@ -1,11 +1,10 @@
 """Fast tests of modules otherwise reached only by slow tiers: the assembly report's claims and
-the robots bench's answer check."""
+the reproduce agreement line."""
 from types import SimpleNamespace
 
 import numpy as np
 
 import fkopt
-from fkopt.bench_robots import _check
 from fkopt.reproduce import assembly as assembly_report
 from fkopt.reproduce.claims import HELD, NOT_CHECKABLE, NOT_HELD
 
@@ -26,20 +25,6 @@ def test_assembly_claim_holds_only_at_40_solutions_and_is_not_checkable_without_
     assert assembly_report.claims(Store(39))[0].verdict == NOT_HELD
     assert assembly_report.claims(Store(None))[0].verdict == NOT_CHECKABLE
     assert assembly_report.timing_claims(Store(None)) == []
-
-
-def test_robots_bench_check_accepts_the_arms_own_pose_and_refuses_a_moved_or_out_of_limit_one():
-    m = fkopt.mechanism("7dof-arm")
-    rng = np.random.default_rng(0)
-    q = m.bounds[:, 0] + rng.random((4, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
-    T = m.fk_matrix(q)
-    assert _check(m, q, T, (1e-6, 1e-6), 1.0).all()      # the bench's tolerance; arccos near 1 is ~1e-8 rad coarse
-    moved = T.copy()
-    moved[:, 0, 3] += 1.0                                 # one length unit away
-    assert not _check(m, q, moved, (1e-3, 1e-3), 1.0).any()
-    outside = q.copy()
-    outside[:, 0] = m.bounds[0, 1] + 1.0
-    assert not _check(m, outside, m.fk_matrix(outside), (1e-6, 1e-6), 1.0).any()
 
 
 def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cross_platform_rules(tmp_path):

@@ -523,7 +523,7 @@ class URDFArm(FrameArm):
 
 #: Serial chains of the PyPI package ``example-robot-data`` (version 6) that fkopt was tried on:
 #: name -> (file under its robots/ folder, base link, tip link). Tests and ``fkopt bench
-#: --section robots`` use them; docs/robots.md lists the results.
+#: --section ik-one-pose`` / ``ik-batch`` use them; docs/robots.md lists the results.
 EXAMPLE_ROBOTS = {
     "panda": ("panda_description/urdf/panda.urdf", "panda_link0", "panda_hand_tcp"),
     "ur5": ("ur_description/urdf/ur5_robot.urdf", "base_link", "tool0"),
