@@ -659,7 +659,7 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
 
 @app.command()
 def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s on an idle 2-core machine, "
-                                     "20.5 s measured; 27-29 s under load; the first run after installing "
+                                     "22.6 s measured at load average 1.8; 27-29 s under heavier load; the first run after installing "
                                      "also compiles the numerics, ~25 s more)"),
           peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
