@@ -760,7 +760,8 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
                        jobs=default_jobs() if jobs is None else jobs, solving=solving)
-    paths = write_report(out, changes_since=before)
+    written = write_report(out, changes_since=before)     # its snapshot of the tree serves the last line too
+    paths = written.paths
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")
@@ -770,7 +771,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
             table.add_row(str(d.path), str(d.folder), str(d.files), f"{d.wall_s:.1f}")
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
-    con.print(agreement(before, out), highlight=False, markup=False)   # even with -q: what a newcomer must know
+    con.print(agreement(before, out, written.after), highlight=False, markup=False)   # even with -q: what a newcomer must know
     kept.cleanup()
 
 
@@ -801,7 +802,7 @@ def report(results: Path = typer.Argument(Path("results"), help="results root"),
         typer.echo(str(snapshot_to))
         return
     before = load_snapshot(changes_since) if changes_since is not None else None
-    for p in write_report(results, changes_since=before):
+    for p in write_report(results, changes_since=before).paths:
         typer.echo(str(p))
 
 

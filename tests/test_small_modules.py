@@ -55,6 +55,32 @@ def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cros
     assert "refuse" in big and "liu2008/tab3_fig4 runs.csv" in big
 
 
+def test_reproduce_hashes_the_regenerated_tree_once_for_changes_and_its_agreement_line(tmp_path, monkeypatch):
+    """write_report's CHANGES.md and `fkopt reproduce`'s last line are judged on one snapshot of
+    the tree after the rerun (issue 32): one pass over its files, and the same line as from a
+    fresh snapshot."""
+    import shutil
+    from pathlib import Path
+
+    from fkopt.reproduce import changes
+    from fkopt.reproduce.report import write_report
+    root = tmp_path / "results"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "results" / "liu2008" / "tab3_fig4",
+                    root / "liu2008" / "tab3_fig4")
+    runs = root / "liu2008" / "tab3_fig4" / "runs.csv"
+    (tmp_path / "keep").mkdir()
+    before = changes.snapshot(root, keep=tmp_path / "keep")
+    runs.write_text(runs.read_text().replace("9.408561477e-08", "9.408561478e-08", 1))
+    taken = []
+    real = changes.snapshot
+    monkeypatch.setattr(changes, "snapshot", lambda *a, **k: taken.append(a) or real(*a, **k))
+    written = write_report(root, changes_since=before)
+    line = changes.agreement(before, root, written.after)
+    assert len(taken) == 1 and written.after is not None and root / "CHANGES.md" in written.paths
+    assert line == changes.agreement(before, root) and "1 deterministic files in 1 results moved" in line
+    assert "runs.csv" in (root / "CHANGES.md").read_text()
+
+
 def test_field_solvers_answer_on_the_stored_ur5_and_kinbench_judges_them():
     """The outside IK wrappers (TRAC-IK, rtb ik_LM/ik_NR) on the suite's stored UR5: every answer
     judged by kinbench's own FK (the fast tier's reach; tests/test_field.py checks against pinocchio)."""
