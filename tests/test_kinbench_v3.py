@@ -360,6 +360,16 @@ def test_a_malformed_fk_submission_is_one_line_naming_file_line_field_and_allowe
     assert "my-fk.csv" in str(err.value)
 
 
+def test_fk_answers_for_a_robot_the_caller_did_not_pass_are_one_line_saying_so(tmp_path):
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.submissions import read_submission
+    cfg, arms = fk_submission(tmp_path, lambda m, g: pd.DataFrame(
+        [{"robot": "dietmaier-6sps", "query": i, **{f"x{d}": v for d, v in enumerate(x)}, "seconds": 0.01,
+          "reference_seconds": 0.02} for i, x in enumerate(g)]))
+    with pytest.raises(FkoptError, match=r"robot 'dietmaier-6sps': this run takes submitted answers for ur5 only"):
+        read_submission(cfg, 0, {"ur5": arms["ur5"]})
+
+
 def test_an_unreadable_submission_file_is_one_line(tmp_path):
     from fkopt.errors import FkoptError
     from fkopt.kinbench.submissions import read_submission

@@ -161,8 +161,11 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
         if robot not in arms:
             row = int(np.flatnonzero(names == robot)[0]) + 2 if isinstance(robot, str) else \
                 int(np.flatnonzero(pd.isna(names))[0]) + 2
+            if robot in clock.problems:     # a problem of the track whose answers the caller did not pass
+                raise FkoptError(f"{where}: line {row}: robot '{robot}': this run takes submitted answers for "
+                                 f"{', '.join(arms) or 'no robot'} only")
             raise FkoptError(f"{where}: line {row}: robot '{robot}' is not one of tracks.clock.problems "
-                             f"({', '.join(arms)})")
+                             f"({', '.join(clock.problems)})")
     frames = []
     for robot, (mech, queries) in arms.items():
         g = df[df["robot"] == robot]
