@@ -344,6 +344,7 @@ def test_fk_answers_of_scipy_least_squares_submitted_are_verified_by_the_mechani
     (lambda df: pd.concat([df.assign(given_timeout_ms=20), df.iloc[1:].assign(given_timeout_ms=500)]),
      "no row for query 0 at given_timeout_ms 500; every query of the track at every timeout (20, 500 ms)"),
     (lambda df: df.drop(columns="robot"), "missing column 'robot'"),
+    (lambda df: df.assign(claimed="maybe"), "line 2: claimed = maybe; allowed: true, false, 1, 0 or empty"),
     (lambda df: df.iloc[:0], "no rows; needs one per query of each robot it answers"),
 ])
 def test_a_malformed_fk_submission_is_one_line_naming_file_line_field_and_allowed_values(tmp_path, spoil, message):

@@ -33,7 +33,8 @@ reference_seconds      the reference solver's wall time on the same query, measu
                        the same machine (s); the board ranks seconds / reference_seconds. The
                        reference is the track's: ``reference`` (rtb ``ik_LM``) for IK,
                        ``fk_reference`` (scipy ``least_squares``) for FK
-claimed                optional: what the solver said of its answer (stored, never counted)
+claimed                optional: what the solver said of its answer (true/false/1/0/empty; stored,
+                       never counted)
 given_timeout_ms       optional: the timeout the solver was given; then one row per query and per
                        timeout of the track (``timeouts_ms`` for IK, ``fk_timeouts_ms`` for FK),
                        else the one time is judged at every timeout
@@ -107,6 +108,20 @@ def _check_numbers(g: pd.DataFrame, where: str, n: int, timed: bool) -> None:
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise FkoptError(f"{where}: line {_line(g, k)}: {col} = {g[col].astype(str).iloc[k]}; allowed: {allowed}")
+
+
+_CLAIMS = {"true": True, "1": True, "1.0": True, "false": False, "0": False, "0.0": False, "nan": False, "": False}
+
+
+def _claims(g: pd.DataFrame, where: str) -> np.ndarray:
+    """The optional ``claimed`` column as booleans (empty: no claim)."""
+    text = g["claimed"].astype(str).str.strip().str.lower()
+    bad = ~text.isin(list(_CLAIMS))
+    if bad.any():
+        k = int(np.flatnonzero(bad.to_numpy())[0])
+        raise FkoptError(f"{where}: line {_line(g, k)}: claimed = {g['claimed'].astype(str).iloc[k]}; "
+                         "allowed: true, false, 1, 0 or empty")
+    return text.map(_CLAIMS).to_numpy(bool)
 
 
 def _answers(g: pd.DataFrame, where: str, robot: str, mech, dim: int) -> np.ndarray:
@@ -202,7 +217,7 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
                               "given_timeout_ms": g["given_timeout_ms"].to_numpy(float) if timed else np.nan,
                               "seconds": g["seconds"].to_numpy(float),
                               "reference_seconds": g["reference_seconds"].to_numpy(float),
-                              "claimed": g["claimed"].astype(bool).to_numpy() if "claimed" in g else False,
+                              "claimed": _claims(g, where) if "claimed" in g else False,
                               "position_m": v["position_m"], "rotation_rad": v["rotation_rad"],
                               "in_limits": v["in_limits"], "leg_residual": v["leg_residual"]})
         prefix = answer_prefix(mech)
