@@ -502,3 +502,28 @@ def test_reverify_compares_infinities_and_skips_suites_without_tracks(tmp_path):
     assert _close([np.inf, 1.0, np.nan], [np.inf, 1.0 + 1e-12, np.nan]).all()
     assert not _close([np.inf, 1.0], [-np.inf, 1.1]).any()
     assert reverify(tmp_path, SimpleNamespace(tracks=None)) == []
+
+
+def test_an_fk_submission_reaches_the_suites_board_judged_by_the_mechanisms_ik(tmp_path):
+    """scipy least_squares' answers on Dietmaier's frozen queries, submitted through the suite
+    file, run by ``fkopt suite``'s pipeline: the board carries the outside FK entry, its answers
+    are stored beside the organiser's and the spoilt (claimed) answer is a failure."""
+    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinbench.physical import LADDER
+
+    def rows(mech, generating):
+        df = least_squares_rows(mech, generating).drop(columns="residual_by_scipy")
+        df.loc[0, "x0"] += 1e-3                       # 1 mm off, still claimed
+        df.loc[0, "claimed"] = True
+        return df
+    cfg, _ = fk_submission(tmp_path, rows)
+    path = tmp_path / "tests" / "tiny.yaml"
+    folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    mine = board[(board.solver == "my-fk") & (board.robot == "dietmaier-6sps")]
+    assert len(mine) and (mine["entry"] == "outside").all() and (mine["source"] == "submitted").all()
+    answers = pd.read_csv(folder / "answers.csv.gz")
+    sub = answers[answers.solver == "my-fk"].sort_values("query")
+    assert len(sub) == 3 and sub["position_m"].iloc[0] >= 1e-3 - 1e-9
+    rung = f"success_{rung_label(LADDER[2])}"         # 1e-5 m: the 1 mm spoilt answer fails it
+    assert (mine[rung] <= 2 / 3 + 1e-12).all()
