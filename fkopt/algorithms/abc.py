@@ -257,15 +257,16 @@ class ABC(Algorithm):
         if problem.cases is not None:
             problem._check_cases(state.x)
         J = problem._joint_rows(state.x.shape[:-1])
-        # GABC refreshes the best-so-far between the phases: new arrays, as update_best makes
-        best_x, best_f = (state.best_x, state.best_f) if rule == 0 else (state.best_x.copy(), state.best_f.copy())
+        # the best-so-far is refreshed in the pass (GABC's between the phases and minimize's
+        # update_best after them): new arrays, as update_best makes
+        best_x, best_f = state.best_x.copy(), state.best_f.copy()
         C = getattr(self.params, "C", 0.0)
         # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
         # (a target per row: the numpy path evaluates the fresh scouts in a fitness call of their own)
         scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
                            problem.bounds, J, absolute, log_arrays(state, runs), problem.cases is not None)
         log_kept(state, kept)
-        state.best_x, state.best_f = best_x, best_f
+        state.best_x, state.best_f, state.best_folded = best_x, best_f, True
         state.evaluations = state.evaluations + (2 * population + scout)
 
     def step(self, state, xs, xk, phi, streams):

@@ -52,6 +52,8 @@ class State:
     best_x: np.ndarray | None = None
     best_f: np.ndarray | None = None
     log: "EvaluationLog | None" = None   # set by Algorithm.minimize: see evaluated()
+    # a compiled iteration already folded x/f into best_x/best_f (Algorithm.update_best's rule)
+    best_folded: bool = False
 
 
 @dataclass
@@ -318,8 +320,12 @@ class Algorithm:
         """Fold the memory ``state.x``/``state.f`` into the best-so-far of each run.
 
         The first minimum of each run wins; arrays are replaced (never written in place), and
-        only when some run improved.
+        only when some run improved. A compiled iteration that did this already (the same rule,
+        into new arrays) sets ``state.best_folded``; the call then only clears it.
         """
+        if getattr(state, "best_folded", False):
+            state.best_folded = False
+            return
         f = state.f
         runs, population = f.shape
         flat = f.argmin(axis=1)

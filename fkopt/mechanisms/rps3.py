@@ -240,8 +240,9 @@ class ThreeRPS(ParallelMechanism):
             return None
         ra, rb = self.geometry.ra, self.geometry.rb
 
-        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute, log):
-            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log, BLOCK)
+        def step(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, absolute, log):
+            return mod.pso_rps3(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log,
+                                BLOCK)
         return step
 
     def compiled_abc_step(self):

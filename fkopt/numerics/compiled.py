@@ -608,7 +608,25 @@ def _log_points(a, vals, lbest, lcount, lactive, hr, he, hf, nh):
 
 
 @njit(cache=True, error_model="numpy")
-def _pso_move(x, pos, vel, g, r, w, c1, c2, limit, lo, hi, npos, nvel, arg, block):
+def _fold_best(a, x, f, best_x, best_f):
+    """:meth:`fkopt.algorithms.base.Algorithm.update_best` of run ``a``: its first minimum of f
+    (a NaN first, as ``argmin``), if below best_f[a], into best_x[a], best_f[a]."""
+    pop, dim = x.shape[1], x.shape[2]
+    b = 0
+    for i in range(pop):
+        if f[a, i] != f[a, i]:
+            b = i
+            break
+        if f[a, i] < f[a, b]:
+            b = i
+    if f[a, b] < best_f[a]:
+        best_f[a] = f[a, b]
+        for d in range(dim):
+            best_x[a, d] = x[a, b, d]
+
+
+@njit(cache=True, error_model="numpy")
+def _pso_move(x, pos, vel, g, r, w, c1, c2, limit, bounds, npos, nvel, arg, block):
     """The move of :meth:`fkopt.algorithms.pso.PSO.iterate`, every run and particle in one pass:
     velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations in their order), clamp,
     move, clip onto the box (velocity zeroed where clipped) into npos, nvel; the half-angle
@@ -622,7 +640,7 @@ def _pso_move(x, pos, vel, g, r, w, c1, c2, limit, lo, hi, npos, nvel, arg, bloc
                 v = v + (r[a, 1, i, d] * c2) * (g[a, d] - pos[a, i, d])
                 v = min(max(v, -limit[d]), limit[d])
                 mv = pos[a, i, d] + v
-                cp = min(max(mv, lo[d]), hi[d])
+                cp = min(max(mv, bounds[d, 0]), bounds[d, 1])
                 nvel[a, i, d] = 0.0 if cp != mv else v
                 npos[a, i, d] = cp
             s, off = _slot(a * pop + i, 0, n, block)
@@ -631,11 +649,13 @@ def _pso_move(x, pos, vel, g, r, w, c1, c2, limit, lo, hi, npos, nvel, arg, bloc
 
 
 @njit(cache=True, error_model="numpy")
-def _pso_finish(x, fb, npos, tan, J, ra, rb, absolute, nx, nf, fout, lbest, lcount, lactive, hr, he, hf, block):
+def _pso_finish(x, fb, npos, tan, J, ra, rb, absolute, nx, nf, fout, best_x, best_f, lbest, lcount, lactive, hr,
+                he, hf, block):
     """The rest of a PSO iteration after numpy's tangents ``tan``: the fitness of the positions
-    (:func:`_rps3_tan`) into fout, the personal bests into nx, nf, and the fitness reported to the
-    evaluation log held as arrays (:func:`_log_points`). Returns the number of improvements the
-    log keeps."""
+    (:func:`_rps3_tan`) into fout, the personal bests into nx, nf, the fitness reported to the
+    evaluation log held as arrays (:func:`_log_points`), and the personal bests folded into the
+    best-so-far best_x, best_f (:func:`_fold_best`). Returns the number of improvements the log
+    keeps."""
     runs, pop, dim = npos.shape
     n = runs * pop
     one = J.shape[1] == 1
@@ -655,28 +675,31 @@ def _pso_finish(x, fb, npos, tan, J, ra, rb, absolute, nx, nf, fout, lbest, lcou
                 for d in range(dim):
                     nx[a, i, d] = x[a, i, d]
         nh = _log_points(a, fout[a], lbest, lcount, lactive, hr, he, hf, nh)
+        _fold_best(a, nx, nf, best_x, best_f)
     return nh
 
 
-def pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log, block):
+def pso_rps3(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log, block):
     """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem
     (:func:`_pso_move`, :func:`numpy_tan`, :func:`_pso_finish`): (personal bests x, their fitness,
-    positions, velocities, fitness of the positions), all new arrays, and (rows, evaluation
-    numbers, values) of the improvements kept by ``log`` (best, count, active arrays updated in
-    place, as :func:`abc_rps3`). ``block``: the poses per block of the numpy fitness."""
+    positions, velocities, fitness of the positions, best-so-far point and fitness (``g`` and
+    ``fb``'s best folded in: :meth:`fkopt.algorithms.base.Algorithm.update_best`)), all new
+    arrays, and (rows, evaluation numbers, values) of the improvements kept by ``log`` (best,
+    count, active arrays updated in place, as :func:`abc_rps3`). ``g``, ``g_f``: the best-so-far
+    point and fitness (the global best); ``limit``, ``bounds``: C-contiguous float arrays (dim,),
+    (dim, 2); ``block``: the poses per block of the numpy fitness."""
     nx, nf, npos, nvel, fout = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel), \
         np.empty_like(fb)
     n = fb.size
     arg, tan = np.empty(2 * n), np.empty(2 * n)
     hr, he, hf = np.empty(n, dtype=np.intp), np.empty(n, dtype=np.int64), np.empty(n)
     best, count, active = log
-    lo, hi = np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float)
-    _pso_move(x, pos, vel, np.ascontiguousarray(g), r, float(w), float(c1), float(c2),
-              np.ascontiguousarray(limit, dtype=float), lo, hi, npos, nvel, arg, block)
+    best_x, best_f = np.array(g, dtype=float, order="C"), np.array(g_f, dtype=float)
+    _pso_move(x, pos, vel, best_x, r, float(w), float(c1), float(c2), limit, bounds, npos, nvel, arg, block)
     numpy_tan(arg, tan, ((0, n),), block)
-    nh = _pso_finish(x, fb, npos, tan, np.ascontiguousarray(J, dtype=float), float(ra), float(rb), bool(absolute),
-                     nx, nf, fout, best, count, active, hr, he, hf, block)
-    return nx, nf, npos, nvel, fout, (hr[:nh], he[:nh], hf[:nh])
+    nh = _pso_finish(x, fb, npos, tan, J, float(ra), float(rb), bool(absolute), nx, nf, fout, best_x, best_f, best,
+                     count, active, hr, he, hf, block)
+    return nx, nf, npos, nvel, fout, best_x, best_f, (hr[:nh], he[:nh], hf[:nh])
 
 
 @njit(cache=True, error_model="numpy")
@@ -848,11 +871,12 @@ def _abc_employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, ra,
 
 
 @njit(cache=True, error_model="numpy")
-def _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, src_all, jj_all, mv_all, tan, fo, lbest, lcount, lactive,
-                         hr, he, hf, nh, block):
+def _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, src_all, jj_all, mv_all, tan, fo, best_x, best_f, lbest,
+                         lcount, lactive, hr, he, hf, nh, block):
     """After numpy's tangents of the onlookers' candidates, for every run: their fitness into fo,
     the reports to the log, then the synchronous onlookers -- per source the lowest candidate, the
-    first onlooker reaching it, if it beats the source; a trial per attempt. Returns nh."""
+    first onlooker reaching it, if it beats the source; a trial per attempt -- and the sources
+    folded into the best-so-far (:func:`_fold_best`, what minimize's update_best does next). Returns nh."""
     runs, pop, dim = x.shape
     n = runs * pop
     one = J.shape[1] == 1
@@ -887,6 +911,7 @@ def _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, src_all, jj_all, mv_a
                 x[a, s, jj[w_]] = mv[w_]
                 f[a, s] = bs[s]
                 trial[a, s] = 0
+        _fold_best(a, x, f, best_x, best_f)
     return nh
 
 
@@ -895,7 +920,8 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     GABC's best-so-far refreshed between the phases, rules 1 and 2) on a 3-RPS FK problem:
     :func:`_abc_employed_move`, :func:`numpy_tan`, :func:`_abc_employed_finish`, :func:`numpy_tan`,
     :func:`_abc_onlooker_finish` on the state arrays x, f, trial (C-contiguous, updated in place)
-    and best_x, best_f (updated in place: pass copies), reporting to ``log`` (best (runs,) float,
+    and best_x, best_f (updated in place: pass copies; GABC's refresh between the phases and
+    minimize's update_best after the iteration both folded in), reporting to ``log`` (best (runs,) float,
     count (runs,) int64, active (runs,) bool, updated in place). ``separate``: the numpy path
     evaluates the fresh scouts in a fitness call of their own (a target per row); ``block``: the
     poses per block of the numpy fitness. Returns (scout (runs,) 0/1, (rows, evaluation numbers,
@@ -918,6 +944,6 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     nh = _abc_employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, ra, rb, absolute, separate, ns, jj,
                               mv, scout, tan, fe, fo_src, fo_jj, fo_mv, arg, best, count, active, hr, he, hf, block)
     numpy_tan(arg, tan, ((0, n),), block)
-    nh = _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, fo_src, fo_jj, fo_mv, tan, fo, best, count, active,
-                              hr, he, hf, nh, block)
+    nh = _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, fo_src, fo_jj, fo_mv, tan, fo, best_x, best_f, best,
+                              count, active, hr, he, hf, nh, block)
     return (scout >= 0).astype(np.int64), (hr[:nh], he[:nh], hf[:nh])
