@@ -113,7 +113,7 @@ class PSO(Algorithm):
                 state.limit = (np.ascontiguousarray(self.velocity_limit(problem.bounds), dtype=float),
                                np.ascontiguousarray(problem.bounds, dtype=float))
             # the evaluation log's bookkeeping and update_best run in the same pass
-            state.x, state.f, state.pos, state.vel, _, state.best_x, state.best_f, kept = step(
+            state.x, state.f, state.pos, state.vel, state.best_x, state.best_f, kept = step(
                 state.x, state.f, state.pos, state.vel, state.best_x, state.best_f, r, self.inertia_weight(state),
                 p.c1, p.c2, *state.limit, J, absolute, log_arrays(state, runs))
             state.best_folded = True

@@ -21,6 +21,7 @@ load the cache.
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 from numba import njit
@@ -586,6 +587,30 @@ def rps3_fitness(P, J, ra, rb, absolute, block):
     return out
 
 
+_scratch = threading.local()
+
+
+def _scratch_arrays(key, make):
+    """This thread's scratch arrays for ``key`` (the kind and shape of an iteration), made by
+    ``make()`` on first use: a swarm iteration's buffers are the same every iteration, and a
+    dozen allocations cost about as much as a kernel's call. Nothing returned to a caller
+    lives in them (see :func:`_kept`)."""
+    cache = getattr(_scratch, "arrays", None)
+    if cache is None:
+        cache = _scratch.arrays = {}
+    got = cache.get(key)
+    if got is None:
+        if len(cache) >= 16:           # a few shapes at a time (memory stays bounded)
+            cache.clear()
+        got = cache[key] = make()
+    return got
+
+
+def _kept(hr, he, hf, nh):
+    """The log's improvements (rows, evaluation numbers, values) out of the scratch arrays, as new arrays."""
+    return hr[:nh].copy(), he[:nh].copy(), hf[:nh].copy()
+
+
 @njit(cache=True, error_model="numpy")
 def _log_points(a, vals, lbest, lcount, lactive, hr, he, hf, nh):
     """:meth:`fkopt.algorithms.base.EvaluationLog.add` of the values ``vals`` (k,) that run ``a``
@@ -682,24 +707,23 @@ def _pso_finish(x, fb, npos, tan, J, ra, rb, absolute, nx, nf, fout, best_x, bes
 def pso_rps3(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log, block):
     """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem
     (:func:`_pso_move`, :func:`numpy_tan`, :func:`_pso_finish`): (personal bests x, their fitness,
-    positions, velocities, fitness of the positions, best-so-far point and fitness (``g`` and
-    ``fb``'s best folded in: :meth:`fkopt.algorithms.base.Algorithm.update_best`)), all new
-    arrays, and (rows, evaluation numbers, values) of the improvements kept by ``log`` (best,
+    positions, velocities, best-so-far point and fitness (``g`` with the new personal bests folded
+    in: :meth:`fkopt.algorithms.base.Algorithm.update_best`)), all new arrays, and (rows, evaluation numbers, values) of the improvements kept by ``log`` (best,
     count, active arrays updated in place, as :func:`abc_rps3`). ``g``, ``g_f``: the best-so-far
     point and fitness (the global best); ``limit``, ``bounds``: C-contiguous float arrays (dim,),
     (dim, 2); ``block``: the poses per block of the numpy fitness."""
-    nx, nf, npos, nvel, fout = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel), \
-        np.empty_like(fb)
+    nx, nf, npos, nvel = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel)
     n = fb.size
-    arg, tan = np.empty(2 * n), np.empty(2 * n)
-    hr, he, hf = np.empty(n, dtype=np.intp), np.empty(n, dtype=np.int64), np.empty(n)
+    fout, arg, tan, hr, he, hf = _scratch_arrays(
+        ("pso", fb.shape), lambda: (np.empty(fb.shape), np.empty(2 * n), np.empty(2 * n), np.empty(n, dtype=np.intp),
+                                    np.empty(n, dtype=np.int64), np.empty(n)))
     best, count, active = log
     best_x, best_f = np.array(g, dtype=float, order="C"), np.array(g_f, dtype=float)
     _pso_move(x, pos, vel, best_x, r, float(w), float(c1), float(c2), limit, bounds, npos, nvel, arg, block)
     numpy_tan(arg, tan, ((0, n),), block)
     nh = _pso_finish(x, fb, npos, tan, J, float(ra), float(rb), bool(absolute), nx, nf, fout, best_x, best_f, best,
                      count, active, hr, he, hf, block)
-    return nx, nf, npos, nvel, fout, best_x, best_f, (hr[:nh], he[:nh], hf[:nh])
+    return nx, nf, npos, nvel, best_x, best_f, _kept(hr, he, hf, nh)
 
 
 @njit(cache=True, error_model="numpy")
@@ -929,15 +953,17 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     runs, pop = f.shape
     n = runs * pop
     separate = bool(separate)
-    lo, hi = np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float)
     J = np.ascontiguousarray(J, dtype=float)
     ra, rb, absolute, C, limit, rule = float(ra), float(rb), bool(absolute), float(C), int(limit), int(rule)
-    jj, fo_jj, fo_src = (np.empty((runs, pop), dtype=np.int64) for _ in range(3))
-    mv, fo_mv, fe, fo = (np.empty((runs, pop)) for _ in range(4))
-    scout = np.empty(runs, dtype=np.int64)
-    arg, tan = np.empty(2 * (n + runs)), np.empty(2 * (n + runs))
-    most = runs * (2 * pop + 1)
-    hr, he, hf = np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most)
+
+    def make():
+        most = runs * (2 * pop + 1)
+        return ([np.empty((runs, pop), dtype=np.int64) for _ in range(3)] + [np.empty((runs, pop)) for _ in range(4)]
+                + [np.empty(runs, dtype=np.int64), np.empty(2 * (n + runs)), np.empty(2 * (n + runs)),
+                   np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most),
+                   np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float)])
+    jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, tan, hr, he, hf, lo, hi = _scratch_arrays(
+        ("abc", runs, pop, bounds.tobytes()), make)
     best, count, active = log
     ns = _abc_employed_move(x, trial, best_x, u, limit, rule, C, lo, hi, separate, jj, mv, scout, arg, block)
     numpy_tan(arg, tan, ((0, n), (n, ns)) if separate else ((0, n + ns),), block)
@@ -946,4 +972,4 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     numpy_tan(arg, tan, ((0, n),), block)
     nh = _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, fo_src, fo_jj, fo_mv, tan, fo, best_x, best_f, best,
                               count, active, hr, he, hf, nh, block)
-    return (scout >= 0).astype(np.int64), (hr[:nh], he[:nh], hf[:nh])
+    return (scout >= 0).astype(np.int64), _kept(hr, he, hf, nh)
