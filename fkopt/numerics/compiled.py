@@ -537,6 +537,8 @@ def _slot(c, s0, sl, block):
     """(position of alpha's argument, offset of beta's from it) in the tangent buffer of pose c
     of a fitness call over poses [s0, s0 + sl), cut into blocks of ``block`` poses."""
     k = c - s0
+    if sl <= block:                    # one block (the usual case): no integer division
+        return 2 * s0 + k, sl
     first = (k // block) * block
     return 2 * (s0 + first) + (k - first), min(block, sl - first)
 
