@@ -171,7 +171,9 @@ SWARM_CASES = [("pso", {}, 10, {}), ("abc", {}, 10, {}), ("abc", {"limit": 3}, 1
                ("gabc", {}, 40, {}),        # 40 > 32 bees: the roulette's binary search (abc.DENSE_ROULETTE)
                ("abc", {}, 10, {"objective": "absolute"}),
                ("pso", {}, 10, {"objective": "absolute"}),
-               ("gabc", {}, 10, {"target": 1e-6, "stop_at_target": True})]   # frozen runs: the log's active mask
+               ("gabc", {}, 10, {"target": 1e-6, "stop_at_target": True}),   # frozen runs: the log's active mask
+               ("pabc", {}, 10, {}),        # PSO then ABC on one state (PSOState and ABCState fields)
+               ("pso+lm", {}, 10, {}), ("gabc+lm", {}, 10, {})]   # a hybrid's swarm phase on its inner state
 
 
 @pytest.mark.parametrize("algorithm,params,population,options", SWARM_CASES,
