@@ -205,10 +205,10 @@ def rows_of(problem, rows: np.ndarray):
 
 def compiled_step(problem, kind: str):
     """(compiled iteration, absolute objective) when the problem's mechanism offers one for the
-    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness under
-    ``FKOPT_NUMERICS=compiled``) and the problem is a plain FK problem of three variables without
-    angle-valued joints, else None. The same operations as the numpy iteration; the fitness'
-    ``tan`` may be an ulp from numpy's (tests/test_numerics.py)."""
+    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness unless
+    ``FKOPT_NUMERICS=numpy`` or numba is missing) and the problem is a plain FK problem of three
+    variables without angle-valued joints, else None. The same operations as the numpy
+    iteration, numpy's own ``np.tan`` included: the same bits (tests/test_numerics.py)."""
     # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
     # or a caller may change the variable between iterations).
     key = (kind, os.environ.get(_NUMERICS_ENV))

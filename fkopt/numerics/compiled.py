@@ -11,7 +11,8 @@ load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
 * :func:`rps3_fitness`, :func:`pso_rps3`, :func:`abc_rps3` -- the 3-RPS swarm fitness and the PSO
-  and ABC/GABC iterations on it (``FKOPT_NUMERICS=compiled``). These compile with
+  and ABC/GABC iterations on it (the default path; numpy's own ``np.tan`` between a move and a
+  finish kernel, so the numpy path's bits: :func:`numpy_tan`). These compile with
   ``error_model="numpy"``: a float division by zero gives numpy's inf/NaN instead of a Python
   exception, so no check guards each division (half of the fitness' time, measured: 57 -> 29 ns
   per point); the values are the same wherever the divisor is not zero;
