@@ -86,12 +86,13 @@ class _Arm:
     """One arm of the bench: fkopt's model, rtb's ETS, pinocchio's check, poses and targets."""
 
     def __init__(self, name, n, seed):
+        from .adapters.field import arm_urdf
         from .adapters.field.rtb import chain_ets
         from .mechanisms import urdf
         self.name = name
         self.m = m = urdf.example_robot(name)
         self.pfk = PinocchioFK(m)
-        self.ets, self.rtb_version = chain_ets(m.path, m.base_link, m.tip_link)
+        self.ets, self.rtb_version = chain_ets(arm_urdf(m))
         rng = np.random.default_rng(seed)
         self.Q = m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
         self.T = np.array([self.pfk.frame(np.radians(q)) for q in self.Q])

@@ -43,8 +43,9 @@ def _rtb_ets(path: Path, base: str, tip: str):
     except Exception as err:          # ImportError, or a broken install
         return None, f"roboticstoolbox-python not importable ({type(err).__name__}: {err}); " \
                      "pip install roboticstoolbox-python: the rtb rows are skipped"
+    from .adapters.field import ArmURDF
     from .adapters.field.rtb import chain_ets
-    return chain_ets(path, base, tip), None
+    return chain_ets(ArmURDF.from_file(path, base, tip)), None
 
 
 def _check(m, q, Tt, tol, scale):

@@ -156,9 +156,10 @@ def test_rtb_chain_below_a_moving_joint_has_the_chains_joints_only(name):
     """rtb's robot.ets(base, tip) takes the joint into base too when it moves (PR2's and TIAGo's
     torso lift, Talos's torso); the adapter's ETS has the chain's joints, with fkopt's FK."""
     pytest.importorskip("roboticstoolbox")
+    from fkopt.adapters.field import arm_urdf
     from fkopt.adapters.field.rtb import chain_ets
     m = arm(name)
-    ets, _ = chain_ets(m.path, m.base_link, m.tip_link)
+    ets, _ = chain_ets(arm_urdf(m))
     q, T = targets(m, 3, 6)
     assert ets.n == m.dof
     for k in range(3):

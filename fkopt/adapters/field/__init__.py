@@ -81,6 +81,40 @@ class FieldIK:
         raise NotImplementedError
 
 
+@dataclass(frozen=True)
+class ArmURDF:
+    """The URDF a field package reads for an arm: its text, the chain's base and tip links, the
+    moving joints (fkopt's unknowns, in order) and where the text came from (for messages and
+    ``settings["urdf"]``)."""
+    text: str
+    base_link: str
+    tip_link: str
+    joint_names: tuple[str, ...]
+    source: str
+
+    @classmethod
+    def from_file(cls, path, base_link: str, tip_link: str) -> "ArmURDF":
+        """A URDF file as it is (the joints are not listed)."""
+        from ...files import read_text
+        from ...mechanisms.urdf import MAX_URDF_BYTES
+        return cls(read_text(path, MAX_URDF_BYTES, field="urdf geometry.file"), base_link, tip_link, (), str(path))
+
+
+def arm_urdf(arm, *, written: bool = False) -> ArmURDF:
+    """The robot's own URDF file when ``arm`` was read from one without a tool frame (the file as
+    people use it), else -- an MJCF arm, a DH table, a tool frame, or ``written`` -- the URDF
+    written from fkopt's chain (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, FK-checked
+    against MuJoCo in tests/test_urdf_writer.py)."""
+    own = getattr(arm, "name", None) == "urdf" and getattr(arm.geometry_values(), "tool", None) is None
+    if own and not written:
+        mine = ArmURDF.from_file(arm.path, arm.base_link, arm.tip_link)
+        return ArmURDF(mine.text, mine.base_link, mine.tip_link, tuple(arm.joint_names), mine.source)
+    from ...mechanisms.urdf_writer import chain_urdf
+    w = chain_urdf(arm)
+    return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names,
+                   f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}")
+
+
 def internal_bounds(arm) -> tuple[np.ndarray, np.ndarray]:
     """The arm's joint limits in SI units (rad, m)."""
     return arm.bounds[:, 0] * arm._to_si, arm.bounds[:, 1] * arm._to_si
