@@ -1,6 +1,8 @@
 """The field's solvers through their own packages (``pip install -e ".[field]"``), for kinbench v3.
 
-Every IK wrapper here takes a fkopt URDF arm (:class:`fkopt.mechanisms.urdf.URDFArm`), is built
+Every IK wrapper here takes a fkopt URDF or MJCF arm (:class:`fkopt.mechanisms.urdf.URDFArm`,
+:class:`fkopt.mechanisms.mjcf.MJCFArm`) and reads it as URDF (:func:`arm_urdf`: the robot's own
+file, or for an MJCF arm the URDF written from fkopt's chain, ``settings["urdf"]`` says which), is built
 once per arm (the package parses the file, outside the clock) and answers one target pose at a
 time: :meth:`FieldIK.solve1` takes a 4x4 tip frame in the arm's base frame (m) and returns the
 joints in fkopt's public units (deg, m) or ``None`` when the package gave no answer, plus what

@@ -1,6 +1,10 @@
 """pinocchio's closed-loop inverse kinematics (CLIK), the damped-least-squares loop of
 pinocchio's documentation ("Inverse kinematics (clik)", examples/inverse-kinematics.py;
-Carpentier et al., SII 2019), on pinocchio's own model of the URDF.
+Carpentier et al., SII 2019), on pinocchio's own model of the URDF (:func:`fkopt.adapters.field.arm_urdf`: the robot's file,
+or for an MJCF arm the URDF written from fkopt's chain). Chosen over pinocchio's own MJCF reader
+so that every field package reads one model of an MJCF arm, the written URDF FK-checked against
+MuJoCo (tests/test_urdf_writer.py), and so that MuJoCo's ``qpos0``/``ref`` and joint equalities
+mean what fkopt's MJCF reader says they mean rather than what a second reader makes of them.
 
 The loop: err = log6(oMdes^-1 oMtip) in the tip's local frame (m, rad), J = Jlog6(oMdes^-1
 oMtip) * J_tip(q), v = -J^T (J J^T + damp I)^-1 err, q <- integrate(q, v dt).

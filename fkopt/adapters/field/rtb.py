@@ -14,8 +14,8 @@ none); a sub-chain ``robot.ets(start, end)`` keeps the whole robot's joint indic
 so a chain starting below the root (Baxter's arm from its torso) would read q at the wrong
 places, and it includes the joint into ``start`` when that one moves -- the wrapper composes the
 links' own ETS from below ``base`` to ``tip`` and renumbers the chain's joints 0..n-1; the ETS is checked against fkopt's FK
-at a random configuration when built. When it misreads the robot's own file (iCub's: 1.5 m off,
-the ETS of a file with that many fixed frames), the wrapper reads the URDF written from fkopt's
+at a random configuration when built. When it misreads the robot's own file (iCub's: 1.5 m off), the
+wrapper reads the URDF written from fkopt's
 chain instead (:func:`fkopt.adapters.field.arm_urdf`, ``settings["urdf_note"]``), checked the same
 way; an arm rtb misreads either way is refused with one line. MJCF arms always reach it through
 the written URDF (rtb reads only URDF).
