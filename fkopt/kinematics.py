@@ -187,6 +187,35 @@ def _mechanism(mechanism, kind: type, what: str) -> Mechanism:
     return mechanism
 
 
+#: A target frame's rotation may be this far from orthonormal (max |R R^T - I|).
+FRAME_ORTHONORMAL_TOL = 1e-9
+
+
+def _targets(m, poses) -> np.ndarray:
+    """Targets of :func:`inverse` as rows: poses (..., 6) as they are, tip frames (..., 4, 4) as
+    (..., 12) = (x, y, z, R row-major); a frame needs a finite, orthonormal rotation and the
+    last row (0, 0, 0, 1)."""
+    a = np.asarray(poses, dtype=float)
+    if a.ndim < 2 or a.shape[-2:] != (4, 4):
+        return _values(m, a, m.pose_names, "target pose")
+    if a.ndim == 2:                                    # one frame: the same checks on floats (a few µs less)
+        f = a.ravel().tolist()
+        a0, a1, a2, x, b0, b1, b2, y, c0, c1, c2, z = f[:12]
+        gap = max(abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0), abs(b0 * b0 + b1 * b1 + b2 * b2 - 1.0),
+                  abs(c0 * c0 + c1 * c1 + c2 * c2 - 1.0), abs(a0 * b0 + a1 * b1 + a2 * b2),
+                  abs(a0 * c0 + a1 * c1 + a2 * c2), abs(b0 * c0 + b1 * c1 + b2 * c2))
+        if math.isfinite(sum(f)) and gap <= FRAME_ORTHONORMAL_TOL and f[12:] == [0.0, 0.0, 0.0, 1.0]:
+            return np.array([x, y, z, a0, a1, a2, b0, b1, b2, c0, c1, c2])
+    if not np.isfinite(a).all():
+        raise FkoptError(f"{m.name} target frame: values must be finite")
+    R = a[..., :3, :3]
+    gap = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max()
+    if not gap <= FRAME_ORTHONORMAL_TOL or not (a[..., 3, :] == (0.0, 0.0, 0.0, 1.0)).all():
+        raise FkoptError(f"{m.name} target frame: needs an orthonormal rotation (max |R R^T - I| "
+                         f"<= {FRAME_ORTHONORMAL_TOL:g}, got {gap:.3g}) and last row 0 0 0 1")
+    return np.concatenate([a[..., :3, 3], R.reshape(a.shape[:-2] + (9,))], axis=-1)
+
+
 def _values(mechanism: Mechanism, values, names, what: str) -> np.ndarray:
     a = np.asarray(values, dtype=float)
     if a.ndim == 0 or a.shape[-1] != len(names):
@@ -882,7 +911,7 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
             rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
             solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
             evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
-    Rt = _zyz_matrix1(*pose[3:].tolist())
+    Rt = pose[3:].reshape(3, 3).tolist() if len(pose) == 12 else _zyz_matrix1(*pose[3:].tolist())
     near: list[int] = []
 
     def start_of(j):
@@ -953,7 +982,9 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
     URDF arms, through ``frame``, ``frame_jacobian``, ``frame_jacobian1``, ``kinematic_key`` and
     ``periodic_mask`` only). ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles
-    (deg), as ``arm.fk`` returns them. ``start``: the current joints (n,) or (..., n) inside the
+    (deg), as ``arm.fk`` returns them; or tip frames (..., 4, 4) in the base frame, as
+    ``arm.fk_matrix`` returns them, whose rotation is used as given (no Euler angles: no digits
+    lost near their singularity at sin(beta) = 0, no conversion per call). ``start``: the current joints (n,) or (..., n) inside the
     limits (default mid-range): the first candidate begins there; when it is solved and the arm
     has self-motion (more than 6 joints, or a ``mask``), the answer is then moved along the
     self-motion to the solution locally nearest to ``start`` (Euclidean distance in rad and
@@ -996,14 +1027,14 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
     if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
         raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
-    P0 = _values(m, poses, m.pose_names, "target pose")
+    P0 = _targets(m, poses)
     if P0.ndim == 1 and rest <= 0 and not exact_rotation:
         return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
                             int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
                             + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap,
                             _task_mask(mask), compiled)
     shape = P0.shape[:-1]
-    P = P0.reshape(-1, 6)
+    P = P0.reshape(-1, P0.shape[-1])
     N, n = len(P), m.dof
     reach = m.reach
     dist = np.sqrt(_sumsq(P[:, :3]))
@@ -1053,7 +1084,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     if N * K < fill:                                   # small batches: more candidates per row
         K = max(K, fill // N)
     L = float(orientation_scale) if orientation_scale else reach
-    pt, Rt = P[:, :3], _zyz_matrix(P[:, 3:])
+    pt, Rt = P[:, :3], (P[:, 3:].reshape(N, 3, 3) if P.shape[1] == 12 else _zyz_matrix(P[:, 3:]))
     to_deg = 180.0 / np.pi if m.angle_mask(m.joint_units).all() else _public(m, np.ones(n))
     budget = K + max(0, int(restarts))                 # starts per row, first ones included
     # start j of row i: the given start (j = 0, when given or without table), then the
