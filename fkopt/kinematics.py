@@ -865,6 +865,18 @@ def _fast_context(m, table: int, W) -> dict:
     return got
 
 
+def _fast_result(m, answer, tp: float, tr: float) -> InverseResult:
+    """The :class:`InverseResult` of one compiled call's (public joints, info)
+    (:func:`fkopt.numerics.compiled.inverse_pose`)."""
+    out, info = answer
+    perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
+    return InverseResult(
+        mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
+        rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+        solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
+        evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
+
+
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
@@ -874,14 +886,24 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
     batch's bookkeeping costs more than the iteration itself for a single pose."""
     tp, tr = tol
     n = m.dof
-    c = _arm_constants(m)
-    x, y, z = (float(v) for v in pose[:3])
+    x, y, z = pose[:3].tolist()
     reach = m.reach
     dist = math.sqrt(x * x + y * y + z * z)
     if dist > reach * (1.0 + 1e-12):
         unit = m.pose_units[0]
         raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
                          f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
+    L = float(orientation_scale) if orientation_scale else reach
+    nn = min(table, kn) if table else 0
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and start is None:
+        # the common call, before any other set-up: no start to check, no self-motion step, pose to
+        # answer in one compiled call (the Python around it is a fifth of a warm call, more when cold)
+        ctx = _fast_context(m, int(table), W)
+        return _fast_result(m, fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"], ctx["mid"],
+                                                 0 if table else 1, nn, int(seed), int(budget), tol, int(iterations),
+                                                 float(damping), float(down), float(up), float(step_cap)), tp, tr)
+    c = _arm_constants(m)
     lo, hi = c["lo"], c["hi"]
     blo, bhi, angle = c["blo"], c["bhi"], c["angle"]
     own0 = 1 if (start is not None or not table) else 0
@@ -896,21 +918,12 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
-    L = float(orientation_scale) if orientation_scale else reach
-    nn = min(table, kn) if table else 0
-    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
-    if fast is not None and (start is None or (n <= 6 and W is None)):
-        # no self-motion step after the loop: pose to answer in one compiled call
+    if fast is not None and n <= 6 and W is None:
+        # a start, but no self-motion step after the loop: pose to answer in one compiled call
         ctx = _fast_context(m, int(table), W)
-        out, info = fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"],
-                                      ctx["mid"] if start is None else np.array(q0), own0, nn, int(seed), int(budget),
-                                      tol, int(iterations), float(damping), float(down), float(up), float(step_cap))
-        perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
-        return InverseResult(
-            mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
-            rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
-            solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
-            evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
+        return _fast_result(m, fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"], np.array(q0), own0, nn, int(seed), int(budget),
+                                                 tol, int(iterations), float(damping), float(down), float(up),
+                                                 float(step_cap)), tp, tr)
     Rt = pose[3:].reshape(3, 3).tolist() if len(pose) == 12 else _zyz_matrix1(*pose[3:].tolist())
     near: list[int] = []
 
@@ -1025,7 +1038,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
     except (TypeError, ValueError):
         raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
-    if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
+    if not (tp > 0 and tr > 0 and math.isfinite(tp) and math.isfinite(tr)):
         raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
     P0 = _targets(m, poses)
     if P0.ndim == 1 and rest <= 0 and not exact_rotation:
