@@ -51,6 +51,26 @@ def test_compiled_one_pose_inverse_gives_the_reference_answers(name, arm):
             assert np.array_equal(a.evaluations[key], b.evaluations[key])
 
 
+@pytest.mark.parametrize("name,arm", arms(), ids=lambda v: v if isinstance(v, str) else "")
+def test_a_target_frame_gives_the_reference_answers_on_both_paths_and_in_batches(name, arm):
+    """fkopt.inverse given 4x4 tip frames (the rotation as given, no Euler angles): the compiled
+    one-pose call, the Python reference and every row of a batch agree bit for bit, and every
+    answer's FK is the frame to the tolerance."""
+    q = random_joints(arm, 6, 5)
+    frames = arm.fk_matrix(q)
+    b = fkopt.inverse(arm, frames, seed=4, tol=(1e-9, 1e-9), options=InverseOptions(compiled=True))
+    for k in range(6):
+        one = [fkopt.inverse(arm, frames[k], seed=4, tol=(1e-9, 1e-9), options=InverseOptions(compiled=c))
+               for c in (False, True)]
+        assert np.array_equal(one[0].joints, one[1].joints) and np.array_equal(one[1].joints, b.joints[k])
+        assert int(one[0].restarts) == int(one[1].restarts) == int(b.restarts[k])
+        assert bool(one[1].solved)
+        F = arm.fk_matrix(one[1].joints)                  # our own check, in the arm's length unit
+        assert np.linalg.norm(F[:3, 3] - frames[k][:3, 3]) <= 1.01e-9
+    slow = fkopt.inverse(arm, frames, seed=4, tol=(1e-9, 1e-9), options=InverseOptions(compiled=False))
+    assert slow.solved.all() and b.solved.all()
+
+
 def test_the_environment_switch_forces_the_reference(monkeypatch):
     monkeypatch.setenv(numerics_path.ENV, "numpy")
     assert numerics_path.compiled(None) is None

@@ -368,7 +368,8 @@ def _nearest_into(Ft, norms, f, idx, best):
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`), the
+    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
+    a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
     start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
@@ -377,12 +378,17 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
     r2d = 180.0 / math.pi
-    a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
-    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
     T = np.empty((3, 3))
-    T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
-    T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
-    T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
+    if pose.shape[0] == 12:                        # a frame row: the rotation as given, row-major
+        for r in range(3):
+            for c in range(3):
+                T[r, c] = pose[3 + 3 * r + c]
+    else:
+        a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
+        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+        T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+        T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+        T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
     pt = pose[:3].copy()
     near = np.empty((nn, n))
     if nn > 0:
