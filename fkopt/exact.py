@@ -78,10 +78,14 @@ class ExactSolver(Algorithm):
 class ForwardParams(Params):
     tol: float = Field(1e-9, gt=0, description="largest accepted max |ik(pose) - joints|, joint units")
     global_search: bool = Field(True, description="fall back to fkopt.forward's global stage")
+    # 0 by default: the stored paper and kinbench results were made without the start table
+    table: int = Field(0, ge=0, description="fkopt.forward's start table size (0: none, the stored results' "
+                                            "setting; fkopt.forward's own default is 4096)")
 
 
 def _forward(problem, row: int, seed: int, p) -> tuple[np.ndarray, int]:
-    out = forward(problem.mechanism, problem.joints[row], tol=p.tol, seed=seed, global_search=p.global_search)
+    out = forward(problem.mechanism, problem.joints[row], tol=p.tol, seed=seed, global_search=p.global_search,
+                  table=p.table)
     return out.pose, int(out.evaluations["residual"]) + int(out.evaluations["jacobian"])
 
 

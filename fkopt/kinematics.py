@@ -113,6 +113,10 @@ INVERSE_TOL = (1e-6, 1e-6)
 #: The swarm budget of one pose: fkopt.forward's global stage (gabc+lm) and a forward solve by a
 #: named algorithm (:func:`fkopt.by_algorithm.forward_by`, ``fkopt fk --algorithm``).
 FORWARD_SWARM = {"population": 20, "iterations": 300}
+#: forward's start table: poses of the bounds and their joints (see :func:`forward`).
+FORWARD_TABLE = 4096
+#: Start-table poses nearest to the joints that a row not solved from its start tries.
+FORWARD_NEIGHBOURS = 16
 #: The budget of one IK pose by a named algorithm (:func:`fkopt.by_algorithm.inverse_by`).
 INVERSE_SWARM = {"population": 50, "iterations": 500}
 
@@ -526,17 +530,23 @@ def _verify(mechanism, L, x, resid, tol):
 
 
 def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: int = 0,
-            global_search: bool = True) -> ForwardResult:
+            global_search: bool = True, table: int = FORWARD_TABLE,
+            neighbours: int = FORWARD_NEIGHBOURS) -> ForwardResult:
     """Forward kinematics of a parallel mechanism for joints (..., m), batched over leading axes.
 
     ``mechanism``: a registered name or a :class:`ParallelMechanism`. ``start``: start pose(s)
     (n,) or (..., n) (default: centre of the bounds). ``tol``: largest accepted
     max |ik(pose) - joints|, joint units. ``seed``: the global stage's seed.
-    ``global_search=False`` stops after the deterministic starts. See the module docstring.
+    ``global_search=False`` stops after the deterministic starts. ``table``: size of the start
+    table (poses of the bounds and their joints, :func:`_forward_table`; 0: none, the behaviour
+    before it); ``neighbours``: how many of its poses nearest to the joints a row not solved from
+    ``start`` tries before the deterministic restarts. See the module docstring.
     """
     m = _mechanism(mechanism, ParallelMechanism, "forward")
     if not (np.isfinite(tol) and tol > 0):
         raise FkoptError(f"forward tol: must be a positive number, got {tol}")
+    if int(table) < 0 or int(neighbours) < 0:
+        raise FkoptError(f"forward table, neighbours: must be >= 0, got {table}, {neighbours}")
     J0 = _values(m, joints, m.joint_names, "joints")
     shape = J0.shape[:-1]
     L = J0.reshape(-1, J0.shape[-1])
@@ -565,6 +575,28 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
         x, resid, solved = _verify(m, L, x, rx, tol)
         stage = np.where(solved, 0, -1)
         todo = np.flatnonzero(~solved)
+        if len(todo) and table and neighbours:          # the start table's poses nearest in joint space
+            tab = _forward_table(m, int(table))
+            k = min(int(neighbours), len(tab["pose"]))
+            near = _nearest(tab, _joint_features(tab, L[todo]), k)
+            for j in range(k):
+                if not len(todo):
+                    break
+                s0 = tab["pose"][near[:, j]]
+                got = _newton_scalar(m, s0[0], L[todo[0]], ftol, evals) if (
+                    N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any()) else None
+                if got is not None:
+                    xs, rs = got
+                elif N == 1:
+                    xs, rs = _newton1(res, np.array(s0[0], dtype=float), ftol, evals)
+                else:
+                    xs, rs = _newton(res, s0, todo, ftol, evals)
+                xs, rs, ok = _verify(m, L[todo], xs, rs, tol)
+                better = ok | (rs < resid[todo])
+                x[todo[better]], resid[todo[better]] = xs[better], rs[better]
+                solved[todo[ok]] = True
+                stage[todo[ok]] = 1
+                todo, near = todo[~ok], near[~ok]
         if len(todo):                                   # deterministic restarts
             quarter = 0.25 * (bounds[:, 1] - bounds[:, 0])
             starts = np.concatenate([centre + np.diag(quarter), centre - np.diag(quarter)])
@@ -733,6 +765,51 @@ def _nearest(table: dict, feats: np.ndarray, k: int) -> np.ndarray:
         part = np.argpartition(d2, k - 1)[:k] if k < len(d2) else np.arange(len(d2))
         out[i] = part[np.argsort(d2[part], kind="stable")]
     return out
+
+
+def _forward_table(m, size: int) -> dict:
+    """forward's start table: ``size`` poses drawn uniformly inside ``m.bounds`` by a fixed hash
+    (independent of ``seed``; the same counter-based draws as inverse's table) and their joints by
+    the closed-form inverse map, with the features k-d tree queries compare (:func:`_joint_features`:
+    each joint divided by its spread over the table, so legs of different ranges weigh alike; an
+    angle joint as (cos, sin) divided by its spread in radians). Poses whose joints are not finite
+    are left out. Cached per mechanism class, bounds and geometry -- the joints of a few fixed
+    probe poses stand for the geometry, so a mechanism built again (``forward("6-sps", ...)``)
+    finds its table. A dict with "pose", "joints", "features", "feature_scale", "angle" (and "tree")."""
+    n = len(m.pose_names)
+    lo, hi = m.bounds[:, 0], m.bounds[:, 1]
+    probe = lo + (hi - lo) * _uniform_hash(0xF0D, np.arange(4), np.zeros(4, dtype=np.int64), n)
+    with np.errstate(all="ignore"):
+        key = ("forward", type(m).__module__, type(m).__qualname__, m.bounds.tobytes(), int(size),
+               np.asarray(m.ik(probe), dtype=float).tobytes())
+    got = _TABLES.get(key)
+    if got is None:
+        poses = lo + (hi - lo) * _uniform_hash(0xF0D, np.arange(size), np.ones(size, dtype=np.int64), n)
+        with np.errstate(all="ignore"):
+            joints = np.asarray(m.ik(poses), dtype=float)
+        keep = np.isfinite(joints).all(axis=-1)
+        poses, joints = poses[keep], joints[keep]
+        angle = m.angle_mask(m.joint_units)
+        tab = {"pose": poses, "joints": joints, "angle": angle}
+        raw = _joint_features(tab, joints)
+        spread = raw.std(axis=0) if len(raw) > 1 else np.ones(raw.shape[-1])
+        spread = np.where(spread > 0, spread, 1.0)
+        tab["feature_scale"] = 1.0 / spread
+        tab["features"] = raw * tab["feature_scale"]
+        got = _TABLES[key] = tab
+    return got
+
+
+def _joint_features(tab: dict, joints: np.ndarray) -> np.ndarray:
+    """Joints (k, m) as the start table's features: lengths as they are, an angle joint (deg) as
+    (cos, sin) (so 359 deg is near 1 deg), each times the table's ``feature_scale`` once built."""
+    angle = tab["angle"]
+    if angle.any():
+        a = np.radians(joints[:, angle])
+        f = np.concatenate([joints[:, ~angle], np.cos(a), np.sin(a)], axis=-1)
+    else:
+        f = np.array(joints, dtype=float)
+    return f * tab["feature_scale"] if "feature_scale" in tab else f
 
 
 #: Names of the six task components ``mask`` selects, in order.
