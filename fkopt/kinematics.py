@@ -14,8 +14,17 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
    scalar tests (its cost is numpy's per-call overhead), on Python floats throughout when the
    mechanism has ``ik_jacobian1`` (6-SPS: the same formulas per leg) and a 6x6 Gaussian
    elimination with partial pivoting.
-2. Rows not solved restart the same Newton from a few deterministic starts: the centre moved by
-   +-1/4 of the box width along each coordinate (2 n starts), all rows at once.
+2. Rows not solved restart the same Newton from a start table's poses nearest in joint space
+   (as inverse's table, turned round for a parallel mechanism: ``table`` poses drawn uniformly in
+   the bounds by a fixed hash, their joints by the closed-form inverse map, scipy's k-d tree over
+   the joints each divided by its spread over the table; :func:`_forward_table`, built once per
+   mechanism geometry), ``neighbours`` of them per row, nearest first, until one is solved; then
+   from a few deterministic starts: the centre moved by +-1/4 of the box width along each
+   coordinate (2 n starts), all rows at once. Measured on 100 frozen queries of Dietmaier's 6-6
+   platform (kinbench v3's uniform set, tol 1e-10): the table solves 99 in ~2 ms median per
+   query, 53 into the generating pose (scipy least_squares from random starts within 500 ms: 45);
+   without it 80 solved, ~31 ms median, 34 the generating pose. ``table=0`` is the solver before
+   the table (rows the start solves have the same answers either way).
 3. Rows still not solved go to a seeded global search, one row at a time: ``gabc+lm``
    (population 20, 300 iterations, seed ``seed``, run id = row index) through :func:`fkopt.solve`.
 
