@@ -126,6 +126,8 @@ FORWARD_SWARM = {"population": 20, "iterations": 300}
 FORWARD_TABLE = 4096
 #: Start-table poses nearest to the joints that a row not solved from its start tries.
 FORWARD_NEIGHBOURS = 16
+#: Of those, how many all run before a row keeps the likeliest of their solutions.
+FORWARD_CANDIDATES = 8
 #: The budget of one IK pose by a named algorithm (:func:`fkopt.by_algorithm.inverse_by`).
 INVERSE_SWARM = {"population": 50, "iterations": 500}
 
@@ -540,7 +542,7 @@ def _verify(mechanism, L, x, resid, tol):
 
 def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: int = 0,
             global_search: bool = True, table: int = FORWARD_TABLE,
-            neighbours: int = FORWARD_NEIGHBOURS) -> ForwardResult:
+            neighbours: int = FORWARD_NEIGHBOURS, candidates: int = FORWARD_CANDIDATES) -> ForwardResult:
     """Forward kinematics of a parallel mechanism for joints (..., m), batched over leading axes.
 
     ``mechanism``: a registered name or a :class:`ParallelMechanism`. ``start``: start pose(s)
@@ -549,13 +551,16 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
     ``global_search=False`` stops after the deterministic starts. ``table``: size of the start
     table (poses of the bounds and their joints, :func:`_forward_table`; 0: none, the behaviour
     before it); ``neighbours``: how many of its poses nearest to the joints a row not solved from
-    ``start`` tries before the deterministic restarts. See the module docstring.
+    ``start`` tries before the deterministic restarts; ``candidates``: how many of those (nearest
+    first) all run, the row keeping the likeliest of their solutions (smallest Jacobian volume,
+    :func:`_jacobian_volume`; 1: the first that solves). See the module docstring.
     """
     m = _mechanism(mechanism, ParallelMechanism, "forward")
     if not (np.isfinite(tol) and tol > 0):
         raise FkoptError(f"forward tol: must be a positive number, got {tol}")
-    if int(table) < 0 or int(neighbours) < 0:
-        raise FkoptError(f"forward table, neighbours: must be >= 0, got {table}, {neighbours}")
+    if int(table) < 0 or int(neighbours) < 0 or int(candidates) < 1:
+        raise FkoptError(f"forward table, neighbours, candidates: must be >= 0, >= 0, >= 1, "
+                         f"got {table}, {neighbours}, {candidates}")
     J0 = _values(m, joints, m.joint_names, "joints")
     shape = J0.shape[:-1]
     L = J0.reshape(-1, J0.shape[-1])
@@ -587,20 +592,38 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
         if len(todo) and table and neighbours:          # the start table's poses nearest in joint space
             tab = _forward_table(m, int(table))
             k = min(int(neighbours), len(tab["pose"]))
+            first = min(max(int(candidates), 1), k)
             near = _nearest(tab, _joint_features(tab, L[todo]), k)
-            for j in range(k):
-                if not len(todo):
-                    break
-                s0 = tab["pose"][near[:, j]]
-                got = _newton_scalar(m, s0[0], L[todo[0]], ftol, evals) if (
-                    N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any()) else None
+            scalar = N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any()
+
+            def local(s0, rows):
+                got = _newton_scalar(m, s0[0], L[rows[0]], ftol, evals) if scalar else None
                 if got is not None:
                     xs, rs = got
                 elif N == 1:
                     xs, rs = _newton1(res, np.array(s0[0], dtype=float), ftol, evals)
                 else:
-                    xs, rs = _newton(res, s0, todo, ftol, evals)
-                xs, rs, ok = _verify(m, L[todo], xs, rs, tol)
+                    xs, rs = _newton(res, s0, rows, ftol, evals)
+                return _verify(m, L[rows], xs, rs, tol)
+            # the first `candidates` starts all run; a row keeps its likeliest solution among them
+            kept = np.full(len(todo), np.inf)             # the kept solution's Jacobian volume
+            for j in range(first):
+                xs, rs, ok = local(tab["pose"][near[:, j]], todo)
+                vol = np.full(len(todo), np.inf)
+                if ok.any():
+                    vol[ok] = _jacobian_volume(res, xs[ok], todo[ok], evals)
+                take = ok & (vol < kept)                  # ties: the nearer start's
+                take |= ~solved[todo] & ~ok & (rs < resid[todo])
+                x[todo[take]], resid[todo[take]] = xs[take], rs[take]
+                kept = np.where(take & ok, vol, kept)
+                solved[todo[ok]] = True
+                stage[todo[ok]] = 1
+            left = ~solved[todo]
+            todo, near = todo[left], near[left]
+            for j in range(first, k):                     # then one after another until one solves
+                if not len(todo):
+                    break
+                xs, rs, ok = local(tab["pose"][near[:, j]], todo)
                 better = ok | (rs < resid[todo])
                 x[todo[better]], resid[todo[better]] = xs[better], rs[better]
                 solved[todo[ok]] = True
@@ -807,6 +830,22 @@ def _forward_table(m, size: int) -> dict:
         tab["features"] = raw * tab["feature_scale"]
         got = _TABLES[key] = tab
     return got
+
+
+def _jacobian_volume(res: _Residuals, x: np.ndarray, idx: np.ndarray, evals) -> np.ndarray:
+    """sqrt(det(J^T J)) (|det J| for a square J) of d joints / d pose at poses x (k, n), rows
+    ``idx``: the likelihood weight of an assembly mode. For a pose drawn uniformly in the bounds
+    the joints' density is sum over the modes x_i of 1 / |det J(x_i)| (change of variables), so
+    given the joints the generating pose is mode i with probability proportional to
+    1 / |det J(x_i)|: the smallest volume is the likeliest mode (measured on 100 frozen Dietmaier
+    queries: the generating pose 60 times against 51 for the solution of the nearest start).
+    One Jacobian evaluation per pose, counted."""
+    _, J, ne, nj = res.rj(x, idx)
+    np.add.at(evals[0], idx, ne)
+    np.add.at(evals[1], idx, nj)
+    if J.shape[-1] == J.shape[-2]:
+        return np.abs(np.linalg.det(J))
+    return np.sqrt(np.abs(np.linalg.det(np.swapaxes(J, -1, -2) @ J)))
 
 
 def _joint_features(tab: dict, joints: np.ndarray) -> np.ndarray:

@@ -79,3 +79,28 @@ def test_exact_solver_keeps_the_stored_setting():
 def test_table_bad_input():
     with pytest.raises(FkoptError, match="table"):
         fkopt.forward("6-sps", kinematics.np.ones(6), table=-1)
+
+
+def test_a_row_keeps_the_likeliest_of_its_candidate_solutions():
+    """The first ``candidates`` table starts all run; the answer is the solution among theirs with
+    the smallest |det J| (the likeliest mode for a pose drawn uniformly in the bounds), recomputed
+    here from each start alone and the mechanism's own Jacobian."""
+    m, X, L = dietmaier_queries(3, seed=5)
+    tab = kinematics._forward_table(m, kinematics.FORWARD_TABLE)
+    near = kinematics._nearest(tab, kinematics._joint_features(tab, L), 4)
+    compared = 0
+    for i in range(len(L)):
+        got = fkopt.forward(m, L[i], tol=1e-10, candidates=4, global_search=False)
+        if got.stage != 1:
+            continue
+        alone = [fkopt.forward(m, L[i], tol=1e-10, start=tab["pose"][j], table=0, global_search=False)
+                 for j in near[i]]
+        sols = [a.pose for a in alone if a.solved and a.stage == 0]
+        if not sols:
+            continue
+        vol = [abs(np.linalg.det(m.jacobian(p[None])[0])) for p in sols]
+        np.testing.assert_array_equal(got.pose, sols[int(np.argmin(vol))])
+        compared += len(sols) > 1
+    assert compared >= 1
+    first = fkopt.forward(m, L, tol=1e-10, candidates=1, global_search=False)
+    assert first.solved.all()
