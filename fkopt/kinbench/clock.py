@@ -87,10 +87,11 @@ class FkoptInverse:
 
 
 class FkoptForward:
-    """The organiser's FK entry: :func:`fkopt.kinematics.forward` (local Newton, deterministic
-    restarts, global search) with ``tol`` = 1e-10 on max |ik(pose) - legs| (joint units); its
-    seed per query from the wrapper's generator; no wall-clock limit. One call before the clock
-    (imports, first-call set-up)."""
+    """The organiser's FK entry: :func:`fkopt.kinematics.forward` (local Newton, the start
+    table's nearest poses, deterministic restarts, global search) with its defaults and ``tol`` =
+    1e-10 on max |ik(pose) - legs| (joint units); its seed per query from the wrapper's
+    generator; no wall-clock limit. One call and the start table (4096 closed-form evaluations)
+    before the clock, as :class:`FkoptInverse`'s table and the field's URDF parsing."""
 
     name = "fkopt.forward"
     package = "fkopt"
@@ -100,6 +101,8 @@ class FkoptForward:
         from ..kinematics import forward
         self.mechanism, self.timeout, self.rng, self._forward = mechanism, float(timeout), rng, forward
         forward(mechanism, mechanism.ik(mechanism.bounds.mean(axis=1)[None])[0], tol=self.TOL)
+        from ..kinematics import FORWARD_TABLE, _forward_table
+        _forward_table(mechanism, FORWARD_TABLE)                           # start table, outside the clock
         self.settings = {"timeout_s": self.timeout, "tol": self.TOL, "wall_clock_limit": False,
                          "seed": "per query from the wrapper's generator", "defaults": "fkopt.forward's"}
 
