@@ -96,7 +96,8 @@ def _inverse(problem, row: int, seed: int, p) -> tuple[np.ndarray, int]:
 
 
 class Forward(ExactSolver):
-    """:func:`fkopt.forward` on each row's joints (start: the centre of the bounds)."""
+    """:func:`fkopt.forward` on each row's joints (start: the centre of the bounds; ``table`` 0
+    unless the config sets it: the stored results' setting, without forward's start table)."""
 
     name = "forward"
     Params = ForwardParams

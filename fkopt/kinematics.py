@@ -16,15 +16,21 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
    elimination with partial pivoting.
 2. Rows not solved restart the same Newton from a start table's poses nearest in joint space
    (as inverse's table, turned round for a parallel mechanism: ``table`` poses drawn uniformly in
-   the bounds by a fixed hash, their joints by the closed-form inverse map, scipy's k-d tree over
-   the joints each divided by its spread over the table; :func:`_forward_table`, built once per
-   mechanism geometry), ``neighbours`` of them per row, nearest first, until one is solved; then
-   from a few deterministic starts: the centre moved by +-1/4 of the box width along each
-   coordinate (2 n starts), all rows at once. Measured on 100 frozen queries of Dietmaier's 6-6
-   platform (kinbench v3's uniform set, tol 1e-10): the table solves 99 in ~2 ms median per
-   query, 53 into the generating pose (scipy least_squares from random starts within 500 ms: 45);
-   without it 80 solved, ~31 ms median, 34 the generating pose. ``table=0`` is the solver before
-   the table (rows the start solves have the same answers either way).
+   the bounds by a fixed hash, their joints by the closed-form inverse map, compared by the joints
+   each divided by its spread over the table, nearest found exactly as inverse's (brute force
+   below 32 rows, scipy's k-d tree from 32 on); :func:`_forward_table`, built once per mechanism
+   geometry). A row takes ``neighbours`` of them, nearest first: the first ``candidates`` all
+   run and the row keeps the likeliest of their solutions, the one with the smallest Jacobian
+   volume (for a pose drawn uniformly in the bounds, mode i generated the joints with
+   probability proportional to 1 / |det J(x_i)|, :func:`_jacobian_volume`); when none of them
+   solves, the rest one after another until one does. Then a few deterministic starts: the centre
+   moved by +-1/4 of the box width along each coordinate (2 n starts), all rows at once.
+   Measured on 100 frozen queries of Dietmaier's 6-6 platform (kinbench v3's uniform set, tol
+   1e-10, one query per call): 99 solved, 64 into the generating pose, median ~7 ms per query
+   (``candidates=1``, the nearest start's solution: 53, ~2 ms; 200 held-out uniform poses: 64
+   and 55); without the table (``table=0``, the solver before it) 80 solved, 34 the generating
+   pose, ~31 ms; scipy least_squares from random starts within 500 ms: 45. Rows the start
+   solves have the same answers with or without the table.
 3. Rows still not solved go to a seeded global search, one row at a time: ``gabc+lm``
    (population 20, 300 iterations, seed ``seed``, run id = row index) through :func:`fkopt.solve`.
 
@@ -838,7 +844,7 @@ def _jacobian_volume(res: _Residuals, x: np.ndarray, idx: np.ndarray, evals) -> 
     the joints' density is sum over the modes x_i of 1 / |det J(x_i)| (change of variables), so
     given the joints the generating pose is mode i with probability proportional to
     1 / |det J(x_i)|: the smallest volume is the likeliest mode (measured on 100 frozen Dietmaier
-    queries: the generating pose 60 times against 51 for the solution of the nearest start).
+    queries: the generating pose 64 times against 53 for the solution of the nearest start).
     One Jacobian evaluation per pose, counted."""
     _, J, ne, nj = res.rj(x, idx)
     np.add.at(evals[0], idx, ne)
