@@ -597,9 +597,9 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
         todo = np.flatnonzero(~solved)
         if len(todo) and table and neighbours:          # the start table's poses nearest in joint space
             tab = _forward_table(m, int(table))
-            k = min(int(neighbours), len(tab["pose"]))
+            k = min(int(neighbours), len(tab["pose"]))     # 0 when no table pose had finite joints
             first = min(max(int(candidates), 1), k)
-            near = _nearest(tab, _joint_features(tab, L[todo]), k)
+            near = _nearest(tab, _joint_features(tab, L[todo]), k) if k else np.zeros((len(todo), 0), np.intp)
             scalar = N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any()
 
             def local(s0, rows):
@@ -830,7 +830,7 @@ def _forward_table(m, size: int) -> dict:
         angle = m.angle_mask(m.joint_units)
         tab = {"pose": poses, "joints": joints, "angle": angle}
         raw = _joint_features(tab, joints)
-        spread = raw.std(axis=0) if len(raw) > 1 else np.ones(raw.shape[-1])
+        spread = raw.std(axis=0) if len(raw) > 1 else np.ones(raw.shape[-1])     # (no pose: no table)
         spread = np.where(spread > 0, spread, 1.0)
         tab["feature_scale"] = 1.0 / spread
         tab["features"] = raw * tab["feature_scale"]
