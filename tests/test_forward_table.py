@@ -104,3 +104,21 @@ def test_a_row_keeps_the_likeliest_of_its_candidate_solutions():
     assert compared >= 1
     first = fkopt.forward(m, L, tol=1e-10, candidates=1, global_search=False)
     assert first.solved.all()
+
+
+def test_the_exact_solver_takes_the_table_when_a_config_asks():
+    """``params: {table: 4096}`` gives the exact solver fkopt.forward's own default answers; a
+    negative size is one line naming the parameter."""
+    from fkopt.exact import Exact, row_seeds
+    from fkopt.problems import fk_problem
+    from fkopt.solve import solve
+    from fkopt.streams import RunStreams
+    m, X, L = dietmaier_queries(2, seed=9)
+    res = solve(fk_problem(m, L), Exact(table=kinematics.FORWARD_TABLE, global_search=False), population=20,
+                iterations=2, runs=1, seed=[1, 2])
+    seeds = row_seeds(RunStreams([1, 2], [0, 0]))
+    for c in range(2):
+        ref = fkopt.forward(m, L[c], seed=seeds[c], global_search=False)
+        np.testing.assert_array_equal(res.x[c, 0], ref.pose)
+    with pytest.raises(FkoptError, match="parameter 'table'"):
+        Exact(table=-1)
