@@ -254,3 +254,46 @@ def test_compiled_abc_iteration_only_where_it_is_the_same_algorithm(monkeypatch)
         assert Mine()._compiled_iteration(p) is None
     monkeypatch.setenv(numerics_path.ENV, "numpy")
     assert ABC()._compiled_iteration(p) is None
+
+
+def _generator(seed, run):
+    from fkopt.streams import run_seed_sequence
+    return np.random.Generator(np.random.PCG64(run_seed_sequence(seed, run)))
+
+
+@pytest.mark.parametrize("seed,rows,width,col", [(0, 1, 1, 0), (1, 3, 349, 0), (12345, 5, 1000, 7), (7, 2, 9, 8)])
+def test_compiled_refill_is_generator_random_bit_for_bit_and_leaves_the_same_state(seed, rows, width, col):
+    """fill_uniforms calls each PCG64's own C next_double, as Generator.random does per value: the
+    same values, the same bit generator state after, so a later numpy draw continues the stream."""
+    import ctypes
+    mine = [_generator(seed, k) for k in range(rows)]
+    ref = [_generator(seed, k) for k in range(rows)]
+    buf = np.full((rows, width), -1.0)
+    states = np.array([g.bit_generator.ctypes.state_address for g in mine], dtype=np.intp)
+    compiled.fill_uniforms(buf, col, states, ctypes.cast(mine[0].bit_generator.ctypes.next_double,
+                                                         ctypes.c_void_p).value)
+    assert (buf[:, :col] == -1.0).all()                       # columns before col untouched
+    for k in range(rows):
+        assert np.array_equal(buf[k, col:], ref[k].random(width - col))
+        assert mine[k].bit_generator.state == ref[k].bit_generator.state
+        assert np.array_equal(mine[k].random(17), ref[k].random(17))
+        assert mine[k].integers(1 << 40) == ref[k].integers(1 << 40)
+
+
+def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(monkeypatch):
+    """Above BUFFER_VALUES // CHUNK runs the refill is the compiled kernel (one call for every run),
+    below it and under FKOPT_NUMERICS=numpy the per-run numpy calls; every run's values are those of
+    its own Generator.random either way, across several refills and a tail kept between them."""
+    from fkopt import streams as streams_mod
+    monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)   # 200 runs: refills of 256 (< CHUNK)
+    runs, seed, sizes = 200, 42, (100, 3 * 70, 1, 300, 255, 600)
+    got = {}
+    for mode in ("auto", "numpy"):
+        monkeypatch.setenv(numerics_path.ENV, mode)
+        s = streams_mod.RunStreams(seed, range(runs))
+        got[mode] = np.concatenate([s.uniform(n).copy() for n in sizes], axis=1)
+        assert (s._fill is not None) == (mode == "auto")
+    assert streams_mod.RunStreams(seed, range(3))._compiled_fill() is None    # few runs: numpy's calls
+    assert np.array_equal(got["auto"], got["numpy"])
+    for k in (0, 1, 117, runs - 1):
+        assert np.array_equal(got["auto"][k], _generator(seed, k).random(sum(sizes)))

@@ -18,6 +18,8 @@ load the cache.
   per point); the values are the same wherever the divisor is not zero;
 * :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
+* :func:`fill_uniforms` -- the refill of :class:`fkopt.streams.RunStreams`' buffer, every run in one
+  call through numpy's own ``next_double`` of each run's PCG64 (so numpy's ``Generator.random`` bits);
 """
 from __future__ import annotations
 
@@ -25,7 +27,9 @@ import math
 import threading
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.core.extending import intrinsic
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -976,3 +980,37 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     nh = _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, fo_src, fo_jj, fo_mv, tan, fo, best_x, best_f, best,
                               count, active, hr, he, hf, nh, block)
     return (scout >= 0).astype(np.int64), _kept(hr, he, hf, nh)
+
+
+@intrinsic
+def _call_next_double(typingctx, fn, state):
+    """``fn(state)`` for a C function ``double fn(void *)`` at address ``fn`` and a pointer
+    ``state``, both given as integers: numpy's bit generator C interface
+    (``BitGenerator.ctypes.next_double``, ``.state_address``). The addresses are arguments, not
+    globals, so the caller stays cacheable on disk (a ctypes pointer frozen into the code is not)."""
+    sig = types.float64(types.intp, types.intp)
+
+    def codegen(context, builder, signature, args):
+        voidp = ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.DoubleType(), [voidp])
+        return builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [builder.inttoptr(args[1], voidp)])
+    return sig, codegen
+
+
+@njit(cache=True)
+def _fill_uniforms(buf, col, states, next_double):
+    for r in range(buf.shape[0]):
+        state = states[r]
+        for j in range(col, buf.shape[1]):
+            buf[r, j] = _call_next_double(next_double, state)
+
+
+def fill_uniforms(buf, col, states, next_double):
+    """Row r of ``buf`` (runs, m), float64 and C-contiguous, from column ``col`` on: the next
+    ``m - col`` values of the PCG64 whose state is at address ``states[r]`` (np.intp (runs,)),
+    drawn by ``next_double`` (the address of that bit generator's C ``next_double``), which is
+    what ``Generator.random(out=buf[r, col:])`` does value by value (numpy's
+    ``random_standard_uniform_fill``): the same bits and the same generator state afterwards, in
+    one call for every run instead of one Python call per run. The generators' locks are not
+    taken: the caller owns them (one :class:`fkopt.streams.RunStreams`, one thread)."""
+    _fill_uniforms(buf, int(col), states, int(next_double))
