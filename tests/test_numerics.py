@@ -297,3 +297,19 @@ def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(
     assert np.array_equal(got["auto"], got["numpy"])
     for k in (0, 1, 117, runs - 1):
         assert np.array_equal(got["auto"][k], _generator(seed, k).random(sum(sizes)))
+
+
+def test_compiled_refill_reuses_a_buffer_only_when_no_view_of_it_is_alive(monkeypatch):
+    """The compiled refill writes into a spare buffer again only when nothing handed out points into
+    it: a view an algorithm keeps across refills keeps its values."""
+    from fkopt import streams as streams_mod
+    monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    s = streams_mod.RunStreams(5, range(200))
+    kept = s.uniform(300)                         # held through every refill below
+    copy = kept.copy()
+    for _ in range(10):
+        s.uniform(400)                            # dropped at once: its buffer is free again
+    assert np.array_equal(kept, copy)
+    assert 2 <= len(s._stores) <= 4
+    assert np.array_equal(s.uniform(7)[3], _generator(5, 3).random(300 + 4000 + 7)[-7:])
