@@ -29,11 +29,11 @@ Refills. With many runs (more than ``BUFFER_VALUES // CHUNK`` = 128) each run re
 :data:`CHUNK` values and one Python call ``Generator.random(out=...)`` per run cost about half of the
 refill (4.0 ns per value at 3000 runs x 349 values, measured, against 2.0 for a compiled loop).
 There, when the compiled numerics path runs (:mod:`fkopt.numerics.path`; numba is imported then,
-never for a few runs), one compiled call refills every run through each generator's own C
-``next_double`` (:func:`fkopt.numerics.compiled.fill_uniforms`) -- the function
-``Generator.random`` calls per value, so the same bits and the same generator state after; and
-since a refill then costs no call per run, the buffer is smaller (:data:`COMPILED_BUFFER_VALUES`)
-and stays in cache.
+never for a few runs), one compiled call refills every run (:func:`fkopt.numerics.compiled.fill_uniforms`):
+numpy's PCG64 step and ``next_double`` on the runs' 128-bit states held in one array, so the same
+bits as ``Generator.random`` (tested); the states go back into the generators when the numpy
+refill takes over. Since a refill then costs no call per run, the buffer is smaller
+(:data:`COMPILED_BUFFER_VALUES`) and stays in cache.
 ``FKOPT_NUMERICS=numpy`` keeps the per-run numpy calls.
 """
 from __future__ import annotations
@@ -95,7 +95,7 @@ class RunStreams:
         self._buffer = np.empty((self._runs, 0))
         self._pos = 0
         self._size = 0
-        self._fill = None              # (kernel, state addresses, next_double) once the compiled refill is chosen
+        self._fill = None              # (kernel, PCG64 states, kernels module) while the compiled refill runs
         self._stores: list[np.ndarray] = []   # the compiled refill's buffers (see _free_store)
 
     @property
@@ -106,6 +106,8 @@ class RunStreams:
         """Keep the unread tail and append at least ``n`` fresh values per run."""
         tail = self._size - self._pos
         fill = self._compiled_fill()
+        if fill is None and self._fill is not None:   # the compiled path was left: numpy's calls continue
+            self._sync_generators()
         fresh = max(n, self._refill_size if fill is None else
                     max(COMPILED_MIN_REFILL, min(CHUNK, COMPILED_BUFFER_VALUES // self._runs)))
         if fill is None:
@@ -117,7 +119,7 @@ class RunStreams:
             need = self._runs * (tail + fresh)
             buf = self._free_store(need, 2 * self._runs * fresh)[:need].reshape(self._runs, tail + fresh)
             buf[:, :tail] = self._buffer[:, self._pos:]
-            fill[0](buf, tail, fill[1], fill[2])
+            fill[0](buf, tail, fill[1])
         self._buffer, self._pos, self._size = buf, 0, tail + fresh
 
     def _free_store(self, need: int, size: int) -> np.ndarray:
@@ -138,20 +140,26 @@ class RunStreams:
         return store
 
     def _compiled_fill(self):
-        """(kernel, state addresses, next_double address) of the compiled refill, or None for
-        numpy's per-run calls: with refills shorter than :data:`CHUNK` (many runs) and the compiled
-        path on (asked on every refill: ``FKOPT_NUMERICS`` may change between calls)."""
+        """(kernel, PCG64 states) of the compiled refill, or None for numpy's per-run calls: with
+        refills shorter than :data:`CHUNK` (many runs) and the compiled path on (asked on every
+        refill: ``FKOPT_NUMERICS`` may change between calls). The states are the generators'
+        own, copied into one array on first use; from then on the array is the streams' state
+        (:meth:`_sync_generators` writes it back)."""
         if self._refill_size >= CHUNK:
             return None
         kernels = numerics_path.compiled()
         if kernels is None:
             return None
         if self._fill is None:
-            import ctypes
-            bits = [g.bit_generator.ctypes for g in self._generators]
-            states = np.array([b.state_address for b in bits], dtype=np.intp)
-            self._fill = (kernels.fill_uniforms, states, ctypes.cast(bits[0].next_double, ctypes.c_void_p).value)
+            self._fill = (kernels.fill_uniforms, kernels.pcg64_states(self._generators), kernels)
         return self._fill
+
+    def _sync_generators(self) -> None:
+        """The compiled refill's states back into the generators (numpy draws continue the
+        streams), and the compiled refill forgotten (it takes them up again when next used)."""
+        if self._fill is not None:
+            self._fill[2].store_pcg64_states(self._generators, self._fill[1])
+            self._fill = None
 
     def uniform(self, *shape: int) -> np.ndarray:
         """Uniforms in [0, 1) shaped (runs, *shape); each run's values come from its own stream.

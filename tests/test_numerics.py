@@ -261,23 +261,27 @@ def _generator(seed, run):
     return np.random.Generator(np.random.PCG64(run_seed_sequence(seed, run)))
 
 
-@pytest.mark.parametrize("seed,rows,width,col", [(0, 1, 1, 0), (1, 3, 349, 0), (12345, 5, 1000, 7), (7, 2, 9, 8)])
+@pytest.mark.parametrize("seed,rows,width,col", [(0, 1, 1, 0), (1, 3, 349, 0), (12345, 9, 1000, 7), (7, 6, 9, 8)])
 def test_compiled_refill_is_generator_random_bit_for_bit_and_leaves_the_same_state(seed, rows, width, col):
-    """fill_uniforms calls each PCG64's own C next_double, as Generator.random does per value: the
-    same values, the same bit generator state after, so a later numpy draw continues the stream."""
-    import ctypes
+    """fill_uniforms runs numpy's PCG64 and next_double on the states in one array (four runs at a
+    time, then the rest): the values of Generator.random, and, written back, the same generator
+    state, so a later numpy draw continues the stream; a second fill continues it too."""
     mine = [_generator(seed, k) for k in range(rows)]
     ref = [_generator(seed, k) for k in range(rows)]
-    buf = np.full((rows, width), -1.0)
-    states = np.array([g.bit_generator.ctypes.state_address for g in mine], dtype=np.intp)
-    compiled.fill_uniforms(buf, col, states, ctypes.cast(mine[0].bit_generator.ctypes.next_double,
-                                                         ctypes.c_void_p).value)
-    assert (buf[:, :col] == -1.0).all()                       # columns before col untouched
+    S = compiled.pcg64_states(mine)
+    for _ in range(2):
+        buf = np.full((rows, width), -1.0)
+        compiled.fill_uniforms(buf, col, S)
+        assert (buf[:, :col] == -1.0).all()                       # columns before col untouched
+        for k in range(rows):
+            assert np.array_equal(buf[k, col:], ref[k].random(width - col))
+    compiled.store_pcg64_states(mine, S)
     for k in range(rows):
-        assert np.array_equal(buf[k, col:], ref[k].random(width - col))
         assert mine[k].bit_generator.state == ref[k].bit_generator.state
         assert np.array_equal(mine[k].random(17), ref[k].random(17))
         assert mine[k].integers(1 << 40) == ref[k].integers(1 << 40)
+    with pytest.raises(ValueError, match="PCG64 only"):
+        compiled.pcg64_states([np.random.Generator(np.random.MT19937(1))])
 
 
 def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(monkeypatch):
@@ -293,6 +297,11 @@ def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(
         s = streams_mod.RunStreams(seed, range(runs))
         got[mode] = np.concatenate([s.uniform(n).copy() for n in sizes], axis=1)
         assert (s._fill is not None) == (mode == "auto")
+        if mode == "auto":             # leaving the compiled path: the numpy refill continues the streams
+            monkeypatch.setenv(numerics_path.ENV, "numpy")
+            more = s.uniform(5000)
+            assert s._fill is None
+            assert np.array_equal(more[199], _generator(seed, 199).random(sum(sizes) + 5000)[-5000:])
     assert streams_mod.RunStreams(seed, range(3))._compiled_fill() is None    # few runs: numpy's calls
     assert np.array_equal(got["auto"], got["numpy"])
     for k in (0, 1, 117, runs - 1):

@@ -19,7 +19,7 @@ load the cache.
 * :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
 * :func:`fill_uniforms` -- the refill of :class:`fkopt.streams.RunStreams`' buffer, every run in one
-  call through numpy's own ``next_double`` of each run's PCG64 (so numpy's ``Generator.random`` bits);
+  call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits);
 """
 from __future__ import annotations
 
@@ -982,35 +982,94 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     return (scout >= 0).astype(np.int64), _kept(hr, he, hf, nh)
 
 
+
 @intrinsic
-def _call_next_double(typingctx, fn, state):
-    """``fn(state)`` for a C function ``double fn(void *)`` at address ``fn`` and a pointer
-    ``state``, both given as integers: numpy's bit generator C interface
-    (``BitGenerator.ctypes.next_double``, ``.state_address``). The addresses are arguments, not
-    globals, so the caller stays cacheable on disk (a ctypes pointer frozen into the code is not)."""
-    sig = types.float64(types.intp, types.intp)
+def _mulhi(typingctx, a, b):
+    """The high 64 bits of the 128-bit product of two uint64 (LLVM's i128 multiply)."""
+    sig = types.uint64(types.uint64, types.uint64)
 
     def codegen(context, builder, signature, args):
-        voidp = ir.IntType(8).as_pointer()
-        fnty = ir.FunctionType(ir.DoubleType(), [voidp])
-        return builder.call(builder.inttoptr(args[0], fnty.as_pointer()), [builder.inttoptr(args[1], voidp)])
+        i128 = ir.IntType(128)
+        wide = builder.mul(builder.zext(args[0], i128), builder.zext(args[1], i128))
+        return builder.trunc(builder.lshr(wide, ir.Constant(i128, 64)), ir.IntType(64))
     return sig, codegen
 
 
+#: PCG64's 128-bit LCG multiplier (O'Neill's PCG_DEFAULT_MULTIPLIER_128, numpy's PCG64), low and high words.
+_PCG_LO = np.uint64(0x4385DF649FCCF645)
+_PCG_HI = np.uint64(0x2360ED051FC65DA4)
+
+
+@njit(inline="always")
+def _pcg64_double(lo, hi, inc_lo, inc_hi):
+    """One step of numpy's PCG64 (XSL-RR 128/64): state = state * M + inc (mod 2^128), output
+    rotr64(hi ^ lo, hi >> 58) of the new state, and ``next_double``'s (out >> 11) * 2^-53.
+    Returns (lo, hi, double)."""
+    plo = lo * _PCG_LO
+    phi = _mulhi(lo, _PCG_LO) + lo * _PCG_HI + hi * _PCG_LO
+    lo = plo + inc_lo
+    hi = phi + inc_hi + (np.uint64(1) if lo < plo else np.uint64(0))
+    x = hi ^ lo
+    rot = hi >> np.uint64(58)
+    out = (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
+    return lo, hi, np.float64(out >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
 @njit(cache=True)
-def _fill_uniforms(buf, col, states, next_double):
-    for r in range(buf.shape[0]):
-        state = states[r]
-        for j in range(col, buf.shape[1]):
-            buf[r, j] = _call_next_double(next_double, state)
+def _fill_uniforms(buf, col, S):
+    rows, width = buf.shape[0], buf.shape[1]
+    r = 0
+    while r + 4 <= rows:               # four runs at a time: four independent LCG chains in flight
+        a0, a1, b0, b1 = S[r, 0], S[r, 1], S[r + 1, 0], S[r + 1, 1]
+        c0, c1, d0, d1 = S[r + 2, 0], S[r + 2, 1], S[r + 3, 0], S[r + 3, 1]
+        for j in range(col, width):
+            a0, a1, va = _pcg64_double(a0, a1, S[r, 2], S[r, 3])
+            b0, b1, vb = _pcg64_double(b0, b1, S[r + 1, 2], S[r + 1, 3])
+            c0, c1, vc = _pcg64_double(c0, c1, S[r + 2, 2], S[r + 2, 3])
+            d0, d1, vd = _pcg64_double(d0, d1, S[r + 3, 2], S[r + 3, 3])
+            buf[r, j], buf[r + 1, j], buf[r + 2, j], buf[r + 3, j] = va, vb, vc, vd
+        S[r, 0], S[r, 1], S[r + 1, 0], S[r + 1, 1] = a0, a1, b0, b1
+        S[r + 2, 0], S[r + 2, 1], S[r + 3, 0], S[r + 3, 1] = c0, c1, d0, d1
+        r += 4
+    while r < rows:
+        lo, hi = S[r, 0], S[r, 1]
+        for j in range(col, width):
+            lo, hi, v = _pcg64_double(lo, hi, S[r, 2], S[r, 3])
+            buf[r, j] = v
+        S[r, 0], S[r, 1] = lo, hi
+        r += 1
 
 
-def fill_uniforms(buf, col, states, next_double):
+def fill_uniforms(buf, col, S):
     """Row r of ``buf`` (runs, m), float64 and C-contiguous, from column ``col`` on: the next
-    ``m - col`` values of the PCG64 whose state is at address ``states[r]`` (np.intp (runs,)),
-    drawn by ``next_double`` (the address of that bit generator's C ``next_double``), which is
-    what ``Generator.random(out=buf[r, col:])`` does value by value (numpy's
-    ``random_standard_uniform_fill``): the same bits and the same generator state afterwards, in
-    one call for every run instead of one Python call per run. The generators' locks are not
-    taken: the caller owns them (one :class:`fkopt.streams.RunStreams`, one thread)."""
-    _fill_uniforms(buf, int(col), states, int(next_double))
+    ``m - col`` doubles of the PCG64 whose 128-bit state and increment are S[r] = (state low,
+    state high, inc low, inc high) (uint64 (runs, 4), advanced in place) -- numpy's
+    ``Generator.random`` value by value (PCG64's XSL-RR output, ``next_double``), the same bits;
+    one call for every run instead of one Python call per run, and the states in one compact
+    array instead of behind two pointers per generator (with 1000 runs those pointer chases were
+    cache misses on every refill). See :func:`pcg64_states`."""
+    _fill_uniforms(buf, int(col), S)
+
+
+_WORD = (1 << 64) - 1
+
+
+def pcg64_states(generators) -> np.ndarray:
+    """S (runs, 4) uint64 of :func:`fill_uniforms` from numpy PCG64 generators' ``state``."""
+    S = np.empty((len(generators), 4), dtype=np.uint64)
+    for r, g in enumerate(generators):
+        st = g.bit_generator.state
+        if st["bit_generator"] != "PCG64":
+            raise ValueError(f"fill_uniforms draws PCG64 only, not {st['bit_generator']}")
+        S[r] = (st["state"]["state"] & _WORD, st["state"]["state"] >> 64, st["state"]["inc"] & _WORD,
+                st["state"]["inc"] >> 64)
+    return S
+
+
+def store_pcg64_states(generators, S) -> None:
+    """Write S (see :func:`pcg64_states`) back into the generators, so that numpy draws continue
+    the streams where :func:`fill_uniforms` left them."""
+    for g, (lo, hi, ilo, ihi) in zip(generators, S.tolist()):
+        st = g.bit_generator.state
+        st["state"] = {"state": lo | (hi << 64), "inc": ilo | (ihi << 64)}
+        g.bit_generator.state = st
