@@ -53,9 +53,9 @@ CHUNK = 8192
 BUFFER_VALUES = 1 << 20
 MIN_REFILL = 256
 #: The same bound for the compiled refill (512 kB), which has no per-run cost: a buffer that stays
-#: in a core's cache (2 MB L2 here) beside a swarm's state. 3-RPS GABC at 100 cases x 30 runs, 1000
-#: rows per chunk, CPU time measured on a loaded machine: 96-97 ns per evaluation with 1048 values
-#: per run and refill (8 MB), 86-87 with 16 to 64 (128 to 512 kB), 87-92 with 128 to 256.
+#: in a core's cache (2 MB L2 here) beside a swarm's state. 3-RPS GABC / PSO at 100 cases x 30 runs,
+#: 1000 rows per chunk, 200 iterations, CPU time on a loaded machine (best of 2): 86 / 85 ns per
+#: evaluation with 1048 values per run and refill (8 MB), 78-81 / 78-83 with 16 to 256 (64 here).
 COMPILED_BUFFER_VALUES = 1 << 16
 COMPILED_MIN_REFILL = 32
 
