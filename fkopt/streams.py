@@ -25,16 +25,17 @@ Speed. ``uniform`` returns a view into the buffer (no copy, no per-run call): a 
 reshape, about a microsecond whatever the number of runs. Each value is handed out once, so an
 algorithm may overwrite the view it got without affecting any other draw.
 
-Refills. With many runs (more than ``BUFFER_VALUES // CHUNK`` = 128) each run refills fewer than
-:data:`CHUNK` values and one Python call ``Generator.random(out=...)`` per run cost about half of the
-refill (4.0 ns per value at 3000 runs x 349 values, measured, against 2.0 for a compiled loop).
-There, when the compiled numerics path runs (:mod:`fkopt.numerics.path`; numba is imported then,
-never for a few runs), one compiled call refills every run (:func:`fkopt.numerics.compiled.fill_uniforms`):
-numpy's PCG64 step and ``next_double`` on the runs' 128-bit states held in one array, so the same
-bits as ``Generator.random`` (tested); the states go back into the generators when the numpy
-refill takes over. Since a refill then costs no call per run, the buffer is smaller
-(:data:`COMPILED_BUFFER_VALUES`) and stays in cache.
-``FKOPT_NUMERICS=numpy`` keeps the per-run numpy calls.
+Refills. On the compiled numerics path (:mod:`fkopt.numerics.path`) one compiled call refills
+every run (:func:`fkopt.numerics.compiled.fill_uniforms`): numpy's PCG64 step and ``next_double``
+on the runs' 128-bit states held in one array, so the same bits as ``Generator.random`` (tested);
+the states go back into the generators when the numpy refill takes over. It runs with many runs
+(more than ``BUFFER_VALUES // CHUNK`` = 128; numba is imported if need be), where one Python call
+``Generator.random(out=...)`` per run and refill and the generators' scattered states cost half
+the refill, and with fewer runs once numba is loaded anyway (a compiled swarm's first iteration
+loads it; never imported for them). With no call per run the buffer is smaller
+(:data:`COMPILED_BUFFER_VALUES`) and stays in cache. Measured (CPU ns per evaluation, 3-RPS,
+600 iterations): 100 cases x 30 runs GABC / ABC / PSO 84 / 86 / 89 -> 80 / 79 / 74; 1 case x 30
+runs PSO / GABC 162 / 137 -> 139 / 123. ``FKOPT_NUMERICS=numpy`` keeps the per-run numpy calls.
 """
 from __future__ import annotations
 
@@ -140,14 +141,13 @@ class RunStreams:
         return store
 
     def _compiled_fill(self):
-        """(kernel, PCG64 states) of the compiled refill, or None for numpy's per-run calls: with
-        refills shorter than :data:`CHUNK` (many runs) and the compiled path on (asked on every
-        refill: ``FKOPT_NUMERICS`` may change between calls). The states are the generators'
+        """(kernel, PCG64 states) of the compiled refill, or None for numpy's per-run calls: when
+        the compiled path is on (asked on every refill: ``FKOPT_NUMERICS`` may change between
+        calls) and either refills are shorter than :data:`CHUNK` (many runs; numba is imported if
+        need be) or numba is loaded already (a compiled swarm's first iteration loads it). The states are the generators'
         own, copied into one array on first use; from then on the array is the streams' state
         (:meth:`_sync_generators` writes it back)."""
-        if self._refill_size >= CHUNK:
-            return None
-        kernels = numerics_path.compiled()
+        kernels = numerics_path.compiled() if self._refill_size < CHUNK else numerics_path.loaded()
         if kernels is None:
             return None
         if self._fill is None:

@@ -286,7 +286,7 @@ def test_compiled_refill_is_generator_random_bit_for_bit_and_leaves_the_same_sta
 
 def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(monkeypatch):
     """Above BUFFER_VALUES // CHUNK runs the refill is the compiled kernel (one call for every run),
-    below it and under FKOPT_NUMERICS=numpy the per-run numpy calls; every run's values are those of
+    below it only once numba is loaded, and under FKOPT_NUMERICS=numpy the per-run numpy calls; every run's values are those of
     its own Generator.random either way, across several refills and a tail kept between them."""
     from fkopt import streams as streams_mod
     monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)   # 200 runs: refills of 256 (< CHUNK)
@@ -302,7 +302,12 @@ def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(
             more = s.uniform(5000)
             assert s._fill is None
             assert np.array_equal(more[199], _generator(seed, 199).random(sum(sizes) + 5000)[-5000:])
-    assert streams_mod.RunStreams(seed, range(3))._compiled_fill() is None    # few runs: numpy's calls
+    few = streams_mod.RunStreams(seed, range(3))         # few runs: numpy's calls unless numba is loaded
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    assert numerics_path.compiled() is compiled and few._compiled_fill() is not None
+    monkeypatch.setitem(numerics_path._STATE, "module", None)
+    few._fill = None
+    assert few._compiled_fill() is None
     assert np.array_equal(got["auto"], got["numpy"])
     for k in (0, 1, 117, runs - 1):
         assert np.array_equal(got["auto"][k], _generator(seed, k).random(sum(sizes)))
