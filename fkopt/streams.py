@@ -128,9 +128,9 @@ class RunStreams:
         points into, for the compiled refill's next buffer: one of :attr:`_stores` when its reference
         count says nothing else holds it (every view of a view keeps the owning array as its
         ``base``), else a new one of ``size`` values, kept while fewer than four are. Why: a fresh
-        512 kB ``np.empty`` per refill is fresh pages from the kernel, and their first touch cost
-        about as much as the values' generation (measured, PSO at 100 cases: alloc, copy and fill
-        5.2 + 19.5 ns per evaluation). A view an algorithm keeps is never overwritten."""
+        ``np.empty`` per refill is fresh pages from the OS on first touch (measured with the first
+        compiled refill, PSO at 100 cases: allocation and tail copy 5.2 ns per evaluation beside
+        19.5 for the fill). A view an algorithm keeps is never overwritten."""
         for store in self._stores:
             # references: the list, this loop's variable, getrefcount's argument -- nothing else
             if store.size >= need and sys.getrefcount(store) <= 3:
@@ -144,9 +144,9 @@ class RunStreams:
         """(kernel, PCG64 states) of the compiled refill, or None for numpy's per-run calls: when
         the compiled path is on (asked on every refill: ``FKOPT_NUMERICS`` may change between
         calls) and either refills are shorter than :data:`CHUNK` (many runs; numba is imported if
-        need be) or numba is loaded already (a compiled swarm's first iteration loads it). The states are the generators'
-        own, copied into one array on first use; from then on the array is the streams' state
-        (:meth:`_sync_generators` writes it back)."""
+        need be) or numba is loaded already (a compiled swarm's first iteration loads it). The
+        states are the generators' own, copied into one array on first use; from then on the array
+        is the streams' state (:meth:`_sync_generators` writes it back)."""
         kernels = numerics_path.compiled() if self._refill_size < CHUNK else numerics_path.loaded()
         if kernels is None:
             return None

@@ -286,8 +286,9 @@ def test_compiled_refill_is_generator_random_bit_for_bit_and_leaves_the_same_sta
 
 def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(monkeypatch):
     """Above BUFFER_VALUES // CHUNK runs the refill is the compiled kernel (one call for every run),
-    below it only once numba is loaded, and under FKOPT_NUMERICS=numpy the per-run numpy calls; every run's values are those of
-    its own Generator.random either way, across several refills and a tail kept between them."""
+    below it only once numba is loaded, and under FKOPT_NUMERICS=numpy the per-run numpy calls;
+    every run's values are those of its own Generator.random either way, across several refills
+    and a tail kept between them."""
     from fkopt import streams as streams_mod
     monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)   # 200 runs: refills of 256 (< CHUNK)
     runs, seed, sizes = 200, 42, (100, 3 * 70, 1, 300, 255, 600)
