@@ -274,3 +274,77 @@ def test_compiled_abc_iteration_only_where_it_is_the_same_algorithm(monkeypatch)
         assert Mine()._compiled_iteration(p) is None
     monkeypatch.setenv(numerics_path.ENV, "numpy")
     assert ABC()._compiled_iteration(p) is None
+
+
+def _generator(seed, run):
+    from fkopt.streams import run_seed_sequence
+    return np.random.Generator(np.random.PCG64(run_seed_sequence(seed, run)))
+
+
+@pytest.mark.parametrize("seed,rows,width,col", [(0, 1, 1, 0), (1, 3, 349, 0), (12345, 9, 1000, 7), (7, 6, 9, 8)])
+def test_compiled_refill_is_generator_random_bit_for_bit_and_leaves_the_same_state(seed, rows, width, col):
+    """fill_uniforms runs numpy's PCG64 and next_double on the states in one array (four runs at a
+    time, then the rest): the values of Generator.random, and, written back, the same generator
+    state, so a later numpy draw continues the stream; a second fill continues it too."""
+    mine = [_generator(seed, k) for k in range(rows)]
+    ref = [_generator(seed, k) for k in range(rows)]
+    S = compiled.pcg64_states(mine)
+    for _ in range(2):
+        buf = np.full((rows, width), -1.0)
+        compiled.fill_uniforms(buf, col, S)
+        assert (buf[:, :col] == -1.0).all()                       # columns before col untouched
+        for k in range(rows):
+            assert np.array_equal(buf[k, col:], ref[k].random(width - col))
+    compiled.store_pcg64_states(mine, S)
+    for k in range(rows):
+        assert mine[k].bit_generator.state == ref[k].bit_generator.state
+        assert np.array_equal(mine[k].random(17), ref[k].random(17))
+        assert mine[k].integers(1 << 40) == ref[k].integers(1 << 40)
+    with pytest.raises(ValueError, match="PCG64 only"):
+        compiled.pcg64_states([np.random.Generator(np.random.MT19937(1))])
+
+
+def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(monkeypatch):
+    """Above BUFFER_VALUES // CHUNK runs the refill is the compiled kernel (one call for every run),
+    below it only once numba is loaded, and under FKOPT_NUMERICS=numpy the per-run numpy calls;
+    every run's values are those of its own Generator.random either way, across several refills
+    and a tail kept between them."""
+    from fkopt import streams as streams_mod
+    monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)   # 200 runs: refills of 256 (< CHUNK)
+    runs, seed, sizes = 200, 42, (100, 3 * 70, 1, 300, 255, 600)
+    got = {}
+    for mode in ("auto", "numpy"):
+        monkeypatch.setenv(numerics_path.ENV, mode)
+        s = streams_mod.RunStreams(seed, range(runs))
+        got[mode] = np.concatenate([s.uniform(n).copy() for n in sizes], axis=1)
+        assert (s._fill is not None) == (mode == "auto")
+        if mode == "auto":             # leaving the compiled path: the numpy refill continues the streams
+            monkeypatch.setenv(numerics_path.ENV, "numpy")
+            more = s.uniform(5000)
+            assert s._fill is None
+            assert np.array_equal(more[199], _generator(seed, 199).random(sum(sizes) + 5000)[-5000:])
+    few = streams_mod.RunStreams(seed, range(3))         # few runs: numpy's calls unless numba is loaded
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    assert numerics_path.compiled() is compiled and few._compiled_fill() is not None
+    monkeypatch.setitem(numerics_path._STATE, "module", None)
+    few._fill = None
+    assert few._compiled_fill() is None
+    assert np.array_equal(got["auto"], got["numpy"])
+    for k in (0, 1, 117, runs - 1):
+        assert np.array_equal(got["auto"][k], _generator(seed, k).random(sum(sizes)))
+
+
+def test_compiled_refill_reuses_a_buffer_only_when_no_view_of_it_is_alive(monkeypatch):
+    """The compiled refill writes into a spare buffer again only when nothing handed out points into
+    it: a view an algorithm keeps across refills keeps its values."""
+    from fkopt import streams as streams_mod
+    monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    s = streams_mod.RunStreams(5, range(200))
+    kept = s.uniform(300)                         # held through every refill below
+    copy = kept.copy()
+    for _ in range(10):
+        s.uniform(400)                            # dropped at once: its buffer is free again
+    assert np.array_equal(kept, copy)
+    assert 2 <= len(s._stores) <= 4
+    assert np.array_equal(s.uniform(7)[3], _generator(5, 3).random(300 + 4000 + 7)[-7:])

@@ -18,6 +18,8 @@ load the cache.
   per point); the values are the same wherever the divisor is not zero;
 * :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
+* :func:`fill_uniforms` -- the refill of :class:`fkopt.streams.RunStreams`' buffer, every run in one
+  call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits);
 """
 from __future__ import annotations
 
@@ -25,7 +27,9 @@ import math
 import threading
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.core.extending import intrinsic
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -982,3 +986,96 @@ def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, 
     nh = _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, fo_src, fo_jj, fo_mv, tan, fo, best_x, best_f, best,
                               count, active, hr, he, hf, nh, block)
     return (scout >= 0).astype(np.int64), _kept(hr, he, hf, nh)
+
+
+
+@intrinsic
+def _mulhi(typingctx, a, b):
+    """The high 64 bits of the 128-bit product of two uint64 (LLVM's i128 multiply)."""
+    sig = types.uint64(types.uint64, types.uint64)
+
+    def codegen(context, builder, signature, args):
+        i128 = ir.IntType(128)
+        wide = builder.mul(builder.zext(args[0], i128), builder.zext(args[1], i128))
+        return builder.trunc(builder.lshr(wide, ir.Constant(i128, 64)), ir.IntType(64))
+    return sig, codegen
+
+
+#: PCG64's 128-bit LCG multiplier (O'Neill's PCG_DEFAULT_MULTIPLIER_128, numpy's PCG64), low and high words.
+_PCG_LO = np.uint64(0x4385DF649FCCF645)
+_PCG_HI = np.uint64(0x2360ED051FC65DA4)
+
+
+@njit(inline="always")
+def _pcg64_double(lo, hi, inc_lo, inc_hi):
+    """One step of numpy's PCG64 (XSL-RR 128/64): state = state * M + inc (mod 2^128), output
+    rotr64(hi ^ lo, hi >> 58) of the new state, and ``next_double``'s (out >> 11) * 2^-53.
+    Returns (lo, hi, double)."""
+    plo = lo * _PCG_LO
+    phi = _mulhi(lo, _PCG_LO) + lo * _PCG_HI + hi * _PCG_LO
+    lo = plo + inc_lo
+    hi = phi + inc_hi + (np.uint64(1) if lo < plo else np.uint64(0))
+    x = hi ^ lo
+    rot = hi >> np.uint64(58)
+    out = (x >> rot) | (x << ((np.uint64(64) - rot) & np.uint64(63)))
+    return lo, hi, np.float64(out >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True)
+def _fill_uniforms(buf, col, S):
+    rows, width = buf.shape[0], buf.shape[1]
+    r = 0
+    while r + 4 <= rows:               # four runs at a time: four independent LCG chains in flight
+        a0, a1, b0, b1 = S[r, 0], S[r, 1], S[r + 1, 0], S[r + 1, 1]
+        c0, c1, d0, d1 = S[r + 2, 0], S[r + 2, 1], S[r + 3, 0], S[r + 3, 1]
+        for j in range(col, width):
+            a0, a1, va = _pcg64_double(a0, a1, S[r, 2], S[r, 3])
+            b0, b1, vb = _pcg64_double(b0, b1, S[r + 1, 2], S[r + 1, 3])
+            c0, c1, vc = _pcg64_double(c0, c1, S[r + 2, 2], S[r + 2, 3])
+            d0, d1, vd = _pcg64_double(d0, d1, S[r + 3, 2], S[r + 3, 3])
+            buf[r, j], buf[r + 1, j], buf[r + 2, j], buf[r + 3, j] = va, vb, vc, vd
+        S[r, 0], S[r, 1], S[r + 1, 0], S[r + 1, 1] = a0, a1, b0, b1
+        S[r + 2, 0], S[r + 2, 1], S[r + 3, 0], S[r + 3, 1] = c0, c1, d0, d1
+        r += 4
+    while r < rows:
+        lo, hi = S[r, 0], S[r, 1]
+        for j in range(col, width):
+            lo, hi, v = _pcg64_double(lo, hi, S[r, 2], S[r, 3])
+            buf[r, j] = v
+        S[r, 0], S[r, 1] = lo, hi
+        r += 1
+
+
+def fill_uniforms(buf, col, S):
+    """Row r of ``buf`` (runs, m), float64 and C-contiguous, from column ``col`` on: the next
+    ``m - col`` doubles of the PCG64 whose 128-bit state and increment are S[r] = (state low,
+    state high, inc low, inc high) (uint64 (runs, 4), advanced in place) -- numpy's
+    ``Generator.random`` value by value (PCG64's XSL-RR output, ``next_double``), the same bits;
+    one call for every run instead of one Python call per run, and the states in one compact
+    array instead of behind two pointers per generator (with 1000 runs those pointer chases were
+    cache misses on every refill). See :func:`pcg64_states`."""
+    _fill_uniforms(buf, int(col), S)
+
+
+_WORD = (1 << 64) - 1
+
+
+def pcg64_states(generators) -> np.ndarray:
+    """S (runs, 4) uint64 of :func:`fill_uniforms` from numpy PCG64 generators' ``state``."""
+    S = np.empty((len(generators), 4), dtype=np.uint64)
+    for r, g in enumerate(generators):
+        st = g.bit_generator.state
+        if st["bit_generator"] != "PCG64":
+            raise ValueError(f"fill_uniforms draws PCG64 only, not {st['bit_generator']}")
+        S[r] = (st["state"]["state"] & _WORD, st["state"]["state"] >> 64, st["state"]["inc"] & _WORD,
+                st["state"]["inc"] >> 64)
+    return S
+
+
+def store_pcg64_states(generators, S) -> None:
+    """Write S (see :func:`pcg64_states`) back into the generators, so that numpy draws continue
+    the streams where :func:`fill_uniforms` left them."""
+    for g, (lo, hi, ilo, ihi) in zip(generators, S.tolist()):
+        st = g.bit_generator.state
+        st["state"] = {"state": lo | (hi << 64), "inc": ilo | (ihi << 64)}
+        g.bit_generator.state = st

@@ -53,6 +53,15 @@ def compiled(want: bool | None = None):
     return _STATE["module"]
 
 
+def loaded():
+    """:func:`compiled`'s module only when it is already imported (by an earlier :func:`compiled`
+    call), else None; never imports numba. For work that pays for the compiled path only once numba
+    is loaded anyway (the run streams' refills with a few runs)."""
+    if requested() == "numpy":
+        return None
+    return _STATE.get("module")
+
+
 def describe() -> dict:
     """What ``env.json`` records (its ``numerics``): ``path``, the path a default ``fkopt.inverse``
     call takes in this process ('compiled' with numba, else 'numpy'); ``mode``, the
