@@ -196,7 +196,11 @@ def _targets(m, poses) -> np.ndarray:
     """Targets of :func:`inverse` as rows: poses (..., 6) as they are, tip frames (..., 4, 4) as
     (..., 12) = (x, y, z, R row-major); a frame needs a finite, orthonormal rotation and the
     last row (0, 0, 0, 1)."""
-    a = np.asarray(poses, dtype=float)
+    try:
+        a = np.asarray(poses, dtype=float)
+    except (TypeError, ValueError):
+        raise FkoptError(f"{m.name} target pose: expected numbers, (..., {len(m.pose_names)}) values "
+                         f"({', '.join(m.pose_names)}) or (..., 4, 4) tip frames; got {type(poses).__name__}") from None
     if a.ndim < 2 or a.shape[-2:] != (4, 4):
         return _values(m, a, m.pose_names, "target pose")
     if a.ndim == 2:                                    # one frame: the same checks on floats (a few µs less)
