@@ -22,10 +22,12 @@ counts as solved only when the independent FK of it (continuous joints wrapped) 
 tolerances of the target and it is inside the limits; neither library's own verdict is counted
 (``ik-batch`` also reports how many of fkopt's answers it called solved but were not).
 
-* ``ik-one-pose``: one pose per call, fkopt (``fkopt.inverse(arm, pose)``, the compiled one-pose
-  loop unless ``FKOPT_NUMERICS=numpy``) and rtb alternating query by query in this process (which
-  of the two goes first alternates too), after one warm-up call each (numba's cache load and the
-  arm's start table happen there, reported as "first call"). Per arm: median ms of each,
+* ``ik-one-pose``: one pose per call, fkopt (a prepared ``fkopt.InverseSolver(arm, tol=...)``
+  called per pose -- ``fkopt.inverse(arm, pose)``'s answers bit for bit with its per-call set-up
+  done once; the compiled one-pose loop unless ``FKOPT_NUMERICS=numpy``) and rtb alternating query
+  by query in this process (which of the two goes first alternates too), after one warm-up call
+  each (making the solver, numba's cache load and the arm's start table happen there, reported as
+  "first call"). Per arm: median ms of each,
   the ratio of the medians fkopt/rtb, solved fraction of each; then the median ratio over arms and
   the largest (targets <= 1 and <= 2, issue 29).
 * ``ik-batch``: all ``n`` poses (1000; 200 in quick mode) in one ``fkopt.inverse`` call beside rtb
@@ -231,7 +233,8 @@ def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
     ratios = {}
     for a in arms:
         t = time.perf_counter()
-        kinematics.inverse(a.m, a.P[0], tol=a.tol)
+        solver = kinematics.InverseSolver(a.m, tol=a.tol)     # set-up once, as a control loop would
+        solver(a.P[0])
         t_first = time.perf_counter() - t
         a.rtb(0)
         tf, tr, okf, okr = [], [], 0, 0
@@ -239,7 +242,7 @@ def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
             for who in ((0, 1) if k % 2 == 0 else (1, 0)):
                 if who == 0:
                     t = time.perf_counter()
-                    res = kinematics.inverse(a.m, a.P[k], tol=a.tol)
+                    res = solver(a.P[k])
                     tf.append(time.perf_counter() - t)
                     okf += a.verified(res.joints, k)
                 else:
