@@ -1126,9 +1126,11 @@ def inverse_solver(arm, *, tol=INVERSE_TOL, mask=None, **options) -> InverseSolv
 _SOLVERS_PER_ARM = 16
 
 
-def _solver_for(m, options: InverseOptions, tol: tuple[float, float], W) -> InverseSolver:
+def _solver_for(m, options, tol: tuple[float, float], W) -> InverseSolver:
     """The :class:`InverseSolver` :func:`inverse` runs one pose through, cached on the arm by
-    (options, tol, mask, numerics mode): ``FKOPT_NUMERICS`` may change between calls."""
+    (options, tol, mask, numerics mode): ``FKOPT_NUMERICS`` may change between calls. ``options``:
+    an :class:`InverseOptions`, or its field values in order as a tuple (inverse's keywords: the
+    options object is made only when the solver is)."""
     key = (options, tol, None if W is None else W.tobytes(), numerics_path.requested())
     cache = m.__dict__.get("_inverse_solvers")
     if cache is None:
@@ -1137,6 +1139,8 @@ def _solver_for(m, options: InverseOptions, tol: tuple[float, float], W) -> Inve
     if got is None:
         if len(cache) >= _SOLVERS_PER_ARM:
             cache.pop(next(iter(cache)))
+        if not isinstance(options, InverseOptions):
+            options = InverseOptions(*options)
         got = cache[key] = InverseSolver(m, options, tol=tol, mask=None if W is None else W)
     elif got._bounds != m.bounds.tobytes():
         got._prepare()
@@ -1191,10 +1195,9 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     P0 = _targets(m, poses)
     if P0.ndim == 1 and rest <= 0 and not exact_rotation:
         # one pose: through the prepared solver (cached per arm, options, tol and mask), the one code path
-        o = options if options is not None else InverseOptions(
-            restarts=restarts, starts=starts, rest=rest, orientation_scale=orientation_scale, iterations=iterations,
-            damping=damping, step_cap=step_cap, down=down, up=up, fill=fill, exact_rotation=exact_rotation,
-            table=table, neighbours=neighbours, tail=tail, compiled=compiled)
+        o = options if options is not None else (restarts, starts, rest, orientation_scale, iterations, damping,
+                                                 step_cap, down, up, fill, exact_rotation, table, neighbours, tail,
+                                                 compiled)
         return _solver_for(m, o, (tp, tr), _task_mask(mask))._one(P0, start, seed)
     shape = P0.shape[:-1]
     P = P0.reshape(-1, P0.shape[-1])
