@@ -155,3 +155,12 @@ def test_options_are_validated_and_prepared_once_not_per_call(monkeypatch):
     assert counts["prepare"] == 2 and arm.bounds[0, 0] <= r.joints[0] <= arm.bounds[0, 1]
     assert _bits(r) == _bits(fkopt.inverse(arm, T, tol=(1e-9, 1e-9), seed=1))
     assert first.joints.shape == r.joints.shape
+
+
+def test_the_control_loop_example_of_docs_robots_runs(capsys):
+    """docs/robots.md's 1 kHz loop, shortened to 20 ticks (its timing is not asserted)."""
+    text = (Path(__file__).parents[1] / "docs" / "robots.md").read_text(encoding="utf-8")
+    code = text.split("### A prepared solver for a control loop")[1].split("```python\n")[1].split("```")[0]
+    assert "ticks, late, solved = 1e-3, 1000, 0, 0" in code
+    exec(compile(code.replace("1e-3, 1000, 0, 0", "1e-3, 20, 0, 0"), "docs/robots.md (control loop)", "exec"), {})
+    assert "20 of 20 ticks solved" in capsys.readouterr().out
