@@ -344,6 +344,11 @@ def _nearest_into(Ft, norms, f, idx, best):
     d2 = np.zeros(N)
     for j in range(c):
         fj = f[j]
+        if fj == 0.0:
+            # a feature the task mask leaves out (or an exact zero): each term would be +-0.0, which
+            # leaves every sum as it is (finite table, and -0.0 + 0.0 only changes a zero's sign,
+            # which |F_i|^2 - 2 d2 does not see), so skipping its pass keeps the bits
+            continue
         for i in range(N):
             d2[i] += Ft[j, i] * fj
     m = 0
