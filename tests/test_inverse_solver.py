@@ -164,3 +164,22 @@ def test_the_control_loop_example_of_docs_robots_runs(capsys):
     assert "ticks, late, solved = 1e-3, 1000, 0, 0" in code
     exec(compile(code.replace("1e-3, 1000, 0, 0", "1e-3, 20, 0, 0"), "docs/robots.md (control loop)", "exec"), {})
     assert "20 of 20 ticks solved" in capsys.readouterr().out
+
+
+def test_the_path_is_chosen_when_the_solver_is_made_and_inverse_follows_the_switch(monkeypatch):
+    """FKOPT_NUMERICS=numpy when a solver is made: it runs the Python reference (no kernel bound);
+    fkopt.inverse keys its cached solvers on the switch, so it follows a change between calls --
+    and both paths give the same bits."""
+    from fkopt.numerics import path as numerics_path
+    arm = fkopt.mechanism("7dof-arm")
+    T = arm.fk_matrix(arm.bounds.mean(axis=1) + 7.0)
+    monkeypatch.setenv(numerics_path.ENV, "numpy")
+    slow = fkopt.InverseSolver(arm, tol=(1e-9, 1e-9))
+    assert slow._kernel is None
+    a = fkopt.inverse(arm, T, tol=(1e-9, 1e-9), seed=2)
+    pytest.importorskip("numba")
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    fast = fkopt.InverseSolver(arm, tol=(1e-9, 1e-9))
+    assert fast._kernel is not None
+    b = fkopt.inverse(arm, T, tol=(1e-9, 1e-9), seed=2)
+    assert _bits(a) == _bits(b) == _bits(slow(T, seed=2)) == _bits(fast(T, seed=2))
