@@ -882,26 +882,32 @@ def _fast_result(m, answer, tp: float, tr: float) -> InverseResult:
         evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
 
 
+def _unreachable(m, x, y, z, dist) -> FkoptError:
+    """The one-line error of a target farther from the base than the arm's reach."""
+    unit = m.pose_units[0]
+    return FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
+                      f"(distance {dist:.1f} {unit} > reach {m.reach:.1f} {unit})")
+
+
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
     Python floats (:func:`fkopt.numerics.dls.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
     first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
-    batch's bookkeeping costs more than the iteration itself for a single pose."""
+    batch's bookkeeping costs more than the iteration itself for a single pose. The compiled call
+    without a start is :meth:`InverseSolver._one`'s own; this one serves the rest (a start, or the
+    Python reference)."""
     tp, tr = tol
     n = m.dof
     x, y, z = pose[:3].tolist()
     reach = m.reach
     dist = math.sqrt(x * x + y * y + z * z)
     if dist > reach * (1.0 + 1e-12):
-        unit = m.pose_units[0]
-        raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
-                         f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
+        raise _unreachable(m, x, y, z, dist)
     L = float(orientation_scale) if orientation_scale else reach
     nn = min(table, kn) if table else 0
     fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
-    # (the compiled call without a start, the common one, is InverseSolver's own: InverseSolver._one)
     c = _arm_constants(m)
     lo, hi = c["lo"], c["hi"]
     blo, bhi, angle = c["blo"], c["bhi"], c["angle"]
@@ -1030,7 +1036,7 @@ class InverseSolver:
     prepares again on the next call (one byte comparison per call keeps that honest)."""
 
     __slots__ = ("arm", "options", "tol", "mask", "_W", "_bounds", "_fast", "_one_pose", "_budget", "_table",
-                 "_kn", "_L", "_kernel", "_tail", "_head", "_names", "_reach")
+                 "_kn", "_L", "_kernel", "_tail", "_reach")
 
     def __init__(self, arm, options: InverseOptions | None = None, *, tol=INVERSE_TOL, mask=None):
         self.arm = m = _inverse_arm(arm)
@@ -1049,7 +1055,6 @@ class InverseSolver:
         """Everything that depends on the arm's limits and the options, once."""
         m, o = self.arm, self.options
         self._bounds = m.bounds.tobytes()
-        self._names = tuple(m.joint_names)
         self._reach = float(m.reach)
         self._one_pose = o.rest <= 0 and not o.exact_rotation
         first = max(1, int(o.starts), o.fill)
@@ -1065,7 +1070,6 @@ class InverseSolver:
             nn = min(self._table, self._kn[0]) if self._table else 0
             tp, tr = self.tol
             self._kernel = fast._inverse_pose
-            self._head = (ctx["chain"],)
             # the arguments after (chain, pose, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed)
             self._tail = (ctx, float(self._L), ctx["W"], ctx["mid"], 0 if self._table else 1, ctx["tq"], ctx["Ft"],
                           ctx["norms"], ctx["w"], ctx["fmask"], nn, self._budget, tp, tr, int(o.iterations),
@@ -1097,9 +1101,7 @@ class InverseSolver:
             x, y, z = pose[0], pose[1], pose[2]
             dist = math.sqrt(x * x + y * y + z * z)
             if dist > self._reach * (1.0 + 1e-12):
-                unit = self.arm.pose_units[0]
-                raise FkoptError(f"{self.arm.name} target ({x:g}, {y:g}, {z:g}) unreachable "
-                                 f"(distance {dist:.1f} {unit} > reach {self._reach:.1f} {unit})")
+                raise _unreachable(self.arm, x, y, z, dist)
             (ctx, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, budget, tp, tr, it, damping, down, up, cap,
              slo, shi, lo, hi, angle, periodic, blo, bhi) = self._tail
             out, info = np.empty(ctx["n"]), np.empty(5)
@@ -1207,9 +1209,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     far = dist > reach * (1.0 + 1e-12)
     if far.any():
         k = int(np.flatnonzero(far)[0])
-        unit = m.pose_units[0]
-        raise FkoptError(f"{m.name} target ({P[k, 0]:g}, {P[k, 1]:g}, {P[k, 2]:g}) unreachable "
-                         f"(distance {dist[k]:.1f} {unit} > reach {reach:.1f} {unit})")
+        raise _unreachable(m, P[k, 0], P[k, 1], P[k, 2], dist[k])
     lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     # saturation bounds: none for periodic (continuous) joints, wrapped at the end
