@@ -183,3 +183,12 @@ def test_the_path_is_chosen_when_the_solver_is_made_and_inverse_follows_the_swit
     assert fast._kernel is not None
     b = fkopt.inverse(arm, T, tol=(1e-9, 1e-9), seed=2)
     assert _bits(a) == _bits(b) == _bits(slow(T, seed=2)) == _bits(fast(T, seed=2))
+
+
+@pytest.mark.parametrize("options", [{"rest": 0.1}, {"exact_rotation": True}])
+def test_options_without_a_one_pose_loop_go_to_inverses_batched_loop(options):
+    arm = fkopt.mechanism("7dof-arm")
+    T = arm.fk_matrix(arm.bounds.mean(axis=1) + 7.0)
+    got = fkopt.InverseSolver(arm, InverseOptions(**options))(T, seed=1)
+    want = fkopt.inverse(arm, T, seed=1, **options)
+    assert got.joints.shape == (7,) and bool(got.solved) and np.array_equal(got.joints, want.joints)
