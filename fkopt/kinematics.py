@@ -1201,6 +1201,11 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
                                                  step_cap, down, up, fill, exact_rotation, table, neighbours, tail,
                                                  compiled)
         return _solver_for(m, o, (tp, tr), _task_mask(mask))._one(P0, start, seed)
+    if options is None:                                # the same checks as a one-pose call's solver
+        InverseOptions(restarts, starts, rest, orientation_scale, iterations, damping, step_cap, down, up, fill,
+                       exact_rotation, table, neighbours, tail, compiled).validated()
+    else:
+        options.validated()
     shape = P0.shape[:-1]
     P = P0.reshape(-1, P0.shape[-1])
     N, n = len(P), m.dof

@@ -192,3 +192,13 @@ def test_options_without_a_one_pose_loop_go_to_inverses_batched_loop(options):
     got = fkopt.InverseSolver(arm, InverseOptions(**options))(T, seed=1)
     want = fkopt.inverse(arm, T, seed=1, **options)
     assert got.joints.shape == (7,) and bool(got.solved) and np.array_equal(got.joints, want.joints)
+
+
+def test_inverse_checks_its_options_alike_for_one_pose_and_a_batch():
+    arm = fkopt.mechanism("7dof-arm")
+    frames = arm.fk_matrix(np.stack([arm.bounds.mean(axis=1)] * 2))
+    for target in (frames[0], frames):
+        with pytest.raises(FkoptError, match="inverse options damping: expected a number > 0"):
+            fkopt.inverse(arm, target, damping=-1.0)
+        with pytest.raises(FkoptError, match="inverse options restarts"):
+            fkopt.inverse(arm, target, options=InverseOptions(restarts=-2))
