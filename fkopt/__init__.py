@@ -26,7 +26,8 @@ from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
 #: pay only for what they touch: the optimiser layer imports pydantic, the version
 #: importlib.metadata.
 _LAZY = {"ForwardResult": "kinematics", "InverseResult": "kinematics", "forward": "kinematics",
-         "inverse": "kinematics", "FKProblem": "problems", "IKProblem": "problems",
+         "inverse": "kinematics", "InverseSolver": "kinematics", "inverse_solver": "kinematics",
+         "InverseOptions": "numerics", "FKProblem": "problems", "IKProblem": "problems",
          "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve"}
 
 
@@ -76,5 +77,6 @@ def algorithm(name: str, **params):
 
 
 __all__ = ["FkoptError", "FKProblem", "IKProblem", "Result", "algorithm", "fk_problem", "ik_problem",
-           "mechanism", "solve", "forward", "inverse", "ForwardResult", "InverseResult",
+           "mechanism", "solve", "forward", "inverse", "InverseSolver", "inverse_solver",
+           "InverseOptions", "ForwardResult", "InverseResult",
            "MECHANISMS", "ALGORITHMS", "__version__"]

@@ -117,6 +117,7 @@ from .algorithms.hybrid import GABCLM
 from .errors import FkoptError
 from .mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from .numerics import path as numerics_path
+from .numerics.options import InverseOptions
 from .numerics.dls import inverse_candidates, rotation_error1
 from .problems import fk_problem, so3_right_jacobian_inverse
 from .solve import solve
@@ -216,7 +217,11 @@ def _targets(m, poses) -> np.ndarray:
     """Targets of :func:`inverse` as rows: poses (..., 6) as they are, tip frames (..., 4, 4) as
     (..., 12) = (x, y, z, R row-major); a frame needs a finite, orthonormal rotation and the
     last row (0, 0, 0, 1)."""
-    a = np.asarray(poses, dtype=float)
+    try:
+        a = np.asarray(poses, dtype=float)
+    except (TypeError, ValueError):
+        raise FkoptError(f"{m.name} target pose: expected numbers, (..., {len(m.pose_names)}) values "
+                         f"({', '.join(m.pose_names)}) or (..., 4, 4) tip frames; got {type(poses).__name__}") from None
     if a.ndim < 2 or a.shape[-2:] != (4, 4):
         return _values(m, a, m.pose_names, "target pose")
     if a.ndim == 2:                                    # one frame: the same checks on floats (a few µs less)
@@ -1008,32 +1013,32 @@ def _fast_result(m, answer, tp: float, tr: float) -> InverseResult:
         evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
 
 
+def _unreachable(m, x, y, z, dist) -> FkoptError:
+    """The one-line error of a target farther from the base than the arm's reach."""
+    unit = m.pose_units[0]
+    return FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
+                      f"(distance {dist:.1f} {unit} > reach {m.reach:.1f} {unit})")
+
+
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
     Python floats (:func:`fkopt.numerics.dls.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
     first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
-    batch's bookkeeping costs more than the iteration itself for a single pose."""
+    batch's bookkeeping costs more than the iteration itself for a single pose. The compiled call
+    without a start is :meth:`InverseSolver._one`'s own; this one serves the rest (a start, or the
+    Python reference)."""
     tp, tr = tol
     n = m.dof
     x, y, z = pose[:3].tolist()
     reach = m.reach
     dist = math.sqrt(x * x + y * y + z * z)
     if dist > reach * (1.0 + 1e-12):
-        unit = m.pose_units[0]
-        raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
-                         f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
+        raise _unreachable(m, x, y, z, dist)
     L = float(orientation_scale) if orientation_scale else reach
     nn = min(table, kn) if table else 0
     fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
-    if fast is not None and start is None:
-        # the common call, before any other set-up: no start to check, no self-motion step, pose to
-        # answer in one compiled call (the Python around it is a fifth of a warm call, more when cold)
-        ctx = _fast_context(m, int(table), W)
-        return _fast_result(m, fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"], ctx["mid"],
-                                                 0 if table else 1, nn, int(seed), int(budget), tol, int(iterations),
-                                                 float(damping), float(down), float(up), float(step_cap)), tp, tr)
     c = _arm_constants(m)
     lo, hi = c["lo"], c["hi"]
     blo, bhi, angle = c["blo"], c["bhi"], c["angle"]
@@ -1115,6 +1120,166 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
 
 
+def _inverse_arm(arm) -> SerialMechanism:
+    """``arm`` of :func:`inverse` as a serial mechanism with an analytic frame Jacobian."""
+    m = _mechanism(arm, SerialMechanism, "inverse")
+    if not hasattr(m, "frame_jacobian"):
+        raise FkoptError(f"inverse needs an arm with an analytic frame Jacobian; '{m.name}' has none "
+                         "(use fkopt.solve with an ik_problem)")
+    return m
+
+
+def _tolerance(tol) -> tuple[float, float]:
+    """``tol`` of :func:`inverse` as (position, orientation) positive finite floats."""
+    try:
+        if isinstance(tol, tuple) and len(tol) == 2:      # the common case, without numpy's broadcast
+            tp, tr = float(tol[0]), float(tol[1])
+        else:
+            tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
+    except (TypeError, ValueError):
+        raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
+    if not (tp > 0 and tr > 0 and math.isfinite(tp) and math.isfinite(tr)):
+        raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
+    return tp, tr
+
+
+class InverseSolver:
+    """:func:`inverse` prepared for one arm, one :class:`fkopt.numerics.InverseOptions`, one
+    tolerance and one task mask: for a control loop that asks for one pose per tick.
+
+    ``solver = fkopt.InverseSolver(arm, options, tol=..., mask=...)`` does the per-arm and
+    per-option set-up once -- the options validated, the chain as arrays, the start table
+    (``options.table`` FK evaluations) and its features, the limits in internal units, the
+    compiled kernel's argument list -- and ``solver(target, seed=..., start=...)`` goes from the
+    target straight to the compiled one-pose loop (:func:`fkopt.numerics.compiled.inverse_pose`).
+    Per call it checks only the target (shape, finite, an orthonormal frame, within reach) and
+    ``seed``. Its answers are :func:`inverse`'s bit for bit: ``inverse`` itself runs every one-pose
+    call through a solver like this one (cached per arm, options, tol and mask), and sends
+    batches and the options without a one-pose loop (``rest`` > 0, ``exact_rotation``) to its
+    batched loop, as the solver does.
+
+    ``target``: a tip frame (4, 4) in the base frame (cheapest: no Euler angles), or a pose (6,)
+    as ``arm.fk`` gives it; a batch (..., 4, 4) / (..., 6) goes to :func:`inverse`'s batched loop.
+    ``seed``: the restarts' stream (an int). ``start``: the current joints (deg), as in
+    :func:`inverse` (the given start first, then the self-motion step on a redundant arm).
+
+    The solver reads the arm's limits when it is made; if ``arm.bounds`` changes later it
+    prepares again on the next call (one byte comparison per call keeps that honest)."""
+
+    __slots__ = ("arm", "options", "tol", "mask", "_W", "_bounds", "_fast", "_one_pose", "_budget", "_table",
+                 "_kn", "_L", "_kernel", "_tail", "_reach")
+
+    def __init__(self, arm, options: InverseOptions | None = None, *, tol=INVERSE_TOL, mask=None):
+        self.arm = m = _inverse_arm(arm)
+        if options is None:
+            options = InverseOptions()
+        elif not isinstance(options, InverseOptions):
+            raise FkoptError(f"InverseSolver options: expected fkopt.numerics.InverseOptions, "
+                             f"got {type(options).__name__}")
+        self.options = options.validated()
+        self.tol = _tolerance(tol)
+        self.mask = mask
+        self._W = _task_mask(mask)
+        self._prepare()
+
+    def _prepare(self) -> None:
+        """Everything that depends on the arm's limits and the options, once."""
+        m, o = self.arm, self.options
+        self._bounds = m.bounds.tobytes()
+        self._reach = float(m.reach)
+        self._one_pose = o.rest <= 0 and not o.exact_rotation
+        first = max(1, int(o.starts), o.fill)
+        self._budget = first + max(0, int(o.restarts))
+        self._table = int(o.table)
+        # neighbours per pose: without / with a start (own0 = 1 when a start is given or there is no table)
+        self._kn = (first - (0 if self._table else 1) + int(o.neighbours), first - 1 + int(o.neighbours))
+        self._L = float(o.orientation_scale) if o.orientation_scale else m.reach
+        self._fast = fast = numerics_path.compiled(o.compiled) if hasattr(m, "chain") else None
+        self._kernel = None
+        if fast is not None and self._one_pose:
+            ctx = _fast_context(m, self._table, self._W)
+            nn = min(self._table, self._kn[0]) if self._table else 0
+            tp, tr = self.tol
+            self._kernel = fast._inverse_pose
+            # the arguments after (chain, pose, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed)
+            self._tail = (ctx, float(self._L), ctx["W"], ctx["mid"], 0 if self._table else 1, ctx["tq"], ctx["Ft"],
+                          ctx["norms"], ctx["w"], ctx["fmask"], nn, self._budget, tp, tr, int(o.iterations),
+                          float(o.damping), float(o.down), float(o.up), float(o.step_cap), ctx["slo"], ctx["shi"],
+                          ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
+
+    def __repr__(self) -> str:
+        return f"InverseSolver({self.arm.name!r}, {self.options!r}, tol={self.tol!r}, mask={self.mask!r})"
+
+    def __call__(self, target, *, seed: int = 0, start=None) -> InverseResult:
+        if self.arm.bounds.tobytes() != self._bounds:
+            self._prepare()
+        P0 = _targets(self.arm, target)
+        if P0.ndim == 1 and self._one_pose:
+            return self._one(P0, start, seed)
+        return inverse(self.arm, target, start=start, tol=self.tol, mask=self.mask, seed=seed, options=self.options)
+
+    def _one(self, pose: np.ndarray, start, seed) -> InverseResult:
+        """One checked target row (6,) or (12,): the compiled kernel straight away when there is no
+        start (the common call), else :func:`_inverse_one` with the prepared options."""
+        if type(seed) is not int:
+            try:
+                seed = int(seed)
+            except (TypeError, ValueError):
+                raise FkoptError(f"inverse seed: expected an integer, got {seed!r}") from None
+        if self._kernel is not None and start is None:
+            if not pose.flags.c_contiguous:         # a strided view would compile another specialisation
+                pose = np.ascontiguousarray(pose)
+            x, y, z = pose[0], pose[1], pose[2]
+            dist = math.sqrt(x * x + y * y + z * z)
+            if dist > self._reach * (1.0 + 1e-12):
+                raise _unreachable(self.arm, x, y, z, dist)
+            (ctx, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, budget, tp, tr, it, damping, down, up, cap,
+             slo, shi, lo, hi, angle, periodic, blo, bhi) = self._tail
+            out, info = np.empty(ctx["n"]), np.empty(5)
+            self._kernel(ctx["chain"], pose, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, it,
+                         damping, down, up, cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info)
+            return _fast_result(self.arm, (out, info), tp, tr)
+        o = self.options
+        return _inverse_one(self.arm, pose, start, self.tol, seed, self._budget, self._table,
+                            self._kn[0 if start is None else 1], o.orientation_scale, o.iterations, o.damping, o.down,
+                            o.up, o.step_cap, self._W, o.compiled)
+
+
+def inverse_solver(arm, *, tol=INVERSE_TOL, mask=None, **options) -> InverseSolver:
+    """:class:`InverseSolver` from :func:`inverse`'s keyword options (``restarts=50``, ...)."""
+    try:
+        o = InverseOptions(**options)
+    except TypeError:
+        allowed = ", ".join(InverseOptions.__dataclass_fields__)
+        raise FkoptError(f"inverse_solver: unknown option among {sorted(options)}; allowed: {allowed}") from None
+    return InverseSolver(arm, o, tol=tol, mask=mask)
+
+
+#: Prepared solvers kept per arm by :func:`inverse` (the oldest dropped beyond this many).
+_SOLVERS_PER_ARM = 16
+
+
+def _solver_for(m, options, tol: tuple[float, float], W) -> InverseSolver:
+    """The :class:`InverseSolver` :func:`inverse` runs one pose through, cached on the arm by
+    (options, tol, mask, numerics mode): ``FKOPT_NUMERICS`` may change between calls. ``options``:
+    an :class:`InverseOptions`, or its field values in order as a tuple (inverse's keywords: the
+    options object is made only when the solver is)."""
+    key = (options, tol, None if W is None else W.tobytes(), numerics_path.requested())
+    cache = m.__dict__.get("_inverse_solvers")
+    if cache is None:
+        cache = m.__dict__["_inverse_solvers"] = {}
+    got = cache.get(key)
+    if got is None:
+        if len(cache) >= _SOLVERS_PER_ARM:
+            cache.pop(next(iter(cache)))
+        if not isinstance(options, InverseOptions):
+            options = InverseOptions(*options)
+        got = cache[key] = InverseSolver(m, options, tol=tol, mask=None if W is None else W)
+    elif got._bounds != m.bounds.tobytes():
+        got._prepare()
+    return got
+
+
 def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0, restarts: int = 200,
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
@@ -1158,25 +1323,20 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         iterations, damping, step_cap, down, up = o["iterations"], o["damping"], o["step_cap"], o["down"], o["up"]
         fill, exact_rotation, table, neighbours = o["fill"], o["exact_rotation"], o["table"], o["neighbours"]
         tail, compiled = o["tail"], o["compiled"]
-    m = _mechanism(arm, SerialMechanism, "inverse")
-    if not hasattr(m, "frame_jacobian"):
-        raise FkoptError(f"inverse needs an arm with an analytic frame Jacobian; '{m.name}' has none "
-                         "(use fkopt.solve with an ik_problem)")
-    try:
-        if isinstance(tol, tuple) and len(tol) == 2:      # the common case, without numpy's broadcast
-            tp, tr = float(tol[0]), float(tol[1])
-        else:
-            tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
-    except (TypeError, ValueError):
-        raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
-    if not (tp > 0 and tr > 0 and math.isfinite(tp) and math.isfinite(tr)):
-        raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
+    m = _inverse_arm(arm)
+    tp, tr = _tolerance(tol)
     P0 = _targets(m, poses)
     if P0.ndim == 1 and rest <= 0 and not exact_rotation:
-        return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
-                            int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
-                            + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap,
-                            _task_mask(mask), compiled)
+        # one pose: through the prepared solver (cached per arm, options, tol and mask), the one code path
+        o = options if options is not None else (restarts, starts, rest, orientation_scale, iterations, damping,
+                                                 step_cap, down, up, fill, exact_rotation, table, neighbours, tail,
+                                                 compiled)
+        return _solver_for(m, o, (tp, tr), _task_mask(mask))._one(P0, start, seed)
+    if options is None:                                # the same checks as a one-pose call's solver
+        InverseOptions(restarts, starts, rest, orientation_scale, iterations, damping, step_cap, down, up, fill,
+                       exact_rotation, table, neighbours, tail, compiled).validated()
+    else:
+        options.validated()
     shape = P0.shape[:-1]
     P = P0.reshape(-1, P0.shape[-1])
     N, n = len(P), m.dof
@@ -1185,9 +1345,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     far = dist > reach * (1.0 + 1e-12)
     if far.any():
         k = int(np.flatnonzero(far)[0])
-        unit = m.pose_units[0]
-        raise FkoptError(f"{m.name} target ({P[k, 0]:g}, {P[k, 1]:g}, {P[k, 2]:g}) unreachable "
-                         f"(distance {dist[k]:.1f} {unit} > reach {reach:.1f} {unit})")
+        raise _unreachable(m, P[k, 0], P[k, 1], P[k, 2], dist[k])
     lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     # saturation bounds: none for periodic (continuous) joints, wrapped at the end

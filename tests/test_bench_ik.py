@@ -80,6 +80,9 @@ def test_ik_sections_report_every_arm_ratios_and_verified_counts(ur5, monkeypatc
             assert r["unit"] == "x rtb" and np.isfinite(r["value"]) and r["value"] > 0
             assert f"fkopt {n}/{n}" in r["note"] or f"fkopt {n - 1}/{n}" in r["note"]
         assert (sec, "median over arms") in got and (sec, "largest") in got
+    assert got[("ik-one-pose", "prepared / fkopt.inverse")]["unit"] == "x"
+    assert got[("ik-one-pose", "cold: prepared / fkopt.inverse")]["note"].startswith("ur5, 20 poses")
+    assert "same joints as the solver 20/20" in got[("ik-one-pose", "ur5")]["note"]
     assert "rtb DHRobot FK" in got[("ik-batch", "wang7dof")]["note"]
     assert got[("ik-batch", "ur5")]["note"].endswith("fkopt reported solved but not: 0")
     assert not msgs

@@ -61,28 +61,31 @@ ORGANISER = ("fkopt.inverse", "fkopt.forward")
 class FkoptInverse:
     """The organiser's entry: :func:`fkopt.kinematics.inverse` with its defaults and
     ``tol`` = (1e-9 m, 1e-9 rad), tight enough for every rung of the ladder, given the 4x4 target
-    frame itself (no Euler angles: the conversion cost as much as the compiled solve). The start table
-    (4096 FK evaluations and its k-d tree) is built when the wrapper is made, outside the clock,
-    as the field's packages parse their URDF outside it. No wall-clock limit (it runs to its
-    restart limit); its seed per query comes from the wrapper's generator."""
+    frame itself (no Euler angles: the conversion cost as much as the compiled solve), through a
+    prepared :class:`fkopt.kinematics.InverseSolver` (``inverse``'s answers bit for bit; per query
+    only the target is checked and the compiled loop runs). The solver -- its options checked, the
+    start table (4096 FK evaluations) and the kernel's arguments -- is made when the wrapper is
+    made, outside the clock, as the field's packages parse their URDF outside it. No wall-clock
+    limit (it runs to its restart limit); its seed per query comes from the wrapper's generator."""
 
     name = "fkopt.inverse"
     package = "fkopt"
     TOL = (1e-9, 1e-9)
 
     def __init__(self, arm, *, timeout: float, rng: np.random.Generator):
-        from ..kinematics import inverse
-        self.arm, self.timeout, self.rng, self._inverse = arm, float(timeout), rng, inverse
-        inverse(arm, arm.fk(arm.bounds.mean(axis=1)), tol=self.TOL)          # start table, outside the clock
+        from ..kinematics import InverseSolver
+        self.arm, self.timeout, self.rng = arm, float(timeout), rng
+        self._solve = InverseSolver(arm, tol=self.TOL)
+        self._solve(arm.fk_matrix(arm.bounds.mean(axis=1)))         # compiled code loaded, outside the clock
         self.settings = {"timeout_s": self.timeout, "tol": list(self.TOL), "wall_clock_limit": False,
                          "seed": "per query from the wrapper's generator", "defaults": "fkopt.inverse's"}
 
     def solve1(self, T):
-        r = self._inverse(self.arm, T, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
-        return np.asarray(r.joints, dtype=float), bool(r.solved)
+        r = self._solve(T, seed=int(self.rng.integers(2**31 - 1)))
+        return r.joints, bool(r.solved)
 
     def solve_batch(self, T: np.ndarray) -> np.ndarray:
-        r = self._inverse(self.arm, T, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
+        r = self._solve(T, seed=int(self.rng.integers(2**31 - 1)))
         return np.asarray(r.joints, dtype=float)
 
 

@@ -348,6 +348,11 @@ def _nearest_into(Ft, norms, f, idx, best):
     d2 = np.zeros(N)
     for j in range(c):
         fj = f[j]
+        if fj == 0.0:
+            # a feature the task mask leaves out (or an exact zero): each term would be +-0.0, which
+            # leaves every sum as it is (finite table, and -0.0 + 0.0 only changes a zero's sign,
+            # which |F_i|^2 - 2 d2 does not see), so skipping its pass keeps the bits
+            continue
         for i in range(N):
             d2[i] += Ft[j, i] * fj
     m = 0
@@ -368,7 +373,7 @@ def _nearest_into(Ft, norms, f, idx, best):
         idx[pos] = i
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
@@ -378,7 +383,9 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
-    used, evaluations)."""
+    used, evaluations). Releases the GIL (``nogil``; the same arithmetic), so that a control
+    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.InverseSolver`
+    calls it directly; not measured as a speed-up here: the shared 2-core VM had no idle core)."""
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
     r2d = 180.0 / math.pi

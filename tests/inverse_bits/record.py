@@ -1,0 +1,27 @@
+"""Records tests/inverse_bits/one_pose.json: one-pose ``fkopt.inverse`` answers (joints as the
+hex of their float64 bytes, restarts, evaluations) of the code before ``fkopt.InverseSolver``
+(commit 255c592), for tests/test_inverse_solver.py to hold the solver and ``inverse`` to.
+Run from a checkout of that commit: ``PYTHONPATH=<it> python tests/inverse_bits/record.py OUT``."""
+import json
+import sys
+import tempfile
+
+import numpy as np
+
+import fkopt
+from fkopt.mechanisms.urdf import example_robot, example_robots_folder
+
+sys.path.insert(0, __file__.rsplit("/", 1)[0])
+from cases import arms, calls  # noqa: E402
+
+out = {}
+tmp = tempfile.mkdtemp()
+for name, arm in arms(fkopt, example_robot, example_robots_folder, mjcf_file=f"{tmp}/anchored.xml"):
+    rows = []
+    for target, kw in calls(arm, name):
+        r = fkopt.inverse(arm, target, **kw)
+        rows.append({"joints": np.asarray(r.joints, dtype=float).tobytes().hex(), "restarts": int(r.restarts),
+                     "evaluations": int(r.evaluations["jacobian"]), "solved": bool(r.solved)})
+    out[name] = rows
+with open(sys.argv[1], "w") as f:
+    json.dump(out, f, indent=0)
