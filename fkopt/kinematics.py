@@ -587,17 +587,21 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
     evals = (np.zeros(N, dtype=np.int64), np.zeros(N, dtype=np.int64))
     ftol = 0.01 * tol
     all_rows = np.arange(N)
-    with np.errstate(all="ignore"):
-        got = None
-        if N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any():
-            got = _newton_scalar(m, x0[0], L[0], ftol, evals)
+    scalar = N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any()
+
+    def local(s0, rows):
+        """Newton from starts s0 on rows of L (scalar, one row or a batch), verified."""
+        got = _newton_scalar(m, s0[0], L[rows[0]], ftol, evals) if scalar else None
         if got is not None:
-            x, rx = got
+            xs, rs = got
         elif N == 1:
-            x, rx = _newton1(res, np.array(x0[0], dtype=float), ftol, evals)
+            xs, rs = _newton1(res, np.array(s0[0], dtype=float), ftol, evals)
         else:
-            x, rx = _newton(res, x0, all_rows, ftol, evals)
-        x, resid, solved = _verify(m, L, x, rx, tol)
+            xs, rs = _newton(res, s0, rows, ftol, evals)
+        return _verify(m, L[rows], xs, rs, tol)
+
+    with np.errstate(all="ignore"):
+        x, resid, solved = local(x0, all_rows)
         stage = np.where(solved, 0, -1)
         todo = np.flatnonzero(~solved)
         if len(todo) and table and neighbours:          # the start table's poses nearest in joint space
@@ -605,17 +609,6 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
             k = min(int(neighbours), len(tab["pose"]))     # 0 when no table pose had finite joints
             first = min(max(int(candidates), 1), k)
             near = _nearest(tab, _joint_features(tab, L[todo]), k) if k else np.zeros((len(todo), 0), np.intp)
-            scalar = N == 1 and hasattr(m, "ik_jacobian1") and not res.angle.any()
-
-            def local(s0, rows):
-                got = _newton_scalar(m, s0[0], L[rows[0]], ftol, evals) if scalar else None
-                if got is not None:
-                    xs, rs = got
-                elif N == 1:
-                    xs, rs = _newton1(res, np.array(s0[0], dtype=float), ftol, evals)
-                else:
-                    xs, rs = _newton(res, s0, rows, ftol, evals)
-                return _verify(m, L[rows], xs, rs, tol)
             # the first `candidates` starts all run; a row keeps its likeliest solution among them
             kept = np.full(len(todo), np.inf)             # the kept solution's Jacobian volume
             for j in range(first):

@@ -49,17 +49,10 @@ def test_default_file_is_wang7dof_and_matches_mj_kinematics_and_the_urdf_arm():
     check_against_mujoco(fkopt.mechanism("mjcf", tip="tool_site"), model, None, "tool_site")
 
 
-ANCHORED = """<mujoco><compiler angle="degree"/><worldbody><body name="b0">
-  <body name="l1" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
-    <joint name="j1" type="hinge" axis="0.3 -1 0.2" pos="0.05 0.02 -0.1" ref="20" range="-170 150"/>
-    <joint name="j2" type="slide" axis="1 1 0" range="-0.2 0.3" ref="0.05"/>
-    <body name="l2" pos="0 0 0.4" euler="10 20 30"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
-      <joint name="j3" type="hinge" axis="0 1 0" pos="0 0.1 0"/>
-      <body name="l3" pos="0.2 0 0"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
-        <joint name="j4" type="hinge" axis="1 0 0" range="-90 90"/>
-        <joint name="j5" type="hinge" axis="0 0 1" range="-90 90"/>
-        <site name="tcp" pos="0 0.03 0.1" axisangle="1 1 0 25"/></body></body></body></body></worldbody>
-  <equality><joint joint1="j5" joint2="j4" polycoef="0.1 -0.5 0 0 0"/></equality></mujoco>"""
+# an MJCF arm with a slide joint, a hinge anchored off its body and a joint equality (one copy,
+# shared with the recorded one-pose answers of tests/inverse_bits)
+from inverse_bits.cases import ANCHORED_MJCF as ANCHORED  # noqa: E402
+
 
 
 def test_anchors_references_slides_and_joint_equalities_match_mj_kinematics(tmp_path):
