@@ -68,6 +68,8 @@ def test_mechanism_docs_do_not_contradict_the_robots_page():
 
 
 def test_readme_quotes_the_stored_v3_robot_board():
-    from fkopt.kinbench.advice import robots_markdown, robots_summary
-    table = robots_markdown(robots_summary(ROOT / "results" / "kinbench" / "kinbench-v3-robots"))
-    assert table in (ROOT / "README.md").read_text(encoding="utf-8")
+    from fkopt.kinbench.advice import fk_sentence, robots_markdown, robots_summary
+    folder = ROOT / "results" / "kinbench" / "kinbench-v3-robots"
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert robots_markdown(robots_summary(folder)) in readme
+    assert fk_sentence(folder) in readme.splitlines()

@@ -74,3 +74,19 @@ def robots_markdown(table: pd.DataFrame, timeout_ms: float = 20.0) -> str:
         lines.append(f"| {r['solver']} | {r['entry']} | {r['arms']} | {pct} | {r['worst_arm']:.0f} | "
                      f"{r['median_ms']:.3g} | {r['median_ratio']:.3g} |")
     return "\n".join(lines)
+
+
+def fk_sentence(folder: str | Path, timeout_ms: float = 500.0) -> str:
+    """The FK rows of a stored per-robot board at ``timeout_ms`` as README's one sentence: per
+    parallel mechanism, each solver's success at the generating pose (the board's rung) and, in
+    brackets, the share solved in another assembly mode; best first."""
+    board = pd.read_csv(Path(folder) / "leaderboard-robots.csv")
+    board = board[board["other_mode"].notna() & np.isclose(board["timeout_ms"], timeout_ms)]
+    parts = []
+    for robot, rows in board.groupby("robot", sort=False):
+        rung = f"success_{rows['rung'].iloc[0]}"
+        rows = rows.sort_values(rung, ascending=False, kind="stable")
+        cells = [f"`{r['solver']}` {100 * r[rung]:.0f} % (+{100 * r['other_mode']:.0f} % another mode)"
+                 for _, r in rows.iterrows()]
+        parts.append(f"FK of {robot} at {timeout_ms:g} ms, at the generating pose: " + ", ".join(cells))
+    return "; ".join(parts) + "."
