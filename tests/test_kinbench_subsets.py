@@ -14,18 +14,19 @@ from fkopt.kinbench.config import load_suite
 
 from test_kinbench import SUITES, tiny
 
-SWARMS = {"name": "swarms", "solvers": ["pso"], "problems": ["mao2017-3rps"], "sets": ["uniform", "boundary"],
+SOLVERS = [{"name": "lm"}, {"name": "pso"}, {"name": "gabc"}]
+SWARMS = {"name": "swarms", "solvers": ["pso", "gabc"], "problems": ["mao2017-3rps"], "sets": ["uniform", "boundary"],
           "poses": 1, "runs": 1}
 
 
 def subset_suite(tmp_path, **over):
-    """lm on every cell (2 problems x 4 sets x 2 poses x 2 runs), pso on a subset of them."""
-    return tiny(tmp_path, solvers=[{"name": "lm"}, {"name": "pso"}], subsets=[SWARMS], **over)
+    """lm on every cell (2 problems x 4 sets x 2 poses x 2 runs), pso and gabc on a subset of them."""
+    return tiny(tmp_path, solvers=SOLVERS, subsets=[SWARMS], budget_per_dim=300, **over)
 
 
 # -- config -------------------------------------------------------------------------------------
 @pytest.mark.parametrize("subset, fragment", [
-    ({**SWARMS, "solvers": ["nope"]}, "subsets[0].solvers: 'nope' is not one of the suite's solvers (allowed: lm, pso)"),
+    ({**SWARMS, "solvers": ["nope"]}, "subsets[0].solvers: 'nope' is not one of the suite's solvers (allowed: lm, pso, gabc)"),
     ({**SWARMS, "problems": ["ur5"]}, "subsets[0].problems: 'ur5' is not one of the suite's problems (allowed: "
                                       "mao2017-3rps, wu2015-3ppr)"),
     ({**SWARMS, "poses": 3}, "subsets[0].poses: 3 (allowed: 1 to the suite's poses, 2)"),
@@ -35,7 +36,7 @@ def subset_suite(tmp_path, **over):
     ({**SWARMS, "budget_per_dim": 10}, "budget_per_dim"),
 ])
 def test_a_bad_subset_is_one_line_naming_the_file_the_field_and_what_is_allowed(tmp_path, subset, fragment):
-    path = tiny(tmp_path, solvers=[{"name": "lm"}, {"name": "pso"}], subsets=[subset])
+    path = tiny(tmp_path, solvers=SOLVERS, subsets=[subset])
     with pytest.raises(FkoptError) as err:
         load_any(path)
     text = str(err.value)
@@ -45,9 +46,9 @@ def test_a_bad_subset_is_one_line_naming_the_file_the_field_and_what_is_allowed(
 def test_a_solver_in_two_subsets_and_a_set_the_suite_does_not_run_are_refused(tmp_path):
     two = json.loads(json.dumps([SWARMS, {**SWARMS, "name": "again"}]))     # no YAML aliases
     with pytest.raises(FkoptError, match=r"subsets\[1\]\.solvers: 'pso' is already in subset 'swarms'"):
-        load_any(tiny(tmp_path, solvers=[{"name": "lm"}, {"name": "pso"}], subsets=two))
+        load_any(tiny(tmp_path, solvers=SOLVERS, subsets=two))
     with pytest.raises(FkoptError, match=r"subsets\[0\]\.sets: 'printed' is not one of the suite's sets"):
-        load_any(tiny(tmp_path / "b", solvers=[{"name": "lm"}, {"name": "pso"}], sets=["uniform", "boundary"],
+        load_any(tiny(tmp_path / "b", solvers=SOLVERS, sets=["uniform", "boundary"],
                       subsets=[{**SWARMS, "sets": ["printed"]}]))
 
 
@@ -113,7 +114,7 @@ def test_a_subset_suite_writes_one_board_per_subset(written):
     lb = pd.read_csv(folder / "leaderboard.csv")
     assert set(lb.loc[lb.scope == "board:full/overall", "solver"]) == {"lm"}
     sub = lb[lb.scope == "board:swarms/overall"].set_index("solver")
-    assert set(sub.index) == {"lm", "pso"} and (sub["instances"] == 2).all()    # the 2 cells pso ran
+    assert set(sub.index) == {"lm", "pso", "gabc"} and (sub["instances"] == 2).all()    # the 2 cells pso ran
     ms = pd.read_csv(folder / "measures.csv")
     assert set(ms.loc[(ms.board == "swarms"), "trials"]) == {1}                 # lm: run 0 of those cells only
     ecdf = pd.read_csv(folder / "ecdf.csv")
@@ -122,7 +123,8 @@ def test_a_subset_suite_writes_one_board_per_subset(written):
     assert set(er.board) == {"full", "swarms"} and (er.loc[er.board == "full", "solver"] == "lm").all()
     assert (folder / "ecdf_swarms_all.png").exists() and (folder / "ecdf_full_all.png").exists()
     md = (folder / "leaderboard.md").read_text()
-    assert "### board:swarms/track:black-box" in md and "ERT ratio to the virtual best solver" in md
+    assert "### board:swarms/track:black-box" in md and "### board:swarms/class:parallel-fk-3dof/track:black-box" \
+        in md.split("## ERT ratio to the virtual best solver")[1]      # pso beside gabc; lm alone in its track: none
     assert "Boards: each compares only the solvers that ran every cell" in md
     assert json.loads((folder / "meta.json").read_text())["config"]["subsets"][0]["name"] == "swarms"
 
@@ -158,7 +160,7 @@ def test_an_interrupted_subset_suite_resumes_with_the_same_bytes(written, tmp_pa
     seen = []
     folder = run_config(load_any(path), out, source=str(path), resume=True,
                         progress=lambda label, done, total: seen.append((done, total))).folder
-    assert seen == [(1, 3), (2, 3), (3, 3)]   # lm on two problems, pso on one: the kept task, then two solved
+    assert seen == [(1, 4), (2, 4), (3, 4), (4, 4)]   # lm on two problems, pso and gabc on one: one kept
     for name in ("runs.csv", "measures.csv", "ecdf.csv", "leaderboard.csv", "ert_ratio.csv", "trace.csv.gz"):
         assert (folder / name).read_bytes() == (whole / name).read_bytes(), name
 
@@ -168,7 +170,7 @@ def test_a_subset_solver_gets_the_numbers_it_gets_on_the_whole_suite(written, tm
     on every cell (seeds per case and run, not per task)."""
     from fkopt.kinbench.runner import run_suite
     cut = written[3].runs
-    every = run_suite(load_any(tiny(tmp_path, solvers=[{"name": "pso"}]))).runs
+    every = run_suite(load_any(tiny(tmp_path, solvers=[{"name": "pso"}], budget_per_dim=300))).runs
     key = ["problem", "set", "pose", "run"]
     a = cut[cut.solver == "pso"].reset_index(drop=True)
     b = every.merge(a[key], on=key).reset_index(drop=True)

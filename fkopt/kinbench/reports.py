@@ -412,7 +412,7 @@ def ert_ratio_sections(tables: dict) -> list[tuple[str, pd.DataFrame]]:
     out = []
     for (board, cls, track), g in er.groupby(["board", "class", "track"], sort=False):
         summary = M.ert_ratio_summary(g)
-        if summary.empty:
+        if summary.empty or g["solver"].nunique() < 2:     # a track of one solver is its own best
             continue
         wide = summary.pivot_table(index="solver", columns="target", values="median_ert_ratio", sort=False)
         wide = wide[sorted(wide.columns, reverse=True)]
