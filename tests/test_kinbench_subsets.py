@@ -126,6 +126,8 @@ def test_a_subset_suite_writes_one_board_per_subset(written):
     assert "### board:swarms/track:black-box" in md and "### board:swarms/class:parallel-fk-3dof/track:black-box" \
         in md.split("## ERT ratio to the virtual best solver")[1]      # pso beside gabc; lm alone in its track: none
     assert "Boards: each compares only the solvers that ran every cell" in md
+    page = (folder / "index.html").read_text()
+    assert "board:swarms/overall" in page and "Boards: each compares" in page and "data:image/png;base64," in page
     assert json.loads((folder / "meta.json").read_text())["config"]["subsets"][0]["name"] == "swarms"
 
 
