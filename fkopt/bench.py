@@ -27,13 +27,11 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    1000 reachable poses batched and one at a time, beside roboticstoolbox-python's ``ik_LM``
    (run in the Python named by ``FKOPT_RTB_PYTHON``, or /work/venv-rtb, when installed); the
    whole ``fkopt fk`` process beside ``python -c "import numpy"``.
-4c. ``robots`` -- ``fkopt.inverse`` on the Panda, UR5 and Kinova of example-robot-data and the
-   wang7dof arm beside roboticstoolbox's ETS ``ik_LM`` on the same poses, timed alternately
-   (:mod:`fkopt.bench_robots`).
-4e. ``ik-one-pose`` and ``ik-batch`` -- ``fkopt.inverse`` on 14 arms of example-robot-data beside
-   roboticstoolbox's ETS ``ik_LM`` at 1e-6 m and 1e-6 rad, one pose per call alternating query by
-   query, and 1000 poses in one fkopt call beside rtb per pose; every answer verified by
-   pinocchio's FK; ratios per arm and their median (:mod:`fkopt.bench_ik`).
+4c. ``ik-one-pose`` and ``ik-batch`` -- ``fkopt.inverse`` on 14 arms of example-robot-data and the
+   wang7dof DH arm beside roboticstoolbox's ETS ``ik_LM`` at 1e-6 m and 1e-6 rad, one pose per
+   call alternating query by query, and 1000 poses in one fkopt call beside rtb per pose; every
+   answer verified by an independent FK (pinocchio's; rtb's DHRobot for the DH arm); ratios per
+   arm and their median (:mod:`fkopt.bench_ik`).
 4d. ``cases`` -- N cases x 30 runs solved together (N = 1, 10, 100; GABC, 3-RPS, population 10,
    600 iterations): wall time and ns per evaluation, beside the same GABC as a plain C loop
    (``fkopt/bench_ref/gabc_3rps.c``, compiled with the system's C compiler into a temporary
@@ -964,7 +962,7 @@ def _fmt(v: float) -> str:
     return f"{v:.4g}"
 
 
-SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "robots", "ik-one-pose", "ik-batch",
+SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "ik-one-pose", "ik-batch",
             "cases", "swarms", "scaling")
 
 
@@ -1010,9 +1008,6 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     if "kinematics" in want:
         timed("kinematics", bench_kinematics, rows, quick, np.random.default_rng(12), messages)
         timed("kinematics", bench_cli_process, rows, quick)
-    if "robots" in want:
-        from .bench_robots import bench_robots
-        timed("robots", bench_robots, rows, quick, messages)
     if "ik-one-pose" in want:
         from .bench_ik import bench_ik_one_pose
         timed("ik-one-pose", bench_ik_one_pose, rows, quick, messages)

@@ -1,25 +1,31 @@
 """``fkopt bench --section ik-one-pose`` and ``--section ik-batch``: ``fkopt.inverse`` on real arms
-beside roboticstoolbox's ETS ``ik_LM`` (C++), the answers of both verified by pinocchio's FK.
+beside roboticstoolbox's ETS ``ik_LM`` (C++), the answers of both verified by an FK independent of
+fkopt's: pinocchio's for the URDF arms, roboticstoolbox's ``DHRobot`` for the DH arm.
 
-Arms (:data:`ARMS`, chains of :data:`fkopt.mechanisms.urdf.EXAMPLE_ROBOTS` in example-robot-data):
-Panda, UR3, UR5, UR10, Kinova j2s6s200, xArm7, Unitree Z1, Baxter's two arms, PR2's left arm,
-Romeo's left arm, TIAGo's arm, Talos's left arm, Unitree G1's left arm (6 and 7 joints). An arm
-whose rtb ETS disagrees with fkopt's FK when read (iCub's arm: rtb misreads its URDF) or that
-pinocchio reads differently is left out with a message.
+Arms (:data:`ARMS`): chains of :data:`fkopt.mechanisms.urdf.EXAMPLE_ROBOTS` in example-robot-data
+(Panda, UR3, UR5, UR10, Kinova j2s6s200, xArm7, Unitree Z1, Baxter's two arms, PR2's left arm,
+Romeo's left arm, TIAGo's arm, Talos's left arm, Unitree G1's left arm; 6 and 7 joints) and the
+wang7dof arm (:data:`DH_ARM`): fkopt's DH model ``7dof-arm`` in mm, checked by rtb's ``DHRobot`` of
+the paper's DH table (:data:`fkopt.mechanisms.dh_arm.WANG7DOF`, standard DH, in m), rtb's ETS read
+from ``mechanisms/data/wang7dof.urdf`` (its q1 is continuous there: answers wrapped into
+[-180, 180) deg before the limits are checked). An arm whose rtb ETS disagrees with the check's FK
+when read (iCub's arm: rtb misreads its URDF) or whose check disagrees with fkopt's FK is left out
+with a message.
 
 Per arm ``n`` poses: joints uniform inside the limits (generator seeded per arm), target frame =
-pinocchio's FK of those joints (not fkopt's, not rtb's). Tolerance 1e-6 m and 1e-6 rad for both:
-fkopt gets ``tol=(1e-6, 1e-6)``; rtb stops at E = 1/2 |e|^2 < tol (e = position error, rotation
-vector) and gets tol = 1/2 (1e-6)^2, which implies both (and is no looser). rtb: ``ilimit=30``,
-``slimit=100`` (its defaults), ``joint_limits=True``, first start q0 uniform in the limits from a
-seeded generator. An answer counts as solved only when pinocchio's FK of it (continuous joints
-wrapped) is within both tolerances of the target and it is inside the limits; neither library's own
-verdict is counted.
+the independent FK of those joints (not fkopt's, not rtb's ETS). Tolerance 1e-6 m and 1e-6 rad for
+both: fkopt gets ``tol=(1e-6, 1e-6)`` in the arm's length unit (1e-3 mm for the DH arm); rtb stops
+at E = 1/2 |e|^2 < tol (e = position error, rotation vector) and gets tol = 1/2 (1e-6)^2, which
+implies both (and is no looser). rtb: ``ilimit=30``, ``slimit=100`` (its defaults),
+``joint_limits=True``, first start q0 uniform in the limits from a seeded generator. An answer
+counts as solved only when the independent FK of it (continuous joints wrapped) is within both
+tolerances of the target and it is inside the limits; neither library's own verdict is counted
+(``ik-batch`` also reports how many of fkopt's answers it called solved but were not).
 
 * ``ik-one-pose``: one pose per call, fkopt (``fkopt.inverse(arm, pose)``, the compiled one-pose
   loop unless ``FKOPT_NUMERICS=numpy``) and rtb alternating query by query in this process (which
   of the two goes first alternates too), after one warm-up call each (numba's cache load and the
-  arm's start table happen there, reported on the row "first call"). Per arm: median ms of each,
+  arm's start table happen there, reported as "first call"). Per arm: median ms of each,
   the ratio of the medians fkopt/rtb, solved fraction of each; then the median ratio over arms and
   the largest (targets <= 1 and <= 2, issue 29).
 * ``ik-batch``: all ``n`` poses (1000; 200 in quick mode) in one ``fkopt.inverse`` call beside rtb
@@ -27,7 +33,8 @@ verdict is counted.
   arm µs per pose of each and their ratio; median over arms (target <= 0.5, none above 1).
 
 Timings are wall-clock on whatever else the machine is doing: read the ratios, not the times.
-Skipped with a message when roboticstoolbox-python, pinocchio or example-robot-data is missing.
+Skipped with a message when roboticstoolbox-python or pinocchio is missing; without
+example-robot-data only the DH arm is measured.
 """
 from __future__ import annotations
 
@@ -38,9 +45,11 @@ import warnings
 import numpy as np
 
 ARMS = ("panda", "ur3", "ur5", "ur10", "kinova", "xarm7", "z1", "baxter-left", "baxter-right", "pr2-left",
-        "romeo-left", "tiago", "talos-left", "g1-left", "icub-left")
+        "romeo-left", "tiago", "talos-left", "g1-left", "icub-left", "wang7dof")
 #: Quick mode: a subset (6 and 7 joints, the slowest arms of the last measurement included).
-QUICK_ARMS = ("panda", "ur5", "ur10", "kinova", "xarm7", "romeo-left")
+QUICK_ARMS = ("panda", "ur5", "ur10", "kinova", "xarm7", "romeo-left", "wang7dof")
+#: The DH arm: fkopt's ``7dof-arm`` (mm), checked by rtb's DHRobot of the paper's table.
+DH_ARM = "wang7dof"
 TOL = (1e-6, 1e-6)                # m, rad
 RTB_TOL = 0.5 * TOL[0] ** 2       # E = 1/2 |e|^2 < tol  =>  |e| < 1e-6, both errors below their tolerances
 
@@ -49,6 +58,8 @@ class PinocchioFK:
     """Frame of the tip in the base of an arm's URDF chain by pinocchio's own reader and FK
     (Carpentier et al., SII 2019): the independent check of every answer here. Continuous joints
     are pinocchio's (cos, sin) pairs; joints outside the chain stay at pinocchio's neutral."""
+
+    name = "pinocchio FK"
 
     def __init__(self, arm):
         import pinocchio as pin
@@ -73,6 +84,24 @@ class PinocchioFK:
         return (self.data.oMf[self.base].inverse() * self.data.oMf[self.tip]).homogeneous
 
 
+class DHRobotFK:
+    """Frame of the tip of wang7dof's arm by roboticstoolbox's ``DHRobot`` (Corke and Haviland,
+    ICRA 2021) of the paper's standard DH table (:data:`fkopt.mechanisms.dh_arm.WANG7DOF`, lengths
+    in m): the independent check of fkopt's DH model (its own DH code, in mm)."""
+
+    name = "rtb DHRobot FK"
+
+    def __init__(self):
+        import roboticstoolbox as rtb
+        from .mechanisms.dh_arm import WANG7DOF
+        self.robot = rtb.DHRobot([rtb.RevoluteDH(a=a / 1000, alpha=math.radians(al), d=d / 1000)
+                                  for a, al, d in zip(WANG7DOF["a"], WANG7DOF["alpha"], WANG7DOF["d"])])
+
+    def frame(self, q_rad) -> np.ndarray:
+        """4x4 tip-in-base frame at joints ``q_rad`` (n,), SI units."""
+        return self.robot.fkine(np.asarray(q_rad, dtype=float)).A
+
+
 def frame_errors(T, Tt) -> tuple[float, float]:
     """(position error, geodesic rotation error in rad) of frame T against target Tt (4x4):
     the angle from atan2(|vee(M - M^T)| / 2, (tr M - 1) / 2), M = R^T Rt, accurate near 0."""
@@ -83,22 +112,40 @@ def frame_errors(T, Tt) -> tuple[float, float]:
 
 
 class _Arm:
-    """One arm of the bench: fkopt's model, rtb's ETS, pinocchio's check, poses and targets."""
+    """One arm of the bench: fkopt's model, rtb's ETS, the independent check, poses and targets.
+    ``scale``: the arm's length unit per m (1000 for the DH arm in mm); ``tol``: :data:`TOL` in it."""
 
     def __init__(self, name, n, seed):
         from .adapters.field.rtb import chain_ets
         from .mechanisms import urdf
         self.name = name
-        self.m = m = urdf.example_robot(name)
-        self.pfk = PinocchioFK(m)
-        self.ets, self.rtb_version = chain_ets(m.path, m.base_link, m.tip_link)
+        if name == DH_ARM:
+            from . import mechanism
+            self.m = m = mechanism("7dof-arm")
+            self.check = DHRobotFK()
+            path, base, tip = urdf.DEFAULT_FILE, "link0", "tool"
+            self.scale = 1000.0
+            self.periodic = mechanism("urdf").periodic_mask()      # the URDF's q1 is continuous
+        else:
+            self.m = m = urdf.example_robot(name)
+            self.check = PinocchioFK(m)
+            path, base, tip = m.path, m.base_link, m.tip_link
+            self.scale = 1.0
+            self.periodic = m.periodic_mask()
+        self.tol = (TOL[0] * self.scale, TOL[1])
+        self.ets, self.rtb_version = chain_ets(path, base, tip)
         rng = np.random.default_rng(seed)
         self.Q = m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
-        self.T = np.array([self.pfk.frame(np.radians(q)) for q in self.Q])
+        self.T = np.array([self.check.frame(np.radians(q)) for q in self.Q])
         self.P = m.fk(self.Q)                                  # the same targets as fkopt's poses
         lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
         self.q0 = lo + rng.random((n, m.dof)) * (hi - lo)     # rtb's first start per pose
-        self.periodic = m.periodic_mask()
+
+    def fkopt_frame(self, q_deg) -> np.ndarray:
+        """fkopt's FK of joints (n, dof) in deg, lengths in m."""
+        T = self.m.fk_matrix(q_deg)
+        T[..., :3, 3] /= self.scale
+        return T
 
     def problem(self) -> str | None:
         """Why this arm cannot be compared (readers disagree), or None."""
@@ -106,12 +153,14 @@ class _Arm:
         if self.ets.n != m.dof:
             return f"{self.name}: rtb's chain has {self.ets.n} joints, fkopt's {m.dof}"
         q = np.radians(self.Q[0])
-        gap_rtb = np.abs(self.ets.fkine(q).A - m.fk_matrix(self.Q[:1])[0]).max()
-        gap_pin = np.abs(self.T[0] - m.fk_matrix(self.Q[:1])[0]).max()
-        if not gap_pin < 1e-9:
-            return f"{self.name}: pinocchio's FK differs from fkopt's by {gap_pin:.2g} m"
+        mine = self.fkopt_frame(self.Q[:1])[0]
+        gap_rtb = np.abs(self.ets.fkine(q).A - self.T[0]).max()
+        gap_check = np.abs(self.T[0] - mine).max()
+        if not gap_check < 1e-9:
+            return f"{self.name}: {self.check.name} differs from fkopt's by {gap_check:.2g} m"
         if not gap_rtb < 1e-9:
-            return f"{self.name}: rtb's ETS FK differs from pinocchio's and fkopt's by {gap_rtb:.2g} (rtb misreads it)"
+            return (f"{self.name}: rtb's ETS FK differs from {self.check.name} and fkopt's by {gap_rtb:.2g} "
+                    "(rtb misreads it)")
         return None
 
     def rtb(self, k):
@@ -119,7 +168,7 @@ class _Arm:
         return np.degrees(sol.q if hasattr(sol, "q") else sol[0])
 
     def verified(self, q_deg, k) -> bool:
-        """pinocchio's check of one answer (deg) to pose k: both tolerances, inside the limits."""
+        """The independent check of one answer (deg) to pose k: both tolerances, inside the limits."""
         q = np.array(q_deg, dtype=float)
         if not np.isfinite(q).all():
             return False
@@ -127,7 +176,7 @@ class _Arm:
         b = self.m.bounds
         if not ((q >= b[:, 0]) & (q <= b[:, 1])).all():
             return False
-        pe, re = frame_errors(self.pfk.frame(np.radians(q)), self.T[k])
+        pe, re = frame_errors(self.check.frame(np.radians(q)), self.T[k])
         return pe <= TOL[0] and re <= TOL[1]
 
 
@@ -142,8 +191,9 @@ def _arms(names, n, messages):
         return []
     from .mechanisms import urdf
     if urdf.example_robots_folder() is None:
-        messages.append("ik sections skipped: example-robot-data not installed (pip install example-robot-data)")
-        return []
+        messages.append("ik sections: example-robot-data not installed (pip install example-robot-data): "
+                        f"the {DH_ARM} arm only")
+        names = [k for k in names if k == DH_ARM]
     out = []
     for i, name in enumerate(names):
         with warnings.catch_warnings():
@@ -180,7 +230,7 @@ def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
     ratios = {}
     for a in arms:
         t = time.perf_counter()
-        kinematics.inverse(a.m, a.P[0], tol=TOL)
+        kinematics.inverse(a.m, a.P[0], tol=a.tol)
         t_first = time.perf_counter() - t
         a.rtb(0)
         tf, tr, okf, okr = [], [], 0, 0
@@ -188,7 +238,7 @@ def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
             for who in ((0, 1) if k % 2 == 0 else (1, 0)):
                 if who == 0:
                     t = time.perf_counter()
-                    res = kinematics.inverse(a.m, a.P[k], tol=TOL)
+                    res = kinematics.inverse(a.m, a.P[k], tol=a.tol)
                     tf.append(time.perf_counter() - t)
                     okf += a.verified(res.joints, k)
                 else:
@@ -200,7 +250,7 @@ def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
         ratios[a.name] = f_ms / r_ms
         rows.add(sec, a.name, f_ms / r_ms, "x rtb",
                  f"{a.m.dof} joints; fkopt median {f_ms:.3f} ms (mean {np.mean(tf) * 1e3:.3f}), rtb median "
-                 f"{r_ms:.3f} ms (mean {np.mean(tr) * 1e3:.3f}); solved (pinocchio FK, 1e-6 m, 1e-6 rad, limits) "
+                 f"{r_ms:.3f} ms (mean {np.mean(tr) * 1e3:.3f}); solved ({a.check.name}, 1e-6 m, 1e-6 rad, limits) "
                  f"fkopt {okf}/{n}, rtb {okr}/{n}; first call {t_first * 1e3:.0f} ms")
     _summary(rows, sec, ratios, 1, 2, f"ratio of median times per pose, {n} poses per arm, "
              f"fkopt path {'compiled' if fast is not None else 'numpy'}, rtb {arms[0].rtb_version}")
@@ -216,20 +266,23 @@ def bench_ik_batch(rows, quick: bool, messages: list[str]) -> None:
         return
     ratios = {}
     for a in arms:
-        kinematics.inverse(a.m, a.P[:64], tol=TOL)                # warm: start table, tree, compile
+        kinematics.inverse(a.m, a.P[:64], tol=a.tol)              # warm: start table, tree, compile
         best_f = best_r = np.inf
         for _ in range(reps):
             t = time.perf_counter()
-            res = kinematics.inverse(a.m, a.P, tol=TOL)
+            res = kinematics.inverse(a.m, a.P, tol=a.tol)
             best_f = min(best_f, time.perf_counter() - t)
             t = time.perf_counter()
             qr = [a.rtb(k) for k in range(n)]
             best_r = min(best_r, time.perf_counter() - t)
-        okf = sum(a.verified(res.joints[k], k) for k in range(n))
+        okf_rows = np.array([a.verified(res.joints[k], k) for k in range(n)])
+        okf = int(okf_rows.sum())
+        lie = int((np.asarray(res.solved, bool) & ~okf_rows).sum())
         okr = sum(a.verified(qr[k], k) for k in range(n))
         f_us, r_us = best_f / n * 1e6, best_r / n * 1e6
         ratios[a.name] = f_us / r_us
         rows.add(sec, a.name, f_us / r_us, "x rtb",
                  f"{a.m.dof} joints; fkopt {f_us:.0f} µs/pose in one call of {n}, rtb {r_us:.0f} µs/pose "
-                 f"(one call per pose); best of {reps}; solved (pinocchio FK) fkopt {okf}/{n}, rtb {okr}/{n}")
+                 f"(one call per pose); best of {reps}; solved ({a.check.name}) fkopt {okf}/{n}, rtb {okr}/{n}; "
+                 f"fkopt reported solved but not: {lie}")
     _summary(rows, sec, ratios, 0.5, 1, f"µs per pose, fkopt batched ({n} poses) / rtb per pose")

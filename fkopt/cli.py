@@ -659,13 +659,13 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
 
 @app.command()
 def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (~20 s on an idle 2-core machine, "
-                                     "20.5 s measured; 27-29 s under load; the first run after installing "
+                                     "22.6 s measured at load average 1.8; 27-29 s under heavier load; the first run after installing "
                                      "also compiles the numerics, ~25 s more)"),
           peers: bool = typer.Option(False, "--peers", help="also time NiaPy/MEALPY/... if installed"),
           out: Path = typer.Option(Path("fkopt-bench"), "--out", help="folder for bench.csv and scaling.png "
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
-                                            "throughput, mao2017, peers, adapters, exact, kinematics, robots, "
+                                            "throughput, mao2017, peers, adapters, exact, kinematics, "
                                             "ik-one-pose, ik-batch, cases, swarms, scaling (default: all but peers "
                                             "and adapters)")):
     """Measure fkopt's speed (and peers') on this machine.
@@ -675,10 +675,9 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     (scipy's, pymoo's and NiaPy's DE through fkopt's adapters beside gabc, abc and the plug-in DE
     on kinbench's problems; with --peers or named), exact (batched
     lm), kinematics (fkopt.forward, fkopt.inverse, all assembly modes, the fk process),
-    robots (fkopt.inverse on URDF arms from example-robot-data beside roboticstoolbox's ETS
-    ik_LM, if installed), ik-one-pose and ik-batch (fkopt.inverse on 14 example-robot-data arms beside
-    rtb's ik_LM at 1e-6 m / 1e-6 rad, one pose per call and 1000 poses in one call, answers checked
-    by pinocchio's FK), cases (N cases x 30 runs solved together, beside a compiled C loop when a C
+    ik-one-pose and ik-batch (fkopt.inverse on 14 example-robot-data arms and the wang7dof DH arm
+    beside rtb's ik_LM at 1e-6 m / 1e-6 rad, one pose per call and 1000 poses in one call, answers
+    checked by pinocchio's FK, the DH arm's by rtb's DHRobot), cases (N cases x 30 runs solved together, beside a compiled C loop when a C
     compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop; pygmo's
     bee_colony with a numba fitness beside the batched ABC), scaling (population and runs; draws
     scaling.png). The last line gives the seconds per section."""
@@ -761,7 +760,8 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
                 bar.remove_task(current.pop("solving"))
         done = run_all(planned, out, started=started, finished=finished,
                        jobs=default_jobs() if jobs is None else jobs, solving=solving)
-    paths = write_report(out, changes_since=before)
+    written = write_report(out, changes_since=before)     # its snapshot of the tree serves the last line too
+    paths = written.paths
     total = time.perf_counter() - start
     if not quiet:
         table = Table(title=f"reproduced {len(done)} experiments in {total:.1f} s")
@@ -771,7 +771,7 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
             table.add_row(str(d.path), str(d.folder), str(d.files), f"{d.wall_s:.1f}")
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
-    con.print(agreement(before, out), highlight=False, markup=False)   # even with -q: what a newcomer must know
+    con.print(agreement(before, out, written.after), highlight=False, markup=False)   # even with -q: what a newcomer must know
     kept.cleanup()
 
 
@@ -802,7 +802,7 @@ def report(results: Path = typer.Argument(Path("results"), help="results root"),
         typer.echo(str(snapshot_to))
         return
     before = load_snapshot(changes_since) if changes_since is not None else None
-    for p in write_report(results, changes_since=before):
+    for p in write_report(results, changes_since=before).paths:
         typer.echo(str(p))
 
 

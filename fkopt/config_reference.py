@@ -259,8 +259,9 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "set": ("The pose set whose frozen poses are the queries.", "", "uniform"),
         "queries": ("Queries per arm: the set's first N poses (the suite's `poses` does not cut them); "
                     "default all.", "poses", 20),
-        "submissions": ("Solvers run elsewhere: per query their joints and wall time beside the reference's, "
-                        "verified by fkopt's FK (fkopt.kinbench.submissions).", "",
+        "submissions": ("Solvers run elsewhere: per query their joints (IK) or pose (FK) and wall time beside the "
+                        "reference's, verified by kinbench: fkopt's FK for IK, the mechanism's own inverse map "
+                        "for FK (fkopt.kinbench.submissions).", "",
                         [{"solver": "my-ik", "file": "my-ik.csv", "machine": "i7-1185G7, 1 thread"}]),
         "fk_solvers": ("Solvers of FK on the track's 6-DOF parallel mechanisms.", "", ["fkopt.forward"]),
         "fk_reference": ("The reference of FK: scipy least_squares from random starts.", "", "scipy-least_squares"),

@@ -1,5 +1,5 @@
-"""fkopt.bench_ik: the IK sections' independent check (pinocchio's FK) and their rows, on the UR5
-of example-robot-data (no timing is asserted)."""
+"""fkopt.bench_ik: the IK sections' independent check (pinocchio's FK; rtb's DHRobot for the DH
+arm) and their rows, on the UR5 of example-robot-data and the wang7dof arm (no timing is asserted)."""
 import numpy as np
 import pytest
 
@@ -29,6 +29,32 @@ def test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones(ur5):
     assert not ur5.verified(q, 0)
 
 
+@pytest.fixture(scope="module")
+def wang7dof():
+    pytest.importorskip("pinocchio")
+    pytest.importorskip("roboticstoolbox")
+    from fkopt.bench_ik import _Arm
+    return _Arm("wang7dof", 4, 7)
+
+
+def test_the_dh_arm_is_checked_by_rtbs_dhrobot_in_metres_and_rejects_wrong_or_out_of_limit_joints(wang7dof):
+    a = wang7dof
+    assert a.problem() is None and a.check.name == "rtb DHRobot FK" and a.tol == (1e-3, 1e-6)   # mm
+    T = a.m.fk_matrix(a.Q)
+    assert np.abs(T[:, :3, 3] / 1000 - a.T[:, :3, 3]).max() < 1e-12      # fkopt's mm, rtb's m
+    for k in range(4):
+        assert a.verified(a.Q[k], k)
+        off = a.Q[k].copy()
+        off[3] += 1e-3
+        assert not a.verified(off, k)
+    q = a.Q[0].copy()
+    q[0] += 360.0                                        # continuous q1: the same configuration
+    assert a.verified(q, 0)
+    q = a.Q[0].copy()
+    q[6] = a.m.bounds[6, 1] + 1e-6
+    assert not a.verified(q, 0)
+
+
 def test_frame_errors_of_a_known_rotation_and_offset():
     from fkopt.bench_ik import frame_errors
     T = np.eye(4)
@@ -43,14 +69,17 @@ def test_frame_errors_of_a_known_rotation_and_offset():
 def test_ik_sections_report_every_arm_ratios_and_verified_counts(ur5, monkeypatch):
     from fkopt import bench_ik
     from fkopt.bench import _Rows
-    monkeypatch.setattr(bench_ik, "QUICK_ARMS", ("ur5",))
+    monkeypatch.setattr(bench_ik, "QUICK_ARMS", ("ur5", "wang7dof"))
     rows, msgs = _Rows(), []
     bench_ik.bench_ik_one_pose(rows, True, msgs)
     bench_ik.bench_ik_batch(rows, True, msgs)
     got = {(r["section"], r["item"]): r for r in rows.rows}
     for sec, n in (("ik-one-pose", 20), ("ik-batch", 200)):
-        r = got[(sec, "ur5")]
-        assert r["unit"] == "x rtb" and np.isfinite(r["value"]) and r["value"] > 0
-        assert f"fkopt {n}/{n}" in r["note"] or f"fkopt {n - 1}/{n}" in r["note"]
+        for arm in ("ur5", "wang7dof"):
+            r = got[(sec, arm)]
+            assert r["unit"] == "x rtb" and np.isfinite(r["value"]) and r["value"] > 0
+            assert f"fkopt {n}/{n}" in r["note"] or f"fkopt {n - 1}/{n}" in r["note"]
         assert (sec, "median over arms") in got and (sec, "largest") in got
+    assert "rtb DHRobot FK" in got[("ik-batch", "wang7dof")]["note"]
+    assert got[("ik-batch", "ur5")]["note"].endswith("fkopt reported solved but not: 0")
     assert not msgs

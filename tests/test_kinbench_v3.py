@@ -224,6 +224,163 @@ def test_a_malformed_submission_is_one_line_naming_file_row_and_field(tmp_path, 
     assert not (tmp_path / "out" / "kinbench").exists()
 
 
+def fk_submission(tmp_path, make_rows):
+    """tiny_v3 with Dietmaier's platform on the clock and a submission ``my-fk`` whose CSV
+    ``make_rows(mechanism, generating poses)`` returns; the config and the clock arms as the
+    runner builds them (every arm of the track, IK and FK)."""
+    import yaml
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.posesets import load_pose_sets
+    from fkopt.kinbench.runner import track_arm, track_cases
+    path = tiny_v3(tmp_path, problems=["ur5", "dietmaier-6sps"], fk_solvers=["fkopt.forward"],
+                   fk_reference="scipy-least_squares", fk_timeouts_ms=[20, 500])
+    cfg = load_suite(path)
+    sets, _ = load_pose_sets(cfg.model_copy(update={"poses": None}))
+    arms = {cfg.problems[p].name: (track_arm(cfg, p), q) for p, q in track_cases(cfg, sets)}
+    mech, generating = arms["dietmaier-6sps"]
+    make_rows(mech, generating).to_csv(path.parent / "my-fk.csv", index=False)
+    data = yaml.safe_load(path.read_text())
+    data["tracks"]["clock"]["submissions"] = [{"solver": "my-fk", "file": "my-fk.csv", "machine": "test machine",
+                                               "reference": "scipy-least_squares"}]
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return load_suite(path), arms
+
+
+def least_squares_rows(mech, generating, starts=4):
+    """The outside artefact: scipy.optimize.least_squares (trf, its defaults but tolerances 1e-15)
+    on each frozen query's leg lengths, from ``starts`` random starts in the mechanism's bounds
+    (seeded), the first start's wall time as the answer's and the second's as the reference's
+    (scipy least_squares is the FK reference), the pose of the smallest residual returned."""
+    import time
+    from scipy.optimize import least_squares
+    rng = np.random.default_rng(7)
+    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    rows = []
+    for i, x in enumerate(generating):
+        legs = mech.ik(x[None])[0]
+        fits, times = [], []
+        for _ in range(starts):
+            t0 = time.perf_counter()
+            fit = least_squares(lambda p: (mech.ik(p[None])[0] - legs) / legs, lo + rng.random(6) * (hi - lo),
+                                xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            times.append(time.perf_counter() - t0)
+            fits.append(fit)
+        best = min(fits, key=lambda f: np.abs(f.fun).max())
+        rows.append({"robot": "dietmaier-6sps", "query": i, **{f"x{d}": v for d, v in enumerate(best.x)},
+                     "seconds": times[0], "reference_seconds": times[1], "claimed": bool(best.success),
+                     "residual_by_scipy": np.abs(best.fun).max()})
+    return pd.DataFrame(rows)
+
+
+def test_fk_answers_of_scipy_least_squares_submitted_are_verified_by_the_mechanisms_own_ik(tmp_path):
+    """An honest outside artefact: scipy's answers on the frozen queries, written as a
+    submission, judged by kinbench: leg residual relative to leg length, pose error against the
+    generating pose (m, rad), another assembly mode apart from success; one answer spoilt
+    (1 mm off, still claimed) is a failure."""
+    from fkopt.kinbench.physical import LADDER
+    from fkopt.kinbench.submissions import read_submission
+    from fkopt.rotations import to_array, zyx
+
+    made = {}
+    SPOILT = 2
+
+    def rows(mech, generating):
+        df = least_squares_rows(mech, generating)
+        made["scipy"] = df.copy()
+        df.loc[SPOILT, "x0"] += 1e-3                # Dietmaier's platform is in m: 1 mm off, claimed
+        df.loc[SPOILT, "claimed"] = True
+        return df.drop(columns="residual_by_scipy")
+    cfg, arms = fk_submission(tmp_path, rows)
+    mech, generating = arms["dietmaier-6sps"]
+    got = read_submission(cfg, 0, arms)
+    assert set(got["robot"]) == {"dietmaier-6sps"} and (got["source"] == "submitted").all()
+    assert (got["entry"] == "outside").all() and {f"x{d}" for d in range(6)} <= set(got.columns)
+    scipy = made["scipy"]
+    kept = np.arange(len(got)) != SPOILT
+    # the leg residual kinbench computed is the one scipy minimised (its own fun), except the spoilt row
+    assert np.allclose(got["leg_residual"][kept], scipy["residual_by_scipy"][kept], rtol=0, atol=1e-12)
+    assert got["leg_residual"][SPOILT] > 1e-5
+    # the pose error, recomputed here from the rotation matrices
+    X = scipy[[f"x{d}" for d in range(6)]].to_numpy()
+
+    def R(x):
+        return to_array(zyx(*np.radians(x[:, 3:].T)))
+    angle = np.arccos(np.clip((np.einsum("nij,nij->n", R(X), R(generating)) - 1) / 2, -1, 1))
+    position = np.linalg.norm(X[:, :3] - generating[:, :3], axis=1)
+    assert np.allclose(got["rotation_rad"][kept], angle[kept], atol=1e-7)
+    assert np.allclose(got["position_m"][kept], position[kept], atol=1e-12)
+    assert got["position_m"][SPOILT] == pytest.approx(np.linalg.norm(X[SPOILT, :3] + [1e-3, 0, 0]
+                                                                     - generating[SPOILT, :3]))
+    # success at the 1e-5 rung: at the generating pose; solved legs elsewhere: another assembly mode
+    board = clock_board(got, timeouts_ms=(20.0, 500.0), reference="my-fk")   # its own rows' reference_seconds
+    rung = rung_label(LADDER[2])
+    at = board.set_index("timeout_ms").loc[500.0]
+    right = (position <= 1e-5) & (angle <= 1e-5)
+    right[SPOILT] = False
+    late = got["seconds"].to_numpy() > 0.5
+    assert at[f"success_{rung}"] == pytest.approx(np.mean(right & ~late))
+    solved = scipy["residual_by_scipy"].to_numpy() <= 1e-5
+    solved[SPOILT] = False
+    assert at["other_mode"] == pytest.approx(np.mean(solved & ~right & ~late))
+    # scipy's seeded starts reach the generating pose once and another assembly mode once: both counts are tested
+    assert right.sum() >= 1 and (solved & ~right).sum() >= 1
+
+
+@pytest.mark.parametrize("spoil, message", [
+    (lambda df: df.assign(x3="abc"), "line 2: x3 = abc; allowed: a finite number within +-1e+06, or empty"),
+    (lambda df: df.assign(x1=np.nan, x2=np.nan).iloc[:1].pipe(lambda d: pd.concat([d, df.iloc[1:]])),
+     "line 2: answer partly empty; give all of x0..x5 or none"),
+    (lambda df: df.assign(x0=1e300), "line 2: x0 = 1e+300; allowed: a finite number within +-1e+06"),
+    (lambda df: df.assign(x4="inf"), "line 2: x4 = inf; allowed: a finite number"),
+    (lambda df: df.assign(seconds=np.nan), "line 2: seconds = nan; allowed: a positive number of s up to 3600"),
+    (lambda df: df.assign(reference_seconds=1e9), "line 2: reference_seconds = 1000000000.0; allowed: a positive"),
+    (lambda df: df.drop(columns="x5"), "missing column 'x5' (dietmaier-6sps answers with a 6-DOF pose"),
+    (lambda df: df.assign(q0=1.0), "robot dietmaier-6sps: column q0 must be empty"),
+    (lambda df: df.iloc[:2], "robot dietmaier-6sps: no row for query 2; every query of the track (3 queries)"),
+    (lambda df: pd.concat([df, df.iloc[:1].assign(query=3)]), "line 5: query = 3; allowed: an integer 0..2"),
+    (lambda df: pd.concat([df, df.iloc[:1]]), "robot dietmaier-6sps: query 0 appears twice"),
+    (lambda df: pd.concat([df.assign(given_timeout_ms=t) for t in (20, 100)]),
+     "given_timeout_ms = 100 is not a timeout of the track; allowed: 20, 500"),
+    (lambda df: pd.concat([df.assign(given_timeout_ms=20), df.iloc[1:].assign(given_timeout_ms=500)]),
+     "no row for query 0 at given_timeout_ms 500; every query of the track at every timeout (20, 500 ms)"),
+    (lambda df: df.drop(columns="robot"), "missing column 'robot'"),
+    (lambda df: df.assign(claimed="maybe"), "line 2: claimed = maybe; allowed: true, false, 1, 0 or empty"),
+    (lambda df: df.iloc[:0], "no rows; needs one per query of each robot it answers"),
+])
+def test_a_malformed_fk_submission_is_one_line_naming_file_line_field_and_allowed_values(tmp_path, spoil, message):
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.submissions import read_submission
+
+    def rows(mech, generating):
+        return spoil(pd.DataFrame([{"robot": "dietmaier-6sps", "query": i, **{f"x{d}": v for d, v in enumerate(x)},
+                                    "seconds": 0.01, "reference_seconds": 0.02} for i, x in enumerate(generating)]))
+    cfg, arms = fk_submission(tmp_path, rows)
+    with pytest.raises(FkoptError) as err:
+        read_submission(cfg, 0, arms)
+    assert message in str(err.value) and "\n" not in str(err.value)
+    assert "my-fk.csv" in str(err.value)
+
+
+def test_fk_answers_for_a_robot_the_caller_did_not_pass_are_one_line_saying_so(tmp_path):
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.submissions import read_submission
+    cfg, arms = fk_submission(tmp_path, lambda m, g: pd.DataFrame(
+        [{"robot": "dietmaier-6sps", "query": i, **{f"x{d}": v for d, v in enumerate(x)}, "seconds": 0.01,
+          "reference_seconds": 0.02} for i, x in enumerate(g)]))
+    with pytest.raises(FkoptError, match=r"robot 'dietmaier-6sps': this run takes submitted answers for ur5 only"):
+        read_submission(cfg, 0, {"ur5": arms["ur5"]})
+
+
+def test_an_unreadable_submission_file_is_one_line(tmp_path):
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.submissions import read_submission
+    cfg, arms = fk_submission(tmp_path, lambda m, g: pd.DataFrame({"robot": ["x"]}))
+    (tmp_path / "tests" / "my-fk.csv").write_bytes(b'robot,query\n"unclosed,1\n' + b"\x00" * 10)
+    with pytest.raises(FkoptError, match=r"my-fk.csv: (unreadable CSV|missing column)") as err:
+        read_submission(cfg, 0, arms)
+    assert "\n" not in str(err.value)
+
+
 def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
     import sys
     from fkopt.adapters.field import make_ik
@@ -345,3 +502,28 @@ def test_reverify_compares_infinities_and_skips_suites_without_tracks(tmp_path):
     assert _close([np.inf, 1.0, np.nan], [np.inf, 1.0 + 1e-12, np.nan]).all()
     assert not _close([np.inf, 1.0], [-np.inf, 1.1]).any()
     assert reverify(tmp_path, SimpleNamespace(tracks=None)) == []
+
+
+def test_an_fk_submission_reaches_the_suites_board_judged_by_the_mechanisms_ik(tmp_path):
+    """scipy least_squares' answers on Dietmaier's frozen queries, submitted through the suite
+    file, run by ``fkopt suite``'s pipeline: the board carries the outside FK entry, its answers
+    are stored beside the organiser's and the spoilt (claimed) answer is a failure."""
+    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinbench.physical import LADDER
+
+    def rows(mech, generating):
+        df = least_squares_rows(mech, generating).drop(columns="residual_by_scipy")
+        df.loc[0, "x0"] += 1e-3                       # 1 mm off, still claimed
+        df.loc[0, "claimed"] = True
+        return df
+    cfg, _ = fk_submission(tmp_path, rows)
+    path = tmp_path / "tests" / "tiny.yaml"
+    folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    mine = board[(board.solver == "my-fk") & (board.robot == "dietmaier-6sps")]
+    assert len(mine) and (mine["entry"] == "outside").all() and (mine["source"] == "submitted").all()
+    answers = pd.read_csv(folder / "answers.csv.gz")
+    sub = answers[answers.solver == "my-fk"].sort_values("query")
+    assert len(sub) == 3 and sub["position_m"].iloc[0] >= 1e-3 - 1e-9
+    rung = f"success_{rung_label(LADDER[2])}"         # 1e-5 m: the 1 mm spoilt answer fails it
+    assert (mine[rung] <= 2 / 3 + 1e-12).all()

@@ -120,3 +120,32 @@ def test_the_cutters_keep_only_the_chain_and_refuse_what_they_do_not_cut(tmp_pat
     assert "visual" not in text and "dynamics" not in text and 'lower="-1"' in text
     with pytest.raises(FkoptError, match="link 'c' is not below link 'a'"):
         cut_urdf(u, "a", "c")
+
+
+def test_the_urdf_cutter_reads_bounded_through_fkopts_urdf_reader_and_copies_attribute_strings(tmp_path):
+    """cut_urdf walks the chain fkopt's URDF arm walks (one reader, one walk), keeps each joint's
+    strings as written (the same doubles), and refuses what the arm refuses, in one line."""
+    from fkopt.errors import FkoptError
+    from fkopt.kinbench.robots import cut_urdf
+    from fkopt.mechanisms.urdf import MAX_URDF_BYTES
+    u = tmp_path / "arm.urdf"
+    u.write_text('<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'
+                 '<joint name="j1" type="revolute"><parent link="a"/><child link="b"/>'
+                 '<origin xyz="0 0 0.10000000000000001" rpy="0 0 1.5707963267948966"/><axis xyz="0 0 1"/>'
+                 '<limit lower="-1.0e0" upper="2.5" effort="9" velocity="1"/></joint>'
+                 '<joint name="j2" type="fixed"><parent link="b"/><child link="c"/></joint></robot>')
+    text = ET.tostring(cut_urdf(u, "a", "c"), "unicode")
+    assert 'xyz="0 0 0.10000000000000001"' in text and 'lower="-1.0e0"' in text and 'effort="9"' in text
+    assert text.index('name="j1"') < text.index('name="j2"') and text.count("<link") == 3
+    u.write_text('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+                 '<parent link="a"/><child link="b"/><axis xyz="0 0 1e308"/></joint></robot>')
+    with pytest.raises(FkoptError, match="joint 'j' axis") as err:
+        cut_urdf(u, "a", "b")
+    assert "\n" not in str(err.value)
+    u.write_text("<robot>" + " " * MAX_URDF_BYTES + "</robot>")
+    with pytest.raises(FkoptError, match="arm.urdf") as err:
+        cut_urdf(u, "a", "b")
+    assert "\n" not in str(err.value)
+    u.write_text("<robot><link name='a'>")
+    with pytest.raises(FkoptError, match="malformed URDF"):
+        cut_urdf(u, "a", "b")

@@ -1,11 +1,10 @@
 """Fast tests of modules otherwise reached only by slow tiers: the assembly report's claims and
-the robots bench's answer check."""
+the reproduce agreement line."""
 from types import SimpleNamespace
 
 import numpy as np
 
 import fkopt
-from fkopt.bench_robots import _check
 from fkopt.reproduce import assembly as assembly_report
 from fkopt.reproduce.claims import HELD, NOT_CHECKABLE, NOT_HELD
 
@@ -26,20 +25,6 @@ def test_assembly_claim_holds_only_at_40_solutions_and_is_not_checkable_without_
     assert assembly_report.claims(Store(39))[0].verdict == NOT_HELD
     assert assembly_report.claims(Store(None))[0].verdict == NOT_CHECKABLE
     assert assembly_report.timing_claims(Store(None)) == []
-
-
-def test_robots_bench_check_accepts_the_arms_own_pose_and_refuses_a_moved_or_out_of_limit_one():
-    m = fkopt.mechanism("7dof-arm")
-    rng = np.random.default_rng(0)
-    q = m.bounds[:, 0] + rng.random((4, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
-    T = m.fk_matrix(q)
-    assert _check(m, q, T, (1e-6, 1e-6), 1.0).all()      # the bench's tolerance; arccos near 1 is ~1e-8 rad coarse
-    moved = T.copy()
-    moved[:, 0, 3] += 1.0                                 # one length unit away
-    assert not _check(m, q, moved, (1e-3, 1e-3), 1.0).any()
-    outside = q.copy()
-    outside[:, 0] = m.bounds[0, 1] + 1.0
-    assert not _check(m, outside, m.fk_matrix(outside), (1e-6, 1e-6), 1.0).any()
 
 
 def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cross_platform_rules(tmp_path):
@@ -68,6 +53,32 @@ def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cros
     assert ulp.startswith("reproduce: 1 deterministic files in 1 results moved") and "accept all" in ulp
     big = line_after(lambda t: "".join(t.splitlines(keepends=True)[:-3]))        # runs lost
     assert "refuse" in big and "liu2008/tab3_fig4 runs.csv" in big
+
+
+def test_reproduce_hashes_the_regenerated_tree_once_for_changes_and_its_agreement_line(tmp_path, monkeypatch):
+    """write_report's CHANGES.md and `fkopt reproduce`'s last line are judged on one snapshot of
+    the tree after the rerun (issue 32): one pass over its files, and the same line as from a
+    fresh snapshot."""
+    import shutil
+    from pathlib import Path
+
+    from fkopt.reproduce import changes
+    from fkopt.reproduce.report import write_report
+    root = tmp_path / "results"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "results" / "liu2008" / "tab3_fig4",
+                    root / "liu2008" / "tab3_fig4")
+    runs = root / "liu2008" / "tab3_fig4" / "runs.csv"
+    (tmp_path / "keep").mkdir()
+    before = changes.snapshot(root, keep=tmp_path / "keep")
+    runs.write_text(runs.read_text().replace("9.408561477e-08", "9.408561478e-08", 1))
+    taken = []
+    real = changes.snapshot
+    monkeypatch.setattr(changes, "snapshot", lambda *a, **k: taken.append(a) or real(*a, **k))
+    written = write_report(root, changes_since=before)
+    line = changes.agreement(before, root, written.after)
+    assert len(taken) == 1 and written.after is not None and root / "CHANGES.md" in written.paths
+    assert line == changes.agreement(before, root) and "1 deterministic files in 1 results moved" in line
+    assert "runs.csv" in (root / "CHANGES.md").read_text()
 
 
 def test_field_solvers_answer_on_the_stored_ur5_and_kinbench_judges_them():

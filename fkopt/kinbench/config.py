@@ -202,11 +202,12 @@ class ClockTrack(Strict):
             if name not in fk_known:
                 raise ValueError(f"fk solver '{name}' is not a clock-track FK solver (allowed: {', '.join(fk_known)})")
         for sub in self.submissions:
-            if sub.solver in [*self.solvers, self.reference] or [s.solver for s in self.submissions].count(sub.solver) > 1:
+            if sub.solver in [*self.solvers, self.reference, *self.fk_solvers, self.fk_reference] or [s.solver for s in self.submissions].count(sub.solver) > 1:
                 raise ValueError(f"submissions: solver '{sub.solver}' repeats a solver of the track")
-            if sub.reference is not None and sub.reference != self.reference:
+            if sub.reference is not None and sub.reference not in (self.reference, self.fk_reference):
                 raise ValueError(f"submissions[{sub.solver}].reference: '{sub.reference}' is not the track's "
-                                 f"reference ({self.reference}); its times would not be ratios to the same solver")
+                                 f"reference ({self.reference} for IK, {self.fk_reference} for FK); its times "
+                                 "would not be ratios to the same solver")
         return self
 
 

@@ -160,27 +160,23 @@ _URDF_JOINT_PARTS = ("origin", "axis", "limit", "mimic")
 
 
 def cut_urdf(path: Path, base: str, tip: str) -> ET.Element:
-    """The ``<robot>`` of the chain ``base`` -> ``tip`` of URDF ``path``, kinematics only."""
-    robot = ET.parse(path).getroot()
-    by_child = {j.find("child").get("link"): j for j in robot.iter("joint") if j.find("child") is not None}
-    chain, link = [], tip
-    while link != base:
-        joint = by_child.get(link)
-        if joint is None:
-            raise FkoptError(f"{path}: link '{tip}' is not below link '{base}'")
-        chain.append(joint)
-        link = joint.find("parent").get("link")
-    out = ET.Element("robot", name=robot.get("name", "robot"))
+    """The ``<robot>`` of the chain ``base`` -> ``tip`` of URDF ``path``, kinematics only: the
+    chain as fkopt's URDF arm reads it (:func:`fkopt.mechanisms.urdf.load_urdf`, bounded, and
+    :func:`~fkopt.mechanisms.urdf.urdf_chain`), each joint's parts copied from its XML element."""
+    from ..mechanisms.urdf import load_urdf, urdf_chain
+    robot = load_urdf(path)
+    out = ET.Element("robot", name=robot.name)
     ET.SubElement(out, "link", name=base)
-    for joint in reversed(chain):
-        ET.SubElement(out, "link", name=joint.find("child").get("link"))
-        j = ET.SubElement(out, "joint", name=joint.get("name"), type=joint.get("type"))
-        ET.SubElement(j, "parent", link=joint.find("parent").get("link"))
-        ET.SubElement(j, "child", link=joint.find("child").get("link"))
+    for joint in urdf_chain(robot, path, base, tip):
+        e = joint.element
+        ET.SubElement(out, "link", name=joint.child)
+        j = ET.SubElement(out, "joint", name=joint.name, type=joint.type)
+        ET.SubElement(j, "parent", link=joint.parent)
+        ET.SubElement(j, "child", link=joint.child)
         for part in _URDF_JOINT_PARTS:
-            e = joint.find(part)
-            if e is not None:
-                ET.SubElement(j, part, dict(e.attrib))
+            kept = e.find(part)
+            if kept is not None:
+                ET.SubElement(j, part, dict(kept.attrib))
     return out
 
 
@@ -206,7 +202,12 @@ def _cut_defaults(default: ET.Element) -> ET.Element:
 def cut_mjcf(path: Path, base: str, tip: str) -> ET.Element:
     """The ``<mujoco>`` of the chain ``base`` -> ``tip`` (a body or a site) of MJCF ``path``,
     kinematics only (module docstring)."""
-    root = ET.parse(path).getroot()
+    from ..files import read_input
+    from ..mechanisms.mjcf import MAX_MJCF_BYTES
+    try:
+        root = ET.fromstring(read_input(path, MAX_MJCF_BYTES, field="robots"))
+    except ET.ParseError as err:
+        raise FkoptError(f"{path}: malformed MJCF ({err})") from None
     if root.find(".//include") is not None:
         raise FkoptError(f"{path}: <include> is not cut; compile and save the model first")
     world = root.find("worldbody")

@@ -159,13 +159,13 @@ def track_arm(config: SuiteConfig, p: int, files: Path | None = None):
 
 
 def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> pd.DataFrame | None:
-    """Every outside submission of the clock track, verified by fkopt's FK (answers rows)."""
+    """Every outside submission of the clock track (IK joints or FK poses), verified by kinbench's
+    own FK or IK (answers rows)."""
     if not tracks or not config.tracks.clock.submissions:
         return None
     from .submissions import read_submission
-    from .clock import is_ik
+    # every arm of the track: IK answers (joints) and FK answers of parallel mechanisms (poses)
     arms = {config.problems[p].name: (track_arm(config, p, files), queries) for p, queries in tracks}
-    arms = {name: v for name, v in arms.items() if is_ik(v[0])}       # submissions: IK answers
     return pd.concat([read_submission(config, k, arms, files) for k in range(len(config.tracks.clock.submissions))],
                      ignore_index=True)
 

@@ -87,10 +87,13 @@ MAX_URDF_VALUE = MAX_MAGNITUDE
 MAX_URDF_BYTES = 4 << 20
 
 
-def _load(path: Path) -> SimpleNamespace:
+def load_urdf(path: Path) -> SimpleNamespace:
     """The links and joints of a URDF file (what a kinematic chain needs: no meshes, inertias
-    or transmissions), read with the standard library's XML parser -- importing a URDF library
-    cost 1.3-2.0 s per process. Every failure is one line naming the file."""
+    or transmissions), read bounded (:func:`fkopt.files.read_input`) with the standard library's
+    XML parser -- importing a URDF library cost 1.3-2.0 s per process. Every failure is one line
+    naming the file. ``name``: the robot's; each joint keeps its XML ``element`` too (the cutter of
+    kinbench's robot copies, :func:`fkopt.kinbench.robots.cut_urdf`, copies its attribute strings
+    verbatim)."""
     import xml.etree.ElementTree as ET
     check_geometry_file(path, "urdf", MAX_URDF_BYTES, "a URDF file")
     try:
@@ -135,11 +138,15 @@ def _load(path: Path) -> SimpleNamespace:
                 multiplier=_floats(mi.get("multiplier"), 1, (1.0,), f"joint '{name}' mimic multiplier", path)[0],
                 offset=_floats(mi.get("offset"), 1, (0.0,), f"joint '{name}' mimic offset", path)[0])
         joints[name] = SimpleNamespace(name=name, type=kind, parent=parent.get("link"), child=child.get("link"),
-                                       origin=origin, axis=np.array(axis), limit=limit, mimic=mimic)
-    return SimpleNamespace(link_map=links, joint_map=joints)
+                                       origin=origin, axis=np.array(axis), limit=limit, mimic=mimic, element=e)
+    return SimpleNamespace(name=root.get("name", "robot"), link_map=links, joint_map=joints)
 
 
-def _chain(robot, path: Path, base: str | None, tip: str | None) -> list:
+def urdf_chain(robot, path: Path, base: str | None, tip: str | None) -> list:
+    """The joints of :func:`load_urdf`'s ``robot`` from link ``base`` to link ``tip``, base
+    first: walked up from the tip through each link's parent joint (None: the one root, the one
+    leaf). One line naming the file when a link is unknown, the tip is not below the base, the
+    joints loop, or the chain is too long, holds an unsupported joint type or no moving joint."""
     links = robot.link_map
     by_child = {j.child: j for j in robot.joint_map.values()}
     parents = {j.parent for j in robot.joint_map.values()}
@@ -363,9 +370,9 @@ class URDFArm(FrameArm):
 
     def _read_chain(self, path: Path, g) -> list:
         """The chain from ``g.base`` to ``g.tip``: joints with name, type, parent, child, origin
-        (4x4), axis, limit and mimic as :func:`_load` gives them (the MJCF arm reads the same
+        (4x4), axis, limit and mimic as :func:`load_urdf` gives them (the MJCF arm reads the same
         records from MuJoCo's compiled model)."""
-        return _chain(_load(path), path, g.base, g.tip)
+        return urdf_chain(load_urdf(path), path, g.base, g.tip)
 
     def _build(self, chain, source, tool) -> None:
         """Constant parts of the recursion (module docstring of :meth:`frame`): per moving joint
@@ -523,7 +530,7 @@ class URDFArm(FrameArm):
 
 #: Serial chains of the PyPI package ``example-robot-data`` (version 6) that fkopt was tried on:
 #: name -> (file under its robots/ folder, base link, tip link). Tests and ``fkopt bench
-#: --section robots`` use them; docs/robots.md lists the results.
+#: --section ik-one-pose`` / ``ik-batch`` use them; docs/robots.md lists the results.
 EXAMPLE_ROBOTS = {
     "panda": ("panda_description/urdf/panda.urdf", "panda_link0", "panda_hand_tcp"),
     "ur5": ("ur_description/urdf/ur5_robot.urdf", "base_link", "tool0"),

@@ -149,9 +149,10 @@ def _claim_moves(before: str | None, after: str | None) -> list[str]:
     return out
 
 
-def describe(before: Snapshot, root: str | Path) -> str:
-    """CHANGES.md: what the tree under ``root`` changed against ``before`` (timings never count)."""
-    after = snapshot(root)
+def describe(before: Snapshot, root: str | Path, after: Snapshot | None = None) -> str:
+    """CHANGES.md: what the tree under ``root`` changed against ``before`` (timings never count).
+    ``after``: the tree's snapshot when the caller has taken it (default: taken here)."""
+    after = snapshot(root) if after is None else after
     lines = ["# What the last regeneration moved", "",
              "Written by `fkopt reproduce` (or `make bench-suite`, through `fkopt report --changes-since`) "
              "from the tree before and after it ran (`fkopt/reproduce/changes.py`); "
@@ -191,17 +192,19 @@ def describe(before: Snapshot, root: str | Path) -> str:
     return "\n".join(lines)
 
 
-def agreement(before: Snapshot, root: str | Path) -> str:
+def agreement(before: Snapshot, root: str | Path, after: Snapshot | None = None) -> str:
     """One line for the end of ``fkopt reproduce``: how many deterministic files moved against
     the tree before it (timings never count) and whether ``fkopt check``'s cross-platform rules
     (:mod:`fkopt.compare`) accept the new files against the old. On the platform that made the
     stored results nothing moves; on another CPU (another SIMD width in numpy's kernels, another
     BLAS) the last digits of path-dependent runs move and the rules decide whether that is all.
-    Needs a snapshot taken with ``keep``."""
+    Needs a snapshot taken with ``keep``. ``after``: the tree's snapshot the caller already took
+    for :func:`describe` (``fkopt reproduce`` threads the one :func:`write_changes` took, so the
+    tree is hashed once at its end), default: taken here."""
     from ..compare import ANY, compare_folders
     from .check import rules_for
     root = Path(root)
-    after = snapshot(root)
+    after = snapshot(root) if after is None else after
     moved: dict[str, list[str]] = {}
     for label in sorted(set(after.files) & set(before.files)):
         old, new = before.files[label], after.files[label]
@@ -233,10 +236,12 @@ def agreement(before: Snapshot, root: str | Path) -> str:
                    "see CHANGES.md and run `fkopt check`")
 
 
-def write_changes(root: str | Path, before: Snapshot) -> Path:
-    """Write CHANGES.md at the root of the regenerated tree; returns its path."""
+def write_changes(root: str | Path, before: Snapshot) -> tuple[Path, Snapshot]:
+    """Write CHANGES.md at the root of the regenerated tree; returns its path and the snapshot of
+    the tree it compared (for :func:`agreement`, without hashing the tree again)."""
     from ..files import write_file_atomically
     path = Path(root) / CHANGES_FILE
-    text = describe(before, root)
+    after = snapshot(root)
+    text = describe(before, root, after)
     write_file_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
-    return path
+    return path, after

@@ -6,11 +6,13 @@ measured in seconds lives in TIMING.md, which changes on every run. Never edit e
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
 from . import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
+from .changes import Snapshot
 from .claims import CLAIMS_FILE, RULES, TIMING_CLAIMS_FILE, Claim, claims_frame
 from .engine import info, judge_paper
 from ..experiment.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
@@ -253,7 +255,17 @@ def draw_paper_figures(root: str | Path) -> list[Path]:
     return out
 
 
-def write_report(root: str | Path, changes_since=None) -> list[Path]:
+@dataclass
+class WrittenReport:
+    """What :func:`write_report` wrote, and the tree's snapshot CHANGES.md was computed from
+    (None without ``changes_since``): ``fkopt reproduce`` judges its agreement line on that same
+    snapshot instead of hashing the tree a second time."""
+
+    paths: list[Path]
+    after: Snapshot | None = None
+
+
+def write_report(root: str | Path, changes_since=None) -> WrittenReport:
     """Write REPORT.md, TIMING.md, index.csv and every paper's claims.csv under ``root``;
     with ``changes_since`` (a :class:`~.changes.Snapshot` of the tree before a rerun) also
     CHANGES.md, after the verdicts it compares and before the report that links it.
@@ -276,11 +288,13 @@ def write_report(root: str | Path, changes_since=None) -> list[Path]:
     for path, df in claims_files(root).items():
         df.to_csv(inside(root, path, "report"), index=False)
         paths.append(path)
+    after = None
     if changes_since is not None:
         from .changes import write_changes
-        paths.append(write_changes(root, changes_since))
+        changes_path, after = write_changes(root, changes_since)
+        paths.append(changes_path)
     report, timing, index = build_report(root)
     paths[0].write_text(report)
     paths[1].write_text(timing)
     index.to_csv(paths[2], index=False, float_format="%.10g")
-    return paths + figures
+    return WrittenReport(paths + figures, after)
