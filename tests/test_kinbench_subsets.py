@@ -178,3 +178,9 @@ def test_a_subset_solver_gets_the_numbers_it_gets_on_the_whole_suite(written, tm
     b = every.merge(a[key], on=key).reset_index(drop=True)
     assert len(a) == 2 and len(every) == 2 * 4 * 2 * 2
     pd.testing.assert_frame_equal(a, b[a.columns])
+
+
+def test_the_virtual_best_solves_a_cell_when_any_solver_does_at_the_fewest_evaluations():
+    runs = _runs([("p", 0, "a", 10), ("p", 1, "a", None), ("p", 0, "b", 40), ("p", 1, "b", 20)])
+    vbs = M.virtual_best_ecdf(runs, [1e-2])
+    assert vbs["evals_per_dim"].tolist() == [10.0, 20.0] and vbs["fraction"].tolist() == [0.5, 1.0]

@@ -145,6 +145,17 @@ def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFra
     return pd.concat(frames, ignore_index=True)
 
 
+def virtual_best_ecdf(runs: pd.DataFrame, targets) -> pd.DataFrame:
+    """The ECDF of the virtual best solver over ``runs`` (one board's, or one class of it): per
+    cell (problem, set, pose, run) and target the fewest evaluations / dimension any solver
+    needed, as steps (evals_per_dim, fraction) of the same (cell, target) pairs as each solver's
+    ECDF (COCO's "best 2009"-style reference curve, from the solvers run here)."""
+    per_dim = pd.DataFrame(hits(runs, targets) / runs["dim"].to_numpy(dtype=float)[:, None], index=runs.index)
+    best = per_dim.groupby([runs[c] for c in CELL], sort=False).min().to_numpy()
+    steps = ecdf_steps({"virtual best": best})
+    return steps.rename(columns={"evaluations": "evals_per_dim"})[["evals_per_dim", "fraction"]]
+
+
 def trial_scores(runs: pd.DataFrame, targets, budget_per_dim: float) -> np.ndarray:
     """(rows,) the normalised log-area score of every trial (see the module docstring)."""
     per_dim = hits(runs, targets) / runs["dim"].to_numpy(dtype=float)[:, None]

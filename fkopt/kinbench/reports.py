@@ -273,18 +273,33 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         return rest if board is None else f"{board}_{rest}"
     scopes = [s for s in df["scope"].unique() if s != "all"]
     stems = file_names((short(s) for s in scopes), reserved=("all",))
+    rows_of = {}                                   # scope -> its run rows (the virtual best's cells)
+    for board, runs in suite_boards(sr):
+        prefix = "" if board is None else f"{BOARD_PREFIX}{board}/"
+        rows_of[f"{prefix}all"] = runs
+        rows_of.update({f"{prefix}class:{c}": r for c, r in runs.groupby("class", sort=True)})
     for scope, g in df.groupby("scope", sort=False):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
         top = float(sr.config.budget_per_dim)
-        for (solver, track), s in g.groupby(["solver", "track"], sort=False):
+        curves = list(g.groupby(["solver", "track"], sort=False))
+        if scope in rows_of and g["solver"].nunique() > 1:
+            curves.append((("virtual best", "best"), M.virtual_best_ecdf(rows_of[scope], sr.config.targets)))
+        ends = []
+        for (solver, track), s in curves:
             s = s.dropna(subset=["evals_per_dim"])      # a solver that reached nothing: flat at 0
             b = np.concatenate([[1.0], np.maximum(s["evals_per_dim"].to_numpy(), 1.0), [top]])
             f = np.concatenate([[0.0], s["fraction"].to_numpy(), [s["fraction"].max() if len(s) else 0.0]])
             x, y = np.log10(b), f
-            line, = ax.step(x, y, where="post", linestyle=styles.get(track, "-"), label=f"{solver} ({track})")
-            ax.annotate(solver, (x[-1], y[-1]), xytext=(3, 0), textcoords="offset points", fontsize=7,
-                        color=line.get_color(), va="center")
-        ax.set_xlabel("log10(evaluations / dimension)")
+            style = {"color": "black", "linestyle": ":", "linewidth": 1.6} if track == "best" else \
+                {"linestyle": styles.get(track, "-")}
+            line, = ax.step(x, y, where="post", label=f"{solver} ({track})" if track != "best" else solver, **style)
+            ends.append((solver, x[-1], y[-1], line.get_color()))
+        # names at the right end (COCO), spread apart where lines end together
+        for (solver, x_end, _, color), y in zip(ends, spread_labels([e[2] for e in ends], 0.045)):
+            ax.annotate(solver, (x_end, y), xytext=(3, 0), textcoords="offset points", fontsize=7, color=color,
+                        va="center", annotation_clip=False)
+        ax.axvline(np.log10(top), color="grey", linewidth=0.8)     # the budget
+        ax.set_xlabel(f"log10(evaluations / dimension); budget {top:g} x dimension marked")
         ax.set_ylabel("fraction of (problem, pose, target, run)")
         ax.set_ylim(-0.02, 1.02)
         board, within = split_scope(scope)
