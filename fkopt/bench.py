@@ -40,7 +40,8 @@ Sections of the table (and of ``bench.csv``: columns section, item, value, unit,
    size (rows per chunk) that :data:`fkopt.solve.CHUNK_POINTS` was chosen from.
 4f. ``swarms`` -- GABC, ABC and PSO on 3-RPS at 1 case and 100 cases x 30 runs beside the same
    algorithm as the C loop of ``fkopt/bench_ref/gabc_3rps.c``, alternating: ns per evaluation and
-   the ratio (issue 29's targets: <= 3 at 1 case, <= 1.5 at 100 cases); and pygmo's C++
+   the ratio (issue 29's targets: <= 3 at 1 case, <= 1.5 at 100 cases), for the default path (the
+   iterations compiled, the numpy path's bits) and ``FKOPT_NUMERICS=numpy``; and pygmo's C++
    ``bee_colony`` with a numba-compiled fitness beside fkopt's batched ABC (population 10, 600
    iterations, 30 runs), the ratio per run (target >= 10; the row needs pygmo and numba).
 5. ``scaling`` -- GABC on the 3-RPS case with population 10..1000 (30 runs) and runs 1..1000
@@ -778,12 +779,12 @@ SWARM_TARGETS = {1: 3.0, 100: 1.5}
 def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
     """GABC, ABC and PSO on 3-RPS (population 10, 600 iterations; 100 in quick mode; 30 runs) at
     1 case and at 100 cases, beside the same algorithm as the plain C loop of
-    :data:`REFERENCE_C` on the same cases; alternating fkopt solve, C run (best of 2 each; 1 in
-    quick mode). Rows: ns per evaluation of each and the ratio fkopt / C, against
-    :data:`SWARM_TARGETS`, for the default path and, with numba, ``FKOPT_NUMERICS=compiled``
-    (the 3-RPS fitness and the whole iteration compiled: :func:`fkopt.numerics.compiled.abc_rps3`,
-    ``pso_rps3``). Skipped with a message when there
-    is no C compiler."""
+    :data:`REFERENCE_C` on the same cases; alternating fkopt solve on the default path, on
+    ``FKOPT_NUMERICS=numpy`` and the C run (best of 2 each; 1 in quick mode). Rows: ns per
+    evaluation and the ratio fkopt / C, against :data:`SWARM_TARGETS`, for the default path
+    (with numba: the whole iteration compiled around numpy's np.tan,
+    :func:`fkopt.numerics.compiled.abc_rps3`, ``pso_rps3``; the numpy path's bits, checked here
+    run for run) and the numpy path. Skipped with a message when there is no C compiler."""
     import tempfile
     from . import mechanism
     from .solve import solve
@@ -795,9 +796,10 @@ def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
     try:
         with numerics_path.forced("compiled"):
             fast = numerics_path.compiled() is not None
-            if fast:                   # numba's import and cache load before any timing
-                fk_problem(m, joints[:1]).fitness(m.bounds.mean(axis=1)[None])
-    except Exception:                  # numba missing or broken: the default path's rows only
+            if fast:                   # numba's import and the kernels' cache load before any timing
+                solve(fk_problem(m, joints[:1]), "pso", population=10, iterations=2, runs=2, seed=1)
+                solve(fk_problem(m, joints[:1]), "abc", population=10, iterations=2, runs=2, seed=1)
+    except Exception:                  # numba missing or broken: the numpy path's rows only
         fast = False
     with tempfile.TemporaryDirectory() as tmp:
         built = compile_reference(Path(tmp))
@@ -808,30 +810,33 @@ def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
             for n in SWARM_TARGETS:
                 problem = fk_problem(m, joints[:n])
                 f_ns, k_ns, c_ns = np.inf, np.inf, np.inf
-                for _ in range(reps):              # default path, compiled 3-RPS fitness, C loop
-                    t = time.perf_counter()
-                    res = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
-                    f_ns = min(f_ns, (time.perf_counter() - t) / float(res.evaluations.sum()) * 1e9)
+                for _ in range(reps):              # numpy path, default path, C loop
+                    with numerics_path.forced("numpy"):
+                        t = time.perf_counter()
+                        res = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
+                        f_ns = min(f_ns, (time.perf_counter() - t) / float(res.evaluations.sum()) * 1e9)
                     if fast:
-                        with numerics_path.forced("compiled"):
+                        with numerics_path.forced("auto"):
                             t = time.perf_counter()
                             rk = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
                             k_ns = min(k_ns, (time.perf_counter() - t) / float(rk.evaluations.sum()) * 1e9)
                     ref = run_reference(built[0], joints[:n], iterations, 10, 30, algorithm=alg)
                     c_ns = min(c_ns, ref["seconds"] / ref["evaluations"] * 1e9)
-                ratio, target = f_ns / c_ns, SWARM_TARGETS[n]
+                target = SWARM_TARGETS[n]
                 label = f"{alg} {n} case{'s' if n > 1 else ''} x 30 runs"
-                rows.add("swarms", label, ratio, "x C loop",
-                         f"fkopt {f_ns:.0f} ns/eval, C loop {c_ns:.0f} ns/eval ({built[1]}); {iterations} it, "
-                         f"population 10; best of {reps}; median final fitness fkopt "
-                         f"{float(np.median(res.fitness)):.2g}, C {ref['median']:.2g}; target <= {target:g}: "
-                         f"{'met' if ratio <= target else 'NOT met'}")
+                common = (f"C loop {c_ns:.0f} ns/eval ({built[1]}); {iterations} it, population 10; best of {reps}; "
+                          f"median final fitness C {ref['median']:.2g}")
                 if fast:
-                    what = "the whole iteration and its evaluation log"
-                    rows.add("swarms", label + ", FKOPT_NUMERICS=compiled", k_ns / c_ns, "x C loop",
-                             f"compiled: {what}; {k_ns:.0f} ns/eval; "
-                             f"median final fitness {float(np.median(rk.fitness)):.2g}; target <= {target:g}: "
-                             f"{'met' if k_ns <= target * c_ns else 'NOT met'}")
+                    same = all(np.array_equal(getattr(res, k), getattr(rk, k)) for k in ("x", "fitness", "history"))
+                    rows.add("swarms", label, k_ns / c_ns, "x C loop",
+                             f"default path (compiled: the whole iteration and its evaluation log, numpy's np.tan); "
+                             f"fkopt {k_ns:.0f} ns/eval, {common}, fkopt {float(np.median(rk.fitness)):.2g}; "
+                             f"runs {'bit-identical to' if same else 'DIFFERENT from'} FKOPT_NUMERICS=numpy; "
+                             f"target <= {target:g}: {'met' if k_ns <= target * c_ns else 'NOT met'}")
+                rows.add("swarms", label + ", FKOPT_NUMERICS=numpy", f_ns / c_ns, "x C loop",
+                         f"numpy path{'' if fast else ' (the default here: no numba)'}; fkopt {f_ns:.0f} ns/eval, "
+                         f"{common}, fkopt {float(np.median(res.fitness)):.2g}; target <= {target:g}: "
+                         f"{'met' if f_ns <= target * c_ns else 'NOT met'}")
 
 
 #: Issue 29: pygmo's bee_colony with a compiled fitness at least this many times fkopt's batched
@@ -843,7 +848,7 @@ def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
     """pygmo's C++ ``bee_colony`` (gen 600, limit 30 = fkopt's default SN * dim, population 10)
     on mao2017's 3-RPS case with the fitness compiled by numba (the 3-RPS point of
     :func:`fkopt.numerics.compiled._rps3_point`, called once per point as pygmo asks), beside
-    fkopt's ABC solving the 30 runs in one batch (default path and ``FKOPT_NUMERICS=compiled``);
+    fkopt's ABC solving the 30 runs in one batch (``FKOPT_NUMERICS=numpy`` and the compiled default path);
     alternating, best of 2 for fkopt, pygmo's median run; ratio pygmo / fkopt per run against
     :data:`PYGMO_TARGET`. Quick mode: 100 iterations, 10 pygmo runs. Skipped with a message
     without pygmo or numba."""
@@ -883,7 +888,7 @@ def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
     p_run = float(np.median([r[0] for r in peer]))
     p_evals = float(np.median([r[1] for r in peer]))
     p_fit = float(np.median([r[2] for r in peer]))
-    for mode, label in (("numpy", "default path"), ("compiled", "FKOPT_NUMERICS=compiled")):
+    for mode, label in (("numpy", "FKOPT_NUMERICS=numpy"), ("compiled", "default path (compiled)")):
         ratio = p_run / best[mode]
         res = fk[mode]
         rows.add("swarms", f"pygmo bee_colony (numba fitness) / fkopt abc per run, {label}", ratio, "x",

@@ -116,6 +116,7 @@ class _Arm:
     ``scale``: the arm's length unit per m (1000 for the DH arm in mm); ``tol``: :data:`TOL` in it."""
 
     def __init__(self, name, n, seed):
+        from .adapters.field import ArmURDF, arm_urdf
         from .adapters.field.rtb import chain_ets
         from .mechanisms import urdf
         self.name = name
@@ -123,17 +124,17 @@ class _Arm:
             from . import mechanism
             self.m = m = mechanism("7dof-arm")
             self.check = DHRobotFK()
-            path, base, tip = urdf.DEFAULT_FILE, "link0", "tool"
+            source = ArmURDF.from_file(urdf.DEFAULT_FILE, "link0", "tool")     # fkopt's URDF of the paper's table
             self.scale = 1000.0
             self.periodic = mechanism("urdf").periodic_mask()      # the URDF's q1 is continuous
         else:
             self.m = m = urdf.example_robot(name)
             self.check = PinocchioFK(m)
-            path, base, tip = m.path, m.base_link, m.tip_link
+            source = arm_urdf(m)                     # the robot's own file, as the field's packages read it
             self.scale = 1.0
             self.periodic = m.periodic_mask()
         self.tol = (TOL[0] * self.scale, TOL[1])
-        self.ets, self.rtb_version = chain_ets(path, base, tip)
+        self.ets, self.rtb_version = chain_ets(source)
         rng = np.random.default_rng(seed)
         self.Q = m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
         self.T = np.array([self.check.frame(np.radians(q)) for q in self.Q])

@@ -187,6 +187,35 @@ def _mechanism(mechanism, kind: type, what: str) -> Mechanism:
     return mechanism
 
 
+#: A target frame's rotation may be this far from orthonormal (max |R R^T - I|).
+FRAME_ORTHONORMAL_TOL = 1e-9
+
+
+def _targets(m, poses) -> np.ndarray:
+    """Targets of :func:`inverse` as rows: poses (..., 6) as they are, tip frames (..., 4, 4) as
+    (..., 12) = (x, y, z, R row-major); a frame needs a finite, orthonormal rotation and the
+    last row (0, 0, 0, 1)."""
+    a = np.asarray(poses, dtype=float)
+    if a.ndim < 2 or a.shape[-2:] != (4, 4):
+        return _values(m, a, m.pose_names, "target pose")
+    if a.ndim == 2:                                    # one frame: the same checks on floats (a few µs less)
+        f = a.ravel().tolist()
+        a0, a1, a2, x, b0, b1, b2, y, c0, c1, c2, z = f[:12]
+        gap = max(abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0), abs(b0 * b0 + b1 * b1 + b2 * b2 - 1.0),
+                  abs(c0 * c0 + c1 * c1 + c2 * c2 - 1.0), abs(a0 * b0 + a1 * b1 + a2 * b2),
+                  abs(a0 * c0 + a1 * c1 + a2 * c2), abs(b0 * c0 + b1 * c1 + b2 * c2))
+        if math.isfinite(sum(f)) and gap <= FRAME_ORTHONORMAL_TOL and f[12:] == [0.0, 0.0, 0.0, 1.0]:
+            return np.array([x, y, z, a0, a1, a2, b0, b1, b2, c0, c1, c2])
+    if not np.isfinite(a).all():
+        raise FkoptError(f"{m.name} target frame: values must be finite")
+    R = a[..., :3, :3]
+    gap = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max()
+    if not gap <= FRAME_ORTHONORMAL_TOL or not (a[..., 3, :] == (0.0, 0.0, 0.0, 1.0)).all():
+        raise FkoptError(f"{m.name} target frame: needs an orthonormal rotation (max |R R^T - I| "
+                         f"<= {FRAME_ORTHONORMAL_TOL:g}, got {gap:.3g}) and last row 0 0 0 1")
+    return np.concatenate([a[..., :3, 3], R.reshape(a.shape[:-2] + (9,))], axis=-1)
+
+
 def _values(mechanism: Mechanism, values, names, what: str) -> np.ndarray:
     a = np.asarray(values, dtype=float)
     if a.ndim == 0 or a.shape[-1] != len(names):
@@ -836,6 +865,18 @@ def _fast_context(m, table: int, W) -> dict:
     return got
 
 
+def _fast_result(m, answer, tp: float, tr: float) -> InverseResult:
+    """The :class:`InverseResult` of one compiled call's (public joints, info)
+    (:func:`fkopt.numerics.compiled.inverse_pose`)."""
+    out, info = answer
+    perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
+    return InverseResult(
+        mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
+        rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
+        solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
+        evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
+
+
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
@@ -845,14 +886,24 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
     batch's bookkeeping costs more than the iteration itself for a single pose."""
     tp, tr = tol
     n = m.dof
-    c = _arm_constants(m)
-    x, y, z = (float(v) for v in pose[:3])
+    x, y, z = pose[:3].tolist()
     reach = m.reach
     dist = math.sqrt(x * x + y * y + z * z)
     if dist > reach * (1.0 + 1e-12):
         unit = m.pose_units[0]
         raise FkoptError(f"{m.name} target ({x:g}, {y:g}, {z:g}) unreachable "
                          f"(distance {dist:.1f} {unit} > reach {reach:.1f} {unit})")
+    L = float(orientation_scale) if orientation_scale else reach
+    nn = min(table, kn) if table else 0
+    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
+    if fast is not None and start is None:
+        # the common call, before any other set-up: no start to check, no self-motion step, pose to
+        # answer in one compiled call (the Python around it is a fifth of a warm call, more when cold)
+        ctx = _fast_context(m, int(table), W)
+        return _fast_result(m, fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"], ctx["mid"],
+                                                 0 if table else 1, nn, int(seed), int(budget), tol, int(iterations),
+                                                 float(damping), float(down), float(up), float(step_cap)), tp, tr)
+    c = _arm_constants(m)
     lo, hi = c["lo"], c["hi"]
     blo, bhi, angle = c["blo"], c["bhi"], c["angle"]
     own0 = 1 if (start is not None or not table) else 0
@@ -867,22 +918,13 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
             box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
             raise FkoptError(f"{m.name} start: joints must be inside the limits ({box})")
         q0 = [math.radians(v) if a else v for v, a in zip(sl, angle)]
-    L = float(orientation_scale) if orientation_scale else reach
-    nn = min(table, kn) if table else 0
-    fast = numerics_path.compiled(compiled) if hasattr(m, "chain") else None
-    if fast is not None and (start is None or (n <= 6 and W is None)):
-        # no self-motion step after the loop: pose to answer in one compiled call
+    if fast is not None and n <= 6 and W is None:
+        # a start, but no self-motion step after the loop: pose to answer in one compiled call
         ctx = _fast_context(m, int(table), W)
-        out, info = fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"],
-                                      ctx["mid"] if start is None else np.array(q0), own0, nn, int(seed), int(budget),
-                                      tol, int(iterations), float(damping), float(down), float(up), float(step_cap))
-        perr, rerr, used, ev = float(info[0]), float(info[1]), int(info[3]), np.array(int(info[4]), dtype=np.int64)
-        return InverseResult(
-            mechanism=m.name, names=tuple(m.joint_names), joints=out, position_error=np.array(perr),
-            rotation_error=np.array(rerr), residual=np.array(max(perr / tp, rerr / tr)),
-            solved=np.array(perr <= tp and rerr <= tr and info[2] > 0), restarts=np.array(used - 1, dtype=np.int64),
-            evaluations={"residual": ev, "jacobian": ev.copy()}, tol=(tp, tr))
-    Rt = _zyz_matrix1(*pose[3:].tolist())
+        return _fast_result(m, fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"], np.array(q0), own0, nn, int(seed), int(budget),
+                                                 tol, int(iterations), float(damping), float(down), float(up),
+                                                 float(step_cap)), tp, tr)
+    Rt = pose[3:].reshape(3, 3).tolist() if len(pose) == 12 else _zyz_matrix1(*pose[3:].tolist())
     near: list[int] = []
 
     def start_of(j):
@@ -953,7 +995,9 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
     URDF arms, through ``frame``, ``frame_jacobian``, ``frame_jacobian1``, ``kinematic_key`` and
     ``periodic_mask`` only). ``poses``: x, y, z (length unit of the arm) and Z-Y-Z Euler angles
-    (deg), as ``arm.fk`` returns them. ``start``: the current joints (n,) or (..., n) inside the
+    (deg), as ``arm.fk`` returns them; or tip frames (..., 4, 4) in the base frame, as
+    ``arm.fk_matrix`` returns them, whose rotation is used as given (no Euler angles: no digits
+    lost near their singularity at sin(beta) = 0, no conversion per call). ``start``: the current joints (n,) or (..., n) inside the
     limits (default mid-range): the first candidate begins there; when it is solved and the arm
     has self-motion (more than 6 joints, or a ``mask``), the answer is then moved along the
     self-motion to the solution locally nearest to ``start`` (Euclidean distance in rad and
@@ -994,16 +1038,16 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
     except (TypeError, ValueError):
         raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
-    if not (tp > 0 and tr > 0 and np.isfinite(tp) and np.isfinite(tr)):
+    if not (tp > 0 and tr > 0 and math.isfinite(tp) and math.isfinite(tr)):
         raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
-    P0 = _values(m, poses, m.pose_names, "target pose")
+    P0 = _targets(m, poses)
     if P0.ndim == 1 and rest <= 0 and not exact_rotation:
         return _inverse_one(m, P0, start, (tp, tr), seed, max(1, int(starts), fill) + max(0, int(restarts)),
                             int(table), max(1, int(starts), fill) - (1 if (start is not None or not table) else 0)
                             + int(neighbours), orientation_scale, iterations, damping, down, up, step_cap,
                             _task_mask(mask), compiled)
     shape = P0.shape[:-1]
-    P = P0.reshape(-1, 6)
+    P = P0.reshape(-1, P0.shape[-1])
     N, n = len(P), m.dof
     reach = m.reach
     dist = np.sqrt(_sumsq(P[:, :3]))
@@ -1053,7 +1097,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     if N * K < fill:                                   # small batches: more candidates per row
         K = max(K, fill // N)
     L = float(orientation_scale) if orientation_scale else reach
-    pt, Rt = P[:, :3], _zyz_matrix(P[:, 3:])
+    pt, Rt = P[:, :3], (P[:, 3:].reshape(N, 3, 3) if P.shape[1] == 12 else _zyz_matrix(P[:, 3:]))
     to_deg = 180.0 / np.pi if m.angle_mask(m.joint_units).all() else _public(m, np.ones(n))
     budget = K + max(0, int(restarts))                 # starts per row, first ones included
     # start j of row i: the given start (j = 0, when given or without table), then the

@@ -10,8 +10,8 @@ changes with the machine and is never compared by ``fkopt check``:
   the ``FKOPT_NUMERICS`` mode it ran under and numba's version
   (:func:`fkopt.numerics.path.describe`); ``fkopt check`` reruns under that mode
   (:func:`fkopt.numerics.path.forced`). Not part of the fingerprint: one-pose inverse answers
-  are the same on both paths (tests/test_numerics.py), and the compiled swarm fitness runs
-  only under an explicit ``FKOPT_NUMERICS=compiled``, which is recorded;
+  are the same on both paths, and so are the 3-RPS swarm runs, compiled by default around
+  numpy's own ``np.tan`` (tests/test_numerics.py);
 * ``fingerprint`` -- what decides the bits of a result, in two parts (:data:`BLAS_KEYS`):
 
   - the arithmetic fkopt's own elementwise code runs: Python, numpy, scipy and pandas versions,

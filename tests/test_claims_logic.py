@@ -276,3 +276,21 @@ def test_timed_runs_are_interleaved(monkeypatch):
     assert [c[0] for c in calls[:2]] == ["a", "b"] and all(it == 2 for _, it, _ in calls[:2])   # warm-ups
     assert timed == [("a", 0), ("b", 0), ("a", 1), ("b", 1), ("a", 2), ("b", 2)]
     assert [len(s) for s in seconds] == [3, 3]
+
+
+def test_timed_runs_run_on_the_numpy_reference_path_whatever_solved_the_runs(monkeypatch):
+    """Compiled kernels exist for some algorithms only (ABC on 3-RPS, not ACO): a timing claim
+    compares algorithms on one implementation path, the numpy reference, and the variable is
+    restored afterwards."""
+    import os
+    from types import SimpleNamespace as NS
+
+    from fkopt.experiment import timing
+    from fkopt.numerics import path
+    seen = []
+    monkeypatch.setattr(timing, "solve", lambda *a, **kw: seen.append(path.requested()))
+    monkeypatch.delenv(path.ENV, raising=False)
+    config = NS(runs=2, population=5, iterations=3, threshold=None, stop_at_threshold=False)
+    specs = [(NS(name=n, population=None, iterations=None, start=None, params={}), None, 1) for n in ("abc", "aco")]
+    timing.time_case(config, specs, per=2)
+    assert seen and set(seen) == {"numpy"} and path.ENV not in os.environ and path.requested() == "auto"

@@ -188,6 +188,24 @@ def test_arm_scalar_frame_jacobian_matches_the_vectorised_one():
         np.testing.assert_allclose(np.radians(J1), JJ, atol=1e-12)   # per radian -> per degree
 
 
+def test_inverse_takes_tip_frames_and_refuses_a_bad_one_with_one_line():
+    m = fkopt.mechanism("7dof-arm")
+    q = random_poses(m, 3, seed=2)
+    F = m.fk_matrix(q)
+    r = fkopt.inverse(m, F[0], seed=1)
+    assert r.solved and np.abs(m.fk_matrix(r.joints) - F[0]).max() < 1e-5
+    assert fkopt.inverse(m, F, seed=1).solved.all()
+    bad = [F[0] * np.array([[1.0, 1, 1, 1]] * 3 + [[1, 1, 1, 1]]) * 1.01, F[0].copy(), F[0].copy()]
+    bad[0][3] = (0, 0, 0, 1)                                   # a scaled rotation
+    bad[1][3, 3] = 2.0                                         # not homogeneous
+    bad[2][0, 3] = np.nan
+    for frame in bad:
+        for target in (frame, np.stack([F[1], frame])):
+            with pytest.raises(fkopt.errors.FkoptError) as err:
+                fkopt.inverse(m, target)
+            assert "target frame" in str(err.value) and "\n" not in str(err.value)
+
+
 def test_inverse_one_pose_solves_within_limits_and_is_seeded():
     m = fkopt.mechanism("7dof-arm")
     P = m.fk(random_poses(m, 6, seed=11))

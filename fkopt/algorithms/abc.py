@@ -58,10 +58,11 @@ winner written back as its one moved coordinate; the roulette as a dense count o
 (SN, runs) arrays for small colonies or a vectorised binary search for large ones (the same
 integers either way). ``fkopt bench`` measures what an evaluation costs.
 
-Under ``FKOPT_NUMERICS=compiled`` on a 3-RPS FK problem, fkopt's own ABC and GABC (raw selection)
-run each iteration as one compiled pass instead (:func:`fkopt.numerics.compiled.abc_rps3`: the same
-draws in one block per iteration, the same operations, the evaluation log's bookkeeping inside);
-its records equal these phases on the compiled fitness bit for bit (tests/test_numerics.py).
+On a 3-RPS FK problem with numba installed (unless ``FKOPT_NUMERICS=numpy``), fkopt's own ABC and
+GABC (raw selection) run each iteration compiled instead (:func:`fkopt.numerics.compiled.abc_rps3`:
+the same draws in one block per iteration, the same operations, numpy's own ``np.tan``, the
+evaluation log's bookkeeping and the best-so-far inside); its records equal these phases bit for
+bit (tests/test_numerics.py).
 """
 from __future__ import annotations
 
@@ -224,7 +225,7 @@ class ABC(Algorithm):
 
     def iterate(self, state, problem, streams):
         fused = self._compiled_iteration(problem)
-        if fused is not None:                      # FKOPT_NUMERICS=compiled on a built-in fitness
+        if fused is not None:                      # a built-in fitness with a compiled iteration
             return self._iterate_compiled(state, problem, streams, *fused)
         # The scout of the previous iteration's trials flies first; its fresh source is
         # evaluated together with the employed candidates (one fitness call, not two).
@@ -249,7 +250,7 @@ class ABC(Algorithm):
     def _iterate_compiled(self, state, problem, streams, step, absolute, rule):
         """:meth:`iterate` in one compiled pass (:func:`fkopt.numerics.compiled.abc_rps3`): the
         same draws (one block per iteration holding the phases' draws in their order), the same
-        operations, the same log reports; the fitness' ``tan`` may be an ulp from numpy's."""
+        operations (numpy's ``np.tan`` included), the same log reports, the best-so-far folded in."""
         _aux(state, problem)                        # x, f, trial: C-contiguous arrays of our own
         runs, population, dim = state.x.shape
         per_phase = (4 if rule == 2 else 3) * population
@@ -257,14 +258,16 @@ class ABC(Algorithm):
         if problem.cases is not None:
             problem._check_cases(state.x)
         J = problem._joint_rows(state.x.shape[:-1])
-        # GABC refreshes the best-so-far between the phases: new arrays, as update_best makes
-        best_x, best_f = (state.best_x, state.best_f) if rule == 0 else (state.best_x.copy(), state.best_f.copy())
+        # the best-so-far is refreshed in the pass (GABC's between the phases and minimize's
+        # update_best after them): new arrays, as update_best makes
+        best_x, best_f = state.best_x.copy(), state.best_f.copy()
         C = getattr(self.params, "C", 0.0)
         # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
+        # (a target per row: the numpy path evaluates the fresh scouts in a fitness call of their own)
         scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
-                           problem.bounds, J, absolute, log_arrays(state, runs))
+                           problem.bounds, J, absolute, log_arrays(state, runs), problem.cases is not None)
         log_kept(state, kept)
-        state.best_x, state.best_f = best_x, best_f
+        state.best_x, state.best_f, state.best_folded = best_x, best_f, True
         state.evaluations = state.evaluations + (2 * population + scout)
 
     def step(self, state, xs, xk, phi, streams):

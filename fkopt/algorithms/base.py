@@ -52,6 +52,8 @@ class State:
     best_x: np.ndarray | None = None
     best_f: np.ndarray | None = None
     log: "EvaluationLog | None" = None   # set by Algorithm.minimize: see evaluated()
+    # a compiled iteration already folded x/f into best_x/best_f (Algorithm.update_best's rule)
+    best_folded: bool = False
 
 
 @dataclass
@@ -203,10 +205,10 @@ def rows_of(problem, rows: np.ndarray):
 
 def compiled_step(problem, kind: str):
     """(compiled iteration, absolute objective) when the problem's mechanism offers one for the
-    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness under
-    ``FKOPT_NUMERICS=compiled``) and the problem is a plain FK problem of three variables without
-    angle-valued joints, else None. The same operations as the numpy iteration; the fitness'
-    ``tan`` may be an ulp from numpy's (tests/test_numerics.py)."""
+    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness unless
+    ``FKOPT_NUMERICS=numpy`` or numba is missing) and the problem is a plain FK problem of three
+    variables without angle-valued joints, else None. The same operations as the numpy
+    iteration, numpy's own ``np.tan`` included: the same bits (tests/test_numerics.py)."""
     # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
     # or a caller may change the variable between iterations).
     key = (kind, os.environ.get(_NUMERICS_ENV))
@@ -318,8 +320,12 @@ class Algorithm:
         """Fold the memory ``state.x``/``state.f`` into the best-so-far of each run.
 
         The first minimum of each run wins; arrays are replaced (never written in place), and
-        only when some run improved.
+        only when some run improved. A compiled iteration that did this already (the same rule,
+        into new arrays) sets ``state.best_folded``; the call then only clears it.
         """
+        if getattr(state, "best_folded", False):
+            state.best_folded = False
+            return
         f = state.f
         runs, population = f.shape
         flat = f.argmin(axis=1)

@@ -57,6 +57,7 @@ class HybridState:
     best_x = _swarm_field("best_x")
     best_f = _swarm_field("best_f")
     log = _swarm_field("log")
+    best_folded = _swarm_field("best_folded")
 
 
 class HybridParams(Params):

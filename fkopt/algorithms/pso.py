@@ -61,6 +61,7 @@ class PSOState(State):
     vel: np.ndarray                    # (runs, population, dim) velocities
     t: int = 0                         # iterations done
     span: int | None = None            # iterations of the linear inertia schedule
+    clamp_box: tuple | None = None     # (velocity clamp, bounds) of the compiled iteration, made once
 
 
 class PSO(Algorithm):
@@ -103,15 +104,19 @@ class PSO(Algorithm):
         runs, population, dim = state.x.shape
         r = streams.uniform(2, population, dim)     # a fresh view: ours to overwrite
         fused = self._compiled_step(problem)
-        if fused is not None:                      # FKOPT_NUMERICS=compiled on a built-in fitness
+        if fused is not None:                      # a built-in fitness with a compiled iteration
             step, absolute = fused
             if problem.cases is not None:
                 problem._check_cases(state.pos)
             J = problem._joint_rows(state.pos.shape[:-1])     # the fitness' target rows
-            # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
-            state.x, state.f, state.pos, state.vel, _, kept = step(
-                state.x, state.f, state.pos, state.vel, state.best_x, r, self.inertia_weight(state), p.c1, p.c2,
-                self.velocity_limit(problem.bounds), problem.bounds, J, absolute, log_arrays(state, runs))
+            if state.clamp_box is None:            # the clamp and box as the kernel reads them, once
+                state.clamp_box = (np.ascontiguousarray(self.velocity_limit(problem.bounds), dtype=float),
+                               np.ascontiguousarray(problem.bounds, dtype=float))
+            # the evaluation log's bookkeeping and update_best run in the same pass
+            state.x, state.f, state.pos, state.vel, state.best_x, state.best_f, kept = step(
+                state.x, state.f, state.pos, state.vel, state.best_x, state.best_f, r, self.inertia_weight(state),
+                p.c1, p.c2, *state.clamp_box, J, absolute, log_arrays(state, runs))
+            state.best_folded = True
             log_kept(state, kept)
             state.evaluations = state.evaluations + population
             return

@@ -22,6 +22,13 @@ times measured here:
   (5: the fewest with which a rank test can reach p < 0.05). This keeps ``make reproduce``
   within its budget: the budget only shortens the samples of tasks whose runs take more than
   ``TIMING_BUDGET_S / TIMING_RUNS`` each, and those still get 5 runs.
+* **Path**: every timed run runs on the numpy reference path (``FKOPT_NUMERICS=numpy``,
+  :func:`fkopt.numerics.path.forced`), whatever path solved the runs. Compiled kernels exist for
+  some algorithms and mechanisms only (PSO, ABC and GABC on 3-RPS; the one-pose IK loop), and a
+  time claim compares algorithms, not how much of each fkopt compiled: with ABC compiled and
+  ACO not, "ABC takes longer than ACO" would be judged on fkopt's engineering. The runs are the
+  same on both paths (bit for bit, tests/test_numerics.py); only their time differs, and the
+  compiled path's speed is measured by ``fkopt bench`` against its peers.
 * **Spread**: the sample's median and quartiles are reported; two algorithms' times differ only
   if a two-sided Mann-Whitney rank test over the sampled runs rejects equality at alpha = 0.05
   (verdict *within noise* otherwise; see :mod:`fkopt.reproduce.claims`).
@@ -35,6 +42,7 @@ import time
 
 import numpy as np
 
+from ..numerics.path import forced
 from ..solve import solve
 
 #: Timed runs per algorithm (spread over the first TIMING_RUNS cases; see the module docstring).
@@ -61,6 +69,11 @@ def time_case(config, timed: list[tuple], per: int) -> list[np.ndarray]:
     falls on every algorithm alike instead of on whichever was timed then. One planned timing task
     of an experiment (:func:`fkopt.experiment.runner.experiment_plan`) is one call.
     """
+    with forced("numpy"):            # one implementation path for every algorithm (module docstring)
+        return _time_case(config, timed, per)
+
+
+def _time_case(config, timed: list[tuple], per: int) -> list[np.ndarray]:
     kwargs = [_kwargs(config, spec, problem, seed) for spec, problem, seed in timed]
     for (spec, problem, _), kw in zip(timed, kwargs):
         solve(problem, spec.name, iterations=2, run_ids=[0], **kw)   # warm-up, untimed

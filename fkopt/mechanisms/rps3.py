@@ -214,42 +214,50 @@ class ThreeRPS(ParallelMechanism):
 
     def compiled_fitness(self, poses, rows, absolute: bool):
         """The fitness of :meth:`fkopt.problems.FKProblem.fitness` of poses (n, 3) against leg rows
-        (3, 1) or (3, n) in one compiled pass (:func:`fkopt.numerics.compiled.rps3_fitness`), or
-        None unless ``FKOPT_NUMERICS=compiled`` asks for it: its ``tan`` is the C library's, which
-        may differ from numpy's SIMD one by an ulp, and a swarm amplifies an ulp into another
-        run, so the default keeps numpy's bits (the stored results') and importing numba (~0.9 s)
-        pays only in long runs. Tested to 1e-9 relative against the numpy path per evaluation,
-        and on swarm outcomes (tests/test_numerics.py)."""
+        (3, 1) or (3, n) compiled (:func:`fkopt.numerics.compiled.rps3_fitness`: numpy's ``np.tan``
+        in this method's layout, the rest compiled, so the numpy path's bits), or None unless
+        ``FKOPT_NUMERICS=compiled`` asks for it: importing numba (~0.5-0.9 s) does not pay for
+        one fitness call (the swarm iterations compile on their own, :meth:`compiled_pso_step`)."""
         if numerics_path.requested() != "compiled":
             return None
         mod = numerics_path.compiled(True)
-        return mod.rps3_fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute)
+        return mod.rps3_fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute, BLOCK)
+
+    def _swarm_kernels(self):
+        """:mod:`fkopt.numerics.compiled` for the compiled swarm iterations, or None: with
+        ``FKOPT_NUMERICS=numpy``, or without numba under the default (``auto``; ``compiled``
+        makes a missing numba an error). numba is imported here, on the first swarm iteration on
+        this mechanism, never for a single fitness call."""
+        return numerics_path.compiled()
 
     def compiled_pso_step(self):
         """A function (state arrays, ...) -> new arrays running one PSO iteration with this fitness
         compiled (:func:`fkopt.numerics.compiled.pso_rps3`, same arguments after the fitness'
-        leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as :meth:`compiled_fitness`)."""
-        if numerics_path.requested() != "compiled":
+        leg radii; numpy's ``np.tan`` in the numpy path's layout, so the numpy path's bits), or
+        None (:meth:`_swarm_kernels`)."""
+        mod = self._swarm_kernels()
+        if mod is None:
             return None
-        mod = numerics_path.compiled(True)
         ra, rb = self.geometry.ra, self.geometry.rb
 
-        def step(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, absolute, log):
-            return mod.pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log)
+        def step(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, absolute, log):
+            return mod.pso_rps3(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log,
+                                BLOCK)
         return step
 
     def compiled_abc_step(self):
-        """A function (state arrays, ..., log arrays) -> (scouts, log improvements), running one
-        ABC or GABC iteration with this fitness compiled (:func:`fkopt.numerics.compiled.abc_rps3`, same
-        arguments after the fitness' leg radii), or None unless ``FKOPT_NUMERICS=compiled`` (as
-        :meth:`compiled_fitness`)."""
-        if numerics_path.requested() != "compiled":
+        """A function (state arrays, ..., log arrays, separate) -> (scouts, log improvements),
+        running one ABC or GABC iteration with this fitness compiled
+        (:func:`fkopt.numerics.compiled.abc_rps3`, same arguments after the fitness' leg radii;
+        numpy's tangents as in :meth:`compiled_pso_step`), or None (:meth:`_swarm_kernels`)."""
+        mod = self._swarm_kernels()
+        if mod is None:
             return None
-        mod = numerics_path.compiled(True)
         ra, rb = self.geometry.ra, self.geometry.rb
 
-        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log):
-            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log)
+        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate):
+            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log,
+                                separate, BLOCK)
         return step
 
     def jacobian(self, poses) -> np.ndarray:

@@ -11,7 +11,8 @@ load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
 * :func:`rps3_fitness`, :func:`pso_rps3`, :func:`abc_rps3` -- the 3-RPS swarm fitness and the PSO
-  and ABC/GABC iterations on it (``FKOPT_NUMERICS=compiled``). These compile with
+  and ABC/GABC iterations on it (the default path; numpy's own ``np.tan`` between a move and a
+  finish kernel, so the numpy path's bits: :func:`numpy_tan`). These compile with
   ``error_model="numpy"``: a float division by zero gives numpy's inf/NaN instead of a Python
   exception, so no check guards each division (half of the fitness' time, measured: 57 -> 29 ns
   per point); the values are the same wherever the divisor is not zero;
@@ -21,6 +22,7 @@ load the cache.
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 from numba import njit
@@ -366,7 +368,8 @@ def _nearest_into(Ft, norms, f, idx, best):
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`), the
+    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
+    a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
     start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
@@ -375,12 +378,17 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
     r2d = 180.0 / math.pi
-    a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
-    ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
     T = np.empty((3, 3))
-    T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
-    T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
-    T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
+    if pose.shape[0] == 12:                        # a frame row: the rotation as given, row-major
+        for r in range(3):
+            for c in range(3):
+                T[r, c] = pose[3 + 3 * r + c]
+    else:
+        a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
+        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+        T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+        T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+        T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
     pt = pose[:3].copy()
     near = np.empty((nn, n))
     if nn > 0:
@@ -470,15 +478,13 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
 
 
 @njit(cache=True, error_model="numpy")
-def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
-    """Fitness of one 3-RPS pose (alpha, beta in deg, z) against legs (j0, j1, j2): the operations
-    of :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` in their order, then
-    :meth:`fkopt.problems.FKProblem.fitness` (sum of squared or absolute residuals). ``tan`` is
-    the C library's; numpy's (SIMD) may differ from it by an ulp (see tests/test_numerics.py)."""
-    half = math.pi / 360.0
+def _rps3_tan(ta, tb, z, j0, j1, j2, ra, rb, absolute):
+    """Fitness of one 3-RPS pose from its half-angle tangents ta = tan(alpha/2), tb = tan(beta/2)
+    (alpha, beta in rad) and z, against legs (j0, j1, j2): the operations of
+    :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` after its ``np.tan`` in their order, then
+    :meth:`fkopt.problems.FKProblem.fitness` (sum of squared or absolute residuals)."""
     s3 = 0.5 * math.sqrt(3.0)
     pm_rb, pm_2 = s3 * rb, -2.0 * s3
-    ta, tb = math.tan(p0 * half), math.tan(p1 * half)
     ta2, tb2 = ta * ta, tb * tb
     ra_, rb_ = 1.0 / (1.0 + ta2), 1.0 / (1.0 + tb2)
     sa, sb = (ta + ta) * ra_, (tb + tb) * rb_
@@ -510,88 +516,108 @@ def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
     return (r1 * r1 + r2 * r2) + r3 * r3
 
 
+#: Degrees -> half-angle in radians (the factor :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` uses).
+_HALF_DEG = math.pi / 360.0
+
+
 @njit(cache=True, error_model="numpy")
-def _rps3_fitness(P, J, ra, rb, absolute, out):
-    """:func:`_rps3_point` of poses P (n, 3) against leg rows J (3, 1) or (3, n) into out (n,)."""
+def _rps3_point(p0, p1, z, j0, j1, j2, ra, rb, absolute):
+    """Fitness of one 3-RPS pose (alpha, beta in deg, z) against legs (j0, j1, j2) with the C
+    library's ``tan`` (:func:`_rps3_tan`): numpy's (SIMD) may differ from it by an ulp, so this
+    serves only callers that want one point per call (the pygmo bench row); the fitness of
+    :func:`rps3_fitness` and the swarm iterations take numpy's tangents (:func:`numpy_tan`)."""
+    return _rps3_tan(math.tan(p0 * _HALF_DEG), math.tan(p1 * _HALF_DEG), z, j0, j1, j2, ra, rb, absolute)
+
+
+# -- numpy's tangents in a compiled iteration ---------------------------------------------------
+# A swarm turns an ulp into another run, and numpy's tan (SIMD code on some machines) may be an
+# ulp from the C library's on ~0.7 % of inputs. So the compiled iterations stop where the numpy
+# path calls np.tan: a move kernel writes the half-angle arguments of the candidates into a
+# buffer laid out as the numpy path's own call sees them (ThreeRPS.ik_columns: per block of at most
+# `block` poses of one fitness call, the block's alphas, then its betas, contiguous), numpy_tan
+# runs np.tan on each such block, and a finish kernel computes the rest of the fitness from the
+# tangents (_rps3_tan). The same ufunc on the same values at the same positions of arrays of the
+# same lengths: the numpy path's bits on any build, whether its SIMD loop has a scalar tail or not.
+
+@njit(cache=True)
+def _slot(c, s0, sl, block):
+    """(position of alpha's argument, offset of beta's from it) in the tangent buffer of pose c
+    of a fitness call over poses [s0, s0 + sl), cut into blocks of ``block`` poses."""
+    k = c - s0
+    if sl <= block:                    # one block (the usual case): no integer division
+        return 2 * s0 + k, sl
+    first = (k // block) * block
+    return 2 * (s0 + first) + (k - first), min(block, sl - first)
+
+
+def numpy_tan(arg, out, segments, block):
+    """``np.tan`` of the argument buffer ``arg`` into ``out`` as the numpy path calls it: for each
+    fitness call (start pose, poses) in ``segments``, one call per block of at most ``block``
+    poses on that block's contiguous [alphas, betas]."""
+    tan = np.tan
+    for s0, sl in segments:
+        for b0 in range(0, sl, block):
+            s, e = 2 * (s0 + b0), 2 * (s0 + min(b0 + block, sl))
+            tan(arg[s:e], out[s:e])
+
+
+@njit(cache=True, error_model="numpy")
+def _rps3_args(P, arg, block):
+    """The half-angle arguments of poses P (n, 3) into ``arg`` as one fitness call (:func:`_slot`)."""
+    n = P.shape[0]
+    for i in range(n):
+        s, off = _slot(i, 0, n, block)
+        arg[s] = P[i, 0] * _HALF_DEG
+        arg[s + off] = P[i, 1] * _HALF_DEG
+
+
+@njit(cache=True, error_model="numpy")
+def _rps3_from_tan(P, tan, J, ra, rb, absolute, out, block):
+    """:func:`_rps3_tan` of poses P (n, 3) with numpy's tangents ``tan`` (:func:`_rps3_args`'
+    layout) against leg rows J (3, 1) or (3, n) into out (n,)."""
+    n = P.shape[0]
     one = J.shape[1] == 1
-    for i in range(P.shape[0]):
+    for i in range(n):
         c = 0 if one else i
-        out[i] = _rps3_point(P[i, 0], P[i, 1], P[i, 2], J[0, c], J[1, c], J[2, c], ra, rb, absolute)
+        s, off = _slot(i, 0, n, block)
+        out[i] = _rps3_tan(tan[s], tan[s + off], P[i, 2], J[0, c], J[1, c], J[2, c], ra, rb, absolute)
 
 
-@njit(cache=True, error_model="numpy")
-def _pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, lo, hi, J, ra, rb, absolute, nx, nf, npos, nvel, fout,
-              lbest, lcount, lactive, hr, he, hf):
-    """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem, every run
-    and particle in one pass: velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations
-    in their order), clamp, move, clip onto the box (velocity zeroed where clipped), the
-    fitness (:func:`_rps3_point`) and the personal best; new arrays nx, nf, npos, nvel, fout; the
-    fitness reported to the evaluation log held as arrays (:func:`_log_points`). Returns the
-    number of improvements the log keeps."""
-    runs, pop, dim = pos.shape
-    one = J.shape[1] == 1
-    nh = 0
-    for a in range(runs):
-        for i in range(pop):
-            for d in range(dim):
-                v = vel[a, i, d] * w + (r[a, 0, i, d] * c1) * (x[a, i, d] - pos[a, i, d])
-                v = v + (r[a, 1, i, d] * c2) * (g[a, d] - pos[a, i, d])
-                v = min(max(v, -limit[d]), limit[d])
-                mv = pos[a, i, d] + v
-                cp = min(max(mv, lo[d]), hi[d])
-                nvel[a, i, d] = 0.0 if cp != mv else v
-                npos[a, i, d] = cp
-            c = 0 if one else a * pop + i
-            f = _rps3_point(npos[a, i, 0], npos[a, i, 1], npos[a, i, 2], J[0, c], J[1, c], J[2, c], ra, rb,
-                            absolute)
-            fout[a, i] = f
-            if f < fb[a, i]:
-                nf[a, i] = f
-                for d in range(dim):
-                    nx[a, i, d] = npos[a, i, d]
-            else:
-                nf[a, i] = fb[a, i]
-                for d in range(dim):
-                    nx[a, i, d] = x[a, i, d]
-        nh = _log_points(a, fout[a], lbest, lcount, lactive, hr, he, hf, nh)
-    return nh
-
-
-def pso_rps3(x, fb, pos, vel, g, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log):
-    """:func:`_pso_rps3`: (personal bests x, their fitness, positions, velocities, fitness of the
-    positions), all new arrays, and (rows, evaluation numbers, values) of the improvements kept
-    by ``log`` (best, count, active arrays updated in place, as :func:`abc_rps3`)."""
-    nx, nf, npos, nvel, fout = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel), \
-        np.empty_like(fb)
-    most = fb.size
-    hr, he, hf = np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most)
-    best, count, active = log
-    nh = _pso_rps3(x, fb, pos, vel, np.ascontiguousarray(g), r, float(w), float(c1), float(c2),
-                   np.ascontiguousarray(limit, dtype=float), np.ascontiguousarray(bounds[:, 0], dtype=float),
-                   np.ascontiguousarray(bounds[:, 1], dtype=float), np.ascontiguousarray(J, dtype=float), float(ra),
-                   float(rb), bool(absolute), nx, nf, npos, nvel, fout, best, count, active, hr, he, hf)
-    return nx, nf, npos, nvel, fout, (hr[:nh], he[:nh], hf[:nh])
-
-
-def rps3_fitness(P, J, ra, rb, absolute):
-    """:func:`_rps3_fitness` of poses (n, 3) against leg rows J: fitness (n,)."""
-    out = np.empty(P.shape[0])
-    _rps3_fitness(np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(J, dtype=float), float(ra), float(rb),
-                  bool(absolute), out)
+def rps3_fitness(P, J, ra, rb, absolute, block):
+    """The 3-RPS fitness of poses (n, 3) against leg rows J (3, 1) or (3, n): fitness (n,), the
+    numpy path's bits (numpy's tangents in its layout, :func:`numpy_tan`; ``block``: the poses
+    per block of the numpy fitness)."""
+    P = np.ascontiguousarray(P, dtype=float)
+    n = P.shape[0]
+    out, arg, tan = np.empty(n), np.empty(2 * n), np.empty(2 * n)
+    _rps3_args(P, arg, block)
+    numpy_tan(arg, tan, ((0, n),), block)
+    _rps3_from_tan(P, tan, np.ascontiguousarray(J, dtype=float), float(ra), float(rb), bool(absolute), out, block)
     return out
 
 
-@njit(cache=True, error_model="numpy")
-def _abc_move(xs, xk, xb, phi, psi, rule):
-    """The neighbour move of :meth:`fkopt.algorithms.abc.ABC.move` (rule 0) and
-    :meth:`fkopt.algorithms.gabc.GABC.move` (1: mao2017 eq. 19, 2: zhu2010 with psi = C u) on one
-    coordinate, numpy's operations in their order, before clipping."""
-    out = (xs - xk) * phi
-    if rule == 1:
-        out = out + (xb - xk) * phi
-    elif rule == 2:
-        out = out + (xb - xs) * psi
-    return xs + out
+_scratch = threading.local()
+
+
+def _scratch_arrays(key, make):
+    """This thread's scratch arrays for ``key`` (the kind and shape of an iteration), made by
+    ``make()`` on first use: a swarm iteration's buffers are the same every iteration, and a
+    dozen allocations cost about as much as a kernel's call. Nothing returned to a caller
+    lives in them (see :func:`_kept`)."""
+    cache = getattr(_scratch, "arrays", None)
+    if cache is None:
+        cache = _scratch.arrays = {}
+    got = cache.get(key)
+    if got is None:
+        if len(cache) >= 16:           # a few shapes at a time (memory stays bounded)
+            cache.clear()
+        got = cache[key] = make()
+    return got
+
+
+def _kept(hr, he, hf, nh):
+    """The log's improvements (rows, evaluation numbers, values) out of the scratch arrays, as new arrays."""
+    return hr[:nh].copy(), he[:nh].copy(), hf[:nh].copy()
 
 
 @njit(cache=True, error_model="numpy")
@@ -616,36 +642,154 @@ def _log_points(a, vals, lbest, lcount, lactive, hr, he, hf, nh):
 
 
 @njit(cache=True, error_model="numpy")
-def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb, absolute, fe, fs, scout, fo,
-              lbest, lcount, lactive, hr, he, hf):
-    """One iteration of :meth:`fkopt.algorithms.abc.ABC.iterate` (scout, employed, onlooker;
-    GABC's best-so-far refreshed between the phases, rules 1 and 2) on a 3-RPS FK problem, run by
-    run, with the fitness :func:`_rps3_point` (NaN read as +inf, as ``np.fmin(f, inf)``).
+def _fold_best(a, x, f, best_x, best_f):
+    """:meth:`fkopt.algorithms.base.Algorithm.update_best` of run ``a``: its first minimum of f
+    (a NaN first, as ``argmin``), if below best_f[a], into best_x[a], best_f[a]."""
+    pop, dim = x.shape[1], x.shape[2]
+    b = 0
+    for i in range(pop):
+        if f[a, i] != f[a, i]:
+            b = i
+            break
+        if f[a, i] < f[a, b]:
+            b = i
+    if f[a, b] < best_f[a]:
+        best_f[a] = f[a, b]
+        for d in range(dim):
+            best_x[a, d] = x[a, b, d]
 
-    ``u`` (runs, D): the iteration's uniforms of each run in the order of the abc module's
-    docstring (scout dim, employed 3 SN [+ SN psi], onlooker SN roulette, 3 SN [+ SN psi]).
-    Updates x, f, trial and (rules 1, 2) best_x, best_f in place; writes the employed candidates'
-    fitness fe (runs, SN), the scout's fresh fitness fs (runs,) with scout (runs,) 1 where one
-    flew, and the onlooker candidates' fitness fo (runs, SN); and reports them, in that order, to
-    the evaluation log held as arrays (:func:`_log_points`; the log's best lbest, count lcount,
-    active runs lactive, improvements into hr, he, hf). Returns the number of improvements."""
-    runs, pop, dim = x.shape
+
+@njit(cache=True, error_model="numpy")
+def _pso_move(x, pos, vel, g, r, w, c1, c2, limit, bounds, npos, nvel, arg, block):
+    """The move of :meth:`fkopt.algorithms.pso.PSO.iterate`, every run and particle in one pass:
+    velocity w v + (c1 r1)(p - x) + (c2 r2)(g - x) (numpy's operations in their order), clamp,
+    move, clip onto the box (velocity zeroed where clipped) into npos, nvel; the half-angle
+    arguments of the new positions into ``arg`` (one fitness call, :func:`_slot`)."""
+    runs, pop, dim = pos.shape
+    n = runs * pop
+    for a in range(runs):
+        for i in range(pop):
+            for d in range(dim):
+                v = vel[a, i, d] * w + (r[a, 0, i, d] * c1) * (x[a, i, d] - pos[a, i, d])
+                v = v + (r[a, 1, i, d] * c2) * (g[a, d] - pos[a, i, d])
+                v = min(max(v, -limit[d]), limit[d])
+                mv = pos[a, i, d] + v
+                cp = min(max(mv, bounds[d, 0]), bounds[d, 1])
+                nvel[a, i, d] = 0.0 if cp != mv else v
+                npos[a, i, d] = cp
+            s, off = _slot(a * pop + i, 0, n, block)
+            arg[s] = npos[a, i, 0] * _HALF_DEG
+            arg[s + off] = npos[a, i, 1] * _HALF_DEG
+
+
+@njit(cache=True, error_model="numpy")
+def _pso_finish(x, fb, npos, tan, J, ra, rb, absolute, nx, nf, fout, best_x, best_f, lbest, lcount, lactive, hr,
+                he, hf, block):
+    """The rest of a PSO iteration after numpy's tangents ``tan``: the fitness of the positions
+    (:func:`_rps3_tan`) into fout, the personal bests into nx, nf, the fitness reported to the
+    evaluation log held as arrays (:func:`_log_points`), and the personal bests folded into the
+    best-so-far best_x, best_f (:func:`_fold_best`). Returns the number of improvements the log
+    keeps."""
+    runs, pop, dim = npos.shape
+    n = runs * pop
     one = J.shape[1] == 1
-    zhu = rule == 2
-    block = (4 if zhu else 3) * pop
-    v = np.empty(dim)
-    src = np.empty(pop, dtype=np.int64)
-    jj = np.empty(pop, dtype=np.int64)
-    mv = np.empty(pop)
-    bs = np.empty(pop)
-    first = np.empty(pop, dtype=np.int64)
-    cdf = np.empty(pop)
     nh = 0
     for a in range(runs):
-        c = 0 if one else a * pop
-        j0, j1, j2 = J[0, c], J[1, c], J[2, c]
-        # -- scout: the source with the most trials (first of equals) if they exceed limit
-        scout[a] = 0
+        for i in range(pop):
+            c = 0 if one else a * pop + i
+            s, off = _slot(a * pop + i, 0, n, block)
+            f = _rps3_tan(tan[s], tan[s + off], npos[a, i, 2], J[0, c], J[1, c], J[2, c], ra, rb, absolute)
+            fout[a, i] = f
+            if f < fb[a, i]:
+                nf[a, i] = f
+                for d in range(dim):
+                    nx[a, i, d] = npos[a, i, d]
+            else:
+                nf[a, i] = fb[a, i]
+                for d in range(dim):
+                    nx[a, i, d] = x[a, i, d]
+        nh = _log_points(a, fout[a], lbest, lcount, lactive, hr, he, hf, nh)
+        _fold_best(a, nx, nf, best_x, best_f)
+    return nh
+
+
+def pso_rps3(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log, block):
+    """One iteration of :meth:`fkopt.algorithms.pso.PSO.iterate` on a 3-RPS FK problem
+    (:func:`_pso_move`, :func:`numpy_tan`, :func:`_pso_finish`): (personal bests x, their fitness,
+    positions, velocities, best-so-far point and fitness (``g`` with the new personal bests folded
+    in: :meth:`fkopt.algorithms.base.Algorithm.update_best`)), all new arrays, and (rows, evaluation numbers, values) of the improvements kept by ``log`` (best,
+    count, active arrays updated in place, as :func:`abc_rps3`). ``g``, ``g_f``: the best-so-far
+    point and fitness (the global best); ``limit``, ``bounds``: C-contiguous float arrays (dim,),
+    (dim, 2); ``block``: the poses per block of the numpy fitness."""
+    nx, nf, npos, nvel = np.empty_like(x), np.empty_like(fb), np.empty_like(pos), np.empty_like(vel)
+    n = fb.size
+    fout, arg, tan, hr, he, hf = _scratch_arrays(
+        ("pso", fb.shape), lambda: (np.empty(fb.shape), np.empty(2 * n), np.empty(2 * n), np.empty(n, dtype=np.intp),
+                                    np.empty(n, dtype=np.int64), np.empty(n)))
+    best, count, active = log
+    best_x, best_f = np.array(g, dtype=float, order="C"), np.array(g_f, dtype=float)
+    _pso_move(x, pos, vel, best_x, r, float(w), float(c1), float(c2), limit, bounds, npos, nvel, arg, block)
+    numpy_tan(arg, tan, ((0, n),), block)
+    nh = _pso_finish(x, fb, npos, tan, J, float(ra), float(rb), bool(absolute), nx, nf, fout, best_x, best_f, best,
+                     count, active, hr, he, hf, block)
+    return nx, nf, npos, nvel, best_x, best_f, _kept(hr, he, hf, nh)
+
+
+@njit(cache=True, error_model="numpy")
+def _abc_move(xs, xk, xb, phi, psi, rule):
+    """The neighbour move of :meth:`fkopt.algorithms.abc.ABC.move` (rule 0) and
+    :meth:`fkopt.algorithms.gabc.GABC.move` (1: mao2017 eq. 19, 2: zhu2010 with psi = C u) on one
+    coordinate, numpy's operations in their order, before clipping."""
+    out = (xs - xk) * phi
+    if rule == 1:
+        out = out + (xb - xk) * phi
+    elif rule == 2:
+        out = out + (xb - xs) * psi
+    return xs + out
+
+
+@njit(cache=True, error_model="numpy")
+def _abc_moves(x, best_x, u, o, a, src, rule, C, lo, hi, jj, mv, arg, base, n, block):
+    """The moves of one phase of run ``a`` (uniforms of the block at ``u[a, o:]``): bee i moves
+    coordinate j of source src[i] against a neighbour k != src[i], clipped, into jj[a], mv[a];
+    the candidate (the source with that coordinate moved) is pose base + i of a fitness call
+    over poses [0, n), whose half-angle arguments go into ``arg`` (:func:`_slot`)."""
+    pop, dim = x.shape[1], x.shape[2]
+    zhu = rule == 2
+    for i in range(pop):
+        s = src[i]
+        j = int(u[a, o + i] * dim)
+        k = int(u[a, o + pop + i] * (pop - 1))
+        if k >= s:
+            k += 1
+        phi = u[a, o + 2 * pop + i] * 2.0 - 1.0
+        psi = C * u[a, o + 3 * pop + i] if zhu else 0.0
+        m = _abc_move(x[a, s, j], x[a, k, j], best_x[a, j], phi, psi, rule)
+        m = min(max(m, lo[j]), hi[j])
+        jj[a, i] = j
+        mv[a, i] = m
+        p, off = _slot(base + i, 0, n, block)
+        arg[p] = (m if j == 0 else x[a, s, 0]) * _HALF_DEG
+        arg[p + off] = (m if j == 1 else x[a, s, 1]) * _HALF_DEG
+
+
+@njit(cache=True, error_model="numpy")
+def _abc_employed_move(x, trial, best_x, u, limit, rule, C, lo, hi, separate, jj, mv, scout, arg, block):
+    """Scout and employed moves of :meth:`fkopt.algorithms.abc.ABC.iterate` for every run, up to
+    numpy's tangents. ``u`` (runs, D): the iteration's uniforms of each run in the order of the
+    abc module's docstring (scout dim, employed 3 SN [+ SN psi], onlooker SN roulette, 3 SN [+ SN
+    psi]). The scout (the source with the most trials, first of equals, if they exceed limit) is
+    placed in x, its trials reset, scout[a] its source's index or -1; the employed bees' moves go
+    into jj, mv (all from the sources as they stand, the scout's fresh one included). The
+    arguments go into ``arg`` as the numpy path's fitness calls see them: candidates as poses
+    [0, runs SN), the fresh scouts, in run order, after them in the same call (``separate``
+    False) or in a call of their own (True: a target per row). Returns the number of scouts."""
+    runs, pop, dim = x.shape
+    n = runs * pop
+    src = np.arange(pop)
+    ns = 0
+    for a in range(runs):
+        scout[a] = -1
         s = 0
         over = False
         for i in range(pop):
@@ -657,47 +801,69 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
             for d in range(dim):
                 x[a, s, d] = lo[d] + u[a, d] * (hi[d] - lo[d])
             trial[a, s] = 0
-            g = _rps3_point(x[a, s, 0], x[a, s, 1], x[a, s, 2], j0, j1, j2, ra, rb, absolute)
+            scout[a] = s
+            ns += 1
+    for a in range(runs):
+        _abc_moves(x, best_x, u, dim, a, src, rule, C, lo, hi, jj, mv, arg, a * pop, n if separate else n + ns,
+                   block)
+    c = n
+    for a in range(runs):
+        if scout[a] >= 0:
+            p, off = _slot(c, n if separate else 0, ns if separate else n + ns, block)
+            arg[p] = x[a, scout[a], 0] * _HALF_DEG
+            arg[p + off] = x[a, scout[a], 1] * _HALF_DEG
+            c += 1
+    return ns
+
+
+@njit(cache=True, error_model="numpy")
+def _abc_employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, ra, rb, absolute, separate, ns, jj, mv,
+                         scout, tan, fe, fo_src, fo_jj, fo_mv, arg, lbest, lcount, lactive, hr, he, hf, block):
+    """After numpy's tangents ``tan`` of :func:`_abc_employed_move`'s arguments, for every run:
+    the fitness of the fresh scout and of the employed candidates (NaN read as +inf, as
+    ``np.fmin(f, inf)``) into fe, the greedy selection, the reports to the evaluation log held
+    as arrays (employed, then the scout: :func:`_log_points`), GABC's best-so-far (rules 1, 2),
+    the onlookers' roulette into fo_src and their moves into fo_jj, fo_mv with their arguments
+    in ``arg`` (one call of runs SN poses). Returns the number of improvements the log keeps."""
+    runs, pop, dim = x.shape
+    n = runs * pop
+    one = J.shape[1] == 1
+    block4 = (4 if rule == 2 else 3) * pop
+    cdf = np.empty(pop)
+    fs = np.empty(1)
+    nh = 0
+    c_scout = n
+    for a in range(runs):
+        c = 0 if one else a * pop
+        j0, j1, j2 = J[0, c], J[1, c], J[2, c]
+        s = scout[a]
+        if s >= 0:
+            p, off = _slot(c_scout, n if separate else 0, ns if separate else n + ns, block)
+            c_scout += 1
+            g = _rps3_tan(tan[p], tan[p + off], x[a, s, 2], j0, j1, j2, ra, rb, absolute)
             if g != g:
                 g = np.inf
-            fs[a] = g
-            scout[a] = 1
-        # -- employed: bee i moves coordinate j of source i against neighbour k != i (all
-        # candidates from the sources as they stand, the scout's fresh one included)
-        o = dim
-        for i in range(pop):
-            j = int(u[a, o + i] * dim)
-            k = int(u[a, o + pop + i] * (pop - 1))
-            if k >= i:
-                k += 1
-            phi = u[a, o + 2 * pop + i] * 2.0 - 1.0
-            psi = C * u[a, o + 3 * pop + i] if zhu else 0.0
-            m = _abc_move(x[a, i, j], x[a, k, j], best_x[a, j], phi, psi, rule)
-            m = min(max(m, lo[j]), hi[j])
-            jj[i] = j
-            mv[i] = m
-        if over:
-            f[a, s] = fs[a]
+            fs[0] = g
+            f[a, s] = g
         # candidate i is source i with coordinate jj[i] moved; the greedy step of bee i changes
-        # source i only, so each bee is evaluated and selected in one pass (the moves above read
-        # the sources before any of them changed, as numpy's vectorised phase)
+        # source i only (the moves read the sources before any of them changed, as numpy's
+        # vectorised phase)
         for i in range(pop):
-            for d in range(dim):
-                v[d] = x[a, i, d]
-            v[jj[i]] = mv[i]
-            g = _rps3_point(v[0], v[1], v[2], j0, j1, j2, ra, rb, absolute)
+            p, off = _slot(a * pop + i, 0, n if separate else n + ns, block)
+            j = jj[a, i]
+            g = _rps3_tan(tan[p], tan[p + off], mv[a, i] if j == 2 else x[a, i, 2], j0, j1, j2, ra, rb, absolute)
             if g != g:
                 g = np.inf
             fe[a, i] = g
             if g < f[a, i]:
                 f[a, i] = g
-                x[a, i, jj[i]] = mv[i]
+                x[a, i, j] = mv[a, i]
                 trial[a, i] = 0
             else:
                 trial[a, i] += 1
         nh = _log_points(a, fe[a], lbest, lcount, lactive, hr, he, hf, nh)
-        if over:
-            nh = _log_points(a, fs[a:a + 1], lbest, lcount, lactive, hr, he, hf, nh)
+        if s >= 0:
+            nh = _log_points(a, fs, lbest, lcount, lactive, hr, he, hf, nh)
         if rule != 0:     # Algorithm.update_best: the first minimum, if it beats the best so far
             b = 0
             for i in range(1, pop):
@@ -708,12 +874,13 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
                 for d in range(dim):
                     best_x[a, d] = x[a, b, d]
         # -- onlookers: roulette on the qualities 1/(1+f) (1-f below 0), cumulated in order
-        o = dim + block
+        o = dim + block4
         acc = 0.0
         for i in range(pop):
             q = 1.0 / (1.0 + f[a, i]) if f[a, i] >= 0 else 1.0 - f[a, i]
             acc = acc + q
             cdf[i] = acc
+        src = fo_src[a]
         for i in range(pop):
             w = u[a, o + i] * cdf[pop - 1]
             # the first index with cdf > w = the count of cdf <= w (cdf is sorted): a branch-free
@@ -732,28 +899,34 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
                     else:
                         hi_i = mid
             src[i] = 0 if n_le == pop else n_le
-        o += pop
+        _abc_moves(x, best_x, u, o + pop, a, src, rule, C, lo, hi, fo_jj, fo_mv, arg, a * pop, n, block)
+    return nh
+
+
+@njit(cache=True, error_model="numpy")
+def _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, src_all, jj_all, mv_all, tan, fo, best_x, best_f, lbest,
+                         lcount, lactive, hr, he, hf, nh, block):
+    """After numpy's tangents of the onlookers' candidates, for every run: their fitness into fo,
+    the reports to the log, then the synchronous onlookers -- per source the lowest candidate, the
+    first onlooker reaching it, if it beats the source; a trial per attempt -- and the sources
+    folded into the best-so-far (:func:`_fold_best`, what minimize's update_best does next). Returns nh."""
+    runs, pop, dim = x.shape
+    n = runs * pop
+    one = J.shape[1] == 1
+    bs = np.empty(pop)
+    first = np.empty(pop, dtype=np.int64)
+    for a in range(runs):
+        c = 0 if one else a * pop
+        j0, j1, j2 = J[0, c], J[1, c], J[2, c]
+        src, jj, mv = src_all[a], jj_all[a], mv_all[a]
         for i in range(pop):
-            s = src[i]
-            j = int(u[a, o + i] * dim)
-            k = int(u[a, o + pop + i] * (pop - 1))
-            if k >= s:
-                k += 1
-            phi = u[a, o + 2 * pop + i] * 2.0 - 1.0
-            psi = C * u[a, o + 3 * pop + i] if zhu else 0.0
-            m = _abc_move(x[a, s, j], x[a, k, j], best_x[a, j], phi, psi, rule)
-            m = min(max(m, lo[j]), hi[j])
-            jj[i] = j
-            mv[i] = m
-            for d in range(dim):
-                v[d] = x[a, s, d]
-            v[j] = m
-            g = _rps3_point(v[0], v[1], v[2], j0, j1, j2, ra, rb, absolute)
+            p, off = _slot(a * pop + i, 0, n, block)
+            g = _rps3_tan(tan[p], tan[p + off], mv[i] if jj[i] == 2 else x[a, src[i], 2], j0, j1, j2, ra, rb,
+                          absolute)
             if g != g:
                 g = np.inf
             fo[a, i] = g
         nh = _log_points(a, fo[a], lbest, lcount, lactive, hr, he, hf, nh)
-        # synchronous onlookers: per source the lowest candidate, the first onlooker reaching it
         for i in range(pop):
             bs[i] = np.inf
             first[i] = pop
@@ -771,21 +944,41 @@ def _abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, lo, hi, J, ra, rb,
                 x[a, s, jj[w_]] = mv[w_]
                 f[a, s] = bs[s]
                 trial[a, s] = 0
+        _fold_best(a, x, f, best_x, best_f)
     return nh
 
 
-def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log):
-    """:func:`_abc_rps3` on the state arrays x, f, trial (C-contiguous, updated in place) and
-    best_x, best_f (updated in place: pass copies), reporting to ``log`` (best (runs,) float,
-    count (runs,) int64, active (runs,) bool, updated in place). Returns (scout (runs,) 0/1,
-    (rows, evaluation numbers, values) of the improvements the log keeps)."""
+def abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log, separate, block):
+    """One iteration of :meth:`fkopt.algorithms.abc.ABC.iterate` (scout, employed, onlooker;
+    GABC's best-so-far refreshed between the phases, rules 1 and 2) on a 3-RPS FK problem:
+    :func:`_abc_employed_move`, :func:`numpy_tan`, :func:`_abc_employed_finish`, :func:`numpy_tan`,
+    :func:`_abc_onlooker_finish` on the state arrays x, f, trial (C-contiguous, updated in place)
+    and best_x, best_f (updated in place: pass copies; GABC's refresh between the phases and
+    minimize's update_best after the iteration both folded in), reporting to ``log`` (best (runs,) float,
+    count (runs,) int64, active (runs,) bool, updated in place). ``separate``: the numpy path
+    evaluates the fresh scouts in a fitness call of their own (a target per row); ``block``: the
+    poses per block of the numpy fitness. Returns (scout (runs,) 0/1, (rows, evaluation numbers,
+    values) of the improvements the log keeps)."""
     runs, pop = f.shape
-    fe, fs, scout, fo = np.empty((runs, pop)), np.empty(runs), np.empty(runs, dtype=np.uint8), np.empty((runs, pop))
-    most = runs * (2 * pop + 1)
-    hr, he, hf = np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most)
+    n = runs * pop
+    separate = bool(separate)
+    J = np.ascontiguousarray(J, dtype=float)
+    ra, rb, absolute, C, limit, rule = float(ra), float(rb), bool(absolute), float(C), int(limit), int(rule)
+
+    def make():
+        most = runs * (2 * pop + 1)
+        return ([np.empty((runs, pop), dtype=np.int64) for _ in range(3)] + [np.empty((runs, pop)) for _ in range(4)]
+                + [np.empty(runs, dtype=np.int64), np.empty(2 * (n + runs)), np.empty(2 * (n + runs)),
+                   np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most),
+                   np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float)])
+    jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, tan, hr, he, hf, lo, hi = _scratch_arrays(
+        ("abc", runs, pop, bounds.tobytes()), make)
     best, count, active = log
-    nh = _abc_rps3(x, f, trial, best_x, best_f, u, int(limit), int(rule), float(C),
-                   np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float),
-                   np.ascontiguousarray(J, dtype=float), float(ra), float(rb), bool(absolute), fe, fs, scout, fo,
-                   best, count, active, hr, he, hf)
-    return scout, (hr[:nh], he[:nh], hf[:nh])
+    ns = _abc_employed_move(x, trial, best_x, u, limit, rule, C, lo, hi, separate, jj, mv, scout, arg, block)
+    numpy_tan(arg, tan, ((0, n), (n, ns)) if separate else ((0, n + ns),), block)
+    nh = _abc_employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, ra, rb, absolute, separate, ns, jj,
+                              mv, scout, tan, fe, fo_src, fo_jj, fo_mv, arg, best, count, active, hr, he, hf, block)
+    numpy_tan(arg, tan, ((0, n),), block)
+    nh = _abc_onlooker_finish(x, f, trial, J, ra, rb, absolute, fo_src, fo_jj, fo_mv, tan, fo, best_x, best_f, best,
+                              count, active, hr, he, hf, nh, block)
+    return (scout >= 0).astype(np.int64), _kept(hr, he, hf, nh)

@@ -5,7 +5,10 @@ without numba); ``FKOPT_NUMERICS=compiled`` makes a missing numba an error inste
 fallback. Otherwise the compiled path runs when numba is importable. numba is imported on the
 first call that wants a compiled kernel, never at ``import fkopt`` (importing numba and loading its
 cache costs more than one pose saves, so a one-pose ``fkopt ik`` process keeps the reference:
-see ``fkopt/cli.py``).
+see ``fkopt/cli.py``); the 3-RPS swarm iterations (PSO, ABC, GABC) import it on their first
+iteration. Both paths give the same bits on those swarms (numpy's own ``np.tan`` inside the
+compiled iterations, :func:`fkopt.numerics.compiled.numpy_tan`), so stored results do not depend
+on the path.
 """
 from __future__ import annotations
 
@@ -53,9 +56,10 @@ def compiled(want: bool | None = None):
 def describe() -> dict:
     """What ``env.json`` records (its ``numerics``): ``path``, the path a default ``fkopt.inverse``
     call takes in this process ('compiled' with numba, else 'numpy'); ``mode``, the
-    ``FKOPT_NUMERICS`` setting it ran under ('auto', 'numpy' or 'compiled': with 'compiled' the
-    3-RPS swarm fitness is compiled too, ``compiled_fitness``, and with it the whole PSO, ABC and
-    GABC iterations on it); numba's version; the raw variable."""
+    ``FKOPT_NUMERICS`` setting it ran under ('auto', 'numpy' or 'compiled'; the 3-RPS PSO, ABC
+    and GABC iterations run compiled under both 'auto' and 'compiled', with the numpy path's bits);
+    ``compiled_fitness``: with 'compiled', single 3-RPS fitness calls are compiled too (the same
+    bits); numba's version; the raw variable."""
     try:
         from importlib.metadata import PackageNotFoundError, version
         try:

@@ -1,6 +1,8 @@
 """The field's solvers through their own packages (``pip install -e ".[field]"``), for kinbench v3.
 
-Every IK wrapper here takes a fkopt URDF arm (:class:`fkopt.mechanisms.urdf.URDFArm`), is built
+Every IK wrapper here takes a fkopt URDF or MJCF arm (:class:`fkopt.mechanisms.urdf.URDFArm`,
+:class:`fkopt.mechanisms.mjcf.MJCFArm`) and reads it as URDF (:func:`arm_urdf`: the robot's own
+file, or for an MJCF arm the URDF written from fkopt's chain, ``settings["urdf"]`` says which), is built
 once per arm (the package parses the file, outside the clock) and answers one target pose at a
 time: :meth:`FieldIK.solve1` takes a 4x4 tip frame in the arm's base frame (m) and returns the
 joints in fkopt's public units (deg, m) or ``None`` when the package gave no answer, plus what
@@ -79,6 +81,40 @@ class FieldIK:
 
     def solve1(self, T: np.ndarray) -> tuple[np.ndarray | None, bool]:
         raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class ArmURDF:
+    """The URDF a field package reads for an arm: its text, the chain's base and tip links, the
+    moving joints (fkopt's unknowns, in order) and where the text came from (for messages and
+    ``settings["urdf"]``)."""
+    text: str
+    base_link: str
+    tip_link: str
+    joint_names: tuple[str, ...]
+    source: str
+
+    @classmethod
+    def from_file(cls, path, base_link: str, tip_link: str) -> "ArmURDF":
+        """A URDF file as it is (the joints are not listed)."""
+        from ...files import read_text
+        from ...mechanisms.urdf import MAX_URDF_BYTES
+        return cls(read_text(path, MAX_URDF_BYTES, field="urdf geometry.file"), base_link, tip_link, (), str(path))
+
+
+def arm_urdf(arm, *, written: bool = False) -> ArmURDF:
+    """The robot's own URDF file when ``arm`` was read from one without a tool frame (the file as
+    people use it), else -- an MJCF arm, a DH table, a tool frame, or ``written`` -- the URDF
+    written from fkopt's chain (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, FK-checked
+    against MuJoCo in tests/test_urdf_writer.py)."""
+    own = getattr(arm, "name", None) == "urdf" and getattr(arm.geometry_values(), "tool", None) is None
+    if own and not written:
+        mine = ArmURDF.from_file(arm.path, arm.base_link, arm.tip_link)
+        return ArmURDF(mine.text, mine.base_link, mine.tip_link, tuple(arm.joint_names), mine.source)
+    from ...mechanisms.urdf_writer import chain_urdf
+    w = chain_urdf(arm)
+    return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names,
+                   f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}")
 
 
 def internal_bounds(arm) -> tuple[np.ndarray, np.ndarray]:

@@ -18,27 +18,30 @@ path is the one people run).
 """
 from __future__ import annotations
 
+import tempfile
 import time
 import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
+from pathlib import Path
 
 from ...errors import FkoptError
-from . import FieldIK
+from . import FieldIK, arm_urdf
 
 
-def chain_path(path, base: str, tip: str) -> list[str]:
-    """[base, joint, link, joint, ..., tip] of a URDF file: the elements ikpy must follow."""
-    joints = {}
-    for j in ET.parse(str(path)).getroot().iter("joint"):
+def chain_path(urdf) -> list[str]:
+    """[base, joint, link, joint, ..., tip] of a URDF (:class:`~fkopt.adapters.field.ArmURDF`):
+    the elements ikpy must follow."""
+    base, tip, joints = urdf.base_link, urdf.tip_link, {}
+    for j in ET.fromstring(urdf.text).iter("joint"):
         parent, child = j.find("parent"), j.find("child")
         if parent is not None and child is not None:
             joints[child.get("link")] = (j.get("name"), parent.get("link"))
     out, link = [tip], tip
     while link != base:
         if link not in joints:
-            raise FkoptError(f"ikpy: {path}: no joint chain from {base} to {tip}")
+            raise FkoptError(f"ikpy: {urdf.source}: no joint chain from {base} to {tip}")
         name, link = joints[link]
         out += [name, link]
     return out[::-1]
@@ -55,18 +58,22 @@ class IkPy(FieldIK):
             warnings.simplefilter("ignore")
             import ikpy
             from ikpy.chain import Chain
-            elements = chain_path(arm.path, arm.base_link, arm.tip_link)
-            chain = Chain.from_urdf_file(str(arm.path), base_elements=elements, symbolic=False,
-                                         jax_precompile=False)
-            mask = [link.joint_type != "fixed" for link in chain.links]
-            self.chain = Chain.from_urdf_file(str(arm.path), base_elements=elements, active_links_mask=mask,
-                                              symbolic=False, jax_precompile=False)
+            urdf = arm_urdf(arm)
+            elements = chain_path(urdf)
+            with tempfile.TemporaryDirectory() as tmp:        # ikpy reads a file: a copy it owns briefly
+                path = Path(tmp) / "chain.urdf"
+                path.write_text(urdf.text)
+                chain = Chain.from_urdf_file(str(path), base_elements=elements, symbolic=False,
+                                             jax_precompile=False)
+                mask = [link.joint_type != "fixed" for link in chain.links]
+                self.chain = Chain.from_urdf_file(str(path), base_elements=elements, active_links_mask=mask,
+                                                  symbolic=False, jax_precompile=False)
         names = [link.name for link, on in zip(self.chain.links, mask) if on]
-        if names != list(arm.joint_names):
-            raise FkoptError(f"ikpy: its chain of {arm.path} moves {names}, fkopt's {list(arm.joint_names)}")
+        if names != list(urdf.joint_names):
+            raise FkoptError(f"ikpy: its chain of {urdf.source} moves {names}, fkopt's {list(urdf.joint_names)}")
         self._active = np.flatnonzero(mask)
         self._full = np.zeros(len(self.chain.links))
-        self.settings.update(backend="numpy", optimizer="least_squares", tol=self.TOL, optimizer_budget=self.BUDGET,
+        self.settings.update(urdf=urdf.source, backend="numpy", optimizer="least_squares", tol=self.TOL, optimizer_budget=self.BUDGET,
                              accept=f"({self.ACCEPT} m, {self.ACCEPT}) on ikpy's FK", version=ikpy.__version__,
                              start="uniform in limits (wrapper's generator), restarts until the timeout",
                              wall_clock_limit="between starts")

@@ -1,6 +1,10 @@
 """pinocchio's closed-loop inverse kinematics (CLIK), the damped-least-squares loop of
 pinocchio's documentation ("Inverse kinematics (clik)", examples/inverse-kinematics.py;
-Carpentier et al., SII 2019), on pinocchio's own model of the URDF.
+Carpentier et al., SII 2019), on pinocchio's own model of the URDF (:func:`fkopt.adapters.field.arm_urdf`: the robot's file,
+or for an MJCF arm the URDF written from fkopt's chain). Chosen over pinocchio's own MJCF reader
+so that every field package reads one model of an MJCF arm, the written URDF FK-checked against
+MuJoCo (tests/test_urdf_writer.py), and so that MuJoCo's ``qpos0``/``ref`` and joint equalities
+mean what fkopt's MJCF reader says they mean rather than what a second reader makes of them.
 
 The loop: err = log6(oMdes^-1 oMtip) in the tip's local frame (m, rad), J = Jlog6(oMdes^-1
 oMtip) * J_tip(q), v = -J^T (J J^T + damp I)^-1 err, q <- integrate(q, v dt).
@@ -26,7 +30,7 @@ import time
 import numpy as np
 
 from ...errors import FkoptError
-from . import FieldIK
+from . import FieldIK, arm_urdf
 
 
 class PinCLIK(FieldIK):
@@ -38,29 +42,31 @@ class PinCLIK(FieldIK):
         super().__init__(arm, timeout=timeout, rng=rng)
         import pinocchio as pin
         self._pin = pin
-        full = pin.buildModelFromUrdf(str(arm.path))
-        keep = set(arm.joint_names)
+        urdf = arm_urdf(arm)
+        full = pin.buildModelFromXML(urdf.text)
+        keep = set(urdf.joint_names)
         missing = keep - set(full.names)
         if missing:
-            raise FkoptError(f"pin-clik: pinocchio's model of {arm.path} has no joint {sorted(missing)[0]}")
+            raise FkoptError(f"pin-clik: pinocchio's model of {urdf.source} has no joint {sorted(missing)[0]}")
         lock = [full.getJointId(n) for n in full.names[1:] if n not in keep]
         model = pin.buildReducedModel(full, lock, pin.neutral(full)) if lock else full
         self.model, self.data = model, model.createData()
         # links are BODY frames; a joint may share a link's name (z1's gripperStator), so ask for the body
-        self._tip = model.getFrameId(arm.tip_link, pin.FrameType.BODY)
-        self._base = model.getFrameId(arm.base_link, pin.FrameType.BODY)
+        self._tip = model.getFrameId(urdf.tip_link, pin.FrameType.BODY)
+        self._base = model.getFrameId(urdf.base_link, pin.FrameType.BODY)
         if self._tip >= model.nframes or self._base >= model.nframes:
-            raise FkoptError(f"pin-clik: pinocchio's model of {arm.path} lacks frame {arm.base_link} or {arm.tip_link}")
-        joints = [model.joints[model.getJointId(n)] for n in arm.joint_names]
+            raise FkoptError(f"pin-clik: pinocchio's model of {urdf.source} lacks frame {urdf.base_link} or "
+                             f"{urdf.tip_link}")
+        joints = [model.joints[model.getJointId(n)] for n in urdf.joint_names]
         self._idx_q = [j.idx_q for j in joints]
         self._nq = [j.nq for j in joints]
         self._idx_v = [j.idx_v for j in joints]
         if model.nv != arm.dof:
-            raise FkoptError(f"pin-clik: pinocchio's reduced model of {arm.path} has {model.nv} joints, fkopt {arm.dof}")
+            raise FkoptError(f"pin-clik: pinocchio's reduced model of {urdf.source} has {model.nv} joints, fkopt {arm.dof}")
         pin.framesForwardKinematics(model, self.data, pin.neutral(model))
         self._oMbase = self.data.oMf[self._base].copy()
         self._per = arm.periodic_mask()
-        self.settings.update(dt=self.DT, damp=self.DAMP, eps=self.EPS, it_max=self.IT_MAX, version=pin.__version__,
+        self.settings.update(urdf=urdf.source, dt=self.DT, damp=self.DAMP, eps=self.EPS, it_max=self.IT_MAX, version=pin.__version__,
                              limits="q clipped into fkopt's limits after each step",
                              start="uniform in limits (wrapper's generator), restarts until the timeout",
                              wall_clock_limit=True)

@@ -14,7 +14,11 @@ none); a sub-chain ``robot.ets(start, end)`` keeps the whole robot's joint indic
 so a chain starting below the root (Baxter's arm from its torso) would read q at the wrong
 places, and it includes the joint into ``start`` when that one moves -- the wrapper composes the
 links' own ETS from below ``base`` to ``tip`` and renumbers the chain's joints 0..n-1; the ETS is checked against fkopt's FK
-at a random configuration when built, so an arm rtb misreads is refused with one line.
+at a random configuration when built. When it misreads the robot's own file (iCub's: 1.5 m off), the
+wrapper reads the URDF written from fkopt's
+chain instead (:func:`fkopt.adapters.field.arm_urdf`, ``settings["urdf_note"]``), checked the same
+way; an arm rtb misreads either way is refused with one line. MJCF arms always reach it through
+the written URDF (rtb reads only URDF).
 """
 from __future__ import annotations
 
@@ -26,24 +30,24 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import FkoptError
-from . import FieldIK
+from . import FieldIK, arm_urdf
 
 
-def chain_ets(path: Path, base: str, tip: str):
-    """roboticstoolbox's ETS of the chain base -> tip of a URDF file, joints numbered 0..n-1."""
+def chain_ets(urdf):
+    """roboticstoolbox's ETS of the chain base -> tip of a URDF (:class:`~fkopt.adapters.field.ArmURDF`),
+    joints numbered 0..n-1."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         import roboticstoolbox as rtb
         from roboticstoolbox.models.URDF.URDFRobot import URDF_file
-    from ...files import read_input
-    from ...mechanisms.urdf import MAX_URDF_BYTES
-    tree = ET.ElementTree(ET.fromstring(read_input(path, MAX_URDF_BYTES, field="urdf geometry.file")))
+    base, tip = urdf.base_link, urdf.tip_link
+    tree = ET.ElementTree(ET.fromstring(urdf.text))
     for parent in list(tree.getroot().iter()):
         for e in list(parent):
             if e.tag in ("visual", "collision", "transmission", "gazebo"):
                 parent.remove(e)
     with tempfile.TemporaryDirectory() as tmp:
-        copy = Path(tmp) / Path(path).name
+        copy = Path(tmp) / "chain.urdf"
         tree.write(str(copy))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -57,7 +61,7 @@ def chain_ets(path: Path, base: str, tip: str):
         below.append(link)
         link = link.parent
     if link is None:
-        raise FkoptError(f"rtb: link '{tip}' of {path} is not below '{base}'")
+        raise FkoptError(f"rtb: link '{tip}' of {urdf.source} is not below '{base}'")
     ets = rtb.ETS()
     for lk in reversed(below):
         ets = ets * lk.ets
@@ -76,18 +80,31 @@ class _Rtb(FieldIK):
 
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
-        self.ets, version = chain_ets(arm.path, arm.base_link, arm.tip_link)
-        if self.ets.n != arm.dof:
-            raise FkoptError(f"{self.name}: rtb's chain of {arm.path} has {self.ets.n} joints, fkopt's {arm.dof}")
-        q = self.random_start()
-        gap = np.abs(self.ets.fkine(q).A - arm.fk_matrix(q / arm._to_si)).max()
+        urdf = arm_urdf(arm)
+        self.ets, version, gap = self._read(urdf)
+        if not gap < 1e-9 and not urdf.source.startswith("written"):
+            # rtb misreads the robot's own file (iCub's: 1.5 m off): read the URDF written from
+            # fkopt's chain instead, checked the same way
+            urdf, misread = arm_urdf(arm, written=True), f"rtb misreads {urdf.source} (FK off by {gap:.3g})"
+            self.ets, version, gap = self._read(urdf)
+            self.settings["urdf_note"] = misread
         if not gap < 1e-9:
-            raise FkoptError(f"{self.name}: rtb's FK of {arm.path} differs from fkopt's by {gap:.3g} "
+            raise FkoptError(f"{self.name}: rtb's FK of {urdf.source} differs from fkopt's by {gap:.3g} "
                              "(rtb misreads this URDF)")
         self._call = getattr(self.ets, self.method)
+        self.settings["urdf"] = urdf.source
         self.settings.update(method=self.method, ilimit=self.ILIMIT, slimit=self.SLIMIT, tol=self.TOL,
                              joint_limits=True, version=version, q0="uniform in limits (wrapper's generator)",
                              internal_rng="rtb's own, unseeded", wall_clock_limit=False)
+
+    def _read(self, urdf):
+        """(ETS, rtb's version, max |FK gap| to fkopt's at a random in-limit configuration);
+        inf when rtb's chain has another number of joints."""
+        ets, version = chain_ets(urdf)
+        if ets.n != self.arm.dof:
+            return ets, version, np.inf
+        q = self.random_start()
+        return ets, version, float(np.abs(ets.fkine(q).A - self.arm.fk_matrix(q / self.arm._to_si)).max())
 
     def solve1(self, T):
         sol = self._call(T, q0=self.random_start(), ilimit=self.ILIMIT, slimit=self.SLIMIT, tol=self.TOL,

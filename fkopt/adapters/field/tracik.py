@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import FieldIK
+from . import FieldIK, arm_urdf
 
 
 class TracIK(FieldIK):
@@ -29,19 +29,17 @@ class TracIK(FieldIK):
         super().__init__(arm, timeout=timeout, rng=rng)
         import pytracik
 
-        from ...files import read_text
-        from ...mechanisms.urdf import MAX_URDF_BYTES
+        urdf = arm_urdf(arm)
         self._pt = pytracik
-        self._solver = pytracik.TRAC_IK(arm.base_link, arm.tip_link, read_text(arm.path, MAX_URDF_BYTES, field="urdf geometry.file"), self.timeout,
-                                        self.EPS, pytracik.Speed)
+        self._solver = pytracik.TRAC_IK(urdf.base_link, urdf.tip_link, urdf.text, self.timeout, self.EPS, pytracik.Speed)
         if pytracik.get_num_joints(self._solver) != arm.dof:
             from ...errors import FkoptError
-            raise FkoptError(f"tracik: {arm.path} {arm.base_link} -> {arm.tip_link} has "
+            raise FkoptError(f"tracik: {urdf.source} {urdf.base_link} -> {urdf.tip_link} has "
                              f"{pytracik.get_num_joints(self._solver)} joints in KDL, {arm.dof} in fkopt")
         lo32 = np.nextafter(self.lo_rad.astype(np.float32), np.float32(np.inf))
         hi32 = np.nextafter(self.hi_rad.astype(np.float32), np.float32(-np.inf))
         pytracik.set_joint_limits(self._solver, lo32.astype(float).tolist(), hi32.astype(float).tolist())
-        self.settings.update(solve_type="Speed", eps=self.EPS, limits="fkopt's, float32 rounded inward",
+        self.settings.update(urdf=urdf.source, solve_type="Speed", eps=self.EPS, limits="fkopt's, float32 rounded inward",
                              start="uniform in limits (wrapper's generator)", internal_rng="TRAC-IK's own, unseeded")
 
     def solve1(self, T):
