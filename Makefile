@@ -38,7 +38,7 @@ reproduce-peers:
 # problem, set and pose, the others on the subsets its YAML documents), v3's per-robot board on the
 # clock (one process: its times are ratios measured side by side), the quick tiers (which CI's
 # check reruns: v1, v2, v3 and v3's board) and the libraries subset into results/kinbench/, then
-# the report (~25 min on 2 cores before v3 in full, which adds ~25 min: docs/kinbench.md). Not part of `make reproduce`.
+# the report (~25 min on 2 cores before v3 in full, which adds ~12 min: measured 11 min 49 s, docs/kinbench.md). Not part of `make reproduce`.
 bench-suite:
 	$(FKOPT) report results --snapshot-to .bench-suite-before.json
 	for s in kinbench kinbench-v2 kinbench-v2-libraries kinbench-v3; do \
