@@ -234,6 +234,9 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
                   "poses, runs or a smaller budget.", "", {"solvers": ["gabc", "lm"], "poses": 3, "runs": 3}),
         "check": ("`ci`: the test suite reruns the stored result; `full`: only `fkopt check --subset all`.",
                   "", "full"),
+        "subsets": ("Groups of solvers that run fewer cells than the suite (problems, sets, poses, runs); "
+                    "every board compares solvers only on the cells they all ran (docs/kinbench.md).", "",
+                    [{"name": "per-point", "solvers": ["gabc", "pso"], "problems": ["ur5"], "poses": 20}]),
         "tracks": ("kinbench v3's tracks on the clock: IK of the suite's URDF arms by fkopt.inverse and "
                    "the field's solvers, ranked by wall time as ratios to a reference solver "
                    "(docs/kinbench.md).", "", {"clock": {"problems": ["ur5"], "solvers": ["fkopt.inverse", "tracik"]}}),
@@ -301,6 +304,16 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "ioh": ("An IOHprofiler data folder of its runs, relative to the suite file.", "", "ioh-data/mytool"),
         "algorithm": ("Which algorithm of the `ioh` folder to take when it holds several.", "", "mytool"),
         "description": ("Free text: what the solver is and how it was run.", "", "mytool 1.2, default options"),
+    },
+    "SolverSubset": {
+        "name": ("The subset's board name (not `full`, the board of the whole suite).", "", "per-point"),
+        "solvers": ("Solver labels that run only this subset's cells (each in one subset at most).", "",
+                    ["gabc", "pso"]),
+        "problems": ("Problems the subset's solvers run (names); default all.", "", ["ur5", "panda"]),
+        "sets": ("Pose sets they run; default the suite's.", "", ["uniform"]),
+        "poses": ("The first N poses of each set (at most the suite's poses).", "poses", 20),
+        "runs": ("Runs per pose (at most the suite's runs).", "runs", 1),
+        "description": ("Free text: why these cells (the measured cost).", "", "swarms: 20 poses per set"),
     },
     "QuickTier": {
         "problems": ("Problems of the quick tier (names); default all.", "", ["mao2017-3rps"]),

@@ -112,6 +112,7 @@ OUTPUTS: dict[str, tuple[Output, ...]] = {
         Output("leaderboard.csv", f"{_SUITE}:leaderboard_table", TABLE),
         Output("measures.csv", f"{_SUITE}:measures_table", TABLE),
         Output("scaling.csv", f"{_SUITE}:scaling_table", TABLE),      # classes of several dimensions only
+        Output("ert_ratio.csv", f"{_SUITE}:ert_ratio_table", TABLE),  # suites with subsets (v3) only
         Output("ecdf.csv", f"{_SUITE}:ecdf_table", CURVES, rows=STEPS),
         Output("runs.csv", f"{_SUITE}:runs_table", CURVES, rows=RUNS),
         Output("trace.csv.gz", "fkopt.kinbench.traces:trace_table", CURVES, rows=STEPS),

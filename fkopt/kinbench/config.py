@@ -116,6 +116,27 @@ class SuiteProblem(Strict):
     instances: int | None = Field(None, ge=1, le=100)
 
 
+class SolverSubset(Strict):
+    """Cells a group of solvers runs instead of the whole suite: the expensive per-point solvers
+    (swarms, hybrids, DE) on fewer problems, poses and runs, while the others run everything.
+    Omitted fields keep the suite's value; a subset only cuts (``poses`` <= the suite's,
+    ``runs`` <= the suite's). Every board of the results compares solvers on the cells they all
+    ran (:func:`fkopt.kinbench.measures.boards`): one board for the whole suite (its solvers
+    without a subset) and one per subset (every solver that ran all of its cells)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,31}$")
+    solvers: list[str] = Field(min_length=1)
+    problems: list[str] | None = Field(None, min_length=1)
+    sets: list[Literal["uniform", "near-singular", "boundary", "printed"]] | None = Field(None, min_length=1)
+    poses: int | None = Field(None, ge=1)
+    runs: int | None = Field(None, ge=1, le=MAX_RUNS)
+    description: str = ""
+
+
+#: The board of the suite's own cells (its solvers without a subset); no subset may take the name.
+FULL_BOARD = "full"
+
+
 class QuickTier(Strict):
     """The subset ``--quick`` runs (and ``fkopt check`` reruns): fewer problems, solvers, poses,
     runs and a smaller budget. Omitted fields keep the full suite's value."""
@@ -235,6 +256,8 @@ class SuiteConfig(Located):
     alpha: float = Field(0.05, gt=0, lt=0.5)
     #: Solvers run elsewhere, imported from CSV files of evaluations and best-so-far per run.
     outside: list[OutsideSolver] = Field(default_factory=list)
+    #: Groups of solvers that run a subset of the cells (:class:`SolverSubset`); none: all run all.
+    subsets: list[SolverSubset] = Field(default_factory=list)
     quick: QuickTier | None = None
     #: kinbench v3's tracks on the clock (IK of the suite's URDF arms); None: none.
     tracks: Tracks | None = None
@@ -323,6 +346,57 @@ class SuiteConfig(Located):
         return self
 
     @model_validator(mode="after")
+    def _subsets(self):
+        """Subsets name the suite's solvers, problems and sets, each solver in one subset at most,
+        and only cut the suite (fewer poses and runs)."""
+        seen: dict[str, str] = {}
+        names = [s.name for s in self.subsets]
+        solvers = [s.key for s in self.solvers]
+        problems = [p.name for p in self.problems]
+        for k, sub in enumerate(self.subsets):
+            where = f"subsets[{k}]"
+            if sub.name == FULL_BOARD or names.count(sub.name) > 1:
+                raise ValueError(f"{where}.name: '{sub.name}' is taken (allowed: a name other than "
+                                 f"'{FULL_BOARD}', the board of the whole suite, and the other subsets')")
+            for field, known in (("solvers", solvers), ("problems", problems), ("sets", self.sets)):
+                for name in getattr(sub, field) or []:
+                    if name not in known:
+                        raise ValueError(f"{where}.{field}: '{name}' is not one of the suite's {field} "
+                                         f"(allowed: {', '.join(known)})")
+                values = getattr(sub, field) or []
+                if len(set(values)) != len(values):
+                    raise ValueError(f"{where}.{field}: '{next(v for v in values if values.count(v) > 1)}' repeats")
+            for name in sub.solvers:
+                if name in seen:
+                    raise ValueError(f"{where}.solvers: '{name}' is already in subset '{seen[name]}' "
+                                     "(allowed: each solver in one subset at most)")
+                seen[name] = sub.name
+            if sub.poses is not None and self.poses is not None and sub.poses > self.poses:
+                raise ValueError(f"{where}.poses: {sub.poses} (allowed: 1 to the suite's poses, {self.poses})")
+            if sub.runs is not None and sub.runs > self.runs:
+                raise ValueError(f"{where}.runs: {sub.runs} (allowed: 1 to the suite's runs, {self.runs})")
+        return self
+
+    def subset_of(self, solver: str) -> SolverSubset | None:
+        """The subset solver label ``solver`` runs (None: the whole suite)."""
+        return next((s for s in self.subsets if solver in s.solvers), None)
+
+    def runs_of(self, solver: str) -> int:
+        sub = self.subset_of(solver)
+        return sub.runs if sub is not None and sub.runs is not None else self.runs
+
+    def runs_problem(self, solver: str, problem: str) -> bool:
+        sub = self.subset_of(solver)
+        return sub is None or sub.problems is None or problem in sub.problems
+
+    def board_cells(self) -> list[tuple[str, list[str]]]:
+        """(board name, the solver labels whose cells define it) of every board: the whole suite's
+        (its solvers without a subset, and the outside results) and one per subset."""
+        free = [s.key for s in self.solvers if self.subset_of(s.key) is None] + [o.solver for o in self.outside]
+        out = [(FULL_BOARD, free)] if free else []
+        return out + [(s.name, list(s.solvers)) for s in self.subsets]
+
+    @model_validator(mode="after")
     def _track_problems(self):
         clock = self.tracks.clock if self.tracks is not None else None
         if clock is not None:
@@ -341,6 +415,8 @@ class SuiteConfig(Located):
         data = self.model_dump(mode="json")
         if data.get("tracks") is None:
             data.pop("tracks", None)
+        if not data.get("subsets"):                     # v3's solver subsets, only when there are any
+            data.pop("subsets", None)
         if isinstance(data.get("quick"), dict) and data["quick"].get("queries") is None:
             data["quick"].pop("queries", None)
         for problem in data.get("problems") or []:      # v3's geometry instances, only when asked for
@@ -355,7 +431,8 @@ class SuiteConfig(Located):
                              f"{', '.join(QuickTier.model_fields)})")
         q = self.quick
         data = self.model_dump(mode="json")
-        data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci")
+        # the quick tier is itself a small subset: every quick solver on every quick cell
+        data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci", subsets=[])
         if q.problems:
             data["problems"] = [p for p in data["problems"] if p["name"] in q.problems]
         if q.solvers:

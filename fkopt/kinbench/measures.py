@@ -42,6 +42,54 @@ from .budget import target_column
 INSTANCE = ["problem", "set", "pose"]
 
 
+#: One cell of a suite: a trial (one run on one instance).
+CELL = INSTANCE + ["run"]
+
+
+def board_runs(runs: pd.DataFrame, defining) -> pd.DataFrame:
+    """The rows of a board: the cells (problem, set, pose, run) that the ``defining`` solvers
+    ran, and of those only the solvers that ran every one of them -- so no solver on a board
+    is judged on cells the others did not run, nor left out of cells it did not run (a solver
+    missing a single cell is not on the board). Empty when the defining solvers ran nothing."""
+    keys = runs.loc[runs["solver"].isin(list(defining)), CELL].drop_duplicates()
+    if keys.empty:
+        return runs.iloc[:0]
+    inside = runs[CELL].merge(keys.assign(_in=True), on=CELL, how="left")["_in"].notna().to_numpy()
+    sub = runs[inside]
+    count = sub.groupby("solver", sort=False).size()
+    return sub[sub["solver"].isin(count.index[count == len(keys)])]
+
+
+def boards(runs: pd.DataFrame, cells) -> list[tuple[str, pd.DataFrame]]:
+    """(board name, its rows by :func:`board_runs`) for each (name, defining solvers) of
+    ``cells`` (:meth:`fkopt.kinbench.config.SuiteConfig.board_cells`) that holds any row."""
+    out = [(name, board_runs(runs, defining)) for name, defining in cells]
+    return [(name, sub) for name, sub in out if not sub.empty]
+
+
+def ert_ratio_table(runs: pd.DataFrame, targets) -> pd.DataFrame:
+    """ERT of each solver over the virtual best solver's, per (problem, track, target), COCO's
+    ERT ratio (Hansen et al. 2022, sec. 5; the virtual best solver's ERT is the smallest of any
+    solver of the track on that problem and target): 1 for the best, inf for a solver that
+    never reached the target when another did, NaN when no solver of the track reached it.
+    Over all sets and poses of the problem that ``runs`` holds (one board's cells)."""
+    ert = _ert_rows(runs, ["problem", "class", "track", "solver"], targets, sort=False)
+    finite = ert["ert"].where(np.isfinite(ert["ert"]))
+    ert["ert_best"] = finite.groupby([ert["problem"], ert["track"], ert["target"]]).transform("min")
+    ert["ert_ratio"] = ert["ert"] / ert["ert_best"]
+    return ert[["problem", "class", "track", "solver", "target", "trials", "success_rate", "ert", "ert_best",
+                "ert_ratio"]]
+
+
+def ert_ratio_summary(table: pd.DataFrame) -> pd.DataFrame:
+    """Per (class, track, solver, target): the median ERT ratio over the problems of the class
+    whose target some solver of the track reached (what the board shows; ert_ratio.csv has
+    every problem)."""
+    t = table[table["ert_best"].notna()]
+    return (t.groupby(["class", "track", "solver", "target"], sort=False)
+            .agg(problems=("problem", "nunique"), median_ert_ratio=("ert_ratio", "median")).reset_index())
+
+
 def hits(runs: pd.DataFrame, targets) -> np.ndarray:
     """(rows, targets) evaluations when each target was reached (NaN: not within budget)."""
     return runs[[target_column(t) for t in targets]].to_numpy(dtype=float)
@@ -95,6 +143,17 @@ def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFra
         df.insert(2, "track", df["solver"].map(dict(zip(sub["solver"], sub["track"]))))
         frames.append(df)
     return pd.concat(frames, ignore_index=True)
+
+
+def virtual_best_ecdf(runs: pd.DataFrame, targets) -> pd.DataFrame:
+    """The ECDF of the virtual best solver over ``runs`` (one board's, or one class of it): per
+    cell (problem, set, pose, run) and target the fewest evaluations / dimension any solver
+    needed, as steps (evals_per_dim, fraction) of the same (cell, target) pairs as each solver's
+    ECDF (COCO's "best 2009"-style reference curve, from the solvers run here)."""
+    per_dim = pd.DataFrame(hits(runs, targets) / runs["dim"].to_numpy(dtype=float)[:, None], index=runs.index)
+    best = per_dim.groupby([runs[c] for c in CELL], sort=False).min().to_numpy()
+    steps = ecdf_steps({"virtual best": best})
+    return steps.rename(columns={"evaluations": "evals_per_dim"})[["evals_per_dim", "fraction"]]
 
 
 def trial_scores(runs: pd.DataFrame, targets, budget_per_dim: float) -> np.ndarray:

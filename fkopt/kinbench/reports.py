@@ -20,23 +20,70 @@ from .outside import digest
 from .submissions import submission_digest
 
 
+BOARD_PREFIX = "board:"
+
+
+def suite_boards(sr) -> list[tuple[str | None, pd.DataFrame]]:
+    """The boards every table, ECDF and ranking is computed on: a suite without subsets has
+    one, unnamed (its files look as before subsets existed); a suite with subsets has one per
+    board of :meth:`~fkopt.kinbench.config.SuiteConfig.board_cells`, each only on the cells
+    all its solvers ran (:func:`fkopt.kinbench.measures.boards`)."""
+    if not sr.config.subsets:
+        return [(None, sr.runs)]
+    return M.boards(sr.runs, sr.config.board_cells())
+
+
+def split_scope(scope: str) -> tuple[str | None, str]:
+    """(board, scope within it) of a leaderboard/ECDF scope ("board:per-point/track:black-box")."""
+    if scope.startswith(BOARD_PREFIX) and "/" in scope:
+        board, rest = scope[len(BOARD_PREFIX):].split("/", 1)
+        return board, rest
+    return None, scope
+
+
+def _per_board(sr, table, column: str) -> pd.DataFrame | None:
+    """``table(runs)`` of every board, the board named in ``column`` ("scope": as its prefix;
+    "board": a first column) when the suite has boards."""
+    frames = []
+    for name, runs in suite_boards(sr):
+        t = table(runs)
+        if t is None or t.empty:
+            continue
+        if name is not None:
+            t = t.copy()
+            if column == "scope":
+                t["scope"] = f"{BOARD_PREFIX}{name}/" + t["scope"].astype(str)
+            else:
+                t.insert(0, "board", name)
+        frames.append(t)
+    return pd.concat(frames, ignore_index=True) if frames else None
+
+
 def runs_table(sr) -> pd.DataFrame:
     """One row per run: the run record's (:func:`fkopt.record.runs_table`)."""
     return record.runs_table(sr.record)
 
 
 def measures_table(sr) -> pd.DataFrame:
-    return M.measures_table(sr.runs, sr.config.targets)
+    return _per_board(sr, lambda runs: M.measures_table(runs, sr.config.targets), "board")
 
 
 def ecdf_table(sr) -> pd.DataFrame:
-    return M.ecdf_table(sr.runs, sr.config.targets, sr.config.budget_per_dim)
+    return _per_board(sr, lambda runs: M.ecdf_table(runs, sr.config.targets, sr.config.budget_per_dim), "scope")
 
 
 def leaderboard_table(sr) -> pd.DataFrame:
     c = sr.config
-    return M.leaderboard_table(sr.runs, c.targets, c.budget_per_dim, bootstrap=c.bootstrap, alpha=c.alpha,
-                               seed=c.seed)
+    return _per_board(sr, lambda runs: M.leaderboard_table(runs, c.targets, c.budget_per_dim, bootstrap=c.bootstrap,
+                                                           alpha=c.alpha, seed=c.seed), "scope")
+
+
+def ert_ratio_table(sr) -> pd.DataFrame | None:
+    """ert_ratio.csv (suites with subsets, kinbench v3's evaluations board): per board, problem,
+    track and target, each solver's ERT over the virtual best solver's (COCO's ERT ratio)."""
+    if not sr.config.subsets:
+        return None
+    return _per_board(sr, lambda runs: M.ert_ratio_table(runs, sr.config.targets), "board")
 
 
 def timing_table(sr) -> pd.DataFrame:
@@ -48,7 +95,7 @@ def timing_table(sr) -> pd.DataFrame:
 
 
 def scaling_table(sr) -> pd.DataFrame | None:
-    return M.scaling_table(sr.runs, sr.config.targets)
+    return _per_board(sr, lambda runs: M.scaling_table(runs, sr.config.targets), "board")
 
 
 def scaling_target(targets) -> float:
@@ -175,7 +222,7 @@ def board_top_lines(folder: Path, top: int = 3) -> list[str]:
     if lb_path.exists():
         lb = pd.read_csv(lb_path)
         for scope, g in lb.groupby("scope", sort=False):
-            if scope.startswith("track:"):
+            if split_scope(scope)[1].startswith("track:"):
                 best = ", ".join(f"{r.solver} {r.score:.3f}" for r in g.head(top).itertuples())
                 lines.append(f"{scope} (score, evaluations): {best}")
     robots = folder / "leaderboard-robots.csv"
@@ -218,27 +265,50 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     names = []
     targets = ", ".join(f"{t:.0e}" for t in sr.config.targets)
-    # one file per scope: a class "all" does not overwrite ecdf_all, "a b" and "a_b" differ
+    # one file per scope: a class "all" does not overwrite ecdf_all, "a b" and "a_b" differ;
+    # a board's scopes are ecdf_<board>_all, ecdf_<board>_<class>
+    def short(scope):
+        board, rest = split_scope(scope)
+        rest = rest.removeprefix("class:")
+        return rest if board is None else f"{board}_{rest}"
     scopes = [s for s in df["scope"].unique() if s != "all"]
-    stems = file_names((s.removeprefix("class:") for s in scopes), reserved=("all",))
+    stems = file_names((short(s) for s in scopes), reserved=("all",))
+    rows_of = {}                                   # scope -> its run rows (the virtual best's cells)
+    for board, runs in suite_boards(sr):
+        prefix = "" if board is None else f"{BOARD_PREFIX}{board}/"
+        rows_of[f"{prefix}all"] = runs
+        rows_of.update({f"{prefix}class:{c}": r for c, r in runs.groupby("class", sort=True)})
     for scope, g in df.groupby("scope", sort=False):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
         top = float(sr.config.budget_per_dim)
-        for (solver, track), s in g.groupby(["solver", "track"], sort=False):
+        curves = list(g.groupby(["solver", "track"], sort=False))
+        if scope in rows_of and g["solver"].nunique() > 1:
+            curves.append((("virtual best", "best"), M.virtual_best_ecdf(rows_of[scope], sr.config.targets)))
+        ends = []
+        for (solver, track), s in curves:
             s = s.dropna(subset=["evals_per_dim"])      # a solver that reached nothing: flat at 0
             b = np.concatenate([[1.0], np.maximum(s["evals_per_dim"].to_numpy(), 1.0), [top]])
             f = np.concatenate([[0.0], s["fraction"].to_numpy(), [s["fraction"].max() if len(s) else 0.0]])
             x, y = np.log10(b), f
-            line, = ax.step(x, y, where="post", linestyle=styles.get(track, "-"), label=f"{solver} ({track})")
-            ax.annotate(solver, (x[-1], y[-1]), xytext=(3, 0), textcoords="offset points", fontsize=7,
-                        color=line.get_color(), va="center")
-        ax.set_xlabel("log10(evaluations / dimension)")
+            style = {"color": "black", "linestyle": ":", "linewidth": 1.6} if track == "best" else \
+                {"linestyle": styles.get(track, "-")}
+            line, = ax.step(x, y, where="post", label=f"{solver} ({track})" if track != "best" else solver, **style)
+            ends.append((solver, x[-1], y[-1], line.get_color()))
+        # names at the right end (COCO), spread apart where lines end together
+        for (solver, x_end, _, color), y in zip(ends, spread_labels([e[2] for e in ends], 0.045)):
+            ax.annotate(solver, (x_end, y), xytext=(3, 0), textcoords="offset points", fontsize=7, color=color,
+                        va="center", annotation_clip=False)
+        ax.axvline(np.log10(top), color="grey", linewidth=0.8)     # the budget
+        ax.set_xlabel(f"log10(evaluations / dimension); budget {top:g} x dimension marked")
         ax.set_ylabel("fraction of (problem, pose, target, run)")
         ax.set_ylim(-0.02, 1.02)
-        what = "all problems" if scope == "all" else scope.split(":", 1)[1]
+        board, within = split_scope(scope)
+        what = "all problems" if within == "all" else within.split(":", 1)[1]
+        if board is not None:
+            what = f"board {board} (the cells all its solvers ran), {what}"
         ax.set_title(f"{sr.config.name}: {what}; targets {targets}", fontsize=8)
         legend_off_data(ax, fontsize=7)
-        stem = "ecdf_all" if scope == "all" else f"ecdf_{stems[scope.removeprefix('class:')]}"
+        stem = "ecdf_all" if scope == "all" else f"ecdf_{stems[short(scope)]}"
         names += save(fig, folder / f"{stem}.png")
         pyplot.close(fig)
     return names
@@ -257,6 +327,8 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
     target = scaling_target(sr.config.targets)
     names = []
     shown = df[np.isclose(df["target"], target)]
+    if "board" in shown.columns:                      # one figure per (board, class)
+        shown = shown.assign(**{"class": shown["board"] + "_" + shown["class"]})
     stems = file_names(shown["class"].unique())       # two distinct classes never share a file
     for cls, g in shown.groupby("class", sort=True):
         fig, ax = pyplot.subplots(figsize=(5.2, 3.6))
@@ -326,6 +398,50 @@ def robot_columns(board: pd.DataFrame) -> list[str]:
 PER_PROBLEM = ["set", "solver", "track", "target", "trials", "success_rate", "ert"]
 
 
+def boards_preamble(c) -> str:
+    """What the boards of a suite with subsets are (leaderboard.md and index.html)."""
+    if not c.subsets:
+        return ""
+    parts = []
+    for name, defining in c.board_cells():
+        sub = next((s for s in c.subsets if s.name == name), None)
+        if sub is None:
+            parts.append(f"board '{name}': every problem, set and pose, {c.runs} runs, defined by "
+                         f"{', '.join(defining)}")
+            continue
+        probs = f"{len(sub.problems)} problems" if sub.problems else "every problem"
+        sets = ", ".join(sub.sets) if sub.sets else "every set"
+        poses = f"the first {sub.poses} poses" if sub.poses else "every pose"
+        parts.append(f"board '{name}': {probs}, {sets}, {poses} of each set, {sub.runs or c.runs} runs, defined by "
+                     f"{', '.join(defining)}")
+    return ("Boards: each compares only the solvers that ran every cell (problem, set, pose, run) of it, "
+            "on those cells; a solver with fewer cells is not on a board, and a solver with more is "
+            "judged on the board's cells only. " + "; ".join(parts) + ".")
+
+
+def ert_ratio_sections(tables: dict) -> list[tuple[str, pd.DataFrame]]:
+    """(board / class / track, solvers x targets: median ERT ratio to the virtual best solver)."""
+    er = tables.get("ert_ratio.csv")
+    if er is None or er.empty:
+        return []
+    out = []
+    for (board, cls, track), g in er.groupby(["board", "class", "track"], sort=False):
+        summary = M.ert_ratio_summary(g)
+        if summary.empty or g["solver"].nunique() < 2:     # a track of one solver is its own best
+            continue
+        wide = summary.pivot_table(index="solver", columns="target", values="median_ert_ratio", sort=False)
+        wide = wide[sorted(wide.columns, reverse=True)]
+        wide.columns = [f"ert_ratio_{t:.0e}" for t in wide.columns]
+        out.append((f"board:{board}/class:{cls}/track:{track}", wide.reset_index()))
+    return out
+
+
+ERT_RATIO_NOTE = ("ERT ratio to the virtual best solver (COCO): per problem and target, a solver's ERT over the "
+                  "smallest ERT of any solver of its track on the board; the median over the class's problems "
+                  "(only problems some solver of the track solved at that target); 1 = the best, inf = never "
+                  "reached where another did. ert_ratio.csv has every problem.")
+
+
 def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
     lb = tables.get("leaderboard.csv")
     if lb is None:
@@ -336,25 +452,35 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
     robots = tables.get("leaderboard-robots.csv")
     if robots is not None:
         out += ["## Per robot, on the clock", "", ROBOTS_PREAMBLE, "", _md_table(robots, robot_columns(robots)), ""]
+    if c.subsets:
+        out += [md_text(boards_preamble(c)), ""]
     for title, pred in (("Overall", lambda s: s == "overall"), ("Per track", lambda s: s.startswith("track:")),
                         ("Per problem class", lambda s: s.startswith("class:"))):
         out += [f"## {title}", ""]
         for scope, g in leaderboard_sections(tables):
-            if pred(scope):
+            if pred(split_scope(scope)[1]):
                 out += [f"### {md_text(scope)}", "", _md_table(g, cols), ""]
+    ratios = ert_ratio_sections(tables)
+    if ratios:
+        out += ["## ERT ratio to the virtual best solver", "", ERT_RATIO_NOTE, ""]
+        for scope, g in ratios:
+            out += [f"### {md_text(scope)}", "", _md_table(g, list(g.columns)), ""]
     sc = tables.get("scaling.csv")
     if sc is not None:
         target = scaling_target(c.targets)
         out += ["## Cost against dimension", "", f"ERT (evaluations) and ERT / dimension at target {target:.0e} "
                 "over every problem, set and pose of a dimension, for the classes of several dimensions "
                 "(scaling.csv has every target).", ""]
-        for cls, g in sc[np.isclose(sc["target"], target)].groupby("class", sort=True):
-            out += [f"### {md_text(cls)}", "", _md_table(g.sort_values(["solver", "dim"], kind="stable"), SCALING), ""]
+        by = ["board", "class"] if "board" in sc.columns else "class"
+        for cls, g in sc[np.isclose(sc["target"], target)].groupby(by, sort=True):
+            name = "/".join(cls) if isinstance(cls, tuple) else cls
+            out += [f"### {md_text(name)}", "", _md_table(g.sort_values(["solver", "dim"], kind="stable"), SCALING), ""]
     ms = tables.get("measures.csv")
     if ms is not None:
         out += ["## Per problem", "", "Success rate and ERT (evaluations) per set and target.", ""]
+        per_problem = (["board"] if "board" in ms.columns else []) + PER_PROBLEM
         for problem, g in ms.groupby("problem", sort=False):
-            out += [f"### {md_text(problem)}", "", _md_table(g, PER_PROBLEM), ""]
+            out += [f"### {md_text(problem)}", "", _md_table(g, per_problem), ""]
     tim = tables.get("timing.csv")
     if tim is not None and not tim.empty:
         out += ["## Wall time per solve", "", "Amortised: the batched solve's wall time over its "
@@ -380,8 +506,15 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
         body += ["<h2>Per robot, on the clock</h2>", f"<p>{html.escape(ROBOTS_PREAMBLE)}</p>",
                  table_html(robots, robot_columns(robots), "robots")]
         body += [img(p) for p in sorted(folder.glob("clock_*.png"))]
+    if c.subsets:
+        body.append(f"<p>{html.escape(boards_preamble(c))}</p>")
     for k, (scope, g) in enumerate(leaderboard_sections(tables)):
         body += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
+    ratios = ert_ratio_sections(tables)
+    if ratios:
+        body += ["<h2>ERT ratio to the virtual best solver</h2>", f"<p>{html.escape(ERT_RATIO_NOTE)}</p>"]
+        for k, (scope, g) in enumerate(ratios):
+            body += [f"<h3>{html.escape(scope)}</h3>", table_html(g, list(g.columns), f"er-{k}")]
     figs = sorted(folder.glob("ecdf_*.png"))
     if figs:
         body += ["<h2>Runtime distributions (ECDF)</h2>"] + [img(p) for p in figs]
@@ -390,10 +523,17 @@ def html_page(sr, folder: Path, tables: dict) -> list[str]:
         target = scaling_target(c.targets)
         body.append(f"<h2>Cost against dimension (target {target:.0e})</h2>")
         body += [img(p) for p in sorted(folder.glob("scaling_*.png"))]
-        for k, (cls, g) in enumerate(sc[np.isclose(sc["target"], target)].groupby("class", sort=True)):
-            body += [f"<h3>{html.escape(cls)}</h3>", table_html(g, SCALING, f"sc-{k}")]
+        by = ["board", "class"] if "board" in sc.columns else "class"
+        for k, (cls, g) in enumerate(sc[np.isclose(sc["target"], target)].groupby(by, sort=True)):
+            name = "/".join(cls) if isinstance(cls, tuple) else cls
+            body += [f"<h3>{html.escape(name)}</h3>", table_html(g, SCALING, f"sc-{k}")]
     ms = tables.get("measures.csv")
-    if ms is not None:
+    if ms is not None and "board" in ms.columns:
+        # every problem on every board is ~5 MB of HTML tables for kinbench v3 (92 problems): the
+        # page keeps to the boards and figures, the per-problem tables are in leaderboard.md
+        body += ["<h2>Per problem</h2>", "<p>Success rate and ERT per board, problem, set, solver and target: "
+                 "measures.csv and the per-problem section of leaderboard.md.</p>"]
+    elif ms is not None:
         body.append("<h2>Per problem</h2>")
         for k, (problem, g) in enumerate(ms.groupby("problem", sort=False)):
             body += [f"<h3>{html.escape(problem)}</h3>", table_html(g, PER_PROBLEM, f"pp-{k}")]

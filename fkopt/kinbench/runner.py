@@ -46,7 +46,7 @@ def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
     pop = solver.population or config.population
     cfg = RunConfig(name=problem.name, mechanism=problem.mechanism, objective=problem.objective,
                     algorithms=[solver.model_dump(exclude={"track"})], population=config.population,
-                    iterations=solver.iterations or max(1, math.ceil(budget / pop)), runs=config.runs,
+                    iterations=solver.iterations or max(1, math.ceil(budget / pop)), runs=config.runs_of(solver.key),
                     seed=config.seed, threshold=min(config.targets), stop_at_threshold=True)
     return cfg
 
@@ -70,9 +70,14 @@ class SuiteResult:
         return self.record
 
 
-def _cases(config: SuiteConfig, sets: dict, problem):
-    """(set name, pose index, point) of every case of ``problem``, in set then pose order."""
-    return [(name, i, p) for name in config.sets for i, p in enumerate(sets[(problem.name, name)])]
+def _cases(config: SuiteConfig, sets: dict, problem, solver=None):
+    """(set name, pose index, point) of every case of ``problem``, in set then pose order; of
+    the cells of ``solver``'s subset when it has one (its sets, its first ``poses`` poses)."""
+    sub = config.subset_of(solver.key) if solver is not None else None
+    names = sub.sets if sub is not None and sub.sets is not None else config.sets
+    keep = sub.poses if sub is not None and sub.poses is not None else None
+    return [(name, i, p) for name in config.sets if name in names
+            for i, p in enumerate(sets[(problem.name, name)][:keep])]
 
 
 def instances_of(config: SuiteConfig, sets: dict) -> set[tuple[str, str, int]]:
@@ -96,11 +101,14 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
         if not np.all(mech.in_bounds(np.stack([c[2] for c in cases]))):
             raise FkoptError(f"problems[{problem.name}]: a frozen pose lies outside mechanism.bounds")
         for solver in config.solvers:
+            if not config.runs_problem(solver.key, problem.name):
+                continue
             where = f"solvers[{solver.key}]"
+            cases = _cases(config, sets, problem, solver)
             try:
                 cfg = task_config(config, problem, solver, dim)
                 pop = solver.population or config.population
-                chunk_size(len(cases), config.runs, pop, cfg.iterations, dim)
+                chunk_size(len(cases), cfg.runs, pop, cfg.iterations, dim)
                 # a one-iteration probe on one pose: an unknown solver or parameter, a bad start, a
                 # solver that cannot take this problem (nr on a redundant arm) fail here, before any work
                 probe = cfg.model_copy(update={"runs": 1, "iterations": 1, "stop_at_threshold": False})
@@ -110,7 +118,7 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
             except FkoptError as err:
                 raise FkoptError(f"{where} on problems[{problem.name}]: {err}") from None
             T = cfg.iterations + 1
-            need = max(need, len(cases) * config.runs * 8 * (3 * T + 2 * dim) * 2)
+            need = max(need, len(cases) * cfg.runs * 8 * (3 * T + 2 * dim) * 2)
     if config.outside:            # read and checked now, so a bad file fails before any solve
         instances = instances_of(config, sets)
         for k in range(len(config.outside)):
@@ -221,14 +229,14 @@ def solve_task(payload: dict) -> dict:
     rows = run_rows(config, problem, solver, cases, result, dim, seeds)
     return {"fingerprint": payload["fingerprint"], "problem": payload["problem"], "solver": payload["solver"],
             "dim": dim, "rows": rows.to_dict(orient="list"), "trace": task_trace(result, budget_of(config, dim)),
-            "wall_s": wall, "solves": len(cases) * config.runs}
+            "wall_s": wall, "solves": len(cases) * cfg.runs}
 
 
 def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int, seeds) -> pd.DataFrame:
     """The task's rows of the run record (:mod:`fkopt.record`), measured at the budget."""
     budget = budget_of(config, dim)
     m = at_budget(result.history, result.evaluation_history, budget, config.targets)
-    n, runs = len(cases), config.runs
+    n, runs = len(cases), config.runs_of(solver.key)
     cols = {"problem": problem.name, "class": problem.problem_class,
             "set": np.repeat([c[0] for c in cases], runs), "pose": np.repeat([c[1] for c in cases], runs),
             "solver": solver.key, "track": solver.track, "run": np.tile(np.arange(runs), n),
@@ -302,7 +310,7 @@ def record_problem(task, rec) -> str | None:
         dim = len(cases[0][2]) if cases else rec["dim"]
         if rec["dim"] != dim or isinstance(rec["dim"], bool):
             return f"dim: {str(rec['dim'])[:20]!r}, expected {dim}"
-        budget, runs = budget_of(config, dim), config.runs
+        budget, runs = budget_of(config, dim), config.runs_of(solver.key)
         n = len(cases) * runs
         rows = rec["rows"]
         measures = ["evaluations", "fitness", *(target_column(t) for t in config.targets)]
@@ -372,8 +380,9 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
     data = config.model_dump(mode="json")
     folder = str(files) if files is not None else ""
     tasks = [Task(f"p{p}-s{s}", {"config": data, "folder": folder, "problem": p, "solver": s, "fingerprint": fp,
-                                 "cases": _cases(config, sets, problem)}, f"{problem.name} / {solver.key}")
-             for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)]
+                                 "cases": _cases(config, sets, problem, solver)}, f"{problem.name} / {solver.key}")
+             for p, problem in enumerate(config.problems) for s, solver in enumerate(config.solvers)
+             if config.runs_problem(solver.key, problem.name)]
     tracks = track_cases(config, sets, files)      # the clock track's queries, loaded once per run
     tasks += [Task(f"t{p}", {"config": data, "folder": folder, "problem": p, "track": "clock", "fingerprint": fp,
                              "queries": queries.tolist()}, f"{config.problems[p].name} / clock track")

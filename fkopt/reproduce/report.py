@@ -71,8 +71,11 @@ def suite_section(exp: Experiment, root: Path) -> str:
              "evaluations ([docs/kinbench.md](../docs/kinbench.md)).", ""]
     if exp.has("leaderboard.csv"):
         board = exp.table("leaderboard")
-        overall = board[board["scope"] == "overall"] if "scope" in board.columns else board
+        # a suite with subsets has one overall ranking per board ("board:<name>/overall")
+        overall = board[board["scope"].astype(str).str.split("/").str[-1] == "overall"] if "scope" in board.columns else board
         cols = [c for c in ("rank", "solver", "track", "score", "ci_low", "ci_high", "better_than") if c in board.columns]
+        if "scope" in overall.columns and overall["scope"].nunique() > 1:
+            cols = ["scope", *cols]
         lines += ["Overall (tracks mixed, for reference; each track is ranked on its own in the leaderboard):", "",
                   md_table(overall[cols].astype(object).fillna("")), ""]
     return "\n".join(lines)
