@@ -157,9 +157,12 @@ def test_stored_configs_validate():
     for f in files:   # experiments, studies (kind: study), assembly modes and suites
         cfg = load_any(f)
         tasks = validate_any(cfg)
-        if isinstance(cfg, SuiteConfig):     # one task per (problem, solver), and one per clock-track arm
+        if isinstance(cfg, SuiteConfig):     # one task per (problem, solver) its subset runs, one per clock-track arm
             clock = cfg.tracks.clock if cfg.tracks is not None else None
-            assert tasks == len(cfg.problems) * len(cfg.solvers) + (len(clock.problems) if clock else 0), f
+            pairs = sum(cfg.runs_problem(s.key, p.name) for p in cfg.problems for s in cfg.solvers)
+            assert pairs <= len(cfg.problems) * len(cfg.solvers) and (pairs < len(cfg.problems) * len(cfg.solvers)
+                                                                       or not cfg.subsets), f
+            assert tasks == pairs + (len(clock.problems) if clock else 0), f
         elif isinstance(cfg, AssemblyConfig):
             assert tasks == 1, f
         elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block

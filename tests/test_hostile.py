@@ -1513,7 +1513,8 @@ def test_every_problem_class_gets_its_own_figure(tmp_path):
     scopes = ["all", "class:all", "class:a b", "class:a_b"]
     df = pd.DataFrame([{"scope": s, "solver": "lm", "track": "jacobian", "evals_per_dim": 2.0, "reached": 1,
                         "pairs": 1, "fraction": 1.0} for s in scopes])
-    sr = SimpleNamespace(config=SimpleNamespace(targets=[1e-2], budget_per_dim=50, name="mini"))
+    sr = SimpleNamespace(config=SimpleNamespace(targets=[1e-2], budget_per_dim=50, name="mini", subsets=[]),
+                         runs=pd.DataFrame({"class": []}))
     names = ecdf_figures(sr, tmp_path, {"ecdf.csv": df})
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
     assert len(pngs) == len(scopes) and "ecdf_all.png" in pngs and "ecdf_a_b.png" in pngs
@@ -1566,7 +1567,8 @@ def test_leaderboard_md_escapes_what_it_copies(tmp_path):
     from markdown_it import MarkdownIt
     from fkopt.kinbench.reports import leaderboard_markdown
     config = SimpleNamespace(title=" ".join(HOSTILE_TEXT), name="mini", pose_sets="my-sets", problems=[1],
-                             sets=["uniform"], runs=1, budget_per_dim=50, targets=[1e-2], bootstrap=100, alpha=0.05)
+                             sets=["uniform"], runs=1, budget_per_dim=50, targets=[1e-2], bootstrap=100, alpha=0.05,
+                             subsets=[])
     lb = pd.DataFrame([{"scope": scope, "rank": i + 1, "solver": text, "track": "black-box", "score": 0.5,
                         "ci_low": 0.4, "ci_high": 0.6, "instances": 2, "better_than": text, "success_1e-02": 1.0}
                        for scope in ("overall", f"class:{HOSTILE_TEXT[0]}") for i, text in enumerate(HOSTILE_TEXT)])
