@@ -1654,3 +1654,27 @@ def test_genuine_suite_records_of_every_track_pass_the_resume_check(budget, tmp_
         assert record_problem(task, rec) is None, task.label
         if budget == 1:
             assert rec["rows"]["fitness"][0] == float("inf")
+
+
+def test_a_ctrl_c_inside_a_task_store_write_never_leaves_a_file_its_manifest_does_not_name(tmp_path, monkeypatch):
+    """The race a real SIGINT hit in CI: the task file was in place and the manifest not yet
+    rewritten, so --resume refused the file as "changed since fkopt wrote it". The manifest now
+    names the digest first: interrupted there, no file appears and --resume recomputes the task."""
+    from types import SimpleNamespace
+    from fkopt.experiment.tasks import TaskStore
+    out = tmp_path / "out"
+    store = TaskStore(out, out / ".x.partial", out / "x", "x", {}, "fp")
+    store.open(None, resume=False)
+    store.add("t0", {"fingerprint": "fp", "value": 1})
+    calls = []
+
+    def interrupted():
+        calls.append(1)
+        raise KeyboardInterrupt
+    monkeypatch.setattr(store, "_write_manifest", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        store.add("t1", {"fingerprint": "fp", "value": 2})
+    assert calls and not (store.tasks / "t1.json").exists()
+    again = TaskStore(out, out / ".x.partial", out / "x", "x", {}, "fp")
+    plan = SimpleNamespace(tasks=[SimpleNamespace(id="t0"), SimpleNamespace(id="t1")], check=None)
+    assert list(again.open(plan, resume=True)) == ["t0"]

@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..errors import FkoptError
-from ..files import inside, parse_json, read_stored, stored_sha256, write_json_atomically
+from ..files import inside, parse_json, read_stored, stored_sha256, write_file_atomically, write_json_atomically
 from ..progress import listening
 
 TASKS = "tasks"
@@ -209,9 +209,13 @@ class TaskStore:
 
     def add(self, ident: str, record: Any) -> None:
         path = inside(self.out, self.tasks / f"{ident}.json")
-        write_json_atomically(path, record, separators=(",", ":"))
-        self.digests[ident] = sha256(path)
+        data = json.dumps(record, separators=(",", ":")).encode("utf-8")
+        # The manifest names the file's digest before the file appears: a Ctrl-C between the two
+        # leaves a named task without a file (recomputed by --resume), never a finished file the
+        # manifest does not name (which --resume must refuse as changed since fkopt wrote it).
+        self.digests[ident] = hashlib.sha256(data).hexdigest()
         self._write_manifest()
+        write_file_atomically(path, lambda p: p.write_bytes(data))
 
     def publish_into(self, folder: Path) -> None:
         """Move the task files into the folder about to be published."""
