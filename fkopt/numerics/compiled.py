@@ -875,15 +875,8 @@ def _abc_employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, ra,
         nh = _log_points(a, fe[a], lbest, lcount, lactive, hr, he, hf, nh)
         if s >= 0:
             nh = _log_points(a, fs, lbest, lcount, lactive, hr, he, hf, nh)
-        if rule != 0:     # Algorithm.update_best: the first minimum, if it beats the best so far
-            b = 0
-            for i in range(1, pop):
-                if f[a, i] < f[a, b]:
-                    b = i
-            if f[a, b] < best_f[a]:
-                best_f[a] = f[a, b]
-                for d in range(dim):
-                    best_x[a, d] = x[a, b, d]
+        if rule != 0:     # Algorithm.update_best between the phases (f holds no NaN: fmin'd, g's NaN is inf)
+            _fold_best(a, x, f, best_x, best_f)
         # -- onlookers: roulette on the qualities 1/(1+f) (1-f below 0), cumulated in order
         o = dim + block4
         acc = 0.0
