@@ -1160,7 +1160,7 @@ class InverseSolver:
     prepares again on the next call (one byte comparison per call keeps that honest)."""
 
     __slots__ = ("arm", "options", "tol", "mask", "_W", "_bounds", "_fast", "_one_pose", "_budget", "_table",
-                 "_kn", "_L", "_kernel", "_tail", "_reach")
+                 "_kn", "_L", "_kernel", "_reach")
 
     def __init__(self, arm, options: InverseOptions | None = None, *, tol=INVERSE_TOL, mask=None):
         self.arm = m = _inverse_arm(arm)
@@ -1192,13 +1192,9 @@ class InverseSolver:
         if fast is not None and self._one_pose:
             ctx = _fast_context(m, self._table, self._W)
             nn = min(self._table, self._kn[0]) if self._table else 0
-            tp, tr = self.tol
-            self._kernel = fast._inverse_pose
-            # the arguments after (chain, pose, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed)
-            self._tail = (ctx, float(self._L), ctx["W"], ctx["mid"], 0 if self._table else 1, ctx["tq"], ctx["Ft"],
-                          ctx["norms"], ctx["w"], ctx["fmask"], nn, self._budget, tp, tr, int(o.iterations),
-                          float(o.damping), float(o.down), float(o.up), float(o.step_cap), ctx["slo"], ctx["shi"],
-                          ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
+            self._kernel = fast.bound_inverse_pose(ctx, float(self._L), ctx["W"], ctx["mid"], 0 if self._table else 1,
+                                                   nn, self._budget, self.tol, int(o.iterations), float(o.damping),
+                                                   float(o.down), float(o.up), float(o.step_cap))
 
     def __repr__(self) -> str:
         return f"InverseSolver({self.arm.name!r}, {self.options!r}, tol={self.tol!r}, mask={self.mask!r})"
@@ -1226,12 +1222,7 @@ class InverseSolver:
             dist = math.sqrt(x * x + y * y + z * z)
             if dist > self._reach * (1.0 + 1e-12):
                 raise _unreachable(self.arm, x, y, z, dist)
-            (ctx, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, budget, tp, tr, it, damping, down, up, cap,
-             slo, shi, lo, hi, angle, periodic, blo, bhi) = self._tail
-            out, info = np.empty(ctx["n"]), np.empty(5)
-            self._kernel(ctx["chain"], pose, L, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, it,
-                         damping, down, up, cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info)
-            return _fast_result(self.arm, (out, info), tp, tr)
+            return _fast_result(self.arm, self._kernel(pose, seed), *self.tol)
         o = self.options
         return _inverse_one(self.arm, pose, start, self.tol, seed, self._budget, self._table,
                             self._kn[0 if start is None else 1], o.orientation_scale, o.iterations, o.damping, o.down,

@@ -440,14 +440,28 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
     info[4] = evals
 
 
+def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
+    """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
+    :func:`fkopt.kinematics._fast_context`) and the options bound once: a function
+    (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
+    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.InverseSolver`) keeps it, so
+    a control loop's call does no dictionary lookups."""
+    chain, n = ctx["chain"], ctx["n"]
+    head = (L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn)
+    tail = (budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"], ctx["lo"],
+            ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
+
+    def call(pose, seed):
+        out, info = np.empty(n), np.empty(5)
+        _inverse_pose(chain, pose, *head, seed, *tail, out, info)
+        return out, info
+    return call
+
+
 def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
-    """One pose through :func:`_inverse_pose` with the per-arm constants ``ctx`` (see
-    :func:`fkopt.kinematics._fast_context`): (public joints (n,), info (5,))."""
-    out, info = np.empty(ctx["n"]), np.empty(5)
-    _inverse_pose(ctx["chain"], pose, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
-                  seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
-                  ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
-    return out, info
+    """One pose through :func:`_inverse_pose` (:func:`bound_inverse_pose`, bound for this call):
+    (public joints (n,), info (5,))."""
+    return bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap)(pose, seed)
 
 
 @njit(cache=True, nogil=True)
