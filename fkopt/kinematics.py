@@ -25,12 +25,9 @@ batched over any leading axes, get poses (or joints) back with a verdict per row
    probability proportional to 1 / |det J(x_i)|, :func:`_jacobian_volume`); when none of them
    solves, the rest one after another until one does. Then a few deterministic starts: the centre
    moved by +-1/4 of the box width along each coordinate (2 n starts), all rows at once.
-   Measured on 100 frozen queries of Dietmaier's 6-6 platform (kinbench v3's uniform set, tol
-   1e-10, one query per call): 99 solved, 64 into the generating pose, median ~7 ms per query
-   (``candidates=1``, the nearest start's solution: 53, ~2 ms; 200 held-out uniform poses: 64
-   and 55); without the table (``table=0``, the solver before it) 80 solved, 34 the generating
-   pose, ~31 ms; scipy least_squares from random starts within 500 ms: 45. Rows the start
-   solves have the same answers with or without the table.
+   Rows the start solves have the same answers with or without the table (``table=0`` is the
+   solver before it); what the table buys on Dietmaier's platform is measured in
+   docs/performance.md and docs/python-api.md.
 3. Rows still not solved go to a seeded global search, one row at a time: ``gabc+lm``
    (population 20, 300 iterations, seed ``seed``, run id = row index) through :func:`fkopt.solve`.
 
@@ -841,9 +838,8 @@ def _jacobian_volume(res: _Residuals, x: np.ndarray, idx: np.ndarray, evals) -> 
     ``idx``: the likelihood weight of an assembly mode. For a pose drawn uniformly in the bounds
     the joints' density is sum over the modes x_i of 1 / |det J(x_i)| (change of variables), so
     given the joints the generating pose is mode i with probability proportional to
-    1 / |det J(x_i)|: the smallest volume is the likeliest mode (measured on 100 frozen Dietmaier
-    queries: the generating pose 64 times against 53 for the solution of the nearest start).
-    One Jacobian evaluation per pose, counted."""
+    1 / |det J(x_i)|: the smallest volume is the likeliest mode (against the nearest start's
+    solution: docs/kinbench.md). One Jacobian evaluation per pose, counted."""
     _, J, ne, nj = res.rj(x, idx)
     np.add.at(evals[0], idx, ne)
     np.add.at(evals[1], idx, nj)

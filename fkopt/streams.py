@@ -33,9 +33,8 @@ the states go back into the generators when the numpy refill takes over. It runs
 ``Generator.random(out=...)`` per run and refill and the generators' scattered states cost half
 the refill, and with fewer runs once numba is loaded anyway (a compiled swarm's first iteration
 loads it; never imported for them). With no call per run the buffer is smaller
-(:data:`COMPILED_BUFFER_VALUES`) and stays in cache. Measured (CPU ns per evaluation, 3-RPS,
-600 iterations): 100 cases x 30 runs GABC / ABC / PSO 84 / 86 / 89 -> 80 / 79 / 74; 1 case x 30
-runs PSO / GABC 162 / 137 -> 139 / 123. ``FKOPT_NUMERICS=numpy`` keeps the per-run numpy calls.
+(:data:`COMPILED_BUFFER_VALUES`) and stays in cache (what it buys: docs/performance.md, the
+swarms row). ``FKOPT_NUMERICS=numpy`` keeps the per-run numpy calls.
 """
 from __future__ import annotations
 
@@ -54,9 +53,7 @@ CHUNK = 8192
 BUFFER_VALUES = 1 << 20
 MIN_REFILL = 256
 #: The same bound for the compiled refill (512 kB), which has no per-run cost: a buffer that stays
-#: in a core's cache (2 MB L2 here) beside a swarm's state. 3-RPS GABC / PSO at 100 cases x 30 runs,
-#: 1000 rows per chunk, 200 iterations, CPU time on a loaded machine (best of 2): 86 / 85 ns per
-#: evaluation with 1048 values per run and refill (8 MB), 78-81 / 78-83 with 16 to 256 (64 here).
+#: in a core's cache beside a swarm's state (an 8 MB one did not; docs/performance.md).
 COMPILED_BUFFER_VALUES = 1 << 16
 COMPILED_MIN_REFILL = 32
 
@@ -128,9 +125,8 @@ class RunStreams:
         points into, for the compiled refill's next buffer: one of :attr:`_stores` when its reference
         count says nothing else holds it (every view of a view keeps the owning array as its
         ``base``), else a new one of ``size`` values, kept while fewer than four are. Why: a fresh
-        ``np.empty`` per refill is fresh pages from the OS on first touch (measured with the first
-        compiled refill, PSO at 100 cases: allocation and tail copy 5.2 ns per evaluation beside
-        19.5 for the fill). A view an algorithm keeps is never overwritten."""
+        ``np.empty`` per refill is fresh pages from the OS on first touch, a cost beside the fill
+        itself. A view an algorithm keeps is never overwritten."""
         for store in self._stores:
             # references: the list, this loop's variable, getrefcount's argument -- nothing else
             if store.size >= need and sys.getrefcount(store) <= 3:

@@ -385,7 +385,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
     used, evaluations). Releases the GIL (``nogil``; the same arithmetic), so that a control
     loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.InverseSolver`
-    calls it directly; not measured as a speed-up here: the shared 2-core VM had no idle core)."""
+    calls it directly)."""
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
     r2d = 180.0 / math.pi
