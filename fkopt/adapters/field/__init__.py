@@ -29,8 +29,11 @@ timeout): :mod:`.cmaes` (pycma, IPOP), :mod:`.lbfgsb` (scipy L-BFGS-B from rando
 from __future__ import annotations
 
 import importlib
+import tempfile
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -93,6 +96,16 @@ class ArmURDF:
     tip_link: str
     joint_names: tuple[str, ...]
     source: str
+
+    @contextmanager
+    def as_file(self, text: str | None = None):
+        """The URDF (or ``text``, an edited copy of it) as a file for a package that reads only
+        paths (rtb, ikpy): in a temporary folder of its own, removed when the block ends, so
+        nothing is written beside the robot's files or into the results."""
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "chain.urdf"
+            path.write_text(self.text if text is None else text, encoding="utf-8")
+            yield path
 
     @classmethod
     def from_file(cls, path, base_link: str, tip_link: str) -> "ArmURDF":

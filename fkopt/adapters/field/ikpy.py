@@ -18,13 +18,11 @@ path is the one people run).
 """
 from __future__ import annotations
 
-import tempfile
 import time
 import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
-from pathlib import Path
 
 from ...errors import FkoptError
 from . import FieldIK, arm_urdf
@@ -60,9 +58,7 @@ class IkPy(FieldIK):
             from ikpy.chain import Chain
             urdf = arm_urdf(arm)
             elements = chain_path(urdf)
-            with tempfile.TemporaryDirectory() as tmp:        # ikpy reads a file: a copy it owns briefly
-                path = Path(tmp) / "chain.urdf"
-                path.write_text(urdf.text)
+            with urdf.as_file() as path:                    # ikpy reads a file: a copy it owns briefly
                 chain = Chain.from_urdf_file(str(path), base_elements=elements, symbolic=False,
                                              jax_precompile=False)
                 mask = [link.joint_type != "fixed" for link in chain.links]

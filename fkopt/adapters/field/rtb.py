@@ -22,10 +22,8 @@ the written URDF (rtb reads only URDF).
 """
 from __future__ import annotations
 
-import tempfile
 import warnings
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import numpy as np
 
@@ -46,9 +44,7 @@ def chain_ets(urdf):
         for e in list(parent):
             if e.tag in ("visual", "collision", "transmission", "gazebo"):
                 parent.remove(e)
-    with tempfile.TemporaryDirectory() as tmp:
-        copy = Path(tmp) / "chain.urdf"
-        tree.write(str(copy))
+    with urdf.as_file(ET.tostring(tree.getroot(), encoding="unicode")) as copy:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             links, name, _ = URDF_file(str(copy))
