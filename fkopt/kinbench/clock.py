@@ -223,20 +223,28 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
                     answers[i, j] = q
             if j == j_ref:
                 ref_seconds[i] = min(ref_seconds[i], dt)
-    frames = []
+    return pd.concat([answer_rows(mechanism, robot, name, entry_of(name), "run", np.arange(n),
+                                  np.nan if t is None else t, seconds[:, j], ref_seconds, claimed[:, j],
+                                  answers[:, j], queries, targets)
+                      for j, (name, t, solver) in enumerate(runs)], ignore_index=True)
+
+
+def answer_rows(mechanism, robot: str, solver: str, entry: str, source: str, query, given_timeout_ms, seconds,
+                reference_seconds, claimed, answers: np.ndarray, queries: np.ndarray,
+                targets: np.ndarray) -> pd.DataFrame:
+    """One solver's answers on one arm (IK) or parallel mechanism (FK) as answers rows, each
+    judged by kinbench (:func:`verdicts`), never by what the solver says: the rows of
+    :func:`run_clock` (``source`` = run) and of a submission (``source`` = submitted)."""
+    v = verdicts(mechanism, answers, queries, targets)
+    frame = pd.DataFrame({"robot": robot, "query": query, "solver": solver, "entry": entry, "source": source,
+                          "given_timeout_ms": given_timeout_ms, "seconds": seconds,
+                          "reference_seconds": reference_seconds, "claimed": claimed,
+                          "position_m": v["position_m"], "rotation_rad": v["rotation_rad"],
+                          "in_limits": v["in_limits"], "leg_residual": v["leg_residual"]})
     prefix = answer_prefix(mechanism)
-    for j, (name, t, solver) in enumerate(runs):
-        v = verdicts(mechanism, answers[:, j], queries, targets)
-        frame = pd.DataFrame({"robot": robot, "query": np.arange(n), "solver": name, "entry": entry_of(name),
-                              "source": "run", "given_timeout_ms": np.nan if t is None else t,
-                              "seconds": seconds[:, j], "reference_seconds": ref_seconds,
-                              "claimed": claimed[:, j], "position_m": v["position_m"],
-                              "rotation_rad": v["rotation_rad"], "in_limits": v["in_limits"],
-                              "leg_residual": v["leg_residual"]})
-        for d in range(dim):
-            frame[f"{prefix}{d}"] = answers[:, j, d]
-        frames.append(frame)
-    return pd.concat(frames, ignore_index=True)
+    for d in range(answers.shape[1]):
+        frame[f"{prefix}{d}"] = answers[:, d]
+    return frame
 
 
 def rung_success(answers: pd.DataFrame, ladder=LADDER) -> np.ndarray:

@@ -67,7 +67,7 @@ import pandas as pd
 from ..errors import FkoptError
 from ..experiment.config import files_folder
 from ..files import MAX_INPUT_BYTES, read_input
-from .clock import answer_prefix, is_ik, targets_of, track_settings, verdicts
+from .clock import answer_prefix, answer_rows, is_ik, targets_of, track_settings
 from .outside import read_csv_columns
 
 REQUIRED = ("robot", "query", "seconds", "reference_seconds")
@@ -211,17 +211,11 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
                                 f"timeout ({listed} ms)" if timed else "; every query of the track")
                              + f" ({n} queries) needs one")
         answers = _answers(g, where, robot, mech, dim)
-        v = verdicts(mech, answers, queries[query], targets_of(mech, queries[query]))
-        frame = pd.DataFrame({"robot": robot, "set": clock.set, "query": query, "solver": entry.solver,
-                              "entry": "outside", "source": "submitted",
-                              "given_timeout_ms": g["given_timeout_ms"].to_numpy(float) if timed else np.nan,
-                              "seconds": g["seconds"].to_numpy(float),
-                              "reference_seconds": g["reference_seconds"].to_numpy(float),
-                              "claimed": _claims(g, where) if "claimed" in g else False,
-                              "position_m": v["position_m"], "rotation_rad": v["rotation_rad"],
-                              "in_limits": v["in_limits"], "leg_residual": v["leg_residual"]})
-        prefix = answer_prefix(mech)
-        for d in range(dim):
-            frame[f"{prefix}{d}"] = answers[:, d]
+        frame = answer_rows(mech, robot, entry.solver, "outside", "submitted", query,
+                            g["given_timeout_ms"].to_numpy(float) if timed else np.nan,
+                            g["seconds"].to_numpy(float), g["reference_seconds"].to_numpy(float),
+                            _claims(g, where) if "claimed" in g else False, answers, queries[query],
+                            targets_of(mech, queries[query]))
+        frame.insert(1, "set", clock.set)
         frames.append(frame)
     return pd.concat(frames, ignore_index=True)
