@@ -271,7 +271,7 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
     },
     "ClockSubmission": {
         "solver": ("Name of the submitted solver on the board.", "", "my-ik"),
-        "file": ("CSV of its answers per query (robot, query, q0.., seconds, reference_seconds), relative to "
+        "file": ("CSV of its answers per query (robot, query, q0.. for IK or x0..x5 for FK, seconds, reference_seconds), relative to "
                  "the suite file.", "", "my-ik.csv"),
         "machine": ("The machine it ran on (CPU, threads, OS).", "", "i7-1185G7, 1 thread, Ubuntu 24.04"),
         "reference": ("The reference solver timed beside it; must be the track's.", "", "rtb-ik_LM"),
