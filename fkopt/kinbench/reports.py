@@ -27,10 +27,13 @@ def suite_boards(sr) -> list[tuple[str | None, pd.DataFrame]]:
     """The boards every table, ECDF and ranking is computed on: a suite without subsets has
     one, unnamed (its files look as before subsets existed); a suite with subsets has one per
     board of :meth:`~fkopt.kinbench.config.SuiteConfig.board_cells`, each only on the cells
-    all its solvers ran (:func:`fkopt.kinbench.measures.boards`)."""
-    if not sr.config.subsets:
-        return [(None, sr.runs)]
-    return M.boards(sr.runs, sr.config.board_cells())
+    all its solvers ran (:func:`fkopt.kinbench.measures.boards`). Cut once per result: every
+    table and the ECDF figures ask for them."""
+    got = sr.__dict__.get("_boards")
+    if got is None or got[0] is not sr.runs:
+        boards = [(None, sr.runs)] if not sr.config.subsets else M.boards(sr.runs, sr.config.board_cells())
+        got = sr.__dict__["_boards"] = (sr.runs, boards)
+    return got[1]
 
 
 def split_scope(scope: str) -> tuple[str | None, str]:
