@@ -49,7 +49,8 @@ def _flags_without_type_tag() -> None:
 def _version(value: bool) -> None:
     if value:
         from . import __version__
-        typer.echo(f"fkopt {__version__}")
+        from .numerics.path import version_line
+        typer.echo(f"fkopt {__version__}; {version_line()}")
         raise typer.Exit()
 
 

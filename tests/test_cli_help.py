@@ -16,8 +16,8 @@ ROOT = Path(__file__).resolve().parent.parent
 COMMANDS = typer.main.get_command(cli.app).commands
 
 
-def fkopt(*args, cwd=None, columns=200):
-    env = dict(os.environ, COLUMNS=str(columns), PYTHONPATH=os.pathsep.join(
+def fkopt(*args, cwd=None, columns=200, env=None):
+    env = dict(os.environ, **(env or {}), COLUMNS=str(columns), PYTHONPATH=os.pathsep.join(
         filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
     return subprocess.run([sys.executable, "-m", "fkopt.cli", *args], capture_output=True, text=True,
                           cwd=cwd, env=env, timeout=300)
@@ -25,8 +25,14 @@ def fkopt(*args, cwd=None, columns=200):
 
 def test_version():
     import fkopt as package
-    proc = fkopt("--version")
-    assert proc.returncode == 0 and proc.stdout.strip() == f"fkopt {package.__version__}"
+    proc = fkopt("--version", env={"FKOPT_NUMERICS": "auto"})
+    from importlib.metadata import version
+    assert proc.returncode == 0, proc.stderr
+    # the version, the numerics path a default call takes here and the compiler's version (issue 38)
+    assert proc.stdout.strip() == (f"fkopt {package.__version__}; numerics: compiled (numba {version('numba')}, "
+                                   f"llvmlite {version('llvmlite')})")
+    proc = fkopt("--version", env={"FKOPT_NUMERICS": "numpy"})
+    assert proc.stdout.strip() == f"fkopt {package.__version__}; numerics: numpy (FKOPT_NUMERICS=numpy)"
 
 
 def test_bare_fkopt_prints_help_and_succeeds():

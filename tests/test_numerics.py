@@ -100,7 +100,8 @@ def test_env_json_records_the_numerics_path_and_numbas_version(monkeypatch):
     from fkopt.provenance import environment
     monkeypatch.delenv(numerics_path.ENV, raising=False)
     got = environment()["numerics"]
-    assert got == {"path": "compiled", "mode": "auto", "compiled_fitness": False, "numba": version("numba"), "env": ""}
+    assert got == {"path": "compiled", "mode": "auto", "compiled_fitness": False, "numba": version("numba"),
+                   "llvmlite": version("llvmlite"), "env": ""}
     monkeypatch.setenv(numerics_path.ENV, "numpy")
     assert environment()["numerics"]["path"] == "numpy"
     monkeypatch.setenv(numerics_path.ENV, "compiled")

@@ -4,10 +4,11 @@ reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` ar
 as Python's ``math``). Importing this module imports numba, which costs a noticeable part of a
 second; :mod:`fkopt.numerics.path` imports it only when a compiled kernel is first asked for.
 
-Compiled code is cached on disk (``cache=True``): in the ``__pycache__`` folder beside this file,
-or, when that is not writable, numba's user-wide cache (``~/.cache/numba`` style; ``NUMBA_CACHE_DIR``
-overrides both). The first call after installing compiles (several seconds); later processes
-load the cache.
+Compiled code is cached on disk (``cache=True``, through :func:`fkopt.numerics.jit.njit`: an
+unreadable cache file is set aside and rebuilt, an unwritable folder only costs the cache): in the
+``__pycache__`` folder beside this file, or, when that is not writable, numba's user-wide cache
+(``~/.cache/numba`` style; ``NUMBA_CACHE_DIR`` overrides both). The first call after installing
+compiles (tens of seconds for all kernels, docs/performance.md); later processes load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
 * :func:`rps3_fitness`, :func:`pso_rps3`, :func:`abc_rps3` -- the 3-RPS swarm fitness and the PSO
@@ -27,9 +28,11 @@ import math
 import threading
 
 import numpy as np
-from llvmlite import ir
-from numba import njit, types
+from numba import types               # numba first: without it, the ImportError names numba (not llvmlite)
 from numba.core.extending import intrinsic
+from llvmlite import ir
+
+from .jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -1093,3 +1096,14 @@ def store_pcg64_states(generators, S) -> None:
         st = g.bit_generator.state
         st["state"] = {"state": lo | (hi << 64), "inc": ilo | (ihi << 64)}
         g.bit_generator.state = st
+
+
+@njit(cache=True)
+def _probe(x):
+    return math.sqrt(x * x) + 1.0
+
+
+def probe(x: float) -> float:
+    """x + 1 (x >= 0) through a compiled kernel: :func:`fkopt.numerics.path.compiled` calls it once
+    per process to learn that numba compiles (or loads its cache) here before choosing this path."""
+    return _probe(float(x))
