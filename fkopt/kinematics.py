@@ -981,12 +981,14 @@ def _fast_context(m, table: int, W) -> dict:
         got = c[key] = {
             "n": n, "chain": m.chain().arrays(), "tq": np.ascontiguousarray(tq, dtype=float),
             "Ft": np.ascontiguousarray(F.T, dtype=float), "norms": np.ascontiguousarray(norms, dtype=float), "w": w,
+
             "fmask": np.ascontiguousarray(fmask, dtype=float), "W": np.ones(6) if W is None else np.asarray(W, float),
             "slo": np.asarray(c["slo"], dtype=float), "shi": np.asarray(c["shi"], dtype=float),
             "lo": np.asarray(c["lo"], dtype=float), "hi": np.asarray(c["hi"], dtype=float),
             "angle": np.array(c["angle"], dtype=np.bool_), "periodic": np.array(c["periodic"], dtype=np.bool_),
             "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
             "mid": np.array(c["mid"], dtype=float)}
+        got["table"] = (got["Ft"], got["norms"])        # the compiled nearest-neighbour search's arguments
     return got
 
 

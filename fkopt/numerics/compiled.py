@@ -227,12 +227,15 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
 
 
 @njit(cache=True)
-def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr, iterations, damping, down, up,
-                 step_cap, lo, hi, glo, ghi, best_q):
+def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, tq, seed, row, budget, tp, tr, iterations,
+                 damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
     """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
-    (starts used, evaluations)."""
+    (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
+    called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``, features
+    ``feat``, joints ``tq``), looked up only if a start reaches them -- most poses are solved from
+    their first or second start, and the nearest few cost a tenth of the nearest 64."""
     n = q0.shape[0]
     m = chain[0].shape[0]
     nn = near.shape[0]
@@ -251,6 +254,9 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr,
         if j < own0:
             q[:] = q0
         elif j < own0 + nn:
+            if j - own0 >= have:
+                _near_rows(table, feat, tq, near)        # the top `have` of these are the rows already there
+                have = nn
             q[:] = near[j - own0]
         else:
             _uniform_hash(seed, row, j - own0 - nn, u)
@@ -334,7 +340,8 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
                 step_cap, lo, hi, glo, ghi):
     """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
     best = np.empty(chain.dof)
-    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, int(seed), 0, int(budget),
+    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], NO_TABLE,
+                               np.zeros(12), np.zeros((0, chain.dof)), int(seed), 0, int(budget),
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
     return best, used, evals
@@ -376,13 +383,34 @@ def _nearest_into(Ft, norms, f, idx, best):
         idx[pos] = i
 
 
+#: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
+NO_TABLE = (np.zeros((12, 0)), np.zeros(0))
+
+#: Neighbours looked up before the first start; the rest only when a start reaches them. Most
+#: poses are solved from their first or second start, and the nearest four cost half of the
+#: nearest 64 (the features pass is the same, the sorted insertion is not).
+NEAR_FIRST = 4
+
+
+@njit(cache=True)
+def _near_rows(table, f, tq, near):
+    """The table joints of the len(near) rows nearest to f (:func:`_nearest_into` on ``table`` =
+    (features transposed, norms)) into near."""
+    k = near.shape[0]
+    idx = np.empty(k, dtype=np.int64)
+    _nearest_into(table[0], table[1], f, idx, np.empty(k))
+    for i in range(k):
+        near[i, :] = tq[idx[i]]
+
+
 @njit(cache=True, nogil=True)
-def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
     the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
-    start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
+    start table's ``nn`` nearest configurations (:func:`_nearest_into`: the first
+    :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
@@ -405,21 +433,19 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
         T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
     pt = pose[:3].copy()
     near = np.empty((nn, n))
+    f = np.empty(12)
+    have = min(nn, NEAR_FIRST)
     if nn > 0:
-        f = np.empty(12)
         f[0], f[1], f[2] = pt[0], pt[1], pt[2]
         for r in range(3):
             for c in range(3):
                 f[3 + 3 * r + c] = wf * T[r, c]
         for j in range(12):
             f[j] = f[j] * fmask[j]
-        idx = np.empty(nn, dtype=np.int64)
-        _nearest_into(Ft, norms, f, idx, np.empty(nn))
-        for k in range(nn):
-            near[k, :] = tq[idx[k]]
+        _near_rows(table, f, tq, near[:have])
     best = np.empty(n)
-    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, 0, budget, tp, tr, iterations, damping,
-                               down, up, step_cap, slo, shi, lo, hi, best)
+    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, f, tq, seed, 0, budget, tp, tr,
+                               iterations, damping, down, up, step_cap, slo, shi, lo, hi, best)
     t = np.empty(n)
     inside = True
     for i in range(n):
@@ -450,7 +476,7 @@ def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping
     kernel's arguments; a prepared solver (:class:`fkopt.kinematics.InverseSolver`) keeps it, so
     a control loop's call does no dictionary lookups."""
     chain, n = ctx["chain"], ctx["n"]
-    head = (L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn)
+    head = (L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn)
     tail = (budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"], ctx["lo"],
             ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
 
@@ -468,13 +494,13 @@ def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, d
 
 
 @njit(cache=True, nogil=True)
-def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
     """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
     ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
     share a batch (:func:`inverse_rows`)."""
     for k in range(first, poses.shape[0], step):
-        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr,
+        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, table, wf, fmask, nn, seed, budget, tp, tr,
                       iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
                       out[k], info[k])
 
@@ -491,7 +517,7 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
     import os
     k = poses.shape[0]
     out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
-    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn,
             seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
             ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
     threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
