@@ -241,6 +241,8 @@ def _targets(m, poses) -> np.ndarray:
 
 def _values(mechanism: Mechanism, values, names, what: str) -> np.ndarray:
     a = np.asarray(values, dtype=float)
+    if a.ndim == 1 and a.shape[0] == len(names) and math.isfinite(sum(a.tolist())):
+        return a          # one row, all finite (a sum that overflows takes the checks below): a control loop's call
     if a.ndim == 0 or a.shape[-1] != len(names):
         raise FkoptError(f"{mechanism.name} {what}: expected (..., {len(names)}) values "
                          f"({', '.join(names)}), got shape {a.shape}")

@@ -149,17 +149,11 @@ def _rotation_error(R, T, e):
     e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
 
 
-@njit(cache=True)
-def _dls_step(J, r, mu, free, d, A, L, y, x):
-    """:func:`fkopt.numerics.dls.dls_step` into d; J's columns with free[i] = False count as zero.
-    Returns False when not positive definite or not finite."""
+@njit(inline="always")
+def _cholesky_solve(J, r, A, L, y, x, d, free, masked):
+    """The rest of :func:`_dls_step` once A = J J^T + mu I is built: Cholesky of A, x = A^{-1} (-r),
+    d = J^T x (J's columns with free[i] False as zero when ``masked``)."""
     n = J.shape[1]
-    for a in range(6):
-        for b in range(a, 6):
-            acc = (J[a, 0] if free[0] else 0.0) * (J[b, 0] if free[0] else 0.0)
-            for i in range(1, n):
-                acc = acc + (J[a, i] if free[i] else 0.0) * (J[b, i] if free[i] else 0.0)
-            A[a, b] = acc + mu if a == b else acc
     for i in range(6):
         for j in range(i + 1):
             acc = 0.0
@@ -185,13 +179,48 @@ def _dls_step(J, r, mu, free, d, A, L, y, x):
     for i in range(6):
         if not math.isfinite(x[i]):
             return False
-    for i in range(n):
-        ji = J[0, i] if free[i] else 0.0
-        acc = ji * x[0]
-        for a in range(1, 6):
-            acc = acc + (J[a, i] if free[i] else 0.0) * x[a]
-        d[i] = acc
+    if masked:
+        for i in range(n):
+            ji = J[0, i] if free[i] else 0.0
+            acc = ji * x[0]
+            for a in range(1, 6):
+                acc = acc + (J[a, i] if free[i] else 0.0) * x[a]
+            d[i] = acc
+    else:
+        for i in range(n):
+            acc = J[0, i] * x[0]
+            for a in range(1, 6):
+                acc = acc + J[a, i] * x[a]
+            d[i] = acc
     return True
+
+
+@njit(cache=True)
+def _dls_step(J, r, mu, free, d, A, L, y, x):
+    """:func:`fkopt.numerics.dls.dls_step` into d; J's columns with free[i] = False count as zero.
+    Returns False when not positive definite or not finite."""
+    n = J.shape[1]
+    for a in range(6):
+        for b in range(a, 6):
+            acc = (J[a, 0] if free[0] else 0.0) * (J[b, 0] if free[0] else 0.0)
+            for i in range(1, n):
+                acc = acc + (J[a, i] if free[i] else 0.0) * (J[b, i] if free[i] else 0.0)
+            A[a, b] = acc + mu if a == b else acc
+    return _cholesky_solve(J, r, A, L, y, x, d, free, True)
+
+
+@njit(cache=True)
+def _dls_step_all(J, r, mu, free, d, A, L, y, x):
+    """:func:`_dls_step` with every column free (``free`` is not read): the same operations
+    without the masks (a free column's value is itself, so the bits are the same)."""
+    n = J.shape[1]
+    for a in range(6):
+        for b in range(a, 6):
+            acc = J[a, 0] * J[b, 0]
+            for i in range(1, n):
+                acc = acc + J[a, i] * J[b, i]
+            A[a, b] = acc + mu if a == b else acc
+    return _cholesky_solve(J, r, A, L, y, x, d, free, False)
 
 
 @njit(cache=True)
@@ -207,17 +236,19 @@ def _uniform_hash(seed, row, draw, out):
 
 
 @njit(cache=True)
-def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
-    """Residual r (6), scaled Jacobian J (6, n) at t; returns (pe, re, S)."""
+def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e, wone=False):
+    """Residual r (6), scaled Jacobian J (6, n) at t; returns (pe, re, S). ``wone``: W is all
+    ones, whose products change no bit (x * 1.0 == x), so they are skipped."""
     prismatic, C, v, var, mult, off, tC, tv = chain
     _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax)
     _rotation_error(R, T, e)
     d0, d1, d2 = (p[0] - pt[0]) * W[0], (p[1] - pt[1]) * W[1], (p[2] - pt[2]) * W[2]
     e0, e1, e2 = e[0] * W[3], e[1] * W[4], e[2] * W[5]
     n = J.shape[1]
-    for a in range(6):
-        for i in range(n):
-            J[a, i] = J[a, i] * W[a]
+    if not wone:
+        for a in range(6):
+            for i in range(n):
+                J[a, i] = J[a, i] * W[a]
     r[0], r[1], r[2], r[3], r[4], r[5] = d0, d1, d2, Lw * e0, Lw * e1, Lw * e2
     for a in range(3, 6):
         for i in range(n):
@@ -227,15 +258,15 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
 
 
 @njit(cache=True)
-def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, tq, seed, row, budget, tp, tr, iterations,
+def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, vdist, tq, seed, row, budget, tp, tr, iterations,
                  damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
     """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
     (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
-    called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``, features
-    ``feat``, joints ``tq``), looked up only if a start reaches them -- most poses are solved from
-    their first or second start, and the nearest few cost a tenth of the nearest 64."""
+    called: the rest are the start table's next nearest (:func:`_near_rows` on the table's
+    distances ``vdist``, joints ``tq``), looked up only if a start reaches them (most poses are
+    solved from their first or second start)."""
     n = q0.shape[0]
     m = chain[0].shape[0]
     nn = near.shape[0]
@@ -247,7 +278,9 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, tq, see
     fixed_val = np.empty(n)
     fixed_order = np.empty(n, dtype=np.int64)
     free = np.ones(n, dtype=np.bool_)
-    allfree = np.ones(n, dtype=np.bool_)
+    wone = True
+    for a in range(6):
+        wone = wone and W[a] == 1.0
     evals = 0
     best_m = math.inf
     for j in range(budget):
@@ -255,14 +288,14 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, tq, see
             q[:] = q0
         elif j < own0 + nn:
             if j - own0 >= have:
-                _near_rows(table, feat, tq, near)        # the top `have` of these are the rows already there
+                _near_rows(vdist, tq, near)             # the top `have` of these are the rows already there
                 have = nn
             q[:] = near[j - own0]
         else:
             _uniform_hash(seed, row, j - own0 - nn, u)
             for i in range(n):
                 q[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
-        pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e)
+        pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e, wone)
         evals += 1
         lam = damping
         for _ in range(iterations):
@@ -273,7 +306,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, tq, see
                 for i in range(n):
                     acc = acc + J[a, i] * J[a, i]
             mu = lam * (acc / 6.0)
-            if not _dls_step(J, r, mu, allfree, d, A, Lc, y, x):
+            if not _dls_step_all(J, r, mu, free, d, A, Lc, y, x):
                 break
             big = abs(d[0])
             for i in range(1, n):
@@ -315,7 +348,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, tq, see
                         break
                 for i in range(n):
                     qn[i] = min(max(qn[i], lo[i]), hi[i])
-            pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e)
+            pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e, wone)
             evals += 1
             if Sn < S:
                 q[:] = qn
@@ -340,21 +373,19 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
                 step_cap, lo, hi, glo, ghi):
     """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
     best = np.empty(chain.dof)
-    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], NO_TABLE,
-                               np.zeros(12), np.zeros((0, chain.dof)), int(seed), 0, int(budget),
+    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], np.zeros(0),
+                               np.zeros((0, chain.dof)), int(seed), 0, int(budget),
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
     return best, used, evals
 
 
 @njit(cache=True)
-def _nearest_into(Ft, norms, f, idx, best):
-    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx:
-    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics._nearest`'s brute force; the dot product
-    summed feature by feature, rows side by side, from ``Ft`` = F transposed), the k smallest kept
-    sorted by insertion (ties: the lower row first)."""
+def _table_distances(Ft, norms, f, v):
+    """v[i] = |F_i|^2 - 2 F_i . f (= |F_i - f|^2 - |f|^2) for every row of the start table, as
+    :func:`fkopt.kinematics._nearest`'s brute force: the dot product summed feature by feature,
+    rows side by side, from ``Ft`` = F transposed."""
     c, N = Ft.shape
-    k = idx.shape[0]
     d2 = np.zeros(N)
     for j in range(c):
         fj = f[j]
@@ -365,40 +396,55 @@ def _nearest_into(Ft, norms, f, idx, best):
             continue
         for i in range(N):
             d2[i] += Ft[j, i] * fj
-    m = 0
     for i in range(N):
-        v = norms[i] - 2.0 * d2[i]
+        v[i] = norms[i] - 2.0 * d2[i]
+
+
+@njit(cache=True)
+def _smallest(v, idx, best):
+    """The k = len(idx) rows of the smallest v, smallest first, into idx (values into best): kept
+    sorted by insertion in row order (ties: the lower row first)."""
+    k = idx.shape[0]
+    m = 0
+    for i in range(v.shape[0]):
+        x = v[i]
         if m < k:
             pos = m
             m += 1
-        elif v < best[k - 1]:
+        elif x < best[k - 1]:
             pos = k - 1
         else:
             continue
-        while pos > 0 and best[pos - 1] > v:
+        while pos > 0 and best[pos - 1] > x:
             best[pos] = best[pos - 1]
             idx[pos] = idx[pos - 1]
             pos -= 1
-        best[pos] = v
+        best[pos] = x
         idx[pos] = i
 
 
-#: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
-NO_TABLE = (np.zeros((12, 0)), np.zeros(0))
+@njit(cache=True)
+def _nearest_into(Ft, norms, f, idx, best):
+    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx
+    (:func:`_table_distances`, then :func:`_smallest`)."""
+    v = np.empty(Ft.shape[1])
+    _table_distances(Ft, norms, f, v)
+    _smallest(v, idx, best)
+
 
 #: Neighbours looked up before the first start; the rest only when a start reaches them. Most
-#: poses are solved from their first or second start, and the nearest four cost half of the
-#: nearest 64 (the features pass is the same, the sorted insertion is not).
+#: poses are solved from their first or second start, and the nearest four cost about half of
+#: the nearest 64 (the distances are the same pass, computed once; the sorted insertion is not).
 NEAR_FIRST = 4
 
 
 @njit(cache=True)
-def _near_rows(table, f, tq, near):
-    """The table joints of the len(near) rows nearest to f (:func:`_nearest_into` on ``table`` =
-    (features transposed, norms)) into near."""
+def _near_rows(v, tq, near):
+    """The table joints of the len(near) rows of the smallest distances v (:func:`_smallest`)
+    into near."""
     k = near.shape[0]
     idx = np.empty(k, dtype=np.int64)
-    _nearest_into(table[0], table[1], f, idx, np.empty(k))
+    _smallest(v, idx, np.empty(k))
     for i in range(k):
         near[i, :] = tq[idx[i]]
 
@@ -409,7 +455,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
     the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
-    start table's ``nn`` nearest configurations (:func:`_nearest_into`: the first
+    start table's ``nn`` nearest configurations (:func:`_table_distances` once, the first
     :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
@@ -433,18 +479,20 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
         T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
     pt = pose[:3].copy()
     near = np.empty((nn, n))
-    f = np.empty(12)
+    vdist = np.empty(tq.shape[0] if nn > 0 else 0)
     have = min(nn, NEAR_FIRST)
     if nn > 0:
+        f = np.empty(12)
         f[0], f[1], f[2] = pt[0], pt[1], pt[2]
         for r in range(3):
             for c in range(3):
                 f[3 + 3 * r + c] = wf * T[r, c]
         for j in range(12):
             f[j] = f[j] * fmask[j]
-        _near_rows(table, f, tq, near[:have])
+        _table_distances(table[0], table[1], f, vdist)
+        _near_rows(vdist, tq, near[:have])
     best = np.empty(n)
-    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, f, tq, seed, 0, budget, tp, tr,
+    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, vdist, tq, seed, 0, budget, tp, tr,
                                iterations, damping, down, up, step_cap, slo, shi, lo, hi, best)
     t = np.empty(n)
     inside = True
