@@ -990,7 +990,8 @@ def _fast_context(m, table: int, W) -> dict:
             "angle": np.array(c["angle"], dtype=np.bool_), "periodic": np.array(c["periodic"], dtype=np.bool_),
             "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
             "mid": np.array(c["mid"], dtype=float)}
-        got["table"] = (got["Ft"], got["norms"])        # the compiled nearest-neighbour search's arguments
+        from .numerics.compiled import start_screen     # the compiled nearest-neighbour search's arguments
+        got["table"] = start_screen(got["Ft"], got["norms"])
     return got
 
 

@@ -258,15 +258,15 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e, wone=False):
 
 
 @njit(cache=True)
-def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, vdist, tq, seed, row, budget, tp, tr, iterations,
+def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq, seed, row, budget, tp, tr, iterations,
                  damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
     """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
     (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
-    called: the rest are the start table's next nearest (:func:`_near_rows` on the table's
-    distances ``vdist``, joints ``tq``), looked up only if a start reaches them (most poses are
-    solved from their first or second start)."""
+    called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``,
+    features ``feat``, the screen ``v32``, joints ``tq``), looked up only if a start reaches them
+    (most poses are solved from their first or second start)."""
     n = q0.shape[0]
     m = chain[0].shape[0]
     nn = near.shape[0]
@@ -288,7 +288,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, vdist, tq, seed, row
             q[:] = q0
         elif j < own0 + nn:
             if j - own0 >= have:
-                _near_rows(vdist, tq, near)             # the top `have` of these are the rows already there
+                _near_rows(table, feat, v32, tq, near)  # the top `have` of these are the rows already there
                 have = nn
             q[:] = near[j - own0]
         else:
@@ -373,8 +373,9 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
                 step_cap, lo, hi, glo, ghi):
     """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
     best = np.empty(chain.dof)
-    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], np.zeros(0),
-                               np.zeros((0, chain.dof)), int(seed), 0, int(budget),
+    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], NO_TABLE,
+                               np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, chain.dof)), int(seed), 0,
+                               int(budget),
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
     return best, used, evals
@@ -432,19 +433,113 @@ def _nearest_into(Ft, norms, f, idx, best):
     _smallest(v, idx, best)
 
 
+#: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
+NO_TABLE = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0)
+
 #: Neighbours looked up before the first start; the rest only when a start reaches them. Most
 #: poses are solved from their first or second start, and the nearest four cost about half of
-#: the nearest 64 (the distances are the same pass, computed once; the sorted insertion is not).
+#: the nearest 64 (the screening pass is the same, computed once; the exact rows are not).
 NEAR_FIRST = 4
+#: The float32 screen's error bound, relative to the sizes in :func:`start_screen`: float32's
+#: unit roundoff is 2^-24, a 12-term dot product and the conversions need at most ~16 of them;
+#: 2^-16 leaves a factor 16 more.
+SCREEN_ROUNDOFF = 2.0 ** -16
+
+
+def start_screen(Ft, norms):
+    """The start table for :func:`_nearest_screened`: (Ft float64 (12, N), norms float64, Ft and
+    norms as float32, max |F_i|^2)."""
+    return (Ft, norms, np.ascontiguousarray(Ft, dtype=np.float32), np.ascontiguousarray(norms, dtype=np.float32),
+            float(norms.max()) if norms.shape[0] else 0.0)
 
 
 @njit(cache=True)
-def _near_rows(v, tq, near):
-    """The table joints of the len(near) rows of the smallest distances v (:func:`_smallest`)
-    into near."""
+def _screen32(table, f, v32):
+    """v32[i] = |F_i|^2 - 2 F_i . f in float32 for every row (half the bytes of the float64 pass,
+    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values."""
+    Ft32, n32 = table[2], table[3]
+    c, N = Ft32.shape
+    for i in range(N):
+        v32[i] = 0.0
+    for j in range(c):
+        fj = np.float32(f[j])
+        if f[j] == 0.0:
+            continue
+        for i in range(N):
+            v32[i] += Ft32[j, i] * fj
+    two = np.float32(2.0)
+    for i in range(N):
+        v32[i] = n32[i] - two * v32[i]
+
+
+@njit(cache=True)
+def _nearest_screened(table, f, v32, idx, best):
+    """:func:`_nearest_into`'s k = len(idx) nearest rows, the same rows in the same order: the
+    float32 screen v32 (:func:`_screen32`) bounds every row's float64 value v within B (sizes
+    times :data:`SCREEN_ROUNDOFF`), so with s_k the k-th smallest screen value, the k-th smallest
+    v is at most s_k + B and a row of the k nearest has v32 <= s_k + 2B; only those rows get the
+    float64 value of :func:`_table_distances` (the same operations), in row order, and the same
+    sorted insertion (ties: the lower row first)."""
+    Ft, norms, _, _, nmax = table
+    k = idx.shape[0]
+    c, N = Ft.shape
+    ff = 0.0
+    for j in range(c):
+        ff += f[j] * f[j]
+    B = SCREEN_ROUNDOFF * (1.0 + nmax + 2.0 * math.sqrt(nmax * ff) + ff)
+    # the k smallest screen values (sorted insertion; k is small)
+    sk = np.empty(k)
+    m = 0
+    for i in range(N):
+        x = np.float64(v32[i])
+        if m < k:
+            pos = m
+            m += 1
+        elif x < sk[k - 1]:
+            pos = k - 1
+        else:
+            continue
+        while pos > 0 and sk[pos - 1] > x:
+            sk[pos] = sk[pos - 1]
+            pos -= 1
+        sk[pos] = x
+    limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
+    m = 0
+    for i in range(N):
+        if not np.float64(v32[i]) <= limit:
+            continue
+        acc = 0.0
+        first = True
+        for j in range(c):
+            fj = f[j]
+            if fj == 0.0:
+                continue
+            # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
+            # |F_i|^2 - 2 d2 does not see)
+            acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
+            first = False
+        x = norms[i] - 2.0 * acc
+        if m < k:
+            pos = m
+            m += 1
+        elif x < best[k - 1]:
+            pos = k - 1
+        else:
+            continue
+        while pos > 0 and best[pos - 1] > x:
+            best[pos] = best[pos - 1]
+            idx[pos] = idx[pos - 1]
+            pos -= 1
+        best[pos] = x
+        idx[pos] = i
+
+
+@njit(cache=True)
+def _near_rows(table, f, v32, tq, near):
+    """The table joints of the len(near) rows nearest to f (:func:`_nearest_screened`) into near."""
     k = near.shape[0]
     idx = np.empty(k, dtype=np.int64)
-    _smallest(v, idx, np.empty(k))
+    _nearest_screened(table, f, v32, idx, np.empty(k))
     for i in range(k):
         near[i, :] = tq[idx[i]]
 
@@ -455,7 +550,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
     the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
-    start table's ``nn`` nearest configurations (:func:`_table_distances` once, the first
+    start table's ``nn`` nearest configurations (:func:`_nearest_screened`, its float32 screen once; the first
     :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
@@ -479,20 +574,20 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
         T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
     pt = pose[:3].copy()
     near = np.empty((nn, n))
-    vdist = np.empty(tq.shape[0] if nn > 0 else 0)
+    v32 = np.empty(tq.shape[0] if nn > 0 else 0, dtype=np.float32)
     have = min(nn, NEAR_FIRST)
+    f = np.empty(12)
     if nn > 0:
-        f = np.empty(12)
         f[0], f[1], f[2] = pt[0], pt[1], pt[2]
         for r in range(3):
             for c in range(3):
                 f[3 + 3 * r + c] = wf * T[r, c]
         for j in range(12):
             f[j] = f[j] * fmask[j]
-        _table_distances(table[0], table[1], f, vdist)
-        _near_rows(vdist, tq, near[:have])
+        _screen32(table, f, v32)
+        _near_rows(table, f, v32, tq, near[:have])
     best = np.empty(n)
-    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, vdist, tq, seed, 0, budget, tp, tr,
+    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, f, v32, tq, seed, 0, budget, tp, tr,
                                iterations, damping, down, up, step_cap, slo, shi, lo, hi, best)
     t = np.empty(n)
     inside = True
