@@ -116,7 +116,7 @@ from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from fkopt.mechanisms.catalog import MECHANISMS
 from fkopt.numerics import path as numerics_path
 from fkopt.numerics.options import InverseOptions
-from fkopt.numerics.dls import inverse_candidates, rotation_error1
+from fkopt.numerics.damped_least_squares import inverse_candidates, rotation_error1
 from fkopt.problems import fk_problem, so3_right_jacobian_inverse
 from fkopt.algorithms.runs import solve
 
@@ -1015,7 +1015,7 @@ def _unreachable(m, x, y, z, dist) -> FkoptError:
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
-    Python floats (:func:`fkopt.numerics.dls.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
+    Python floats (:func:`fkopt.numerics.damped_least_squares.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
     first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
     batch's bookkeeping costs more than the iteration itself for a single pose. The compiled call
