@@ -1,4 +1,4 @@
-"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.dls` compiled by
+"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.damped_least_squares` compiled by
 numba, operation for operation in the reference's order (numba compiles without fast-math, so no
 reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` are the C library's,
 as Python's ``math``). Importing this module imports numba, which costs a noticeable part of a
@@ -17,9 +17,9 @@ compiles (tens of seconds for all kernels, docs/performance.md); later processes
   ``error_model="numpy"``: a float division by zero gives numpy's inf/NaN instead of a Python
   exception, so no check guards each division (half of the fitness' time, measured: 57 -> 29 ns
   per point); the values are the same wherever the divisor is not zero;
-* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
+* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.damped_least_squares.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
-* :func:`fill_uniforms` -- the refill of :class:`fkopt.streams.RunStreams`' buffer, every run in one
+* :func:`fill_uniforms` -- the refill of :class:`fkopt.numerics.streams.RunStreams`' buffer, every run in one
   call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits);
 """
 from __future__ import annotations
@@ -32,7 +32,7 @@ from numba import types               # numba first: without it, the ImportError
 from numba.core.extending import intrinsic
 from llvmlite import ir
 
-from .jit import njit                 # numba.njit with a cache that a corrupted file cannot break
+from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -197,7 +197,7 @@ def _cholesky_solve(J, r, A, L, y, x, d, free, masked):
 
 @njit(cache=True)
 def _dls_step(J, r, mu, free, d, A, L, y, x):
-    """:func:`fkopt.numerics.dls.dls_step` into d; J's columns with free[i] = False count as zero.
+    """:func:`fkopt.numerics.damped_least_squares.dls_step` into d; J's columns with free[i] = False count as zero.
     Returns False when not positive definite or not finite."""
     n = J.shape[1]
     for a in range(6):
@@ -225,7 +225,7 @@ def _dls_step_all(J, r, mu, free, d, A, L, y, x):
 
 @njit(cache=True)
 def _uniform_hash(seed, row, draw, out):
-    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics._uniform_hash` (SplitMix64's finaliser)."""
+    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.solvers._uniform_hash` (SplitMix64's finaliser)."""
     c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
     for k in range(out.shape[0]):
         z = c + np.uint64(k + 1) * _M2
@@ -260,7 +260,7 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e, wone=False):
 @njit(cache=True)
 def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq, seed, row, budget, tp, tr, iterations,
                  damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
-    """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
+    """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
     (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
@@ -384,7 +384,7 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
 @njit(cache=True)
 def _table_distances(Ft, norms, f, v):
     """v[i] = |F_i|^2 - 2 F_i . f (= |F_i - f|^2 - |f|^2) for every row of the start table, as
-    :func:`fkopt.kinematics._nearest`'s brute force: the dot product summed feature by feature,
+    :func:`fkopt.kinematics.solvers._nearest`'s brute force: the dot product summed feature by feature,
     rows side by side, from ``Ft`` = F transposed."""
     c, N = Ft.shape
     d2 = np.zeros(N)
@@ -548,7 +548,7 @@ def _near_rows(table, f, v32, tq, near):
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
+    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics.solvers._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
     start table's ``nn`` nearest configurations (:func:`_nearest_screened`, its float32 screen once; the first
     :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
@@ -556,7 +556,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
     used, evaluations). Releases the GIL (``nogil``; the same arithmetic), so that a control
-    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.InverseSolver`
+    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.solvers.InverseSolver`
     calls it directly)."""
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
@@ -614,9 +614,9 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
 
 def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
     """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
-    :func:`fkopt.kinematics._fast_context`) and the options bound once: a function
+    :func:`fkopt.kinematics.solvers._fast_context`) and the options bound once: a function
     (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
-    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.InverseSolver`) keeps it, so
+    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.solvers.InverseSolver`) keeps it, so
     a control loop's call does no dictionary lookups."""
     chain, n = ctx["chain"], ctx["n"]
     head = (L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn)

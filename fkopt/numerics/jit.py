@@ -29,7 +29,7 @@ import time
 import numba
 from numba.core.caching import FunctionCache
 
-from .notice import notice
+from fkopt.numerics.notice import notice
 
 _LOCK = threading.Lock()
 _ASIDE: dict[str, str] = {}          # cache folder -> the folder its bad files went to (this process)

@@ -16,7 +16,7 @@ import os
 import threading
 from contextlib import contextmanager
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 ENV = "FKOPT_NUMERICS"
 _STATE: dict = {}
@@ -66,7 +66,7 @@ def compiled(want: bool | None = None):
 def _load():
     """(module, None) when numba imports and compiles, else (None, the reason in words)."""
     try:
-        from . import compiled as mod
+        from fkopt.numerics import compiled as mod
     except ImportError as err:
         missing = getattr(err, "name", None) or ""
         if missing.split(".")[0] in ("numba", "llvmlite"):
@@ -84,7 +84,7 @@ def _load():
 
 
 def _say_fallback(reason: str) -> None:
-    from .notice import notice
+    from fkopt.numerics.notice import notice
     notice("fallback", f"compiled numerics unavailable ({reason}); running the numpy path, which is "
                        f"slower (pip install numba to restore it; {ENV}=numpy silences this)")
 
