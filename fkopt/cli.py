@@ -671,7 +671,7 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
                                             "throughput, mao2017, peers, adapters, exact, kinematics, "
-                                            "ik-one-pose, ik-batch, cases, swarms, scaling (default: all but peers "
+                                            "ik-one-pose, ik-batch, cases, swarms, fksgp, scaling (default: all but peers "
                                             "and adapters)")):
     """Measure fkopt's speed (and peers') on this machine.
 

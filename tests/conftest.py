@@ -72,6 +72,7 @@ def cli(monkeypatch, capsys):
 # that no longer exists in its (collected) file is a usage error, not a silent no-op.
 FAST_TIER = "not slow and not stored and not external and not browser"
 TIERS = {
+    "tests/test_bench_fksgp.py::test_beside_fksgp_every_platform_gives_the_same_real_solutions": ("external",),
     "tests/test_numerics_fallback.py::test_every_kind_of_corrupted_cache_file_is_set_aside_and_rebuilt": ("slow",),
     "tests/test_bench_ik.py::test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones": ("external",),
     "tests/test_bench_ik.py::test_ik_sections_report_every_arm_ratios_and_verified_counts": ("external",),

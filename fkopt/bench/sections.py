@@ -973,7 +973,7 @@ def _fmt(v: float) -> str:
 
 
 SECTIONS = ("throughput", "mao2017", "peers", "adapters", "exact", "kinematics", "ik-one-pose", "ik-batch",
-            "cases", "swarms", "scaling")
+            "cases", "swarms", "fksgp", "scaling")
 
 
 def run(quick: bool = False, peers: bool = False, out="bench", sections=None) -> pd.DataFrame:
@@ -1038,6 +1038,9 @@ def run(quick: bool = False, peers: bool = False, out="bench", sections=None) ->
     if "swarms" in want:
         timed("swarms", bench_swarms, rows, quick, np.random.default_rng(29), messages)
         timed("swarms", bench_pygmo_abc, rows, quick, messages)
+    if "fksgp" in want:                                  # skipped with a message without the vendored fkSGP
+        from fkopt.bench.fksgp import bench_fksgp
+        timed("fksgp", bench_fksgp, rows, quick, messages)
     if "scaling" in want:
         curves = timed("scaling", bench_scaling, rows, quick)
         plot_scaling(curves, out / "scaling.png", 50 if quick else 200)

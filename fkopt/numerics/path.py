@@ -23,10 +23,25 @@ _STATE: dict = {}
 _LOCK = threading.RLock()
 
 
+try:       # os.environ's own store: .get on os.environ raises and catches a KeyError when the
+    # variable is unset (~1 µs of every one-pose fkopt.inverse call); its store is kept in step
+    # with os.environ's writes, and a key is encoded as os.environ encodes it
+    _ENV_DATA, _ENV_KEY, _ENV_DECODE = os.environ._data, os.environ.encodekey(ENV), os.environ.decodevalue
+except AttributeError:       # pragma: no cover - another os.environ
+    _ENV_DATA = None
+
+
+def _environ_get() -> str | None:
+    if _ENV_DATA is None:    # pragma: no cover
+        return os.environ.get(ENV)
+    raw = _ENV_DATA.get(_ENV_KEY)
+    return None if raw is None else _ENV_DECODE(raw)
+
+
 def requested() -> str:
     """'auto', 'numpy' or 'compiled' from ``FKOPT_NUMERICS`` (read on every call: a test or a
     caller may change it; the parsed value is kept per raw string)."""
-    raw = os.environ.get(ENV)
+    raw = _environ_get()
     got = _STATE.get(("requested", raw))
     if got is not None:
         return got
