@@ -61,6 +61,7 @@ MECHANISMS: dict[str, str] = {
 
 ALGORITHMS: dict[str, str] = {
     "abc": "fkopt.algorithms.abc:ABC",
+    "abc-wang7dof": "fkopt.algorithms.abc_wang7dof:ABCWang7dof",   # wang7dof eqs. (7)-(8) as printed
     "gabc": "fkopt.algorithms.gabc:GABC",
     "aco": "fkopt.algorithms.aco:ACO",
     "pso": "fkopt.algorithms.pso:PSO",

@@ -108,3 +108,22 @@ def test_claims_and_report_run_on_small_results(small_results):
     report, timing, _ = build_report(small_results)
     assert "## liu2008" in report and "Leg lengths of the printed Tab. 3 pose" in report
     assert "Timing claims" in timing
+
+
+def test_equivalent_euler_angles_are_the_same_pose_not_another_mode():
+    """(alpha + 180, 180 - beta, gamma + 180) deg, or any angle + 360, is the same orientation: the
+    referee's 12th Newton "miss" (newton_starts, Newton run 263) was Tab. 3's pose written so. The
+    comparison is a rotation's (geodesic angle), never raw Euler differences; another mode stays one."""
+    import pandas as pd
+    a, b, g = EXACT[3:]
+    rows = [(a + 180, 180 - b, g + 180), (a - 8460, 180 - b, g - 9180), (a + 2.0, b, g), (-a, b, g)]
+    runs = pd.DataFrame([{"case": "Tab. 3 legs", "iterations_to_threshold": 5.0, "x_x": EXACT[0], "x_y": EXACT[1],
+                          "x_z": EXACT[2], "x_alpha": r[0], "x_beta": r[1], "x_gamma": r[2]} for r in rows])
+    exp = Store(Path(__file__).resolve().parents[1] / "results").get("liu2008", "newton_starts")
+    cols = liu2008.run_columns(exp, runs)
+    assert list(cols.other_mode) == [0.0, 0.0, 1.0, 1.0]
+    assert cols.rotation_deg.iloc[0] < 1e-9 and cols.rotation_deg.iloc[1] < 1e-9
+    stored = liu2008.run_columns(exp, exp.table("runs"))
+    newton = stored[stored.algorithm == "nr"]
+    assert newton.loc[newton.run == 263, "misses"].item() == 0.0      # raw Euler differences counted it
+    assert int(newton.misses.sum()) == int(newton.failed.sum()) == 11

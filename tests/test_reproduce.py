@@ -344,15 +344,15 @@ def test_an_edited_timing_verdict_is_caught_on_any_platform(tmp_path):
     """Stored timing verdicts must be those of the stored timed runs (check measures no time)."""
     import pandas as pd
 
-    from fkopt.reproduce.check import timing_verdicts
+    from fkopt.reproduce.check import verdict_files
     shutil.copytree(RESULTS / "mao2017", tmp_path / "results" / "mao2017")
     exp = Store(tmp_path / "results").get("mao2017", "tab6")
-    assert timing_verdicts(exp) == []
+    assert verdict_files(exp) == []
     file = tmp_path / "results" / "mao2017" / "timing_claims.csv"
     df = pd.read_csv(file, keep_default_na=False)
     df.loc[0, "verdict"] = "not held" if df.loc[0, "verdict"] != "not held" else "held"
     df.to_csv(file, index=False)
-    bad = timing_verdicts(exp)
+    bad = verdict_files(Store(tmp_path / "results").get("mao2017", "tab6"))
     assert [(m.file, m.column) for m in bad] == [("timing_claims.csv", "verdict")]
     assert "every platform" in bad[0].rule
 

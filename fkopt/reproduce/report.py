@@ -14,7 +14,7 @@ import pandas as pd
 from . import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
 from .changes import Snapshot
 from .claims import CLAIMS_FILE, RULES, TIMING_CLAIMS_FILE, Claim, claims_frame
-from .engine import info, judge_paper
+from .engine import claim_experiments, info, judge_paper
 from ..experiment.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
 from .store import Experiment, Store
 
@@ -184,6 +184,10 @@ def build_report(root: str | Path) -> tuple[str, str, pd.DataFrame]:
         if about["inconsistencies"]:
             out += ["### The paper's internal inconsistencies", ""]
             out += [f"- {x}" for x in about["inconsistencies"]] + [""]
+        if judged is None and claim_experiments(paper):
+            out += ["The paper's claims are judged where the experiments they rest on are stored (the "
+                    f"tracked results/REPORT.md: {', '.join(sorted(claim_experiments(paper)))}); this tree holds "
+                    "none of them, so it has no verdicts of the paper.", ""]
         if judged is not None:
             cl, tc = judged
             out += ["### Claims", "", claims_table(cl), ""]
