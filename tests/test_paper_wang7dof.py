@@ -126,7 +126,7 @@ def test_claims_and_report_run_on_small_results(small_results):
     assert "reconstructed PSO (constriction)" in other.condition and "lower_pso" in other.numbers
     assert "position error" in precise.text
     timing = _timing("wang7dof", store)
-    assert len(timing) == 8 and all(c.verdict.removeprefix("conditional: ") in (HELD, NOT_HELD, WITHIN_NOISE)
+    assert len(timing) == 10 and all(c.verdict.removeprefix("conditional: ") in (HELD, NOT_HELD, WITHIN_NOISE)
                                     for c in timing)
     report, timing, _ = build_report(small_results)
     assert "## wang7dof" in report and "printed joint solutions" in report
