@@ -16,12 +16,15 @@ that kind:
   went below ``level`` within ``tolerance`` of ``printed``, and (``faster_than``) significantly
   fewer than the other's;
 * ``timing`` -- ``faster`` takes less time than ``than`` (interleaved single runs; within noise
-  inside the spread; :func:`~.claims.faster_claim`), or every run ``below_ms``; TIMING.md only;
+  inside the spread; :func:`~.claims.faster_claim`), the times of ``close: [a, b]`` do not differ
+  significantly, or every run ``below_ms``; TIMING.md only;
 * ``value`` -- a number measured by the paper module (``quantity`` names a function of its
   ``QUANTITIES``), against the same rules as a magnitude.
 
-The paper's ``provenance`` records every algorithm, comparator and mechanism as ``printed`` or a
-``reconstruction`` (with what fkopt ``chose``); :func:`judge` makes every verdict resting on a
+The paper's ``printed`` table holds the settings SPEC.md cites; its ``provenance`` records every
+algorithm, comparator and mechanism with the printed settings it uses and what fkopt ``chose``
+beyond them, and is ``printed`` or a ``reconstruction`` by that (:func:`derive_provenance`, never
+by hand); :func:`judge` makes every verdict resting on a
 reconstruction conditional, naming it, and a reconstruction fitted to a claim (``circular``) makes
 that claim not checkable. ``hardware`` names the paper's machine for absolute times; kind
 ``statement`` is a claim no number decides (``not_checkable`` says why).
