@@ -214,6 +214,9 @@ def test_claims_files_declare_every_field():
         assert data["title"] and data["notes"] and data["experiments"]
         for c in data["claims"]:
             assert c["id"] and c["text"] and c["kind"], c
+            # fkopt's own findings are never attributed to the paper (liu2008's PSO-vs-Newton time: the paper's
+            # "high computing speed" names no comparator)
+            assert c["id"].startswith("fkopt-") == c["text"].startswith("fkopt's own"), f"{paper}/{c['id']}"
             if c["kind"] == "comparison":
                 assert c.get("basis") in ("iterations", "evaluations"), f"{paper}/{c['id']}: no budget basis"
             if c["kind"] == "magnitude":
