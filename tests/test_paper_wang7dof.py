@@ -4,9 +4,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fkopt.experiment.config import ExperimentConfig, load_config
-from fkopt.experiment.reports import write_experiment
-from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.kinds.experiment.config import ExperimentConfig, load_config
+from fkopt.kinds.experiment.reports import write_experiment
+from fkopt.kinds.experiment.runner import run_experiment, validate_experiment
 from fkopt.mechanisms.dh_arm import SevenDofArm
 from fkopt.problems import ik_problem
 from fkopt.reproduce import PAPERS, wang7dof
@@ -140,7 +140,7 @@ def test_the_abc_as_printed_moves_by_phi_in_0_1_and_picks_onlookers_on_1_over_f(
     from fkopt.algorithms.abc_wang7dof import ABCWang7dof
     from fkopt.registry import algorithm_class
     from fkopt.solve import solve
-    from fkopt.streams import RunStreams
+    from fkopt.numerics.streams import RunStreams
     from types import SimpleNamespace
     algo = algorithm_class("abc-wang7dof")()
     assert isinstance(algo, ABCWang7dof) and algo.compiled_rule() is None

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .abc import ABC, roulette
+from fkopt.algorithms.abc import ABC, roulette
 
 
 class ABCWang7dof(ABC):
