@@ -99,8 +99,10 @@ def test_claims_and_report_run_on_small_results(small_results):
     claims = {c.text[:30]: c for c in _claims("liu2008", store)}
     printed = claims["Tab. 3: the printed pose is th"]
     assert printed.verdict == HELD and printed.numbers["largest_difference"] <= liu2008.PRINTED_HALF_UNIT
-    # 40 iterations cannot reach 0.5 um from a random swarm: the ~55-iteration claim is not held here
-    assert claims["Abstract/Sec. 4: with 80 parti"].verdict == NOT_HELD
+    # 40 iterations cannot reach 0.5 um from a random swarm: the ~55-iteration claim is not held here,
+    # conditional on fkopt's search box, which the paper does not print
+    fifty_five = claims["Abstract/Sec. 4: with 80 parti"]
+    assert fifty_five.verdict == "conditional: " + NOT_HELD and "reconstructed search box" in fifty_five.condition
     timing = _timing("liu2008", store)
     # an absolute time: judged on fkopt's machine by the one hardware rule, conditional and saying so
     assert timing[0].text.startswith("Abstract/Sec. 4: a solve to 0.5 um takes about 3 s")
