@@ -118,6 +118,7 @@ TIERS = {
     "tests/test_plugins.py::test_example_plugin_found_through_entry_points": ("external",),
     "tests/test_urdf.py::test_real_robot_jacobian_matches_finite_differences": ("external",),
     "tests/test_cli.py::test_run_is_deterministic": ("slow",),
+    "tests/test_kinbench_pages.py::test_fkopt_pages_remakes_a_stored_board_from_its_files_alone": ("slow", "stored"),
     "tests/test_export.py::test_export_refuses_what_it_must_not_touch": ("slow",),
 }
 TIER_MARKERS = ("slow", "stored", "external", "browser")

@@ -115,14 +115,15 @@ def words(col: str, reference: str | None = None) -> str:
     return text
 
 
-def _cell(v, percent: bool = False) -> str:
+def _cell(v, percent: bool = False, scale: float = 1.0) -> str:
     if isinstance(v, (bool, np.bool_)):
         return f'<td class="t">{"yes" if v else "no"}</td>'
     if isinstance(v, (float, np.floating)):
-        v = float(v) * (100.0 if percent else 1.0)
+        v = float(v) * scale
         if np.isnan(v):
             return '<td data-v=""></td>'
-        shown = "inf" if np.isinf(v) else (f"{v:.1f}".removesuffix(".0") if percent else f"{v:.4g}")
+        shown = ("inf" if np.isinf(v) else f"{v:.1f}".removesuffix(".0") if percent
+                 else f"{v:.0f}" if abs(v) >= 1e4 else f"{v:.4g}")
         key = "1e308" if np.isinf(v) else f"{v:.6g}"
         return f'<td data-v="{key}">{shown}</td>' if key != shown else f"<td>{shown}</td>"
     if isinstance(v, (int, np.integer)):
@@ -139,8 +140,9 @@ def table_html(df, cols: list[str], ident: str, reference: str | None = None, la
     labels = labels or {}
     head = "".join(f'<th title="{html.escape(c)}">{html.escape(labels.get(c) or words(c, reference))}</th>'
                    for c in cols)
-    pct = [shares and bool(PERCENT.match(c)) for c in cols]
-    body = "".join("<tr>" + "".join(_cell(v, p) for v, p in zip(row, pct)) + "</tr>"
+    pct = [bool(PERCENT.match(c)) or (not shares and c == "worst_arm") for c in cols]
+    scale = [100.0 if p and shares else 1.0 for p in pct]
+    body = "".join("<tr>" + "".join(_cell(v, p, k) for v, p, k in zip(row, pct, scale)) + "</tr>"
                    for row in df[cols].itertuples(index=False))
     return (f'<table class="sortable" id="{html.escape(ident)}"><thead><tr>{head}</tr></thead>'
             f"<tbody>{body}</tbody></table>")
@@ -156,7 +158,7 @@ def img(path: Path, caption: str | None = None, lazy: bool = True) -> str:
 
 def toc(entries: list[tuple[str, str]]) -> str:
     """The table of contents: in-page links (#id, title)."""
-    links = "".join(f'<a href="#{html.escape(i)}">{html.escape(t)}</a>' for i, t in entries)
+    links = " ".join(f'<a href="#{html.escape(i)}">{html.escape(t)}</a>' for i, t in entries)
     return f'<nav class="toc" id="toc"><b>Contents:</b> {links}</nav>'
 
 

@@ -340,7 +340,7 @@ def arm_sections(sr, folder: Path, board: pd.DataFrame) -> list[Section]:
     cols += [c for c in board.columns if c not in known and c not in cols]      # a newer board's columns
     out = []
     for robot, g in board.groupby("robot", sort=False):
-        shown = [c for c in cols if c in g and not (c == "other_mode" and g[c].isna().all())]
+        shown = [c for c in cols if c in g and c != "robot" and not (c == "other_mode" and g[c].isna().all())]
         body = [_p(f"Family {fam.get(robot, '?')}; reference {g['reference'].iloc[0]}, its median "
                    f"{g['reference_ms_median'].iloc[0]:.3g} ms here.", "note"),
                 H.table_html(g, shown, f"arm-table-{ids[robot]}", reference=str(g["reference"].iloc[0]))]
