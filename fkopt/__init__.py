@@ -19,8 +19,8 @@ from __future__ import annotations
 import sys
 import types
 
-from .errors import FkoptError
-from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
+from fkopt.errors import FkoptError
+from fkopt.registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
 
 #: Public names loaded on first use (PEP 562), so that ``import fkopt`` -- and ``fkopt fk`` --
 #: pay only for what they touch: the optimiser layer imports pydantic, the version

@@ -44,7 +44,7 @@ from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import lru_cache
 
-from .errors import FkoptError, did_you_mean
+from fkopt.errors import FkoptError, did_you_mean
 
 MECHANISMS: dict[str, str] = {
     "3-rps": "fkopt.mechanisms.rps3:ThreeRPS",
@@ -71,9 +71,9 @@ ALGORITHMS: dict[str, str] = {
     "abc+lm": "fkopt.algorithms.hybrid:ABCLM",
     "gabc+lm": "fkopt.algorithms.hybrid:GABCLM",
     "pso+lm": "fkopt.algorithms.hybrid:PSOLM",
-    "forward": "fkopt.exact:Forward",     # fkopt.forward as a solver (parallel FK)
-    "inverse": "fkopt.exact:Inverse",     # fkopt.inverse as a solver (serial IK)
-    "exact": "fkopt.exact:Exact",         # forward or inverse, by the mechanism's kind
+    "forward": "fkopt.kinematics.as_algorithms:Forward",     # fkopt.forward as a solver (parallel FK)
+    "inverse": "fkopt.kinematics.as_algorithms:Inverse",     # fkopt.inverse as a solver (serial IK)
+    "exact": "fkopt.kinematics.as_algorithms:Exact",         # forward or inverse, by the mechanism's kind
 }
 
 #: Prefixes reserved for the adapters of other libraries' optimisers (fkopt.adapters).
@@ -104,9 +104,9 @@ class Entry:
 
 def _base(kind: str) -> type:
     if kind == "mechanism":
-        from .mechanisms.base import Mechanism
+        from fkopt.mechanisms.base import Mechanism
         return Mechanism
-    from .algorithms.base import Algorithm
+    from fkopt.algorithms.base import Algorithm
     return Algorithm
 
 
@@ -121,7 +121,7 @@ def check_class(obj, kind: str, where: str):
         raise FkoptError(f"{kind} plug-in '{where}' ({obj.__module__}.{obj.__qualname__}) does not subclass "
                          f"{base.__module__}.{base.__qualname__}; refused")
     if kind == "mechanism":
-        from .mechanisms.base import ParallelMechanism, SerialMechanism
+        from fkopt.mechanisms.base import ParallelMechanism, SerialMechanism
         family = ("parallel" if issubclass(obj, ParallelMechanism)
                   else "serial" if issubclass(obj, SerialMechanism) else None)
         if family is None:
@@ -130,7 +130,7 @@ def check_class(obj, kind: str, where: str):
         missing = [] if hasattr(obj, "name") else ["name"]
         missing += [m for m in REQUIRED["mechanism"][family] if getattr(obj, m) is getattr(family_base, m)]
     else:
-        from .algorithms.base import Algorithm
+        from fkopt.algorithms.base import Algorithm
         missing = [] if hasattr(obj, "name") else ["name"]
         # either the two-method protocol or a minimize of its own (adapters)
         if obj.minimize is Algorithm.minimize:
@@ -196,7 +196,7 @@ def _load(table: dict[str, str], kind: str, name: str):
     if sep and prefix in ADAPTER_PREFIXES:
         if kind != "algorithm":
             raise FkoptError(f"'{name}': the prefix '{prefix}:' is reserved for algorithm adapters")
-        from .adapters import adapter_class
+        from fkopt.adapters import adapter_class
         return adapter_class(prefix, rest)
     eps = entry_points(kind)
     if name in eps:
@@ -247,7 +247,7 @@ def entries(kind: str) -> list[Entry]:
     table = MECHANISMS if kind == "mechanism" else ALGORITHMS
     out = [Entry(kind, n, t, "built-in") for n, t in table.items()]
     if kind == "algorithm":
-        from .adapters import ADAPTERS
+        from fkopt.adapters import ADAPTERS
         out += [Entry(kind, f"{p}:{n}", t, f"adapter ({p}, {'optional' if p != 'scipy' else 'core'})")
                 for p, names in ADAPTERS.items() for n, t in names.items()]
     out += [Entry(kind, n, t, f"entry point ({origin})")

@@ -4,7 +4,7 @@ Rows. Every (case, run) pair is one *row* of one array: a problem with a case ax
 targets, see :mod:`fkopt.problems`) and R runs gives ``cases * R`` rows, case-major, advanced
 together through the algorithm's (runs, population, dim) axis -- algorithms know nothing of
 cases; row i simply gets the target ``problem.take(case of row i)``. Every row draws from its
-own stream, ``run_seed_sequence(seed of its case, run id)`` (:mod:`fkopt.streams`), so a case
+own stream, ``run_seed_sequence(seed of its case, run id)`` (:mod:`fkopt.numerics.streams`), so a case
 gives bit-identical numbers alone (solved with the seed recorded for it, ``result.seeds[c]``),
 inside a batch, in chunks, or one run at a time.
 
@@ -32,11 +32,11 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .algorithms.base import Algorithm, RunRecord
-from .errors import FkoptError
-from .progress import part
-from .registry import algorithm_class
-from .streams import CHUNK, RunStreams, case_seed
+from fkopt.algorithms.base import Algorithm, RunRecord
+from fkopt.errors import FkoptError
+from fkopt.progress import part
+from fkopt.registry import algorithm_class
+from fkopt.numerics.streams import CHUNK, RunStreams, case_seed
 
 #: Points (rows x population) advanced together; chosen by measurement (module docstring).
 CHUNK_POINTS = 10_000
@@ -188,7 +188,7 @@ def validate_budget(population: int, iterations: int, runs: int, local: bool = F
 
 def case_seeds(seed: int | Sequence[int], cases: int | None) -> np.ndarray:
     """The integer seed of every case: ``seed`` itself for a single-target problem; for a
-    problem with cases, one seed per case as given, or :func:`fkopt.streams.case_seed` of one
+    problem with cases, one seed per case as given, or :func:`fkopt.numerics.streams.case_seed` of one
     int ``seed`` (case c's seed is then the first word of ``SeedSequence(seed, spawn_key=(c,))``)."""
     if np.ndim(seed) == 0:
         if cases is None:

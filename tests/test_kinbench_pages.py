@@ -65,7 +65,7 @@ def drawn(monkeypatch):
     """The figures a maker saves, measured before they are written: every end-of-line name's
     box against the title's and the legend's, and the title's width against the figure's."""
     import importlib
-    plotting = importlib.import_module("fkopt.experiment.plotting")
+    plotting = importlib.import_module("fkopt.run.plotting")
     seen = []
     original = plotting.save
 

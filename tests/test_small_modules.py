@@ -109,7 +109,7 @@ def test_by_algorithm_judges_a_swarm_answer_like_the_exact_solvers():
     import numpy as np
 
     import fkopt
-    from fkopt.by_algorithm import forward_by, inverse_by
+    from fkopt.kinematics.by_algorithm import forward_by, inverse_by
     m = fkopt.mechanism("3-rps")
     legs = m.ik(np.array([9.0, 13.0, 622.0]))
     r = forward_by(m, legs, "gabc+lm", tol=1e-6, budget={"population": 10, "iterations": 60})

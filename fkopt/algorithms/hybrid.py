@@ -24,11 +24,11 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from .abc import ABCParams
-from .base import Algorithm, Params, State
-from .gabc import GABCParams
-from .lm import LMCore, LMParams, LMState
-from .pso import PSOParams
+from fkopt.algorithms.abc import ABCParams
+from fkopt.algorithms.base import Algorithm, Params, State
+from fkopt.algorithms.gabc import GABCParams
+from fkopt.algorithms.lm import LMCore, LMParams, LMState
+from fkopt.algorithms.pso import PSOParams
 
 
 def _swarm_field(name: str) -> property:
@@ -75,7 +75,7 @@ class SwarmLM(Algorithm):
 
     def __init__(self, **params):
         super().__init__(**params)
-        from ..registry import algorithm_class
+        from fkopt.registry import algorithm_class
 
         values = self.params.model_dump()
         cls = algorithm_class(self.swarm)

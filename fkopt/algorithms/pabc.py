@@ -21,9 +21,9 @@ from dataclasses import dataclass, fields
 import numpy as np
 from pydantic import Field
 
-from .abc import ABC, ABCParams, ABCState
-from .base import Algorithm
-from .pso import PSO, PSOParams, PSOState
+from fkopt.algorithms.abc import ABC, ABCParams, ABCState
+from fkopt.algorithms.base import Algorithm
+from fkopt.algorithms.pso import PSO, PSOParams, PSOState
 
 
 class PABCParams(PSOParams, ABCParams):

@@ -37,7 +37,7 @@ import zlib
 import numpy as np
 import pandas as pd
 
-from .physical import LADDER, fk_verdicts, ik_verdicts, rung_label
+from fkopt.kinbench.physical import LADDER, fk_verdicts, ik_verdicts, rung_label
 
 #: Timeouts of the clock track (ms): IK of serial arms, FK of parallel mechanisms.
 TIMEOUTS_MS = (1.0, 5.0, 20.0)
@@ -59,10 +59,10 @@ ORGANISER = ("fkopt.inverse", "fkopt.forward")
 
 
 class FkoptInverse:
-    """The organiser's entry: :func:`fkopt.kinematics.inverse` with its defaults and
+    """The organiser's entry: :func:`fkopt.kinematics.solvers.inverse` with its defaults and
     ``tol`` = (1e-9 m, 1e-9 rad), tight enough for every rung of the ladder, given the 4x4 target
     frame itself (no Euler angles: the conversion cost as much as the compiled solve), through a
-    prepared :class:`fkopt.kinematics.InverseSolver` (``inverse``'s answers bit for bit; per query
+    prepared :class:`fkopt.kinematics.solvers.InverseSolver` (``inverse``'s answers bit for bit; per query
     only the target is checked and the compiled loop runs). The solver -- its options checked, the
     start table (4096 FK evaluations) and the kernel's arguments -- is made when the wrapper is
     made, outside the clock, as the field's packages parse their URDF outside it. No wall-clock
@@ -73,7 +73,7 @@ class FkoptInverse:
     TOL = (1e-9, 1e-9)
 
     def __init__(self, arm, *, timeout: float, rng: np.random.Generator):
-        from ..kinematics import InverseSolver
+        from fkopt.kinematics.solvers import InverseSolver
         self.arm, self.timeout, self.rng = arm, float(timeout), rng
         self._solve = InverseSolver(arm, tol=self.TOL)
         self._solve(arm.fk_matrix(arm.bounds.mean(axis=1)))         # compiled code loaded, outside the clock
@@ -90,7 +90,7 @@ class FkoptInverse:
 
 
 class FkoptForward:
-    """The organiser's FK entry: :func:`fkopt.kinematics.forward` (local Newton, the start
+    """The organiser's FK entry: :func:`fkopt.kinematics.solvers.forward` (local Newton, the start
     table's nearest poses, deterministic restarts, global search) with its defaults and ``tol`` =
     1e-10 on max |ik(pose) - legs| (joint units); its seed per query from the wrapper's
     generator; no wall-clock limit. One call and the start table (4096 closed-form evaluations)
@@ -101,10 +101,10 @@ class FkoptForward:
     TOL = 1e-10
 
     def __init__(self, mechanism, *, timeout: float, rng: np.random.Generator):
-        from ..kinematics import forward
+        from fkopt.kinematics.solvers import forward
         self.mechanism, self.timeout, self.rng, self._forward = mechanism, float(timeout), rng, forward
         forward(mechanism, mechanism.ik(mechanism.bounds.mean(axis=1)[None])[0], tol=self.TOL)
-        from ..kinematics import FORWARD_TABLE, _forward_table
+        from fkopt.kinematics.solvers import FORWARD_TABLE, _forward_table
         _forward_table(mechanism, FORWARD_TABLE)                           # start table, outside the clock
         self.settings = {"timeout_s": self.timeout, "tol": self.TOL, "wall_clock_limit": False,
                          "seed": "per query from the wrapper's generator", "defaults": "fkopt.forward's"}
@@ -135,9 +135,9 @@ def make_solver(name: str, mechanism, *, timeout: float, rng: np.random.Generato
     if name == FkoptForward.name:
         return FkoptForward(mechanism, timeout=timeout, rng=rng)
     if name == FK_REFERENCE:
-        from ..adapters.field.scipy_fk import LeastSquaresFK
+        from fkopt.adapters.field.scipy_fk import LeastSquaresFK
         return LeastSquaresFK(mechanism, timeout=timeout, rng=rng)
-    from ..adapters.field import make_ik
+    from fkopt.adapters.field import make_ik
     return make_ik(name, mechanism, timeout=timeout, rng=rng)
 
 

@@ -43,10 +43,9 @@ from typing import Literal
 
 from pydantic import Field, PrivateAttr, ValidationError, field_validator, model_validator
 
-from ..errors import FkoptError
-from ..experiment.config import (MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict,
-                                 unique_labels)
-from ..files import error_line, load_mapping
+from fkopt.errors import FkoptError
+from fkopt.run.config_base import MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict, unique_labels
+from fkopt.files import error_line, load_mapping
 
 #: Pose sets of kinbench v1 (see :mod:`fkopt.kinbench.posesets`).
 SETS = ("uniform", "near-singular", "boundary", "printed")
@@ -65,7 +64,7 @@ MAX_BUDGET_PER_DIM = 10_000_000
 
 def default_track(name: str) -> str | None:
     """The track of a built-in solver or an adapter; None for anything else (a plug-in)."""
-    from ..registry import ADAPTER_PREFIXES
+    from fkopt.registry import ADAPTER_PREFIXES
     if name in KNOWN_TRACKS:
         return KNOWN_TRACKS[name]
     return ADAPTER_TRACK if name.split(":", 1)[0] in ADAPTER_PREFIXES else None
@@ -153,7 +152,7 @@ class QuickTier(Strict):
 
 #: Solvers the clock track knows: the organiser's and the field's (fkopt.adapters.field).
 def clock_solvers() -> tuple[str, ...]:
-    from ..adapters.field import IK_SOLVERS
+    from fkopt.adapters.field import IK_SOLVERS
     return ("fkopt.inverse", *IK_SOLVERS)
 
 
@@ -289,7 +288,7 @@ class SuiteConfig(Located):
                 raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
-            from .instances import expand
+            from fkopt.kinbench.instances import expand
             try:
                 out += expand(checked, seed, f"problems[{i}]")
             except FkoptError as err:

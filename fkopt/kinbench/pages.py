@@ -27,8 +27,8 @@ from types import SimpleNamespace
 import numpy as np
 import pandas as pd
 
-from ..errors import FkoptError
-from . import html as H
+from fkopt.errors import FkoptError
+from fkopt.kinbench import html as H
 
 #: Every page's size in bytes stays below this (issue 37: a page loads in a moment).
 PAGE_LIMIT = 500_000
@@ -62,7 +62,7 @@ def meta_of(sr) -> dict:
     if isinstance(stored, dict):
         return stored
     try:
-        from .reports import meta
+        from fkopt.kinbench.reports import meta
         return meta(sr)
     except Exception:        # a result without a manifest (a test's stand-in): nothing recorded
         return {}
@@ -73,7 +73,7 @@ def env_of(sr) -> dict:
     if isinstance(stored, dict):
         return stored
     try:
-        from ..provenance import environment
+        from fkopt.run.provenance import environment
         return environment()
     except Exception:
         return {}
@@ -122,13 +122,13 @@ def documented_settings(name: str) -> str:
     import importlib
     import inspect
     try:
-        from . import clock
+        from fkopt.kinbench import clock
         if name == clock.FkoptInverse.name:
             doc = inspect.getdoc(clock.FkoptInverse)
         elif name == clock.FkoptForward.name:
             doc = inspect.getdoc(clock.FkoptForward)
         else:
-            from ..adapters.field import IK_SOLVERS
+            from fkopt.adapters.field import IK_SOLVERS
             module = {clock.FK_REFERENCE: "scipy_fk"}.get(name) or IK_SOLVERS.get(name, (None,))[0]
             if module is None:
                 return ""
@@ -156,10 +156,10 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
     names = list(dict.fromkeys([clock.reference, *clock.solvers, clock.fk_reference, *clock.fk_solvers]
                                + ([] if answers is None else list(answers["solver"].unique()))))
     try:
-        from ..adapters.field import PACKAGES
+        from fkopt.adapters.field import PACKAGES
     except Exception:
         PACKAGES = {}
-    from .clock import entry_of
+    from fkopt.kinbench.clock import entry_of
     rows = []
     for name in names:
         if answers is not None and name not in set(answers["solver"]):
@@ -187,7 +187,7 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
 
 def suite_settings_section(sr) -> Section:
     """Every solver of an evaluations board with its settings (the stored config's)."""
-    from .reports import boards_preamble, preamble
+    from fkopt.kinbench.reports import boards_preamble, preamble
     c = sr.config
     rows = []
     for s in c.solvers:
@@ -207,7 +207,7 @@ def suite_settings_section(sr) -> Section:
 
 
 def _rung_label(rung: int) -> str:
-    from .physical import LADDER, rung_label
+    from fkopt.kinbench.physical import LADDER, rung_label
     return rung_label(LADDER[rung])
 
 
@@ -218,7 +218,7 @@ def _families(c) -> dict[str, str]:
 
 def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
     """(which solver per arm family, summary per solver, the lead figure's file name)."""
-    from .advice import family_advice, fk_robots, summarise_board
+    from fkopt.kinbench.advice import family_advice, fk_robots, summarise_board
     clock = sr.config.tracks.clock
     fam = family_advice(board, _families(sr.config))
     success = [col for col in board.columns if col.startswith("success_")]
@@ -260,8 +260,8 @@ def _targets(c) -> list[str]:
 def evaluations_lead(sr, tables: dict) -> tuple[Section, Section, str]:
     """(which solver per problem class, summary per solver, the lead figure's file name) of an
     evaluations board."""
-    from .advice import class_advice
-    from .reports import scaling_target, split_scope
+    from fkopt.kinbench.advice import class_advice
+    from fkopt.kinbench.reports import scaling_target, split_scope
     c = sr.config
     targets = _targets(c)
     target = "1e-06" if "1e-06" in targets else f"{scaling_target(c.targets):.0e}"   # advice_table's, docs/robots.md
@@ -328,8 +328,8 @@ def detail_page(folder: Path, name: str, title: str, intro: str, sections: list[
 
 
 def arm_sections(sr, folder: Path, board: pd.DataFrame) -> list[Section]:
-    from ..files import file_names
-    from .reports import robot_columns
+    from fkopt.files import file_names
+    from fkopt.kinbench.reports import robot_columns
     fam = _families(sr.config)
     stems = file_names(board["robot"].unique(), reserved=("all",))
     ids = file_names(board["robot"].unique(), allowed="A-Za-z0-9_-")
@@ -354,7 +354,7 @@ def arm_sections(sr, folder: Path, board: pd.DataFrame) -> list[Section]:
 def ranking_sections(sr, tables: dict) -> list[Section]:
     """Every scope's ranking, the ERT ratios, the scaling tables and (suites without boards)
     the per-problem tables."""
-    from .reports import (ERT_RATIO_NOTE, PER_PROBLEM, SCALING, ert_ratio_sections, leaderboard_columns,
+    from fkopt.kinbench.reports import (ERT_RATIO_NOTE, PER_PROBLEM, SCALING, ert_ratio_sections, leaderboard_columns,
                           leaderboard_sections, scaling_target)
     c = sr.config
     lb = tables["leaderboard.csv"]
@@ -383,7 +383,7 @@ def ranking_sections(sr, tables: dict) -> list[Section]:
 # -- the pages -------------------------------------------------------------------------------------
 def write_pages(sr, folder: Path, tables: dict) -> list[str]:
     """index.html and its detail pages (the names written)."""
-    from .reports import ROBOTS_PREAMBLE
+    from fkopt.kinbench.reports import ROBOTS_PREAMBLE
     lb = tables.get("leaderboard.csv")
     if lb is None:
         return []
@@ -451,9 +451,10 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
 def stored_suite(folder: str | Path):
     """(result, tables) of a stored suite folder: its config (meta.json), meta.json and env.json,
     and every table file it holds, read back -- what the figures and pages are made of."""
-    from ..files import parse_json, read_stored
-    from ..outputs import FIGURE, OUTPUTS
-    from .config import SuiteConfig
+    from fkopt.files import parse_json, read_stored
+    from fkopt.kinbench.config import SuiteConfig
+    from fkopt.kinbench.kind import OUTPUTS
+    from fkopt.run.writers import FIGURE
     folder = Path(folder)
     where = folder / "meta.json"
     if not where.is_file():
@@ -462,7 +463,7 @@ def stored_suite(folder: str | Path):
     if not isinstance(meta, dict) or meta.get("kind") != "suite":
         raise FkoptError(f"{where}: kind: {meta.get('kind') if isinstance(meta, dict) else None!r} "
                          "(allowed: suite; pages are a kinbench suite's)")
-    from ..experiment.kinds import from_dict
+    from fkopt.run.pipeline import from_dict
     config = from_dict(meta.get("config") or {}, f"{where}: config")
     if not isinstance(config, SuiteConfig):
         raise FkoptError(f"{where}: config: not a suite's")
@@ -473,7 +474,7 @@ def stored_suite(folder: str | Path):
     text = {"problem": str, "solver": str, "robot": str, "scope": str, "set": str, "class": str, "board": str,
             "track": str, "better_than": str}
     tables = {}
-    for out in OUTPUTS["suite"]:
+    for out in OUTPUTS:
         path = folder / out.file
         if out.role != FIGURE and path.is_file():
             try:
@@ -492,15 +493,16 @@ def stored_suite(folder: str | Path):
 def regenerate(folder: str | Path, figures: bool = True) -> list[str]:
     """Rewrite a stored suite folder's figures (``figures``) and pages from its stored tables;
     no solver runs, no table is written. Returns the names written."""
-    from ..outputs import FIGURE, OUTPUTS, _load
+    from fkopt.kinbench.kind import OUTPUTS
+    from fkopt.run.writers import FIGURE
     folder = Path(folder)
     sr, tables = stored_suite(folder)
     written = []
-    for out in OUTPUTS["suite"]:
+    for out in OUTPUTS:
         if out.role != FIGURE or out.file in ("leaderboard.md", INDEX):
             continue
         if figures and sr.runs is not None:
-            written += _load(out.make)(sr, folder, tables)
+            written += out.make(sr, folder, tables)
     return written + write_pages(sr, folder, tables)
 
 

@@ -2,6 +2,6 @@
 
 One module per mechanism, registered in :mod:`fkopt.registry`.
 """
-from .base import Mechanism, ParallelMechanism, SerialMechanism
+from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 
 __all__ = ["Mechanism", "ParallelMechanism", "SerialMechanism"]

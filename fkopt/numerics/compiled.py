@@ -18,7 +18,7 @@ load the cache.
   per point); the values are the same wherever the divisor is not zero;
 * :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
-* :func:`fill_uniforms` -- the refill of :class:`fkopt.streams.RunStreams`' buffer, every run in one
+* :func:`fill_uniforms` -- the refill of :class:`fkopt.numerics.streams.RunStreams`' buffer, every run in one
   call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits);
 """
 from __future__ import annotations
@@ -193,7 +193,7 @@ def _dls_step(J, r, mu, free, d, A, L, y, x):
 
 @njit(cache=True)
 def _uniform_hash(seed, row, draw, out):
-    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics._uniform_hash` (SplitMix64's finaliser)."""
+    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.solvers._uniform_hash` (SplitMix64's finaliser)."""
     c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
     for k in range(out.shape[0]):
         z = c + np.uint64(k + 1) * _M2
@@ -340,7 +340,7 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
 @njit(cache=True)
 def _nearest_into(Ft, norms, f, idx, best):
     """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx:
-    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics._nearest`'s brute force; the dot product
+    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics.solvers._nearest`'s brute force; the dot product
     summed feature by feature, rows side by side, from ``Ft`` = F transposed), the k smallest kept
     sorted by insertion (ties: the lower row first)."""
     c, N = Ft.shape
@@ -377,14 +377,14 @@ def _nearest_into(Ft, norms, f, idx, best):
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
+    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics.solvers._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
     start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
     used, evaluations). Releases the GIL (``nogil``; the same arithmetic), so that a control
-    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.InverseSolver`
+    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.solvers.InverseSolver`
     calls it directly)."""
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
@@ -442,9 +442,9 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
 
 def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
     """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
-    :func:`fkopt.kinematics._fast_context`) and the options bound once: a function
+    :func:`fkopt.kinematics.solvers._fast_context`) and the options bound once: a function
     (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
-    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.InverseSolver`) keeps it, so
+    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.solvers.InverseSolver`) keeps it, so
     a control loop's call does no dictionary lookups."""
     chain, n = ctx["chain"], ctx["n"]
     head = (L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn)

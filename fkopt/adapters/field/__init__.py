@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import FkoptError
+from fkopt.errors import FkoptError
 
 #: name -> (module, class) of every IK wrapper; black-box ones minimise :func:`pose_objective`.
 IK_SOLVERS = {
@@ -110,8 +110,8 @@ class ArmURDF:
     @classmethod
     def from_file(cls, path, base_link: str, tip_link: str) -> "ArmURDF":
         """A URDF file as it is (the joints are not listed)."""
-        from ...files import read_text
-        from ...mechanisms.urdf import MAX_URDF_BYTES
+        from fkopt.files import read_text
+        from fkopt.mechanisms.urdf import MAX_URDF_BYTES
         return cls(read_text(path, MAX_URDF_BYTES, field="urdf geometry.file"), base_link, tip_link, (), str(path))
 
 
@@ -124,7 +124,7 @@ def arm_urdf(arm, *, written: bool = False) -> ArmURDF:
     if own and not written:
         mine = ArmURDF.from_file(arm.path, arm.base_link, arm.tip_link)
         return ArmURDF(mine.text, mine.base_link, mine.tip_link, tuple(arm.joint_names), mine.source)
-    from ...mechanisms.urdf_writer import chain_urdf
+    from fkopt.mechanisms.urdf_writer import chain_urdf
     w = chain_urdf(arm)
     return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names,
                    f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}")
@@ -185,7 +185,7 @@ def solve(solver: FieldIK, targets: np.ndarray) -> IKAnswers:
 def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
     """Position error (m) and geodesic rotation error (rad) of rows q (k, dof) against one
     target T, from fkopt's FK: shape (k, 2)."""
-    from ...rotations import geodesic_angle
+    from fkopt.numerics.rotations import geodesic_angle
     F = arm.fk_matrix(q_public)
     pe = np.linalg.norm(F[:, :3, 3] - T[:3, 3], axis=-1)
     re = geodesic_angle(soa(F[:, :3, :3]), soa(np.broadcast_to(T[:3, :3], (len(F), 3, 3))))
@@ -193,7 +193,7 @@ def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
 
 
 def soa(R: np.ndarray):
-    """A (..., 3, 3) stack as :data:`fkopt.rotations.Matrix` (nested tuples of arrays)."""
+    """A (..., 3, 3) stack as :data:`fkopt.numerics.rotations.Matrix` (nested tuples of arrays)."""
     return tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3))
 
 
