@@ -150,6 +150,8 @@ def test_the_board_page_opens_with_the_advice_and_takes_new_solvers_and_columns(
         text = (folder / name).read_text()
         targets = _toc_targets(text)
         assert targets and set(targets) <= _anchors(text), name            # every contents link lands
+        ids = re.findall(r'id="([^"]+)"', text)
+        assert len(ids) == len(set(ids)), name                              # each lands on one place
     order = [index.index(f'id="{i}"') for i in ("toc", "advice", "summary", "figures", "settings", "machine")]
     assert order == sorted(order)
     summary = index[index.index('id="summary"'):index.index('id="figures"')]

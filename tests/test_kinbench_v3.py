@@ -125,7 +125,9 @@ def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
     assert any("fkopt.inverse" in line and "success 100 / 100 / 100 / 100 %" in line for line in lines)
     assert "Per robot, on the clock" in (folder / "leaderboard.md").read_text()
     page = (folder / "index.html").read_text()
-    assert page.index("Per robot, on the clock") < page.index('alt="clock_ur5"') < page.index("<h2>overall")
+    assert page.index("Which solver for my arm") < page.index("Summary per solver") < page.index('alt="clock_all"')
+    arms = (folder / "arms.html").read_text()
+    assert arms.index('id="arm-ur5"') < arms.index('alt="clock_ur5"') < arms.index('id="arm-panda"')
     assert (folder / "clock_panda.png").exists() and (folder / "clock_panda.pdf").exists()
 
 

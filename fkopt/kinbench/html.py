@@ -40,12 +40,12 @@ h3 { font-size: 1em; margin: 0.6em 0 0.2em; } p { margin: 0.3em 0; }
 nav.toc { font-size: 0.85em; margin: 0.2em 0 0.4em; } nav.toc a { margin-right: 0.9em; white-space: nowrap; }
 table { border-collapse: collapse; margin: 0.3em 0 0.8em; font-size: 0.8em; }
 th, td { border: 1px solid #ccc; padding: 0.1em 0.4em; text-align: right; }
-th { background: #eee; cursor: pointer; font-weight: normal; vertical-align: bottom; max-width: 11em; min-width: 4.5em;
+th { background: #eee; cursor: pointer; font-weight: normal; vertical-align: bottom; max-width: 11em; min-width: 4em;
      font-size: 0.95em; line-height: 1.15; }
 th[data-dir=asc]::after { content: " \\25B2"; } th[data-dir=desc]::after { content: " \\25BC"; }
 td.t { text-align: left; white-space: nowrap; } td.w { text-align: left; white-space: normal; max-width: 60em; }
-.lead { display: flex; gap: 1.2em; align-items: flex-start; flex-wrap: wrap; }
-.lead > div { flex: 1 1 44em; min-width: 0; overflow-x: auto; } .lead > figure { flex: 0 1 26em; margin: 0; }
+.lead { display: grid; grid-template-columns: minmax(0, auto) minmax(18em, 25em); gap: 1.2em; align-items: start; }
+.lead > div { min-width: 0; overflow-x: auto; } .lead > figure { margin: 0; }
 figure { margin: 0.3em 0; display: inline-block; max-width: 100%; } figure img { width: 100%; max-width: 42em; }
 figcaption { font-size: 0.8em; color: #444; } .figs figure { width: 32em; margin-right: 0.6em; }
 details { margin: 0.2em 0; } summary { cursor: pointer; } .note { font-size: 0.85em; color: #444; }
@@ -153,7 +153,8 @@ def img(path: Path, caption: str | None = None, lazy: bool = True) -> str:
     name = html.escape(Path(path).name)
     cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
     loading = ' loading="lazy"' if lazy else ""
-    return f'<figure><img alt="{html.escape(Path(path).stem)}" src="{name}"{loading}>{cap}</figure>'
+    return (f'<figure><a href="{name}"><img alt="{html.escape(Path(path).stem)}" src="{name}"{loading}></a>'
+            f"{cap}</figure>")
 
 
 def toc(entries: list[tuple[str, str]]) -> str:

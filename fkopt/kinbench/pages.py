@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import html
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
@@ -137,7 +138,8 @@ def documented_settings(name: str) -> str:
         return ""
     paras = [" ".join(p.split()) for p in (doc or "").split("\n\n")]
     chosen = next((p for p in paras if p.startswith("Settings:")), paras[0] if paras else "")
-    return chosen.replace("``", "")
+    chosen = re.sub(r":\w+:`~?([^`]+)`", r"\1", chosen)        # Sphinx roles (:func:`x`) as plain names
+    return chosen.replace("``", "").replace("`", "")
 
 
 def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
@@ -229,7 +231,7 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
            "kinbench's FK, a failure counted at the timeout.", "note"),
         H.table_html(fam.assign(n_arms=fam["arms"].str.count(",") + 1),
                      ["family", "n_arms", "solver", "timeout_ms", *success, "median_ms", *extra, "median_ratio"],
-                     "advice", shares=False, labels={"n_arms": "arms", "family": "arm family (joints)",
+                     "advice-table", shares=False, labels={"n_arms": "arms", "family": "arm family (joints)",
                                                      "median_ratio": f"median time ratio to {clock.reference} "
                                                                      f"(FK: {clock.fk_reference})"}),
         "<details><summary>arms of each family</summary>" + "".join(
@@ -240,7 +242,7 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
     cols = ["solver", "entry", "arms", *success, "worst_arm", "median_ms",
             *(["cpu_ms_median"] if "cpu_ms_median" in summary else []), "median_ratio"]
     body = [_p(f"IK at a {t:g} ms timeout, success mean over the arms an entry ran (README's table).", "note"),
-            H.table_html(summary, cols, "summary", shares=False,
+            H.table_html(summary, cols, "summary-table", shares=False,
                          labels={"median_ratio": f"median time ratio to {clock.reference}"})]
     fk = [r for r in board["robot"].unique() if r in fk_robots(board)]
     if fk:
@@ -248,7 +250,7 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
         fks = summarise_board(board, tf, fk=True)
         body += [_p(f"FK of the parallel mechanisms ({', '.join(fk)}) at {tf:g} ms, success at the generating pose; "
                     f"ratios to {clock.fk_reference}.", "note"),
-                 H.table_html(fks, [c for c in cols if c in fks], "summary-fk", shares=False,
+                 H.table_html(fks, [c for c in cols if c in fks], "summary-fk-table", shares=False,
                               labels={"median_ratio": f"median time ratio to {clock.fk_reference}"})]
     return advice, Section("summary", "Summary per solver", body), "clock_all.png"
 
@@ -273,7 +275,7 @@ def evaluations_lead(sr, tables: dict) -> tuple[Section, Section, str]:
         advice_cols = ["class", "problems", "solver", *[f"success_{t}" for t in targets], "ms_per_solve", "candidates"]
         body = [_p(f"Among the solvers run on every problem of the class: best success at fitness {H.number(target)} "
                    "(mean over the class's problems), then median time per solve.", "note"),
-                H.table_html(adv, advice_cols, "advice", labels={"candidates": "solvers compared",
+                H.table_html(adv, advice_cols, "advice-table", labels={"candidates": "solvers compared",
                                                                 "problems": "problems"})]
     else:
         body = [_p("No runs stored: nothing to advise.")]
@@ -300,7 +302,7 @@ def evaluations_lead(sr, tables: dict) -> tuple[Section, Section, str]:
     if c.subsets:
         first = c.board_cells()[0][0]
         figure = f"ecdf_{first}_all.png"
-    return advice, Section("summary", "Summary per solver", [_p(text, "note"), H.table_html(summary, cols, "summary")]), figure
+    return advice, Section("summary", "Summary per solver", [_p(text, "note"), H.table_html(summary, cols, "summary-table")]), figure
 
 
 # -- detail pages ---------------------------------------------------------------------------------
@@ -430,14 +432,12 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
                                           "<p>" + " · ".join(_link(f, f) for f in files) + "</p>"])
     machine = machine_section(sr)
     sections = [advice, summary, figs, settings, machine, *details, files_sec]
-    caption = ("Every IK arm pooled: the share of queries answered right at the board's rung against the time "
-               "(per arm: the Per arm page)." if robots is not None and not robots.empty else
-               "Every problem of the first board: the share of (problem, pose, target, run) reached against the "
-               "evaluations per unknown.")
+    caption = ("Every IK arm pooled; each arm's on the Per arm page." if robots is not None and not robots.empty
+               else "Every problem of the first board.")
     lead_fig = H.img(lead_path, caption, lazy=False) if lead_path.exists() else ""
     body = [f"<h1>{html.escape(c.title or c.name)}</h1>",
             H.toc([(s.ident, s.title) for s in sections]),
-            f'<div class="lead"><div>{advice.html()}{summary.html()}</div>{lead_fig}</div>']
+            f'<div class="lead"><div>{advice.html()}</div>{lead_fig}</div>', summary.html()]
     body += [s.html() for s in sections[2:]]
     body.append(_p("Click a column header to sort; hover a header for its CSV column.", "note"))
     (folder / INDEX).write_text(H.page(f"{c.name} leaderboard", body), encoding="utf-8")
