@@ -167,6 +167,25 @@ def test_the_board_page_opens_with_the_advice_and_takes_new_solvers_and_columns(
     assert "data:image" not in index and "http://" not in index and "https://" not in index
 
 
+def test_an_arm_a_package_cannot_take_is_left_out_not_counted_as_zero(tmp_path):
+    from fkopt.kinbench.advice import summarise_board
+    sr, tables = stored_suite(QUICK)
+    tables = _newer_board(tables)
+    board = tables["leaderboard-robots.csv"]
+    success = [c for c in board.columns if c.startswith("success_")]
+    board[success] = board[success].astype(object)
+    board.loc[(board["solver"] == "eaik") & (board["robot"] == "panda"), success] = "not applicable: no decomposition"
+    summary = summarise_board(board, 20.0).set_index("solver")
+    ik_arms = board.loc[board["other_mode"].isna(), "robot"].nunique()
+    assert summary.loc["eaik", "arms"] == ik_arms - 1 and summary.loc["tracik", "arms"] == ik_arms
+    rung = "success_1e-05m_1e-05rad"              # eaik's rows are tracik's: its mean is tracik's without panda
+    others = board[(board["solver"] == "tracik") & (board["timeout_ms"] == 20.0) & board["other_mode"].isna()
+                   & (board["robot"] != "panda")]
+    assert summary.loc["eaik", rung] == pytest.approx(100 * others[rung].astype(float).mean())
+    write_pages(sr, tmp_path, {**tables, "leaderboard-robots.csv": board})
+    assert "not applicable: no decomposition" in (tmp_path / "arms.html").read_text()
+
+
 def test_the_page_shows_the_load_and_settings_a_board_recorded(tmp_path):
     sr, tables = stored_suite(QUICK)
     sr.meta = {**sr.meta, "load_avg": {"start": [1.25, 0.5, 0.25], "end": [2.0, 1.0, 0.5]},

@@ -100,6 +100,11 @@ def summarise_board(board: pd.DataFrame, timeout_ms: float, fk: bool = False) ->
     board = board[np.isclose(board["timeout_ms"], timeout_ms) & (board["robot"].isin(fk_set) == fk)]
     success = [c for c in board.columns if c.startswith("success_")]
     rung = f"success_{board['rung'].iloc[0]}"
+    # a cell such as "not applicable: ..." (an arm a package cannot take) is no number: that arm
+    # is left out of the entry's mean and count, never read as a zero
+    numbers = [*success, "time_ms_median", "time_ratio_median", *(["cpu_ms_median"] if "cpu_ms_median" in board else [])]
+    board = board.assign(**{c: pd.to_numeric(board[c], errors="coerce") for c in numbers})
+    board = board[board[rung].notna()]
     g = board.groupby(["solver", "entry"], sort=False)
     out = g[success].mean().mul(100)
     out["worst_arm"] = g[rung].min().mul(100)
