@@ -48,7 +48,7 @@ td.t { text-align: left; white-space: nowrap; } td.w { text-align: left; white-s
 .lead > div { min-width: 0; overflow-x: auto; } .lead > figure { margin: 0; }
 figure { margin: 0.3em 0; display: inline-block; max-width: 100%; } figure img { width: 100%; max-width: 42em; }
 figcaption { font-size: 0.8em; color: #444; } .figs figure { width: 32em; margin-right: 0.6em; }
-details { margin: 0.2em 0; } summary { cursor: pointer; } .note { font-size: 0.85em; color: #444; }
+span.n { white-space: nowrap; } details { margin: 0.2em 0; } summary { cursor: pointer; } .note { font-size: 0.85em; color: #444; }
 """
 
 #: CSV columns -> page header (words, units); a column not named here falls back to :func:`words`.
@@ -132,13 +132,18 @@ def _cell(v, percent: bool = False, scale: float = 1.0) -> str:
     return f'<td class="{"w" if len(text) > 60 else "t"}">{text}</td>'
 
 
+def _unbroken(text: str) -> str:
+    """Escaped header text whose numbers (1e-5) never break at their minus sign."""
+    return re.sub(r"(\d[\d.]*e[-+]?\d+)", r'<span class="n">\1</span>', html.escape(text))
+
+
 def table_html(df, cols: list[str], ident: str, reference: str | None = None, labels: dict | None = None,
                shares: bool = True) -> str:
     """A sortable table of ``df[cols]``; headers in words (:func:`words`, or ``labels``), the CSV's
     column name in each header's tooltip; shares (success) shown in per cent (``shares=False``:
     the table holds per cent already, as :mod:`fkopt.kinbench.advice`'s summaries)."""
     labels = labels or {}
-    head = "".join(f'<th title="{html.escape(c)}">{html.escape(labels.get(c) or words(c, reference))}</th>'
+    head = "".join(f'<th title="{html.escape(c)}">{_unbroken(labels.get(c) or words(c, reference))}</th>'
                    for c in cols)
     pct = [bool(PERCENT.match(c)) or (not shares and c == "worst_arm") for c in cols]
     scale = [100.0 if p and shares else 1.0 for p in pct]
