@@ -786,6 +786,7 @@ def schema(kind: str = typer.Argument("experiment", help="experiment | study | a
     A YAML file whose first line is `# yaml-language-server: $schema=PATH` (PATH relative to the
     file: the committed copies are docs/schema/<kind>.json) is validated and completed by editors
     using yaml-language-server. Every field is described in docs/config-reference.md."""
+    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
     from fkopt.run.config_reference import schema_text
     typer.echo(schema_text(kind), nl=False)
 

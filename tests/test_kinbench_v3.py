@@ -385,7 +385,7 @@ def test_an_unreadable_submission_file_is_one_line(tmp_path):
 
 def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
     import sys
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     from fkopt.errors import FkoptError
     monkeypatch.setitem(sys.modules, "pytracik", None)          # import pytracik -> ImportError
     with pytest.raises(FkoptError, match=r"field solver 'tracik' needs pytracik \(pip install -e \"\.\[field\]\"\)"):
@@ -425,16 +425,19 @@ def test_every_field_wrapper_is_importable_without_its_package_and_documents_set
     """Each wrapper module imports its outside package only when built (so fkopt imports without
     the [field] extra) and its docstring states the settings it uses and the quirks it handles."""
     import importlib
-    from fkopt.adapters.field import BLACK_BOX, IK_SOLVERS, PACKAGES, BlackBoxIK, FieldIK
-    assert set(IK_SOLVERS) == set(PACKAGES) and set(BLACK_BOX) <= set(IK_SOLVERS)
-    modules = {m for m, _ in IK_SOLVERS.values()} | {"scipy_fk"}
-    for module in modules:
-        mod = importlib.import_module(f"fkopt.adapters.field.{module}")
+    from fkopt.adapters.field import FieldIK
+    from fkopt.registry import FK_SOLVERS, IK_SOLVERS, SOLVERS
+    field = [SOLVERS[n] for n in IK_SOLVERS + FK_SOLVERS if SOLVERS[n].package != "fkopt"]
+    assert {e.name for e in field} >= {"tracik", "rtb-ik_LM", "pin-clik", "ikpy", "scipy-least_squares"}
+    for entry in field:
+        mod = importlib.import_module(entry.make.__module__)
+        assert mod.__name__.startswith("fkopt.adapters.field."), entry.name
         doc = mod.__doc__ or ""
-        assert "Settings" in doc and ("Quirk" in doc or "quirk" in doc or module in ("lbfgsb", "scipy_fk")), module
-    for name, (module, cls) in IK_SOLVERS.items():
-        klass = getattr(importlib.import_module(f"fkopt.adapters.field.{module}"), cls)
-        assert issubclass(klass, BlackBoxIK if name in BLACK_BOX else FieldIK) and klass.name == name
+        short = mod.__name__.rsplit(".", 1)[-1]
+        assert "Settings" in doc and ("Quirk" in doc or "quirk" in doc or short in ("lbfgsb", "scipy_fk")), short
+        # the entry's facts are the wrapper's own
+        assert entry.make.name == entry.name and entry.make.package == entry.package
+        assert entry.role == "fk" or issubclass(entry.make, FieldIK)
 
 
 def test_the_black_box_objective_is_zero_at_the_answer_and_grows_with_the_error():

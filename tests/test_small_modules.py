@@ -88,7 +88,8 @@ def test_field_solvers_answer_on_the_stored_ur5_and_kinbench_judges_them():
     import pytest
 
     import fkopt
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     from fkopt.kinbench.physical import ik_verdicts
     arm = fkopt.mechanism("urdf", file="configs/suites/robots/ur5.urdf", base="base_link", tip="tool0")
     rng = np.random.default_rng(4)

@@ -40,4 +40,4 @@ OUTPUTS = (
     Output("index.html", reports.html_page, FIGURE),     # and arms.html, rankings.html (kinbench.pages)
 )
 
-SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta))
+SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig))

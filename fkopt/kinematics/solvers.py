@@ -111,13 +111,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fkopt.algorithms.hybrid import GABCLM
-from fkopt.errors import FkoptError
+from fkopt.errors import FkoptError, did_you_mean
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
+from fkopt.mechanisms.catalog import MECHANISMS
 from fkopt.numerics import path as numerics_path
 from fkopt.numerics.options import InverseOptions
-from fkopt.numerics.dls import inverse_candidates, rotation_error1
+from fkopt.numerics.damped_least_squares import inverse_candidates, rotation_error1
 from fkopt.problems import fk_problem, so3_right_jacobian_inverse
-from fkopt.solve import solve
+from fkopt.algorithms.runs import solve
 
 #: Default forward tolerance: max |ik(pose) - joints| in the joint units.
 FORWARD_TOL = 1e-9
@@ -197,8 +198,10 @@ class InverseResult:
 
 def _mechanism(mechanism, kind: type, what: str) -> Mechanism:
     if isinstance(mechanism, str):
-        from fkopt.registry import mechanism_class
-        mechanism = mechanism_class(mechanism)()
+        if mechanism not in MECHANISMS:
+            raise FkoptError(f"unknown mechanism '{mechanism}'; allowed: {did_you_mean(mechanism, list(MECHANISMS))} "
+                             "(a plug-in: pass fkopt.mechanism(name))")
+        mechanism = MECHANISMS[mechanism]()
     if not isinstance(mechanism, kind):
         other = "inverse" if what == "forward" else "forward"
         raise FkoptError(f"{what} needs a {'parallel mechanism' if kind is ParallelMechanism else 'serial arm'}; "
@@ -1012,7 +1015,7 @@ def _unreachable(m, x, y, z, dist) -> FkoptError:
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
                  down, up, step_cap, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
-    Python floats (:func:`fkopt.numerics.dls.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
+    Python floats (:func:`fkopt.numerics.damped_least_squares.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
     first needs one -- then seeded random draws), with only the numpy calls it cannot avoid: a
     batch's bookkeeping costs more than the iteration itself for a single pose. The compiled call

@@ -1,4 +1,4 @@
-"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.dls` compiled by
+"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.damped_least_squares` compiled by
 numba, operation for operation in the reference's order (numba compiles without fast-math, so no
 reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` are the C library's,
 as Python's ``math``). Importing this module imports numba, which costs a noticeable part of a
@@ -16,7 +16,7 @@ load the cache.
   ``error_model="numpy"``: a float division by zero gives numpy's inf/NaN instead of a Python
   exception, so no check guards each division (half of the fitness' time, measured: 57 -> 29 ns
   per point); the values are the same wherever the divisor is not zero;
-* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
+* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.damped_least_squares.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
 * :func:`fill_uniforms` -- the refill of :class:`fkopt.numerics.streams.RunStreams`' buffer, every run in one
   call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits);
@@ -148,7 +148,7 @@ def _rotation_error(R, T, e):
 
 @njit(cache=True)
 def _dls_step(J, r, mu, free, d, A, L, y, x):
-    """:func:`fkopt.numerics.dls.dls_step` into d; J's columns with free[i] = False count as zero.
+    """:func:`fkopt.numerics.damped_least_squares.dls_step` into d; J's columns with free[i] = False count as zero.
     Returns False when not positive definite or not finite."""
     n = J.shape[1]
     for a in range(6):
@@ -226,7 +226,7 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
 @njit(cache=True)
 def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr, iterations, damping, down, up,
                  step_cap, lo, hi, glo, ghi, best_q):
-    """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
+    """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
     (starts used, evaluations)."""

@@ -1,6 +1,7 @@
 """The reference of fkopt's config files, generated from the pydantic models that validate them.
 
-For every kind of file (:data:`MODELS`) this module gives
+For every registered kind of file (:data:`fkopt.run.kinds.KINDS`, each with its ``model``) this
+module gives
 
 * :func:`json_schema` -- the model's JSON Schema with every field's description, unit and an
   example added (what ``fkopt schema KIND`` prints and ``docs/schema/<kind>.json`` holds, for
@@ -17,7 +18,6 @@ when the committed files differ from what this module generates). Regenerate the
 """
 from __future__ import annotations
 
-import importlib
 import json
 import types
 import typing
@@ -26,14 +26,8 @@ from typing import Any, Literal, get_args, get_origin
 
 from fkopt.errors import FkoptError
 from fkopt.files import models_in
+from fkopt.run.kinds import KINDS
 
-#: kind -> "module:Class" of the model that validates a file of that kind (imported on first use).
-MODELS: dict[str, str] = {
-    "experiment": "fkopt.kinds.experiment.config:ExperimentConfig",
-    "study": "fkopt.kinds.study.config:StudyConfig",
-    "assembly": "fkopt.kinds.assembly.kind:AssemblyConfig",
-    "suite": "fkopt.kinbench.config:SuiteConfig",
-}
 #: What each kind of file is, for the reference's headings.
 KIND_TEXT = {
     "experiment": "An experiment: listed (or random) cases of one mechanism, solved by every algorithm "
@@ -331,15 +325,15 @@ SHARED = {"AssemblyConfig": "ExperimentConfig", "StudyConfig": "ExperimentConfig
 
 
 def kinds() -> list[str]:
-    return list(MODELS)
+    """The registered kinds of config file (importing :mod:`fkopt.kinbench` registers all four)."""
+    return list(KINDS)
 
 
 def model(kind: str):
-    """The pydantic model of ``kind`` (experiment, study, assembly)."""
-    if kind not in MODELS:
-        raise FkoptError(f"schema: unknown kind '{kind}'; allowed: {', '.join(MODELS)}")
-    module, attr = MODELS[kind].split(":")
-    return getattr(importlib.import_module(module), attr)
+    """The pydantic model of ``kind`` (experiment, study, assembly, suite)."""
+    if kind not in KINDS:
+        raise FkoptError(f"schema: unknown kind '{kind}'; allowed: {', '.join(KINDS)}")
+    return KINDS[kind].model
 
 
 def field_doc(model_name: str, field: str) -> tuple[str, str, Any] | None:
@@ -450,11 +444,11 @@ def markdown() -> str:
              "schema, e.g. `# yaml-language-server: $schema=../../docs/schema/experiment.json` (a path "
              "relative to the file, or a URL). The schemas are in [schema/](schema/), and `fkopt schema KIND` "
              "prints them.", ""]
-    for kind in MODELS:
+    for kind in KINDS:
         lines += [f"- [{kind}](#{kind}-files): {KIND_TEXT[kind]}"]
     lines.append("")
     documented: set[str] = set()
-    for kind in MODELS:
+    for kind in KINDS:
         lines += [f"## {kind} files", "", KIND_TEXT[kind],
                   f"Schema: [schema/{kind}.json](schema/{kind}.json).", ""]
         for m in models_of(kind):
@@ -479,7 +473,7 @@ def markdown() -> str:
 def generated(root: Path = Path(".")) -> dict[Path, str]:
     """Every generated file (path under ``root``) and its text."""
     files = {root / REFERENCE: markdown()}
-    for kind in MODELS:
+    for kind in KINDS:
         files[root / SCHEMA_DIR / f"{kind}.json"] = schema_text(kind)
     return files
 
@@ -494,5 +488,6 @@ def write(root: Path = Path(".")) -> list[Path]:
 
 
 if __name__ == "__main__":
+    import fkopt.kinbench  # noqa: F401  (the script's entry: registers every built-in kind)
     for p in write(Path(__file__).resolve().parent.parent):
         print(p)

@@ -17,12 +17,17 @@ from pathlib import Path
 
 import numpy as np
 
+from fkopt.registry import solver_entry
+
 #: Lowest floor used to draw exact zeros on a log axis.
 MIN_FLOOR = 1e-30
 
-#: Display names of fkopt's registered methods (the names the papers use).
-METHOD_NAMES = {"abc": "ABC", "gabc": "GABC", "pso": "PSO", "pabc": "P-ABC", "aco": "ACO",
-                "lm": "Levenberg-Marquardt", "nr": "Newton-Raphson"}
+
+
+def _display(method: str, fallback: str) -> str:
+    """A solver's display name from the registry (the names the papers use), else ``fallback``."""
+    entry = solver_entry(method)
+    return entry.display if entry is not None and entry.display else fallback
 
 
 def plt():
@@ -55,8 +60,8 @@ def algorithm_name(method: str, params: dict | None = None, label: str | None = 
     """The paper's name of a configured algorithm: method, GABC rule, selection, hybrids."""
     params = params or {}
     if "+" in method:
-        return "+".join(METHOD_NAMES.get(m, m.upper()) for m in method.split("+"))
-    name = METHOD_NAMES.get(method, method)
+        return "+".join(_display(m, m.upper()) for m in method.split("+"))
+    name = _display(method, method)
     if method == "gabc":
         name = "GABC (Zhu & Kwong)" if params.get("rule") == "zhu2010" else "GABC (eq. 19)"
     if method == "pso" and params.get("w") == 1.0:

@@ -98,6 +98,8 @@ class Kind:
     outputs: tuple = ()
     #: result -> the content of its meta.json (without the file digests)
     meta: Callable[[Any], dict] | None = None
+    #: the pydantic model of its file (the config reference, fkopt.run.config_reference)
+    model: type | None = None
 
 
 @dataclass

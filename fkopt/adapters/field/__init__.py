@@ -19,6 +19,8 @@ given (no global RNG); a package whose internal restarts draw from its own RNG s
 packages with only iteration limits (roboticstoolbox) run to their limits -- the clock track
 (:mod:`fkopt.kinbench.clock`) counts any answer later than the timeout as a failure at the timeout.
 
+The wrappers are registered, with their package, track and timing rule, in the one solver
+registry (:data:`fkopt.registry.SOLVERS`; :func:`fkopt.registry.clock_solver` builds one).
 Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
 (roboticstoolbox-python ``ik_LM``, ``ik_NR``), :mod:`.pin` (pinocchio's CLIK), :mod:`.ikpy`;
 black-box optimisers on :func:`pose_objective` (:class:`BlackBoxIK`, restarts until the
@@ -28,7 +30,6 @@ timeout): :mod:`.cmaes` (pycma, IPOP), :mod:`.lbfgsb` (scipy L-BFGS-B from rando
 """
 from __future__ import annotations
 
-import importlib
 import tempfile
 import time
 from contextlib import contextmanager
@@ -39,25 +40,6 @@ from typing import Any
 import numpy as np
 
 from fkopt.errors import FkoptError
-
-#: name -> (module, class) of every IK wrapper; black-box ones minimise :func:`pose_objective`.
-IK_SOLVERS = {
-    "tracik": ("tracik", "TracIK"),
-    "rtb-ik_LM": ("rtb", "RtbLM"),
-    "rtb-ik_NR": ("rtb", "RtbNR"),
-    "pin-clik": ("pin", "PinCLIK"),
-    "ikpy": ("ikpy", "IkPy"),
-    "cma-es": ("cmaes", "CmaES"),
-    "scipy-lbfgsb": ("lbfgsb", "LBFGSB"),
-    "nevergrad-ngopt": ("nevergrad_ngopt", "NGOpt"),
-}
-#: The outside package each wrapper needs (for the one-line message when it is missing).
-PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
-            "pin-clik": "pin", "ikpy": "ikpy", "cma-es": "cma", "scipy-lbfgsb": "scipy",
-            "nevergrad-ngopt": "nevergrad"}
-#: Wrappers that only see the objective (the black-box track); the others use Jacobians.
-BLACK_BOX = ("cma-es", "scipy-lbfgsb", "nevergrad-ngopt")
-
 
 class FieldIK:
     """One outside IK solver on one arm; subclasses set ``name``, ``package``, ``settings``."""
@@ -144,25 +126,6 @@ class IKAnswers:
     seconds: np.ndarray
     claimed: np.ndarray
     settings: dict = field(default_factory=dict)
-
-
-def make_ik(name: str, arm, *, timeout: float, rng: np.random.Generator) -> FieldIK:
-    """The wrapper ``name`` of :data:`IK_SOLVERS` built on ``arm``; a missing package or an arm the
-    package cannot read is one line (:class:`FkoptError`)."""
-    if name not in IK_SOLVERS:
-        raise FkoptError(f"unknown field solver '{name}'; allowed: {', '.join(IK_SOLVERS)}")
-    module, cls = IK_SOLVERS[name]
-    try:
-        mod = importlib.import_module(f"{__name__}.{module}")
-        return getattr(mod, cls)(arm, timeout=timeout, rng=rng)
-    except ImportError as err:
-        raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[field]\"): "
-                         f"{err}") from None
-    except FkoptError:
-        raise
-    except Exception as err:     # the outside package refused this arm: one line, not its traceback
-        raise FkoptError(f"field solver '{name}' ({PACKAGES[name]}) cannot read {getattr(arm, 'path', 'this arm')}: "
-                         f"{type(err).__name__}: {str(err).splitlines()[0][:160] if str(err) else ''}") from None
 
 
 def timed1(solver: FieldIK, T: np.ndarray) -> tuple[np.ndarray, float, bool]:

@@ -157,4 +157,4 @@ OUTPUTS = (
     Output("timing.csv", timing_table, TIMING),
 )
 
-ASSEMBLY = register(Kind(KIND, assembly_from_dict, _plan, _validate, _merge, OUTPUTS, meta))
+ASSEMBLY = register(Kind(KIND, assembly_from_dict, _plan, _validate, _merge, OUTPUTS, meta, AssemblyConfig))

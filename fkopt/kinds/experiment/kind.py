@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from fkopt.run.memory import algorithm_resources
 from fkopt.solve import batch_bytes, chunk_size
-from fkopt.kinds.experiment.config import experiment_from_dict
+from fkopt.kinds.experiment.config import ExperimentConfig, experiment_from_dict
 from fkopt.kinds.experiment.runner import experiment_plan, keeps_x_history, merge_experiment
 from fkopt.kinds.experiment import reports
 from fkopt.run.kinds import register
@@ -56,4 +56,4 @@ OUTPUTS = (
 )
 
 EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
-                           _experiment_merge, OUTPUTS, reports.meta))
+                           _experiment_merge, OUTPUTS, reports.meta, ExperimentConfig))

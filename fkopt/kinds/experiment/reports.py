@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fkopt.registry import algorithm_class
 from fkopt.run import record
 from fkopt.run.writers import FLOAT, write_outputs, write_result
 from fkopt.run import plotting
@@ -235,12 +236,13 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
         it = np.arange(hist.shape[1])
         line = _band(axes[0], it, hist, floor, name, end=end)
         _band(axes[1], evals.mean(axis=0), hist, floor, name, color=line.get_color(), end=end)
-        if spec.name == "pabc":
-            sw = int(round(float(spec.params.get("switch", 0.5)) * (hist.shape[1] - 1)))
+        phases = getattr(algorithm_class(spec.name), "phase_change", None)   # P-ABC: PSO then ABC
+        if phases:
+            sw = algorithm_class(spec.name).phase_iteration(spec.params, hist.shape[1] - 1)
             y = np.median(np.maximum(hist[:, sw], floor))
             for ax, x in zip(axes, (sw, evals.mean(axis=0)[sw])):
                 ax.plot(x, y, marker="v", ms=7, color=line.get_color(), zorder=5)
-            axes[0].annotate("switch PSO → ABC", (sw, y), textcoords="offset points", xytext=(4, 8), fontsize=7,
+            axes[0].annotate(phases, (sw, y), textcoords="offset points", xytext=(4, 8), fontsize=7,
                              color=line.get_color())
     runs = curves[0][2].shape[0]
     what = "best-so-far " + plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))

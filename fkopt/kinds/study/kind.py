@@ -45,4 +45,4 @@ OUTPUTS = (
     Output("tracking_time", reports.tracking_time_figure, FIGURE),
 )
 
-STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta))
+STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig))
