@@ -118,26 +118,22 @@ def _settings_text(settings) -> str:
 
 def documented_settings(name: str) -> str:
     """An entry's settings as its wrapper documents them (the "Settings:" paragraph of its
-    module's docstring; the organiser's entries: their class's docstring), read from fkopt's
-    source, or "" when fkopt has no wrapper of that name."""
+    module's docstring, else its class's first paragraph: the organiser's entries), read from
+    fkopt's source through the solver registry, or "" when fkopt has no solver of that name."""
     import importlib
     import inspect
-    try:
-        from fkopt.kinbench import clock
-        if name == clock.FkoptInverse.name:
-            doc = inspect.getdoc(clock.FkoptInverse)
-        elif name == clock.FkoptForward.name:
-            doc = inspect.getdoc(clock.FkoptForward)
-        else:
-            from fkopt.adapters.field import IK_SOLVERS
-            module = {clock.FK_REFERENCE: "scipy_fk"}.get(name) or IK_SOLVERS.get(name, (None,))[0]
-            if module is None:
-                return ""
-            doc = inspect.getdoc(importlib.import_module(f"fkopt.adapters.field.{module}"))
-    except Exception:        # a wrapper whose module needs its package at import: nothing to quote
+    from fkopt.registry import solver_entry
+    entry = solver_entry(name)
+    if entry is None:
         return ""
-    paras = [" ".join(p.split()) for p in (doc or "").split("\n\n")]
-    chosen = next((p for p in paras if p.startswith("Settings:")), paras[0] if paras else "")
+    paras = []
+    for doc in (inspect.getdoc(importlib.import_module(entry.make.__module__)), inspect.getdoc(entry.make)):
+        paras = [" ".join(p.split()) for p in (doc or "").split("\n\n")]
+        chosen = next((p for p in paras if p.startswith("Settings:")), None)
+        if chosen is not None:
+            break
+    else:
+        chosen = paras[0] if paras else ""
     chosen = re.sub(r":\w+:`~?([^`]+)`", r"\1", chosen)        # Sphinx roles (:func:`x`) as plain names
     return chosen.replace("``", "").replace("`", "")
 
@@ -157,11 +153,8 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
     recorded = meta.get("settings") if isinstance(meta.get("settings"), dict) else {}
     names = list(dict.fromkeys([clock.reference, *clock.solvers, clock.fk_reference, *clock.fk_solvers]
                                + ([] if answers is None else list(answers["solver"].unique()))))
-    try:
-        from fkopt.adapters.field import PACKAGES
-    except Exception:
-        PACKAGES = {}
     from fkopt.kinbench.clock import entry_of
+    from fkopt.registry import solver_entry
     rows = []
     for name in names:
         if answers is not None and name not in set(answers["solver"]):
@@ -179,8 +172,9 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
         sub = next((s for s in clock.submissions if s.solver == name), None)
         if sub is not None:
             text, where = f"submitted: {sub.description} (machine: {sub.machine})", "the submission (config)"
-        rows.append({"solver": name, "entry": entry_of(name), "package": "fkopt" if entry_of(name) == "organiser"
-                     else PACKAGES.get(name, "-"), "wall-clock limit": limit, "settings": text, "from": where})
+        known = solver_entry(name)
+        rows.append({"solver": name, "entry": entry_of(name), "package": known.package if known is not None else "-",
+                     "wall-clock limit": limit, "settings": text, "from": where})
     body.append(H.table_html(pd.DataFrame(rows), ["solver", "entry", "package", "wall-clock limit", "settings", "from"],
                              "settings-table", labels={"wall-clock limit": "wall-clock limit",
                                                        "settings": "settings", "from": "settings from"}))
