@@ -421,7 +421,8 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
     shown = [p for p in figures if p.exists() and p.name != lead_png]
     figs = Section("figures", "Figures", [_p("Each figure is the PNG beside this page (a PDF twin beside it).", "note"),
                                           '<div class="figs">' + "".join(H.img(p) for p in shown) + "</div>"])
-    files = sorted(p.name for p in folder.iterdir() if p.suffix in (".csv", ".gz", ".md") or p.name in ("meta.json", "env.json"))
+    # meta.json and env.json are written after the pages when fkopt suite runs: named all the same
+    files = sorted({p.name for p in folder.iterdir() if p.suffix in (".csv", ".gz", ".md")} | {"meta.json", "env.json"})
     files_sec = Section("files", "Files", [_p("The tables behind this page (column names as in the CSVs):", "note"),
                                           "<p>" + " · ".join(_link(f, f) for f in files) + "</p>"])
     machine = machine_section(sr)
