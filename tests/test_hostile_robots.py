@@ -325,3 +325,30 @@ def test_break19_mjcf_range_lower_above_upper_is_refused_like_urdf(tmp_path):
     pytest.importorskip("mujoco")
     path = mjcf(tmp_path, j1='name="j1" axis="0 0 1" range="1 -1"')
     refused(path, str(path), "joint 'j1' range", "lower 1 > upper -1")
+
+
+# --- release pins ----------------------------------------------------------------------------------
+SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
+
+
+@pytest.mark.parametrize("suite, robot", [("kinbench-v3.yaml", "iiwa-mj.xml"), ("kinbench-v3-robots.yaml", "ur5.urdf"),
+                                          ("kinbench-v3.yaml", "pr2-left-gripper.urdf")])
+def test_v3s_robot_files_are_pinned_by_sha256_like_v1_and_v2(suite, robot, tmp_path):
+    """Only v1/v2's robot files were pinned: a v3 robot file could be changed (an expression added to
+    an element fkopt ignores) and the suite still ran as released kinbench-v3."""
+    import shutil
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.posesets import load_pose_sets
+    from fkopt.kinbench.releases import RELEASES
+    assert "robots/" + robot in RELEASES["kinbench-v3"].files
+    for name in ("kinbench-v3", "robots"):
+        shutil.copytree(SUITES / name, tmp_path / name)
+    shutil.copy(SUITES / suite, tmp_path / suite)
+    load_pose_sets(load_suite(tmp_path / suite))            # as released: accepted
+    edited = tmp_path / "robots" / robot
+    text = edited.read_text()
+    cut = text.rindex("</")
+    edited.write_text(text[:cut] + '<!-- ${1} -->' + text[cut:])
+    with pytest.raises(FkoptError) as err:
+        load_pose_sets(load_suite(tmp_path / suite))
+    assert f"robots/{robot}: differs from released kinbench-v3" in str(err.value) and "\n" not in str(err.value)

@@ -18,7 +18,7 @@ from fkopt.kinbench.releases import RELEASES, check_release, release_files
 
 ROOT = Path(__file__).resolve().parents[1]
 SUITES = ROOT / "configs" / "suites"
-RELEASED_SUITES = {"kinbench-v1": "kinbench.yaml", "kinbench-v2": "kinbench-v2.yaml"}
+RELEASED_SUITES = {"kinbench-v1": "kinbench.yaml", "kinbench-v2": "kinbench-v2.yaml", "kinbench-v3": "kinbench-v3.yaml"}
 
 
 def copy_suite(tmp_path, suite="kinbench.yaml"):
