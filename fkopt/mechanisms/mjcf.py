@@ -58,9 +58,11 @@ class MJCFGeometry(URDFGeometry):
 
 #: Largest file an MJCF names (a mesh, texture, height field, skin or model asset; bytes), and the
 #: most all of them may hold together, counted per reference (MuJoCo loads a file once per asset
-#: naming it). Robot meshes are megabytes; a 300-byte MJCF naming a 1.9 GB mesh took 1.97 GB.
-MAX_MJCF_ASSET_BYTES = 32 << 20
-MAX_MJCF_TOTAL_BYTES = 128 << 20
+#: naming it). Robot meshes are megabytes (robosuite's largest 9 MB); a 300-byte MJCF naming a
+#: 1.9 GB mesh took 1.97 GB, and MuJoCo's peak memory is about 20 times the mesh bytes it
+#: compiles (docs/reliability.md).
+MAX_MJCF_ASSET_BYTES = 16 << 20
+MAX_MJCF_TOTAL_BYTES = 64 << 20
 #: Most pixels of a PNG texture or height field (MuJoCo decodes it whole: 4 bytes a pixel); a
 #: small PNG can declare 30 000 x 30 000 pixels.
 MAX_PNG_PIXELS = 4096 * 4096

@@ -131,13 +131,10 @@ def check_expression_free(text: str, where: str) -> None:
     would evaluate: ``${`` or ``$(`` in any attribute value or text once XML entities are decoded
     (``&#36;{`` is ``${`` to xacro), or the word xacro anywhere (a namespace, an element, an
     attribute)."""
-    import xml.etree.ElementTree as ET
+    from ...files import parse_xml
     if "xacro" in text.lower():
         raise FkoptError(f"{where}: names xacro; fkopt hands outside packages no file they would expand")
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as err:
-        raise FkoptError(f"{where}: malformed URDF ({err})") from None
+    root = parse_xml(text, where)                   # nesting bounded (break 3: TRAC-IK crashed on depth)
     for e in root.iter():
         for value in (e.text, e.tail, *e.attrib.values(), *e.attrib.keys(), e.tag):
             if value and any(x in value for x in _EXPRESSION):
