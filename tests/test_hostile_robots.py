@@ -183,6 +183,17 @@ def run_bounded(code: str, timeout: float = 120.0):
     return out.returncode, out.stderr
 
 
+#: Reads an MJCF in a child process (run_bounded): a hang is a failure, not a hung suite.
+REFUSED = """
+import fkopt
+from fkopt.errors import FkoptError
+try:
+    fkopt.mechanism("mjcf", file={path!r})
+except FkoptError as err:
+    raise SystemExit("FkoptError: " + str(err))
+"""
+
+
 @pytest.mark.parametrize("tag", ["include", "mesh"])
 def test_break4_an_mjcf_naming_a_fifo_is_refused_not_a_hang(tag, tmp_path):
     """Break 4: an MJCF ``<include>`` or ``<mesh>`` of a FIFO blocked MuJoCo forever."""
@@ -192,16 +203,21 @@ def test_break4_an_mjcf_naming_a_fifo_is_refused_not_a_hang(tag, tmp_path):
     head = ('<include file="pipe"/>' if tag == "include"
             else '<asset><mesh name="m" file="pipe"/></asset>')
     path = mjcf(tmp_path, head=head)
-    code = f"""
-import fkopt
-from fkopt.errors import FkoptError
-try:
-    fkopt.mechanism("mjcf", file={str(path)!r})
-except FkoptError as err:
-    raise SystemExit("FkoptError: " + str(err))
-"""
-    status, err = run_bounded(code)
+    status, err = run_bounded(REFUSED.format(path=str(path)))
     assert status != 0 and "FkoptError:" in err and "FIFO" in err and "pipe" in err, err
+
+
+def test_break4_a_fifo_beside_an_included_file_is_refused_too(tmp_path):
+    """MuJoCo also looks for a nested include beside the file that includes it (sub/a.xml naming
+    b.xml finds sub/b.xml): that candidate gets the same checks."""
+    pytest.importorskip("mujoco")
+    import os
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "a.xml").write_text('<mujoco><include file="b.xml"/></mujoco>')
+    os.mkfifo(tmp_path / "sub" / "b.xml")
+    path = mjcf(tmp_path, head='<include file="sub/a.xml"/>')
+    status, err = run_bounded(REFUSED.format(path=str(path)))
+    assert status != 0 and "FkoptError:" in err and "FIFO" in err and "b.xml" in err, err
 
 
 @pytest.mark.parametrize("head", [
@@ -331,8 +347,7 @@ def test_break19_mjcf_range_lower_above_upper_is_refused_like_urdf(tmp_path):
 SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
 
 
-@pytest.mark.parametrize("suite, robot", [("kinbench-v3.yaml", "iiwa-mj.xml"), ("kinbench-v3-robots.yaml", "ur5.urdf"),
-                                          ("kinbench-v3.yaml", "pr2-left-gripper.urdf")])
+@pytest.mark.parametrize("suite, robot", [("kinbench-v3.yaml", "iiwa-mj.xml"), ("kinbench-v3-robots.yaml", "ur5.urdf")])
 def test_v3s_robot_files_are_pinned_by_sha256_like_v1_and_v2(suite, robot, tmp_path):
     """Only v1/v2's robot files were pinned: a v3 robot file could be changed (an expression added to
     an element fkopt ignores) and the suite still ran as released kinbench-v3."""

@@ -74,44 +74,70 @@ _ASSET_DIRS = ("meshdir", "texturedir", "assetdir")
 
 def check_mjcf_files(path: Path) -> None:
     """Every file MuJoCo would open for the MJCF ``path`` gets the top file's checks before MuJoCo
-    opens any (issue 42): the top file and each ``<include file>`` (relative to the top file's
-    folder, as MuJoCo resolves it) bounded in bytes (:data:`MAX_MJCF_BYTES`) and in nesting
-    (:data:`fkopt.files.MAX_XML_DEPTH`); every attribute naming a file (``file``, ``fileright``,
-    ... on any element) and the ``<compiler>`` folders a relative path that resolves, links
-    included, inside the top file's folder, to a regular file (not a FIFO, which blocked MuJoCo
-    forever, nor a device) of at most :data:`MAX_MJCF_ASSET_BYTES`, all of them together at most
-    :data:`MAX_MJCF_TOTAL_BYTES`, a PNG at most :data:`MAX_PNG_PIXELS`. One line naming the file."""
+    opens any (issue 42): each ``<include file>``, recursively, bounded in bytes
+    (:data:`MAX_MJCF_BYTES`) and in nesting (:data:`fkopt.files.MAX_XML_DEPTH`); every attribute
+    naming a file (``file``, ``fileright``, ... on any element) and the ``<compiler>`` folders a
+    relative path without ``..`` that resolves, links included, inside the top file's folder, to
+    a regular file (not a FIFO, which blocked MuJoCo forever, nor a device) of at most
+    :data:`MAX_MJCF_ASSET_BYTES`; all files named, counted per reference, at most
+    :data:`MAX_MJCF_TOTAL_BYTES`; a PNG at most :data:`MAX_PNG_PIXELS`. MuJoCo looks for a name
+    beside the top file and beside the file naming it, joined to the compiler's folders or not
+    (``strippath``: the name without its folder), so every such candidate that exists is
+    checked. One line naming the file."""
     from ..files import check_within, open_input, parse_xml, read_input
     folder = path.resolve().parent
     where = f"mjcf {path}"
-    docs, queue, seen = [], [path], set()
+    total, count = 0, 0
+
+    def counted(fd: int, what: str) -> bytes:
+        """The first 24 bytes of an opened file, its size added to the total (closed here)."""
+        nonlocal total, count
+        with os.fdopen(fd, "rb") as fh:
+            size, head = os.fstat(fh.fileno()).st_size, fh.read(24)
+        total, count = total + size, count + 1
+        if count > MAX_MJCF_FILES:
+            raise FkoptError(f"{where}: names more than {MAX_MJCF_FILES} files")
+        if total > MAX_MJCF_TOTAL_BYTES:
+            raise FkoptError(f"{where}: the files it names hold more than {MAX_MJCF_TOTAL_BYTES >> 20} MB together "
+                             f"(at {what}), the most accepted")
+        return head
+
+    docs, queue, seen = [], [(path, None)], set()
     while queue:
-        f = queue.pop()
+        f, what = queue.pop()
+        if what is not None:
+            counted(open_input(f, MAX_MJCF_BYTES, what, within=folder), what)
         key = f.resolve()
-        if key in seen:                        # a cycle: MuJoCo refuses it with its own message
+        if key in seen:                        # parsed once; counted per reference above
             continue
         seen.add(key)
-        if len(seen) > MAX_MJCF_FILES:
-            raise FkoptError(f"{where}: includes more than {MAX_MJCF_FILES} files")
-        field = "mjcf geometry.file" if f is path else f"mjcf {path} <include>"
-        root = parse_xml(read_input(f, MAX_MJCF_BYTES, field=field, within=None if f is path else folder),
+        field = "mjcf geometry.file" if what is None else what
+        root = parse_xml(read_input(f, MAX_MJCF_BYTES, field=field, within=None if what is None else folder),
                          f"mjcf {f}")
-        docs.append(root)
+        docs.append((root, key.parent))
         for inc in root.iter("include"):
             name = inc.get("file")
             if name is None:
                 continue
-            queue.append(_inside(folder, name, f"{where}: <include file='{short_token(name)}'>"))
-    dirs = [folder]
-    for root in docs:
+            label = f"{where}: <include file='{short_token(name)}'>"
+            for candidate in dict.fromkeys((_inside(folder, name, label), _inside(key.parent, name, label))):
+                if candidate.exists() or candidate.is_symlink():
+                    queue.append((candidate, label))
+    bases = list(dict.fromkeys([folder, *(d for _, d in docs)]))
+    dirs = list(bases)
+    for root, _ in docs:
         for c in root.iter("compiler"):
             for attr in _ASSET_DIRS:
-                if c.get(attr) is not None:
-                    d = _inside(folder, c.get(attr), f"{where}: <compiler {attr}='{short_token(c.get(attr))}'>")
-                    check_within(d, folder, f"{where}: <compiler {attr}>")
-                    dirs.append(d)
-    total, count = 0, 0
-    for root in docs:
+                value = c.get(attr)
+                if value is not None:
+                    label = f"{where}: <compiler {attr}='{short_token(value)}'>"
+                    for base in bases:
+                        d = _inside(base, value, label)
+                        if d.exists() or d.is_symlink():
+                            check_within(d, folder, label)
+                        dirs.append(d)
+    dirs = list(dict.fromkeys(dirs))
+    for root, _ in docs:
         for e in root.iter():
             if e.tag == "include":
                 continue
@@ -126,20 +152,10 @@ def check_mjcf_files(path: Path) -> None:
                     continue
                 what = f"{where}: <{e.tag} {attr}='{short_token(name)}'>"
                 _inside(folder, name, what)
-                count += 1
-                if count > MAX_MJCF_FILES:
-                    raise FkoptError(f"{where}: names more than {MAX_MJCF_FILES} files")
-                # MuJoCo joins the name to its folder (``strippath`` keeps only the file's own name)
                 for candidate in dict.fromkeys(d / n for d in dirs for n in (name, Path(name).name)):
                     if not candidate.exists() and not candidate.is_symlink():
                         continue
-                    fd = open_input(candidate, MAX_MJCF_ASSET_BYTES, what, within=folder)
-                    with os.fdopen(fd, "rb") as fh:
-                        size, head = os.fstat(fh.fileno()).st_size, fh.read(24)
-                    total += size
-                    if total > MAX_MJCF_TOTAL_BYTES:
-                        raise FkoptError(f"{where}: the files it names hold more than {MAX_MJCF_TOTAL_BYTES >> 20} MB "
-                                         "together, the most accepted")
+                    head = counted(open_input(candidate, MAX_MJCF_ASSET_BYTES, what, within=folder), what)
                     if head[:8] == b"\x89PNG\r\n\x1a\n" and len(head) == 24:
                         width, height = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
                         if width * height > MAX_PNG_PIXELS:
