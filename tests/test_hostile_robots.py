@@ -220,6 +220,19 @@ def test_break4_a_fifo_beside_an_included_file_is_refused_too(tmp_path):
     assert status != 0 and "FkoptError:" in err and "FIFO" in err and "b.xml" in err, err
 
 
+def test_break4_a_model_asset_is_checked_like_an_include(tmp_path):
+    """``<asset><model file>`` is an MJCF MuJoCo parses in turn: its nesting and the files it names
+    get the top file's checks."""
+    pytest.importorskip("mujoco")
+    from fkopt.files import MAX_XML_DEPTH
+    deep = "<default>" * MAX_XML_DEPTH + "</default>" * MAX_XML_DEPTH
+    (tmp_path / "gripper.xml").write_text(f"<mujoco>{deep}</mujoco>")
+    path = mjcf(tmp_path, head='<asset><model name="g" file="gripper.xml"/></asset>')
+    refused(path, "gripper.xml", f"deeper than {MAX_XML_DEPTH}")
+    (tmp_path / "gripper.xml").write_text('<mujoco><asset><mesh name="m" file="/etc/passwd"/></asset></mujoco>')
+    refused(path, "/etc/passwd", "only files inside")
+
+
 @pytest.mark.parametrize("head", [
     '<include file="/etc/passwd"/>',
     '<include file="../outside.xml"/>',

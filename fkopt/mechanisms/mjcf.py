@@ -115,11 +115,11 @@ def check_mjcf_files(path: Path) -> None:
         root = parse_xml(read_input(f, MAX_MJCF_BYTES, field=field, within=None if what is None else folder),
                          f"mjcf {f}")
         docs.append((root, key.parent))
-        for inc in root.iter("include"):
+        for inc in root.iter():
             name = inc.get("file")
-            if name is None:
+            if inc.tag not in _XML_FILES or name is None:
                 continue
-            label = f"{where}: <include file='{short_token(name)}'>"
+            label = f"{where}: <{inc.tag} file='{short_token(name)}'>"
             for candidate in dict.fromkeys((_inside(folder, name, label), _inside(key.parent, name, label))):
                 if candidate.exists() or candidate.is_symlink():
                     queue.append((candidate, label))
@@ -139,7 +139,7 @@ def check_mjcf_files(path: Path) -> None:
     dirs = list(dict.fromkeys(dirs))
     for root, _ in docs:
         for e in root.iter():
-            if e.tag == "include":
+            if e.tag in _XML_FILES:
                 continue
             for attr, value in e.attrib.items():
                 # a numeric attribute holding NaN or inf: refused here, as URDF's reader refuses it
@@ -163,6 +163,9 @@ def check_mjcf_files(path: Path) -> None:
                                              "pixels are accepted")
 
 
+#: Elements naming an MJCF file MuJoCo parses in turn: ``<include>`` and ``<asset><model>``
+#: (a model to ``<attach>``); each is checked like the top file, and so are the files it names.
+_XML_FILES = ("include", "model")
 #: Attributes that name things (never numbers), left out of the NaN/inf check.
 _NAME_ATTRS = ("name", "class", "childclass", "prefix")
 
