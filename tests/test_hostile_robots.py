@@ -94,13 +94,19 @@ def test_an_own_urdf_read_as_it_stands_must_hold_no_expression(tmp_path):
     """The one route that still hands a file as it stands to rtb (``ArmURDF.from_file``, for
     example-robot-data's files in ``fkopt bench``) proves first that nothing in it is evaluated."""
     from fkopt.adapters.field import ArmURDF
-    for extra in ('<material name="${1+1}"/>', '<material name="$(find x)"/>',
-                  '<xacro:include xmlns:xacro="http://www.ros.org/wiki/xacro" filename="/etc/passwd"/>'):
+    for extra in ('<material name="${1+1}"/>', '<material name="$(find x)"/>', '<material name="&#36;{1}"/>',
+                  '<material name="m"><![CDATA[${1}]]></material>', '<gazebo>$(env HOME)</gazebo>',
+                  '<xacro:include xmlns:xacro="http://www.ros.org/wiki/xacro" filename="/etc/passwd"/>',
+                  '<material xmlns:xacro="u" xacro:if="1" name="m"/>'):
         path = tmp_path / "x.urdf"
         path.write_text(two_joint_urdf(extra))
         with pytest.raises(FkoptError) as err:
             ArmURDF.from_file(path, "l0", "l2")
         assert str(path) in str(err.value) and "\n" not in str(err.value)
+    # a namespace declaration alone, as most of example-robot-data's files have, passes
+    path.write_text(two_joint_urdf().replace('<robot name="r">',
+                                             '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'))
+    assert ArmURDF.from_file(path, "l0", "l2").text.startswith("<robot")
 
 
 def test_break8_an_arm_with_a_joint_named_like_a_written_fixed_joint(tmp_path):
