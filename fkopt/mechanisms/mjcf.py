@@ -1,5 +1,11 @@
 """Serial arms read from MJCF (MuJoCo) files: ``fkopt.mechanism("mjcf", file="arm.xml", base="link0", tip="tool")``.
 
+Before MuJoCo opens anything, fkopt checks the file and every file it names
+(:func:`check_mjcf_files`: includes and assets inside the file's folder, regular files, size
+caps, bounded nesting, no NaN or inf); afterwards every number it takes from the compiled model
+meets URDF's rule (:func:`fkopt.mechanisms.urdf.check_numbers`) and a range with lower > upper
+is refused as URDF refuses it (docs/reliability.md section 10).
+
 The file is compiled by the ``mujoco`` package's own compiler (``MjModel.from_xml_path``), so
 everything MJCF defines -- ``<default>`` classes, ``<include>``, ``euler``/``axisangle``/``xyaxes``
 orientations, ``angle="degree"``, ``ref``, ``autolimits`` -- means what MuJoCo says it means;
