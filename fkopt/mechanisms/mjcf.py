@@ -46,9 +46,9 @@ from types import SimpleNamespace
 import numpy as np
 from pydantic import Field
 
-from ..errors import FkoptError, did_you_mean
-from ..files import check_geometry_file, short_token
-from .urdf import URDFArm, URDFGeometry, check_numbers
+from fkopt.errors import FkoptError, did_you_mean
+from fkopt.files import check_geometry_file, short_token
+from fkopt.mechanisms.urdf import URDFArm, URDFGeometry, check_numbers
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.xml"
 #: Largest MJCF file compiled (bytes), as for URDF: kinematic descriptions are kilobytes.
@@ -90,7 +90,7 @@ def check_mjcf_files(path: Path) -> None:
     beside the top file and beside the file naming it, joined to the compiler's folders or not
     (``strippath``: the name without its folder), so every such candidate that exists is
     checked. One line naming the file."""
-    from ..files import check_within, open_input, parse_xml, read_input
+    from fkopt.files import check_within, open_input, parse_xml, read_input
     folder = path.resolve().parent
     where = f"mjcf {path}"
     total, count = 0, 0
