@@ -397,7 +397,7 @@ def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "pytracik", None)          # import pytracik -> ImportError
     with pytest.raises(FkoptError, match=r"field solver 'tracik' needs pytracik \(pip install -e \"\.\[field\]\"\)"):
         make_ik("tracik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
-    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: tracik, rtb-ik_LM"):
+    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: fkopt.inverse, tracik, rtb-ik_LM"):
         make_ik("trac-ik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
 
 
