@@ -490,5 +490,5 @@ def write(root: Path = Path(".")) -> list[Path]:
 
 if __name__ == "__main__":
     import fkopt.kinbench  # noqa: F401  (the script's entry: registers every built-in kind)
-    for p in write(Path(__file__).resolve().parent.parent):
+    for p in write(Path(__file__).resolve().parents[2]):
         print(p)
