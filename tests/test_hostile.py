@@ -890,7 +890,13 @@ def _interrupt(tmp_path, prev, slow, command, how):
     p = subprocess.Popen([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q",
                           "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True, env=env)
-    time.sleep(3.0)                  # imports and validation take about a second; then it computes
+    # interrupt once it computes: its lock file (OUT/<paper>/.<name>.lock) appears after imports and
+    # validation (about a second on an idle machine, far longer on a loaded one), then half a second
+    lock = out / slow["paper"] / f".{slow['name']}.lock"
+    deadline = time.monotonic() + 240
+    while not lock.exists() and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)
     assert p.poll() is None, "the rerun finished before it could be interrupted; make SLOW slower"
     os.killpg(p.pid, how)
     _, err = p.communicate(timeout=60)
