@@ -693,14 +693,24 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
 
 @app.command()
 def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="folder of experiment files"),
-              out: Path = typer.Option(Path("results"), "--out", help="results root"),
+              out: Path = typer.Option(DEFAULT_OUT / "reproduce", "--out", help="results root written (default: a "
+                                       "git-ignored folder of its own; --out results rewrites the stored "
+                                       "results, as make reproduce does)"),
+              stored: Path = typer.Option(Path("results"), "--compare-with", help="the stored results the new "
+                                          "files are compared with (the closing line and OUT/CHANGES.md)"),
               jobs: Optional[int] = typer.Option(None, "--jobs", "-j", help="worker processes for the "
                                                  "experiments' solves (default: the CPUs available; "
                                                  "1: all in this process); timings are measured "
                                                  "afterwards, one at a time"),
               quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress bars and no "
                                          "closing table; errors are still printed")):
-    """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
+    """Run every experiment under CONFIGS into OUT (REPORT.md, TIMING.md, index.csv, CHANGES.md) and
+    compare them with the stored results.
+
+    By default OUT is fkopt-results/reproduce/ (git-ignored), so the tracked results/ stay as
+    they are; the last line says how many deterministic files moved from the stored ones and
+    whether fkopt check's cross-platform rules accept them. --out results rewrites the stored
+    results (make reproduce)."""
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
@@ -714,7 +724,11 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     from .reproduce.changes import agreement
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
     kept = tempfile.TemporaryDirectory(prefix="fkopt-reproduce-")   # the old files, to judge what moved
-    before = snapshot(out, keep=Path(kept.name))    # what the tree held, for CHANGES.md
+    in_place = out.resolve() == stored.resolve()
+    # what the stored tree held, for CHANGES.md and the closing line: in place, the whole tree;
+    # into a folder of its own, the stored results of the configs rerun (nothing else is compared)
+    before = snapshot(stored, keep=Path(kept.name),
+                      only=None if in_place else {"/".join(p.config.folder_parts) for p in planned})
     con = _console()
     start = time.perf_counter()
     heart = _Heartbeat(con, quiet=quiet)
@@ -772,6 +786,9 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
     con.print(agreement(before, out, written.after), highlight=False, markup=False)   # even with -q: what a newcomer must know
+    if not in_place:
+        con.print(f"reproduce: wrote {out}/ (REPORT.md, CHANGES.md); the stored {stored}/ is unchanged "
+                  f"(fkopt reproduce --out {stored} rewrites it)", highlight=False, markup=False)
     kept.cleanup()
 
 
