@@ -278,9 +278,35 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
                scheduler=scheduler, resume=resume, force=force, quiet=quiet)
 
 
+#: What Ctrl-C ends and how to continue it: set while a config runs, printed by :func:`main`.
+_INTERRUPTED = {"hint": None}
+
+
+def resume_hint(command: str, path, config, out: Path, quick: bool = False) -> str:
+    """The command that continues an interrupted run of ``config``, as it works: studies and
+    suites keep their finished tasks (``.<name>.partial``) and the command the user ran, with
+    ``--resume``, reuses them; an experiment or assembly search keeps none and starts again."""
+    kind = getattr(config, "kind", None) or "experiment"
+    where = "" if out == DEFAULT_OUT else f" --out {out}"
+    if kind in ("study", "suite"):
+        again = f"fkopt {command} {path}{' --quick' if quick else ''}{where} --resume"
+        return f"the finished tasks of this {kind} are kept: {again} continues"
+    return f"an {kind} keeps no finished tasks: fkopt {command} {path}{where} starts it again"
+
+
 def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
-               force: bool, quiet: bool) -> None:
-    """Validate every (path, config) and check every output folder, then run them in order."""
+               force: bool, quiet: bool, command: str = "run", quick: bool = False) -> None:
+    """Validate every (path, config) and check every output folder, then run them in order.
+    Interrupted or failed, it leaves no folder it created empty (``OUT/<paper>/``)."""
+    from .files import no_empty_folders_left
+    folders = [out, *{out / config.folder_parts[0] for _, config in files}]
+    with no_empty_folders_left(folders):
+        _run_checked(files, out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, force=force,
+                     quiet=quiet, command=command, quick=quick)
+
+
+def _run_checked(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
+                 force: bool, quiet: bool, command: str, quick: bool) -> None:
     from .experiment.executors import validate_executor
     from .experiment.kinds import plan_config, prepare_output, run_config
     validate_executor(executor, jobs, scheduler)
@@ -298,9 +324,11 @@ def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | N
         planned.append((path, config, plan, tasks))
     con = _console()
     for path, config, plan, tasks in planned:
+        _INTERRUPTED["hint"] = resume_hint(command, path, config, out, quick)
         with _progress(con, config.name, tasks, quiet) as progress:
             outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True,
                                  jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, plan=plan)
+        _INTERRUPTED["hint"] = None
         if not quiet:
             _print_outcome(con, outcome, tasks)
 
@@ -421,7 +449,7 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
     if getattr(cfg, "kind", None) != "study":
         raise FkoptError(f"{config}: not a study file (kind: study); run it with: fkopt run {config}")
     _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler,
-               resume=resume, force=force, quiet=quiet)
+               resume=resume, force=force, quiet=quiet, command="study")
 
 
 @app.command()
@@ -444,7 +472,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
     if quick:
         cfg = cfg.quick_tier(str(config))
     _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,
-               force=force, quiet=quiet)
+               force=force, quiet=quiet, command="suite", quick=quick)
 
 
 SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",
@@ -897,8 +925,9 @@ _reflowed_help()
 
 def main() -> None:
     """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
-    interrupted = ("fkopt: interrupted (previous results are kept; the finished tasks of a "
-                   "study are kept too: fkopt study CONFIG --resume continues)")
+    def interrupted() -> str:
+        hint = _INTERRUPTED["hint"]
+        return "fkopt: interrupted (previous results are kept" + (f"; {hint})" if hint else ")")
 
     def fail(message: str) -> None:
         from .files import one_line
@@ -912,7 +941,7 @@ def main() -> None:
     except FkoptError as err:
         fail(str(err))
     except KeyboardInterrupt:
-        print(interrupted, file=sys.stderr)
+        print(interrupted(), file=sys.stderr)
         sys.exit(130)
     except MemoryError:
         fail("out of memory; reduce runs, population, iterations or cases")
@@ -928,13 +957,13 @@ def main() -> None:
         if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
             fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
         if kind == "Abort":
-            print("fkopt: interrupted", file=sys.stderr)
+            print(interrupted(), file=sys.stderr)
             sys.exit(130)
         if callable(getattr(err, "format_message", None)):
             fail(f"{err.format_message()} (see fkopt --help)")
         raise
     if code == 130:   # typer (>= 0.12) turns Ctrl-C into a returned 130 when not standalone
-        print(interrupted, file=sys.stderr)
+        print(interrupted(), file=sys.stderr)
         sys.exit(130)
     if isinstance(code, int) and code:
         sys.exit(code)

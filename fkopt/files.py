@@ -510,6 +510,23 @@ def output_folder(out: str | Path, *parts: str, option: str = "--out") -> Path:
     return target
 
 
+@contextlib.contextmanager
+def no_empty_folders_left(folders):
+    """Run the block; if it fails (an error, Ctrl-C), remove those of ``folders`` that did not
+    exist before it and are empty after it (deepest first): an interrupted fresh run leaves no
+    empty ``OUT/<paper>/`` behind. A folder holding anything is never touched."""
+    fresh = sorted({Path(f) for f in folders if not Path(f).exists()}, key=lambda p: -len(p.parts))
+    try:
+        yield
+    except BaseException:
+        for folder in fresh:
+            try:
+                folder.rmdir()            # only an empty folder: rmdir refuses anything else
+            except OSError:
+                pass
+        raise
+
+
 # -- atomic writes ---------------------------------------------------------------------------------
 _RENAME_EXCHANGE = 2
 _AT_FDCWD = -100

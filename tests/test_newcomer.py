@@ -1,0 +1,100 @@
+"""A newcomer's first hour on a fresh clone (issue 41): the first command leaves `git status`
+clean, `fkopt ik` takes the rotations URDF users write, Ctrl-C names the command that resumes,
+`fkopt list` fits a screen, mistakes get a "did you mean"."""
+import hashlib
+from pathlib import Path
+
+import yaml
+
+
+def _tree(root: Path) -> dict[str, str]:
+    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_reproduce_writes_a_folder_of_its_own_and_compares_with_the_stored_results(tmp_path, monkeypatch, cli):
+    """Without --out, `fkopt reproduce` writes fkopt-results/reproduce/ (git-ignored) and leaves
+    the stored results/ byte for byte; its last lines compare the two and name the command that
+    rewrites results/."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "configs" / "mini").mkdir(parents=True)
+    (tmp_path / "configs" / "mini" / "a.yaml").write_text(yaml.safe_dump(
+        {"paper": "mini", "name": "a", "mechanism": {"name": "3-rps"}, "iterations": 20, "runs": 2, "seed": 4,
+         "cases": [{"pose": {"alpha": 5, "beta": 3, "z": 600}}], "algorithms": [{"name": "gabc"}]}))
+    code, out, err = cli("reproduce", "--out", "results", "--jobs", "1", "-q")     # make reproduce
+    assert code == 0, err
+    stored = _tree(tmp_path / "results")
+    assert "mini/a/summary.csv" in stored
+    code, out, err = cli("reproduce", "--jobs", "1", "-q")
+    assert code == 0, err
+    assert _tree(tmp_path / "results") == stored                       # the tracked results untouched
+    mine = tmp_path / "fkopt-results" / "reproduce"
+    assert (mine / "mini" / "a" / "summary.csv").read_bytes() == (tmp_path / "results/mini/a/summary.csv").read_bytes()
+    assert (mine / "REPORT.md").is_file() and (mine / "CHANGES.md").is_file()
+    assert "every deterministic file is byte-identical to the stored one" in out
+    assert "--out results rewrites it" in out
+
+
+def test_gitignore_covers_what_readmes_first_command_writes():
+    root = Path(__file__).resolve().parent.parent
+    ignored = (root / ".gitignore").read_text().splitlines()
+    assert "/fkopt-results/" in ignored
+    from fkopt.cli import DEFAULT_OUT
+    assert Path("fkopt-results/reproduce").parts[0] == DEFAULT_OUT.name
+
+
+def _interrupted(tmp_path, command, config, *extra):
+    """Run `fkopt COMMAND c.yaml --out OUT -q EXTRA` in its own process group, send it a real
+    SIGINT once it computes, and return (exit status, stderr, OUT)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(Path(__file__).resolve().parents[1]),
+                                                                         os.environ.get("PYTHONPATH")]))}
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml.safe_dump(config))
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q", *extra],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True, env=env)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and p.poll() is None and not list(out.glob("*/.*.lock")):
+        time.sleep(0.05)                 # until it computes (it holds OUT/<paper>/.<name>.lock)
+    time.sleep(0.5)
+    assert p.poll() is None, "the run finished before it could be interrupted; make it slower"
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    return p.returncode, err, cfg, out
+
+
+def test_ctrl_c_of_a_fresh_experiment_names_a_rerun_and_leaves_no_empty_folder(tmp_path):
+    code, err, cfg, out = _interrupted(tmp_path, "run", {
+        "name": "slow", "paper": "mine", "mechanism": {"name": "3-rps"}, "seed": 1,
+        "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}], "algorithms": [{"name": "abc"}, {"name": "pso"}],
+        "population": 40, "iterations": 3000, "runs": 60})
+    assert code == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err[-500:]
+    assert f"an experiment keeps no finished tasks: fkopt run {cfg} --out {out} starts it again" in err
+    assert "--resume" not in err
+    assert not (out / "mine").exists()          # no empty OUT/<paper>/ left behind
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_ctrl_c_of_a_study_names_the_command_that_resumes_it(tmp_path):
+    code, err, cfg, out = _interrupted(tmp_path, "study", {
+        "kind": "study", "name": "slow", "mechanism": {"name": "3-rps"}, "poses": {"uniform": 400, "seed": 1},
+        "algorithms": [{"name": "gabc"}], "population": 20, "iterations": 400, "runs": 5, "seed": 1, "chunk": 40})
+    assert code == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err[-500:]
+    assert f"the finished tasks of this study are kept: fkopt study {cfg} --out {out} --resume continues" in err
+    assert (out / "studies" / ".slow.partial").is_dir()      # what --resume reuses
+
+
+def test_resume_hint_names_the_suite_command_with_its_tier():
+    from types import SimpleNamespace
+
+    from fkopt.cli import DEFAULT_OUT, resume_hint
+    suite = SimpleNamespace(kind="suite")
+    assert resume_hint("suite", "s.yaml", suite, DEFAULT_OUT, quick=True) == \
+        "the finished tasks of this suite are kept: fkopt suite s.yaml --quick --resume continues"
+    assert resume_hint("run", "a.yaml", SimpleNamespace(kind="assembly"), Path("o")) == \
+        "an assembly keeps no finished tasks: fkopt run a.yaml --out o starts it again"
