@@ -518,9 +518,69 @@ def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
     raise typer.Exit(1)
 
 
+#: The rotations ``fkopt ik`` takes for a serial arm's target, by name (degrees; a quaternion unitless).
+ARM_ROTATIONS = {
+    ("alpha", "beta", "gamma"): "Z-Y-Z Euler angles, R = Rz(alpha) Ry(beta) Rz(gamma) (fkopt fk prints these)",
+    ("roll", "pitch", "yaw"): "R = Rz(yaw) Ry(pitch) Rx(roll), as URDF composes rpy",
+    ("qw", "qx", "qy", "qz"): "a unit quaternion (normalised)",
+}
+
+
+def _rotation_counts(mask: Optional[str]) -> bool:
+    """Whether the orientation is part of the task (--mask names rx, ry or rz, or no --mask)."""
+    return mask is None or any(part.strip() in ("rx", "ry", "rz") for part in mask.split(","))
+
+
+def arm_target(m, given: dict[str, float], rotation: bool) -> np.ndarray:
+    """The tip frame (4, 4) of a serial arm's ``--pose``: x, y, z and one rotation of
+    :data:`ARM_ROTATIONS` by name (none when ``rotation`` is False: the identity, which no
+    error then counts). Every refusal is one line naming what is allowed."""
+    from . import rotations
+    names = set(given)
+    allowed = ["x", "y", "z", *(n for group in ARM_ROTATIONS for n in group)]
+    unknown = sorted(names - set(allowed))
+    if unknown:
+        from .files import did_you_mean
+        raise FkoptError(f"--pose: unknown name '{unknown[0]}'{did_you_mean(unknown[0], allowed)}; {m.name} takes "
+                         "x, y, z and one rotation: " + "; ".join(", ".join(g) for g in ARM_ROTATIONS))
+    missing = [n for n in ("x", "y", "z") if n not in names]
+    if missing:
+        raise FkoptError(f"--pose: missing {', '.join(missing)} (the tip position, {m.pose_units[0]})")
+    groups = [g for g in ARM_ROTATIONS if names & set(g)]
+    if len(groups) > 1:
+        raise FkoptError("--pose: give one rotation, not " + " and ".join("/".join(g) for g in groups))
+    if not groups and rotation:
+        raise FkoptError("--pose: missing the rotation: " + "; or ".join(", ".join(g) for g in ARM_ROTATIONS)
+                         + " (or --mask x,y,z for the position only)")
+    T = np.eye(4)
+    T[:3, 3] = [given["x"], given["y"], given["z"]]
+    if groups:
+        group = groups[0]
+        absent = [n for n in group if n not in names]
+        if absent:
+            raise FkoptError(f"--pose: {', '.join(group)} go together; missing {', '.join(absent)}")
+        v = [given[n] for n in group]
+        if group[0] == "qw":
+            if not math.isclose(math.sqrt(sum(c * c for c in v)), 1.0, abs_tol=1e-3):
+                raise FkoptError(f"--pose: qw, qx, qy, qz must be a unit quaternion (norm 1 within 1e-3), "
+                                 f"got norm {math.sqrt(sum(c * c for c in v)):.6g}")
+            R = rotations.quaternion_matrix(*v)
+        elif group[0] == "roll":
+            R = rotations.zyx(*np.radians(v))
+        else:
+            R = rotations.zyz(*np.radians(v))
+        T[:3, :3] = rotations.to_array(R)
+    return T
+
+
 @app.command()
 def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
-       pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
+       pose: str = typer.Option(..., "--pose", help="parallel mechanism: its pose names (fkopt list MECH), e.g. "
+                                "alpha=9,beta=13,z=622. Serial arm: x, y, z (its length unit) and one rotation "
+                                "in degrees: alpha, beta, gamma (Z-Y-Z Euler, R = Rz(alpha) Ry(beta) Rz(gamma), "
+                                "as fkopt fk prints), or roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll), as "
+                                "URDF composes rpy), or qw, qx, qy, qz (a unit quaternion); no rotation with "
+                                "--mask x,y,z"),
        geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
                                                "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered swarm/local solver for "
@@ -541,7 +601,14 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     Exit 1 (one line on stderr) when the answer is not a solution within the tolerances; exit 2
     for bad input (non-finite values, a pose outside the workspace or beyond the arm's reach)."""
     m = _mechanism(mech, geometry)
-    values = m.as_values(parse_assignments(pose, "--pose"), m.pose_names, "--pose")
+    given = parse_assignments(pose, "--pose")
+    serial_frame = m.kind != "parallel" and tuple(m.pose_names[3:]) == ("alpha", "beta", "gamma")
+    rotation = _rotation_counts(mask)
+    if serial_frame:
+        target = arm_target(m, given, rotation)
+        values = m.as_values(np.concatenate([target[:3, 3], [0.0, 0.0, 0.0]]), m.pose_names, "--pose")
+    else:
+        values = m.as_values(given, m.pose_names, "--pose")
     if m.kind == "parallel":
         if algorithm:
             raise FkoptError(f"--algorithm: '{mech}' has a closed-form inverse map; no solver is used")
@@ -560,6 +627,10 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
     if algorithm:
         from .by_algorithm import inverse_by
+        if serial_frame:       # the swarms' objective takes Z-Y-Z angles: the target's, exactly as given
+            from .rotations import zyz_angles
+            R = target[:3, :3]
+            values = np.concatenate([target[:3, 3], np.degrees(zyz_angles(tuple(tuple(r) for r in R)))])
         out = inverse_by(m, values, algorithm, tol=(position_tol, orientation_tol), seed=seed).as_dict()
         out.pop("restarts")
         out["objective"] = "geodesic"
@@ -570,16 +641,19 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
         # One pose per process: loading numba and its cache (~0.7 s) costs more than the compiled
         # loop saves, so the command keeps the reference path (fkopt.numerics.path).
-        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed, start=q0, mask=mask,
-                    compiled=False)
+        r = inverse(m, target if serial_frame else values, tol=(position_tol, orientation_tol), seed=seed,
+                    start=q0, mask=mask, compiled=False)
         out = r.as_dict()
         out["algorithm"] = "inverse"
         perr, rerr = out["position_error"], out["rotation_error_rad"]
     unit = m.pose_units[0]
+    if not rotation:            # --mask without rx, ry, rz: no rotation was sought, so none is reported
+        out.pop("rotation_error_rad", None)
     if not out["solved"]:
-        _not_solved(f"no joints within the limits reach this pose: best position error {perr:.3g} {unit}, "
-                    f"orientation error {rerr:.3g} rad (tolerances {position_tol:g} {unit}, "
-                    f"{orientation_tol:g} rad)", out, as_json, m.joint_units)
+        turn = f", orientation error {rerr:.3g} rad" if rotation else ""
+        tols = f"{position_tol:g} {unit}" + (f", {orientation_tol:g} rad" if rotation else "")
+        _not_solved(f"no joints within the limits reach this pose: best position error {perr:.3g} {unit}"
+                    f"{turn} (tolerance{'s' if rotation else ''} {tols})", out, as_json, m.joint_units)
     _emit(out, as_json, m.joint_units,
           notes={"position_error": f"{unit} (residual: tool position |fk(q) - target|)",
                  "rotation_error_rad": "rad (residual: geodesic orientation error)"})

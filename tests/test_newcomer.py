@@ -98,3 +98,76 @@ def test_resume_hint_names_the_suite_command_with_its_tier():
         "the finished tasks of this suite are kept: fkopt suite s.yaml --quick --resume continues"
     assert resume_hint("run", "a.yaml", SimpleNamespace(kind="assembly"), Path("o")) == \
         "an assembly keeps no finished tasks: fkopt run a.yaml --out o starts it again"
+
+
+def _frame(arm, q):
+    import numpy as np
+    return np.asarray(arm.fk_matrix(np.asarray(q, dtype=float))).reshape(4, 4)
+
+
+def test_ik_on_an_arm_takes_roll_pitch_yaw_a_quaternion_or_zyz_angles(cli):
+    """The same tip frame given three ways (roll/pitch/yaw and the quaternion by scipy, the Z-Y-Z
+    angles by fkopt fk) is reached each time: fk of each answer is that frame."""
+    import json
+
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    import fkopt
+    arm = fkopt.mechanism("urdf")                     # wang7dof's arm as URDF (metres)
+    T = _frame(arm, [10, 20, 30, 40, 50, 60, 70])
+    xyz = dict(zip("xyz", T[:3, 3].tolist()))
+    r = Rotation.from_matrix(T[:3, :3])
+    yaw, pitch, roll = r.as_euler("ZYX", degrees=True).tolist()     # intrinsic Z-Y-X: Rz(yaw) Ry(pitch) Rx(roll)
+    qx, qy, qz, qw = r.as_quat().tolist()
+    code, out, err = cli("fk", "urdf", "--joints", ",".join(f"q{i + 1}={v}" for i, v in
+                                                             enumerate([10, 20, 30, 40, 50, 60, 70])), "--json")
+    assert code == 0, err
+    zyz = {k: v for k, v in json.loads(out)["pose"].items() if k in ("alpha", "beta", "gamma")}
+    for rotation in ({"roll": roll, "pitch": pitch, "yaw": yaw}, {"qw": qw, "qx": qx, "qy": qy, "qz": qz}, zyz):
+        pose = ",".join(f"{k}={v!r}" for k, v in {**xyz, **rotation}.items())
+        code, out, err = cli("ik", "urdf", "--pose", pose, "--json")
+        assert code == 0, (rotation, err)
+        answer = json.loads(out)
+        got = _frame(arm, list(answer["joints"].values()))
+        assert np.abs(got[:3, 3] - T[:3, 3]).max() < 1e-6
+        assert Rotation.from_matrix(got[:3, :3].T @ T[:3, :3]).magnitude() < 1e-6
+        assert answer["solved"] and answer["rotation_error_rad"] < 1e-6
+
+
+def test_ik_help_states_each_rotation(cli):
+    code, out, _ = cli("ik", "--help")
+    text = " ".join(out.replace("│", " ").split())
+    for words in ("roll, pitch, yaw", "R = Rz(yaw) Ry(pitch) Rx(roll)", "qw, qx, qy, qz", "alpha, beta, gamma",
+                  "Z-Y-Z"):
+        assert words in text, words
+
+
+def test_ik_with_a_position_mask_needs_no_angles_and_reports_no_rotation_error(cli):
+    import json
+
+    import numpy as np
+
+    import fkopt
+    arm = fkopt.mechanism("urdf")
+    T = _frame(arm, [10, 20, 30, 40, 50, 60, 70])
+    pose = ",".join(f"{k}={v!r}" for k, v in zip("xyz", T[:3, 3].tolist()))
+    code, out, err = cli("ik", "urdf", "--pose", pose, "--mask", "x,y,z", "--json")
+    assert code == 0, err
+    answer = json.loads(out)
+    assert "rotation_error_rad" not in answer and answer["solved"]
+    assert np.abs(_frame(arm, list(answer["joints"].values()))[:3, 3] - T[:3, 3]).max() < 1e-6
+    code, out, err = cli("ik", "urdf", "--pose", pose, "--mask", "x,y,z")
+    assert code == 0 and "rotation_error" not in out
+    code, out, err = cli("ik", "urdf", "--pose", pose)          # the rotation counts: it is asked for
+    assert code == 2 and "missing the rotation" in err and "--mask x,y,z" in err
+
+
+def test_ik_rotation_mistakes_are_one_line(cli):
+    base = "x=0.1,y=0.2,z=0.3"
+    for extra, words in ((",roll=1,alpha=2,beta=0,gamma=0", "give one rotation"),
+                         (",rol=1,pitch=2,yaw=3", "did you mean 'roll'?"),
+                         (",roll=1", "missing pitch, yaw"),
+                         (",qw=0.5,qx=0,qy=0,qz=0", "unit quaternion")):
+        code, out, err = cli("ik", "urdf", "--pose", base + extra)
+        assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (extra, err)
