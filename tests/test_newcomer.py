@@ -171,3 +171,45 @@ def test_ik_rotation_mistakes_are_one_line(cli):
                          (",qw=0.5,qx=0,qy=0,qz=0", "unit quaternion")):
         code, out, err = cli("ik", "urdf", "--pose", base + extra)
         assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (extra, err)
+
+
+def _config(tmp_path, text):
+    path = tmp_path / "c.yaml"
+    path.write_text("name: c\nmechanism: {name: 3-rps}\ncases:\n  - pose: {alpha: 9, beta: 13, z: 622}\n" + text)
+    return path
+
+
+def test_misspelt_algorithm_and_parameter_names_get_a_did_you_mean(tmp_path, cli):
+    code, _, err = cli("run", _config(tmp_path, "algorithms: [{name: gabcc}]\n"), "--out", tmp_path / "o")
+    assert code == 2 and "unknown algorithm 'gabcc' (did you mean 'gabc'?)" in err
+    code, _, err = cli("run", _config(tmp_path, "algorithms: [{name: gabc, params: {limt: 3}}]\n"),
+                       "--out", tmp_path / "o")
+    assert code == 2 and "parameter 'limt': unknown parameter (did you mean 'limit'?)" in err
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+
+
+def test_error_paths_are_written_one_way(tmp_path, cli):
+    """A pydantic field path and fkopt's own checks both write list items as [i]."""
+    path = tmp_path / "c.yaml"
+    path.write_text("name: c\nmechanism: {name: 3-rps}\ncases:\n  - poze: {alpha: 9, beta: 13, z: 622}\n"
+                    "algorithms: [{name: gabc}]\n")
+    code, _, err = cli("run", path, "--out", tmp_path / "o")
+    assert code == 2 and "cases[0].poze: unknown field (did you mean 'pose'?)" in err, err
+    path.write_text("name: c\nmechanism: {name: 3-rps}\ncases:\n  - pose: {alpha: 9, beta: 13, zz: 622}\n"
+                    "algorithms: [{name: gabc}]\n")
+    code, _, err = cli("run", path, "--out", tmp_path / "o")
+    assert code == 2 and "cases[0].pose: unknown variable 'zz' (did you mean 'z'?)" in err, err
+
+
+def test_a_quoted_number_is_refused_with_one_line_and_1e_minus_10_is_a_number(tmp_path, cli):
+    for text, words in (('iterations: "300"\n', "iterations: needs a number, got the text '300' (write it "
+                                                "without quotes)"),
+                        ("algorithms: [{name: gabc, params: {limit: '3'}}]\n", "parameter 'limit': needs a number"),
+                        ('threshold: "nan"\n', "threshold: needs a number (finite)")):
+        body = text if text.startswith("algorithms") else "algorithms: [{name: gabc}]\n" + text
+        code, _, err = cli("run", _config(tmp_path, body), "--out", tmp_path / "o")
+        assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (text, err)
+    path = tmp_path / "c.yaml"
+    path.write_text(path.read_text().replace('threshold: "nan"', "threshold: 1e-10\niterations: 3\nruns: 2"))
+    from fkopt.experiment.config import load_config
+    assert load_config(path).threshold == 1e-10                  # YAML 1.2's float without a dot

@@ -35,7 +35,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
 
 from ..errors import FkoptError
-from ..files import MAX_COMPONENT, check_component, error_line, load_mapping
+from ..files import MAX_COMPONENT, check_component, error_line, load_mapping, no_quoted_numbers
 
 #: Documented upper limits (docs/cli.md, "Bad input"); a memory estimate refuses smaller jobs that
 #: still cannot fit (:func:`fkopt.experiment.kinds.check_memory`).
@@ -52,8 +52,9 @@ def Seed(default: int = 0):
 
 
 class Strict(BaseModel):
-    #: Unknown fields are errors; NaN and inf are never accepted as numbers.
+    #: Unknown fields are errors; NaN and inf are never accepted as numbers, nor text as a number.
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    _numbers = field_validator("*", mode="before")(no_quoted_numbers)
 
 
 def safe_component(value, field: str):

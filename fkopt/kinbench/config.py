@@ -286,7 +286,7 @@ class SuiteConfig(Located):
             try:                                                       # its fields first, then the draws
                 checked = SuiteProblem(**p).model_dump(mode="json")
             except ValidationError as err:
-                raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
+                raise ValueError(f"problems[{i}].{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
             from .instances import expand
