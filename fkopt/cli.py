@@ -129,8 +129,12 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
                                                      "overrides (for urdf also the .urdf file itself)"),
              as_json: bool = typer.Option(False, "--json", help="print one JSON object instead of "
                                           "tables: {mechanisms, algorithms, origins}, or with MECH its "
-                                          "geometry, bounds, units and names")):
-    """List the mechanisms and algorithms fkopt knows, and where each comes from."""
+                                          "geometry, bounds, units and names"),
+             long: bool = typer.Option(False, "--long", "-l", help="the full tables: each mechanism's pose, "
+                                       "joints and paper, each algorithm's parameters with their defaults, "
+                                       "and where each comes from")):
+    """List the mechanisms and algorithms fkopt knows: their names by kind (--long: pose, joints,
+    parameters and where each comes from)."""
     if mech is not None:
         return _list_mechanism(mech, as_json, geometry)
     if geometry is not None:
@@ -141,6 +145,8 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
                                "origins": {"mechanisms": {e.name: e.origin for e in mechs},
                                            "algorithms": {e.name: e.origin for e in algos}}}))
         return
+    if not long:
+        return _list_names(mechs, algos)
     from rich import box
     from rich.markup import escape
     from rich.table import Table
@@ -178,6 +184,60 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
     con.print(table)
     typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm\n"
                "(see docs/plugins.md).")
+
+
+def _list_names(mechs, algos) -> None:
+    """``fkopt list`` without --long: the names, one line per kind, to fit a screen."""
+    import textwrap
+    groups: dict[str, list[str]] = {}
+    notes = []
+    for e in mechs:
+        try:   # class attributes only: listing builds no mechanism
+            m = registry.mechanism_class(e.name)
+        except FkoptError as err:
+            notes.append(f"{e.name}: {err}")
+            continue
+        label = {"parallel": "parallel (fk)", "serial": "serial (ik)"}.get(m.kind, m.kind)
+        groups.setdefault(label, []).append(e.name + ("*" if m.reconstruction else ""))
+    lines = ["mechanisms (fkopt list MECH: its geometry, bounds, units and names)"]
+    lines += _name_lines(groups)
+    groups = {}
+    for e in algos:
+        if e.origin.startswith("adapter"):
+            library = e.name.partition(":")[0]
+            optional = " (optional)" if "optional" in e.origin else ""
+            groups.setdefault(f"{library}{optional}", []).append(e.name)
+            continue
+        if not e.origin.startswith("built-in"):
+            groups.setdefault("plug-ins", []).append(e.name)
+            continue
+        try:
+            cls = registry.algorithm_class(e.name)
+        except FkoptError as err:
+            notes.append(f"{e.name}: {err}")
+            continue
+        module = cls.__module__.rsplit(".", 1)[-1]
+        kind = ("exact" if module == "exact" else "swarm + local" if "+" in e.name
+                else "local" if getattr(cls, "local", False) else "swarm")
+        groups.setdefault(kind, []).append(e.name)
+    lines += ["algorithms (fkopt list --long: their parameters and defaults)"]
+    lines += _name_lines(groups)
+    lines.append("* a reconstruction: the paper does not print the whole model (docs/models.md). Also any "
+                 "package.module:Class subclassing Mechanism or Algorithm (docs/plugins.md).")
+    lines += [f"error: {n}" for n in notes]
+    width = 80
+    out = []
+    for line in lines:
+        indent = " " * (line.index(":") + 2) if line.startswith("  ") and ":" in line else "  "
+        out += textwrap.wrap(line, width, subsequent_indent=indent, break_on_hyphens=False) or [""]
+    typer.echo("\n".join(out))
+
+
+def _name_lines(groups: dict[str, list[str]]) -> list[str]:
+    if not groups:
+        return []
+    wide = max(len(k) for k in groups) + 1
+    return [f"  {(k + ':').ljust(wide)} " + ", ".join(v) for k, v in groups.items()]
 
 
 def unit_groups(names, units) -> str:
@@ -238,7 +298,8 @@ def _list_mechanism(name: str, as_json: bool, geometry: Optional[Path] = None) -
             chain.add_row(escape(j["name"]), j["type"], *(f"{v:g}" if v != "-" else v for v in lim), j["unit"],
                           escape(j["unknown"]), f"{j['multiplier']:g}", f"{j['offset']:g}")
         con.print(chain)
-    geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)")
+    geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)" if geometry is None
+                else f"geometry: the defaults with the values of {geometry}")
     for col in ("key", "value", "description"):
         geo.add_column(col)
     fields = type(m.geometry).model_fields

@@ -213,3 +213,27 @@ def test_a_quoted_number_is_refused_with_one_line_and_1e_minus_10_is_a_number(tm
     path.write_text(path.read_text().replace('threshold: "nan"', "threshold: 1e-10\niterations: 3\nruns: 2"))
     from fkopt.experiment.config import load_config
     assert load_config(path).threshold == 1e-10                  # YAML 1.2's float without a dot
+
+
+def test_fkopt_list_piped_fits_a_screen_and_long_has_the_detail(cli):
+    import json
+    code, out, _ = cli("list")
+    assert code == 0 and len(out.splitlines()) <= 20
+    names = json.loads(cli("list", "--json")[1])
+    for name in names["mechanisms"] + [n for n in names["algorithms"] if not n.startswith("niapy:")]:
+        assert name in out, name                                # every name, by kind
+    assert "parallel (fk): 3-rps" in out and "local:" in out and "swarm + local:" in out
+    code, detail, _ = cli("list", "--long")
+    assert code == 0 and "C=1.5" in detail and "built-in" in detail   # parameters and origins
+
+
+def test_fkopt_list_urdf_with_a_users_geometry_does_not_call_it_the_default(tmp_path, cli):
+    from fkopt.mechanisms.urdf import DEFAULT_FILE
+    (tmp_path / "arm.urdf").write_text(DEFAULT_FILE.read_text())
+    (tmp_path / "arm.yaml").write_text("file: arm.urdf\ntip: tool\n")
+    code, out, err = cli("list", "urdf", "--geometry", tmp_path / "arm.yaml")
+    assert code == 0, err
+    text = " ".join(out.split())
+    assert "default geometry" not in text and f"the values of {tmp_path / 'arm.yaml'}" in text
+    code, out, _ = cli("list", "urdf")
+    assert "default geometry" in out
