@@ -237,3 +237,31 @@ def test_fkopt_list_urdf_with_a_users_geometry_does_not_call_it_the_default(tmp_
     assert "default geometry" not in text and f"the values of {tmp_path / 'arm.yaml'}" in text
     code, out, _ = cli("list", "urdf")
     assert "default geometry" in out
+
+
+def test_every_count_of_v3_arms_is_the_count_of_the_suite_files():
+    """Suite titles, docs/kinbench.md and README say how many arms, and of which format, the
+    suite files hold (they said 22, 23 and 24 of one suite); the robots board says of how many."""
+    import re
+
+    from fkopt.kinbench.config import load_suite
+    root = Path(__file__).resolve().parent.parent
+    v3 = load_suite(root / "configs/suites/kinbench-v3.yaml")
+    robots = load_suite(root / "configs/suites/kinbench-v3-robots.yaml")
+
+    def arms(suite):
+        kinds = [p.mechanism.name for p in suite.problems]
+        return kinds.count("urdf") + kinds.count("mjcf"), kinds.count("urdf"), kinds.count("mjcf")
+    n, urdf, mjcf = arms(v3)
+    assert f"{n} real arms ({urdf} URDF, {mjcf} MJCF)" in v3.title
+    m, urdf_b, mjcf_b = arms(robots)
+    assert f"{m} of v3's {n} real arms ({urdf_b} URDF, {mjcf_b} MJCF)" in robots.title
+    docs = (root / "docs/kinbench.md").read_text()
+    assert f"| real arms | {n} ({urdf} URDF, {mjcf} MJCF)" in docs
+    assert f"{m}\nof v3's real arms ({urdf_b} URDF, {mjcf_b} MJCF)" in docs or \
+        f"{m} of v3's real arms ({urdf_b} URDF, {mjcf_b} MJCF)" in " ".join(docs.split())
+    readme = " ".join((root / "README.md").read_text().split())
+    assert f"adds {n} real arms" in readme
+    assert "The full tier was not run" not in docs                    # it is stored (README says so)
+    assert not re.findall(r"^#+ .*\(issue \d+", docs, flags=re.M)    # titles say what, not which issue
+    assert "quick tier: 13 of its 92 problems" in v3.quick_tier().title

@@ -435,6 +435,8 @@ class SuiteConfig(Located):
         data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci", subsets=[])
         if q.problems:
             data["problems"] = [p for p in data["problems"] if p["name"] in q.problems]
+        if data.get("title"):     # the suite's title counts the suite's arms, not the tier's
+            data["title"] = f"{data['title']} -- quick tier: {len(data['problems'])} of its {len(self.problems)} problems"
         if q.solvers:
             data["solvers"] = [s for s in data["solvers"] if (s.get("label") or s["name"]) in q.solvers]
         for key in ("sets", "poses", "runs", "budget_per_dim"):
