@@ -265,3 +265,18 @@ def test_every_count_of_v3_arms_is_the_count_of_the_suite_files():
     assert "The full tier was not run" not in docs                    # it is stored (README says so)
     assert not re.findall(r"^#+ .*\(issue \d+", docs, flags=re.M)    # titles say what, not which issue
     assert "quick tier: 13 of its 92 problems" in v3.quick_tier().title
+
+
+def test_ci_runs_readmes_test_command_and_it_uses_both_cores():
+    root = Path(__file__).resolve().parent.parent
+    lines = (root / "README.md").read_text().splitlines()
+    block = lines[lines.index("```bash") + 1:lines.index("```")]
+    command = block[1].split("#")[0].strip()
+    assert command == ".venv/bin/python -m pytest"
+    ci = [line.strip() for line in (root / ".ci" / "run").read_text().splitlines()]
+    assert command in ci                                              # exactly README's command
+    import tomllib
+    project = tomllib.loads((root / "pyproject.toml").read_text())
+    assert "-n 2" in project["tool"]["pytest"]["ini_options"]["addopts"]
+    assert any(d.startswith("pytest-xdist") for d in project["project"]["optional-dependencies"]["test"])
+    assert "chromium-driver" in " ".join(lines)                       # how to run the browser test
