@@ -541,13 +541,33 @@ SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": 
          "mean_evaluations": "mean evals"}
 
 
+def summary_rows(df, cols: list[str]) -> tuple[list[list[str]], list[str]]:
+    """The printed cells of a summary and the notes under it. Many cases (more than 8): one row
+    per algorithm, its success the fraction of all runs (the mean of the cases' rates: every
+    case has the same runs) and the other columns medians over the cases -- a median of the
+    cases' success rates printed 0 beside a median iterations to the threshold of the few cases
+    that reached it. A cell with no value (no run reached the threshold) is "-", not nan."""
+    import pandas as pd
+    notes = []
+    if df["case"].nunique() > 8:   # many cases: one line per algorithm
+        cases = df["case"].nunique()
+        how = {c: ("mean" if c == "success_rate" else "median") for c in cols[2:]}
+        df = df.groupby("algorithm", sort=False).agg(how).reset_index()
+        df.insert(0, "case", f"all {cases} cases")
+        notes.append(f"over all {cases} cases: success is the fraction of all runs, the other columns "
+                     "the median over the cases" + (" (med. it→thr: of the cases some run reached the "
+                                                    "threshold in)" if "median_iterations_to_threshold" in cols else ""))
+    rows = [["-" if isinstance(v, float) and pd.isna(v) else f"{v:.3g}" if isinstance(v, float) else str(v)
+             for v in row[cols]] for _, row in df.iterrows()]
+    if any("-" == cell for row in rows for cell in row[2:]):
+        notes.append("-: no value (no run reached the threshold)")
+    return rows, notes
+
+
 def _print_summary(con, df, folder: Path, wall: float) -> None:
     from rich.table import Table
     cols = [c for c in ("case", "algorithm", *SHORT) if c in df]
-    if df["case"].nunique() > 8:   # many cases: one line per algorithm
-        df = df.groupby("algorithm", sort=False).agg({c: "median" for c in cols[2:]}).reset_index()
-        df.insert(0, "case", "median over cases")
-    rows = [[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]] for _, row in df.iterrows()]
+    rows, notes = summary_rows(df, cols)
     table = Table(title=f"{folder}  ({wall:.2f} s)")
     for j, c in enumerate(cols):
         # values are never cut ("1.54e-…", "succe…"): each column is as wide as its widest value
@@ -557,6 +577,8 @@ def _print_summary(con, df, folder: Path, wall: float) -> None:
     for r in rows:
         table.add_row(*r)
     _print_wide(con, table)
+    for note in notes:
+        con.print(note, markup=False, highlight=False)
 
 
 def _print_wide(con, renderable) -> None:
