@@ -915,6 +915,8 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     before = snapshot(stored, keep=Path(kept.name),
                       only=None if in_place else {"/".join(p.config.folder_parts) for p in planned})
     con = _console()
+    _INTERRUPTED["hint"] = ("the configs finished so far are written; fkopt reproduce"
+                            + ("" if out == DEFAULT_OUT / "reproduce" else f" --out {out}") + " starts again")
     start = time.perf_counter()
     heart = _Heartbeat(con, quiet=quiet)
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
