@@ -321,3 +321,29 @@ def test_time_figures_start_their_axis_at_zero(tmp_path, monkeypatch):
     run_config(load_any(cfg), tmp_path / "out", source=str(cfg))
     times = {k: v for k, v in seen.items() if k.endswith("time")}
     assert times and all(low == 0 for low, _ in times.values()), seen
+
+
+def test_every_frozen_arm_pose_lies_within_the_arms_limits_as_read_now():
+    """The released v2/v3 pose sets were drawn when URDF limits were rounded to the nearest;
+    the generator still draws in that box (they regenerate bit for bit) and clips to the arm's
+    bounds. No frozen joint lies in the sliver between: every one is inside the bounds fkopt
+    reads now, which never lie outside the files' limits."""
+    import numpy as np
+
+    from fkopt.kinbench.config import load_suite
+    from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
+    from fkopt.mechanisms.urdf import URDFArm
+    root = Path(__file__).resolve().parent.parent / "configs" / "suites"
+    checked = 0
+    for suite in ("kinbench-v2.yaml", "kinbench-v3.yaml"):
+        cfg = load_suite(root / suite)
+        sets, _ = load_pose_sets(cfg)
+        for problem in cfg.problems:
+            mech, _ = problem_mechanism(problem, root)
+            if not isinstance(mech, URDFArm):
+                continue
+            for (name, _set), pts in sets.items():
+                if name == problem.name and len(pts):
+                    assert (pts >= mech.bounds[:, 0]).all() and (pts <= mech.bounds[:, 1]).all(), (name, _set)
+                    checked += 1
+    assert checked > 60
