@@ -211,7 +211,7 @@ def test_a_quoted_number_is_refused_with_one_line_and_1e_minus_10_is_a_number(tm
         assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (text, err)
     path = tmp_path / "c.yaml"
     path.write_text(path.read_text().replace('threshold: "nan"', "threshold: 1e-10\niterations: 3\nruns: 2"))
-    from fkopt.experiment.config import load_config
+    from fkopt.kinds.experiment.config import load_config
     assert load_config(path).threshold == 1e-10                  # YAML 1.2's float without a dot
 
 
@@ -305,8 +305,8 @@ def test_time_figures_start_their_axis_at_zero(tmp_path, monkeypatch):
     """chang2024 Tab. 2's time per pose started at 30 ms, drawing a 32 vs 80 ms gap as 1 to 25."""
     import yaml
 
-    from fkopt.experiment import reports
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.kinds.experiment import reports
+    from fkopt.run.pipeline import load_any, run_config
     seen = {}
     real = reports._save
 

@@ -28,14 +28,14 @@ from typing import Any, Callable, ClassVar
 
 import numpy as np
 
-from .. import rotations
-from ..errors import FkoptError, did_you_mean
+from fkopt.numerics import rotations
+from fkopt.errors import FkoptError, did_you_mean
 
 
 def _geometry_base():
     from pydantic import BaseModel, ConfigDict, field_validator
 
-    from ..files import MAX_MAGNITUDE, no_quoted_numbers
+    from fkopt.files import MAX_MAGNITUDE, no_quoted_numbers
 
     class Geometry(BaseModel):
         """Base of every mechanism's geometry model (unknown keys are rejected; every number,
@@ -101,7 +101,7 @@ def validate_geometry(model: type, geometry: dict[str, Any], where: str, clean=l
 def describe_validation_error(err, where: str) -> str:
     """Collapse a pydantic error into one line: ``where.field: message``."""
     first = err.errors()[0]
-    from ..files import field_path
+    from fkopt.files import field_path
     loc = field_path(first["loc"])
     msg = first["msg"].removeprefix("Value error, ")
     return f"{where}.{loc}: {msg}" if loc else f"{where}: {msg}"
@@ -140,7 +140,7 @@ class Mechanism:
     #: Set when the model is a reconstruction (docs/models.md), with a one-sentence explanation.
     reconstruction: ClassVar[str | None] = None
     #: True when the fitness path (forward/inverse map, no Jacobian) is elementwise numpy, with no
-    #: BLAS call (:mod:`fkopt.compare`); False for mechanisms fkopt has not read (plug-ins).
+    #: BLAS call (:mod:`fkopt.run.compare`); False for mechanisms fkopt has not read (plug-ins).
     blas_free_fitness: ClassVar[bool] = False
     pose_names: ClassVar[tuple[str, ...]]
     pose_units: ClassVar[tuple[str, ...]]
@@ -188,7 +188,7 @@ class Mechanism:
         bounds = dict(self.default_bounds)
         for key, value in overrides.items():
             if key not in names:
-                from ..files import did_you_mean as closest
+                from fkopt.files import did_you_mean as closest
                 raise FkoptError(f"{self.name} bounds: unknown variable '{key}'{closest(key, names)}; "
                                  f"allowed: {', '.join(names)}")
             try:
@@ -212,7 +212,7 @@ class Mechanism:
         unknown = set(values) - set(names)
         missing = [n for n in names if n not in values]
         if unknown:
-            from ..files import did_you_mean as closest
+            from fkopt.files import did_you_mean as closest
             word = sorted(unknown)[0]
             raise FkoptError(f"{self.name} {what}: unknown variable '{word}'{closest(word, names)}; "
                              f"allowed: {', '.join(names)}")
@@ -225,7 +225,7 @@ class Mechanism:
         """``values`` after checking |v| <= :data:`fkopt.files.MAX_MAGNITUDE` (1e9 in the
         mechanism's units; past it a square overflows in FK, IK or a Jacobian): one line naming
         the variable otherwise."""
-        from ..files import MAX_MAGNITUDE, no_quoted_numbers
+        from fkopt.files import MAX_MAGNITUDE
         big = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
         if big.size:
             i = int(big[0])
