@@ -234,9 +234,9 @@ def test_fkopt_list_urdf_with_a_users_geometry_does_not_call_it_the_default(tmp_
     code, out, err = cli("list", "urdf", "--geometry", tmp_path / "arm.yaml")
     assert code == 0, err
     text = " ".join(out.split())
-    assert "default geometry" not in text and f"the values of {tmp_path / 'arm.yaml'}" in text
+    assert "default geometry (override" not in text and "geometry: the defaults with the values of" in text
     code, out, _ = cli("list", "urdf")
-    assert "default geometry" in out
+    assert "default geometry (override" in " ".join(out.split())
 
 
 def test_every_count_of_v3_arms_is_the_count_of_the_suite_files():
