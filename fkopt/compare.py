@@ -142,12 +142,13 @@ def _py(v):
 
 def _read(path: Path) -> pd.DataFrame:
     """A CSV (or gzip'ed CSV) as text cells, so 'identical' means identical as written."""
-    return pd.read_csv(io.BytesIO(_bytes(path)), dtype=str, keep_default_na=False)
+    from .files import parse_csv
+    return parse_csv(_bytes(path), str(path), dtype=str, keep_default_na=False)
 
 
 def _stored_csv(folder: Path, name: str) -> pd.DataFrame:
-    from .files import read_stored
-    return pd.read_csv(io.BytesIO(read_stored(folder, name)))
+    from .files import read_stored_csv
+    return read_stored_csv(folder, name)
 
 
 def _outcome(col: str) -> bool:

@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import FkoptError
-from .files import file_names, parse_json, read_stored
+from .files import file_names, parse_json, read_stored, read_stored_csv
 from .iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
@@ -119,7 +119,7 @@ def _meta(folder: Path) -> dict:
 def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
     path = folder / "runs.csv"
     try:
-        runs = pd.read_csv(io.BytesIO(read_stored(folder, "runs.csv")), dtype=dict.fromkeys(labels, str))
+        runs = read_stored_csv(folder, "runs.csv", dtype=dict.fromkeys(labels, str))
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
         raise FkoptError(f"{path}: cannot read ({str(err).strip().splitlines()[0] if str(err).strip() else err})") from None
     missing = [c for c in columns if c not in runs.columns]

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..files import MAX_UNPACKED, read_input
+from ..files import MAX_UNPACKED, check_csv_shape, read_input
 
 FILE = "trace.csv.gz"
 COLUMNS = ("case", "algorithm", "run", "iteration", "evaluations", "best_fitness")
@@ -112,6 +112,7 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
     labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
     # bounded: a regular file inside the folder, unpacked size measured by streaming before parsing
     data = read_input(path, MAX_UNPACKED, within=folder, unpacked=MAX_UNPACKED if limit is None else limit)
+    check_csv_shape(data, str(path))
     try:
         table = pd.read_csv(io.BytesIO(data), dtype=dict.fromkeys(labels, "category"))
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as err:

@@ -13,13 +13,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..files import read_stored_csv
+
 
 def advice_table(folder: str | Path, target: str = "1e-06", top: int = 3) -> pd.DataFrame:
     """Columns problem, class, solver, success (share reached ``target``), ms_per_solve; the
     ``top`` solvers of each problem, best first, problems in the order runs.csv lists them."""
     folder = Path(folder)
-    runs = pd.read_csv(folder / "runs.csv")
-    timing = pd.read_csv(folder / "timing.csv")
+    runs = read_stored_csv(folder, "runs.csv")
+    timing = read_stored_csv(folder, "timing.csv")
     column = f"evals_to_{target}"
     if column not in runs:
         raise ValueError(f"{folder / 'runs.csv'}: no column {column} (targets: "
@@ -48,7 +50,7 @@ def robots_summary(folder: str | Path, timeout_ms: float = 20.0) -> pd.DataFrame
     arm at the board's rung) and its median time and median time ratio to the reference (median
     over arms); best first (mean success at the rung, then ratio). FK rows (the parallel
     mechanisms, another timeout ladder) are left out."""
-    board = pd.read_csv(Path(folder) / "leaderboard-robots.csv")
+    board = read_stored_csv(folder, "leaderboard-robots.csv")
     fk_robots = set(board.loc[board["other_mode"].notna(), "robot"])      # FK rows count other modes
     board = board[np.isclose(board["timeout_ms"], timeout_ms) & ~board["robot"].isin(fk_robots)]
     success = [c for c in board.columns if c.startswith("success_")]
@@ -80,7 +82,7 @@ def fk_sentence(folder: str | Path, timeout_ms: float = 500.0) -> str:
     """The FK rows of a stored per-robot board at ``timeout_ms`` as README's one sentence: per
     parallel mechanism, each solver's success at the generating pose (the board's rung) and, in
     brackets, the share solved in another assembly mode; best first."""
-    board = pd.read_csv(Path(folder) / "leaderboard-robots.csv")
+    board = read_stored_csv(folder, "leaderboard-robots.csv")
     board = board[board["other_mode"].notna() & np.isclose(board["timeout_ms"], timeout_ms)]
     parts = []
     for robot, rows in board.groupby("robot", sort=False):

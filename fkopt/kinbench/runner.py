@@ -288,17 +288,20 @@ def record_problem(task, rec) -> str | None:
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
     if task.payload.get("track"):
+        from .answer_checks import clock_record_problem
         try:
-            if int(rec["problem"]) != task.payload["problem"] or rec["track"] != task.payload["track"]:
+            if type(rec["problem"]) is not int or rec["problem"] != task.payload["problem"] \
+                    or rec["track"] != task.payload["track"]:
                 return "its problem/track are not its file name's"
             if not isinstance(rec["answers"], dict) or not all(isinstance(v, list) for v in rec["answers"].values()):
                 return "answers: not a table of answers"
-            float(rec["wall_s"])
+            if _numbers([rec["wall_s"]], "wall_s", 0, float(np.finfo(float).max)):
+                return "wall_s: not a non-negative finite number"
+            return clock_record_problem(task, rec)      # every answer counted and judged again
         except KeyError as err:
-            return f"field {err.args[0]!r} is missing"
-        except (TypeError, ValueError) as err:
+            return f"field {str(err.args[0])[:40]!r} is missing"
+        except (TypeError, ValueError, IndexError, AttributeError, FkoptError) as err:
             return f"{type(err).__name__}: {str(err)[:120]}"
-        return None
     payload = task.payload
     try:
         if rec["problem"] != payload["problem"] or rec["solver"] != payload["solver"] \

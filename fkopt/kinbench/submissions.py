@@ -66,7 +66,7 @@ import pandas as pd
 
 from ..errors import FkoptError
 from ..experiment.config import files_folder
-from ..files import MAX_INPUT_BYTES, read_input
+from ..files import MAX_INPUT_BYTES, csv_numbers, read_input
 from .clock import answer_prefix, answer_rows, is_ik, targets_of, track_settings
 from .outside import read_csv_columns
 
@@ -97,7 +97,7 @@ def _line(g: pd.DataFrame, k: int) -> int:
 
 def _check_numbers(g: pd.DataFrame, where: str, n: int, timed: bool) -> None:
     for col in ("query", "seconds", "reference_seconds") + (("given_timeout_ms",) if timed else ()):
-        v = pd.to_numeric(g[col], errors="coerce").to_numpy(float)
+        v = csv_numbers(g[col])       # never raises: a 400-digit integer is inf, refused here
         with np.errstate(invalid="ignore"):
             if col == "query":
                 bad = ~np.isfinite(v) | (v < 0) | (v != np.round(v)) | (v >= n)
@@ -140,7 +140,7 @@ def _answers(g: pd.DataFrame, where: str, robot: str, mech, dim: int) -> np.ndar
         raise FkoptError(f"{where}: robot {robot}: column {extra[0]} must be empty ({robot} answers with "
                          f"{what}: columns {cols[0]}..{cols[-1]})")
     raw = g[cols]
-    values = raw.apply(pd.to_numeric, errors="coerce").to_numpy(float)
+    values = np.stack([csv_numbers(raw[c]) for c in cols], axis=-1) if len(raw) else np.zeros((0, dim))
     with np.errstate(invalid="ignore"):
         bad = (raw.notna().to_numpy() & ~np.isfinite(values)) | (np.abs(values) > MAX_ANSWER)
     if bad.any():
@@ -189,8 +189,8 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
         n, dim = len(queries), queries.shape[1]
         _, _, timeouts = track_settings(clock, mech)
         _check_numbers(g, where, n, timed)
-        query = pd.to_numeric(g["query"]).to_numpy(float).astype(int)
-        given = pd.to_numeric(g["given_timeout_ms"]).to_numpy(float) if timed else np.zeros(len(g))
+        query = csv_numbers(g["query"]).astype(int)          # range-checked above
+        given = csv_numbers(g["given_timeout_ms"]) if timed else np.zeros(len(g))
         have = list(zip(query, given))
         seen: set = set()
         for key in have:
@@ -212,8 +212,8 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
                              + f" ({n} queries) needs one")
         answers = _answers(g, where, robot, mech, dim)
         frame = answer_rows(mech, robot, entry.solver, "outside", "submitted", query,
-                            g["given_timeout_ms"].to_numpy(float) if timed else np.nan,
-                            g["seconds"].to_numpy(float), g["reference_seconds"].to_numpy(float),
+                            given if timed else np.nan,
+                            csv_numbers(g["seconds"]), csv_numbers(g["reference_seconds"]),
                             _claims(g, where) if "claimed" in g else False, answers, queries[query],
                             targets_of(mech, queries[query]))
         frame.insert(1, "set", clock.set)

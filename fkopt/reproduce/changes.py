@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..errors import FkoptError
 from ..files import read_stored
 from ..outputs import deterministic_files, sha256
 from .claims import CLAIMS_FILE
@@ -88,9 +89,10 @@ def load_snapshot(path: str | Path) -> Snapshot:
 def _table(text: str | None) -> pd.DataFrame | None:
     if not text:
         return None
+    from ..files import parse_csv
     try:
-        return pd.read_csv(io.StringIO(text))
-    except (ValueError, pd.errors.ParserError):
+        return parse_csv(text.encode("utf-8"), "stored table")
+    except (FkoptError, ValueError, pd.errors.ParserError):
         return None
 
 

@@ -38,7 +38,7 @@ import pandas as pd
 
 from ..compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
 from ..errors import FkoptError
-from ..files import odd_entries, parse_json, read_stored
+from ..files import odd_entries, parse_json, read_stored, read_stored_csv
 from ..experiment.kinds import from_dict, rerun_files
 from ..numerics import path as numerics_path
 from ..provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
@@ -134,7 +134,7 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     from ..experiment.runner import build_cases, build_mechanism, build_problem, make_problem
     label = _label(exp)
     try:
-        runs = pd.read_csv(io.BytesIO(read_stored(exp.folder, "runs.csv")))
+        runs = read_stored_csv(exp.folder, "runs.csv")
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(label, "runs.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
     mech = build_mechanism(config)
@@ -277,7 +277,7 @@ def timing_verdicts(exp: Experiment) -> list[Mismatch]:
     if not file.is_file():
         return []
     try:
-        stored = pd.read_csv(io.BytesIO(read_stored(file.parent, file.name)), keep_default_na=False)
+        stored = read_stored_csv(file.parent, file.name, keep_default_na=False)
         judged = judge_paper(exp.paper, Store(exp.folder.parents[1]), timing_only=True)
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, "-", "file", f"unreadable ({err})", "readable",

@@ -344,10 +344,10 @@ def read_claims(file: str | Path) -> pd.DataFrame:
     :class:`~fkopt.errors.FkoptError` line naming it."""
     import io
     from ..errors import FkoptError
-    from ..files import read_text
+    from ..files import parse_csv, read_text
     text = read_text(file, MAX_CLAIMS_BYTES)
     try:
-        df = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
+        df = parse_csv(text.encode("utf-8"), str(file), dtype=str, keep_default_na=False)
     except (ValueError, pd.errors.ParserError) as err:
         raise FkoptError(f"{file}: not a CSV table ({(str(err).splitlines() or [''])[0][:200]})") from None
     if not {"claim", "verdict"} <= set(df.columns):

@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..errors import FkoptError
-from ..files import parse_json, read_stored
+from ..files import parse_json, read_stored, read_stored_csv
 
 
 @dataclass
@@ -62,7 +62,7 @@ class Experiment:
         if not (self.folder / file).exists() and (self.folder / f"{file}.gz").exists():
             file += ".gz"      # trace.csv.gz (fkopt.experiment.traces)
         # bounded: inside the folder, a regular file, a gzip bomb one line, not the memory
-        return pd.read_csv(io.BytesIO(read_stored(self.folder, file)), keep_default_na=True)
+        return read_stored_csv(self.folder, file, keep_default_na=True)
 
     def figures(self) -> list[str]:
         return sorted(p.name for p in self.folder.glob("*.png"))
