@@ -140,6 +140,11 @@ def track_cases(config: SuiteConfig, sets: dict, files: Path | None = None) -> l
     if config.poses is not None:
         sets, _ = load_pose_sets(config.model_copy(update={"poses": None}), files)
     index = {p.name: k for k, p in enumerate(config.problems)}
+    for name in clock.problems:     # never silently fewer queries than asked for
+        have = len(sets[(name, clock.set)])
+        if clock.queries is not None and clock.queries > have:
+            raise FkoptError(f"tracks.clock.queries: {clock.queries}, but set '{clock.set}' of problem {name} holds "
+                             f"{have} poses; allowed: 1 to {have} (or omit it: every pose of the set)")
     return [(index[name], np.asarray(sets[(name, clock.set)][:clock.queries], dtype=float)) for name in clock.problems]
 
 

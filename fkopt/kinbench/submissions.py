@@ -71,6 +71,10 @@ from .clock import answer_prefix, answer_rows, is_ik, targets_of, track_settings
 from .outside import read_csv_columns
 
 REQUIRED = ("robot", "query", "seconds", "reference_seconds")
+#: The optional columns; with REQUIRED and the answers' q0, q1, ... / x0..x5 the only ones allowed.
+OPTIONAL = ("claimed", "given_timeout_ms")
+#: The largest given_timeout_ms: the tracks' own bound on a timeout (``timeouts_ms`` in (0, 10000]).
+MAX_TIMEOUT_MS = 10_000.0
 #: A wall time beyond an hour per query is no clock-track answer (the longest timeout is 10 s).
 MAX_SECONDS = 3600.0
 #: The largest |joint| (deg / m) or |pose component| (length unit / deg) a submission may give.
@@ -103,8 +107,9 @@ def _check_numbers(g: pd.DataFrame, where: str, n: int, timed: bool) -> None:
                 bad = ~np.isfinite(v) | (v < 0) | (v != np.round(v)) | (v >= n)
                 allowed = f"an integer 0..{n - 1}"
             else:
-                bad = ~np.isfinite(v) | (v <= 0) | (v > MAX_SECONDS)
-                allowed = f"a positive number of {'ms' if col == 'given_timeout_ms' else 's'} up to {MAX_SECONDS:g}"
+                top = MAX_TIMEOUT_MS if col == "given_timeout_ms" else MAX_SECONDS
+                bad = ~np.isfinite(v) | (v <= 0) | (v > top)
+                allowed = f"a positive number of {'ms' if col == 'given_timeout_ms' else 's'} up to {top:g}"
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise FkoptError(f"{where}: line {_line(g, k)}: {col} = {g[col].astype(str).iloc[k]}; allowed: {allowed}")
@@ -167,6 +172,11 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
     where = f"tracks.clock.submissions[{entry.solver}]: {path}"
     df = read_csv_columns(path, where, REQUIRED, {"robot": str},
                           f"{', '.join(REQUIRED)}, q0, q1, ... (IK) or x0..x5 (FK)")
+    stray = [c for c in df.columns if c not in (*REQUIRED, *OPTIONAL)
+             and not (str(c)[:1] in "qx" and str(c)[1:].isdigit() and str(c)[1:] == str(int(str(c)[1:])))]
+    if stray:      # a typo ('given_timeout', 'clamed') would otherwise be ignored without a word
+        raise FkoptError(f"{where}: stray column '{str(stray[0])[:40]}'; allowed: {', '.join(REQUIRED + OPTIONAL)}, "
+                         "q0, q1, ... (IK) or x0..x5 (FK)")
     if df.empty:
         raise FkoptError(f"{where}: no rows; needs one per query of each robot it answers "
                          f"(robots: {', '.join(arms)})")
