@@ -309,7 +309,7 @@ def parse_csv(data: bytes, where: str, **options):
     try:
         return pd.read_csv(io.BytesIO(data), **options)
     except pd.errors.EmptyDataError:
-        raise FkoptError(f"{where}: empty CSV (no header)") from None
+        raise FkoptError(f"{where}: unreadable CSV (empty: no header)") from None
     except (ValueError, OverflowError, pd.errors.ParserError, UnicodeDecodeError) as err:
         raise FkoptError(f"{where}: unreadable CSV ({type(err).__name__}: {one_line(str(err), 120)})") from None
 
