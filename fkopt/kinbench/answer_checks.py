@@ -64,9 +64,9 @@ def key_problems(g: pd.DataFrame, robot: str, n: int, solvers, timeouts, optiona
                        f"track ({', '.join(f'{x:g}' for x in timeouts)} ms)"
             keys = list(zip(query[mine].astype(int).tolist(), t.tolist()))
         if len(set(keys)) != count:
-            return f"{robot}/{name}: {count - len(set(keys))} answers repeated ({RULE})"
+            return f"{robot}/{name}: {count - len(set(keys))} answers repeated"
         if count != want:
-            return f"{robot}/{name}: {count} answers, the config implies {want} ({RULE})"
+            return f"{robot}/{name}: {count} answers, the config implies {want}"
     return None
 
 
