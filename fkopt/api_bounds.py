@@ -23,8 +23,8 @@ import numbers
 
 import numpy as np
 
-from .errors import FkoptError
-from .files import MAX_MAGNITUDE
+from fkopt.errors import FkoptError
+from fkopt.files import MAX_MAGNITUDE
 
 #: Largest |value| of a number given to the API (targets, joints, starts, float options).
 MAX_API_VALUE = MAX_MAGNITUDE

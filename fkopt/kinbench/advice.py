@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..files import read_stored_csv
+from fkopt.files import read_stored_csv
 
 
 def advice_table(folder: str | Path, target: str = "1e-06", top: int = 3) -> pd.DataFrame:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..files import csv_numbers
+from fkopt.files import csv_numbers
 
 #: The columns of every answers row (:func:`fkopt.kinbench.clock.answer_rows`, ``set`` added by
 #: the runner), before the answer's own ``q0..`` / ``x0..``.
@@ -72,7 +72,7 @@ def key_problems(g: pd.DataFrame, robot: str, n: int, solvers, timeouts, optiona
 
 def expected_solvers(clock, mechanism) -> list[str]:
     """The solvers the clock track runs on ``mechanism``, the reference first."""
-    from .clock import track_settings
+    from fkopt.kinbench.clock import track_settings
     solvers, reference, _ = track_settings(clock, mechanism)
     return list(dict.fromkeys([reference, *solvers]))
 
@@ -94,11 +94,11 @@ def clock_record_problem(task, rec: dict) -> str | None:
     the times positive and finite; every verdict recomputed from the stored joints or pose with
     kinbench's own FK/IK (:func:`fkopt.kinbench.clock.verdicts`) -- joints moved with their
     verdicts kept are caught; the throughput rows' robots, solvers, batches and rates."""
-    from ..files import MAX_MAGNITUDE
-    from .clock import answer_prefix, entry_of, targets_of, track_settings, verdicts
-    from .config import suite_from_dict
-    from .runner import track_arm
-    from .verify import _close
+    from fkopt.files import MAX_MAGNITUDE
+    from fkopt.kinbench.clock import answer_prefix, entry_of, targets_of, track_settings, verdicts
+    from fkopt.kinbench.config import suite_from_dict
+    from fkopt.kinbench.runner import track_arm
+    from fkopt.kinbench.verify import _close
     payload = task.payload
     from pathlib import Path
     config = suite_from_dict(payload["config"], "suite task")
@@ -155,7 +155,7 @@ def clock_record_problem(task, rec: dict) -> str | None:
 
 
 def _throughput_problem(config, arm, robot: str, rate) -> str | None:
-    from .clock import is_ik, track_settings
+    from fkopt.kinbench.clock import is_ik, track_settings
     tp = config.tracks.throughput
     if tp is None:
         return None if rate is None else "throughput: present, but the config has no throughput track"

@@ -43,10 +43,10 @@ from typing import Literal
 
 from pydantic import Field, PrivateAttr, ValidationError, field_validator, model_validator
 
-from ..errors import FkoptError
-from ..experiment.config import (MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict,
-                                 unique_labels)
-from ..files import error_line, load_mapping
+from fkopt.errors import FkoptError
+from fkopt.registry import IK_SOLVERS, track_of
+from fkopt.run.config_base import MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict, unique_labels
+from fkopt.files import error_line, load_mapping
 
 #: Pose sets of kinbench v1 (see :mod:`fkopt.kinbench.posesets`).
 SETS = ("uniform", "near-singular", "boundary", "printed")
@@ -55,11 +55,6 @@ TRACKS = ("black-box", "jacobian", "exact")
 #: The COCO-style target ladder on the problem's fitness.
 TARGETS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
 #: Track of fkopt's built-in solvers and the adapters (anything else must state its track).
-KNOWN_TRACKS = {"abc": "black-box", "gabc": "black-box", "pso": "black-box", "aco": "black-box",
-                "pabc": "black-box", "nr": "jacobian", "lm": "jacobian", "dls": "jacobian",
-                "abc+lm": "jacobian", "gabc+lm": "jacobian", "pso+lm": "jacobian",
-                "forward": "exact", "inverse": "exact", "exact": "exact"}
-ADAPTER_TRACK = "black-box"     # scipy:, pymoo:, niapy: (registry.ADAPTER_PREFIXES) minimise the fitness only
 MAX_BUDGET_PER_DIM = 10_000_000
 
 
@@ -69,11 +64,8 @@ MAX_QUICK_NAME = 64 - len("-quick")
 
 
 def default_track(name: str) -> str | None:
-    """The track of a built-in solver or an adapter; None for anything else (a plug-in)."""
-    from ..registry import ADAPTER_PREFIXES
-    if name in KNOWN_TRACKS:
-        return KNOWN_TRACKS[name]
-    return ADAPTER_TRACK if name.split(":", 1)[0] in ADAPTER_PREFIXES else None
+    """The track of a built-in solver or an adapter (the registry's entry); None for a plug-in."""
+    return track_of(name)
 
 
 class SuiteSolver(AlgorithmSpec):
@@ -156,10 +148,9 @@ class QuickTier(Strict):
     queries: int | None = Field(None, ge=1)
 
 
-#: Solvers the clock track knows: the organiser's and the field's (fkopt.adapters.field).
+#: Solvers the clock track knows: the organiser's and the field's (the registry's IK solvers).
 def clock_solvers() -> tuple[str, ...]:
-    from ..adapters.field import IK_SOLVERS
-    return ("fkopt.inverse", *IK_SOLVERS)
+    return IK_SOLVERS
 
 
 class ClockSubmission(Strict):
@@ -285,7 +276,7 @@ class SuiteConfig(Located):
         problems = [p.model_dump(mode="json") if isinstance(p, SuiteProblem) else p for p in data["problems"]]
         if not any(isinstance(p, dict) and p.get("instances") for p in problems):
             return data
-        from .instances import MAX_SUITE_INSTANCES
+        from fkopt.kinbench.instances import MAX_SUITE_INSTANCES
         counts = [p.get("instances") for p in problems if isinstance(p, dict)]
         total = sum(c for c in counts if isinstance(c, int) and not isinstance(c, bool) and c > 0)
         if total > MAX_SUITE_INSTANCES:     # bounded before any geometry is drawn (~0.3 s per instance)
@@ -304,7 +295,7 @@ class SuiteConfig(Located):
                 raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
-            from .instances import expand
+            from fkopt.kinbench.instances import expand
             try:
                 out += expand(checked, seed, f"problems[{i}]")
             except FkoptError as err:

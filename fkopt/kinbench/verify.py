@@ -34,13 +34,13 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     (:func:`fkopt.kinbench.answer_checks.key_problems`): one per (query, solver, timeout) the
     config implies, so a failure deleted, a success repeated or a solver dropped is a mismatch
     naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`)."""
-    from ..errors import FkoptError
-    from ..files import csv_numbers, read_stored_csv
-    from .answer_checks import RULE, expected_solvers, key_problems
-    from .clock import answer_prefix, targets_of, track_settings, verdicts
-    from .posesets import load_pose_sets
-    from .reports import robots_board_table
-    from .runner import track_arm, track_cases
+    from fkopt.errors import FkoptError
+    from fkopt.files import csv_numbers, read_stored_csv
+    from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
+    from fkopt.kinbench.clock import answer_prefix, targets_of, track_settings, verdicts
+    from fkopt.kinbench.posesets import load_pose_sets
+    from fkopt.kinbench.reports import robots_board_table
+    from fkopt.kinbench.runner import track_arm, track_cases
     folder = Path(folder)
     if config.tracks is None or config.tracks.clock is None:
         return []

@@ -1,10 +1,10 @@
-"""Options of ``fkopt.inverse`` (documented in :func:`fkopt.kinematics.inverse`)."""
+"""Options of ``fkopt.inverse`` (documented in :func:`fkopt.kinematics.solvers.inverse`)."""
 from __future__ import annotations
 
 import numbers
 from dataclasses import asdict, dataclass, fields
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 
 
@@ -38,7 +38,7 @@ class InverseOptions:
         """These options when every one is of its type and range, else FkoptError naming the
         first bad one and what it allows; the ranges, upper bounds included, are
         :mod:`fkopt.api_bounds`'s (``table`` at most 1,000,000: its memory)."""
-        from ..api_bounds import check_options
+        from fkopt.api_bounds import check_options
         for f in fields(self):
             v = getattr(self, f.name)
             if f.name in ("exact_rotation",):
