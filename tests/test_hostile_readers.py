@@ -77,7 +77,7 @@ def test_no_reader_of_fkopt_calls_pandas_read_csv_on_unchecked_bytes():
 
 # -- break 10: numbers range-checked before any cast -----------------------------------------------
 def test_a_400_digit_query_in_a_submission_is_one_line(tmp_path):
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     path = submission(tmp_path, lambda df: df.astype({"query": object}).assign(query=["9" * 400] + list(df["query"][1:])))
     with pytest.raises(FkoptError) as err:
         run_config(load_any(path), tmp_path / "out", source=str(path))
@@ -165,7 +165,7 @@ def test_a_finished_clock_task_file_is_reused(clock_task):
 
 @pytest.mark.parametrize("edit", FORGERIES)
 def test_resume_refuses_a_forged_clock_task_file_with_a_re_signed_digest(clock_task, tmp_path, edit):
-    from fkopt.experiment.tasks import TaskStore
+    from fkopt.run.tasks import TaskStore
     plan, task, rec = clock_task
     assert plan.check(task, _forged(rec, edit))            # the record check names why
     out = tmp_path / "out"
@@ -181,7 +181,7 @@ def test_resume_refuses_a_forged_clock_task_file_with_a_re_signed_digest(clock_t
 # -- breaks 12, 13: fkopt check counts every answer, reads them bounded ----------------------------
 @pytest.fixture(scope="module")
 def stored_board(tmp_path_factory):
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     from fkopt.kinbench.config import load_suite
     tmp = tmp_path_factory.mktemp("board")
     path = tiny_v3(tmp)
@@ -318,7 +318,7 @@ def test_a_suite_name_too_long_for_its_quick_result_is_refused_not_cut(tmp_path)
 
 # -- break 17: submissions as docs/kinbench.md describes them --------------------------------------
 def test_a_stray_column_in_a_submission_is_refused(tmp_path):
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     path = submission(tmp_path, lambda df: df.assign(given_timeout=5))      # a typo of given_timeout_ms
     with pytest.raises(FkoptError) as err:
         run_config(load_any(path), tmp_path / "out", source=str(path))
@@ -374,7 +374,7 @@ def test_instances_are_counted_before_any_is_drawn(tmp_path, monkeypatch):
 
 def test_digests_of_forged_task_files_are_what_the_store_recorded(clock_task, tmp_path):
     """The forgeries above pass the digest check (fkopt re-signed them): only the record check stops them."""
-    from fkopt.experiment.tasks import TaskStore, read_manifest
+    from fkopt.run.tasks import TaskStore, read_manifest
     plan, task, rec = clock_task
     out = tmp_path / "out"
     store = TaskStore(out, out / "k" / ".t.partial", out / "k" / "t", "t", {}, plan.fingerprint)
