@@ -8,7 +8,6 @@ last regeneration moved, and nobody writes that list by hand.
 """
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 

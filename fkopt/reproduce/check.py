@@ -28,7 +28,6 @@ not compared (they depend on the plotting library's version).
 """
 from __future__ import annotations
 
-import io
 import shutil
 import tempfile
 from pathlib import Path

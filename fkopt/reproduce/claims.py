@@ -342,7 +342,6 @@ def read_claims(file: str | Path) -> pd.DataFrame:
     """A stored ``claims.csv`` (or ``timing_claims.csv``) as text columns; a file that is not
     UTF-8, too large, not a CSV or without ``claim`` and ``verdict`` columns is one
     :class:`~fkopt.errors.FkoptError` line naming it."""
-    import io
     from fkopt.errors import FkoptError
     from fkopt.files import parse_csv, read_text
     text = read_text(file, MAX_CLAIMS_BYTES)

@@ -1,7 +1,6 @@
 """Read access to a results tree ``RESULTS/<paper>/<experiment>/``."""
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path

@@ -57,7 +57,6 @@ A mismatch names the experiment, the file, the row, the column, both values and 
 """
 from __future__ import annotations
 
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path

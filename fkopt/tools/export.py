@@ -37,7 +37,6 @@ input file has been read and checked, and only over a folder that ``fkopt export
 """
 from __future__ import annotations
 
-import io
 import json
 import re
 from dataclasses import dataclass, field

@@ -14,7 +14,6 @@ Success rate is the share of runs below the threshold. Evaluations are the mean 
 """
 from __future__ import annotations
 
-import io
 import sys
 from pathlib import Path
 
