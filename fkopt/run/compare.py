@@ -149,7 +149,7 @@ def _py(v):
 
 def _read(path: Path) -> pd.DataFrame:
     """A CSV (or gzip'ed CSV) as text cells, so 'identical' means identical as written."""
-    from .files import parse_csv
+    from fkopt.files import parse_csv
     return parse_csv(_bytes(path), str(path), dtype=str, keep_default_na=False)
 
 
