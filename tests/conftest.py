@@ -99,6 +99,9 @@ TIERS = {
     "tests/test_releases.py::test_fkopt_check_refuses_a_run_whose_released_pose_sets_were_swapped_after_it":
         ("slow",),
     "tests/test_robots.py::test_stored_urdf_copy_matches_pinocchio_on_the_original": ("external",),
+    "tests/test_hostile_robots.py::test_break8_every_outside_solver_reads_an_arm_with_a_fixed3_joint":
+        ("external",),
+    "tests/test_hostile_robots.py::test_v3s_robot_files_are_pinned_by_sha256_like_v1_and_v2": ("slow",),
     "tests/test_robots.py::test_stored_mjcf_copy_matches_mj_kinematics_on_the_original": ("external",),
     "tests/test_hostile.py::test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it":
         ("external",),
