@@ -77,6 +77,10 @@ TIERS = {
     "tests/test_bench_ik.py::test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones": ("external",),
     "tests/test_bench_ik.py::test_ik_sections_report_every_arm_ratios_and_verified_counts": ("external",),
     "tests/test_kinbench_v3.py::test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board": ("slow",),
+    "tests/test_hostile_readers.py::test_check_fails_a_board_whose_answers_are_missing_duplicated_extra_or_unreadable":
+        ("slow",),
+    "tests/test_hostile_readers.py::test_fkopt_check_of_a_board_whose_answers_are_not_gzip_names_the_file_and_exits_1":
+        ("slow",),
     "tests/test_kinbench_v3.py::test_a_suite_with_tracks_writes_the_robot_board_and_every_answer": ("slow",),
     "tests/test_kinbench_v3.py::test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apart":
         ("slow",),

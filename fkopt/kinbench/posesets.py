@@ -262,7 +262,8 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     """The points of a pose-set CSV: ASCII, a header of exactly ``unknowns``, every row that
     many finite numbers; anything else one line naming the file, the line and what is allowed
     (no cell of the file is quoted beyond a short sanitised token)."""
-    from fkopt.files import short_token
+    from fkopt.files import check_csv_shape, short_token
+    check_csv_shape(data, str(path))        # line length and fields bounded before any split
     try:
         text = data.decode("ascii")
     except UnicodeDecodeError as err:

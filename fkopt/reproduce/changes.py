@@ -8,12 +8,12 @@ last regeneration moved, and nobody writes that list by hand.
 """
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
 
+from fkopt.errors import FkoptError
 from fkopt.files import read_stored
 from fkopt.run.writers import deterministic_files, sha256
 from fkopt.reproduce.claims import CLAIMS_FILE
@@ -95,9 +95,10 @@ def load_snapshot(path: str | Path) -> Snapshot:
 def _table(text: str | None) -> pd.DataFrame | None:
     if not text:
         return None
+    from fkopt.files import parse_csv
     try:
-        return pd.read_csv(io.StringIO(text))
-    except (ValueError, pd.errors.ParserError):
+        return parse_csv(text.encode("utf-8"), "stored table")
+    except (FkoptError, ValueError, pd.errors.ParserError):
         return None
 
 
