@@ -28,7 +28,8 @@ from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
 _LAZY = {"ForwardResult": "kinematics", "InverseResult": "kinematics", "forward": "kinematics",
          "inverse": "kinematics", "InverseSolver": "kinematics", "inverse_solver": "kinematics",
          "InverseOptions": "numerics", "FKProblem": "problems", "IKProblem": "problems",
-         "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve"}
+         "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve",
+         "inverse_path": "branches", "AllSolutions": "branches", "PathResult": "branches"}
 
 
 def __getattr__(name: str):
@@ -77,6 +78,6 @@ def algorithm(name: str, **params):
 
 
 __all__ = ["FkoptError", "FKProblem", "IKProblem", "Result", "algorithm", "fk_problem", "ik_problem",
-           "mechanism", "solve", "forward", "inverse", "InverseSolver", "inverse_solver",
+           "mechanism", "solve", "forward", "inverse", "inverse_path", "AllSolutions", "PathResult", "InverseSolver", "inverse_solver",
            "InverseOptions", "ForwardResult", "InverseResult",
            "MECHANISMS", "ALGORITHMS", "__version__"]

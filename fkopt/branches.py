@@ -67,7 +67,7 @@ ACCEPT_TOL = (1e-10, 1e-10)
 #: revolute joints modulo 2 pi).
 MERGE_TOL = 1e-6
 #: Stopping rule defaults: consecutive starts without a new solution, most starts per pose.
-PATIENCE = 48
+PATIENCE = 32
 #: ... and at least this many times the starts it took to find the last new solution.
 GROWTH = 0.0
 MAX_STARTS = 400
@@ -200,8 +200,7 @@ TABLE = 4096
 def _context(m, locked: dict[int, float], W) -> dict:
     """The search's constants for arm m with joints ``locked``: the reduced chain as arrays, the
     free joints' internal limits, revolute mask, draw box, and a start table of ``TABLE`` free
-    configurations drawn by inverse's fixed hash inside the limits (revolute joints over their
-    limits clipped to one turn about 0), with their tool features as inverse's table. Cached on
+    configurations drawn by inverse's fixed hash inside the limits, with their tool features as inverse's table. Cached on
     the arm by (bounds, locked values, mask)."""
     from .kinematics import _internal, _public, _sumsq, _uniform_hash
     key = (m.bounds.tobytes(), tuple(sorted(locked.items())), None if W is None else W.tobytes())
@@ -218,11 +217,10 @@ def _context(m, locked: dict[int, float], W) -> dict:
     angle = m.angle_mask(m.joint_units)
     # revolute = an angle unknown that drives revolute joints (prismatic joints have length units)
     revolute = angle.copy()
-    glo = np.where(revolute, np.maximum(lo, -np.pi), lo)
-    ghi = np.where(revolute, np.minimum(hi, np.pi), hi)
-    # a revolute joint whose limits lie away from 0 draws over its limits (still at most one turn)
-    narrow = revolute & (glo >= ghi)
-    glo, ghi = np.where(narrow, lo, glo), np.where(narrow, np.minimum(hi, lo + 2 * np.pi), ghi)
+    # draws: a revolute joint over one whole turn (the search solves modulo 2 pi, limits after),
+    # a prismatic one inside its limits
+    glo = np.where(revolute, -np.pi, lo)
+    ghi = np.where(revolute, np.pi, hi)
     full = lo + (hi - lo) * _uniform_hash(0x5EED, np.arange(TABLE), np.zeros(TABLE, dtype=np.int64), n)
     for k, v in locked.items():
         full[:, k] = v
@@ -438,3 +436,177 @@ def inverse_all(arm, poses, *, tol=None, mask=None, seed: int = 0, **options):
         frames[:, 3, 3] = 1.0
         return [all_solutions(m, f, tol=tol, mask=mask, seed=seed, **options) for f in frames]
     return [all_solutions(m, r, tol=tol, mask=mask, seed=seed, **options) for r in flat]
+
+
+# ----------------------------------------------------------------------------------------------
+# paths
+# ----------------------------------------------------------------------------------------------
+def _frames(m, poses) -> np.ndarray:
+    """Targets (..., w, 6) or (..., w, 4, 4) as rows (..., w, 12): x, y, z, R row-major."""
+    from .kinematics import _targets, _zyz_matrix
+    P = _targets(m, poses)
+    if P.shape[-1] == 12:
+        return np.ascontiguousarray(P, dtype=float)
+    flat = P.reshape(-1, 6)
+    out = np.concatenate([flat[:, :3], _zyz_matrix(flat[:, 3:]).reshape(-1, 9)], axis=1)
+    return np.ascontiguousarray(out.reshape(P.shape[:-1] + (12,)))
+
+
+def _between(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
+    """The frame row a fraction s of the way from a to b (12,): position linear, rotation along
+    the geodesic (Ra exp(s log(Ra^T Rb)))."""
+    from scipy.spatial.transform import Rotation
+    Ra, Rb = a[3:].reshape(3, 3), b[3:].reshape(3, 3)
+    rel = Rotation.from_matrix(Ra.T @ Rb).as_rotvec()
+    R = Ra @ Rotation.from_rotvec(s * rel).as_matrix()
+    return np.concatenate([a[:3] + s * (b[:3] - a[:3]), R.reshape(9)])
+
+
+def _smallest_singular(m, t, L: float) -> float:
+    """Smallest singular value of the frame Jacobian at internal joints t, rotation rows times
+    L (length units per radian), per internal unit."""
+    _, _, J = m.frame_jacobian1([float(v) for v in t])
+    J = np.array(J)
+    J[3:] *= L
+    return float(np.linalg.svd(J, compute_uv=False)[-1])
+
+
+def inverse_path(arm, poses, *, start, tol=ALL_TOL, max_step: float = MAX_STEP, substeps: int = SUBSTEPS,
+                 orientation_scale: float | None = None, iterations: int = ITERATIONS) -> PathResult:
+    """Joints along a path of poses that stay on one branch: see the module docstring.
+
+    ``poses``: (w, 6) / (w, 4, 4) waypoints, or a batch of paths (p, w, 6) / (p, w, 4, 4);
+    ``start``: the joints before the first waypoint (n,) or one per path (p, n), public units,
+    inside the limits; ``tol``: a waypoint's (position, rotation) tolerance; ``max_step``: the
+    largest joint change between waypoints (rad, or length unit for a prismatic joint) without a
+    break; ``substeps``: intermediate poses tried across a waypoint the direct step misses."""
+    from .kinematics import _internal, _public, _tolerance, _values
+    m = _arm(arm)
+    tp, tr = _tolerance(tol)
+    if not (isinstance(max_step, (int, float)) and not isinstance(max_step, bool) and max_step > 0
+            and math.isfinite(max_step)):
+        raise FkoptError(f"{m.name} inverse_path max_step: expected a positive number (rad), got {max_step!r}")
+    if isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
+        raise FkoptError(f"{m.name} inverse_path substeps: expected an integer >= 1, got {substeps!r}")
+    F = _frames(m, poses)
+    if F.ndim < 2:
+        raise FkoptError(f"{m.name} inverse_path poses: expected waypoints (w, 6) or (w, 4, 4), got one pose")
+    batch = F.shape[:-2]
+    w = F.shape[-2]
+    Fp = F.reshape((-1, w, 12))
+    S = _values(m, start, m.joint_names, "inverse_path start")
+    if S.ndim == 1:
+        S = np.broadcast_to(S, (len(Fp), m.dof))
+    S = S.reshape(-1, m.dof)
+    if len(S) != len(Fp):
+        raise FkoptError(f"{m.name} inverse_path start: one start per path, got {len(S)} for {len(Fp)} paths")
+    if not m.in_bounds(S).all():
+        box = ", ".join(f"{a} [{b[0]:g}, {b[1]:g}]" for a, b in zip(m.joint_names, m.bounds.tolist()))
+        raise FkoptError(f"{m.name} inverse_path start: joints must be inside the limits ({box})")
+    kern = _kernels()
+    L = float(orientation_scale) if orientation_scale else m.reach
+    per = m.periodic_mask()
+    lo = np.where(per, -np.inf, _internal(m, m.bounds[:, 0]))
+    hi = np.where(per, np.inf, _internal(m, m.bounds[:, 1]))
+    chain = m.chain().arrays()
+    W = np.ones(6)
+    n = m.dof
+    J = np.empty((len(Fp), w, n))
+    E = np.empty((len(Fp), w, 2))
+    breaks = []
+    for path in range(len(Fp)):
+        P = Fp[path]
+        out, errs = J[path], E[path]
+        q = _internal(m, S[path]).astype(float)
+        found = []
+        k = 0
+        while k < w:
+            k = kern.track(chain, P, k, q, L, W, (tp, tr), iterations, 0.01, 0.1, 10.0, 2.0, lo, hi, max_step, out,
+                           errs)
+            if k >= w:
+                break
+            # the direct step missed: follow the branch through intermediate poses
+            prev = P[k - 1] if k > 0 else _frames(m, m.fk_matrix(_public(m, q)[None]))[0]
+            sub = np.array([_between(prev, P[k], (i + 1) / substeps) for i in range(substeps)])
+            qs = q.copy()
+            so, se = np.empty((substeps, n)), np.empty((substeps, 2))
+            f = kern.track(chain, sub, 0, qs, L, W, (tp, tr), iterations, 0.01, 0.1, 10.0, 2.0, lo, hi,
+                           max(max_step, 0.5), so, se)
+            if f >= substeps and np.abs(qs - q).max() <= max_step:
+                out[k], errs[k] = qs, se[-1]
+                q = qs
+                k += 1
+                continue
+            reason, detail = _why(m, P, k, q, qs, so, se, f, substeps, L, lo, hi, tp, tr, max_step)
+            chosen = _reseat(m, P[k], q, tp, tr)
+            if chosen is None:
+                out[k] = q
+                p1, R1, _ = m.frame_jacobian1(q.tolist())
+                errs[k] = _frame_errors(p1, R1, P[k])
+                reason = "unreachable"
+                detail = "no solution of this waypoint (joint limits ignored); the previous joints are kept"
+            else:
+                out[k] = chosen
+                p1, R1, _ = m.frame_jacobian1(chosen.tolist())
+                errs[k] = _frame_errors(p1, R1, P[k])
+                q = chosen
+            found.append((int(k), reason, detail))
+            k += 1
+        breaks.append(found)
+    joints = _public(m, J)
+    pe, re = E[..., 0], E[..., 1]
+    return PathResult(mechanism=m.name, names=tuple(m.joint_names), joints=joints.reshape(batch + (w, n)),
+                      position_error=pe.reshape(batch + (w,)), rotation_error=re.reshape(batch + (w,)),
+                      solved=((pe <= tp) & (re <= tr)).reshape(batch + (w,)),
+                      breaks=breaks[0] if not batch else breaks, max_step=float(max_step), tol=(tp, tr))
+
+
+def _frame_errors(p, R, row) -> tuple[float, float]:
+    """(position, geodesic rotation) error of frame (p, R) against a frame row (12,)."""
+    T = row[3:].reshape(3, 3)
+    M = np.array(R) @ T.T
+    s = 0.5 * math.sqrt((M[2, 1] - M[1, 2]) ** 2 + (M[0, 2] - M[2, 0]) ** 2 + (M[1, 0] - M[0, 1]) ** 2)
+    return math.dist(p, row[:3].tolist()), math.atan2(s, 0.5 * (np.trace(M) - 1.0))
+
+
+def _why(m, P, k, q, qs, so, se, f, substeps, L, lo, hi, tp, tr, max_step) -> tuple[str, str]:
+    """Why waypoint k cannot be reached on the branch of q (see the module docstring)."""
+    if f < substeps:
+        at = so[f]
+        if se[f, 0] <= tp and se[f, 1] <= tr:
+            out = [m.joint_names[i] for i in range(m.dof) if not lo[i] <= at[i] <= hi[i]]
+            if out:
+                return "joint limit", f"the branch reaches this waypoint only with {', '.join(out)} outside its limits"
+        before = so[f - 1] if f > 0 else q
+        sv = _smallest_singular(m, before, L)
+        if sv < SINGULAR:
+            return "singularity", (f"the branch stops converging next to a singular configuration "
+                                   f"(smallest singular value {sv:.2g})")
+        sv = min(sv, _smallest_singular(m, q, L))
+        if se[f, 0] > tp or se[f, 1] > tr:
+            return "singularity", (f"the branch folds back before this waypoint (no convergence along it; smallest "
+                                   f"singular value {sv:.2g})")
+        return "step", f"a joint moves {np.abs(at - before).max():.3g} between intermediate poses"
+    big = float(np.abs(qs - q).max())
+    sv = min(_smallest_singular(m, q, L), _smallest_singular(m, qs, L))
+    if sv < SINGULAR:
+        return "singularity", f"the branch moves {big:.3g} past a near-singular configuration (smallest singular value {sv:.2g})"
+    return "step", f"the branch moves {big:.3g} between waypoints, above max_step {max_step:g}: waypoints too far apart"
+
+
+def _reseat(m, row, q, tp, tr) -> np.ndarray | None:
+    """The solution of the waypoint (frame row) nearest to q (internal units), every in-limit
+    copy considered; None when there is none."""
+    from .kinematics import _internal
+    T = np.eye(4)
+    T[:3, 3], T[:3, :3] = row[:3], row[3:].reshape(3, 3)
+    tol = (max(tp, ALL_TOL[0]), max(tr, ALL_TOL[1]))
+    try:
+        got = all_solutions(m, T, tol=tol, copies=True) if m.dof <= 6 else \
+            all_solutions(m, T, tol=tol, spread=8)
+    except FkoptError:
+        return None
+    if not len(got):
+        return None
+    cand = _internal(m, got.solutions)
+    return cand[int(np.argmin(np.abs(cand - q).max(axis=1)))].astype(float)

@@ -71,7 +71,7 @@ def _rotation_target(pose, T):
 @njit(cache=True)
 def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, patience, tp, tr, accept_p,
             accept_r, iterations, damping, down, up, step_cap, slo, shi, glo, ghi, revolute, merge_tol, growth,
-            sols, found_at, info):
+            window, held_draws, sols, found_at, info):
     """Distinct converged solutions of one pose (internal units, revolute joints wrapped into
     [-pi, pi)) into ``sols`` (cap, n); returns how many. ``info`` = (starts run, converged
     starts, evaluations, starts after the last new solution, the start that found the last new
@@ -102,15 +102,56 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
     evals = 0
     last_new = -1
     runs = 0
+    nw = n - window + 1 if n > window else 0      # windows of `window` consecutive joints
+    hlo, hhi = np.empty(n), np.empty(n)
+    derived = 0                                  # (solution, window) pairs done
+    tries = 0                                    # draws of the current pair
+    nb = 0                                       # table neighbours run so far
+    draw = 0
     for j in range(max_starts):
-        if j < nn:
-            q0[:] = tq[near_idx[j]]
+        held = derived < k * nw
+        if held:
+            # a found solution with one window of joints drawn afresh and the others held at its
+            # values (their limits set to the value): the solutions that share the held joints
+            # with it (a wrist flip, an elbow flip of three parallel axes) are the window's own
+            # small subproblem, reached in a few steps, where uniform starts rarely land
+            # (the window's values: the farthest from the solution's of 4 hash draws, so that the
+            # start leaves its basin)
+            s_, w_ = derived // nw, derived % nw
+            far = -1.0
+            for c in range(4):
+                _uniform_hash(seed, 1 + w_ + nw * (4 * tries + c), s_, u)
+                acc = 0.0
+                for i in range(w_, min(n, w_ + window)):
+                    d = glo[i] + (ghi[i] - glo[i]) * u[i] - sols[s_, i]
+                    if revolute[i]:
+                        d = _wrap(d)
+                    acc += d * d
+                if acc > far:
+                    far = acc
+                    for i in range(n):
+                        q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
+            for i in range(n):
+                if w_ <= i < w_ + window:
+                    hlo[i], hhi[i] = slo[i], shi[i]
+                else:
+                    q0[i] = sols[s_, i]
+                    hlo[i], hhi[i] = q0[i], q0[i]
+            tries += 1
+        elif nb < nn:
+            q0[:] = tq[near_idx[nb]]
+            nb += 1
         else:
-            _uniform_hash(seed, 0, j - nn, u)
+            _uniform_hash(seed, 0, draw, u)
+            draw += 1
             for i in range(n):
                 q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
-        _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
-                             up, step_cap, slo, shi, glo, ghi, best)
+        if held:
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
+                                 up, step_cap, hlo, hhi, glo, ghi, best)
+        else:
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
+                                 up, step_cap, slo, shi, glo, ghi, best)
         pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
         if W[3] * W[4] * W[5] != 0.0:
             re = max(re, _geodesic(R, T))
@@ -140,15 +181,21 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
                 k += 1
                 new = True
                 last_new = j
-        since = 0 if new else since + 1
-        if since >= patience and since >= growth * (last_new + 1):
+        if held and (new or tries >= held_draws):     # next pair after a new solution or held_draws draws
+            derived += 1
+            tries = 0
+        # the stopping rule counts the neighbour and hash-draw starts only: the derived starts are
+        # bounded (windows per solution) and run before them
+        since = 0 if new else (since if held else since + 1)
+        # nothing found yet: four times the patience before giving a pose up
+        if since >= (patience if k > 0 else 4 * patience) and since >= growth * (last_new + 1):
             break
     info[0], info[1], info[2], info[3], info[4] = runs, converged, evals, since, last_new
     return k
 
 
 def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up, step_cap,
-           glo, ghi, revolute, merge_tol, cap, growth):
+           glo, ghi, revolute, merge_tol, cap, growth, window=3, held_draws=4):
     """:func:`_search` of one pose row with the per-arm constants ``ctx``
     (:func:`fkopt.kinematics._fast_context`) and the unlimited saturation bounds of the search:
     (solutions (k, n) internal units, the start that found each (k,), info (5,))."""
@@ -159,7 +206,7 @@ def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterati
     k = _search(ctx["chain"], pose, float(L), W, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], int(nn),
                 int(seed), int(max_starts), int(patience), float(tol[0]), float(tol[1]), float(accept[0]),
                 float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap), slo, shi,
-                glo, ghi, revolute, float(merge_tol), float(growth), sols, found_at, info)
+                glo, ghi, revolute, float(merge_tol), float(growth), int(window), int(held_draws), sols, found_at, info)
     return sols[:k].copy(), found_at[:k].copy(), info
 
 
