@@ -31,7 +31,9 @@ default the redundant count of joints from the third joint on, IKFast's usual fr
 combination is searched, and the union is returned, each row with its locked values.
 
 **Paths.** ``inverse_path(arm, poses, start=q0)`` follows one branch: waypoint k's loop starts at
-waypoint k-1's answer (no table, no restarts), and the answer passes when it converges within
+waypoint k-1's answer plus the step that reached it (a linear predictor, so that where two branches
+meet at a singularity -- an elbow passing straight -- the path stays on its own; no table, no
+restarts; a redundant arm saturates at its limits, its self-motion absorbing them), and the answer passes when it converges within
 ``tol``, stays inside the limits, and no joint moves more than ``max_step`` (radians, or length
 units for a prismatic joint). A waypoint that does not pass is tried again through ``substeps``
 intermediate poses (position linear, rotation along the geodesic) from the previous answer,
@@ -510,6 +512,9 @@ def inverse_path(arm, poses, *, start, tol=ALL_TOL, max_step: float = MAX_STEP, 
     hi = np.where(per, np.inf, _internal(m, m.bounds[:, 1]))
     chain = m.chain().arrays()
     W = np.ones(6)
+    # a redundant arm saturates at its limits while following (its self-motion absorbs them);
+    # a non-redundant one follows unsaturated, so that a limit shows as a limit break
+    slo, shi = (lo, hi) if m.dof > 6 else (np.full(m.dof, -np.inf), np.full(m.dof, np.inf))
     n = m.dof
     J = np.empty((len(Fp), w, n))
     E = np.empty((len(Fp), w, 2))
@@ -521,8 +526,8 @@ def inverse_path(arm, poses, *, start, tol=ALL_TOL, max_step: float = MAX_STEP, 
         found = []
         k = 0
         while k < w:
-            k = kern.track(chain, P, k, q, L, W, (tp, tr), iterations, 0.01, 0.1, 10.0, 2.0, lo, hi, max_step, out,
-                           errs)
+            k = kern.track(chain, P, k, q, L, W, (tp, tr), iterations, 0.01, 0.1, 10.0, 2.0, lo, hi, slo, shi,
+                           max_step, out, errs)
             if k >= w:
                 break
             # the direct step missed: follow the branch through intermediate poses
@@ -530,7 +535,7 @@ def inverse_path(arm, poses, *, start, tol=ALL_TOL, max_step: float = MAX_STEP, 
             sub = np.array([_between(prev, P[k], (i + 1) / substeps) for i in range(substeps)])
             qs = q.copy()
             so, se = np.empty((substeps, n)), np.empty((substeps, 2))
-            f = kern.track(chain, sub, 0, qs, L, W, (tp, tr), iterations, 0.01, 0.1, 10.0, 2.0, lo, hi,
+            f = kern.track(chain, sub, 0, qs, L, W, (tp, tr), iterations, 0.01, 0.1, 10.0, 2.0, lo, hi, slo, shi,
                            max(max_step, 0.5), so, se)
             if f >= substeps and np.abs(qs - q).max() <= max_step:
                 out[k], errs[k] = qs, se[-1]

@@ -89,3 +89,15 @@ def test_bad_input_is_one_line():
         fkopt.inverse_path(m, np.stack([T, T]), start=np.zeros((3, 6)))
     with pytest.raises(FkoptError, match="expected waypoints"):
         fkopt.inverse_path(m, T[0], start=[0] * 6)
+
+
+def test_an_elbow_passing_straight_keeps_its_branch():
+    """The UR5's elbow crosses 0 (the arm straight, where the elbow-up and elbow-down branches
+    meet): started from the previous answer alone, the loop was as near to the other branch and
+    took it with small steps, a silent flip; the predictor (previous step continued) keeps the
+    path on its own branch, the generating joints."""
+    m = ur5()
+    Q = segment(np.array([-212.0, -277.1, 4.5, -71.6, 6.0, 96.4]), [-203.0, -276.5, -6.0, -64.0, 14.0, 98.8])
+    assert np.abs(np.diff(np.radians(Q), axis=0)).max() <= 0.02 and Q[0, 2] > 0 > Q[-1, 2]
+    r = fkopt.inverse_path(m, m.fk_matrix(Q), start=Q[0])
+    assert r.breaks == [] and np.abs(r.joints - Q).max() < 1e-6

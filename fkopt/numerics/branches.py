@@ -211,11 +211,12 @@ def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterati
 
 
 @njit(cache=True)
-def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up, step_cap, lo, hi, max_step,
-           out, errs):
+def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up, step_cap, lo, hi, slo, shi,
+           max_step, out, errs):
     """Follow the branch through waypoints first, first + 1, ... of ``poses`` from joints ``q``
-    (internal units, updated in place): each waypoint's loop starts at the previous answer,
-    without saturation (the limits are checked after). Answers into ``out`` rows and their
+    (internal units, updated in place): each waypoint's loop starts at the previous answer plus
+    the previous step (a linear predictor), saturating at [slo, shi] (a redundant arm's self-motion then keeps off its limits; +-inf
+    for a non-redundant arm, which has none), the limits [lo, hi] checked after. Answers into ``out`` rows and their
     (position, rotation) errors into ``errs``; returns the first waypoint that did not pass
     (no convergence within tol, a joint step above ``max_step``, or a joint outside [lo, hi]),
     or len(poses) when all passed. ``out`` of the failing row holds the loop's answer."""
@@ -226,12 +227,19 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
     empty = np.empty((0, n))
     r, J = np.empty(6), np.empty((6, n))
     p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
-    free_lo, free_hi = np.full(n, -np.inf), np.full(n, np.inf)
+    vel = np.zeros(n)
+    q0 = np.empty(n)
     for k in range(first, poses.shape[0]):
         _rotation_target(poses[k], T)
         pt = poses[k, :3].copy()
-        _inverse_one(chain, pt, T, Lw, W, q, 1, empty, 0, 0, 1, tp, tr, iterations, damping, down, up, step_cap,
-                     free_lo, free_hi, lo, hi, best)
+        # predictor: the previous step continued (zero on the first waypoint of a call), then the
+        # loop corrects; where two branches meet at a singularity (an elbow passing straight) the
+        # predicted start lies on the branch the path was on, where the previous answer alone is
+        # as near to the other
+        for i in range(n):
+            q0[i] = q[i] + vel[i]
+        _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, 0, 1, tp, tr, iterations, damping, down, up, step_cap,
+                     slo, shi, lo, hi, best)
         pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
         if W[3] * W[4] * W[5] != 0.0:
             re = max(re, _geodesic(R, T))
@@ -244,11 +252,15 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
             inside = inside and lo[i] <= best[i] <= hi[i]
         if not (pe <= tp and re <= tr) or big > max_step or not inside:
             return k
+        for i in range(n):
+            vel[i] = best[i] - q[i]
         q[:] = best
     return poses.shape[0]
 
 
-def track(chain, poses, first, q, L, W, tol, iterations, damping, down, up, step_cap, lo, hi, max_step, out, errs):
+def track(chain, poses, first, q, L, W, tol, iterations, damping, down, up, step_cap, lo, hi, slo, shi, max_step,
+          out, errs):
     """:func:`_track` with typed arguments; returns the first waypoint that did not pass."""
     return _track(chain, poses, int(first), q, float(L), W, float(tol[0]), float(tol[1]), int(iterations),
-                  float(damping), float(down), float(up), float(step_cap), lo, hi, float(max_step), out, errs)
+                  float(damping), float(down), float(up), float(step_cap), lo, hi, slo, shi, float(max_step), out,
+                  errs)
