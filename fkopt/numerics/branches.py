@@ -212,7 +212,7 @@ def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterati
 
 @njit(cache=True)
 def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up, step_cap, lo, hi, slo, shi,
-           max_step, out, errs):
+           max_step, predict, out, errs):
     """Follow the branch through waypoints first, first + 1, ... of ``poses`` from joints ``q``
     (internal units, updated in place): each waypoint's loop starts at the previous answer plus
     the previous step (a linear predictor), saturating at [slo, shi] (a redundant arm's self-motion then keeps off its limits; +-inf
@@ -252,15 +252,16 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
             inside = inside and lo[i] <= best[i] <= hi[i]
         if not (pe <= tp and re <= tr) or big > max_step or not inside:
             return k
-        for i in range(n):
-            vel[i] = best[i] - q[i]
+        if predict:
+            for i in range(n):
+                vel[i] = best[i] - q[i]
         q[:] = best
     return poses.shape[0]
 
 
 def track(chain, poses, first, q, L, W, tol, iterations, damping, down, up, step_cap, lo, hi, slo, shi, max_step,
-          out, errs):
+          out, errs, predict=True):
     """:func:`_track` with typed arguments; returns the first waypoint that did not pass."""
     return _track(chain, poses, int(first), q, float(L), W, float(tol[0]), float(tol[1]), int(iterations),
-                  float(damping), float(down), float(up), float(step_cap), lo, hi, slo, shi, float(max_step), out,
-                  errs)
+                  float(damping), float(down), float(up), float(step_cap), lo, hi, slo, shi, float(max_step),
+                  bool(predict), out, errs)
