@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 import fkopt
-from fkopt.adapters.field import NotApplicable, make_ik
+from fkopt.adapters.field import NotApplicable
+from fkopt.adapters.field.eaik import EAIK
 from fkopt.kinbench.robots import ARMS
 
 ARMS_MEASURED = ("ur3", "ur5", "ur10", "z1", "kinova-j2s6s200", "so101", "ur5e-mj", "spot-arm-mj")
@@ -89,14 +90,14 @@ def measure(name: str, poses: int, seed: int, lock: int | None = None) -> dict:
     keep = np.arange(m.dof)
     try:
         if lock is None:
-            ref = make_ik("eaik", m, timeout=1.0, rng=np.random.default_rng(seed))
+            ref = EAIK(m, timeout=1.0, rng=np.random.default_rng(seed))
         else:
             value = float(m.bounds[lock, 0] + 0.3 * (m.bounds[lock, 1] - m.bounds[lock, 0]))
             q[:, lock] = value
             fixed = {m.joint_names[lock]: value}
             keep = np.delete(keep, lock)
             with tempfile.TemporaryDirectory() as tmp:
-                ref = make_ik("eaik", locked_arm(m, lock, value, Path(tmp)), timeout=1.0,
+                ref = EAIK(locked_arm(m, lock, value, Path(tmp)), timeout=1.0,
                               rng=np.random.default_rng(seed))
     except NotApplicable as err:
         return {"arm": name, "locked": fixed, "eaik": f"not applicable: {err}"}

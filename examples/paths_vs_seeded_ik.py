@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import fkopt
-from fkopt.adapters.field import make_ik
+from fkopt.adapters.field.rtb import RtbLM
+from fkopt.adapters.field.tracik import TracIK
 
 SUITES = Path(__file__).resolve().parents[1] / "configs" / "suites"
 ARMS = ("ur5", "kinova-j2s6s200", "z1", "panda", "iiwa-mj")
@@ -90,15 +91,13 @@ def measure(name: str, paths: int, seed: int) -> dict:
     T = m.fk_matrix(Q)
     digest = hashlib.sha256(np.ascontiguousarray(Q).tobytes()).hexdigest()[:16]
     entries = {"fkopt.inverse_path": lambda k: fkopt.inverse_path(m, T[k], start=Q[k, 0]).joints}
-    for label, key, fn in (("rtb ik_LM, seeded", "rtb-ik_LM", seeded_rtb), ("TRAC-IK, seeded", "tracik", seeded_tracik)):
+    for label, cls, fn in (("rtb ik_LM, seeded", RtbLM, seeded_rtb), ("TRAC-IK, seeded", TracIK, seeded_tracik)):
         try:
-            if key == "tracik":
+            if cls is TracIK:
                 # the adapter's eps (1e-5 per component, for the board's rungs) is above this
                 # bench's 1e-6: the same wrapper with eps 1e-7
-                from fkopt.adapters.field.tracik import TracIK
-                w = type("TracIKFine", (TracIK,), {"EPS": 1e-7})(m, timeout=0.005, rng=np.random.default_rng(seed))
-            else:
-                w = make_ik(key, m, timeout=0.005, rng=np.random.default_rng(seed))
+                cls = type("TracIKFine", (TracIK,), {"EPS": 1e-7})
+            w = cls(m, timeout=0.005, rng=np.random.default_rng(seed))
             entries[label] = (lambda w, fn: lambda k: fn(w, T[k], Q[k, 0]))(w, fn)
         except Exception as err:                        # an entry that cannot read the arm: say why
             entries[label] = f"not available: {err}"

@@ -1,4 +1,4 @@
-"""Every IK solution of a pose: fkopt.inverse(arm, pose, solutions="all") (fkopt/branches.py)."""
+"""Every IK solution of a pose: fkopt.inverse(arm, pose, solutions="all") (fkopt/kinematics/branches.py)."""
 from __future__ import annotations
 
 import json
@@ -124,7 +124,7 @@ def test_copies_lists_each_in_limit_turn_of_a_joint_with_limits_wider_than_a_tur
 def test_a_turn_by_pi_about_the_tool_axis_is_not_a_solution():
     """The rotation vector of R Rt^T vanishes at exactly pi: a check on it alone would accept the
     UR5 with its last joint turned by 180 deg. The search's verification uses the trace too."""
-    from fkopt.branches import _context, _verify
+    from fkopt.kinematics.branches import _context, _verify
     m = stored("ur5")
     q = np.array([10.0, -60.0, 80.0, 20.0, 50.0, 30.0])
     T = m.fk_matrix(q[None])[0]
@@ -175,9 +175,9 @@ def test_all_solutions_recall_against_eaik_on_the_ur5():
     fkopt/adapters/field/eaik.py): fkopt returns at least 99 % of them and no row that fails
     verification at 1e-9 m / 1e-9 rad (docs/robots.md has the 1000-pose measurement per arm)."""
     pytest.importorskip("eaik")
-    from fkopt.adapters.field import make_ik
+    from fkopt.adapters.field.eaik import EAIK
     m = stored("ur5")
-    ref = make_ik("eaik", m, timeout=1.0, rng=np.random.default_rng(0))
+    ref = EAIK(m, timeout=1.0, rng=np.random.default_rng(0))
     rng = np.random.default_rng(11)
     q = m.bounds[:, 0] + (m.bounds[:, 1] - m.bounds[:, 0]) * rng.random((100, m.dof))
     T = m.fk_matrix(q)

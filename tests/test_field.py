@@ -66,9 +66,10 @@ JACOBIAN_FLOOR = {"tracik": (0.02, 0.7), "rtb-ik_LM": (0.02, 0.7), "rtb-ik_NR": 
 
 
 def _needs(solver):
-    from fkopt.adapters.field import PACKAGES
+    from fkopt.registry import SOLVERS
     module = {"pytracik": "pytracik", "roboticstoolbox-python": "roboticstoolbox", "pin": "pinocchio"}
-    pytest.importorskip(module.get(PACKAGES[solver], PACKAGES[solver]))
+    package = SOLVERS[solver].package
+    pytest.importorskip(module.get(package, package))
 
 
 @pytest.mark.parametrize("solver", list(JACOBIAN_FLOOR))
@@ -76,7 +77,8 @@ def _needs(solver):
 def test_field_solver_answers_verified(solver, name):
     """Each wrapper answers reachable in-limit poses; kinbench's own check passes the loose rungs
     on most of them (TRAC-IK misses some: its answers are its own, verified, not trusted)."""
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     _needs(solver)
     timeout, floor = JACOBIAN_FLOOR[solver]
     m = arm(name)
@@ -106,7 +108,8 @@ def test_field_solvers_read_an_mjcf_arm_through_the_written_urdf(solver):
     solves 50 % of these UR5e poses in 20 ms; on the UR5 it solves 95 % through the robot's file
     and through the written URDF alike, so the shortfall is the arm's, not the written file's)."""
     pytest.importorskip("mujoco")
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     _needs(solver)
     timeout, floor = JACOBIAN_FLOOR[solver]
     m = stored("ur5e-mj")
@@ -121,7 +124,7 @@ def test_rtb_reads_the_written_urdf_where_it_misreads_the_robots_file():
     """rtb's FK of iCub's file is 1.5 m off fkopt's and pinocchio's: the wrapper reads the URDF
     written from fkopt's chain instead and says so; the other packages keep the robot's file."""
     pytest.importorskip("roboticstoolbox")
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     m = stored("icub-left")
     w = make_ik("rtb-ik_LM", m, timeout=0.02, rng=np.random.default_rng(1))
     assert "rtb misreads" in w.settings["urdf_note"] and w.settings["urdf"].startswith("written")
@@ -135,7 +138,8 @@ def test_black_box_wrappers_improve_on_their_start_and_never_leave_the_limits(so
     so); here: answers inside the limits, their objective (|dp|^2 + angle^2) under a quarter of
     the median at random joints, and a claim of success is one kinbench confirms."""
     from fkopt.adapters.field import pose_objective
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     _needs(solver)
     m = arm("ur5")
     _, T = targets(m, 2, 6)
@@ -212,10 +216,10 @@ def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits(
     fkopt's FK to 1e-9, the generating configuration is among them (up to whole turns), and the
     board's one answer is one of them."""
     pytest.importorskip("eaik")
-    from fkopt.adapters.field import make_ik
+    from fkopt.adapters.field.eaik import EAIK
     m = stored("ur5")
     q, T = targets(m, 10, 7)
-    w = make_ik("eaik", m, timeout=0.02, rng=np.random.default_rng(0))
+    w = EAIK(m, timeout=0.02, rng=np.random.default_rng(0))
     for k in range(len(q)):
         s = w.solutions(T[k])
         exact = ~s.least_squares & s.in_limits
@@ -230,8 +234,9 @@ def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits(
 
 @pytest.mark.parametrize("name, why", [("panda", "7 joints: EAIK solves 1-6R")])
 def test_eaik_is_not_applicable_to_an_arm_it_cannot_decompose(name, why):
-    """A 7-joint arm is a "not applicable: why" cell, not a zero: make_ik raises NotApplicable."""
+    """A 7-joint arm is a "not applicable: why" cell, not a zero: the wrapper raises NotApplicable."""
     pytest.importorskip("eaik")
-    from fkopt.adapters.field import NotApplicable, make_ik
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.adapters.field.eaik import EAIK
     with pytest.raises(NotApplicable, match=why):
-        make_ik("eaik", stored(name), timeout=0.02, rng=np.random.default_rng(0))
+        EAIK(stored(name), timeout=0.02, rng=np.random.default_rng(0))

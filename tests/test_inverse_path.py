@@ -1,4 +1,4 @@
-"""IK along a path on one branch: fkopt.inverse_path (fkopt/branches.py)."""
+"""IK along a path on one branch: fkopt.inverse_path (fkopt/kinematics/branches.py)."""
 from __future__ import annotations
 
 from pathlib import Path

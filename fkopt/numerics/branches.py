@@ -1,4 +1,4 @@
-"""Compiled kernels of :mod:`fkopt.branches`: every IK solution of one pose by seeded restarts of
+"""Compiled kernels of :mod:`fkopt.kinematics.branches`: every IK solution of one pose by seeded restarts of
 the one-pose loop, and branch following along a path.
 
 Both are built on :func:`fkopt.numerics.compiled._inverse_one` (the damped least-squares loop of
@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .compiled import _evaluate, _inverse_one, _nearest_into, _uniform_hash
+from fkopt.numerics.compiled import _evaluate, _inverse_one, _nearest_into, _uniform_hash
 
 TWO_PI = 2.0 * math.pi
 

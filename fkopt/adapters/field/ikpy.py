@@ -24,8 +24,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from ...errors import FkoptError
-from . import FieldIK, arm_urdf
+from fkopt.errors import FkoptError
+from fkopt.adapters.field import FieldIK, arm_urdf
 
 
 def chain_path(urdf) -> list[str]:

@@ -29,8 +29,8 @@ import time
 
 import numpy as np
 
-from ...errors import FkoptError
-from . import FieldIK, arm_urdf
+from fkopt.errors import FkoptError
+from fkopt.adapters.field import FieldIK, arm_urdf
 
 
 class PinCLIK(FieldIK):

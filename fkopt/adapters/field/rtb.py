@@ -27,8 +27,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from ...errors import FkoptError
-from . import FieldIK, arm_urdf
+from fkopt.errors import FkoptError
+from fkopt.adapters.field import FieldIK, arm_urdf
 
 
 def chain_ets(urdf):
