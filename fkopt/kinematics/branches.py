@@ -338,7 +338,9 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     ``fixed``: {joint name: value} locked joints (public units); ``spread``: K samples per locked
     joint of a redundant arm's self-motion (``spread_joints`` names them); ``tol``: the
     verification tolerances (default :data:`ALL_TOL`); ``seed``: the hash draws' stream;
-    ``patience`` / ``max_starts``: the stopping rule; ``copies``: list every in-limit copy of a
+    ``patience`` / ``max_starts``: the stopping rule (``growth`` > 0 also asks for at least
+    ``growth`` times the starts that found the last new solution; 0 by default, measured no
+    better); ``copies``: list every in-limit copy of a
     joint whose limits span more than 2 pi."""
     from fkopt.kinematics.solvers import _public, _targets, _task_mask, _tolerance, _unreachable
     m = _arm(arm)
@@ -429,10 +431,21 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
                         fixed=fixed_out, search=stats, tol=(tp, tr))
 
 
+#: The keywords of :func:`all_solutions` that ``fkopt.inverse(..., solutions="all")`` passes on.
+ALL_OPTIONS = ("fixed", "spread", "spread_joints", "patience", "growth", "max_starts", "copies",
+               "orientation_scale")
+
+
 def inverse_all(arm, poses, *, tol=None, mask=None, seed: int = 0, **options):
     """``fkopt.inverse(arm, poses, solutions="all")``: one pose -> :class:`AllSolutions`; a batch
     (..., 6) or (..., 4, 4) -> a list of them, rows in C order of the leading axes."""
-    from fkopt.kinematics.solvers import _targets
+    from fkopt.kinematics.solvers import INVERSE_TOL, _targets
+    bad = sorted(set(options) - set(ALL_OPTIONS))
+    if bad:
+        raise FkoptError(f"inverse solutions='all': option {bad[0]!r} is the one-answer solver's; "
+                         f"allowed: tol, mask, seed, {', '.join(ALL_OPTIONS)}")
+    if tol is INVERSE_TOL:                         # the one-answer default passed on: this search's own
+        tol = None
     m = _arm(arm)
     P = _targets(m, poses)
     if P.ndim == 1:

@@ -1268,7 +1268,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
             table: int = 4096, neighbours: int = 32, tail: int = 256, compiled: bool | None = None,
-            options=None, solutions: str = "one", **every) -> InverseResult:
+            options=None) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
@@ -1299,18 +1299,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     ``numpy``; same answers as the Python loop). ``options``: an
     :class:`fkopt.numerics.InverseOptions` holding all of the above at once (it replaces the
     keywords). See the module docstring.
-
-    ``solutions="all"``: every solution of each pose instead of one (:mod:`fkopt.kinematics.branches`; an
-    :class:`fkopt.kinematics.branches.AllSolutions` per pose, a list for a batch); it takes ``tol`` (default
-    1e-9, 1e-9 then), ``mask``, ``seed`` and the keywords of :func:`fkopt.kinematics.branches.all_solutions`
-    (``fixed``, ``spread``, ``copies``, ``patience``, ...).
     """
-    if solutions != "one" or every:
-        if solutions != "all":
-            raise FkoptError(f"inverse solutions: expected 'one' or 'all', got {solutions!r}")
-        from fkopt.kinematics.branches import inverse_all
-        return inverse_all(arm, poses, tol=None if tol is INVERSE_TOL else tol, mask=mask, seed=seed,
-                           orientation_scale=orientation_scale, **every)
     if options is not None:
         o = options.as_dict()
         restarts, starts, rest, orientation_scale = o["restarts"], o["starts"], o["rest"], o["orientation_scale"]
