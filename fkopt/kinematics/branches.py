@@ -307,6 +307,17 @@ def _verify(m, ctx, pose_row: np.ndarray, public_full: np.ndarray, W) -> tuple[f
     return math.hypot(*dp), re
 
 
+def _windows(n: int) -> list[tuple[int, int]]:
+    """The derived starts' windows (first, last joint drawn afresh; the others held): every three
+    consecutive joints (a wrist, three parallel axes); all but the first joint (the solutions
+    that share the base rotation: a UR's four per shoulder side, which a near-straight wrist
+    makes hard to reach otherwise); and every joint, from the first turned by pi (the other
+    shoulder side; the kernel reads the window (0, n - 1) so)."""
+    if n <= 3:
+        return []
+    return [(i, i + 2) for i in range(n - 2)] + ([(1, n - 1), (0, n - 1)] if n > 4 else [])
+
+
 def _spread_locks(m, spread, spread_joints, redundancy: int) -> list[dict[int, float]]:
     """The locked values of ``spread``: K values per locked joint at the centres of K equal bins
     of its limits, every combination."""
@@ -383,7 +394,7 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
         nn = min(NEIGHBOURS, len(ctx["tq"]))
         sols, found_at, info = kern.search(ctx, row, L, ctx["W"], nn, int(seed), int(max_starts), int(patience), SEARCH_TOL,
                                  ACCEPT_TOL, ITERATIONS, 0.01, 0.1, 10.0, 2.0, ctx["glo"], ctx["ghi"],
-                                 ctx["revolute"], MERGE_TOL, CAP, float(growth))
+                                 ctx["revolute"], MERGE_TOL, CAP, float(growth), _windows(ctx["n"]))
         stats["starts"] += int(info[0])
         stats["converged"] += int(info[1])
         stats["evaluations"] += int(info[2])

@@ -71,7 +71,7 @@ def _rotation_target(pose, T):
 @njit(cache=True)
 def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, patience, tp, tr, accept_p,
             accept_r, iterations, damping, down, up, step_cap, slo, shi, glo, ghi, revolute, merge_tol, growth,
-            window, held_draws, sols, found_at, info):
+            wfirst, wlast, held_draws, sols, found_at, info):
     """Distinct converged solutions of one pose (internal units, revolute joints wrapped into
     [-pi, pi)) into ``sols`` (cap, n); returns how many. ``info`` = (starts run, converged
     starts, evaluations, starts after the last new solution, the start that found the last new
@@ -102,7 +102,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
     evals = 0
     last_new = -1
     runs = 0
-    nw = n - window + 1 if n > window else 0      # windows of `window` consecutive joints
+    nw = wfirst.shape[0]                         # windows: joints wfirst[w] .. wlast[w] drawn afresh
     hlo, hhi = np.empty(n), np.empty(n)
     derived = 0                                  # (solution, window) pairs done
     tries = 0                                    # draws of the current pair
@@ -122,7 +122,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
             for c in range(4):
                 _uniform_hash(seed, 1 + w_ + nw * (4 * tries + c), s_, u)
                 acc = 0.0
-                for i in range(w_, min(n, w_ + window)):
+                for i in range(wfirst[w_], wlast[w_] + 1):
                     d = glo[i] + (ghi[i] - glo[i]) * u[i] - sols[s_, i]
                     if revolute[i]:
                         d = _wrap(d)
@@ -132,11 +132,15 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
                     for i in range(n):
                         q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
             for i in range(n):
-                if w_ <= i < w_ + window:
+                if wfirst[w_] <= i <= wlast[w_]:
                     hlo[i], hhi[i] = slo[i], shi[i]
                 else:
                     q0[i] = sols[s_, i]
                     hlo[i], hhi[i] = q0[i], q0[i]
+            if wfirst[w_] == 0 and wlast[w_] == n - 1 and revolute[0]:
+                # the whole arm free, from the solution's first joint turned by pi: the other
+                # shoulder side (its solutions share no joint with this one)
+                q0[0] = sols[s_, 0] + math.pi
             tries += 1
         elif nb < nn:
             q0[:] = tq[near_idx[nb]]
@@ -195,18 +199,21 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
 
 
 def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up, step_cap,
-           glo, ghi, revolute, merge_tol, cap, growth, window=3, held_draws=4):
+           glo, ghi, revolute, merge_tol, cap, growth, windows, held_draws=4):
     """:func:`_search` of one pose row with the per-arm constants ``ctx``
     (:func:`fkopt.kinematics._fast_context`) and the unlimited saturation bounds of the search:
     (solutions (k, n) internal units, the start that found each (k,), info (5,))."""
     n = ctx["n"]
+    wfirst = np.array([w[0] for w in windows], dtype=np.int64)
+    wlast = np.array([w[1] for w in windows], dtype=np.int64)
     sols, info, found_at = np.empty((cap, n)), np.zeros(5), np.zeros(cap, dtype=np.int64)
     slo = np.where(revolute, -np.inf, ctx["lo"])
     shi = np.where(revolute, np.inf, ctx["hi"])
     k = _search(ctx["chain"], pose, float(L), W, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], int(nn),
                 int(seed), int(max_starts), int(patience), float(tol[0]), float(tol[1]), float(accept[0]),
                 float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap), slo, shi,
-                glo, ghi, revolute, float(merge_tol), float(growth), int(window), int(held_draws), sols, found_at, info)
+                glo, ghi, revolute, float(merge_tol), float(growth), wfirst, wlast, int(held_draws), sols,
+                found_at, info)
     return sols[:k].copy(), found_at[:k].copy(), info
 
 
