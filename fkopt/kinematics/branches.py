@@ -7,8 +7,11 @@ configurations nearest to the target in tool pose, then counter-based hash draws
 joints over one turn, prismatic joints inside their limits); each start runs the damped
 least-squares loop without revolute limits to ``SEARCH_TOL`` (a solution is one modulo 2 pi per
 revolute joint), converged answers are wrapped and merged when every joint agrees within
-``MERGE_TOL``. **Stopping rule**: the search stops after ``patience`` consecutive starts that
-found nothing new, or after ``max_starts``. It is a rule, not a certificate: a branch whose basin
+``MERGE_TOL``. Each solution found adds *derived* starts (:func:`_windows`): a window of joints
+drawn afresh with the others held at its values, which reach the solutions sharing those joints
+with it (wrist and elbow flips, the other shoulder side) where uniform starts rarely land.
+**Stopping rule**: the search stops after ``patience`` consecutive table or hash starts that
+found nothing new (four times that while none is found), or after ``max_starts``. It is a rule, not a certificate: a branch whose basin
 of attraction is small can be missed; its measured miss rate against EAIK's analytic sets is in
 docs/robots.md, and ``result.search`` reports the starts run and the starts since the last new
 solution, so a caller can ask for a larger ``patience``.
