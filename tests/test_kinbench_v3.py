@@ -246,14 +246,14 @@ def fk_submission(tmp_path, make_rows):
     return load_suite(path), arms
 
 
-def least_squares_rows(mech, generating, starts=4):
+def least_squares_rows(mech, generating, starts=4, seed=7):
     """The outside artefact: scipy.optimize.least_squares (trf, its defaults but tolerances 1e-15)
     on each frozen query's leg lengths, from ``starts`` random starts in the mechanism's bounds
     (seeded), the first start's wall time as the answer's and the second's as the reference's
     (scipy least_squares is the FK reference), the pose of the smallest residual returned."""
     import time
     from scipy.optimize import least_squares
-    rng = np.random.default_rng(7)
+    rng = np.random.default_rng(seed)
     lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
     rows = []
     for i, x in enumerate(generating):
@@ -285,7 +285,16 @@ def test_fk_answers_of_scipy_least_squares_submitted_are_verified_by_the_mechani
     SPOILT = 2
 
     def rows(mech, generating):
-        df = least_squares_rows(mech, generating)
+        # scipy's seeded starts must reach the generating pose once and another assembly mode once
+        # (both counts are tested below); which seeds do depends on the platform's LAPACK, so the
+        # first seed from 7 that does is taken
+        for seed in range(7, 47):
+            df = least_squares_rows(mech, generating, seed=seed)
+            keep = df.index != SPOILT
+            near = np.linalg.norm(df[[f"x{d}" for d in range(3)]].to_numpy() - generating[:, :3], axis=1) <= 1e-6
+            solved = df["residual_by_scipy"].to_numpy() <= 1e-5
+            if (near & keep).any() and (solved & ~near & keep).any():
+                break
         made["scipy"] = df.copy()
         df.loc[SPOILT, "x0"] += 1e-3                # Dietmaier's platform is in m: 1 mm off, claimed
         df.loc[SPOILT, "claimed"] = True
