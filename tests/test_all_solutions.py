@@ -191,3 +191,13 @@ def test_all_solutions_recall_against_eaik_on_the_ur5():
             total += 1
             missed += int(not len(r) or turns_gap(r.solutions, row).min() > 1e-4)
     assert failed == 0 and total > 500 and missed <= 0.01 * total
+
+
+def test_without_the_compiled_path_it_refuses_with_one_line(monkeypatch):
+    m = stored("ur5")
+    T = m.fk_matrix(np.array([[20.0, -70.0, 60.0, 30.0, 40.0, 50.0]]))[0]
+    monkeypatch.setenv("FKOPT_NUMERICS", "numpy")
+    with pytest.raises(FkoptError, match="need numba"):
+        fkopt.inverse(m, T, solutions="all")
+    with pytest.raises(FkoptError, match="need numba"):
+        fkopt.inverse_path(m, T[None], start=[20.0, -70.0, 60.0, 30.0, 40.0, 50.0])

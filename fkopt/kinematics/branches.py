@@ -257,7 +257,7 @@ def _context(m, locked: dict[int, float], W) -> dict:
 
 def _kernels():
     from fkopt.numerics import path as numerics_path
-    if numerics_path.compiled(True) is None:          # pragma: no cover - FKOPT_NUMERICS=numpy
+    if numerics_path.compiled(True) is None:          # FKOPT_NUMERICS=numpy
         raise FkoptError("inverse solutions='all' and inverse_path run on the compiled kernels; "
                          "they need numba (pip install numba) and FKOPT_NUMERICS other than numpy")
     from fkopt.numerics import branches
