@@ -101,3 +101,16 @@ def test_an_elbow_passing_straight_keeps_its_branch():
     assert np.abs(np.diff(np.radians(Q), axis=0)).max() <= 0.02 and Q[0, 2] > 0 > Q[-1, 2]
     r = fkopt.inverse_path(m, m.fk_matrix(Q), start=Q[0])
     assert r.breaks == [] and np.abs(r.joints - Q).max() < 1e-6
+
+
+def test_waypoints_whose_solutions_all_lie_outside_the_limits_are_joint_limit_breaks_not_unreachable():
+    """The base limited to [-10, 10] deg and the path turning it from 0 to 30 deg: past 10 deg
+    every solution of a waypoint needs the base outside its limits (the other shoulder side too),
+    so those waypoints are 'joint limit' breaks with the previous joints kept, never 'unreachable'."""
+    m = ur5(bounds={"shoulder_pan_joint": [-10.0, 10.0]})
+    Q = segment(np.array([0.0, -70, 60, 20, 50, 30]), [30.0, -70, 60, 20, 50, 30], 40)
+    r = fkopt.inverse_path(m, m.fk_matrix(Q), start=Q[0])
+    past = np.flatnonzero(Q[:, 0] > 10.0 + 1e-9)
+    assert [k for k, _, _ in r.breaks] == past.tolist()
+    assert {why for _, why, _ in r.breaks} == {"joint limit"}
+    assert not r.solved[past].any() and r.solved[:past[0]].all() and m.in_bounds(r.joints).all()

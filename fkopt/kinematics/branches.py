@@ -579,14 +579,18 @@ def inverse_path(arm, poses, *, start, tol=ALL_TOL, max_step: float = MAX_STEP, 
                 continue
             reason, detail = _why(m, P, k, q, qs, so, se, f, substeps, L, lo, hi, tp, tr, max_step)
             chosen = _reseat(m, P[k], q, tp, tr)
-            if chosen is None:
+            if chosen is None or isinstance(chosen, str):
                 out[k] = q
                 p1, R1, _ = m.frame_jacobian1(q.tolist())
                 errs[k] = _frame_errors(p1, R1, P[k])
-                reason = "unreachable"
-                detail = ("no solution of this waypoint (joint limits ignored); the previous joints are kept"
-                          if m.dof <= 6 else "fkopt.inverse found no solution inside the limits (restarts; no "
-                          "certificate for a redundant arm); the previous joints are kept")
+                if isinstance(chosen, str):
+                    reason, detail = "joint limit", ("every solution of this waypoint lies outside the joint limits; "
+                                                     "the previous joints are kept")
+                else:
+                    reason = "unreachable"
+                    detail = ("no solution of this waypoint (joint limits ignored); the previous joints are kept"
+                              if m.dof <= 6 else "fkopt.inverse found no solution inside the limits (restarts; no "
+                              "certificate for a redundant arm); the previous joints are kept")
             else:
                 out[k] = chosen
                 p1, R1, _ = m.frame_jacobian1(chosen.tolist())
@@ -643,9 +647,10 @@ def _why(m, P, k, q, qs, so, se, f, substeps, L, lo, hi, tp, tr, max_step) -> tu
     return "step", f"the branch moves {big:.3g} between waypoints, above max_step {max_step:g}: waypoints too far apart"
 
 
-def _reseat(m, row, q, tp, tr) -> np.ndarray | None:
+def _reseat(m, row, q, tp, tr) -> np.ndarray | str | None:
     """The solution of the waypoint (frame row) nearest to q (internal units), every in-limit
-    copy considered; None when there is none."""
+    copy considered; "outside" when its solutions all lie outside the limits; None when there is
+    none."""
     from fkopt.kinematics.solvers import _internal
     T = np.eye(4)
     T[:3, 3], T[:3, :3] = row[:3], row[3:].reshape(3, 3)
@@ -664,6 +669,7 @@ def _reseat(m, row, q, tp, tr) -> np.ndarray | None:
     except FkoptError:
         return None
     if not len(got):
-        return None
+        # solutions that all lie outside the limits: the waypoint is reachable, not inside them
+        return "outside" if got.search["distinct"] > got.search["unverified"] else None
     cand = _internal(m, got.solutions)
     return cand[int(np.argmin(np.abs(cand - q).max(axis=1)))].astype(float)
