@@ -32,6 +32,8 @@ Every config file, geometry file and results folder of fkopt goes through this m
   reading, ``.gz`` streamed with a cap on the unpacked size; :func:`read_text`,
   :func:`parse_json` / :func:`read_json` (strict JSON) on top. :func:`odd_entries` lists what a
   results folder must not hold (links, FIFOs, devices).
+* :func:`parse_xml` -- the one XML reader of robot files (URDF, MJCF): nesting bounded by
+  :data:`MAX_XML_DEPTH` while parsing.
 * :func:`file_names` -- collision-free file-name stems for user-given names.
 * :func:`strict_json` and :func:`md_text` -- strict JSON output and Markdown-escaped text.
 * :func:`error_line` -- one line from a pydantic ``ValidationError`` (field path and message).
@@ -116,9 +118,23 @@ def _loader():
                         None, None, f"duplicate key '{key}' (first at line {seen[key] + 1})",
                         key_node.start_mark)
                 seen[key] = key_node.start_mark.line
+            for key_node, value_node in node.value:      # a non-finite number names its field
+                if value_node.tag == "tag:yaml.org,2002:float":
+                    try:
+                        self.construct_yaml_float(value_node)
+                    except yaml.constructor.ConstructorError as err:
+                        raise yaml.constructor.ConstructorError(
+                            None, None, f"{self.construct_object(key_node, deep=True)}: {err.problem}",
+                            value_node.start_mark) from None
             return super().construct_mapping(node, deep=deep)
 
     Loader.add_constructor("tag:yaml.org,2002:float", Loader.construct_yaml_float)
+    # YAML 1.2's floats without a dot (1e-10, 2E5), which PyYAML (YAML 1.1) reads as text: a file
+    # writes `threshold: 1e-10` and means a number, and text is refused where a number belongs
+    # (no_quoted_numbers), so a quoted "300" stays text and is refused with one line
+    import re as _re
+    Loader.add_implicit_resolver("tag:yaml.org,2002:float", _re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"),
+                                 list("-+0123456789"))
     return Loader
 
 
@@ -247,6 +263,43 @@ def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str |
                          f"{err.start})") from None
 
 
+#: Deepest element nesting of an XML robot file (URDF, MJCF and every file an MJCF includes):
+#: URDF is 3-4 deep, MJCF nests one body per link (real arms and humanoids: under 40). Checked
+#: while parsing, before any outside library reads the file: TRAC-IK's parser crashed (exit 139)
+#: on a URDF nested 100,000 deep outside the chain.
+MAX_XML_DEPTH = 256
+
+
+def parse_xml(data: bytes | str, where: str, max_depth: int = MAX_XML_DEPTH):
+    """The root element of an XML document (the standard library's parser, streamed), refused
+    with one line naming ``where`` once an element lies deeper than ``max_depth`` (the rest is
+    never parsed) or the XML is malformed."""
+    import xml.etree.ElementTree as ET
+    parser = ET.XMLPullParser(events=("start", "end"))
+    depth, root, step = 0, None, 1 << 16
+
+    def events():
+        nonlocal depth, root
+        for event, element in parser.read_events():
+            if root is None:
+                root = element
+            depth += 1 if event == "start" else -1
+            if depth > max_depth:
+                raise FkoptError(f"{where}: elements nested deeper than {max_depth} levels; refused "
+                                 "before any parser of an outside package reads it")
+    try:
+        for i in range(0, len(data), step):
+            parser.feed(data[i:i + step])
+            events()
+        parser.close()
+        events()
+    except ET.ParseError as err:
+        raise FkoptError(f"{where}: malformed XML ({err})") from None
+    if root is None:
+        raise FkoptError(f"{where}: malformed XML (no element)")
+    return root
+
+
 def parse_json(data: bytes, where: str) -> Any:
     """Strict JSON from the bytes of a file fkopt did not write (``where`` names it): UTF-8,
     ``NaN``/``Infinity`` refused, nesting bounded; every failure is one line."""
@@ -373,6 +426,76 @@ def field_names_at(model, loc: list[str]) -> list[str]:
     return sorted(set(names))
 
 
+def _numeric_only(annotation) -> bool:
+    """Whether a field's type takes numbers (int, float, bool; Optional of them) and no text."""
+    import typing
+    if annotation in (int, float, bool):
+        return True
+    args = typing.get_args(annotation)
+    origin = typing.get_origin(annotation)
+    if origin is typing.Annotated:
+        return _numeric_only(args[0])
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType", None)) and args:
+        kinds = [a for a in args if a is not type(None)]
+        return bool(kinds) and all(_numeric_only(a) for a in kinds)
+    return False
+
+
+def no_quoted_numbers(cls, value, info):
+    """A pydantic ``field_validator("*", mode="before")``: text where a number belongs is refused
+    (``iterations: "300"``), as a YAML file means a number only unquoted; pydantic's lax mode
+    would turn "300" into 300 silently. Lists of numbers are checked item by item. Fields that
+    also take text (a union with str or a Literal) keep it."""
+    import typing
+    field = cls.model_fields.get(info.field_name) if info.field_name else None
+    if field is None:
+        return value
+    annotation = field.annotation
+    items = None
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if typing.get_origin(annotation) is typing.Union or type(None) in args:    # Optional[list[float]]
+        kinds = [a for a in args if a is not type(None)]
+        if len(kinds) == 1:
+            annotation = kinds[0]
+            origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if origin in (list, tuple) and args:
+        inner = [a for a in args if a is not Ellipsis]
+        if inner and all(_numeric_only(a) for a in inner) and isinstance(value, (list, tuple)):
+            items = value
+    elif origin is dict and len(args) == 2 and _numeric_only(args[1]) and isinstance(value, dict):
+        items = list(value.values())
+    if isinstance(value, str) and _numeric_only(annotation):
+        raise ValueError(_text_for_number(value, "a number"))
+    for v in items or ():
+        if isinstance(v, str):
+            raise ValueError(_text_for_number(v, "numbers"))
+    return value
+
+
+def _text_for_number(text: str, wanted: str) -> str:
+    import math
+    try:
+        number = float(text)
+    except ValueError:
+        return f"needs {wanted}, got the text {short_token(repr(text))}"
+    if not math.isfinite(number):
+        return f"needs {wanted} (finite), got the text {short_token(repr(text))}"
+    return f"needs {wanted}, got the text {short_token(repr(text))} (write it without quotes)"
+
+
+def field_path(loc) -> str:
+    """A field's path as every message of fkopt writes it: names joined by dots, list items by
+    index in brackets (``cases[0].pose``, ``algorithms[1].params.limit``), from a pydantic
+    error's ``loc`` (list indices are ints there)."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
 def did_you_mean(word: str, names) -> str:
     """`` (did you mean 'x'?)`` for the closest of ``names`` (difflib, as the CLI's options), else ``""``."""
     import difflib
@@ -415,11 +538,12 @@ def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dic
             union = branch in tags or branch.startswith("list[")
             if union and not branch.startswith(wanted[loc[0]]):
                 continue
-        loc = [p for p in loc if p not in tags and not p.startswith(("function-", "list[", "literal["))]
+        loc = [p for p in e["loc"] if isinstance(p, int)
+               or (p not in tags and not str(p).startswith(("function-", "list[", "literal[")))]
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
             msg = "unknown field" + (hint.get(id(e)) or "")
-        return f"{'.'.join(loc)}: {msg}" if loc else msg
+        return f"{field_path(loc)}: {msg}" if loc else msg
     return str(err).splitlines()[0]
 
 
@@ -508,6 +632,23 @@ def output_folder(out: str | Path, *parts: str, option: str = "--out") -> Path:
     except OSError as err:
         raise FkoptError(f"{option}: cannot write into {parent} ({err.strerror or err})") from None
     return target
+
+
+@contextlib.contextmanager
+def no_empty_folders_left(folders):
+    """Run the block; if it fails (an error, Ctrl-C), remove those of ``folders`` that did not
+    exist before it and are empty after it (deepest first): an interrupted fresh run leaves no
+    empty ``OUT/<paper>/`` behind. A folder holding anything is never touched."""
+    fresh = sorted({Path(f) for f in folders if not Path(f).exists()}, key=lambda p: -len(p.parts))
+    try:
+        yield
+    except BaseException:
+        for folder in fresh:
+            try:
+                folder.rmdir()            # only an empty folder: rmdir refuses anything else
+            except OSError:
+                pass
+        raise
 
 
 # -- atomic writes ---------------------------------------------------------------------------------

@@ -69,6 +69,7 @@ from fkopt.adapters.field.scipy_fk import LeastSquaresFK
 from fkopt.adapters.field.tracik import TracIK
 from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS
 from fkopt.algorithms.abc import ABC
+from fkopt.algorithms.abc_wang7dof import ABCWang7dof
 from fkopt.algorithms.aco import ACO
 from fkopt.algorithms.base import Algorithm
 from fkopt.algorithms.dls import DLS
@@ -121,6 +122,7 @@ def _field(cls, role=IK, display=""):
 #: their own packages (the library adapters are :data:`ADAPTER_FAMILIES`).
 SOLVERS: dict[str, SolverEntry] = {e.name: e for e in (
     _optimiser("abc", ABC, "black-box", "ABC"),
+    _optimiser("abc-wang7dof", ABCWang7dof, "black-box", "ABC (wang7dof eqs. 7-8)"),   # the ABC as wang7dof prints it
     _optimiser("gabc", GABC, "black-box", "GABC"),
     _optimiser("aco", ACO, "black-box", "ACO"),
     _optimiser("pso", PSO, "black-box", "PSO"),
@@ -338,7 +340,8 @@ def _load(table: dict[str, type], kind: str, name: str):
                              "--allow-plugins imports it, if you trust the results folder)")
         return check_class(_import_target(name, kind, name), kind, name)
     allowed = did_you_mean(name, [*table, *eps])
-    raise FkoptError(f"unknown {kind} '{name}'; allowed: {allowed}, "
+    from fkopt.files import did_you_mean as closest     # the one "did you mean" of field names too
+    raise FkoptError(f"unknown {kind} '{name}'{closest(name, [*table, *eps])}; allowed: {allowed}, "
                      + ("scipy:NAME, pymoo:NAME, niapy:NAME, " if kind == "algorithm" else "")
                      + "or package.module:Class of an installed plug-in")
 

@@ -83,11 +83,13 @@ def test_fk_says_which_stage_found_the_pose():
 
 
 def test_list_fits_80_columns():
-    proc = fkopt("list", columns=80)
-    assert proc.returncode == 0
-    wide = [line for line in proc.stdout.splitlines() if len(line) > 80]
-    assert not wide, wide[:2]
-    assert "3-rpupc-ups" in proc.stdout and "q1..q7 [deg]" in proc.stdout
+    for args in (["list"], ["list", "--long"]):
+        proc = fkopt(*args, columns=80)
+        assert proc.returncode == 0
+        wide = [line for line in proc.stdout.splitlines() if len(line) > 80]
+        assert not wide, wide[:2]
+        assert "3-rpupc-ups" in proc.stdout
+    assert "q1..q7 [deg]" in proc.stdout                      # --long: the units of each name
 
 
 def test_unit_groups():

@@ -143,8 +143,9 @@ CORPUS = [
     ("geometry-bomb", BOMB, ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"], ["anchors and aliases"]),
     ("geometry-inf", "ra: .inf\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
      ["not a finite number"]),
+    # 1e400 is a number (YAML 1.2's float without a dot, as fkopt reads YAML): its field and line named
     ("geometry-overflow-text", "ra: 1e400\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
-     ["geometry.ra", "finite"]),
+     ["ra: '1e400'", "not a finite number"]),
     ("geometry-overflow", "ra: 1.0e+400\n", ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{f}"],
      ["not a finite number"]),
     ("geometry-missing", None, ["ik", "3-rps", "--pose", "alpha=0,beta=0,z=600", "--geometry", "{root}/nope.yaml"],
@@ -890,7 +891,13 @@ def _interrupt(tmp_path, prev, slow, command, how):
     p = subprocess.Popen([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q",
                           "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True, env=env)
-    time.sleep(3.0)                  # imports and validation take about a second; then it computes
+    # interrupt once it computes: its lock file (OUT/<paper>/.<name>.lock) appears after imports and
+    # validation (about a second on an idle machine, far longer on a loaded one), then half a second
+    lock = out / slow["paper"] / f".{slow['name']}.lock"
+    deadline = time.monotonic() + 240
+    while not lock.exists() and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)
     assert p.poll() is None, "the rerun finished before it could be interrupted; make SLOW slower"
     os.killpg(p.pid, how)
     _, err = p.communicate(timeout=60)

@@ -125,7 +125,9 @@ def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
     assert any("fkopt.inverse" in line and "success 100 / 100 / 100 / 100 %" in line for line in lines)
     assert "Per robot, on the clock" in (folder / "leaderboard.md").read_text()
     page = (folder / "index.html").read_text()
-    assert page.index("Per robot, on the clock") < page.index('alt="clock_ur5"') < page.index("<h2>overall")
+    assert page.index("Which solver for my arm") < page.index("Summary per solver") < page.index('alt="clock_all"')
+    arms = (folder / "arms.html").read_text()
+    assert arms.index('id="arm-ur5"') < arms.index('alt="clock_ur5"') < arms.index('id="arm-panda"')
     assert (folder / "clock_panda.png").exists() and (folder / "clock_panda.pdf").exists()
 
 
@@ -397,7 +399,7 @@ def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "pytracik", None)          # import pytracik -> ImportError
     with pytest.raises(FkoptError, match=r"field solver 'tracik' needs pytracik \(pip install -e \"\.\[field\]\"\)"):
         make_ik("tracik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
-    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: tracik, rtb-ik_LM"):
+    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: fkopt.inverse, tracik, rtb-ik_LM"):
         make_ik("trac-ik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
 
 

@@ -277,7 +277,7 @@ class SuiteConfig(Located):
             try:                                                       # its fields first, then the draws
                 checked = SuiteProblem(**p).model_dump(mode="json")
             except ValidationError as err:
-                raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
+                raise ValueError(f"problems[{i}].{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
             from fkopt.kinbench.instances import expand
@@ -426,6 +426,8 @@ class SuiteConfig(Located):
         data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci", subsets=[])
         if q.problems:
             data["problems"] = [p for p in data["problems"] if p["name"] in q.problems]
+        if data.get("title"):     # the suite's title counts the suite's arms, not the tier's
+            data["title"] = f"{data['title']} -- quick tier: {len(data['problems'])} of its {len(self.problems)} problems"
         if q.solvers:
             data["solvers"] = [s for s in data["solvers"] if (s.get("label") or s["name"]) in q.solvers]
         for key in ("sets", "poses", "runs", "budget_per_dim"):

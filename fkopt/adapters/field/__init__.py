@@ -1,8 +1,10 @@
 """The field's solvers through their own packages (``pip install -e ".[field]"``), for kinbench v3.
 
 Every IK wrapper here takes a fkopt URDF or MJCF arm (:class:`fkopt.mechanisms.urdf.URDFArm`,
-:class:`fkopt.mechanisms.mjcf.MJCFArm`) and reads it as URDF (:func:`arm_urdf`: the robot's own
-file, or for an MJCF arm the URDF written from fkopt's chain, ``settings["urdf"]`` says which), is built
+:class:`fkopt.mechanisms.mjcf.MJCFArm`) and reads it as URDF (:func:`arm_urdf`: always the URDF
+fkopt writes from its own parsed chain, never the robot's file as it stands -- roboticstoolbox
+runs xacro on what it reads, and xacro evaluates ``${...}`` in any attribute, even in elements
+fkopt ignores, issue 42; ``settings["urdf"]`` says so), is built
 once per arm (the package parses the file, outside the clock) and answers one target pose at a
 time: :meth:`FieldIK.solve1` takes a 4x4 tip frame in the arm's base frame (m) and returns the
 joints in fkopt's public units (deg, m) or ``None`` when the package gave no answer, plus what
@@ -97,26 +99,78 @@ class ArmURDF:
             yield path
 
     @classmethod
-    def from_file(cls, path, base_link: str, tip_link: str) -> "ArmURDF":
-        """A URDF file as it is (the joints are not listed)."""
+    def from_file(cls, path, base_link: str, tip_link: str, joint_names: tuple[str, ...] = ()) -> "ArmURDF":
+        """A URDF file as it stands, for files fkopt did not take from a user (example-robot-data's
+        robots in ``fkopt bench``): read bounded and refused with one line unless
+        :func:`check_expression_free` proves nothing in it would be evaluated."""
         from fkopt.files import read_text
         from fkopt.mechanisms.urdf import MAX_URDF_BYTES
-        return cls(read_text(path, MAX_URDF_BYTES, field="urdf geometry.file"), base_link, tip_link, (), str(path))
+        text = read_text(path, MAX_URDF_BYTES, field="urdf geometry.file")
+        check_expression_free(text, str(path))
+        return cls(text, base_link, tip_link, tuple(joint_names), str(path))
 
 
-def arm_urdf(arm, *, written: bool = False) -> ArmURDF:
-    """The robot's own URDF file when ``arm`` was read from one without a tool frame (the file as
-    people use it), else -- an MJCF arm, a DH table, a tool frame, or ``written`` -- the URDF
-    written from fkopt's chain (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, FK-checked
-    against MuJoCo in tests/test_urdf_writer.py)."""
-    own = getattr(arm, "name", None) == "urdf" and getattr(arm.geometry_values(), "tool", None) is None
-    if own and not written:
-        mine = ArmURDF.from_file(arm.path, arm.base_link, arm.tip_link)
-        return ArmURDF(mine.text, mine.base_link, mine.tip_link, tuple(arm.joint_names), mine.source)
+#: What xacro (run by roboticstoolbox on every file it reads) would evaluate: ``${expr}`` and
+#: ``$(substitution)`` in attribute values and text.
+_EXPRESSION = ("${", "$(")
+
+
+def check_expression_free(text: str, where: str) -> None:
+    """Refuse (one line naming ``where``) a URDF text holding anything xacro would act on, read as
+    xacro reads it (qualified names kept, entities decoded: ``&#36;{`` is ``${`` to xacro, and
+    nesting bounded like :func:`fkopt.files.parse_xml`): an element or attribute with the
+    ``xacro:`` prefix (macros, includes, properties), or ``${`` or ``$(`` in any attribute value
+    or text. A namespace declaration alone (``xmlns:xacro`` on ``<robot>``, as most of
+    example-robot-data's files have) holds nothing to act on and passes."""
+    import xml.parsers.expat
+    from fkopt.files import MAX_XML_DEPTH
+    parser = xml.parsers.expat.ParserCreate()          # no namespace processing: names as xacro sees them
+    depth = 0
+
+    def refuse(why):
+        raise FkoptError(f"{where}: {why}; fkopt hands outside packages no file holding what they would "
+                         "evaluate or include")
+
+    def start(name, attrs):
+        nonlocal depth
+        depth += 1
+        if depth > MAX_XML_DEPTH:
+            refuse(f"elements nested deeper than {MAX_XML_DEPTH} levels")
+        if name.lower().startswith("xacro:"):
+            refuse(f"<{name[:40]}> is a xacro element")
+        for key, value in attrs.items():
+            if key.lower().startswith("xacro:"):
+                refuse(f"<{name[:40]} {key[:40]}> is a xacro attribute")
+            if any(x in value for x in _EXPRESSION):
+                refuse(f"<{name[:40]} {key[:40]}> holds '${{' or '$('")
+
+    def end(name):
+        nonlocal depth
+        depth -= 1
+
+    text_parts: list[str] = []
+    parser.StartElementHandler, parser.EndElementHandler = start, end
+    parser.CharacterDataHandler = text_parts.append
+    try:
+        parser.Parse(text, True)
+    except xml.parsers.expat.ExpatError as err:
+        raise FkoptError(f"{where}: malformed URDF ({err})") from None
+    # text is checked joined: expat may hand one text node over in pieces
+    if any(x in "".join(text_parts) for x in _EXPRESSION):
+        refuse("its text holds '${' or '$('")
+
+
+def arm_urdf(arm) -> ArmURDF:
+    """The URDF an outside package reads for ``arm`` (a URDF or MJCF arm, a DH table, with or
+    without a tool frame): the one written from fkopt's own parsed chain
+    (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, names made safe, FK-checked against MuJoCo
+    in tests/test_urdf_writer.py), never the robot's own file (module docstring); checked once
+    more by :func:`check_expression_free` before any package sees it."""
     from fkopt.mechanisms.urdf_writer import chain_urdf
     w = chain_urdf(arm)
-    return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names,
-                   f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}")
+    source = f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}"
+    check_expression_free(w.text, source)
+    return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names, source)
 
 
 def internal_bounds(arm) -> tuple[np.ndarray, np.ndarray]:

@@ -1,7 +1,8 @@
 """pinocchio's closed-loop inverse kinematics (CLIK), the damped-least-squares loop of
 pinocchio's documentation ("Inverse kinematics (clik)", examples/inverse-kinematics.py;
-Carpentier et al., SII 2019), on pinocchio's own model of the URDF (:func:`fkopt.adapters.field.arm_urdf`: the robot's file,
-or for an MJCF arm the URDF written from fkopt's chain). Chosen over pinocchio's own MJCF reader
+Carpentier et al., SII 2019), on pinocchio's own model of the URDF written from fkopt's chain
+(:func:`fkopt.adapters.field.arm_urdf`, for every arm: no outside package reads the robot's own
+file, docs/reliability.md section 10). Chosen over pinocchio's own MJCF reader
 so that every field package reads one model of an MJCF arm, the written URDF FK-checked against
 MuJoCo (tests/test_urdf_writer.py), and so that MuJoCo's ``qpos0``/``ref`` and joint equalities
 mean what fkopt's MJCF reader says they mean rather than what a second reader makes of them.
