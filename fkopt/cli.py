@@ -724,7 +724,8 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     if all_solutions:
         if algorithm or start:
             raise FkoptError(f"{'--algorithm' if algorithm else '--start'}: not with --all-solutions")
-        _ik_all(m, values, seed, mask, position_tol, orientation_tol, fixed, spread, as_json)
+        _ik_all(m, target if serial_frame else values, seed, mask, position_tol, orientation_tol, fixed, spread,
+                as_json)
         return
     if algorithm:
         from fkopt.kinematics.by_algorithm import inverse_by
