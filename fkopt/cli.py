@@ -683,7 +683,14 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        orientation_tol: float = typer.Option(1e-6, "--orientation-tol", help="largest accepted geodesic "
                                              "orientation error (radians)"),
        as_json: bool = typer.Option(False, "--json", help="print one JSON object: joints, position_error "
-                                    "(length unit of the arm), rotation_error_rad, solved, ...")):
+                                    "(length unit of the arm), rotation_error_rad, solved, ..."),
+       all_solutions: bool = typer.Option(False, "--all-solutions", help="every solution of the pose inside "
+                                          "the limits (fkopt.inverse solutions='all'; tolerances 1e-9 unless "
+                                          "given)"),
+       fixed: Optional[str] = typer.Option(None, "--fixed", help="with --all-solutions: joints locked at "
+                                           "values, e.g. q3=20 (a redundant arm)"),
+       spread: Optional[int] = typer.Option(None, "--spread", min=1, help="with --all-solutions: samples "
+                                            "per locked joint of a redundant arm's self-motion")):
     """Inverse kinematics: closed form for a parallel mechanism, fkopt.inverse for a serial arm.
 
     Exit 1 (one line on stderr) when the answer is not a solution within the tolerances; exit 2
@@ -713,6 +720,14 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
             raise FkoptError(f"{name}: must be a positive number, got {value}")
     if algorithm and (start or mask):
         raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
+    if (fixed or spread) and not all_solutions:
+        raise FkoptError(f"{'--fixed' if fixed else '--spread'}: only with --all-solutions")
+    if all_solutions:
+        if algorithm or start:
+            raise FkoptError(f"{'--algorithm' if algorithm else '--start'}: not with --all-solutions")
+        _ik_all(m, target if serial_frame else values, seed, mask, position_tol, orientation_tol, fixed, spread,
+                as_json)
+        return
     if algorithm:
         from fkopt.kinematics.by_algorithm import inverse_by
         if serial_frame:       # the swarms' objective takes Z-Y-Z angles: the target's, exactly as given
@@ -745,6 +760,31 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     _emit(out, as_json, m.joint_units,
           notes={"position_error": f"{unit} (residual: tool position |fk(q) - target|)",
                  "rotation_error_rad": "rad (residual: geodesic orientation error)"})
+
+
+def _ik_all(m, values, seed, mask, position_tol, orientation_tol, fixed, spread, as_json) -> None:
+    """``fkopt ik --all-solutions``: every solution (fkopt.kinematics.branches), one line each or one JSON
+    object; exit 1 when there is none inside the limits."""
+    from fkopt.kinematics import inverse
+    given = (position_tol, orientation_tol) != (1e-6, 1e-6)          # the command's defaults
+    locked = None if fixed is None else parse_assignments(fixed, "--fixed")
+    extra = {k: v for k, v in (("fixed", locked), ("spread", spread)) if v is not None}
+    r = inverse(m, values, solutions="all", tol=(position_tol, orientation_tol) if given else None, mask=mask,
+                seed=seed, **extra)
+    data = r.as_dict()
+    data["count"] = len(r)
+    if not len(r):
+        _not_solved(f"no solution of this pose inside the joint limits (searched {r.search['starts']} starts; "
+                    f"{r.search['out_of_limits']} solutions outside the limits)", data, as_json, m.joint_units)
+    if as_json:
+        typer.echo(strict_json(data))
+        return
+    unit = m.pose_units[0]
+    typer.echo(f"{len(r)} solutions inside the limits ({', '.join(m.joint_names)}; "
+               f"{', '.join(m.joint_units)}), each verified to {r.tol[0]:g} {unit} / {r.tol[1]:g} rad:")
+    for row, pe, re in zip(r.solutions, r.position_error, r.rotation_error):
+        typer.echo("  " + "  ".join(f"{v:11.6f}" for v in row) + f"   ({pe:.1e} {unit}, {re:.1e} rad)")
+    typer.echo(f"search: {r.search['rule']}; {r.search['starts']} starts")
 
 
 @app.command()

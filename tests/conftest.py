@@ -74,6 +74,7 @@ FAST_TIER = "not slow and not stored and not external and not browser"
 TIERS = {
     "tests/test_bench_fksgp.py::test_beside_fksgp_every_platform_gives_the_same_real_solutions": ("external",),
     "tests/test_numerics_fallback.py::test_every_kind_of_corrupted_cache_file_is_set_aside_and_rebuilt": ("slow",),
+    "tests/test_all_solutions.py::test_all_solutions_recall_against_eaik_on_the_ur5": ("external",),
     "tests/test_bench_ik.py::test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones": ("external",),
     "tests/test_bench_ik.py::test_ik_sections_report_every_arm_ratios_and_verified_counts": ("external",),
     "tests/test_kinbench_v3.py::test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board": ("slow",),

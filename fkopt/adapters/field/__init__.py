@@ -27,7 +27,8 @@ Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
 (roboticstoolbox-python ``ik_LM``, ``ik_NR``), :mod:`.pin` (pinocchio's CLIK), :mod:`.ikpy`;
 black-box optimisers on :func:`pose_objective` (:class:`BlackBoxIK`, restarts until the
 timeout): :mod:`.cmaes` (pycma, IPOP), :mod:`.lbfgsb` (scipy L-BFGS-B from random starts),
-:mod:`.nevergrad_ngopt` (NGOpt); FK of parallel mechanisms: :mod:`.scipy_fk` (scipy
+:mod:`.nevergrad_ngopt` (NGOpt); analytic: :mod:`.eaik` (EAIK, every solution of the 1-6R arms
+it decomposes; elsewhere :class:`NotApplicable`); FK of parallel mechanisms: :mod:`.scipy_fk` (scipy
 ``least_squares`` from random starts, :class:`~.scipy_fk.LeastSquaresFK`).
 """
 from __future__ import annotations
@@ -42,6 +43,12 @@ from typing import Any
 import numpy as np
 
 from fkopt.errors import FkoptError
+
+
+class NotApplicable(FkoptError):
+    """The package cannot take this arm by design (EAIK on a 7-joint arm): the board shows a
+    "not applicable: why" cell for it, never a zero; the message is the why."""
+
 
 class FieldIK:
     """One outside IK solver on one arm; subclasses set ``name``, ``package``, ``settings``."""
