@@ -215,3 +215,21 @@ def test_inverse_one_pose_solves_within_limits_and_is_seeded():
         assert r.position_error <= 1e-6 and r.rotation_error <= 1e-6
         np.testing.assert_array_equal(fkopt.inverse(m, P[k], seed=3).joints, r.joints)
         assert r.evaluations["residual"] == r.evaluations["jacobian"] > 0
+
+
+@pytest.mark.parametrize("compiled", [None, False], ids=["default-path", "python-reference"])
+def test_an_answer_a_half_turn_off_is_not_solved(compiled):
+    """At exactly a half turn the antisymmetric part of R T^T vanishes, and the rotation error
+    read from it was zero: fkopt.inverse started a half turn of the last joint away from the
+    answer returned that start as solved, 180 degrees off (found by the all-solutions search)."""
+    from fkopt.numerics import InverseOptions
+    from fkopt.numerics.rotations import geodesic_angle
+    arm = fkopt.mechanism("urdf", file="configs/suites/robots/ur5.urdf", base="base_link", tip="tool0")
+    q = np.array([10.0, -60.0, 80.0, 20.0, 50.0, 30.0])
+    T = arm.fk_matrix(q[None])[0]
+    r = fkopt.inverse(arm, T, start=q + [0, 0, 0, 0, 0, 180], options=InverseOptions(compiled=compiled))
+    F = arm.fk_matrix(np.asarray(r.joints, float)[None])[0]
+    soa = lambda R: tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3))  # noqa: E731
+    true_angle = float(geodesic_angle(soa(F[None, :3, :3]), soa(T[None, :3, :3]))[0])
+    assert abs(float(r.rotation_error) - true_angle) < 1e-6       # the reported error is the real one
+    assert not bool(r.solved) or true_angle < 1e-6                 # and "solved" means solved

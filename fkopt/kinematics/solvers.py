@@ -117,7 +117,7 @@ from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from fkopt.mechanisms.catalog import MECHANISMS
 from fkopt.numerics import path as numerics_path
 from fkopt.numerics.options import InverseOptions
-from fkopt.numerics.damped_least_squares import inverse_candidates, rotation_error1
+from fkopt.numerics.damped_least_squares import half_turn, inverse_candidates, rotation_error1
 from fkopt.problems import fk_problem, so3_right_jacobian_inverse
 from fkopt.algorithms.runs import solve
 
@@ -717,7 +717,12 @@ def _rotation_error(R: np.ndarray, Rt: np.ndarray) -> np.ndarray:
     c = 0.5 * (M[:, 0, 0] + M[:, 1, 1] + M[:, 2, 2] - 1.0)         # cos(angle)
     angle = np.arctan2(s, c)
     k = np.where(s > 1e-12, angle / np.where(s > 1e-12, 2.0 * s, 1.0), 0.5)
-    return v * k[:, None]
+    e = v * k[:, None]
+    half = (s <= 1e-12) & (c <= 0.0)        # a half turn: its axis from the symmetric part (half_turn)
+    for i in np.flatnonzero(half):
+        e[i] = half_turn(M[i, 0, 0], M[i, 1, 1], M[i, 2, 2], 0.5 * (M[i, 0, 1] + M[i, 1, 0]),
+                         0.5 * (M[i, 0, 2] + M[i, 2, 0]), 0.5 * (M[i, 1, 2] + M[i, 2, 1]))
+    return e
 
 
 def _internal(m, q):

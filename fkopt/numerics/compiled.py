@@ -145,8 +145,26 @@ def _rotation_error(R, T, e):
     s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
     c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
                + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
-    k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
-    e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
+    if s > 1e-12 or c > 0.0:
+        k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
+        e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
+    else:   # a half turn (fkopt.numerics.damped_least_squares.half_turn, operation for operation)
+        m00 = r00 * t00 + r01 * t01 + r02 * t02
+        m11 = r10 * t10 + r11 * t11 + r12 * t12
+        m22 = r20 * t20 + r21 * t21 + r22 * t22
+        m01 = r00 * t10 + r01 * t11 + r02 * t12
+        m02 = r00 * t20 + r01 * t21 + r02 * t22
+        m12 = r10 * t20 + r11 * t21 + r12 * t22
+        if m00 >= m11 and m00 >= m22:
+            a0 = math.sqrt(max(0.5 * (m00 + 1.0), 0.0))
+            a1, a2 = m01 / (2.0 * a0), m02 / (2.0 * a0)
+        elif m11 >= m22:
+            a1 = math.sqrt(max(0.5 * (m11 + 1.0), 0.0))
+            a0, a2 = m01 / (2.0 * a1), m12 / (2.0 * a1)
+        else:
+            a2 = math.sqrt(max(0.5 * (m22 + 1.0), 0.0))
+            a0, a1 = m02 / (2.0 * a2), m12 / (2.0 * a2)
+        e[0], e[1], e[2] = math.pi * a0, math.pi * a1, math.pi * a2
 
 
 @njit(inline="always")

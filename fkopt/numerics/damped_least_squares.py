@@ -122,8 +122,29 @@ def rotation_error1(R, T):
     s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
     c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
                + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
-    k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
-    return v0 * k, v1 * k, v2 * k
+    if s > 1e-12 or c > 0.0:
+        k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
+        return v0 * k, v1 * k, v2 * k
+    return half_turn(r00 * t00 + r01 * t01 + r02 * t02, r10 * t10 + r11 * t11 + r12 * t12,
+                     r20 * t20 + r21 * t21 + r22 * t22, r00 * t10 + r01 * t11 + r02 * t12,
+                     r00 * t20 + r01 * t21 + r02 * t22, r10 * t20 + r11 * t21 + r12 * t22)
+
+
+def half_turn(m00, m11, m22, m01, m02, m12):
+    """Rotation vector of a half turn M = R T^T = 2 a a^T - I (sin = 0, cos = -1), where the
+    antisymmetric part that gives the axis elsewhere vanishes: pi times the axis read from the
+    symmetric part (a_i^2 = (M_ii + 1) / 2 from the largest diagonal, a_j = M_ij / (2 a_i)). Without
+    it the error vector of an answer a half turn off was zero, and such an answer counted as solved."""
+    if m00 >= m11 and m00 >= m22:
+        a0 = math.sqrt(max(0.5 * (m00 + 1.0), 0.0))
+        a1, a2 = m01 / (2.0 * a0), m02 / (2.0 * a0)
+    elif m11 >= m22:
+        a1 = math.sqrt(max(0.5 * (m11 + 1.0), 0.0))
+        a0, a2 = m01 / (2.0 * a1), m12 / (2.0 * a1)
+    else:
+        a2 = math.sqrt(max(0.5 * (m22 + 1.0), 0.0))
+        a0, a1 = m02 / (2.0 * a2), m12 / (2.0 * a2)
+    return math.pi * a0, math.pi * a1, math.pi * a2
 
 
 def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping, down, up, step_cap,
