@@ -19,6 +19,17 @@ import pandas as pd
 
 from fkopt.files import csv_numbers
 
+#: Relative tolerance of recomputed floats against the stored CSV's (written with 10 digits;
+#: answers with 17).
+RTOL = 1e-8
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    same_inf = (np.isinf(a) & np.isinf(b) & (np.sign(a) == np.sign(b))) | (np.isnan(a) & np.isnan(b))
+    with np.errstate(invalid="ignore"):
+        return same_inf | np.isclose(a, b, rtol=RTOL, atol=1e-12)
+
 #: The columns of every answers row (:func:`fkopt.kinbench.clock.answer_rows`, ``set`` added by
 #: the runner), before the answer's own ``q0..`` / ``x0..``.
 ANSWER_COLUMNS = ("robot", "set", "query", "solver", "entry", "source", "given_timeout_ms", "seconds",
@@ -95,10 +106,8 @@ def clock_record_problem(task, rec: dict) -> str | None:
     kinbench's own FK/IK (:func:`fkopt.kinbench.clock.verdicts`) -- joints moved with their
     verdicts kept are caught; the throughput rows' robots, solvers, batches and rates."""
     from fkopt.files import MAX_MAGNITUDE
-    from fkopt.kinbench.clock import answer_prefix, entry_of, targets_of, track_settings, verdicts
+    from fkopt.kinbench.clock import answer_prefix, entry_of, targets_of, track_arm, track_settings, verdicts
     from fkopt.kinbench.config import suite_from_dict
-    from fkopt.kinbench.runner import track_arm
-    from fkopt.kinbench.verify import _close
     payload = task.payload
     from pathlib import Path
     config = suite_from_dict(payload["config"], "suite task")

@@ -37,7 +37,10 @@ import zlib
 import numpy as np
 import pandas as pd
 
+from fkopt.errors import FkoptError
 from fkopt.kinbench.physical import LADDER, fk_verdicts, ik_verdicts, rung_label
+from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
+from fkopt.run.config_base import files_folder
 from fkopt.registry import FK_SOLVERS, clock_solver  # noqa: F401 (FK_SOLVERS: the FK solvers on the clock)
 
 #: Timeouts of the clock track (ms): IK of serial arms, FK of parallel mechanisms.
@@ -250,3 +253,36 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
             row.update({f"success_{rung_label(r)}": float(v["success"][:, k].mean()) for k, r in enumerate(LADDER)})
             rows.append(row)
     return pd.DataFrame(rows)
+
+
+# -- the track's arms and queries ----------------------------------------------------------------
+def track_cases(config, sets: dict, files=None) -> list[tuple[int, np.ndarray]]:
+    """(problem index, queries: joints of the clock set's first ``queries`` poses) of every
+    clock-track arm; the suite's ``poses`` (how many poses the swarms get) does not cut them."""
+    clock = config.tracks.clock if config.tracks is not None else None
+    if clock is None:
+        return []
+    if config.poses is not None:
+        sets, _ = load_pose_sets(config.model_copy(update={"poses": None}), files)
+    index = {p.name: k for k, p in enumerate(config.problems)}
+    for name in clock.problems:     # never silently fewer queries than asked for
+        have = len(sets[(name, clock.set)])
+        if clock.queries is not None and clock.queries > have:
+            raise FkoptError(f"tracks.clock.queries: {clock.queries}, but set '{clock.set}' of problem {name} holds "
+                             f"{have} poses; allowed: 1 to {have} (or omit it: every pose of the set)")
+    return [(index[name], np.asarray(sets[(name, clock.set)][:clock.queries], dtype=float)) for name in clock.problems]
+
+
+def track_arm(config, p: int, files=None):
+    """The URDF arm of clock-track problem ``p`` (the field's packages read URDF only)."""
+    problem = config.problems[p]
+    mech, _ = problem_mechanism(problem, files if files is not None else files_folder(config))
+    if getattr(mech, "kind", None) == "parallel":
+        if len(mech.unknown_names) != 6 or tuple(mech.pose_units[3:]) != ("deg",) * 3:
+            raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a 6-DOF parallel mechanism "
+                             "(x, y, z, three angles): the FK clock judges poses in m and rad")
+        return mech
+    if getattr(mech, "kind", None) != "serial" or not hasattr(mech, "path") or not hasattr(mech, "tip_link"):
+        raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf) or a "
+                         "6-DOF parallel mechanism; the clock track's IK solvers read URDF files")
+    return mech

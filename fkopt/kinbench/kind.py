@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fkopt.kinbench import reports, traces
+from fkopt.kinbench import pages, reports, traces
 from fkopt.run.kinds import register
 from fkopt.run.tasks import Kind
 from fkopt.run.tasks import work_folder  # noqa: F401 (where a suite's task files live; tests)
@@ -37,7 +37,7 @@ OUTPUTS = (
     Output("scaling", reports.scaling_figures, FIGURE),
     Output("clock", reports.clock_figures, FIGURE),
     Output("leaderboard.md", reports.leaderboard_markdown, FIGURE),   # never compared
-    Output("index.html", reports.html_page, FIGURE),     # and arms.html, rankings.html (kinbench.pages)
+    Output("index.html", pages.html_page, FIGURE),     # and arms.html, rankings.html (kinbench.pages)
 )
 
 SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig))

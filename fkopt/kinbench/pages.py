@@ -30,6 +30,7 @@ import pandas as pd
 
 from fkopt.errors import FkoptError
 from fkopt.files import parse_json, read_stored, read_stored_csv
+from fkopt.run.kinds import KINDS
 from fkopt.kinbench import html as H
 
 #: Every page's size in bytes stays below this (issue 37: a page loads in a moment).
@@ -448,7 +449,7 @@ def stored_suite(folder: str | Path):
     """(result, tables) of a stored suite folder: its config (meta.json), meta.json and env.json,
     and every table file it holds, read back -- what the figures and pages are made of."""
     from fkopt.kinbench.config import SuiteConfig
-    from fkopt.kinbench.kind import OUTPUTS
+    OUTPUTS = KINDS["suite"].outputs        # the suite kind's files (registered by fkopt.kinbench)
     from fkopt.run.writers import FIGURE
     folder = Path(folder)
     where = folder / "meta.json"
@@ -488,7 +489,7 @@ def stored_suite(folder: str | Path):
 def regenerate(folder: str | Path, figures: bool = True) -> list[str]:
     """Rewrite a stored suite folder's figures (``figures``) and pages from its stored tables;
     no solver runs, no table is written. Returns the names written."""
-    from fkopt.kinbench.kind import OUTPUTS
+    OUTPUTS = KINDS["suite"].outputs        # the suite kind's files (registered by fkopt.kinbench)
     from fkopt.run.writers import FIGURE
     folder = Path(folder)
     sr, tables = stored_suite(folder)
@@ -518,3 +519,10 @@ def suite_folders(root: str | Path) -> list[Path]:
         elif folder == root:
             raise FkoptError(f"{folder / 'meta.json'}: kind: {kind!r} (allowed: suite; pages are a kinbench suite's)")
     return out
+
+
+def html_page(sr, folder: Path, tables: dict) -> list[str]:
+    """index.html and its detail pages (:mod:`fkopt.kinbench.pages`): which solver per arm family
+    or problem class, the summary per solver, the figures, every entry's settings, the machine's
+    load; per-arm tables and every ranking on pages of their own."""
+    return write_pages(sr, folder, tables)

@@ -561,14 +561,6 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
     return ["leaderboard.md"]
 
 
-def html_page(sr, folder: Path, tables: dict) -> list[str]:
-    """index.html and its detail pages (:mod:`fkopt.kinbench.pages`): which solver per arm family
-    or problem class, the summary per solver, the figures, every entry's settings, the machine's
-    load; per-arm tables and every ranking on pages of their own."""
-    from fkopt.kinbench.pages import write_pages
-    return write_pages(sr, folder, tables)
-
-
 def meta(sr) -> dict:
     c = sr.config
     manifest = sr.manifest or {}

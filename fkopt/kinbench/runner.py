@@ -33,6 +33,8 @@ from fkopt.run.config_base import RunConfig, files_folder
 from fkopt.run.solving import make_problem, solve_cases, start_point, task_seed
 from fkopt.run.tasks import Plan, Ran, Task, run_tasks
 from fkopt.solve import chunk_size
+from fkopt.kinbench.clock import track_arm, track_cases  # noqa: F401 (the clock track's arms; tests)
+from fkopt.kinbench.answer_checks import clock_record_problem
 from fkopt.kinbench.budget import at_budget, budget_of, target_column
 from fkopt.kinbench.config import SuiteConfig, suite_from_dict
 from fkopt.kinbench.outside import digest, read_outside
@@ -129,38 +131,6 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
         validate_track(config, p, files)
     read_submissions(config, tracks, files)
     return need
-
-
-def track_cases(config: SuiteConfig, sets: dict, files: Path | None = None) -> list[tuple[int, np.ndarray]]:
-    """(problem index, queries: joints of the clock set's first ``queries`` poses) of every
-    clock-track arm; the suite's ``poses`` (how many poses the swarms get) does not cut them."""
-    clock = config.tracks.clock if config.tracks is not None else None
-    if clock is None:
-        return []
-    if config.poses is not None:
-        sets, _ = load_pose_sets(config.model_copy(update={"poses": None}), files)
-    index = {p.name: k for k, p in enumerate(config.problems)}
-    for name in clock.problems:     # never silently fewer queries than asked for
-        have = len(sets[(name, clock.set)])
-        if clock.queries is not None and clock.queries > have:
-            raise FkoptError(f"tracks.clock.queries: {clock.queries}, but set '{clock.set}' of problem {name} holds "
-                             f"{have} poses; allowed: 1 to {have} (or omit it: every pose of the set)")
-    return [(index[name], np.asarray(sets[(name, clock.set)][:clock.queries], dtype=float)) for name in clock.problems]
-
-
-def track_arm(config: SuiteConfig, p: int, files: Path | None = None):
-    """The URDF arm of clock-track problem ``p`` (the field's packages read URDF only)."""
-    problem = config.problems[p]
-    mech, _ = problem_mechanism(problem, files if files is not None else files_folder(config))
-    if getattr(mech, "kind", None) == "parallel":
-        if len(mech.unknown_names) != 6 or tuple(mech.pose_units[3:]) != ("deg",) * 3:
-            raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a 6-DOF parallel mechanism "
-                             "(x, y, z, three angles): the FK clock judges poses in m and rad")
-        return mech
-    if getattr(mech, "kind", None) != "serial" or not hasattr(mech, "path") or not hasattr(mech, "tip_link"):
-        raise FkoptError(f"tracks.clock.problems: '{problem.name}' is not a URDF arm (mechanism: urdf) or a "
-                         "6-DOF parallel mechanism; the clock track's IK solvers read URDF files")
-    return mech
 
 
 def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> pd.DataFrame | None:
@@ -293,7 +263,6 @@ def record_problem(task, rec) -> str | None:
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
     if task.payload.get("track"):
-        from fkopt.kinbench.answer_checks import clock_record_problem
         try:
             if type(rec["problem"]) is not int or rec["problem"] != task.payload["problem"] \
                     or rec["track"] != task.payload["track"]:

@@ -16,16 +16,7 @@ from types import SimpleNamespace
 import numpy as np
 import pandas as pd
 
-#: Relative tolerance of recomputed floats against the stored CSV's (written with 10 digits;
-#: answers with 17).
-RTOL = 1e-8
-
-
-def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    same_inf = (np.isinf(a) & np.isinf(b) & (np.sign(a) == np.sign(b))) | (np.isnan(a) & np.isnan(b))
-    with np.errstate(invalid="ignore"):
-        return same_inf | np.isclose(a, b, rtol=RTOL, atol=1e-12)
+from fkopt.kinbench.answer_checks import RTOL, _close  # noqa: F401 (RTOL: the recomputation's tolerance)
 
 
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
@@ -37,10 +28,9 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     from fkopt.errors import FkoptError
     from fkopt.files import csv_numbers, read_stored_csv
     from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
-    from fkopt.kinbench.clock import answer_prefix, targets_of, track_settings, verdicts
+    from fkopt.kinbench.clock import answer_prefix, targets_of, track_arm, track_cases, track_settings, verdicts
     from fkopt.kinbench.posesets import load_pose_sets
     from fkopt.kinbench.reports import robots_board_table
-    from fkopt.kinbench.runner import track_arm, track_cases
     folder = Path(folder)
     if config.tracks is None or config.tracks.clock is None:
         return []
