@@ -204,3 +204,34 @@ def test_rtb_chain_below_a_moving_joint_has_the_chains_joints_only(name):
     assert ets.n == m.dof
     for k in range(3):
         assert np.abs(ets.fkine(np.radians(q[k])).A - T[k]).max() < 1e-12
+
+
+def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits():
+    """EAIK (analytic, by subproblem decomposition) on the UR5: every pose of 10 random in-limit
+    configurations has at most 8 solutions (the UR family's bound); each exact one in the limits reproduces the target by
+    fkopt's FK to 1e-9, the generating configuration is among them (up to whole turns), and the
+    board's one answer is one of them."""
+    pytest.importorskip("eaik")
+    from fkopt.adapters.field import make_ik
+    m = stored("ur5")
+    q, T = targets(m, 10, 7)
+    w = make_ik("eaik", m, timeout=0.02, rng=np.random.default_rng(0))
+    for k in range(len(q)):
+        s = w.solutions(T[k])
+        exact = ~s.least_squares & s.in_limits
+        assert 1 <= len(s.joints) <= 8 and exact.any()
+        e = ik_verdicts(m, s.joints[exact], np.repeat(T[k][None], exact.sum(), axis=0))
+        assert (e["position_m"] < 1e-9).all() and (e["rotation_rad"] < 1e-9).all()
+        turns = (s.joints[exact] - q[k] + 180.0) % 360.0 - 180.0
+        assert np.abs(turns).max(axis=1).min() < 1e-6
+        one, claimed = w.solve1(T[k])
+        assert claimed and np.abs(s.joints[exact] - one).max(axis=1).min() == 0.0
+
+
+@pytest.mark.parametrize("name, why", [("panda", "7 joints: EAIK solves 1-6R")])
+def test_eaik_is_not_applicable_to_an_arm_it_cannot_decompose(name, why):
+    """A 7-joint arm is a "not applicable: why" cell, not a zero: make_ik raises NotApplicable."""
+    pytest.importorskip("eaik")
+    from fkopt.adapters.field import NotApplicable, make_ik
+    with pytest.raises(NotApplicable, match=why):
+        make_ik("eaik", stored(name), timeout=0.02, rng=np.random.default_rng(0))

@@ -23,7 +23,8 @@ Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
 (roboticstoolbox-python ``ik_LM``, ``ik_NR``), :mod:`.pin` (pinocchio's CLIK), :mod:`.ikpy`;
 black-box optimisers on :func:`pose_objective` (:class:`BlackBoxIK`, restarts until the
 timeout): :mod:`.cmaes` (pycma, IPOP), :mod:`.lbfgsb` (scipy L-BFGS-B from random starts),
-:mod:`.nevergrad_ngopt` (NGOpt); FK of parallel mechanisms: :mod:`.scipy_fk` (scipy
+:mod:`.nevergrad_ngopt` (NGOpt); analytic: :mod:`.eaik` (EAIK, every solution of the 1-6R arms
+it decomposes; elsewhere :class:`NotApplicable`); FK of parallel mechanisms: :mod:`.scipy_fk` (scipy
 ``least_squares`` from random starts, :class:`~.scipy_fk.LeastSquaresFK`).
 """
 from __future__ import annotations
@@ -50,13 +51,19 @@ IK_SOLVERS = {
     "cma-es": ("cmaes", "CmaES"),
     "scipy-lbfgsb": ("lbfgsb", "LBFGSB"),
     "nevergrad-ngopt": ("nevergrad_ngopt", "NGOpt"),
+    "eaik": ("eaik", "EAIK"),
 }
 #: The outside package each wrapper needs (for the one-line message when it is missing).
 PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
             "pin-clik": "pin", "ikpy": "ikpy", "cma-es": "cma", "scipy-lbfgsb": "scipy",
-            "nevergrad-ngopt": "nevergrad"}
+            "nevergrad-ngopt": "nevergrad", "eaik": "eaik"}
 #: Wrappers that only see the objective (the black-box track); the others use Jacobians.
 BLACK_BOX = ("cma-es", "scipy-lbfgsb", "nevergrad-ngopt")
+
+
+class NotApplicable(FkoptError):
+    """The package cannot take this arm by design (EAIK on a 7-joint arm): the board shows a
+    "not applicable: why" cell for it, never a zero; the message is the why."""
 
 
 class FieldIK:
@@ -158,7 +165,7 @@ def make_ik(name: str, arm, *, timeout: float, rng: np.random.Generator) -> Fiel
     except ImportError as err:
         raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[field]\"): "
                          f"{err}") from None
-    except FkoptError:
+    except FkoptError:       # NotApplicable included: the caller decides what a cell says
         raise
     except Exception as err:     # the outside package refused this arm: one line, not its traceback
         raise FkoptError(f"field solver '{name}' ({PACKAGES[name]}) cannot read {getattr(arm, 'path', 'this arm')}: "
