@@ -553,7 +553,22 @@ def meta(sr) -> dict:
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
             "outside": {o.solver: digest(c, o, sr.files) for o in c.outside},
             "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)",
-            **submissions_meta(c, sr.files)}
+            **board_meta(sr), **submissions_meta(c, sr.files)}
+
+
+def board_meta(sr) -> dict:
+    """meta.json's record of a per-robot board (only for a suite with a clock track): its frozen
+    board version (:data:`fkopt.kinbench.releases.BOARDS`), the machine's load averages at the
+    clock track's start and end, and every entry's settings."""
+    if getattr(sr, "answers", None) is None:
+        return {}
+    from .releases import board_version
+    out = {"board_version": board_version(sr.config.name)}
+    if getattr(sr, "load_avg", None):
+        out["load_avg"] = sr.load_avg
+    if getattr(sr, "entries", None):
+        out["entries"] = sr.entries
+    return {k: v for k, v in out.items() if v is not None}
 
 
 def submissions_meta(c, files=None) -> dict:
