@@ -122,7 +122,7 @@ class _Arm:
     ``scale``: the arm's length unit per m (1000 for the DH arm in mm); ``tol``: :data:`TOL` in it."""
 
     def __init__(self, name, n, seed):
-        from .adapters.field import ArmURDF, arm_urdf
+        from .adapters.field import ArmURDF
         from .adapters.field.rtb import chain_ets
         from .mechanisms import urdf
         self.name = name
@@ -136,7 +136,9 @@ class _Arm:
         else:
             self.m = m = urdf.example_robot(name)
             self.check = PinocchioFK(m)
-            source = arm_urdf(m)                     # the robot's own file, as the field's packages read it
+            # example-robot-data's own file as people use it (not a user's: from_file proves it
+            # holds nothing xacro would evaluate)
+            source = ArmURDF.from_file(m.path, m.base_link, m.tip_link, m.joint_names)
             self.scale = 1.0
             self.periodic = m.periodic_mask()
         self.tol = (TOL[0] * self.scale, TOL[1])

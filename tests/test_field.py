@@ -118,13 +118,13 @@ def test_field_solvers_read_an_mjcf_arm_through_the_written_urdf(solver):
 
 
 def test_rtb_reads_the_written_urdf_where_it_misreads_the_robots_file():
-    """rtb's FK of iCub's file is 1.5 m off fkopt's and pinocchio's: the wrapper reads the URDF
-    written from fkopt's chain instead and says so; the other packages keep the robot's file."""
+    """rtb's FK of iCub's own file is 1.5 m off fkopt's and pinocchio's; rtb reads only the URDF
+    written from fkopt's chain (issue 42), and reads iCub's right."""
     pytest.importorskip("roboticstoolbox")
     from fkopt.adapters.field import make_ik
     m = stored("icub-left")
     w = make_ik("rtb-ik_LM", m, timeout=0.02, rng=np.random.default_rng(1))
-    assert "rtb misreads" in w.settings["urdf_note"] and w.settings["urdf"].startswith("written")
+    assert w.settings["urdf"].startswith("written")
     q, T = targets(m, 3, 2)
     assert np.abs(w.ets.fkine(np.radians(q[0])).A - T[0]).max() < 1e-12
 

@@ -15,10 +15,19 @@ collisions.
 Only the chain's unknowns are written: a joint that follows another (a mimic with a multiplier
 other than 0) has no plain-URDF form, and the writer refuses it with one line; a mimic with
 multiplier 0 is a fixed joint and is written as one.
+
+Names: the only text copied from the robot's file is the moving joints' names, and every one is
+made safe first (:func:`safe_joint_names`): characters outside [A-Za-z0-9_] become ``_``, at most
+64 characters, unique. XML escaping alone is not enough: roboticstoolbox runs xacro on what it
+reads, and xacro evaluates ``${...}`` and ``$(...)`` in every attribute (issue 42: a joint name
+ran a command). The writer's own links and fixed joints hold a ``-`` (``fkopt-base``,
+``fkopt-link3``, ``fkopt-fixed4``), which no safe joint name holds, so an arm's own ``fixed3``
+or ``base`` cannot collide with them.
 """
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -30,7 +39,32 @@ from ..errors import FkoptError
 LENGTH_SCALE = {"m": 1.0, "mm": 1e-3}
 #: A pitch this close to +-90 deg (cos below this) is written through a second origin (docstring).
 GIMBAL_COS = math.sin(0.1)
-BASE_LINK, TIP_LINK = "base", "tip"
+BASE_LINK, TIP_LINK = "fkopt-base", "fkopt-tip"
+#: Longest joint name written (characters).
+MAX_NAME = 64
+_UNSAFE = re.compile(r"[^A-Za-z0-9_]")
+
+
+def safe_joint_names(names) -> tuple[str, ...]:
+    """The joint names as written (module docstring): only [A-Za-z0-9_], 1..64 characters,
+    unique; a name already safe is kept as it is, the others are changed (``_`` for each unsafe
+    character, then ``_2``, ``_3``, ... until unused)."""
+    names = [str(n) for n in names]
+    kept = {n for n in names if n and len(n) <= MAX_NAME and not _UNSAFE.search(n)}
+    out, used = [], set()
+    for n in names:
+        if n in kept and n not in used:
+            out.append(n)
+            used.add(n)
+            continue
+        stem = (_UNSAFE.sub("_", n) or "joint")[:MAX_NAME - 8]
+        name, k = stem, 1
+        while name in used or name in kept:
+            k += 1
+            name = f"{stem}_{k}"
+        out.append(name)
+        used.add(name)
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -77,15 +111,15 @@ def chain_urdf(arm) -> WrittenURDF:
         raise FkoptError(f"{arm.name}: length unit '{arm.pose_units[0]}' has no URDF form; allowed: "
                          f"{', '.join(LENGTH_SCALE)}")
     uses = np.bincount(ch.var, minlength=ch.dof)
-    names, units = list(arm.joint_names), list(arm.joint_units)
-    robot = ET.Element("robot", name=f"fkopt-{arm.name}")
+    names, units = list(safe_joint_names(arm.joint_names)), list(arm.joint_units)
+    robot = ET.Element("robot", name=f"fkopt-{_UNSAFE.sub('_', str(arm.name))[:MAX_NAME]}")
     ET.SubElement(robot, "link", name=BASE_LINK)
     counter = iter(range(1 << 30))
     parent = BASE_LINK
 
     def joint(name, kind, xyz, rpy, axis=None):
         nonlocal parent
-        child = f"link{next(counter)}"
+        child = f"fkopt-link{next(counter)}"
         ET.SubElement(robot, "link", name=child)
         j = ET.SubElement(robot, "joint", name=name, type=kind)
         ET.SubElement(j, "parent", link=parent)
@@ -99,7 +133,7 @@ def chain_urdf(arm) -> WrittenURDF:
 
     def fixed(C, v):
         for xyz, rpy in _origins(C, v):
-            joint(f"fixed{len(robot)}", "fixed", xyz, rpy)
+            joint(f"fkopt-fixed{len(robot)}", "fixed", xyz, rpy)
 
     bounds = np.asarray(arm.bounds, dtype=float)
     periodic = arm.periodic_mask()
@@ -115,11 +149,11 @@ def chain_urdf(arm) -> WrittenURDF:
             fixed(C @ motion, v)
             continue
         if abs(mult) != 1.0 or uses[k] != 1:
-            raise FkoptError(f"{arm.name} {getattr(arm, 'path', '')}: joint of unknown '{names[k]}' follows another "
+            raise FkoptError(f"{arm.name} {getattr(arm, 'path', '')}: joint of unknown '{arm.joint_names[k]}' follows another "
                              f"joint (mimic, multiplier {mult:g}); a URDF of the chain's unknowns cannot hold it")
         origins = _origins(C @ motion, v)
         for xyz, rpy in origins[:-1]:
-            joint(f"fixed{len(robot)}", "fixed", xyz, rpy)
+            joint(f"fkopt-fixed{len(robot)}", "fixed", xyz, rpy)
         xyz, rpy = origins[-1]
         kind = "prismatic" if prismatic else ("continuous" if periodic[k] else "revolute")
         j = joint(names[k], kind, xyz, rpy, axis=(0.0, 0.0, mult))

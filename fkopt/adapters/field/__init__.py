@@ -1,8 +1,10 @@
 """The field's solvers through their own packages (``pip install -e ".[field]"``), for kinbench v3.
 
 Every IK wrapper here takes a fkopt URDF or MJCF arm (:class:`fkopt.mechanisms.urdf.URDFArm`,
-:class:`fkopt.mechanisms.mjcf.MJCFArm`) and reads it as URDF (:func:`arm_urdf`: the robot's own
-file, or for an MJCF arm the URDF written from fkopt's chain, ``settings["urdf"]`` says which), is built
+:class:`fkopt.mechanisms.mjcf.MJCFArm`) and reads it as URDF (:func:`arm_urdf`: always the URDF
+fkopt writes from its own parsed chain, never the robot's file as it stands -- roboticstoolbox
+runs xacro on what it reads, and xacro evaluates ``${...}`` in any attribute, even in elements
+fkopt ignores, issue 42; ``settings["urdf"]`` says so), is built
 once per arm (the package parses the file, outside the clock) and answers one target pose at a
 time: :meth:`FieldIK.solve1` takes a 4x4 tip frame in the arm's base frame (m) and returns the
 joints in fkopt's public units (deg, m) or ``None`` when the package gave no answer, plus what
@@ -115,26 +117,52 @@ class ArmURDF:
             yield path
 
     @classmethod
-    def from_file(cls, path, base_link: str, tip_link: str) -> "ArmURDF":
-        """A URDF file as it is (the joints are not listed)."""
+    def from_file(cls, path, base_link: str, tip_link: str, joint_names: tuple[str, ...] = ()) -> "ArmURDF":
+        """A URDF file as it stands, for files fkopt did not take from a user (example-robot-data's
+        robots in ``fkopt bench``): read bounded and refused with one line unless
+        :func:`check_expression_free` proves nothing in it would be evaluated."""
         from ...files import read_text
         from ...mechanisms.urdf import MAX_URDF_BYTES
-        return cls(read_text(path, MAX_URDF_BYTES, field="urdf geometry.file"), base_link, tip_link, (), str(path))
+        text = read_text(path, MAX_URDF_BYTES, field="urdf geometry.file")
+        check_expression_free(text, str(path))
+        return cls(text, base_link, tip_link, tuple(joint_names), str(path))
 
 
-def arm_urdf(arm, *, written: bool = False) -> ArmURDF:
-    """The robot's own URDF file when ``arm`` was read from one without a tool frame (the file as
-    people use it), else -- an MJCF arm, a DH table, a tool frame, or ``written`` -- the URDF
-    written from fkopt's chain (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, FK-checked
-    against MuJoCo in tests/test_urdf_writer.py)."""
-    own = getattr(arm, "name", None) == "urdf" and getattr(arm.geometry_values(), "tool", None) is None
-    if own and not written:
-        mine = ArmURDF.from_file(arm.path, arm.base_link, arm.tip_link)
-        return ArmURDF(mine.text, mine.base_link, mine.tip_link, tuple(arm.joint_names), mine.source)
+#: What xacro (run by roboticstoolbox on every file it reads) would evaluate or include:
+#: ``${expr}`` and ``$(substitution)`` in attribute values and text, and ``xacro:`` elements.
+_EXPRESSION = ("${", "$(")
+
+
+def check_expression_free(text: str, where: str) -> None:
+    """Refuse (one line naming ``where``) a URDF text holding anything an expression evaluator
+    would evaluate: ``${`` or ``$(`` in any attribute value or text once XML entities are decoded
+    (``&#36;{`` is ``${`` to xacro), or the word xacro anywhere (a namespace, an element, an
+    attribute)."""
+    import xml.etree.ElementTree as ET
+    if "xacro" in text.lower():
+        raise FkoptError(f"{where}: names xacro; fkopt hands outside packages no file they would expand")
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as err:
+        raise FkoptError(f"{where}: malformed URDF ({err})") from None
+    for e in root.iter():
+        for value in (e.text, e.tail, *e.attrib.values(), *e.attrib.keys(), e.tag):
+            if value and any(x in value for x in _EXPRESSION):
+                raise FkoptError(f"{where}: <{str(e.tag)[:40]}> holds '${{' or '$('; fkopt hands outside "
+                                 "packages no file holding an expression they would evaluate")
+
+
+def arm_urdf(arm) -> ArmURDF:
+    """The URDF an outside package reads for ``arm`` (a URDF or MJCF arm, a DH table, with or
+    without a tool frame): the one written from fkopt's own parsed chain
+    (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, names made safe, FK-checked against MuJoCo
+    in tests/test_urdf_writer.py), never the robot's own file (module docstring); checked once
+    more by :func:`check_expression_free` before any package sees it."""
     from ...mechanisms.urdf_writer import chain_urdf
     w = chain_urdf(arm)
-    return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names,
-                   f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}")
+    source = f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}"
+    check_expression_free(w.text, source)
+    return ArmURDF(w.text, w.base_link, w.tip_link, w.joint_names, source)
 
 
 def internal_bounds(arm) -> tuple[np.ndarray, np.ndarray]:

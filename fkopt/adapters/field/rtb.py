@@ -8,17 +8,18 @@ method usually the fourth), ``joint_limits=True`` (rtb rejects a search ending o
 limits), first start q0 uniform in the limits from the wrapper's generator; rtb's further searches
 draw from its own unseeded RNG. No wall-clock limit: rtb runs to ``slimit``.
 
+rtb reads only the URDF written from fkopt's chain (:func:`fkopt.adapters.field.arm_urdf`): its
+``URDF_file`` runs xacro, which evaluates ``${...}`` in every attribute, so the robot's own file
+would run whatever expression it holds (issue 42).
+
 Quirks worked around: rtb resolves the meshes' ``package://`` paths through xacro, so it reads a
-copy of the file without visual, collision, transmission and gazebo elements (the chain needs
-none); a sub-chain ``robot.ets(start, end)`` keeps the whole robot's joint indices (``jindex``),
+copy of the file without visual, collision, transmission and gazebo elements (the written URDF
+has none; a file from :meth:`~fkopt.adapters.field.ArmURDF.from_file` may); a sub-chain ``robot.ets(start, end)`` keeps the whole robot's joint indices (``jindex``),
 so a chain starting below the root (Baxter's arm from its torso) would read q at the wrong
 places, and it includes the joint into ``start`` when that one moves -- the wrapper composes the
 links' own ETS from below ``base`` to ``tip`` and renumbers the chain's joints 0..n-1; the ETS is checked against fkopt's FK
-at a random configuration when built. When it misreads the robot's own file (iCub's: 1.5 m off), the
-wrapper reads the URDF written from fkopt's
-chain instead (:func:`fkopt.adapters.field.arm_urdf`, ``settings["urdf_note"]``), checked the same
-way; an arm rtb misreads either way is refused with one line. MJCF arms always reach it through
-the written URDF (rtb reads only URDF).
+at a random configuration when built (rtb misread iCub's own file by 1.5 m; it reads the written
+URDF of every kinbench arm right), and an arm rtb misreads is refused with one line.
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from ...errors import FkoptError
-from . import FieldIK, arm_urdf
+from . import FieldIK, arm_urdf, check_expression_free
 
 
 def chain_ets(urdf):
@@ -44,7 +45,9 @@ def chain_ets(urdf):
         for e in list(parent):
             if e.tag in ("visual", "collision", "transmission", "gazebo"):
                 parent.remove(e)
-    with urdf.as_file(ET.tostring(tree.getroot(), encoding="unicode")) as copy:
+    text = ET.tostring(tree.getroot(), encoding="unicode")
+    check_expression_free(text, urdf.source)              # xacro runs on what rtb reads (module docstring)
+    with urdf.as_file(text) as copy:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             links, name, _ = URDF_file(str(copy))
@@ -78,12 +81,6 @@ class _Rtb(FieldIK):
         super().__init__(arm, timeout=timeout, rng=rng)
         urdf = arm_urdf(arm)
         self.ets, version, gap = self._read(urdf)
-        if not gap < 1e-9 and not urdf.source.startswith("written"):
-            # rtb misreads the robot's own file (iCub's: 1.5 m off): read the URDF written from
-            # fkopt's chain instead, checked the same way
-            urdf, misread = arm_urdf(arm, written=True), f"rtb misreads {urdf.source} (FK off by {gap:.3g})"
-            self.ets, version, gap = self._read(urdf)
-            self.settings["urdf_note"] = misread
         if not gap < 1e-9:
             raise FkoptError(f"{self.name}: rtb's FK of {urdf.source} differs from fkopt's by {gap:.3g} "
                              "(rtb misreads this URDF)")
