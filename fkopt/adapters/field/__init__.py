@@ -54,11 +54,14 @@ IK_SOLVERS = {
     "scipy-lbfgsb": ("lbfgsb", "LBFGSB"),
     "nevergrad-ngopt": ("nevergrad_ngopt", "NGOpt"),
     "eaik": ("eaik", "EAIK"),
+    "optik": ("optik", "OptIK"),
+    "pink": ("pink", "Pink"),
 }
 #: The outside package each wrapper needs (for the one-line message when it is missing).
 PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
             "pin-clik": "pin", "ikpy": "ikpy", "cma-es": "cma", "scipy-lbfgsb": "scipy",
-            "nevergrad-ngopt": "nevergrad", "eaik": "eaik"}
+            "nevergrad-ngopt": "nevergrad", "eaik": "eaik",
+            "optik": "optik-py", "pink": "pin-pink"}
 #: Wrappers that only see the objective (the black-box track); the others use Jacobians.
 BLACK_BOX = ("cma-es", "scipy-lbfgsb", "nevergrad-ngopt")
 

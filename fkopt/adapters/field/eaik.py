@@ -12,7 +12,7 @@ Two calls:
 
 How it reads the arm, as its README does: :class:`eaik.IK_URDF.UrdfRobot` on a URDF file. It
 takes *every* actuated joint of the file (the Panda's fingers too), so it is given the URDF
-written from fkopt's chain (:func:`fkopt.adapters.field.arm_urdf` with ``written=True``): the
+written from fkopt's chain (:func:`fkopt.adapters.field.arm_urdf`): the
 chain's joints only. Its end effector is the last joint's child link origin with the base's
 orientation at q = 0 (its ``P``'s last column is zero, ``R6T`` the identity); the arm's tip is
 rigidly attached to that link, so the tip frame is EAIK's frame times one constant transform
@@ -62,7 +62,7 @@ class EAIK(FieldIK):
         prismatic = [n for n, u in zip(arm.unknown_names, arm.unknown_units) if u != "deg"]
         if prismatic:
             raise NotApplicable(f"prismatic joint {prismatic[0]}: EAIK's URDF robots are revolute chains")
-        urdf = arm_urdf(arm, written=True)
+        urdf = arm_urdf(arm)
         with urdf.as_file() as path:
             self._robot = UrdfRobot(str(path))
         if not self._robot.hasKnownDecomposition():
