@@ -193,7 +193,9 @@ BOARDS: dict[str, dict[str, str]] = {
 
 
 def board_version(suite: str) -> str | None:
-    """The current board version of suite ``suite`` ("kinbench-v3-robots/2"), None when it has none."""
-    versions = BOARDS.get(suite)
-    return f"{suite}/{max(versions, key=int)}" if versions else None
+    """The current board version of suite ``suite`` ("kinbench-v3-robots/2"; its quick tier,
+    ``<name>-quick``, has its suite's), None when it has none."""
+    name = suite.removesuffix("-quick")
+    versions = BOARDS.get(name)
+    return f"{name}/{max(versions, key=int)}" if versions else None
 

@@ -21,6 +21,9 @@ Quirk worked around: OptIK's FK is wrong past a fixed joint that lies *between* 
 robots' own files have fixed joints only at the ends, so its authors' tests never meet one). The
 wrapper folds each such fixed joint's origin into the next moving joint's (:func:`fold_fixed`),
 the same chain; its FK is checked against fkopt's when the wrapper is made.
+
+Not applicable (:class:`~fkopt.adapters.field.NotApplicable`): an arm with a prismatic joint (the
+TIAGo's torso): OptIK 0.5's Jacobian panics on one ("not yet supported"), which aborts the process.
 """
 from __future__ import annotations
 
@@ -29,7 +32,12 @@ import warnings
 import numpy as np
 
 from ...errors import FkoptError
-from . import FieldIK, arm_urdf
+from . import FieldIK, NotApplicable, arm_urdf
+
+
+def optik_version() -> str:
+    from importlib.metadata import version
+    return version("optik-py")
 
 
 def fold_fixed(text: str) -> str:
@@ -85,6 +93,9 @@ class OptIK(FieldIK):
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
         import optik
+        prismatic = [n for n, u in zip(arm.unknown_names, arm.unknown_units) if u != "deg"]
+        if prismatic:       # its Jacobian panics ("prismatic joints not yet supported") and aborts the process
+            raise NotApplicable(f"prismatic joint {prismatic[0]}: OptIK {optik_version()} supports revolute joints only")
         urdf = arm_urdf(arm)
         with urdf.as_file(fold_fixed(urdf.text)) as path:
             self._robot = optik.Robot.from_urdf_file(str(path), urdf.base_link, urdf.tip_link)
