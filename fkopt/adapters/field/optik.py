@@ -24,6 +24,8 @@ the same chain; its FK is checked against fkopt's when the wrapper is made.
 
 Not applicable (:class:`~fkopt.adapters.field.NotApplicable`): an arm with a prismatic joint (the
 TIAGo's torso): OptIK 0.5's Jacobian panics on one ("not yet supported"), which aborts the process.
+A continuous joint (which OptIK refuses with a panic) is given to it as a revolute joint with
+limits of a full turn either way (:func:`fold_fixed`).
 """
 from __future__ import annotations
 
@@ -41,7 +43,9 @@ def optik_version() -> str:
 
 
 def fold_fixed(text: str) -> str:
-    """The URDF ``text`` with every fixed joint whose child link is the parent of another joint
+    """The URDF ``text`` as OptIK 0.5 reads it right: a continuous joint made revolute with limits of
+    a turn either way (OptIK panics on a continuous joint; answers are wrapped into [-180, 180) deg
+    as every entry's), and every fixed joint whose child link is the parent of another joint
     folded into that joint: the child joint's origin becomes fixed origin x its origin (URDF rpy
     is the extrinsic x-y-z rotation), its parent the fixed joint's parent; the fixed joint and its
     link go."""
@@ -56,6 +60,14 @@ def fold_fixed(text: str) -> str:
         F = np.eye(4)
         F[:3, :3], F[:3, 3] = Rotation.from_euler("xyz", rpy).as_matrix(), xyz
         return F
+    for j in root.findall("joint"):      # OptIK 0.5 refuses continuous joints (a panic): a turn either way
+        if j.get("type") == "continuous":
+            j.set("type", "revolute")
+            limit = j.find("limit")
+            if limit is None:
+                limit = ET.SubElement(j, "limit", effort="1", velocity="1")
+            limit.set("lower", repr(-2 * np.pi))
+            limit.set("upper", repr(2 * np.pi))
     changed = True
     while changed:
         changed = False
@@ -98,7 +110,12 @@ class OptIK(FieldIK):
             raise NotApplicable(f"prismatic joint {prismatic[0]}: OptIK {optik_version()} supports revolute joints only")
         urdf = arm_urdf(arm)
         with urdf.as_file(fold_fixed(urdf.text)) as path:
-            self._robot = optik.Robot.from_urdf_file(str(path), urdf.base_link, urdf.tip_link)
+            try:
+                self._robot = optik.Robot.from_urdf_file(str(path), urdf.base_link, urdf.tip_link)
+            except BaseException as err:       # a Rust panic arrives as pyo3's PanicException, a BaseException
+                if isinstance(err, (KeyboardInterrupt, SystemExit)):
+                    raise
+                raise FkoptError(f"optik cannot read {urdf.source}: {str(err).splitlines()[0][:160]}") from None
         if self._robot.num_positions() != arm.dof:
             raise FkoptError(f"optik: {urdf.source} {urdf.base_link} -> {urdf.tip_link} has "
                              f"{self._robot.num_positions()} joints in OptIK, {arm.dof} in fkopt")
