@@ -44,20 +44,28 @@ def advice_markdown(table: pd.DataFrame) -> str:
 
 def robots_summary(folder: str | Path, timeout_ms: float = 20.0) -> pd.DataFrame:
     """Per IK solver of a stored per-robot board (``leaderboard-robots.csv``) at ``timeout_ms``:
-    the arms it ran on, its success at each rung of the ladder (mean over arms, and the worst
-    arm at the board's rung) and its median time and median time ratio to the reference (median
-    over arms); best first (mean success at the rung, then ratio). FK rows (the parallel
-    mechanisms, another timeout ladder) are left out."""
+    the arms it ran on and those it cannot take ("not applicable" cells, counted apart, never as
+    zeros), its success at each rung of the ladder (mean over the arms it ran on, and the worst
+    arm at the board's rung) and its median time, median CPU time per call (boards from version 2
+    on) and median time ratio to the reference (median over arms); best first (mean success at
+    the rung, then ratio). FK rows (the parallel mechanisms, another timeout ladder) are left out."""
     board = pd.read_csv(Path(folder) / "leaderboard-robots.csv")
     fk_robots = set(board.loc[board["other_mode"].notna(), "robot"])      # FK rows count other modes
     board = board[np.isclose(board["timeout_ms"], timeout_ms) & ~board["robot"].isin(fk_robots)]
     success = [c for c in board.columns if c.startswith("success_")]
     rung = f"success_{board['rung'].iloc[0]}"
-    g = board.groupby(["solver", "entry"], sort=False)
+    na = (board["not_applicable"].fillna("").astype(str) != "") if "not_applicable" in board else \
+        pd.Series(False, index=board.index)
+    ran = board[~na]
+    g = ran.groupby(["solver", "entry"], sort=False)
     out = g[success].mean().mul(100)
     out["worst_arm"] = g[rung].min().mul(100)
     out["arms"] = g["robot"].nunique()
+    out["not_applicable"] = board[na].groupby(["solver", "entry"], sort=False)["robot"].nunique() \
+        .reindex(out.index).fillna(0).astype(int)
     out["median_ms"] = g["time_ms_median"].median()
+    if "cpu_ms_median" in ran:
+        out["median_cpu_ms"] = g["cpu_ms_median"].median()
     out["median_ratio"] = g["time_ratio_median"].median()
     out = out.reset_index().sort_values([rung, "median_ratio"], ascending=[False, True], kind="stable")
     return out.reset_index(drop=True)
@@ -67,12 +75,17 @@ def robots_markdown(table: pd.DataFrame, timeout_ms: float = 20.0) -> str:
     """The summary as README prints it."""
     success = [c for c in table.columns if c.startswith("success_")]
     rungs = " / ".join(c.removeprefix("success_").replace("_", ", ") for c in success)
+    cpu = "median_cpu_ms" in table
     lines = [f"| solver | entry | arms | success % at {rungs} (mean over arms) | worst arm % | median ms | "
-             "median ratio to rtb `ik_LM` |", "|---|---|---|---|---|---|---|"]
+             + ("median CPU ms per call | " if cpu else "") + "median ratio to rtb `ik_LM` |",
+             "|---|---|---|---|---|---|---|" + ("---|" if cpu else "")]
     for _, r in table.iterrows():
         pct = " / ".join(f"{r[c]:.0f}" for c in success)
-        lines.append(f"| {r['solver']} | {r['entry']} | {r['arms']} | {pct} | {r['worst_arm']:.0f} | "
-                     f"{r['median_ms']:.3g} | {r['median_ratio']:.3g} |")
+        na = int(r.get("not_applicable", 0) or 0)
+        arms = f"{r['arms']}" + (f" (not applicable: {na})" if na else "")
+        lines.append(f"| {r['solver']} | {r['entry']} | {arms} | {pct} | {r['worst_arm']:.0f} | "
+                     f"{r['median_ms']:.3g} | " + (f"{r['median_cpu_ms']:.3g} | " if cpu else "")
+                     + f"{r['median_ratio']:.3g} |")
     return "\n".join(lines)
 
 

@@ -395,7 +395,9 @@ ROBOTS_PREAMBLE = ("IK of real arms, every answer checked by fkopt's FK (positio
 
 def robot_columns(board: pd.DataFrame) -> list[str]:
     return (["solver", "robot", "timeout_ms", "entry"] + [c for c in board.columns if c.startswith("success_")]
-            + ["time_ms_median", "time_ratio_median", "time_ratio_p95", "throughput_qps"])
+            + ["time_ms_median"] + (["cpu_ms_median"] if "cpu_ms_median" in board else [])
+            + ["time_ratio_median", "time_ratio_p95", "throughput_qps"]
+            + (["not_applicable"] if "not_applicable" in board else []))
 
 
 PER_PROBLEM = ["set", "solver", "track", "target", "trials", "success_rate", "ert"]

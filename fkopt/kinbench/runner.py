@@ -209,7 +209,8 @@ def solve_track(payload: dict) -> dict:
     if tp is not None:
         from .clock import is_ik
         batches = tp.batches if is_ik(arm) else tp.fk_batches
-        rate = run_throughput(arm, name, queries, solvers, batches=tuple(batches), repeats=tp.repeats,
+        batched = list(dict.fromkeys([*solvers, *(tp.solvers if is_ik(arm) else [])]))
+        rate = run_throughput(arm, name, queries, batched, batches=tuple(batches), repeats=tp.repeats,
                               reference=reference, seed=config.seed).to_dict(orient="list")
     return {"fingerprint": payload["fingerprint"], "track": "clock", "problem": p,
             "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start,

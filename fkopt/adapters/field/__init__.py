@@ -56,12 +56,15 @@ IK_SOLVERS = {
     "eaik": ("eaik", "EAIK"),
     "optik": ("optik", "OptIK"),
     "pink": ("pink", "Pink"),
+    "pytorch-kinematics": ("torchkin", "TorchIK"),
 }
 #: The outside package each wrapper needs (for the one-line message when it is missing).
 PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
             "pin-clik": "pin", "ikpy": "ikpy", "cma-es": "cma", "scipy-lbfgsb": "scipy",
             "nevergrad-ngopt": "nevergrad", "eaik": "eaik",
-            "optik": "optik-py", "pink": "pin-pink"}
+            "optik": "optik-py", "pink": "pin-pink", "pytorch-kinematics": "pytorch-kinematics"}
+#: Where each wrapper's package is installed from, when not ``.[field]`` (torch is gigabytes).
+EXTRAS = {"pytorch-kinematics": "torch"}
 #: Wrappers that only see the objective (the black-box track); the others use Jacobians.
 BLACK_BOX = ("cma-es", "scipy-lbfgsb", "nevergrad-ngopt")
 
@@ -194,7 +197,7 @@ def make_ik(name: str, arm, *, timeout: float, rng: np.random.Generator) -> Fiel
         mod = importlib.import_module(f"{__name__}.{module}")
         return getattr(mod, cls)(arm, timeout=timeout, rng=rng)
     except ImportError as err:
-        raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[field]\"): "
+        raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[{EXTRAS.get(name, 'field')}]\"): "
                          f"{err}") from None
     except FkoptError:       # NotApplicable included: the caller decides what a cell says
         raise
