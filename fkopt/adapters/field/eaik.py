@@ -10,7 +10,7 @@ Two calls:
 * :meth:`EAIK.solutions` -- every solution EAIK returns for a pose (:class:`Solutions`: joints,
   its least-squares flags, and which lie inside the limits), for "every IK solution".
 
-How it reads the arm, as its README does: :class:`eaik.IK_URDF.UrdfRobot` on a URDF file. It
+Quirks worked around -- how it reads the arm, as its README does: :class:`eaik.IK_URDF.UrdfRobot` on a URDF file. It
 takes *every* actuated joint of the file (the Panda's fingers too), so it is given the URDF
 written from fkopt's chain (:func:`fkopt.adapters.field.arm_urdf`): the
 chain's joints only. Its end effector is the last joint's child link origin with the base's

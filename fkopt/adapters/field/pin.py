@@ -17,12 +17,12 @@ entries):
   in 10 steps) or after ``it_max`` = 100 steps. The board's first CLIK (undamped full steps,
   restart only after 50 steps) ended 97-100 % of its failed starts stuck at a limit.
 
-``dt`` = 1 (a full step: the example's 0.1 shrinks the error by 0.9 per step); ``eps`` = 0.99e-5 on
+Settings: ``dt`` = 1 (a full step: the example's 0.1 shrinks the error by 0.9 per step); ``eps`` = 0.99e-5 on
 |log6| implies the board's rung of 1e-5 m and 1e-5 rad (log6's linear part differs from the tip's
 position error by a factor of at most 1 + angle / 2). The documented example itself (DT 0.1, damp
 1e-12, eps 1e-4, from neutral) is reproduced by tests/test_field.py's reproduction check.
 
-pinocchio's model holds every joint of the URDF (the Panda's fingers): the other joints are
+Quirks worked around: pinocchio's model holds every joint of the URDF (the Panda's fingers): the other joints are
 locked at neutral with ``buildReducedModel``. Continuous joints are (cos, sin) pairs in
 pinocchio's q (nq = 2); the wrapper converts. The target is in the chain's base frame,
 pinocchio's in the model's root frame: the wrapper maps through oMbase (fixed, the base lies

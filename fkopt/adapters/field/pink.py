@@ -14,7 +14,8 @@ a start stops when the task error |log6| (``FrameTask.compute_error``) is below 
 the board's rung of 1e-5 m and 1e-5 rad, as pin-clik's), when it stalls (its error has not
 halved in 10 steps), after 100 steps, or at the query's wall-clock deadline.
 
-The model is pin-clik's (:class:`fkopt.adapters.field.pin.PinCLIK`: pinocchio's model of the
+Quirks worked around: ``solve_ik`` raises ``NoSolutionFound`` when the QP is infeasible (a start
+pressed against a limit); that ends the start, as a stall does. The model is pin-clik's (:class:`fkopt.adapters.field.pin.PinCLIK`: pinocchio's model of the
 URDF fkopt writes from its chain, the other joints locked); the target maps from the chain's base
 frame to the model's root frame through oMbase.
 """

@@ -16,7 +16,8 @@ defaults otherwise (``max_iterations`` 50, ``lr`` 1, ``lm_damping`` 0.1), except
 * the 10 starts per pose drawn uniform in the limits from the wrapper's generator and given as
   ``retry_configs`` (its own sampling draws from torch's global RNG).
 
-Per pose the answer is the first converged start, else the start with the smallest position +
+Quirks worked around: its own start sampling draws from torch's global RNG (so the starts are
+given); its ``converged`` flag is per start. Per pose the answer is the first converged start, else the start with the smallest position +
 rotation error; every answer is judged by kinbench's FK. One torch thread per call
 (``torch.set_num_threads(1)`` around it): the throughput track lets an entry use every core, but
 torch's OpenMP threads wait for each other spinning, and on this shared 2-core machine (load ~13)
