@@ -1,6 +1,6 @@
 """ikpy (Manceron, github.com/Phylliade/ikpy): the chain's FK as matrices and
 ``scipy.optimize.least_squares`` on the position and the three orientation axes, bounded by the
-URDF's joint limits, at ikpy's defaults: ``Chain.from_urdf_file`` with ``symbolic=True`` (the
+URDF's joint limits. Settings: ikpy's defaults: ``Chain.from_urdf_file`` with ``symbolic=True`` (the
 chain's FK compiled from sympy expressions once, when the wrapper is made: its FK runs ~5x
 faster than the plain numpy path the board's first wrapper used), the numpy backend,
 ``optimizer="least_squares"``, scipy's default tolerances and budget (ikpy's ``tol`` and
