@@ -60,9 +60,11 @@ def test_wrong_or_out_of_limit_answer_is_a_failure_whatever_is_claimed():
 
 
 #: Share of 10 random poses each wrapper must solve at (1 mm, 0.01 rad) within its timeout (s);
-#: measured on this machine: TRAC-IK 5 ms 51-90 %, ikpy 20 ms 50-60 % (one start is ~25 ms).
+#: measured on this machine: TRAC-IK 5 ms 51-90 %, ikpy 20 ms 50-60 % (one start is ~25 ms). The
+#: timeouts are wall-clock and these tests check answers, not speed (the board measures speed): the
+#: restart loops get 0.1 s (at load 15 on 2 cores pin-clik solved 6 of 10 UR5 poses in 20 ms).
 JACOBIAN_FLOOR = {"tracik": (0.02, 0.7), "rtb-ik_LM": (0.02, 0.7), "rtb-ik_NR": (0.02, 0.7),
-                  "pin-clik": (0.02, 0.7), "ikpy": (0.1, 0.5), "optik": (0.02, 0.7), "pink": (0.05, 0.5)}
+                  "pin-clik": (0.1, 0.7), "ikpy": (0.1, 0.5), "optik": (0.02, 0.7), "pink": (0.1, 0.5)}
 
 
 def _needs(solver):
