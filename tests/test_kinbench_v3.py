@@ -621,3 +621,17 @@ def test_a_board_names_its_frozen_version_and_its_quick_tier_the_same():
     assert board_version("kinbench-v3-robots") == board_version("kinbench-v3-robots-quick") == \
         f"kinbench-v3-robots/{max(BOARDS['kinbench-v3-robots'], key=int)}"
     assert board_version("kinbench-v2") is None
+
+
+def test_check_compares_meta_json_but_for_the_machines_load_during_the_run(tmp_path):
+    """A per-robot board's meta.json stores the load averages at its start and end: a rerun's differ,
+    so fkopt check compares every other key (the exact tier too) and never those."""
+    import json
+    from fkopt.run.compare import META_RUN, compare_meta
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    meta = {"board_version": "kinbench-v3-robots/2", "load_avg": {"start": [0.5, 0.4, 0.3], "end": [0.6, 0.4, 0.3]}}
+    a.write_text(json.dumps(meta))
+    b.write_text(json.dumps({**meta, "load_avg": {"start": [9.0, 8.0, 7.0], "end": [9.0, 8.0, 7.0]}}))
+    assert compare_meta("x", a, b, variable=META_RUN) == []
+    b.write_text(json.dumps({**meta, "board_version": "kinbench-v3-robots/1"}))
+    assert [m.column for m in compare_meta("x", a, b, variable=META_RUN)] == ["board_version"]

@@ -421,7 +421,9 @@ def compare_folders(name: str, stored: Path, rerun: Path, rules: Rules | bool,
             continue
         if not s.exists():
             continue
-        if rules.tier == EXACT:
+        if rules.tier == EXACT and file == "meta.json":   # identical but for the machine's load during the run
+            out += compare_meta(name, s, r, variable=META_RUN)
+        elif rules.tier == EXACT:
             a, b = _bytes(s), _bytes(r)
             if a != b:
                 out.append(first_difference(name, file, a, b))
@@ -440,12 +442,15 @@ def compare_folders(name: str, stored: Path, rerun: Path, rules: Rules | bool,
     return out
 
 
+#: meta.json keys that depend on the machine's state during the run (a per-robot board's load
+#: averages at its start and end, issue 37): never compared.
+META_RUN = ("load_avg",)
 #: meta.json keys that depend on the platform (digests of the files) or the invocation.
-META_VARIABLE = ("files", "config_file")
+META_VARIABLE = ("files", "config_file") + META_RUN
 
 
-def compare_meta(name: str, stored: Path, rerun: Path) -> list[Mismatch]:
-    """meta.json on another platform: everything but the file digests must be equal."""
+def compare_meta(name: str, stored: Path, rerun: Path, variable: tuple[str, ...] = META_VARIABLE) -> list[Mismatch]:
+    """meta.json on another platform: everything but the file digests (``variable``) must be equal."""
     import json
     try:
         a = json.loads(_bytes(Path(stored)).decode("utf-8"))
@@ -454,6 +459,6 @@ def compare_meta(name: str, stored: Path, rerun: Path) -> list[Mismatch]:
     b = json.loads(_bytes(Path(rerun)).decode("utf-8"))
     out = []
     for key in sorted(set(a) | set(b)):
-        if key not in META_VARIABLE and a.get(key) != b.get(key):
+        if key not in variable and a.get(key) != b.get(key):
             out.append(Mismatch(name, "meta.json", "-", key, a.get(key), b.get(key), "identical"))
     return out
