@@ -32,7 +32,7 @@ reproduce:
 # Slow (NiaPy evaluates one point per call) and outside `make reproduce`; needs install-peers.
 reproduce-peers:
 	$(FKOPT) reproduce --configs peers --out results/peers
-	$(PYTHON) -m fkopt.peers results/peers
+	$(PYTHON) -m fkopt.tools.peers results/peers
 
 # kinbench (docs/kinbench.md): v1, v2 and v3's evaluations track in full (v3: exact and lm on every
 # problem, set and pose, the others on the subsets its YAML documents), v3's per-robot board on the

@@ -19,8 +19,7 @@ from __future__ import annotations
 import sys
 import types
 
-from .errors import FkoptError
-from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
+from fkopt.errors import FkoptError
 
 #: Public names loaded on first use (PEP 562), so that ``import fkopt`` -- and ``fkopt fk`` --
 #: pay only for what they touch: the optimiser layer imports pydantic, the version
@@ -28,7 +27,8 @@ from .registry import ALGORITHMS, MECHANISMS, algorithm_class, mechanism_class
 _LAZY = {"ForwardResult": "kinematics", "InverseResult": "kinematics", "forward": "kinematics",
          "inverse": "kinematics", "InverseSolver": "kinematics", "inverse_solver": "kinematics",
          "InverseOptions": "numerics", "FKProblem": "problems", "IKProblem": "problems",
-         "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve"}
+         "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve",
+         "MECHANISMS": "registry", "ALGORITHMS": "registry", "SOLVERS": "registry"}
 
 
 def __getattr__(name: str):
@@ -68,15 +68,17 @@ sys.modules[__name__].__class__ = _Package
 
 def mechanism(name: str, **geometry):
     """A registered mechanism with optional geometry overrides (and ``bounds={var: [lo, hi]}``)."""
+    from fkopt.registry import mechanism_class    # the registry imports every built-in class: on first use
     return mechanism_class(name)(**geometry)
 
 
 def algorithm(name: str, **params):
     """A registered algorithm with validated parameters."""
+    from fkopt.registry import algorithm_class
     return algorithm_class(name)(**params)
 
 
 __all__ = ["FkoptError", "FKProblem", "IKProblem", "Result", "algorithm", "fk_problem", "ik_problem",
            "mechanism", "solve", "forward", "inverse", "InverseSolver", "inverse_solver",
            "InverseOptions", "ForwardResult", "InverseResult",
-           "MECHANISMS", "ALGORITHMS", "__version__"]
+           "MECHANISMS", "ALGORITHMS", "SOLVERS", "__version__"]

@@ -14,9 +14,9 @@ from typing import Optional
 import numpy as np
 import typer
 
-from . import registry
-from .errors import FkoptError
-from .files import strict_json
+from fkopt import registry
+from fkopt.errors import FkoptError
+from fkopt.files import strict_json
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics. "
@@ -48,7 +48,7 @@ def _flags_without_type_tag() -> None:
 
 def _version(value: bool) -> None:
     if value:
-        from . import __version__
+        from fkopt import __version__
         typer.echo(f"fkopt {__version__}")
         raise typer.Exit()
 
@@ -94,15 +94,15 @@ def parse_assignments(text: str, option: str) -> dict[str, float]:
 def load_geometry(path: Optional[Path]) -> dict:
     if path is None:
         return {}
-    from .files import load_mapping
+    from fkopt.files import load_mapping
     return load_mapping(path, "geometry keys")
 
 
 def _mechanism(name: str, geometry: Optional[Path]):
     """Mechanism ``name`` with the overrides of a --geometry YAML file (its relative file paths,
     e.g. a URDF's, taken from the YAML's folder), or, for ``urdf``, a .urdf file itself."""
-    from . import mechanism
-    from .registry import mechanism_class, resolve_files
+    from fkopt import mechanism
+    from fkopt.registry import mechanism_class, resolve_files
     if geometry is not None and geometry.suffix.lower() == ".urdf":
         try:
             return mechanism(name, file=str(geometry))
@@ -273,7 +273,8 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
     algorithms, a study's pose chunks, a suite's problem x solver pairs) without changing a
     number. The fields of a file are listed in docs/config-reference.md (fkopt schema prints its
     JSON Schema)."""
-    from .experiment.kinds import load_any
+    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+    from fkopt.run.pipeline import load_any
     _run_files([(path, load_any(path)) for path in configs], out, jobs=jobs, executor=executor,
                scheduler=scheduler, resume=resume, force=force, quiet=quiet)
 
@@ -281,8 +282,9 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
 def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
                force: bool, quiet: bool) -> None:
     """Validate every (path, config) and check every output folder, then run them in order."""
-    from .experiment.executors import validate_executor
-    from .experiment.kinds import plan_config, prepare_output, run_config
+    from fkopt.run.executors import validate_executor
+    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+    from fkopt.run.pipeline import plan_config, prepare_output, run_config
     validate_executor(executor, jobs, scheduler)
     planned, folders = [], {}
     for path, config in files:    # fail on any bad file or output folder before running anything
@@ -375,17 +377,17 @@ class _progress:
 
 
 def _print_outcome(con, outcome, tasks: int) -> None:
-    from .experiment.runner import ExperimentResult
-    from .study.runner import StudyResult
+    from fkopt.kinds.experiment.runner import ExperimentResult
+    from fkopt.kinds.study.runner import StudyResult
     result = outcome.result
     if isinstance(result, ExperimentResult):
-        from .experiment.reports import summary_table
+        from fkopt.kinds.experiment.reports import summary_table
         _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
     elif isinstance(result, StudyResult):
-        from .study.reports import summary_table
+        from fkopt.kinds.study.reports import summary_table
         _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
     elif getattr(result.config, "kind", None) == "suite":
-        from .kinbench.reports import board_top_lines
+        from fkopt.kinbench.reports import board_top_lines
         con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
         for line in board_top_lines(outcome.folder):
             con.print(line, markup=False, highlight=False, soft_wrap=True)
@@ -416,7 +418,8 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
     of 2-D grids and pairwise rank tests; mode: tracking solves trajectories step by step, each
     step warm-started from the previous one. Fields: docs/config-reference.md (study);
     examples: configs/studies/."""
-    from .experiment.kinds import load_any
+    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+    from fkopt.run.pipeline import load_any
     cfg = load_any(config)
     if getattr(cfg, "kind", None) != "study":
         raise FkoptError(f"{config}: not a study file (kind: study); run it with: fkopt run {config}")
@@ -437,7 +440,8 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress")):
     """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files
     (= fkopt run on it; --quick picks the file's quick tier)."""
-    from .experiment.kinds import load_any
+    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+    from fkopt.run.pipeline import load_any
     cfg = load_any(config)
     if getattr(cfg, "kind", None) != "suite":
         raise FkoptError(f"{config}: not a suite file (kind: suite); run it with: fkopt run {config}")
@@ -531,14 +535,14 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     if algorithm and (start or mask):
         raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
     if algorithm:
-        from .by_algorithm import inverse_by
+        from fkopt.kinematics.by_algorithm import inverse_by
         out = inverse_by(m, values, algorithm, tol=(position_tol, orientation_tol), seed=seed).as_dict()
         out.pop("restarts")
         out["objective"] = "geodesic"
         out["algorithm"] = algorithm
         perr, rerr = out["position_error"], out["rotation_error_rad"]
     else:
-        from .kinematics import inverse
+        from fkopt.kinematics.solvers import inverse
         q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
         # One pose per process: loading numba and its cache (~0.7 s) costs more than the compiled
         # loop saves, so the command keeps the reference path (fkopt.numerics.path).
@@ -587,7 +591,7 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise FkoptError(f"--tolerance: must be a positive number, got {tolerance}")
     if all_solutions:
-        from .assembly import all_solutions as find_all, solutions_to_dict
+        from fkopt.kinematics.assembly_modes import all_solutions as find_all, solutions_to_dict
         found = find_all(m, values, seed=seed)
         data = solutions_to_dict(found)
         if as_json:
@@ -598,14 +602,14 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
                 _console().print(s)
         return
     if algorithm:
-        from .by_algorithm import forward_by
+        from fkopt.kinematics.by_algorithm import forward_by
         r = forward_by(m, values, algorithm, tol=tolerance, seed=seed)
         out = r.as_dict()
         out.pop("stage")
         out["algorithm"] = algorithm
         x = r.pose
     else:
-        from .kinematics import forward
+        from fkopt.kinematics.solvers import forward
         r = forward(m, values, tol=tolerance, seed=seed)
         out = r.as_dict()
         out["found_by"] = FOUND_BY[out.pop("stage")]
@@ -650,7 +654,7 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
                fmt: str = typer.Option("ioh", "--format", help="ioh: IOHprofiler data for IOHanalyzer"),
                out: Path = typer.Option(..., "--out", help="folder to write (outside RESULTS)")):
     """Export stored results for other tools (IOHanalyzer), without rerunning anything."""
-    from .export import FORMATS, ioh_export
+    from fkopt.tools.export import FORMATS, ioh_export
     if fmt not in FORMATS:
         raise FkoptError(f"--format: unknown format '{fmt}'; allowed: {', '.join(FORMATS)}")
     files = ioh_export(results, out)
@@ -681,8 +685,8 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop; pygmo's
     bee_colony with a numba fitness beside the batched ABC), scaling (population and runs; draws
     scaling.png). The last line gives the seconds per section."""
-    from .bench import SECTIONS, run as run_bench
-    from .files import output_folder
+    from fkopt.bench.sections import SECTIONS, run as run_bench
+    from fkopt.files import output_folder
     bad = [s for s in section if s not in SECTIONS]
     if bad:
         raise typer.BadParameter(f"unknown section {bad[0]!r}; allowed: {', '.join(SECTIONS)}",
@@ -704,14 +708,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
-    from .reproduce.changes import snapshot
-    from .reproduce.report import write_report
-    from .reproduce.run import default_jobs, plan, run_all
+    from fkopt.reproduce.changes import snapshot
+    from fkopt.reproduce.report import write_report
+    from fkopt.reproduce.run import default_jobs, plan, run_all
 
     if jobs is not None and jobs < 1:
         raise FkoptError(f"--jobs: must be at least 1, got {jobs}")
     import tempfile
-    from .reproduce.changes import agreement
+    from fkopt.reproduce.changes import agreement
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
     kept = tempfile.TemporaryDirectory(prefix="fkopt-reproduce-")   # the old files, to judge what moved
     before = snapshot(out, keep=Path(kept.name))    # what the tree held, for CHANGES.md
@@ -782,7 +786,8 @@ def schema(kind: str = typer.Argument("experiment", help="experiment | study | a
     A YAML file whose first line is `# yaml-language-server: $schema=PATH` (PATH relative to the
     file: the committed copies are docs/schema/<kind>.json) is validated and completed by editors
     using yaml-language-server. Every field is described in docs/config-reference.md."""
-    from .config_reference import schema_text
+    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+    from fkopt.run.config_reference import schema_text
     typer.echo(schema_text(kind), nl=False)
 
 
@@ -793,9 +798,9 @@ def report(results: Path = typer.Argument(Path("results"), help="results root"),
            changes_since: Optional[Path] = typer.Option(None, "--changes-since", help="also write CHANGES.md: "
                                                         "what moved since the state recorded in FILE")):
     """Regenerate REPORT.md, TIMING.md and index.csv from stored results (no rerun)."""
-    from .reproduce.changes import load_snapshot, save_snapshot, snapshot
-    from .reproduce.report import write_report
-    from .reproduce.store import Store
+    from fkopt.reproduce.changes import load_snapshot, save_snapshot, snapshot
+    from fkopt.reproduce.report import write_report
+    from fkopt.reproduce.store import Store
     Store(results).require_readable()
     if snapshot_to is not None:
         save_snapshot(snapshot(results), snapshot_to)
@@ -825,15 +830,15 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
 
     Byte for byte where the platform fingerprint in env.json matches this machine; elsewhere
     rows no BLAS call touched stay exact and the rest follow the cross-platform rules of
-    fkopt.compare (docs/regression.md). A missing or unreadable meta.json is a failure.
+    fkopt.run.compare (docs/regression.md). A missing or unreadable meta.json is a failure.
     """
-    from .reproduce.check import check_experiment, select, stored_tier
+    from fkopt.reproduce.check import check_experiment, select, stored_tier
     if tier not in ("auto", "exact", "blas", "any"):
         raise FkoptError(f"--tier: '{tier}' unknown; allowed: auto, exact, blas, any")
     if tolerant and tier not in ("auto", "blas"):
         raise FkoptError(f"--tolerant is --tier blas; it cannot be combined with --tier {tier}")
     forced = "blas" if tolerant else (None if tier == "auto" else tier)
-    from .reproduce.store import locate
+    from fkopt.reproduce.store import locate
     if subset not in ("all", "ci"):
         raise FkoptError(f"--subset: '{subset}' unknown; allowed: all, ci")
     if not results.is_dir():
@@ -884,7 +889,7 @@ def main() -> None:
                    "study are kept too: fkopt study CONFIG --resume continues)")
 
     def fail(message: str) -> None:
-        from .files import one_line
+        from fkopt.files import one_line
         print(f"fkopt: error: {one_line(message)}", file=sys.stderr)
         sys.exit(2)
 

@@ -55,7 +55,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .errors import FkoptError
+from fkopt.errors import FkoptError
 
 #: Largest config or geometry file read (bytes).
 MAX_YAML_BYTES = 1 << 20

@@ -19,10 +19,10 @@ from typing import Literal
 
 import numpy as np
 
-from .errors import FkoptError
-from . import rotations
-from .mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
-from .rotations import wrap_degrees
+from fkopt.errors import FkoptError
+from fkopt.numerics import rotations
+from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
+from fkopt.numerics.rotations import wrap_degrees
 
 #: Version of the fitness definitions below (residuals, objectives, the IK pose error and its
 #: weights). Every released kinbench version records the one it was ranked with
@@ -338,7 +338,7 @@ class IKProblem(Problem):
         self.has_jacobian = hasattr(mechanism, "frame_jacobian")
 
     def _rotation_target(self, ndim: int):
-        """R_target as the nested tuples :mod:`fkopt.rotations` works on, broadcastable."""
+        """R_target as the nested tuples :mod:`fkopt.numerics.rotations` works on, broadcastable."""
         R = self._along(self._R_target, ndim)
         return tuple(tuple(R[..., r, c] for c in range(3)) for r in range(3))
 

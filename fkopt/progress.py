@@ -1,6 +1,6 @@
 """Progress inside a task: how far the running solve is, for a progress bar whose ETA moves.
 
-A task of the runner (:mod:`fkopt.experiment.tasks`) is an algorithm on all cases of an
+A task of the runner (:mod:`fkopt.run.tasks`) is an algorithm on all cases of an
 experiment, a study's chunk of poses or a suite's (problem, solver): a bar that counts finished
 tasks sits at 0/3 for most of a short run. So the innermost loops say how far they are with
 :func:`tick` -- an algorithm after each iteration (:meth:`fkopt.algorithms.base.Algorithm.minimize`),

@@ -1,17 +1,29 @@
-"""Name -> implementation maps for mechanisms and algorithms, built-in and plug-in.
+"""The one registry: every solver and mechanism fkopt can name, each entry carrying its own facts.
+
+A **solver entry** (:class:`SolverEntry`) is a function object (a class) and what is known about
+it: its ``role`` (an ``optimiser`` minimising a problem through :func:`fkopt.solve`, or an ``ik``
+/ ``fk`` solver answering one query at a time on kinbench's clock track), its kinbench
+``track``, the ``package`` it runs through (``fkopt`` or the PyPI package of another library),
+how kinbench ``timing`` measures it and the ``display`` name figures and tables print. Three
+families share it: fkopt's algorithms and exact solvers, other libraries' optimisers (the
+``scipy:``, ``pymoo:`` and ``niapy:`` adapters, :data:`ADAPTER_FAMILIES`) and the field's IK/FK
+solvers through their own packages (:mod:`fkopt.adapters.field`). **Adding an outside solver**:
+one wrapper class in ``fkopt/adapters/field/`` (``name``, ``package``, ``settings``, ``solve1``;
+its package imported inside it, run as its authors run it) and one :class:`SolverEntry` line in
+:data:`SOLVERS`; docs/kinbench.md gets its protocol row.
 
 A name resolves, in this order, to
 
-1. a **built-in** entry of :data:`MECHANISMS` / :data:`ALGORITHMS` (``"module:Class"`` strings
-   imported on first use, so listing names costs nothing). Adding one to fkopt is one module
-   plus one line here;
+1. a **built-in** entry of :data:`MECHANISMS` / :data:`SOLVERS` (function objects; adding one to
+   fkopt is one module plus one line here);
 2. an **adapter** of another library's optimiser (algorithms only): the reserved prefixes
    ``scipy:``, ``pymoo:`` and ``niapy:`` (e.g. ``"pymoo:DE"``), see :mod:`fkopt.adapters`;
 3. an **entry point** of an installed package, in the groups ``fkopt.mechanisms`` and
    ``fkopt.algorithms`` (``[project.entry-points."fkopt.algorithms"] de = "mypkg.de:DE"``).
    Entry points are read only when a name is not built in (or when listing), so ``fkopt fk
    3-rps`` never scans installed packages;
-4. a **direct reference** ``package.module:Class``.
+4. a **direct reference** ``package.module:Class`` (a user's plug-in: the only names given as
+   strings).
 
 Whatever an entry point or a direct reference names is checked *before anything is called*:
 it must be a class and a subclass of fkopt's documented base
@@ -43,41 +55,170 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
+from typing import Callable
 
-from .errors import FkoptError, did_you_mean
+from fkopt.adapters import adapter_class
+from fkopt.adapters.field.cmaes import CmaES
+from fkopt.adapters.field.eaik import EAIK
+from fkopt.adapters.field.ikpy import IkPy
+from fkopt.adapters.field.lbfgsb import LBFGSB
+from fkopt.adapters.field.nevergrad_ngopt import NGOpt
+from fkopt.adapters.field.optik import OptIK
+from fkopt.adapters.field.pin import PinCLIK
+from fkopt.adapters.field.pink import Pink
+from fkopt.adapters.field.rtb import RtbLM, RtbNR
+from fkopt.adapters.field.scipy_fk import LeastSquaresFK
+from fkopt.adapters.field.torchkin import TorchIK
+from fkopt.adapters.field.tracik import TracIK
+from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS
+from fkopt.algorithms.abc import ABC
+from fkopt.algorithms.aco import ACO
+from fkopt.algorithms.base import Algorithm
+from fkopt.algorithms.dls import DLS
+from fkopt.algorithms.gabc import GABC
+from fkopt.algorithms.hybrid import ABCLM, GABCLM, PSOLM
+from fkopt.algorithms.lm import LM
+from fkopt.algorithms.nr import NR
+from fkopt.algorithms.pabc import PABC
+from fkopt.algorithms.pso import PSO
+from fkopt.errors import FkoptError, did_you_mean
+from fkopt.kinematics.as_algorithms import Exact, Forward, Inverse
+from fkopt.kinematics.clock_entries import FkoptForward, FkoptInverse
+from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
+from fkopt.mechanisms.catalog import MECHANISMS
 
-MECHANISMS: dict[str, str] = {
-    "3-rps": "fkopt.mechanisms.rps3:ThreeRPS",
-    "6-sps": "fkopt.mechanisms.sps6:SixSPS",
-    "6-sps-cmm": "fkopt.mechanisms.sps6:SixSPSCMM",
-    "3-rpupc-ups": "fkopt.mechanisms.rpupc_ups:ThreeRPUPcUPS",
-    "3-ppr": "fkopt.mechanisms.ppr3:ThreePPR",
-    "dh-arm": "fkopt.mechanisms.dh_arm:DHArm",
-    "7dof-arm": "fkopt.mechanisms.dh_arm:SevenDofArm",
-    "dh-chain": "fkopt.mechanisms.dh_chain:DHChain",   # seeded spatial chains, n joints (kinbench v3)
-    "urdf": "fkopt.mechanisms.urdf:URDFArm",
-    "mjcf": "fkopt.mechanisms.mjcf:MJCFArm",
-}
+#: Roles of a solver: minimises a problem (fkopt.solve) / answers one IK or FK query (the clock).
+OPTIMISER, IK, FK = "optimiser", "ik", "fk"
+#: How kinbench times each role.
+COUNTED = "evaluations counted by fkopt; process time per run (timing.csv)"
+PER_QUERY = "one query per call, wall clock, on one core (kinbench's clock track)"
 
-ALGORITHMS: dict[str, str] = {
-    "abc": "fkopt.algorithms.abc:ABC",
-    "gabc": "fkopt.algorithms.gabc:GABC",
-    "aco": "fkopt.algorithms.aco:ACO",
-    "pso": "fkopt.algorithms.pso:PSO",
-    "pabc": "fkopt.algorithms.pabc:PABC",
-    "nr": "fkopt.algorithms.nr:NR",
-    "lm": "fkopt.algorithms.lm:LM",
-    "dls": "fkopt.algorithms.dls:DLS",
-    "abc+lm": "fkopt.algorithms.hybrid:ABCLM",
-    "gabc+lm": "fkopt.algorithms.hybrid:GABCLM",
-    "pso+lm": "fkopt.algorithms.hybrid:PSOLM",
-    "forward": "fkopt.exact:Forward",     # fkopt.forward as a solver (parallel FK)
-    "inverse": "fkopt.exact:Inverse",     # fkopt.inverse as a solver (serial IK)
-    "exact": "fkopt.exact:Exact",         # forward or inverse, by the mechanism's kind
-}
+
+@dataclass(frozen=True)
+class SolverEntry:
+    """One solver fkopt can name, with its facts: the class (``make``), its role, kinbench
+    track, package, timing rule and display name."""
+
+    name: str
+    make: Callable            # an Algorithm class (optimiser) or a one-query wrapper class (ik / fk)
+    role: str                 # OPTIMISER, IK or FK
+    track: str | None         # kinbench's evaluations track of an optimiser; "clock" for ik / fk
+    package: str = "fkopt"    # the PyPI package it runs through
+    timing: str = COUNTED
+    display: str = ""         # the name on figures and tables ("" -> the name)
+
+    @property
+    def label(self) -> str:
+        return self.display or self.name
+
+
+def _optimiser(name, cls, track, display=""):
+    return SolverEntry(name, cls, OPTIMISER, track, "fkopt", COUNTED, display)
+
+
+def _field(cls, role=IK, display=""):
+    return SolverEntry(cls.name, cls, role, "clock", cls.package, PER_QUERY, display)
+
+
+#: Every built-in solver: fkopt's algorithms and exact solvers, and the field's solvers through
+#: their own packages (the library adapters are :data:`ADAPTER_FAMILIES`).
+SOLVERS: dict[str, SolverEntry] = {e.name: e for e in (
+    _optimiser("abc", ABC, "black-box", "ABC"),
+    _optimiser("gabc", GABC, "black-box", "GABC"),
+    _optimiser("aco", ACO, "black-box", "ACO"),
+    _optimiser("pso", PSO, "black-box", "PSO"),
+    _optimiser("pabc", PABC, "black-box", "P-ABC"),
+    _optimiser("nr", NR, "jacobian", "Newton-Raphson"),
+    _optimiser("lm", LM, "jacobian", "Levenberg-Marquardt"),
+    _optimiser("dls", DLS, "jacobian"),
+    _optimiser("abc+lm", ABCLM, "jacobian"),
+    _optimiser("gabc+lm", GABCLM, "jacobian"),
+    _optimiser("pso+lm", PSOLM, "jacobian"),
+    _optimiser("forward", Forward, "exact"),     # fkopt.forward as a solver (parallel FK)
+    _optimiser("inverse", Inverse, "exact"),     # fkopt.inverse as a solver (serial IK)
+    _optimiser("exact", Exact, "exact"),         # forward or inverse, by the mechanism's kind
+    _field(FkoptInverse),                        # fkopt.inverse, one query per call
+    _field(FkoptForward, FK),
+    _field(LeastSquaresFK, FK),                  # scipy least_squares: the FK reference
+    _field(TracIK),
+    _field(RtbLM),
+    _field(RtbNR),
+    _field(PinCLIK),
+    _field(IkPy),
+    _field(CmaES),
+    _field(LBFGSB),
+    _field(NGOpt),
+    _field(EAIK),                                # analytic; "not applicable" where it cannot decompose
+    _field(OptIK),
+    _field(Pink),
+    _field(TorchIK),                             # batched: the throughput track (tracks.throughput.solvers)
+)}
+
+#: fkopt's optimisers by name (what ``fkopt.solve`` and config files name).
+ALGORITHMS: dict[str, type] = {n: e.make for n, e in SOLVERS.items() if e.role == OPTIMISER}
+#: The field's one-query IK and FK solvers by name (kinbench's clock track).
+IK_SOLVERS: tuple[str, ...] = tuple(n for n, e in SOLVERS.items() if e.role == IK)
+FK_SOLVERS: tuple[str, ...] = tuple(n for n, e in SOLVERS.items() if e.role == FK)
+
+
+@dataclass(frozen=True)
+class AdapterFamily:
+    """Other libraries' optimisers under a reserved prefix (``pymoo:DE``): the class is made on
+    demand by ``make(method)``; kinbench's track is the black box (they see the fitness only)."""
+
+    prefix: str
+    make: Callable
+    package: str
+    track: str = "black-box"
+    timing: str = COUNTED
+
+
+ADAPTER_FAMILIES: dict[str, AdapterFamily] = {
+    p: AdapterFamily(p, lambda method, p=p: adapter_class(p, method), DISTRIBUTIONS[p]) for p in ADAPTERS}
+
+
+def solver_entry(name: str) -> SolverEntry | None:
+    """The built-in entry of ``name``, else None (adapters and plug-ins: :func:`track_of`)."""
+    return SOLVERS.get(name)
+
+
+def track_of(name: str) -> str | None:
+    """The kinbench track of a built-in solver or an adapter; None for anything else (a plug-in)."""
+    if name in SOLVERS:
+        return SOLVERS[name].track
+    prefix = name.split(":", 1)[0]
+    return ADAPTER_FAMILIES[prefix].track if ":" in name and prefix in ADAPTER_FAMILIES else None
+
+
+def display_name(name: str) -> str:
+    """The name figures and tables print for a solver (its own name when it has no other)."""
+    entry = SOLVERS.get(name)
+    return entry.label if entry is not None else name
+
+
+def clock_solver(name: str, mechanism, *, timeout: float, rng):
+    """The one-query solver ``name`` (:data:`IK_SOLVERS`, :data:`FK_SOLVERS`) built on
+    ``mechanism``; a missing package or a mechanism the package cannot read is one line."""
+    entry = SOLVERS.get(name)
+    if entry is None or entry.role == OPTIMISER:
+        raise FkoptError(f"unknown field solver '{name}'; allowed: {', '.join(IK_SOLVERS + FK_SOLVERS)}")
+    try:
+        return entry.make(mechanism, timeout=timeout, rng=rng)
+    except ImportError as err:
+        extra = getattr(entry.make, "extra", "field")       # torch is an extra of its own
+        raise FkoptError(f"field solver '{name}' needs {entry.package} (pip install -e \".[{extra}]\"): "
+                         f"{err}") from None
+    except FkoptError:       # NotApplicable included: the board shows a "not applicable: why" cell
+        raise
+    except Exception as err:     # the outside package refused this arm: one line, not its traceback
+        raise FkoptError(f"field solver '{name}' ({entry.package}) cannot read "
+                         f"{getattr(mechanism, 'path', 'this arm')}: {type(err).__name__}: "
+                         f"{str(err).splitlines()[0][:160] if str(err) else ''}") from None
+
 
 #: Prefixes reserved for the adapters of other libraries' optimisers (fkopt.adapters).
-ADAPTER_PREFIXES = ("scipy", "pymoo", "niapy")
+ADAPTER_PREFIXES = tuple(ADAPTER_FAMILIES)
 
 #: Entry-point groups third-party packages register in.
 GROUPS = {"mechanism": "fkopt.mechanisms", "algorithm": "fkopt.algorithms"}
@@ -98,16 +239,12 @@ class Entry:
 
     kind: str      # "mechanism" | "algorithm"
     name: str
-    target: str    # "module:Class"
+    target: str    # where it lives: "module.Class" (built-in) or an entry point's "module:Class"
     origin: str    # "built-in", "adapter", "entry point (distribution 1.0)"
 
 
 def _base(kind: str) -> type:
-    if kind == "mechanism":
-        from .mechanisms.base import Mechanism
-        return Mechanism
-    from .algorithms.base import Algorithm
-    return Algorithm
+    return Mechanism if kind == "mechanism" else Algorithm
 
 
 def check_class(obj, kind: str, where: str):
@@ -121,7 +258,6 @@ def check_class(obj, kind: str, where: str):
         raise FkoptError(f"{kind} plug-in '{where}' ({obj.__module__}.{obj.__qualname__}) does not subclass "
                          f"{base.__module__}.{base.__qualname__}; refused")
     if kind == "mechanism":
-        from .mechanisms.base import ParallelMechanism, SerialMechanism
         family = ("parallel" if issubclass(obj, ParallelMechanism)
                   else "serial" if issubclass(obj, SerialMechanism) else None)
         if family is None:
@@ -130,7 +266,6 @@ def check_class(obj, kind: str, where: str):
         missing = [] if hasattr(obj, "name") else ["name"]
         missing += [m for m in REQUIRED["mechanism"][family] if getattr(obj, m) is getattr(family_base, m)]
     else:
-        from .algorithms.base import Algorithm
         missing = [] if hasattr(obj, "name") else ["name"]
         # either the two-method protocol or a minimize of its own (adapters)
         if obj.minimize is Algorithm.minimize:
@@ -186,18 +321,16 @@ def entry_points(kind: str) -> dict[str, tuple[str, str, object]]:
     return out
 
 
-def _load(table: dict[str, str], kind: str, name: str):
+def _load(table: dict[str, type], kind: str, name: str):
     if not isinstance(name, str) or not name:
         raise FkoptError(f"{kind} name must be a non-empty string, got {name!r}")
     if name in table:
-        module, cls = table[name].split(":")
-        return getattr(importlib.import_module(module), cls)
+        return table[name]
     prefix, sep, rest = name.partition(":")
-    if sep and prefix in ADAPTER_PREFIXES:
+    if sep and prefix in ADAPTER_FAMILIES:
         if kind != "algorithm":
             raise FkoptError(f"'{name}': the prefix '{prefix}:' is reserved for algorithm adapters")
-        from .adapters import adapter_class
-        return adapter_class(prefix, rest)
+        return ADAPTER_FAMILIES[prefix].make(rest)
     eps = entry_points(kind)
     if name in eps:
         target, origin, ep = eps[name]
@@ -233,7 +366,6 @@ def resolve_files(cls, geometry: dict, folder) -> dict:
     fields = getattr(cls, "file_fields", ())
     if folder is None or not fields:
         return dict(geometry)
-    from pathlib import Path
     out = dict(geometry)
     for key in fields:
         value = out.get(key)
@@ -245,9 +377,8 @@ def resolve_files(cls, geometry: dict, folder) -> dict:
 def entries(kind: str) -> list[Entry]:
     """Every name of ``kind`` fkopt knows without a direct reference, with its origin."""
     table = MECHANISMS if kind == "mechanism" else ALGORITHMS
-    out = [Entry(kind, n, t, "built-in") for n, t in table.items()]
+    out = [Entry(kind, n, f"{c.__module__}.{c.__qualname__}", "built-in") for n, c in table.items()]
     if kind == "algorithm":
-        from .adapters import ADAPTERS
         out += [Entry(kind, f"{p}:{n}", t, f"adapter ({p}, {'optional' if p != 'scipy' else 'core'})")
                 for p, names in ADAPTERS.items() for n, t in names.items()]
     out += [Entry(kind, n, t, f"entry point ({origin})")

@@ -5,6 +5,8 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
+import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config with the engine)
+
 # The property tests draw their examples from a fixed seed, so a run of README's test command is
 # reproducible like everything else here (a red CI names an example that fails every time).
 # FKOPT_HYPOTHESIS=explore draws fresh examples, to hunt for new counterexamples.

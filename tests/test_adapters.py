@@ -261,7 +261,7 @@ def test_lockstep_counts_every_point_once_and_passes_errors_on():
 def test_batched_fitness_of_every_kinbench_problem_is_that_of_each_point_alone():
     """What lockstep relies on: a point's fitness does not depend on the batch it is in."""
     from pathlib import Path
-    from fkopt.experiment.runner import make_problem
+    from fkopt.kinds.experiment.runner import make_problem
     from fkopt.kinbench.config import load_suite
     from fkopt.kinbench.posesets import problem_mechanism, targets_of
     config = load_suite(Path(__file__).resolve().parents[1] / "configs" / "suites" / "kinbench-v2.yaml")

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import fkopt
-from fkopt.assembly import Solutions, all_solutions, pose_distance, solutions_to_dict
+from fkopt.kinematics.assembly_modes import Solutions, all_solutions, pose_distance, solutions_to_dict
 from fkopt.mechanisms.sps6 import DIETMAIER_LEGS, FULL_TURN
 
 CMM_LEGS = [0.750, 0.780, 0.800, 0.900, 0.870, 0.850]

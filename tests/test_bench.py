@@ -3,9 +3,7 @@ import numpy as np
 import pandas as pd
 
 import fkopt
-from fkopt import bench
-
-
+from fkopt.bench import sections as bench
 def test_quick_run_writes_csv_and_plot(tmp_path):
     df = bench.run(quick=True, peers=False, out=tmp_path / "b")
     csv = pd.read_csv(tmp_path / "b" / "bench.csv")

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 import fkopt
 from fkopt.errors import FkoptError
 from fkopt.problems import BoxedProblem
-from fkopt.streams import case_seed
+from fkopt.numerics.streams import case_seed
 
 M = fkopt.mechanism("3-rps")
 POSES = np.array([[9.0, 13.0, 622.0], [-17.0, 8.0, 436.0], [4.0, -7.0, 509.0], [-13.0, -19.0, 574.0]])
@@ -135,8 +135,8 @@ def test_boxed_problem_searches_one_box_per_case():
 
 
 def test_experiment_batches_cases_with_the_task_seeds():
-    from fkopt.experiment.config import ExperimentConfig
-    from fkopt.experiment.runner import run_experiment, task_seed
+    from fkopt.kinds.experiment.config import ExperimentConfig
+    from fkopt.kinds.experiment.runner import run_experiment, task_seed
     cfg = ExperimentConfig(name="x", mechanism={"name": "3-rps"},
                            cases=[{"pose": dict(zip(M.pose_names, p))} for p in POSES[:3]],
                            algorithms=[{"name": "gabc"}, {"name": "pso", "label": "p"}],
@@ -153,8 +153,8 @@ def test_experiment_batches_cases_with_the_task_seeds():
 
 
 def test_experiment_too_large_for_memory_fails_validation():
-    from fkopt.experiment.config import ExperimentConfig
-    from fkopt.experiment.runner import validate_experiment
+    from fkopt.kinds.experiment.config import ExperimentConfig
+    from fkopt.kinds.experiment.runner import validate_experiment
     cfg = ExperimentConfig(name="huge", mechanism={"name": "3-rps"}, cases={"random": 2000, "seed": 1},
                            algorithms=[{"name": "gabc"}], iterations=100_000, runs=100)
     with pytest.raises(FkoptError, match=r"algorithms\[gabc\]: a batch of 200000 runs \(2000 cases x 100 runs\) of 100000 "

@@ -265,7 +265,7 @@ def test_timed_runs_are_interleaved(monkeypatch):
     """Run k of every algorithm of a case before run k + 1 of any (A B A B ...), warm-ups first."""
     from types import SimpleNamespace as NS
 
-    from fkopt.experiment import timing
+    from fkopt.run import timing
     calls = []
     monkeypatch.setattr(timing, "solve", lambda problem, name, iterations, run_ids, **kw: calls.append(
         (name, iterations, run_ids[0])))
@@ -285,7 +285,7 @@ def test_timed_runs_run_on_the_numpy_reference_path_whatever_solved_the_runs(mon
     import os
     from types import SimpleNamespace as NS
 
-    from fkopt.experiment import timing
+    from fkopt.run import timing
     from fkopt.numerics import path
     seen = []
     monkeypatch.setattr(timing, "solve", lambda *a, **kw: seen.append(path.requested()))

@@ -147,13 +147,13 @@ def test_missing_file():
 
 
 def test_stored_configs_validate():
-    from fkopt.experiment.kinds import load_any, validate_any
+    from fkopt.run.pipeline import load_any, validate_any
     root = Path(__file__).resolve().parents[1] / "configs"
     files = sorted(f for f in root.rglob("*.yaml") if f.name != "claims.yaml")   # claims are no config
     assert files
-    from fkopt.experiment.assembly import AssemblyConfig
+    from fkopt.kinds.assembly.kind import AssemblyConfig
     from fkopt.kinbench.config import SuiteConfig
-    from fkopt.study.config import StudyConfig
+    from fkopt.kinds.study.config import StudyConfig
     for f in files:   # experiments, studies (kind: study), assembly modes and suites
         cfg = load_any(f)
         tasks = validate_any(cfg)
@@ -168,6 +168,6 @@ def test_stored_configs_validate():
         elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block
             assert tasks > 0 and tasks % len(cfg.algorithms) == 0, f
         else:    # one task per algorithm, solving every case, and one timing task per timed case
-            from fkopt.experiment.timing import TIMING_RUNS
+            from fkopt.run.timing import TIMING_RUNS
             cases = cfg.cases.random if hasattr(cfg.cases, "random") else len(cfg.cases)
             assert tasks == len(cfg.algorithms) + min(cases, TIMING_RUNS), f

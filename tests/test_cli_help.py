@@ -10,7 +10,8 @@ import pytest
 import typer.main
 import yaml
 
-from fkopt import bench, cli
+from fkopt import cli
+from fkopt.bench import sections as bench
 
 ROOT = Path(__file__).resolve().parent.parent
 COMMANDS = typer.main.get_command(cli.app).commands
@@ -59,7 +60,7 @@ def test_bench_help_lists_every_section():
 
 def test_study_help_explains_instead_of_pointing_at_a_module():
     text = " ".join(fkopt("study", "--help").stdout.split())
-    assert "see fkopt.study" not in text
+    assert "see fkopt.kinds.study" not in text
     assert "kind: study" in text and "tracking" in text and "docs/config-reference.md" in text
 
 

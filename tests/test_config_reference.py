@@ -7,22 +7,21 @@ from pathlib import Path
 import pytest
 import yaml
 
-from fkopt import config_reference as ref
-
+from fkopt.run import config_reference as ref
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def test_committed_reference_and_schemas_are_current():
     stale = [str(p.relative_to(ROOT)) for p, text in ref.generated(ROOT).items()
              if not p.exists() or p.read_text(encoding="utf-8") != text]
-    assert not stale, f"regenerate with: python -m fkopt.config_reference ({stale})"
+    assert not stale, f"regenerate with: python -m fkopt.run.config_reference ({stale})"
 
 
 @pytest.mark.parametrize("kind", ref.kinds())
 def test_every_field_of_every_model_is_documented(kind):
     missing = [f"{m.__name__}.{f}" for m in ref.models_of(kind) for f in m.model_fields
                if ref.field_doc(m.__name__, f) is None]
-    assert not missing, f"add these to fkopt.config_reference.FIELDS: {missing}"
+    assert not missing, f"add these to fkopt.run.config_reference.FIELDS: {missing}"
 
 
 def test_no_documentation_for_fields_that_do_not_exist():

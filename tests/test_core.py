@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import fkopt
-from fkopt.streams import RunStreams, run_seed_sequence
+from fkopt.numerics.streams import RunStreams, run_seed_sequence
 
 
 @pytest.fixture(scope="module")

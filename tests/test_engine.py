@@ -5,10 +5,10 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import fkopt
-from fkopt import streams as streams_mod
+from fkopt.numerics import streams as streams_mod
 from fkopt.algorithms.abc import ABC, roulette
 from fkopt.algorithms.gabc import GABC
-from fkopt.streams import RunStreams, run_seed_sequence
+from fkopt.numerics.streams import RunStreams, run_seed_sequence
 
 ARRAYS = ("x", "fitness", "history", "x_history", "evaluation_history", "iterations_done")
 

@@ -74,9 +74,9 @@ def test_progress_moves_inside_a_task_and_prints_plain_lines_without_a_terminal(
     and without a terminal nothing was printed. Inside the task the iterations tick
     (fkopt.progress), and a stdout that is not a terminal gets plain lines with the time left."""
     import fkopt.cli
-    import fkopt.experiment.tasks
+    import fkopt.run.tasks
     monkeypatch.setattr(fkopt.cli, "HEARTBEAT_S", 0.0)
-    monkeypatch.setattr(fkopt.experiment.tasks, "RUNNING_EVERY_S", 0.0)
+    monkeypatch.setattr(fkopt.run.tasks, "RUNNING_EVERY_S", 0.0)
     path = tmp_path / "p.yaml"
     path.write_text(yaml.safe_dump({"name": "p", "mechanism": {"name": "3-rps"}, "cases": {"random": 3, "seed": 1},
                                     "algorithms": [{"name": "gabc"}], "runs": 2, "iterations": 40}))
@@ -123,7 +123,7 @@ def test_unknown_fields_name_the_closest_and_case_forms_do_not_mix(cli, tmp_path
 def test_study_and_suite_fields_get_the_hint_too():
     from fkopt.errors import FkoptError
     from fkopt.kinbench.config import suite_from_dict
-    from fkopt.study.config import study_from_dict
+    from fkopt.kinds.study.config import study_from_dict
     with pytest.raises(FkoptError, match=r"budget_per_dm: unknown field \(did you mean 'budget_per_dim'\?\)"):
         suite_from_dict({"kind": "suite", "name": "s", "problems": [], "solvers": [], "budget_per_dm": 3}, "s.yaml")
     with pytest.raises(FkoptError, match=r"\(did you mean 'threshold'\?\)"):

@@ -12,11 +12,11 @@ import pandas as pd
 import pytest
 
 from conftest import Sphere
-from fkopt.experiment.config import ExperimentConfig
-from fkopt.experiment.reports import write_experiment
-from fkopt.experiment.runner import run_experiment
-from fkopt.experiment.traces import MAX_BYTES, read_trace, run_trace
-from fkopt.export import ATTRIBUTES, MARKER
+from fkopt.kinds.experiment.config import ExperimentConfig
+from fkopt.kinds.experiment.reports import write_experiment
+from fkopt.kinds.experiment.runner import run_experiment
+from fkopt.run.trace import MAX_BYTES, read_trace, run_trace
+from fkopt.tools.export import ATTRIBUTES, MARKER
 from fkopt.solve import solve
 from test_cli import assert_one_line_error, cli
 
@@ -291,12 +291,12 @@ def test_an_eof_anywhere_is_an_error_not_an_interruption(monkeypatch, capsys, tm
     """click turns an EOFError into Abort ("interrupted", 130); fkopt says what it is instead."""
     import sys
 
-    import fkopt.export
+    import fkopt.tools.export
     from fkopt.cli import main
 
     def truncated(*args, **kwargs):
         raise EOFError("Compressed file ended before the end-of-stream marker was reached")
-    monkeypatch.setattr(fkopt.export, "ioh_export", truncated)
+    monkeypatch.setattr(fkopt.tools.export, "ioh_export", truncated)
     monkeypatch.setattr(sys, "argv", ["fkopt", "export", str(tmp_path), "--out", str(tmp_path / "o")])
     with pytest.raises(SystemExit) as exc:
         main()

@@ -68,10 +68,11 @@ JACOBIAN_FLOOR = {"tracik": (0.02, 0.7), "rtb-ik_LM": (0.02, 0.7), "rtb-ik_NR": 
 
 
 def _needs(solver):
-    from fkopt.adapters.field import PACKAGES
+    from fkopt.registry import SOLVERS
     module = {"pytracik": "pytracik", "roboticstoolbox-python": "roboticstoolbox", "pin": "pinocchio",
               "optik-py": "optik", "pin-pink": "pink", "pytorch-kinematics": "pytorch_kinematics"}
-    pytest.importorskip(module.get(PACKAGES[solver], PACKAGES[solver]))
+    package = SOLVERS[solver].package
+    pytest.importorskip(module.get(package, package))
 
 
 @pytest.mark.parametrize("solver", list(JACOBIAN_FLOOR))
@@ -79,7 +80,8 @@ def _needs(solver):
 def test_field_solver_answers_verified(solver, name):
     """Each wrapper answers reachable in-limit poses; kinbench's own check passes the loose rungs
     on most of them (TRAC-IK misses some: its answers are its own, verified, not trusted)."""
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     _needs(solver)
     timeout, floor = JACOBIAN_FLOOR[solver]
     m = arm(name)
@@ -109,7 +111,8 @@ def test_field_solvers_read_an_mjcf_arm_through_the_written_urdf(solver):
     solves 50 % of these UR5e poses in 20 ms; on the UR5 it solves 95 % through the robot's file
     and through the written URDF alike, so the shortfall is the arm's, not the written file's)."""
     pytest.importorskip("mujoco")
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     _needs(solver)
     timeout, floor = JACOBIAN_FLOOR[solver]
     m = stored("ur5e-mj")
@@ -124,7 +127,7 @@ def test_rtb_reads_the_written_urdf_where_it_misreads_the_robots_file():
     """rtb's FK of iCub's own file is 1.5 m off fkopt's and pinocchio's; rtb reads only the URDF
     written from fkopt's chain (issue 42), and reads iCub's right."""
     pytest.importorskip("roboticstoolbox")
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     m = stored("icub-left")
     w = make_ik("rtb-ik_LM", m, timeout=0.02, rng=np.random.default_rng(1))
     assert w.settings["urdf"].startswith("written")
@@ -138,7 +141,8 @@ def test_black_box_wrappers_improve_on_their_start_and_never_leave_the_limits(so
     so); here: answers inside the limits, their objective (|dp|^2 + angle^2) under a quarter of
     the median at random joints, and a claim of success is one kinbench confirms."""
     from fkopt.adapters.field import pose_objective
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     _needs(solver)
     m = arm("ur5")
     _, T = targets(m, 2, 6)
@@ -216,7 +220,7 @@ def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits(
     fkopt's FK to 1e-9, the generating configuration is among them (up to whole turns), and the
     board's one answer is one of them."""
     pytest.importorskip("eaik")
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     m = stored("ur5")
     q, T = targets(m, 10, 7)
     w = make_ik("eaik", m, timeout=0.02, rng=np.random.default_rng(0))
@@ -236,7 +240,8 @@ def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits(
 def test_eaik_is_not_applicable_to_an_arm_it_cannot_decompose(name, why):
     """A 7-joint arm is a "not applicable: why" cell, not a zero: make_ik raises NotApplicable."""
     pytest.importorskip("eaik")
-    from fkopt.adapters.field import NotApplicable, make_ik
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.registry import clock_solver as make_ik
     with pytest.raises(NotApplicable, match=why):
         make_ik("eaik", stored(name), timeout=0.02, rng=np.random.default_rng(0))
 
@@ -245,7 +250,8 @@ def test_optik_is_not_applicable_to_a_prismatic_joint_which_would_abort_the_proc
     """OptIK 0.5's Jacobian panics on a prismatic joint and the panic aborts Python: the TIAGo's
     torso lift makes it a "not applicable" cell before any call."""
     pytest.importorskip("optik")
-    from fkopt.adapters.field import NotApplicable, make_ik
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.registry import clock_solver as make_ik
     with pytest.raises(NotApplicable, match="prismatic joint torso_lift_joint"):
         make_ik("optik", stored("tiago-torso"), timeout=0.02, rng=np.random.default_rng(0))
 
@@ -271,7 +277,7 @@ def test_pytorch_kinematics_answers_a_batch_judged_by_kinbench():
     confirms most at the board's rung (measured here: 100 %)."""
     pytest.importorskip("torch", reason="torch is in the [torch] extra, outside [test]")
     pytest.importorskip("pytorch_kinematics", reason="pytorch-kinematics is in the [torch] extra, outside [test]")
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     m = stored("ur5")
     _, T = targets(m, 20, 12)
     w = make_ik("pytorch-kinematics", m, timeout=0.02, rng=np.random.default_rng(3))
@@ -350,7 +356,7 @@ def test_pinocchio_clik_example_converges_as_documented():
         v = -J.T.dot(np.linalg.solve(J.dot(J.T) + damp * np.eye(6), err))
         q = pin.integrate(model, q, v * DT)
     assert np.linalg.norm(err) < eps and i < IT_MAX - 1
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     m = stored("ur5")
     w = make_ik("pin-clik", m, timeout=1.0, rng=np.random.default_rng(0))
     mid = m.bounds.mean(axis=1)
@@ -368,7 +374,7 @@ def test_ikpy_tutorial_protocol_on_baxter():
     positions to 1 mm from its single start (docs/kinbench.md has the share measured here)."""
     pytest.importorskip("ikpy")
     import warnings
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     m = stored("baxter-left")
     w = make_ik("ikpy", m, timeout=1.0, rng=np.random.default_rng(0))
     q, T = targets(m, 30, 8)

@@ -6,10 +6,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fkopt import bench
-from fkopt.experiment import reports
-from fkopt.experiment.config import ExperimentConfig
-from fkopt.experiment.runner import run_experiment
+from fkopt.bench import sections as bench
+from fkopt.kinds.experiment import reports
+from fkopt.kinds.experiment.config import ExperimentConfig
+from fkopt.kinds.experiment.runner import run_experiment
 
 
 @pytest.fixture
@@ -75,7 +75,7 @@ def test_serial_fitness_label_takes_the_arms_length_unit_and_legends_stay_off_th
     import numpy as np
 
     import fkopt
-    from fkopt.experiment import plotting
+    from fkopt.run import plotting
     urdf = fkopt.mechanism("urdf", file="configs/suites/robots/ur5.urdf", base="base_link", tip="tool0")
     assert plotting.fitness_label(urdf, None).endswith("(m + deg)")
     assert plotting.fitness_label(fkopt.mechanism("7dof-arm"), "paper").endswith("(mm + deg)")

@@ -1,4 +1,4 @@
-"""fkopt.forward's start table (joint space, :func:`fkopt.kinematics._forward_table`): built the
+"""fkopt.forward's start table (joint space, :func:`fkopt.kinematics.solvers._forward_table`): built the
 same way every time, it solves Dietmaier's 6-6 platform where the centre start and the
 deterministic restarts do not, and its answers are checked by the mechanism's own closed form
 and by scipy's least_squares run from the table's start (an independent solver)."""
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import fkopt
-from fkopt import kinematics
+from fkopt.kinematics import solvers as kinematics
 from fkopt.errors import FkoptError
 
 
@@ -72,7 +72,7 @@ def test_table_start_agrees_with_scipy_least_squares():
 
 
 def test_exact_solver_keeps_the_stored_setting():
-    from fkopt.exact import ForwardParams
+    from fkopt.kinematics.as_algorithms import ForwardParams
     assert ForwardParams().table == 0
 
 
@@ -109,10 +109,10 @@ def test_a_row_keeps_the_likeliest_of_its_candidate_solutions():
 def test_the_exact_solver_takes_the_table_when_a_config_asks():
     """``params: {table: 4096}`` gives the exact solver fkopt.forward's own default answers; a
     negative size is one line naming the parameter."""
-    from fkopt.exact import Exact, row_seeds
+    from fkopt.kinematics.as_algorithms import Exact, row_seeds
     from fkopt.problems import fk_problem
     from fkopt.solve import solve
-    from fkopt.streams import RunStreams
+    from fkopt.numerics.streams import RunStreams
     m, X, L = dietmaier_queries(2, seed=9)
     res = solve(fk_problem(m, L), Exact(table=kinematics.FORWARD_TABLE, global_search=False), population=20,
                 iterations=2, runs=1, seed=[1, 2])

@@ -358,7 +358,7 @@ def test_suite_resume_refuses_links_and_keeps_its_tasks(tmp_path, monkeypatch, s
     monkeypatch.syspath_prepend(str(Path(__file__).parent))
     from test_kinbench import tiny
     from fkopt.errors import FkoptError
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     from fkopt.kinbench.kind import work_folder
     path = tiny(tmp_path)
     out = tmp_path / "out"
@@ -385,7 +385,7 @@ def test_suite_resume_refuses_corrupt_task_files(tmp_path, monkeypatch, content)
     monkeypatch.syspath_prepend(str(Path(__file__).parent))
     from test_kinbench import tiny
     from fkopt.errors import FkoptError
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     from fkopt.kinbench.kind import work_folder
     import hashlib
     path = tiny(tmp_path)
@@ -527,7 +527,7 @@ def test_bad_scheduler_is_one_line_and_keeps_partial(finished_study, cli, addres
 
 def test_workers_never_exceed_cpus_or_tasks():
     from fkopt.files import available_cpus
-    from fkopt.experiment.executors import worker_count
+    from fkopt.run.executors import worker_count
     assert worker_count(10_000, 10_000) == available_cpus()
     assert worker_count(12, 2) == min(2, available_cpus())
     assert worker_count(1, 5) == 1
@@ -537,7 +537,7 @@ def test_jobs_10000_starts_no_more_processes_than_cpus(tmp_path, monkeypatch):
     """--jobs 10000 on this machine asks the pool for at most the CPUs (and the tasks)."""
     import concurrent.futures
     from fkopt.files import available_cpus
-    from fkopt.experiment import executors
+    from fkopt.run import executors
     asked = []
 
     class Pool(concurrent.futures.ThreadPoolExecutor):
@@ -820,8 +820,8 @@ def test_a_second_run_of_the_same_name_meanwhile_is_refused(tmp_path, cli, monke
     """Run A computes; meanwhile run B of the same paper/name starts: B is refused with one line
     (A holds OUT/<paper>/.<name>.lock), A publishes, and no lock file is left behind."""
     from fkopt.errors import FkoptError
-    from fkopt.experiment import kind as experiment_kind
-    from fkopt.experiment.kinds import from_dict, run_config
+    from fkopt.kinds.experiment import kind as experiment_kind
+    from fkopt.run.pipeline import from_dict, run_config
     out = tmp_path / "out"
     cfg = tmp_path / "a.yaml"
     cfg.write_text(yaml_of({**BASE, "name": "same"}))
@@ -847,8 +847,8 @@ def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli
     computes; meanwhile run B (seed 99) publishes into the same paper/name. A must not replace
     B's result without --force: it is refused at publish time, one line."""
     import contextlib
-    from fkopt.experiment import kind as experiment_kind, kinds
-    from fkopt.experiment.kinds import from_dict, run_config
+    from fkopt.kinds.experiment import kind as experiment_kind, kinds
+    from fkopt.run.pipeline import from_dict, run_config
     monkeypatch.setattr(kinds, "run_lock", lambda out, folder: contextlib.nullcontext())
     out = tmp_path / "out"
     cfg = tmp_path / "a.yaml"
@@ -1138,7 +1138,7 @@ def test_a_swapped_released_set_with_a_resigned_manifest_is_refused(tmp_path, cl
 
 
 def test_a_mini_suite_of_a_private_version_still_validates(tmp_path):
-    from fkopt.experiment.kinds import load_any, validate_any
+    from fkopt.run.pipeline import load_any, validate_any
     path = mini_suite(tmp_path / "s")
     assert validate_any(load_any(path), str(path)) == 1
 
@@ -1264,7 +1264,7 @@ def test_outside_inputs_are_one_line(case, tmp_path, cli):
 
 def test_good_outside_csv_gz_and_ioh_still_validate(tmp_path):
     """The checks above refuse only what is wrong: the same mini suite with well-formed files loads."""
-    from fkopt.experiment.kinds import load_any, validate_any
+    from fkopt.run.pipeline import load_any, validate_any
     from fkopt.kinbench.outside import logged_runs
     from fkopt.kinbench.runner import instances_of
     from fkopt.kinbench.posesets import load_pose_sets
@@ -1287,7 +1287,7 @@ def test_good_outside_csv_gz_and_ioh_still_validate(tmp_path):
 def _forge_task(tmp_path, edit):
     """The mini suite's one task, computed, edited by ``edit`` and kept as a task file of an
     interrupted run with its digest re-signed in the manifest (what an attacker can do)."""
-    from fkopt.experiment.kinds import load_any
+    from fkopt.run.pipeline import load_any
     from fkopt.kinbench.kind import work_folder
     from fkopt.kinbench.runner import solve_task, suite_plan
     path = mini_suite(tmp_path / "s")
@@ -1492,7 +1492,7 @@ def test_export_keeps_pso_plus_lm_and_an_outside_pso_minus_lm_apart(tmp_path, cl
 def test_export_writes_one_folder_per_label(tmp_path):
     """The fast form of the test above: the export's writer, two functions, colliding labels."""
     import numpy as np
-    from fkopt.export import Function, _write_function, algorithm_folders
+    from fkopt.tools.export import Function, _write_function, algorithm_folders
     runs = [(1, np.array([1, 6]), np.array([5.0, 1e-12]), [0.0])]
     fns = [Function(name=f"p{i}__uniform", dim=1, instances=["0"], attributes=[],
                     algorithms={"pso+lm": ({}, runs), "pso-lm": ({}, runs), "pso lm": ({}, runs)}) for i in (1, 2)]
@@ -1644,7 +1644,7 @@ def test_config_and_geometry_files_that_are_not_regular_files_are_one_line(comma
 def test_genuine_suite_records_of_every_track_pass_the_resume_check(budget, tmp_path):
     """The check refuses only what the plan would not produce: every track's own records pass,
     also a run with no answer within its budget (fitness inf, evaluations = budget)."""
-    from fkopt.experiment.kinds import load_any
+    from fkopt.run.pipeline import load_any
     from fkopt.kinbench.runner import record_problem, solve_task, suite_plan
     path = mini_suite(tmp_path / "s", solvers=[{"name": "lm"}, {"name": "forward"}, {"name": "pso"},
                                                {"name": "gabc+lm"}], budget_per_dim=budget)
@@ -1661,7 +1661,7 @@ def test_a_ctrl_c_inside_a_task_store_write_never_leaves_a_file_its_manifest_doe
     rewritten, so --resume refused the file as "changed since fkopt wrote it". The manifest now
     names the digest first: interrupted there, no file appears and --resume recomputes the task."""
     from types import SimpleNamespace
-    from fkopt.experiment.tasks import TaskStore
+    from fkopt.run.tasks import TaskStore
     out = tmp_path / "out"
     store = TaskStore(out, out / ".x.partial", out / "x", "x", {}, "fp")
     store.open(None, resume=False)

@@ -54,7 +54,8 @@ def test_break1_rtb_never_evaluates_an_expression_in_the_users_urdf(tmp_path):
     """Break 1: a ``${...}`` in an element fkopt ignores (<material name>) ran a command whenever
     rtb read the arm; outside packages now read the URDF fkopt writes from its own chain."""
     pytest.importorskip("roboticstoolbox")
-    from fkopt.adapters.field import arm_urdf, make_ik
+    from fkopt.adapters.field import arm_urdf
+    from fkopt.registry import clock_solver as make_ik
     marker = tmp_path / "marker"
     path = tmp_path / "evil.urdf"
     path.write_text(two_joint_urdf(f'<material name="{escape_to(marker)}"/>'))
@@ -70,7 +71,7 @@ def test_break2_an_mjcf_joint_name_is_never_copied_as_an_expression(tmp_path):
     XML escaping held but ``${...}`` is not XML. Written names hold only [A-Za-z0-9_] and stay unique."""
     pytest.importorskip("mujoco")
     pytest.importorskip("roboticstoolbox")
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     from fkopt.mechanisms.urdf_writer import chain_urdf
     marker = tmp_path / "marker"
     evil = escape_to(marker)
@@ -124,9 +125,10 @@ def test_break8_an_arm_with_a_joint_named_like_a_written_fixed_joint(tmp_path):
 
 @pytest.mark.parametrize("solver", ["tracik", "rtb-ik_LM", "pin-clik", "ikpy"])
 def test_break8_every_outside_solver_reads_an_arm_with_a_fixed3_joint(solver, tmp_path):
-    from fkopt.adapters.field import PACKAGES, make_ik
+    from fkopt.registry import SOLVERS, clock_solver as make_ik
     import importlib.util
-    module = {"pin": "pinocchio", "roboticstoolbox-python": "roboticstoolbox"}.get(PACKAGES[solver], PACKAGES[solver])
+    module = {"pin": "pinocchio", "roboticstoolbox-python": "roboticstoolbox"}.get(SOLVERS[solver].package,
+                                                                                  SOLVERS[solver].package)
     if importlib.util.find_spec(module) is None:
         pytest.skip(f"{module} is not installed")
     tail = ('<joint name="tcp" type="fixed"><parent link="l2"/><child link="l3"/>'

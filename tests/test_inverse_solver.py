@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import fkopt
-from fkopt import kinematics
+from fkopt.kinematics import solvers as kinematics
 from fkopt.errors import FkoptError
 from fkopt.mechanisms.urdf import example_robot, example_robots_folder
 from fkopt.numerics import InverseOptions

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from fkopt.errors import FkoptError
-from fkopt.experiment.kinds import from_dict, load_any, run_config
+from fkopt.run.pipeline import from_dict, load_any, run_config
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.config import load_suite
 from fkopt.kinbench.posesets import (BOUNDARY_SHARE, condition_numbers, generate, load_pose_sets,
@@ -136,7 +136,7 @@ def test_a_mechanism_other_than_the_pose_sets_one_is_refused(tmp_path):
     probs = data["problems"][:1]
     probs[0]["mechanism"]["geometry"]["ra"] = 275
     with pytest.raises(FkoptError, match=r"problems\[mao2017-3rps\].mechanism: differs"):
-        from fkopt.experiment.kinds import validate_any
+        from fkopt.run.pipeline import validate_any
         validate_any(load_any(tiny(tmp_path, problems=probs)))
 
 
@@ -220,7 +220,7 @@ def test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it(tmp_path):
     assert "## Per track" in (folder / "leaderboard.md").read_text()
     chk = cli("check", folder)
     assert chk.returncode == 0, chk.stdout + chk.stderr
-    from fkopt.experiment.kinds import prepare_output
+    from fkopt.run.pipeline import prepare_output
     assert prepare_output(load_any(path), out) == folder     # the same suite may rewrite it without --force
     with pytest.raises(FkoptError, match="different config"):
         prepare_output(load_any(tiny(tmp_path / "other", runs=3)), out)
@@ -327,7 +327,7 @@ def test_runs_logged_by_iohexperimenter_are_ranked(tmp_path):
     """Outside runs written by IOHexperimenter's own Analyzer logger (not by fkopt) are read back
     with the best-so-far fitness the runs really reached."""
     ioh = pytest.importorskip("ioh", reason="IOHexperimenter (pip install ioh) is not installed")
-    from fkopt.experiment.runner import make_problem
+    from fkopt.kinds.experiment.runner import make_problem
     from fkopt.kinbench.posesets import targets_of
     path = tiny(tmp_path)
     cfg = load_suite(path)
@@ -470,8 +470,8 @@ def test_exact_solvers_give_fkopt_forward_and_inverse_numbers_and_count_their_ev
     import fkopt
     from fkopt.problems import fk_problem, ik_problem
     from fkopt.solve import solve
-    from fkopt.exact import row_seeds
-    from fkopt.streams import RunStreams
+    from fkopt.kinematics.as_algorithms import row_seeds
+    from fkopt.numerics.streams import RunStreams
     m = fkopt.mechanism("3-rps", ra=274, rb=158)
     poses = m.bounds[:, 0] + np.random.default_rng(3).random((3, 3)) * np.diff(m.bounds).ravel()
     res = solve(fk_problem(m, m.ik(poses)), "exact", population=20, iterations=4, runs=2, seed=[5, 6, 7])

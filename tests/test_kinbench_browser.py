@@ -20,7 +20,7 @@ pytestmark = [pytest.mark.browser,
 
 @pytest.fixture(scope="module")
 def page(tmp_path_factory):
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     tmp = tmp_path_factory.mktemp("kb")
     path = tiny(tmp)
     folder = run_config(load_any(path), tmp / "out", source=str(path)).folder

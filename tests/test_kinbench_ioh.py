@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from fkopt.experiment.kinds import load_any, run_config
+from fkopt.run.pipeline import load_any, run_config
 from fkopt.kinbench.budget import at_budget
 from fkopt.kinbench.traces import COLUMNS, KEYS, budget_trace
 from test_cli import assert_one_line_error
@@ -100,9 +100,9 @@ def test_the_ioh_export_of_a_suite_loads_every_run_in_iohinspector(suite, tmp_pa
 
 def test_a_mixed_tree_of_an_experiment_and_a_suite_exports_both(suite, tmp_path):
     import shutil
-    from fkopt.experiment.config import ExperimentConfig
-    from fkopt.experiment.reports import write_experiment
-    from fkopt.experiment.runner import run_experiment
+    from fkopt.kinds.experiment.config import ExperimentConfig
+    from fkopt.kinds.experiment.reports import write_experiment
+    from fkopt.kinds.experiment.runner import run_experiment
     _, folder = suite
     root = tmp_path / "results"
     shutil.copytree(folder, root / "kinbench" / "tiny")

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from fkopt.errors import FkoptError
-from fkopt.experiment.kinds import load_any, run_config
+from fkopt.run.pipeline import load_any, run_config
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.budget import target_column
 from fkopt.kinbench.config import load_suite

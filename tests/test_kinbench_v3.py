@@ -108,7 +108,7 @@ def tiny_v3(tmp_path, **clock):
 
 
 def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     from fkopt.kinbench.reports import board_top_lines
     path = tiny_v3(tmp_path)
     folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
@@ -136,7 +136,7 @@ def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
 ])
 def test_a_bad_tracks_section_is_one_line_naming_the_field(tmp_path, clock, message):
     from fkopt.errors import FkoptError
-    from fkopt.experiment.kinds import load_any
+    from fkopt.run.pipeline import load_any
     with pytest.raises(FkoptError) as err:
         load_any(tiny_v3(tmp_path, **clock))
     assert message in str(err.value) and "\n" not in str(err.value)
@@ -183,7 +183,7 @@ def submission(tmp_path, rows=None, **entry):
 
 
 def test_a_submission_claiming_success_on_wrong_answers_gets_failures(tmp_path):
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
 
     def spoil(df):
         ur5 = df.index[df.robot == "ur5"]
@@ -216,7 +216,7 @@ def test_a_submission_claiming_success_on_wrong_answers_gets_failures(tmp_path):
 ])
 def test_a_malformed_submission_is_one_line_naming_file_row_and_field(tmp_path, rows, entry, message):
     from fkopt.errors import FkoptError
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     path = submission(tmp_path, rows, **entry)
     with pytest.raises(FkoptError) as err:
         run_config(load_any(path), tmp_path / "out", source=str(path))
@@ -279,7 +279,7 @@ def test_fk_answers_of_scipy_least_squares_submitted_are_verified_by_the_mechani
     (1 mm off, still claimed) is a failure."""
     from fkopt.kinbench.physical import LADDER
     from fkopt.kinbench.submissions import read_submission
-    from fkopt.rotations import to_array, zyx
+    from fkopt.numerics.rotations import to_array, zyx
 
     made = {}
     SPOILT = 2
@@ -383,7 +383,7 @@ def test_an_unreadable_submission_file_is_one_line(tmp_path):
 
 def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
     import sys
-    from fkopt.adapters.field import make_ik
+    from fkopt.registry import clock_solver as make_ik
     from fkopt.errors import FkoptError
     monkeypatch.setitem(sys.modules, "pytracik", None)          # import pytracik -> ImportError
     with pytest.raises(FkoptError, match=r"field solver 'tracik' needs pytracik \(pip install -e \"\.\[field\]\"\)"):
@@ -396,7 +396,7 @@ def test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apa
     """Dietmaier's 6-6 platform (up to 40 assembly modes): fkopt.forward beside scipy
     least_squares, judged against the generating pose, answers whose legs solve the equations
     in another mode counted as other_mode, poses stored as x0..x5."""
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     path = tiny_v3(tmp_path, problems=["dietmaier-6sps"], fk_solvers=["fkopt.forward"],
                    fk_reference="scipy-least_squares", fk_timeouts_ms=[20, 500], queries=2)
     folder = run_config(load_any(path), tmp_path / "out", source=str(path)).folder
@@ -423,16 +423,19 @@ def test_every_field_wrapper_is_importable_without_its_package_and_documents_set
     """Each wrapper module imports its outside package only when built (so fkopt imports without
     the [field] extra) and its docstring states the settings it uses and the quirks it handles."""
     import importlib
-    from fkopt.adapters.field import BLACK_BOX, IK_SOLVERS, PACKAGES, BlackBoxIK, FieldIK
-    assert set(IK_SOLVERS) == set(PACKAGES) and set(BLACK_BOX) <= set(IK_SOLVERS)
-    modules = {m for m, _ in IK_SOLVERS.values()} | {"scipy_fk"}
-    for module in modules:
-        mod = importlib.import_module(f"fkopt.adapters.field.{module}")
+    from fkopt.adapters.field import FieldIK
+    from fkopt.registry import FK_SOLVERS, IK_SOLVERS, SOLVERS
+    field = [SOLVERS[n] for n in IK_SOLVERS + FK_SOLVERS if SOLVERS[n].package != "fkopt"]
+    assert {e.name for e in field} >= {"tracik", "rtb-ik_LM", "pin-clik", "ikpy", "scipy-least_squares"}
+    for entry in field:
+        mod = importlib.import_module(entry.make.__module__)
+        assert mod.__name__.startswith("fkopt.adapters.field."), entry.name
         doc = mod.__doc__ or ""
-        assert "Settings" in doc and ("Quirk" in doc or "quirk" in doc or module in ("lbfgsb", "scipy_fk")), module
-    for name, (module, cls) in IK_SOLVERS.items():
-        klass = getattr(importlib.import_module(f"fkopt.adapters.field.{module}"), cls)
-        assert issubclass(klass, BlackBoxIK if name in BLACK_BOX else FieldIK) and klass.name == name
+        short = mod.__name__.rsplit(".", 1)[-1]
+        assert "Settings" in doc and ("Quirk" in doc or "quirk" in doc or short in ("lbfgsb", "scipy_fk")), short
+        # the entry's facts are the wrapper's own
+        assert entry.make.name == entry.name and entry.make.package == entry.package
+        assert entry.role == "fk" or issubclass(entry.make, FieldIK)
 
 
 def test_the_black_box_objective_is_zero_at_the_answer_and_grows_with_the_error():
@@ -470,7 +473,7 @@ def test_labels_at_the_end_of_ecdf_lines_are_spread_apart():
 def test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board(tmp_path):
     """The clock files vary run to run; check re-verifies them instead: an edited answer (a
     better-looking verdict) or an edited board number is caught, an untouched folder passes."""
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     from fkopt.kinbench.config import load_suite
     from fkopt.kinbench.verify import reverify
     path = tiny_v3(tmp_path)
@@ -508,7 +511,7 @@ def test_an_fk_submission_reaches_the_suites_board_judged_by_the_mechanisms_ik(t
     """scipy least_squares' answers on Dietmaier's frozen queries, submitted through the suite
     file, run by ``fkopt suite``'s pipeline: the board carries the outside FK entry, its answers
     are stored beside the organiser's and the spoilt (claimed) answer is a failure."""
-    from fkopt.experiment.kinds import load_any, run_config
+    from fkopt.run.pipeline import load_any, run_config
     from fkopt.kinbench.physical import LADDER
 
     def rows(mech, generating):
@@ -618,3 +621,17 @@ def test_a_board_names_its_frozen_version_and_its_quick_tier_the_same():
     assert board_version("kinbench-v3-robots") == board_version("kinbench-v3-robots-quick") == \
         f"kinbench-v3-robots/{max(BOARDS['kinbench-v3-robots'], key=int)}"
     assert board_version("kinbench-v2") is None
+
+
+def test_check_compares_meta_json_but_for_the_machines_load_during_the_run(tmp_path):
+    """A per-robot board's meta.json stores the load averages at its start and end: a rerun's differ,
+    so fkopt check compares every other key (the exact tier too) and never those."""
+    import json
+    from fkopt.run.compare import META_RUN, compare_meta
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    meta = {"board_version": "kinbench-v3-robots/2", "load_avg": {"start": [0.5, 0.4, 0.3], "end": [0.6, 0.4, 0.3]}}
+    a.write_text(json.dumps(meta))
+    b.write_text(json.dumps({**meta, "load_avg": {"start": [9.0, 8.0, 7.0], "end": [9.0, 8.0, 7.0]}}))
+    assert compare_meta("x", a, b, variable=META_RUN) == []
+    b.write_text(json.dumps({**meta, "board_version": "kinbench-v3-robots/1"}))
+    assert [m.column for m in compare_meta("x", a, b, variable=META_RUN)] == ["board_version"]

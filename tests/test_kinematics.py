@@ -140,7 +140,7 @@ def test_light_commands_import_no_heavy_layers(args):
     assert proc.returncode == 0, proc.stderr[-500:]
     imported = {line.split("|")[-1].strip() for line in proc.stderr.splitlines() if "|" in line}
     heavy = {m for m in imported if m.split(".")[0] in ("pandas", "matplotlib")
-             or m.startswith(("fkopt.experiment", "fkopt.study", "fkopt.reproduce"))}
+             or m.startswith(("fkopt.kinds.experiment", "fkopt.kinds.study", "fkopt.reproduce"))}
     assert not heavy, sorted(heavy)
 
 
@@ -156,7 +156,7 @@ def test_sps_scalar_jacobian_matches_the_vectorised_one(name):
 
 
 def test_small_solve_matches_numpy_and_refuses_singular():
-    from fkopt.kinematics import _solve_small
+    from fkopt.kinematics.solvers import _solve_small
     rng = np.random.default_rng(3)
     A, b = rng.normal(size=(6, 6)), rng.normal(size=6)
     np.testing.assert_allclose(_solve_small(A.tolist(), b.tolist()), np.linalg.solve(A, b), rtol=1e-10)

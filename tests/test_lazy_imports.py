@@ -47,7 +47,7 @@ def test_pydantic_free_defaults_equal_the_models_defaults(name):
 
 
 def test_lazy_package_attributes():
-    assert fkopt.solve.__module__ == "fkopt.solve" and fkopt.forward.__module__ == "fkopt.kinematics"
+    assert fkopt.solve.__module__ == "fkopt.solve" and fkopt.forward.__module__ == "fkopt.kinematics.solvers"
     assert isinstance(fkopt.__version__, str)
     with pytest.raises(AttributeError):
         fkopt.no_such_name

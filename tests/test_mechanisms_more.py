@@ -8,7 +8,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 import fkopt
-from fkopt import rotations
+from fkopt.numerics import rotations
 from fkopt.mechanisms.dh_arm import DHArm, SevenDofArm
 from fkopt.mechanisms.ppr3 import ThreePPR
 from fkopt.mechanisms.rpupc_ups import ThreeRPUPcUPS

@@ -97,7 +97,7 @@ def test_compiled_batch_rows_are_the_one_pose_reference_answers(name, arm):
 
 def test_env_json_records_the_numerics_path_and_numbas_version(monkeypatch):
     from importlib.metadata import version
-    from fkopt.provenance import environment
+    from fkopt.run.provenance import environment
     monkeypatch.delenv(numerics_path.ENV, raising=False)
     got = environment()["numerics"]
     assert got == {"path": "compiled", "mode": "auto", "compiled_fitness": False, "numba": version("numba"), "env": ""}
@@ -277,7 +277,7 @@ def test_compiled_abc_iteration_only_where_it_is_the_same_algorithm(monkeypatch)
 
 
 def _generator(seed, run):
-    from fkopt.streams import run_seed_sequence
+    from fkopt.numerics.streams import run_seed_sequence
     return np.random.Generator(np.random.PCG64(run_seed_sequence(seed, run)))
 
 
@@ -309,7 +309,7 @@ def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(
     below it only once numba is loaded, and under FKOPT_NUMERICS=numpy the per-run numpy calls;
     every run's values are those of its own Generator.random either way, across several refills
     and a tail kept between them."""
-    from fkopt import streams as streams_mod
+    from fkopt.numerics import streams as streams_mod
     monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)   # 200 runs: refills of 256 (< CHUNK)
     runs, seed, sizes = 200, 42, (100, 3 * 70, 1, 300, 255, 600)
     got = {}
@@ -337,7 +337,7 @@ def test_run_streams_with_many_runs_refill_compiled_with_the_numpy_paths_values(
 def test_compiled_refill_reuses_a_buffer_only_when_no_view_of_it_is_alive(monkeypatch):
     """The compiled refill writes into a spare buffer again only when nothing handed out points into
     it: a view an algorithm keeps across refills keeps its values."""
-    from fkopt import streams as streams_mod
+    from fkopt.numerics import streams as streams_mod
     monkeypatch.setattr(streams_mod, "BUFFER_VALUES", 4096)
     monkeypatch.setenv(numerics_path.ENV, "auto")
     s = streams_mod.RunStreams(5, range(200))

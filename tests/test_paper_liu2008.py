@@ -4,9 +4,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fkopt.experiment.config import ExperimentConfig, load_config
-from fkopt.experiment.reports import write_experiment
-from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.kinds.experiment.config import ExperimentConfig, load_config
+from fkopt.kinds.experiment.reports import write_experiment
+from fkopt.kinds.experiment.runner import run_experiment, validate_experiment
 from fkopt.mechanisms.sps6 import SixSPSCMM
 from fkopt.problems import fk_problem
 from fkopt.reproduce import PAPERS, liu2008

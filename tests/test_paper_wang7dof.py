@@ -4,9 +4,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fkopt.experiment.config import ExperimentConfig, load_config
-from fkopt.experiment.reports import write_experiment
-from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.kinds.experiment.config import ExperimentConfig, load_config
+from fkopt.kinds.experiment.reports import write_experiment
+from fkopt.kinds.experiment.runner import run_experiment, validate_experiment
 from fkopt.mechanisms.dh_arm import SevenDofArm
 from fkopt.problems import ik_problem
 from fkopt.reproduce import PAPERS, wang7dof

@@ -7,9 +7,9 @@ import pandas as pd
 import pytest
 import yaml
 
-from fkopt.experiment.config import ExperimentConfig, load_config
-from fkopt.experiment.reports import write_tables
-from fkopt.experiment.runner import run_experiment, validate_experiment
+from fkopt.kinds.experiment.config import ExperimentConfig, load_config
+from fkopt.kinds.experiment.reports import write_tables
+from fkopt.kinds.experiment.runner import run_experiment, validate_experiment
 from fkopt.problems import fk_problem
 from fkopt.registry import mechanism_class
 from fkopt.reproduce import PAPERS, wu2015

@@ -3,10 +3,10 @@ from pathlib import Path
 
 import pytest
 
-from fkopt.experiment.config import ExperimentConfig, load_config
-from fkopt.experiment.reports import write_experiment
-from fkopt.experiment.runner import run_experiment, validate_experiment
-from fkopt.peers import peers_markdown
+from fkopt.kinds.experiment.config import ExperimentConfig, load_config
+from fkopt.kinds.experiment.reports import write_experiment
+from fkopt.kinds.experiment.runner import run_experiment, validate_experiment
+from fkopt.tools.peers import peers_markdown
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPERS = ("mao2017", "liu2008", "wang7dof", "wu2015", "chang2024")

@@ -1,15 +1,15 @@
-"""The one run record (fkopt.record): its schema, its writers, every kind producing it, one
+"""The one run record (fkopt.run.record): its schema, its writers, every kind producing it, one
 numbering (poses from 0, the index the seed rule takes) and timing runs as planned tasks."""
 import numpy as np
 import pandas as pd
 import pytest
 
-from fkopt import record
-from fkopt.experiment.config import experiment_from_dict
-from fkopt.experiment.kinds import run_in_memory
-from fkopt.experiment.runner import experiment_plan, task_seed
-from fkopt.experiment.tasks import run_tasks
-from fkopt.experiment.timing import sample_plan
+from fkopt.run import record
+from fkopt.kinds.experiment.config import experiment_from_dict
+from fkopt.run.pipeline import run_in_memory
+from fkopt.kinds.experiment.runner import experiment_plan, task_seed
+from fkopt.run.tasks import run_tasks
+from fkopt.run.timing import sample_plan
 
 
 def tiny_experiment(**over):
@@ -100,7 +100,7 @@ def test_an_experiment_record_is_its_runs_csv_and_its_seeds():
 
 
 def test_a_study_and_a_suite_number_poses_from_0_as_their_seeds_do(tmp_path):
-    from fkopt.study import study_from_dict
+    from fkopt.kinds.study import study_from_dict
     study = study_from_dict({"kind": "study", "name": "s", "mechanism": {"name": "3-rps"},
                              "poses": {"uniform": 3, "seed": 3}, "algorithms": [{"name": "lm", "start": "centre",
                                                                               "population": 1, "iterations": 10}],
@@ -110,7 +110,7 @@ def test_a_study_and_a_suite_number_poses_from_0_as_their_seeds_do(tmp_path):
     assert sorted(set(sr.record.pose)) == [0, 1, 2]
     assert all(seed == task_seed(11, p, "lm") for p, seed in zip(sr.record.pose, sr.record.task_seed))
     from test_kinbench import tiny
-    from fkopt.experiment.kinds import load_any
+    from fkopt.run.pipeline import load_any
     suite = load_any(tiny(tmp_path, solvers=[{"name": "lm"}], poses=2, runs=1))
     res = run_in_memory(suite)
     _conforms(res.record, "suite")

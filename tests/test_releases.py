@@ -109,7 +109,7 @@ FITNESS_AT_PROBE = {
 
 
 def probe_fitness(cfg):
-    from fkopt.experiment.runner import make_problem
+    from fkopt.kinds.experiment.runner import make_problem
     sets, _ = load_pose_sets(cfg)
     out = {}
     for problem in cfg.problems:

@@ -85,7 +85,7 @@ def _copy(tmp_path, paper="mao2017", name="tab6"):
 
 def _resign(folder):
     """Record the digests of the edited files, as if a drifted fkopt had written them."""
-    from fkopt.compare import file_digests
+    from fkopt.run.compare import file_digests
     meta = json.loads((folder / "meta.json").read_text())
     meta["files"] = file_digests(folder)
     (folder / "meta.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
@@ -170,7 +170,7 @@ def test_reproduce_in_worker_processes_gives_the_serial_files(tmp_path, cli):
 
     import yaml
 
-    from fkopt.outputs import deterministic_files
+    from fkopt.run.writers import deterministic_files
     configs = tmp_path / "configs" / "mini"
     configs.mkdir(parents=True)
     base = {"paper": "mini", "mechanism": {"name": "3-rps"}, "iterations": 30, "runs": 3, "seed": 4}
@@ -198,7 +198,7 @@ def test_reproduce_in_worker_processes_gives_the_serial_files(tmp_path, cli):
 
 # -- passes on any machine (issue 18): tiers, path-dependent rows, checks on every platform -------
 def test_platform_tier_follows_what_decides_the_bits(monkeypatch):
-    from fkopt import provenance
+    from fkopt.run import provenance
     here = provenance.fingerprint()
     assert provenance.platform_tier(dict(here)) == "exact"
     assert provenance.platform_tier({**here, "blas_runtime": "openblas 0.3.31 kernel=SkylakeX"}) == "blas"
@@ -232,8 +232,8 @@ def _nudged_starts(monkeypatch):
 def test_one_ulp_in_the_exact_solvers_starts_passes_the_cross_platform_rules(monkeypatch, tmp_path):
     """Two reruns on this machine, the second with every exact solver's starts one ulp away: the
     bytes differ in the exact solvers' rows, and the "blas" rules (what --tolerant uses) pass."""
-    from fkopt.compare import compare_folders
-    from fkopt.experiment.kinds import from_dict, rerun_files
+    from fkopt.run.compare import compare_folders
+    from fkopt.run.pipeline import from_dict, rerun_files
     from fkopt.reproduce.check import rules_for
     exp = Store(RESULTS).get("chang2024", "baselines")
     config = from_dict(dict(exp.config), "chang2024/baselines")
@@ -281,7 +281,7 @@ def test_rank_rules_see_a_real_shift_and_forgive_noise():
     import numpy as np
     import pandas as pd
 
-    from fkopt.compare import Rules, compare_runs
+    from fkopt.run.compare import Rules, compare_runs
     rng = np.random.default_rng(1)
     n = 60
     base = pd.DataFrame({"case": "c", "algorithm": "lm", "run": np.arange(n), "final_fitness": 1e-25,
@@ -302,7 +302,7 @@ def test_rank_rules_see_a_real_shift_and_forgive_noise():
 
 def test_a_study_run_moved_is_caught_by_its_recomputed_fitness(tmp_path):
     from fkopt.reproduce.check import recomputed_fitness
-    from fkopt.experiment.kinds import from_dict
+    from fkopt.run.pipeline import from_dict
     folder = _copy(tmp_path, "studies", "3rps_slice")
     exp = Store(folder.parents[1]).get("studies", "3rps_slice")
     config = from_dict(dict(exp.config), "studies/3rps_slice")

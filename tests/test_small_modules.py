@@ -88,7 +88,8 @@ def test_field_solvers_answer_on_the_stored_ur5_and_kinbench_judges_them():
     import pytest
 
     import fkopt
-    from fkopt.adapters.field import make_ik, solve
+    from fkopt.adapters.field import solve
+    from fkopt.registry import clock_solver as make_ik
     from fkopt.kinbench.physical import ik_verdicts
     arm = fkopt.mechanism("urdf", file="configs/suites/robots/ur5.urdf", base="base_link", tip="tool0")
     rng = np.random.default_rng(4)
@@ -109,7 +110,7 @@ def test_by_algorithm_judges_a_swarm_answer_like_the_exact_solvers():
     import numpy as np
 
     import fkopt
-    from fkopt.by_algorithm import forward_by, inverse_by
+    from fkopt.kinematics.by_algorithm import forward_by, inverse_by
     m = fkopt.mechanism("3-rps")
     legs = m.ik(np.array([9.0, 13.0, 622.0]))
     r = forward_by(m, legs, "gabc+lm", tol=1e-6, budget={"population": 10, "iterations": 60})

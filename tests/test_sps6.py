@@ -7,7 +7,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.optimize import least_squares
 
 import fkopt
-from fkopt.assembly import all_solutions
+from fkopt.kinematics.assembly_modes import all_solutions
 from fkopt.mechanisms.sps6 import DIETMAIER_BASE, DIETMAIER_PLATFORM, FULL_TURN, SixSPS, SixSPSCMM
 
 LEGS = np.array([0.750, 0.780, 0.800, 0.900, 0.870, 0.850])               # liu2008 Tab. 3

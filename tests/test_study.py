@@ -13,9 +13,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fkopt.errors import FkoptError
-from fkopt.study import load_any, run_study, study_from_dict
-from fkopt.study.runner import TASKS, plan_tasks, validate_study, work_folder
-from fkopt.study.statistics import ecdf_table, holm, pairwise_tests
+from fkopt.kinds.study import run_study, study_from_dict
+from fkopt.run.pipeline import load_any
+from fkopt.kinds.study.runner import TASKS, plan_tasks, validate_study, work_folder
+from fkopt.kinds.study.statistics import ecdf_table, holm, pairwise_tests
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Files that must not depend on executor, jobs or resume (timing.csv does, by design).
@@ -231,7 +232,7 @@ def test_cli_study_and_resume(tmp_path, cli):
 
 
 def test_cli_ctrl_c_keeps_finished_tasks(tmp_path, cli, monkeypatch):
-    import fkopt.study.runner as runner
+    import fkopt.kinds.study.runner as runner
     study = tmp_path / "s.yaml"
     study.write_text(yaml.safe_dump(small().model_dump(mode="json")))
     real, calls = runner.run_task, []
@@ -325,7 +326,7 @@ TWO_TRAJECTORIES = [
 def test_tracking_batches_trajectories_each_as_if_alone():
     """Step t of every trajectory is one solve; each trajectory's numbers equal those of a solve of
     that trajectory alone (same pose indices, hence the same seeds), for local methods and warm swarms."""
-    from fkopt.study.runner import Task, _track
+    from fkopt.kinds.study.runner import Task, _track
     config = tracking_config(poses=TWO_TRAJECTORIES)
     mech, poses = validate_study(config)
     assert poses.segments == ((0, 6), (6, 10))
@@ -346,7 +347,7 @@ def test_tracking_several_trajectories_report(tmp_path):
     res = run_study(tracking_config(poses=TWO_TRAJECTORIES), tmp_path)
     track = pd.read_csv(res.folder / "tracking.csv")
     lm = track[track.algorithm == "lm"]
-    assert lm.trajectory.tolist() == [0] * 6 + [1] * 4     # indices count from 0 (fkopt.record)
+    assert lm.trajectory.tolist() == [0] * 6 + [1] * 4     # indices count from 0 (fkopt.run.record)
     assert lm.step.tolist() == [0, 1, 2, 3, 4, 5, 0, 1, 2, 3]
     assert lm.warm_start.tolist() == [False] + [True] * 5 + [False] + [True] * 3   # each starts cold
     assert (res.folder / "tracking.png").exists()

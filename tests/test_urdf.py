@@ -9,10 +9,10 @@ from hypothesis import strategies as st
 
 import fkopt
 from fkopt.errors import FkoptError
-from fkopt.experiment.config import load_config
-from fkopt.experiment.runner import run_experiment
+from fkopt.kinds.experiment.config import load_config
+from fkopt.kinds.experiment.runner import run_experiment
 from fkopt.mechanisms.urdf import DEFAULT_FILE, example_robot, example_robots_folder
-from fkopt.rotations import wrap_degrees
+from fkopt.numerics.rotations import wrap_degrees
 
 TWO_JOINTS = """<?xml version="1.0"?>
 <robot name="rp">
@@ -353,8 +353,8 @@ def test_cli_list_and_ik_on_a_urdf_arm(tmp_path):
 def test_fkopt_run_resolves_the_urdf_beside_the_config(tmp_path, monkeypatch):
     """``fkopt run`` loads configs through ``load_any``: the URDF path is relative to the config
     (it was resolved against the working directory, so examples/urdf failed from elsewhere)."""
-    from fkopt.experiment.kinds import load_any
-    from fkopt.experiment.runner import build_mechanism
+    from fkopt.run.pipeline import load_any
+    from fkopt.kinds.experiment.runner import build_mechanism
     root = Path(__file__).resolve().parents[1]
     monkeypatch.chdir(tmp_path)
     config = load_any(root / "examples" / "urdf" / "ur5_ik.yaml")

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
-from .libraries import ADAPTERS, DISTRIBUTIONS  # noqa: F401  (re-exported)
+from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS  # noqa: F401  (re-exported)
 
 
 @lru_cache(maxsize=None)
@@ -35,13 +35,13 @@ def adapter_class(library: str, method: str):
     The library itself is imported here (so a missing optional install fails at validation,
     with the install hint), but no optimiser runs.
     """
-    from . import base
+    from fkopt.adapters import base
     if library == "scipy":
-        from .scipy_ import resolve
+        from fkopt.adapters.scipy_ import resolve
     elif library == "pymoo":
-        from .pymoo_ import resolve
+        from fkopt.adapters.pymoo_ import resolve
     elif library == "niapy":
-        from .niapy_ import resolve
+        from fkopt.adapters.niapy_ import resolve
     else:  # pragma: no cover - registry only routes the reserved prefixes here
         raise FkoptError(f"no adapter for '{library}:'")
     target = resolve(method)   # raises FkoptError for unknown names / missing installs

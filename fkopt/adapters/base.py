@@ -14,7 +14,7 @@ For every library, fkopt -- not the library -- does the bookkeeping:
   that stops by itself (converged) uses fewer, and the records say how many.
 * **Seeds.** Run k of a task gets the integer seed ``SeedSequence(seed, spawn_key=(k,))``
   ``.generate_state(1)[0]`` (scipy gets a ``Generator`` on that SeedSequence), the stream
-  of :mod:`fkopt.streams` -- so run k gives the same numbers alone, in a batch or in a worker.
+  of :mod:`fkopt.numerics.streams` -- so run k gives the same numbers alone, in a batch or in a worker.
 * **Processes.** Runs are independent; ``workers`` (param; default 1) runs them in that many
   processes. The numbers do not depend on it. (A process pool costs ~0.5-1.5 s of start-up and
   imports per solve, more than it saves on the small solves of a suite, whose tasks run in
@@ -49,9 +49,9 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import ConfigDict, Field
 
-from ..algorithms.base import Algorithm, Params, RunRecord
-from ..errors import FkoptError
-from ..progress import tick
+from fkopt.algorithms.base import Algorithm, Params, RunRecord
+from fkopt.errors import FkoptError
+from fkopt.progress import tick
 
 
 class _Stop(Exception):
@@ -154,17 +154,17 @@ def checkpoints(population: int, iterations: int, budget: int) -> np.ndarray:
 
 
 def run_seed(seed: int, run: int) -> np.random.SeedSequence:
-    """Run ``run``'s seed sequence (:func:`fkopt.streams.run_seed_sequence`)."""
+    """Run ``run``'s seed sequence (:func:`fkopt.numerics.streams.run_seed_sequence`)."""
     return np.random.SeedSequence(int(seed), spawn_key=(int(run),))
 
 
 def _runner(library: str):
     if library == "scipy":
-        from .scipy_ import run
+        from fkopt.adapters.scipy_ import run
     elif library == "pymoo":
-        from .pymoo_ import run
+        from fkopt.adapters.pymoo_ import run
     else:
-        from .niapy_ import run
+        from fkopt.adapters.niapy_ import run
     return run
 
 
@@ -181,7 +181,7 @@ def run_one(library: str, method: str, params: dict, problem, population: int, b
         raise
     except Exception as err:   # the library failed: one line naming it
         from importlib.metadata import version
-        from .libraries import DISTRIBUTIONS
+        from fkopt.adapters.libraries import DISTRIBUTIONS
         msg = str(err).strip().splitlines()[0] if str(err).strip() else ""
         raise FkoptError(f"algorithm '{library}:{method}' ({library} {version(DISTRIBUTIONS[library])}) "
                          f"raised {type(err).__name__}: {msg}") from None
@@ -344,7 +344,7 @@ class ExternalAlgorithm(Algorithm):
         except FkoptError:
             raise
         except Exception as err:
-            from .libraries import library_version
+            from fkopt.adapters.libraries import library_version
             msg = (str(err).strip().splitlines() or [type(err).__name__])[0]
             raise FkoptError(f"algorithm '{self.library}:{self.method}' ({self.library} "
                              f"{library_version(self.library)}) rejected params {self.library_params}: "
@@ -366,7 +366,7 @@ class ExternalAlgorithm(Algorithm):
             raise FkoptError(f"algorithm '{self.library}:{self.method}': its population of {points} points per "
                              f"generation exceeds the run's budget of {budget} evaluations (population x "
                              "(iterations + 1), or params.evaluations); lower the library's population")
-        from ..files import available_cpus
+        from fkopt.files import available_cpus
         workers = max(1, min(self.params.workers or 1, available_cpus()))
         return 64 * 8 * points * max(int(dim), 1) * workers
 
@@ -374,7 +374,7 @@ class ExternalAlgorithm(Algorithm):
                  stop_at_target: bool = False, x0=None, snapshots=(), **_ignored) -> RunRecord:
         budget = self.budget_for(population, iterations)
         runs = list(streams.run_ids)
-        # one seed per batch row (rows of several cases carry their case's seed, fkopt.streams)
+        # one seed per batch row (rows of several cases carry their case's seed, fkopt.numerics.streams)
         seeds = [run_seed(s, k) for s, k in zip(streams.seeds, runs)]
         start = None if x0 is None else np.asarray(x0, dtype=float)
         # a problem with a case axis holds one target per row: each run solves its own row's
@@ -383,7 +383,7 @@ class ExternalAlgorithm(Algorithm):
                  population, budget, s, target, stop_at_target,
                  None if start is None else (start if start.ndim == 1 else start[i]))
                 for i, s in enumerate(seeds)]
-        from ..files import available_cpus
+        from fkopt.files import available_cpus
         workers = min(self.params.workers or 1, len(runs), available_cpus())
         if workers <= 1 and self.per_point and len(args) > 1:
             traces = run_lockstep(args, problem, batched)      # batched fitness calls, same numbers

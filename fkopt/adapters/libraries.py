@@ -2,7 +2,7 @@
 optional imports. Shared by :mod:`fkopt.adapters` and the per-library modules (no import loops)."""
 from __future__ import annotations
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 #: Names listed by ``fkopt list`` (niapy accepts any algorithm class of niapy.algorithms).
 ADAPTERS: dict[str, dict[str, str]] = {

@@ -18,8 +18,8 @@ import inspect
 
 import numpy as np
 
-from ..errors import FkoptError
-from .libraries import refuse_unknown, require
+from fkopt.errors import FkoptError
+from fkopt.adapters.libraries import refuse_unknown, require
 
 MODULES = ("niapy.algorithms.basic", "niapy.algorithms.modified", "niapy.algorithms.other")
 RESERVED = {"seed", "callbacks", "individual_type", "initialization_function"}

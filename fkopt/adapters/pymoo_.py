@@ -15,14 +15,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..errors import FkoptError
-from .libraries import refuse_unknown, require
+from fkopt.errors import FkoptError
+from fkopt.adapters.libraries import refuse_unknown, require
 
 RESERVED = {"termination", "seed", "verbose", "save_history", "callback", "display", "output"}
 
 
 def _table() -> dict[str, str]:
-    from .libraries import ADAPTERS
+    from fkopt.adapters.libraries import ADAPTERS
     return ADAPTERS["pymoo"]
 
 

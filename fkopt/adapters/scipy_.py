@@ -19,8 +19,8 @@ import inspect
 
 import numpy as np
 
-from ..errors import FkoptError
-from .libraries import ceil_div, refuse_unknown
+from fkopt.errors import FkoptError
+from fkopt.adapters.libraries import ceil_div, refuse_unknown
 
 METHODS = ("differential_evolution", "dual_annealing")
 RESERVED = {"func", "bounds", "rng", "seed", "workers", "callback", "vectorized", "maxfun", "args"}

@@ -4,6 +4,6 @@ One module per algorithm, registered in :mod:`fkopt.registry`. An algorithm sees
 problem interface (``fitness``, ``bounds``, ``dim``; ``residuals`` for the exact methods) and
 knows nothing of mechanisms.
 """
-from .base import Algorithm, RunRecord, State
+from fkopt.algorithms.base import Algorithm, RunRecord, State
 
 __all__ = ["Algorithm", "RunRecord", "State"]

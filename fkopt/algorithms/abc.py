@@ -34,7 +34,7 @@ Choices fkopt makes where the papers are silent (documented, each a named parame
   nothing recorded and is not flown.
 * A NaN fitness is treated as +inf (never selected, never accepted).
 
-Random numbers (the order matters for reproducibility; see :mod:`fkopt.streams`). Per
+Random numbers (the order matters for reproducibility; see :mod:`fkopt.numerics.streams`). Per
 iteration and run, in this order:
 
 1. scout phase: dim uniforms for a fresh source, drawn every iteration whether or not a scout
@@ -72,7 +72,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from .base import (Algorithm, Params, State, compiled_step, evaluated, log_arrays, log_kept, row_offsets, rows_of,
+from fkopt.algorithms.base import (Algorithm, Params, State, compiled_step, evaluated, log_arrays, log_kept, row_offsets, rows_of,
                    uniform_in)
 
 

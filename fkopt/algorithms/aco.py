@@ -61,7 +61,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, evaluated, uniform_in
+from fkopt.algorithms.base import Algorithm, Params, State, clip, evaluated, uniform_in
 
 
 class ACOParams(Params):

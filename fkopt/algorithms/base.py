@@ -24,10 +24,10 @@ from typing import Any, ClassVar
 import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from ..errors import FkoptError
-from ..numerics.path import ENV as _NUMERICS_ENV
-from ..progress import tick
-from ..streams import RunStreams
+from fkopt.errors import FkoptError
+from fkopt.numerics.path import ENV as _NUMERICS_ENV
+from fkopt.progress import tick
+from fkopt.numerics.streams import RunStreams
 
 
 class Params(BaseModel):
@@ -249,7 +249,7 @@ class Algorithm:
     #: Deterministic local methods (Newton, LM) start from ``x0`` and ignore the population.
     local: ClassVar[bool] = False
     #: True when no BLAS/LAPACK call lies on the algorithm's own path (elementwise numpy only), so
-    #: its results do not depend on which BLAS kernel runs (:mod:`fkopt.compare`). False by default:
+    #: its results do not depend on which BLAS kernel runs (:mod:`fkopt.run.compare`). False by default:
     #: code fkopt has not read (adapters, plug-ins) is assumed to call BLAS somewhere.
     blas_free: ClassVar[bool] = False
     #: Rough evaluations per iteration as a function of population, for documentation.

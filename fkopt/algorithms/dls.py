@@ -29,8 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, rows_of, uniform_in
-from .nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, start_points
+from fkopt.algorithms.base import Algorithm, Params, State, rows_of, uniform_in
+from fkopt.algorithms.nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, start_points
 
 
 class DLSParams(Params):

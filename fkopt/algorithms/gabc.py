@@ -17,8 +17,8 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .abc import ABC, ABCParams
-from .base import row_offsets
+from fkopt.algorithms.abc import ABC, ABCParams
+from fkopt.algorithms.base import row_offsets
 
 
 class GABCParams(ABCParams):

@@ -24,11 +24,11 @@ from typing import ClassVar
 import numpy as np
 from pydantic import Field
 
-from .abc import ABCParams
-from .base import Algorithm, Params, State
-from .gabc import GABCParams
-from .lm import LMCore, LMParams, LMState
-from .pso import PSOParams
+from fkopt.algorithms.abc import ABC, ABCParams
+from fkopt.algorithms.base import Algorithm, Params, State
+from fkopt.algorithms.gabc import GABC, GABCParams
+from fkopt.algorithms.lm import LMCore, LMParams, LMState
+from fkopt.algorithms.pso import PSO, PSOParams
 
 
 def _swarm_field(name: str) -> property:
@@ -68,17 +68,15 @@ class HybridParams(Params):
 
 
 class SwarmLM(Algorithm):
-    """Generic swarm-then-LM hybrid; subclasses set ``swarm`` (a registry name) and ``Params``."""
+    """Generic swarm-then-LM hybrid; subclasses set ``swarm`` (the swarm's class) and ``Params``."""
 
-    swarm: ClassVar[str]
+    swarm: ClassVar[type[Algorithm]]
     evaluations_per_iteration = "the swarm's, then 1 (+2*dim if accepted) per run"
 
     def __init__(self, **params):
         super().__init__(**params)
-        from ..registry import algorithm_class
-
         values = self.params.model_dump()
-        cls = algorithm_class(self.swarm)
+        cls = self.swarm
         self.swarm_algorithm = cls(**{k: values[k] for k in cls.Params.model_fields})
         self.lm = LMCore(LMParams(**{k: values[k] for k in LMParams.model_fields}), self)
 
@@ -125,17 +123,17 @@ class PSOLMParams(PSOParams, LMParams, HybridParams):
 
 class ABCLM(SwarmLM):
     name = "abc+lm"
-    swarm = "abc"
+    swarm = ABC
     Params = ABCLMParams
 
 
 class GABCLM(SwarmLM):
     name = "gabc+lm"
-    swarm = "gabc"
+    swarm = GABC
     Params = GABCLMParams
 
 
 class PSOLM(SwarmLM):
     name = "pso+lm"
-    swarm = "pso"
+    swarm = PSO
     Params = PSOLMParams

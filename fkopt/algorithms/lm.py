@@ -39,8 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, rows_of
-from .nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, scaled_step, start_points
+from fkopt.algorithms.base import Algorithm, Params, State, clip, rows_of
+from fkopt.algorithms.nr import jacobian, jacobian_cost, jacobian_steps, residuals_of, scaled_step, start_points
 
 
 class LMParams(Params):

@@ -43,8 +43,8 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import Field
 
-from ..errors import FkoptError
-from .base import Algorithm, Params, State, clip, rows_of, uniform_in
+from fkopt.errors import FkoptError
+from fkopt.algorithms.base import Algorithm, Params, State, clip, rows_of, uniform_in
 
 
 # -- helpers shared with lm.py and hybrid.py -------------------------------------------------

@@ -21,9 +21,9 @@ from dataclasses import dataclass, fields
 import numpy as np
 from pydantic import Field
 
-from .abc import ABC, ABCParams, ABCState
-from .base import Algorithm
-from .pso import PSO, PSOParams, PSOState
+from fkopt.algorithms.abc import ABC, ABCParams, ABCState
+from fkopt.algorithms.base import Algorithm
+from fkopt.algorithms.pso import PSO, PSOParams, PSOState
 
 
 class PABCParams(PSOParams, ABCParams):
@@ -46,6 +46,13 @@ class PABC(Algorithm):
     reconstruction = ("chang2024's P-ABC equations were lost in extraction; PSO then ABC seeded "
                       "with the personal bests, as reconstructed in docs/models.md")
     evaluations_per_iteration = "population (PSO phase), 2*population (+1 per scout) (ABC phase)"
+    #: The convergence figure marks where the search changes phase (fkopt.kinds.experiment.reports).
+    phase_change = "switch PSO → ABC"
+
+    @staticmethod
+    def phase_iteration(params: dict, last: int) -> int:
+        """The iteration (0..last) at which the PSO phase hands over to ABC."""
+        return int(round(float(params.get("switch", 0.5)) * last))
 
     def __init__(self, **params):
         super().__init__(**params)

@@ -36,7 +36,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .base import Algorithm, Params, State, clip, compiled_step, evaluated, log_arrays, log_kept, uniform_in
+from fkopt.algorithms.base import Algorithm, Params, State, clip, compiled_step, evaluated, log_arrays, log_kept, uniform_in
 
 
 class PSOParams(Params):

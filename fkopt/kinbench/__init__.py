@@ -5,3 +5,7 @@
 COCO-style measures and bootstrap rankings (:mod:`.measures`), and the leaderboard files
 (:mod:`.reports`, :mod:`.html`). See docs/kinbench.md.
 """
+# Importing kinbench registers every built-in kind of config with the engine (fkopt.run.kinds):
+# the three of fkopt.kinds, then kinbench's own suite kind.
+import fkopt.kinds  # noqa: E402,F401
+from fkopt.kinbench import kind  # noqa: E402,F401

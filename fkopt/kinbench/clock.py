@@ -37,7 +37,8 @@ import zlib
 import numpy as np
 import pandas as pd
 
-from .physical import LADDER, fk_verdicts, ik_verdicts, rung_label
+from fkopt.kinbench.physical import LADDER, fk_verdicts, ik_verdicts, rung_label
+from fkopt.registry import FK_SOLVERS, clock_solver  # noqa: F401 (FK_SOLVERS: the FK solvers on the clock)
 
 #: Timeouts of the clock track (ms): IK of serial arms, FK of parallel mechanisms.
 TIMEOUTS_MS = (1.0, 5.0, 20.0)
@@ -58,87 +59,15 @@ REFERENCE_REPEATS = 3
 ORGANISER = ("fkopt.inverse", "fkopt.forward")
 
 
-class FkoptInverse:
-    """The organiser's entry: :func:`fkopt.kinematics.inverse` with its defaults and
-    ``tol`` = (1e-9 m, 1e-9 rad), tight enough for every rung of the ladder, given the 4x4 target
-    frame itself (no Euler angles: the conversion cost as much as the compiled solve), through a
-    prepared :class:`fkopt.kinematics.InverseSolver` (``inverse``'s answers bit for bit; per query
-    only the target is checked and the compiled loop runs). The solver -- its options checked, the
-    start table (4096 FK evaluations) and the kernel's arguments -- is made when the wrapper is
-    made, outside the clock, as the field's packages parse their URDF outside it. No wall-clock
-    limit (it runs to its restart limit); its seed per query comes from the wrapper's generator."""
-
-    name = "fkopt.inverse"
-    package = "fkopt"
-    TOL = (1e-9, 1e-9)
-
-    def __init__(self, arm, *, timeout: float, rng: np.random.Generator):
-        from ..kinematics import InverseSolver
-        self.arm, self.timeout, self.rng = arm, float(timeout), rng
-        self._solve = InverseSolver(arm, tol=self.TOL)
-        self._solve(arm.fk_matrix(arm.bounds.mean(axis=1)))         # compiled code loaded, outside the clock
-        self.settings = {"timeout_s": self.timeout, "tol": list(self.TOL), "wall_clock_limit": False,
-                         "seed": "per query from the wrapper's generator", "defaults": "fkopt.inverse's"}
-
-    def solve1(self, T):
-        r = self._solve(T, seed=int(self.rng.integers(2**31 - 1)))
-        return r.joints, bool(r.solved)
-
-    def solve_batch(self, T: np.ndarray) -> np.ndarray:
-        r = self._solve(T, seed=int(self.rng.integers(2**31 - 1)))
-        return np.asarray(r.joints, dtype=float)
-
-
-class FkoptForward:
-    """The organiser's FK entry: :func:`fkopt.kinematics.forward` (local Newton, the start
-    table's nearest poses, deterministic restarts, global search) with its defaults and ``tol`` =
-    1e-10 on max |ik(pose) - legs| (joint units); its seed per query from the wrapper's
-    generator; no wall-clock limit. One call and the start table (4096 closed-form evaluations)
-    before the clock, as :class:`FkoptInverse`'s table and the field's URDF parsing."""
-
-    name = "fkopt.forward"
-    package = "fkopt"
-    TOL = 1e-10
-
-    def __init__(self, mechanism, *, timeout: float, rng: np.random.Generator):
-        from ..kinematics import forward
-        self.mechanism, self.timeout, self.rng, self._forward = mechanism, float(timeout), rng, forward
-        forward(mechanism, mechanism.ik(mechanism.bounds.mean(axis=1)[None])[0], tol=self.TOL)
-        from ..kinematics import FORWARD_TABLE, _forward_table
-        _forward_table(mechanism, FORWARD_TABLE)                           # start table, outside the clock
-        self.settings = {"timeout_s": self.timeout, "tol": self.TOL, "wall_clock_limit": False,
-                         "seed": "per query from the wrapper's generator", "defaults": "fkopt.forward's"}
-
-    def solve1(self, legs):
-        r = self._forward(self.mechanism, legs, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
-        return np.asarray(r.pose, dtype=float), bool(r.solved)
-
-    def solve_batch(self, legs: np.ndarray) -> np.ndarray:
-        r = self._forward(self.mechanism, legs, tol=self.TOL, seed=int(self.rng.integers(2**31 - 1)))
-        return np.asarray(r.pose, dtype=float)
-
-
-#: Solvers of FK of parallel mechanisms on the clock.
-FK_SOLVERS = (FkoptForward.name, FK_REFERENCE)
-
-
 def is_ik(mechanism) -> bool:
     """IK of a serial arm (targets: tip frames) or FK of a parallel mechanism (targets: legs)."""
     return getattr(mechanism, "kind", None) == "serial"
 
 
 def make_solver(name: str, mechanism, *, timeout: float, rng: np.random.Generator):
-    """The organiser's solver or a field wrapper (:func:`fkopt.adapters.field.make_ik`; for
-    FK, :class:`fkopt.adapters.field.scipy_fk.LeastSquaresFK`)."""
-    if name == FkoptInverse.name:
-        return FkoptInverse(mechanism, timeout=timeout, rng=rng)
-    if name == FkoptForward.name:
-        return FkoptForward(mechanism, timeout=timeout, rng=rng)
-    if name == FK_REFERENCE:
-        from ..adapters.field.scipy_fk import LeastSquaresFK
-        return LeastSquaresFK(mechanism, timeout=timeout, rng=rng)
-    from ..adapters.field import make_ik
-    return make_ik(name, mechanism, timeout=timeout, rng=rng)
+    """The organiser's solver or a field wrapper, from the one solver registry
+    (:func:`fkopt.registry.clock_solver`)."""
+    return clock_solver(name, mechanism, timeout=timeout, rng=rng)
 
 
 def track_settings(clock, mechanism) -> tuple[list[str], str, tuple[float, ...]]:
@@ -195,8 +124,8 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
     cannot take the mechanism by design (:class:`fkopt.adapters.field.NotApplicable`) gets rows
     without answers that say why (``not_applicable``). ``settings``, when given, is filled with
     each solver's settings (its wrapper at the largest timeout)."""
-    from ..adapters.field import NotApplicable
-    from ..adapters.field.cores import pinned
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.adapters.field.cores import pinned
     targets = targets_of(mechanism, queries)
     runs: list[tuple[str, float | None, object]] = []         # (solver name, timeout given, wrapper)
     not_applicable: dict[str, str] = {}                       # solver -> why (a cell, never a zero)
@@ -354,7 +283,7 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
     ref = make_solver(reference, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, reference, -1, 0))
     rows = []
     m = min(reference_queries, len(targets))
-    from ..adapters.field import NotApplicable
+    from fkopt.adapters.field import NotApplicable
     for name in solvers:
         try:
             solver = make_solver(name, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, name, -1, 0))

@@ -43,10 +43,10 @@ from typing import Literal
 
 from pydantic import Field, PrivateAttr, ValidationError, field_validator, model_validator
 
-from ..errors import FkoptError
-from ..experiment.config import (MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict,
-                                 unique_labels)
-from ..files import error_line, load_mapping
+from fkopt.errors import FkoptError
+from fkopt.registry import IK_SOLVERS, track_of
+from fkopt.run.config_base import MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict, unique_labels
+from fkopt.files import error_line, load_mapping
 
 #: Pose sets of kinbench v1 (see :mod:`fkopt.kinbench.posesets`).
 SETS = ("uniform", "near-singular", "boundary", "printed")
@@ -55,20 +55,12 @@ TRACKS = ("black-box", "jacobian", "exact")
 #: The COCO-style target ladder on the problem's fitness.
 TARGETS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
 #: Track of fkopt's built-in solvers and the adapters (anything else must state its track).
-KNOWN_TRACKS = {"abc": "black-box", "gabc": "black-box", "pso": "black-box", "aco": "black-box",
-                "pabc": "black-box", "nr": "jacobian", "lm": "jacobian", "dls": "jacobian",
-                "abc+lm": "jacobian", "gabc+lm": "jacobian", "pso+lm": "jacobian",
-                "forward": "exact", "inverse": "exact", "exact": "exact"}
-ADAPTER_TRACK = "black-box"     # scipy:, pymoo:, niapy: (registry.ADAPTER_PREFIXES) minimise the fitness only
 MAX_BUDGET_PER_DIM = 10_000_000
 
 
 def default_track(name: str) -> str | None:
-    """The track of a built-in solver or an adapter; None for anything else (a plug-in)."""
-    from ..registry import ADAPTER_PREFIXES
-    if name in KNOWN_TRACKS:
-        return KNOWN_TRACKS[name]
-    return ADAPTER_TRACK if name.split(":", 1)[0] in ADAPTER_PREFIXES else None
+    """The track of a built-in solver or an adapter (the registry's entry); None for a plug-in."""
+    return track_of(name)
 
 
 class SuiteSolver(AlgorithmSpec):
@@ -151,10 +143,9 @@ class QuickTier(Strict):
     queries: int | None = Field(None, ge=1)
 
 
-#: Solvers the clock track knows: the organiser's and the field's (fkopt.adapters.field).
+#: Solvers the clock track knows: the organiser's and the field's (the registry's IK solvers).
 def clock_solvers() -> tuple[str, ...]:
-    from ..adapters.field import IK_SOLVERS
-    return ("fkopt.inverse", *IK_SOLVERS)
+    return IK_SOLVERS
 
 
 class ClockSubmission(Strict):
@@ -303,7 +294,7 @@ class SuiteConfig(Located):
                 raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
-            from .instances import expand
+            from fkopt.kinbench.instances import expand
             try:
                 out += expand(checked, seed, f"problems[{i}]")
             except FkoptError as err:

@@ -20,22 +20,22 @@ USAGE = ("usage: python -m fkopt.kinbench.freeze pose-sets SUITE.yaml [POSES [co
 
 
 def main(argv: list[str]) -> int:
-    from ..errors import FkoptError
+    from fkopt.errors import FkoptError
     try:
         if len(argv) >= 2 and argv[0] == "pose-sets":
-            from .config import load_suite
-            from .posesets import pose_set_folder, write_pose_sets
+            from fkopt.kinbench.config import load_suite
+            from fkopt.kinbench.posesets import pose_set_folder, write_pose_sets
             cfg = load_suite(argv[1])
             extra = [int(argv[2])] + argv[3:4] if len(argv) > 2 else []
             print(write_pose_sets(cfg, pose_set_folder(cfg), *extra))
         elif len(argv) == 2 and argv[0] == "robots":
-            from .robots import write_robots
+            from fkopt.kinbench.robots import write_robots
             for path in write_robots(Path(argv[1])):
                 print(path)
         elif len(argv) == 2 and argv[0] == "release":
-            from ..problems import FITNESS_VERSION
-            from .config import load_suite
-            from .releases import release_files
+            from fkopt.problems import FITNESS_VERSION
+            from fkopt.kinbench.config import load_suite
+            from fkopt.kinbench.releases import release_files
             cfg = load_suite(argv[1])
             print(f'    "{cfg.pose_sets}": Release(fitness={FITNESS_VERSION}, files={{')
             for name, digest in release_files(cfg).items():

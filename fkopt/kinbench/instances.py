@@ -35,7 +35,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 #: Parameters drawn per mechanism (module docstring); a mechanism not listed takes no instances.
 SPREADS: dict[str, dict[str, tuple[str, float]]] = {
@@ -64,7 +64,7 @@ def _sig(v: float) -> float:
 
 def draw_geometry(mechanism: str, geometry: dict, rng: np.random.Generator) -> dict:
     """One draw of the parameters of :data:`SPREADS` around ``geometry`` (mechanism defaults filled in)."""
-    from .. import registry
+    from fkopt import registry
     spreads = SPREADS[mechanism]
     cls = registry.mechanism_class(mechanism)
     base = {**cls.Geometry().model_dump(mode="json"), **geometry}
@@ -85,7 +85,7 @@ def draw_geometry(mechanism: str, geometry: dict, rng: np.random.Generator) -> d
 
 def degeneracy(spec, rng: np.random.Generator) -> str | None:
     """Why the instance ``spec`` (a MechanismSpec with bounds) is degenerate, or None (module docstring)."""
-    from .posesets import condition_numbers, problem_mechanism
+    from fkopt.kinbench.posesets import condition_numbers, problem_mechanism
     problem = SimpleNamespace(mechanism=spec, objective=None)
     try:
         mech, _ = problem_mechanism(problem)
@@ -103,8 +103,8 @@ def degeneracy(spec, rng: np.random.Generator) -> str | None:
 
 def expand(problem: dict, seed: int, where: str) -> list[dict]:
     """The K instance problems (dicts of SuiteProblem fields) of a problem with ``instances: K``."""
-    from ..experiment.config import MechanismSpec
-    from .posesets import problem_mechanism
+    from fkopt.run.config_base import MechanismSpec
+    from fkopt.kinbench.posesets import problem_mechanism
     k_total = problem["instances"]
     if len(f"{problem['name']}-i{k_total}") > 64:
         raise FkoptError(f"{where}.name: '{problem['name']}' is too long for its instance names (64 characters)")

@@ -1,12 +1,15 @@
-"""Suites as a kind of the one config pipeline (:mod:`fkopt.experiment.kinds`)."""
+"""Suites as a kind of the one config pipeline (:mod:`fkopt.run.pipeline`)."""
 from __future__ import annotations
 
 from pathlib import Path
 
-from ..experiment.tasks import Kind
-from ..experiment.tasks import work_folder  # noqa: F401 (where a suite's task files live; tests)
-from .config import SuiteConfig, suite_from_dict
-from .runner import merge_suite, suite_plan, validate_suite
+from fkopt.kinbench import reports, traces
+from fkopt.run.kinds import register
+from fkopt.run.tasks import Kind
+from fkopt.run.tasks import work_folder  # noqa: F401 (where a suite's task files live; tests)
+from fkopt.run.writers import CURVES, FIGURE, RUNS, STEPS, TABLE, TIMING, Output
+from fkopt.kinbench.config import SuiteConfig, suite_from_dict
+from fkopt.kinbench.runner import merge_suite, suite_plan, validate_suite
 
 
 def _from_dict(data: dict, where: str) -> SuiteConfig:
@@ -16,4 +19,25 @@ def _from_dict(data: dict, where: str) -> SuiteConfig:
     return config
 
 
-SUITE = Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite)
+#: The files of a suite's folder, in the order they are written.
+OUTPUTS = (
+    Output("leaderboard.csv", reports.leaderboard_table, TABLE),
+    Output("measures.csv", reports.measures_table, TABLE),
+    Output("scaling.csv", reports.scaling_table, TABLE),      # classes of several dimensions only
+    Output("ert_ratio.csv", reports.ert_ratio_table, TABLE),  # suites with subsets (v3) only
+    Output("ecdf.csv", reports.ecdf_table, CURVES, rows=STEPS),
+    Output("runs.csv", reports.runs_table, CURVES, rows=RUNS),
+    Output("trace.csv.gz", traces.trace_table, CURVES, rows=STEPS),
+    Output("timing.csv", reports.timing_table, TIMING),
+    # kinbench v3's tracks on the clock: wall times (and TRAC-IK's wall-clock outcomes) vary
+    Output("answers.csv.gz", reports.answers_table, TIMING, float_format="%.17g"),
+    Output("throughput.csv", reports.throughput_table, TIMING),
+    Output("leaderboard-robots.csv", reports.robots_board_table, TIMING),
+    Output("ecdf", reports.ecdf_figures, FIGURE),
+    Output("scaling", reports.scaling_figures, FIGURE),
+    Output("clock", reports.clock_figures, FIGURE),
+    Output("leaderboard.md", reports.leaderboard_markdown, FIGURE),   # never compared
+    Output("index.html", reports.html_page, FIGURE),                  # inlines the figures
+)
+
+SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig))

@@ -23,7 +23,7 @@ A *trial* is one run on one (problem, set, pose) *instance*; a *triple* is (inst
   replacement; one resample shared by all solvers); solver a is *significantly better* than b
   when the two-sided Wilcoxon signed-rank test on the per-instance differences of their scores
   (paired by instance) rejects equality at ``alpha`` after Holm's correction over all pairs of
-  the scope (:func:`fkopt.study.statistics.holm`), and a's mean score is higher. (A bootstrap
+  the scope (:func:`fkopt.kinds.study.statistics.holm`), and a's mean score is higher. (A bootstrap
   p-value cannot go below 2 / (B + 1), which Holm's correction over the 45 pairs of ten solvers
   would never let pass at B = 1000: the signed-rank test has no such floor.)
 """
@@ -35,9 +35,9 @@ from itertools import combinations
 import numpy as np
 import pandas as pd
 
-from ..study.statistics import ecdf_table as ecdf_steps
-from ..study.statistics import holm
-from .budget import target_column
+from fkopt.kinds.study.statistics import ecdf_table as ecdf_steps
+from fkopt.kinds.study.statistics import holm
+from fkopt.kinbench.budget import target_column
 
 INSTANCE = ["problem", "set", "pose"]
 
@@ -131,7 +131,7 @@ def scaling_table(runs: pd.DataFrame, targets) -> pd.DataFrame | None:
 def ecdf_table(runs: pd.DataFrame, targets, budget_per_dim: float) -> pd.DataFrame:
     """Share of (problem, set, pose, target, run) reached within b x dim evaluations, per scope
     (``all`` and ``class:<c>``) and solver: the steps of the runtime distribution
-    (:func:`fkopt.study.statistics.ecdf_table`, in evaluations / dimension)."""
+    (:func:`fkopt.kinds.study.statistics.ecdf_table`, in evaluations / dimension)."""
     frames = []
     scopes = [("all", runs)] + [(f"class:{c}", g) for c, g in runs.groupby("class", sort=True)]
     for scope, sub in scopes:
@@ -278,7 +278,7 @@ def unit_free_jacobian(mech, points: np.ndarray, length: float) -> np.ndarray:
     points = np.asarray(points, dtype=float)
     if mech.kind == "serial":
         if not hasattr(mech, "frame_jacobian"):
-            from ..errors import FkoptError
+            from fkopt.errors import FkoptError
             raise FkoptError(f"{mech.name}: the unit-free singularity measure needs a frame Jacobian "
                              "(a frame arm: DH, URDF, MJCF)")
         _, _, J = mech.frame_jacobian(points)

@@ -19,7 +19,7 @@ best_so_far     the best fitness found so far, on the problem's fitness (see doc
 ==============  ==========================================================================
 
 **IOH** (what IOHexperimenter's ``Analyzer`` logger writes, read by
-:func:`fkopt.iohformat.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
+:func:`fkopt.tools.iohformat.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
 with its ``IOHprofiler_f*.json`` index and ``.dat`` files); the function name is ``<problem>__<set>`` (two underscores),
 the instance is the pose index + 1, each logged run one run; the ``.dat`` lines are
 ``evaluations raw_y`` with raw_y the problem's fitness (minimised). ``algorithm`` picks one
@@ -41,11 +41,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import FkoptError
-from ..files import MAX_INPUT_BYTES, read_input
-from ..experiment.config import files_folder
-from ..record import run_record
-from .budget import at_budget, budget_of
+from fkopt.errors import FkoptError
+from fkopt.files import MAX_INPUT_BYTES, read_input
+from fkopt.run.config_base import files_folder
+from fkopt.run.record import run_record
+from fkopt.kinbench.budget import at_budget, budget_of
 
 COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
 IOH_SEPARATOR = "__"
@@ -53,7 +53,7 @@ IOH_SEPARATOR = "__"
 
 def outside_path(config, entry, files: Path | None = None) -> Path:
     """An outside entry's file or folder, in ``files`` (default: the suite file's folder,
-    :func:`fkopt.experiment.config.files_folder`)."""
+    :func:`fkopt.kinds.experiment.config.files_folder`)."""
     base = files if files is not None else files_folder(config)
     return Path(base if base is not None else ".") / (entry.file or entry.ioh)
 
@@ -97,7 +97,7 @@ def _csv_log(path: Path, where: str) -> pd.DataFrame:
 
 
 def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
-    from ..iohformat import read_ioh
+    from fkopt.tools.iohformat import read_ioh
     if not path.is_dir():
         raise FkoptError(f"{where}: not a folder")
     data = read_ioh(path)

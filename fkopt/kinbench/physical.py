@@ -6,7 +6,7 @@ a submission claiming success on a wrong answer is a failure.
 
 IK (:func:`ik_verdicts`): the tip frame F = FK(q) against the target T gives the position
 error |p_F - p_T| (m) and the geodesic rotation error, the angle of R_F^T R_T in [0, pi] rad
-(:func:`fkopt.rotations.geodesic_angle`); an answer is a success at rung (e_p, e_r) of
+(:func:`fkopt.numerics.rotations.geodesic_angle`); an answer is a success at rung (e_p, e_r) of
 :data:`LADDER` when both are within it and the joints are inside the arm's limits (exactly, no
 tolerance: continuous joints are wrapped first). The ladder is the same on every arm: (5 mm,
 0.05 rad) and (1 mm, 0.01 rad) as cuRobo reports (Sundaralingam et al. 2023), (1e-5 m, 1e-5 rad)
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rotations import geodesic_angle
+from fkopt.numerics.rotations import geodesic_angle
 
 #: (position m, rotation rad) rungs, loosest first.
 LADDER = ((5e-3, 0.05), (1e-3, 0.01), (1e-5, 1e-5), (1e-8, 1e-8))
@@ -101,9 +101,9 @@ def fk_verdicts(mechanism, poses: np.ndarray, generating: np.ndarray, legs: np.n
 
 def _pose_frames(x: np.ndarray) -> np.ndarray:
     """4x4 frames of parallel-mechanism poses (x, y, z, alpha, beta, gamma deg) with
-    R = Rz(gamma) Ry(beta) Rx(alpha) (:func:`fkopt.rotations.zyx`, the convention of every
+    R = Rz(gamma) Ry(beta) Rx(alpha) (:func:`fkopt.numerics.rotations.zyx`, the convention of every
     6-DOF parallel mechanism in fkopt)."""
-    from ..rotations import to_array, zyx
+    from fkopt.numerics.rotations import to_array, zyx
     T = np.zeros(x.shape[:-1] + (4, 4))
     T[..., :3, :3] = to_array(zyx(*np.radians(np.moveaxis(x[..., 3:6], -1, 0))))
     T[..., :3, 3] = x[..., :3]

@@ -1,7 +1,7 @@
 """Frozen, versioned pose sets (kinbench v1): generated once from a seed, stored with SHA-256.
 
 A pose set is a list of points in the space of a problem's unknowns (the pose of a parallel
-mechanism, the joints of a serial arm), as in a study (:mod:`fkopt.study.poses`); what a solver
+mechanism, the joints of a serial arm), as in a study (:mod:`fkopt.kinds.study.poses`); what a solver
 must reproduce follows from it (joints = ik(pose), or pose = fk(joints)). Sets of v1, each
 drawn from its own stream ``PCG64(SeedSequence([seed, crc32(problem), crc32(set)]))``:
 
@@ -34,8 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FkoptError
-from ..experiment.config import files_folder
+from fkopt.errors import FkoptError
+from fkopt.run.config_base import files_folder
 
 VERSION = "kinbench-v1"
 #: Poses per generated set.
@@ -66,10 +66,10 @@ def set_rng(seed: int, problem: str, name: str) -> np.random.Generator:
 
 def problem_mechanism(problem, folder: Path | None = None):
     """The mechanism of a suite problem (the experiment layer's builder) and the RunConfig it
-    was built from (its objective is what :func:`fkopt.experiment.runner.make_problem` reads; the
+    was built from (its objective is what :func:`fkopt.kinds.experiment.runner.make_problem` reads; the
     one algorithm entry only satisfies the schema)."""
-    from ..experiment.config import RunConfig
-    from ..experiment.runner import build_mechanism
+    from fkopt.run.config_base import RunConfig
+    from fkopt.run.solving import build_mechanism
     cfg = RunConfig(name="pose-set", mechanism=problem.mechanism, objective=problem.objective,
                     algorithms=[{"name": "lm"}])
     return build_mechanism(cfg, folder), cfg
@@ -82,7 +82,7 @@ def targets_of(mech, points: np.ndarray) -> np.ndarray:
 
 def condition_numbers(problem, folder: Path | None, points: np.ndarray) -> np.ndarray:
     """kappa of the residual Jacobian at the true solution of each point (inf where singular)."""
-    from ..experiment.runner import make_problem
+    from fkopt.run.solving import make_problem
     mech, cfg = problem_mechanism(problem, folder)
     prob = make_problem(cfg, mech, targets_of(mech, points))
     x = points[:, None, :]
@@ -124,7 +124,7 @@ def generate(problem, seed: int, n: int = POSES, folder: Path | None = None,
                                  "bound": float(f"{bound:.6g}"), "quantile": SINGULAR_QUANTILE,
                                  "candidates": CANDIDATES}
     elif measure == "sigma":
-        from .measures import characteristic_length, unit_free_sigma_min
+        from fkopt.kinbench.measures import characteristic_length, unit_free_sigma_min
         length = characteristic_length(mech, cand)
         sigma = unit_free_sigma_min(mech, cand, length)
         bound = float(np.quantile(sigma[np.isfinite(sigma)], 1.0 - SINGULAR_QUANTILE))
@@ -190,7 +190,7 @@ def write_pose_sets(config, folder: Path, poses: int = POSES, measure: str = "co
 
 def pose_set_folder(config, files: Path | None = None) -> Path:
     """The suite's pose-set folder, in ``files`` (default: the suite file's folder,
-    :func:`fkopt.experiment.config.files_folder`)."""
+    :func:`fkopt.kinds.experiment.config.files_folder`)."""
     base = files if files is not None else files_folder(config)
     return Path(base if base is not None else ".") / config.pose_sets
 
@@ -243,7 +243,7 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     """The points of a pose-set CSV: ASCII, a header of exactly ``unknowns``, every row that
     many finite numbers; anything else one line naming the file, the line and what is allowed
     (no cell of the file is quoted beyond a short sanitised token)."""
-    from ..files import short_token
+    from fkopt.files import short_token
     try:
         text = data.decode("ascii")
     except UnicodeDecodeError as err:
@@ -277,7 +277,7 @@ def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, s
     the manifest's shape and every set file's contents are checked (a digest proves a file is
     the one the manifest names, not that either is well-formed): one line naming the file.
     ``files``: where the suite's relative files are (:func:`pose_set_folder`)."""
-    from ..files import parse_json, read_input
+    from fkopt.files import parse_json, read_input
     folder = pose_set_folder(config, files)
     mpath = folder / MANIFEST
     if not mpath.exists() and not mpath.is_symlink():
@@ -305,6 +305,6 @@ def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, s
             if meta.get("poses") is not None and meta["poses"] != len(pts):
                 raise FkoptError(f"{where}.sets.{name}.poses: {meta['poses']}, but {path} has {len(pts)} poses")
             out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
-    from .releases import check_release
+    from fkopt.kinbench.releases import check_release
     check_release(config, manifest, files)      # a released version: every file as released, not only as its manifest says
     return out, manifest

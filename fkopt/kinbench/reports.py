@@ -1,4 +1,4 @@
-"""The files of a suite's results folder (listed in :data:`fkopt.outputs.OUTPUTS` ``"suite"``).
+"""The files of a suite's results folder (listed in :data:`fkopt.run.writers.OUTPUTS` ``"suite"``).
 
 Tables come from :mod:`fkopt.kinbench.measures`; this module only shapes and draws them:
 runs.csv, measures.csv (per problem), ecdf.csv, leaderboard.csv, timing.csv, the ECDF figures
@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import record
-from ..files import file_names, md_text
-from . import measures as M
-from .outside import digest
-from .submissions import submission_digest
+from fkopt.run import record
+from fkopt.files import file_names, md_text
+from fkopt.kinbench import measures as M
+from fkopt.kinbench.outside import digest
+from fkopt.kinbench.submissions import submission_digest
 
 
 BOARD_PREFIX = "board:"
@@ -63,7 +63,7 @@ def _per_board(sr, table, column: str) -> pd.DataFrame | None:
 
 
 def runs_table(sr) -> pd.DataFrame:
-    """One row per run: the run record's (:func:`fkopt.record.runs_table`)."""
+    """One row per run: the run record's (:func:`fkopt.run.record.runs_table`)."""
     return record.runs_table(sr.record)
 
 
@@ -91,7 +91,7 @@ def ert_ratio_table(sr) -> pd.DataFrame | None:
 
 def timing_table(sr) -> pd.DataFrame:
     """Per (problem, solver): the batched solve's wall time over its (pose, run) rows (the one
-    timing writer, :func:`fkopt.record.timing_table`)."""
+    timing writer, :func:`fkopt.run.record.timing_table`)."""
     settings = {(p, s): {"runs": int(g["runs"].sum()), "total_s": float(g["seconds"].sum())}
                 for (p, s), g in sr.timing.groupby(["problem", "solver"], sort=False)}
     return record.timing_table(sr.timing, settings, by=("problem", "solver"))
@@ -123,8 +123,8 @@ def robots_board_table(sr) -> pd.DataFrame | None:
     (queries/s and its ratio to the reference's rate; empty for solvers that take no batches)
     and the entry (organiser / outside). Sorted per robot and timeout by success at the rung,
     then by median ratio."""
-    from .clock import clock_board
-    from .physical import LADDER, rung_label
+    from fkopt.kinbench.clock import clock_board
+    from fkopt.kinbench.physical import LADDER, rung_label
     answers = getattr(sr, "answers", None)
     if answers is None or answers.empty:
         return None
@@ -170,9 +170,9 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     answered at the track's rung (kinbench's verdict) against the time to the answer (ms, log),
     one step line per solver and the virtual best solver (per query the fastest right answer of
     any solver run here), the timeout marked; names at the right end, spread apart."""
-    from ..experiment.plotting import plt, save
-    from .clock import rung_success
-    from .physical import LADDER, rung_label
+    from fkopt.run.plotting import plt, save
+    from fkopt.kinbench.clock import rung_success
+    from fkopt.kinbench.physical import LADDER, rung_label
     answers = tables.get("answers.csv.gz")
     if answers is None or answers.empty:
         return []
@@ -260,7 +260,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
     named at its right end as COCO does; tracks told apart by line style."""
-    from ..experiment.plotting import legend_off_data, plt, save
+    from fkopt.run.plotting import legend_off_data, plt, save
     df = tables.get("ecdf.csv")
     if df is None or df.empty:
         return []
@@ -324,7 +324,7 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
     df = tables.get("scaling.csv")
     if df is None or df.empty:
         return []
-    from ..experiment.plotting import legend_off_data, plt, save
+    from fkopt.run.plotting import legend_off_data, plt, save
     pyplot = plt()
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     target = scaling_target(sr.config.targets)
@@ -498,7 +498,7 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
 def html_page(sr, folder: Path, tables: dict) -> list[str]:
     """index.html: the leaderboards (sortable), the ECDF figures inline, the per-problem tables."""
     import html
-    from .html import img, page, table_html
+    from fkopt.kinbench.html import img, page, table_html
     lb = tables.get("leaderboard.csv")
     if lb is None:
         return []
@@ -564,7 +564,7 @@ def board_meta(sr) -> dict:
     clock track's start and end, and every entry's settings."""
     if getattr(sr, "answers", None) is None:
         return {}
-    from .releases import board_version
+    from fkopt.kinbench.releases import board_version
     out = {"board_version": board_version(sr.config.name)}
     if getattr(sr, "load_avg", None):
         out["load_avg"] = sr.load_avg

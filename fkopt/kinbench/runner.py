@@ -1,12 +1,12 @@
 """Run a suite on the experiment layer's one solve path.
 
 One task is one (problem, solver): every pose of every selected set of the problem is a case of
-one batched problem (:func:`fkopt.experiment.runner.make_problem`), solved by
-:func:`fkopt.experiment.runner.solve_cases` for ``runs`` runs in one call. Case seeds:
-:func:`fkopt.experiment.runner.task_seed` of (suite seed, pose index within its set,
+one batched problem (:func:`fkopt.kinds.experiment.runner.make_problem`), solved by
+:func:`fkopt.kinds.experiment.runner.solve_cases` for ``runs`` runs in one call. Case seeds:
+:func:`fkopt.kinds.experiment.runner.task_seed` of (suite seed, pose index within its set,
 ``"<problem>/<set>/<solver label>"``); run k of a case is its k-th child stream
-(:mod:`fkopt.streams`), so a task's numbers do not depend on which other problems, sets,
-solvers or workers there are. The tasks go to the one runner (:mod:`fkopt.experiment.tasks`,
+(:mod:`fkopt.numerics.streams`), so a task's numbers do not depend on which other problems, sets,
+solvers or workers there are. The tasks go to the one runner (:mod:`fkopt.run.tasks`,
 :func:`suite_plan`): in this process, in local worker processes or on Dask, each kept as a task
 file with its SHA-256 until the suite is written, so ``--resume`` continues after a kill.
 
@@ -28,17 +28,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import FkoptError
-from ..record import BATCH, concat, run_record, timing_record
-from ..experiment.config import RunConfig, files_folder
-from ..experiment.runner import make_problem, solve_cases, start_point, task_seed
-from ..experiment.tasks import Plan, Ran, Task, run_tasks
-from ..solve import chunk_size
-from .budget import at_budget, budget_of, target_column
-from .config import SuiteConfig, suite_from_dict
-from .outside import digest, read_outside
-from .posesets import load_pose_sets, problem_mechanism, targets_of
-from .traces import suite_trace, task_trace
+from fkopt.errors import FkoptError
+from fkopt.run.record import BATCH, concat, run_record, timing_record
+from fkopt.run.config_base import RunConfig, files_folder
+from fkopt.run.solving import make_problem, solve_cases, start_point, task_seed
+from fkopt.run.tasks import Plan, Ran, Task, run_tasks
+from fkopt.solve import chunk_size
+from fkopt.kinbench.budget import at_budget, budget_of, target_column
+from fkopt.kinbench.config import SuiteConfig, suite_from_dict
+from fkopt.kinbench.outside import digest, read_outside
+from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism, targets_of
+from fkopt.kinbench.traces import suite_trace, task_trace
 
 
 def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
@@ -55,8 +55,8 @@ def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
 @dataclass
 class SuiteResult:
     config: SuiteConfig
-    record: pd.DataFrame                 # the run record (:mod:`fkopt.record`): one row per (problem, set, pose, solver, run)
-    timing: pd.DataFrame                 # the timing record (:mod:`fkopt.record`): one batch per (problem, solver)
+    record: pd.DataFrame                 # the run record (:mod:`fkopt.run.record`): one row per (problem, set, pose, solver, run)
+    timing: pd.DataFrame                 # the timing record (:mod:`fkopt.run.record`): one batch per (problem, solver)
     manifest: dict
     wall_s: float
     source: str | None = None
@@ -166,7 +166,7 @@ def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> 
     own FK or IK (answers rows)."""
     if not tracks or not config.tracks.clock.submissions:
         return None
-    from .submissions import read_submission
+    from fkopt.kinbench.submissions import read_submission
     # every arm of the track: IK answers (joints) and FK answers of parallel mechanisms (poses)
     arms = {config.problems[p].name: (track_arm(config, p, files), queries) for p, queries in tracks}
     return pd.concat([read_submission(config, k, arms, files) for k in range(len(config.tracks.clock.submissions))],
@@ -176,8 +176,8 @@ def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> 
 def validate_track(config: SuiteConfig, p: int, files: Path | None = None) -> None:
     """Every clock-track solver built once on arm ``p``: a missing package or an arm a package
     misreads is one line before any work."""
-    from ..adapters.field import NotApplicable
-    from .clock import make_solver, track_settings
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.kinbench.clock import make_solver, track_settings
     arm = track_arm(config, p, files)
     solvers, reference, timeouts = track_settings(config.tracks.clock, arm)
     for name in dict.fromkeys([reference, *solvers]):
@@ -191,7 +191,7 @@ def validate_track(config: SuiteConfig, p: int, files: Path | None = None) -> No
 
 def solve_track(payload: dict) -> dict:
     """Worker: the clock (and throughput) track on one arm; returns every answer, JSON-able."""
-    from .clock import run_clock, run_throughput, track_settings
+    from fkopt.kinbench.clock import run_clock, run_throughput, track_settings
     config = suite_from_dict(payload["config"], "suite task")
     files = Path(payload["folder"]) if payload["folder"] else None
     p, clock, tp = payload["problem"], config.tracks.clock, config.tracks.throughput
@@ -207,7 +207,7 @@ def solve_track(payload: dict) -> dict:
     answers.insert(1, "set", clock.set)
     rate = None
     if tp is not None:
-        from .clock import is_ik
+        from fkopt.kinbench.clock import is_ik
         batches = tp.batches if is_ik(arm) else tp.fk_batches
         batched = list(dict.fromkeys([*solvers, *(tp.solvers if is_ik(arm) else [])]))
         rate = run_throughput(arm, name, queries, batched, batches=tuple(batches), repeats=tp.repeats,
@@ -254,7 +254,7 @@ def solve_task(payload: dict) -> dict:
 
 
 def run_rows(config: SuiteConfig, problem, solver, cases, result, dim: int, seeds) -> pd.DataFrame:
-    """The task's rows of the run record (:mod:`fkopt.record`), measured at the budget."""
+    """The task's rows of the run record (:mod:`fkopt.run.record`), measured at the budget."""
     budget = budget_of(config, dim)
     m = at_budget(result.history, result.evaluation_history, budget, config.targets)
     n, runs = len(cases), config.runs_of(solver.key)
@@ -275,7 +275,7 @@ def rows_of(record: dict) -> pd.DataFrame:
 def fingerprint(config: SuiteConfig, manifest: dict) -> str:
     """Hash of everything that changes a task's numbers: the config's result-changing fields and
     the pose sets (a resumed suite must match it)."""
-    from ..experiment.config import numeric_fields
+    from fkopt.run.config_base import numeric_fields
     text = json.dumps([numeric_fields(config.stored_dump()), manifest], sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -451,7 +451,7 @@ def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, 
               executor: str = "local", scheduler: str | None = None) -> SuiteResult:
     """Every (problem, solver) task computed (no task files, nothing written), then the
     imported outside results: the suite's result (``fkopt suite`` runs it through
-    :func:`fkopt.experiment.kinds.run_config`, which keeps task files and resumes)."""
+    :func:`fkopt.run.pipeline.run_config`, which keeps task files and resumes)."""
     plan = suite_plan(config, source)
     ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, progress=progress)
     return merge_suite(config, plan, ran, source=source)

@@ -64,11 +64,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import FkoptError
-from ..experiment.config import files_folder
-from ..files import MAX_INPUT_BYTES, read_input
-from .clock import answer_prefix, answer_rows, is_ik, targets_of, track_settings
-from .outside import read_csv_columns
+from fkopt.errors import FkoptError
+from fkopt.run.config_base import files_folder
+from fkopt.files import MAX_INPUT_BYTES, read_input
+from fkopt.kinbench.clock import answer_prefix, answer_rows, is_ik, targets_of, track_settings
+from fkopt.kinbench.outside import read_csv_columns
 
 REQUIRED = ("robot", "query", "seconds", "reference_seconds")
 #: A wall time beyond an hour per query is no clock-track answer (the longest timeout is 10 s).

@@ -2,8 +2,8 @@
 
 One row per improvement of a run's best-so-far fitness within the suite's budget, at the exact
 evaluation at which it happened, as far as the solver reports it (the rules of an experiment's
-trace, :mod:`fkopt.experiment.traces`, whose :func:`~fkopt.experiment.traces.run_trace` builds
-the rows) -- what :func:`fkopt.export.ioh_export` turns into IOHprofiler data:
+trace, :mod:`fkopt.run.trace`, whose :func:`~fkopt.run.trace.run_trace` builds
+the rows) -- what :func:`fkopt.tools.export.ioh_export` turns into IOHprofiler data:
 
 =============  ==========================================================================
 problem        problem name
@@ -32,9 +32,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..errors import FkoptError
-from ..experiment.traces import FILE, run_trace
-from .budget import budget_of, last_within
+from fkopt.errors import FkoptError
+from fkopt.run.trace import FILE, run_trace
+from fkopt.kinbench.budget import budget_of, last_within
 
 __all__ = ["FILE", "COLUMNS", "budget_trace", "task_trace", "outside_trace", "suite_trace", "trace_table"]
 
@@ -71,7 +71,7 @@ def task_trace(result, budget: int) -> dict:
     """The trace of every (case, run) row of a suite task's batched ``result``, JSON-able (the
     task record's ``"trace"``): ``row`` (case x runs + run, the row of the task's run rows),
     ``evaluations``, ``best_fitness``."""
-    from ..experiment.traces import history_events
+    from fkopt.run.trace import history_events
     ev = np.asarray(result.evaluation_history).reshape(-1, result.evaluation_history.shape[-1])
     events = result.events if result.events is not None else history_events(
         np.asarray(result.history).reshape(ev.shape), ev)
@@ -83,7 +83,7 @@ def outside_trace(config, k: int, dims: dict[str, int], instances: set[tuple[str
                   files=None) -> pd.DataFrame:
     """The trace rows (:mod:`fkopt.kinbench.traces`) of ``config.outside[k]``'s runs, cut at the
     budget as :func:`~fkopt.kinbench.outside.read_outside`'s measures are."""
-    from .outside import in_suite_order, logged_runs
+    from fkopt.kinbench.outside import in_suite_order, logged_runs
     entry = config.outside[k]
     frames = []
     for problem, name, pose, run, ev, hist in logged_runs(config, k, instances, files):

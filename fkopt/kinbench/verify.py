@@ -31,10 +31,10 @@ def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
     """(file, row, column, stored, recomputed, rule) of every disagreement; [] when the stored
     board follows from the stored answers."""
-    from .clock import answer_prefix, targets_of, verdicts
-    from .posesets import load_pose_sets
-    from .reports import robots_board_table
-    from .runner import track_arm, track_cases
+    from fkopt.kinbench.clock import answer_prefix, targets_of, verdicts
+    from fkopt.kinbench.posesets import load_pose_sets
+    from fkopt.kinbench.reports import robots_board_table
+    from fkopt.kinbench.runner import track_arm, track_cases
     folder = Path(folder)
     path = folder / "answers.csv.gz"
     if config.tracks is None or config.tracks.clock is None or not path.exists():

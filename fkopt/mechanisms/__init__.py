@@ -1,7 +1,7 @@
 """Mechanisms: geometry, pose/joint variables with units, search bounds and closed-form maps.
 
-One module per mechanism, registered in :mod:`fkopt.registry`.
+One module per mechanism, listed by name in :mod:`fkopt.mechanisms.catalog`.
 """
-from .base import Mechanism, ParallelMechanism, SerialMechanism
+from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 
 __all__ = ["Mechanism", "ParallelMechanism", "SerialMechanism"]

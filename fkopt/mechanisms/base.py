@@ -28,14 +28,14 @@ from typing import Any, Callable, ClassVar
 
 import numpy as np
 
-from .. import rotations
-from ..errors import FkoptError, did_you_mean
+from fkopt.numerics import rotations
+from fkopt.errors import FkoptError, did_you_mean
 
 
 def _geometry_base():
     from pydantic import BaseModel, ConfigDict, field_validator
 
-    from ..files import MAX_MAGNITUDE
+    from fkopt.files import MAX_MAGNITUDE
 
     class Geometry(BaseModel):
         """Base of every mechanism's geometry model (unknown keys are rejected; every number,
@@ -138,7 +138,7 @@ class Mechanism:
     #: Set when the model is a reconstruction (docs/models.md), with a one-sentence explanation.
     reconstruction: ClassVar[str | None] = None
     #: True when the fitness path (forward/inverse map, no Jacobian) is elementwise numpy, with no
-    #: BLAS call (:mod:`fkopt.compare`); False for mechanisms fkopt has not read (plug-ins).
+    #: BLAS call (:mod:`fkopt.run.compare`); False for mechanisms fkopt has not read (plug-ins).
     blas_free_fitness: ClassVar[bool] = False
     pose_names: ClassVar[tuple[str, ...]]
     pose_units: ClassVar[tuple[str, ...]]
@@ -218,7 +218,7 @@ class Mechanism:
         """``values`` after checking |v| <= :data:`fkopt.files.MAX_MAGNITUDE` (1e9 in the
         mechanism's units; past it a square overflows in FK, IK or a Jacobian): one line naming
         the variable otherwise."""
-        from ..files import MAX_MAGNITUDE
+        from fkopt.files import MAX_MAGNITUDE
         big = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
         if big.size:
             i = int(big[0])

@@ -8,7 +8,7 @@ unit of the table (mm) and the Z-Y-Z Euler angles printed by wang7dof, in degree
     beta = atan2(sqrt(n_z^2 + o_z^2), a_z),  alpha = atan2(a_y, a_x),  gamma = atan2(o_z, -n_z),
 
 so beta is in [0, 180] and the angles are singular at sin(beta) = 0 (see
-:func:`fkopt.rotations.zyz_angles`); :meth:`DHArm.frame` gives the rotation matrix itself for
+:func:`fkopt.numerics.rotations.zyz_angles`); :meth:`DHArm.frame` gives the rotation matrix itself for
 the geodesic error of :class:`fkopt.problems.IKProblem`.
 
 ``dh-arm`` takes any table as geometry (``a``, ``alpha`` [deg], ``d``, ``theta_offset`` [deg],
@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FkoptError
-from .base import FrameArm, lazy_model, validate_geometry
+from fkopt.errors import FkoptError
+from fkopt.mechanisms.base import FrameArm, lazy_model, validate_geometry
 
 #: Batch size from which :meth:`DHArm.frame_jacobian` works on the frame's columns rather than
 #: by batched 4x4 products (those cost about 1 µs per matrix, the columns a fixed ~20 array
@@ -44,7 +44,7 @@ WANG7DOF = dict(
 
 def _dh_geometry():
     from pydantic import Field, model_validator
-    from .base import Geometry
+    from fkopt.mechanisms.base import Geometry
 
     class DHGeometry(Geometry):
         a: list[float] = Field(default_factory=lambda: list(WANG7DOF["a"]),
@@ -281,7 +281,7 @@ class DHArm(FrameArm):
         """The DH table as a :class:`fkopt.numerics.chain.Chain` (same numbers as :meth:`frame_jacobian1`)."""
         got = self.__dict__.get("_chain_arrays")
         if got is None:
-            from ..numerics.chain import from_dh
+            from fkopt.numerics.chain import from_dh
             got = self.__dict__["_chain_arrays"] = from_dh(self._a, self._d, self._ca, self._sa, self._offset_rad)
         return got
 

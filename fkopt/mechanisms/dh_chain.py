@@ -25,8 +25,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .base import lazy_model
-from .dh_arm import DHArm
+from fkopt.mechanisms.base import lazy_model
+from fkopt.mechanisms.dh_arm import DHArm
 
 #: Reach bound of every member (mm): sum over the links of sqrt(a^2 + d^2).
 REACH = 1000.0
@@ -54,7 +54,7 @@ def chain_table(joints: int, seed: int) -> dict:
 
 def _chain_geometry():
     from pydantic import Field
-    from .base import Geometry
+    from fkopt.mechanisms.base import Geometry
 
     class DHChainGeometry(Geometry):
         joints: int = Field(6, ge=1, le=MAX_JOINTS, description="number of revolute joints n")

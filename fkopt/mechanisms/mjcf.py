@@ -39,9 +39,9 @@ from types import SimpleNamespace
 import numpy as np
 from pydantic import Field
 
-from ..errors import FkoptError, did_you_mean
-from ..files import check_geometry_file
-from .urdf import URDFArm, URDFGeometry
+from fkopt.errors import FkoptError, did_you_mean
+from fkopt.files import check_geometry_file
+from fkopt.mechanisms.urdf import URDFArm, URDFGeometry
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.xml"
 #: Largest MJCF file compiled (bytes), as for URDF: kinematic descriptions are kilobytes.

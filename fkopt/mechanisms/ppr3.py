@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from .base import Geometry, ParallelMechanism
+from fkopt.mechanisms.base import Geometry, ParallelMechanism
 
 
 class ThreePPRGeometry(Geometry):

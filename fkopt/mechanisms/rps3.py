@@ -21,9 +21,9 @@ import threading
 import numpy as np
 from pydantic import Field
 
-from .. import rotations
-from ..numerics import path as numerics_path
-from .base import Geometry, ParallelMechanism
+from fkopt.numerics import rotations
+from fkopt.numerics import path as numerics_path
+from fkopt.mechanisms.base import Geometry, ParallelMechanism
 
 
 _HALF_DEG = np.pi / 360.0          # degrees -> half-angle in radians

@@ -44,8 +44,8 @@ import math
 
 import numpy as np
 
-from .. import rotations
-from .base import ParallelMechanism, lazy_model
+from fkopt.numerics import rotations
+from fkopt.mechanisms.base import ParallelMechanism, lazy_model
 
 Vec3 = tuple[float, float, float]
 Points6 = tuple[Vec3, Vec3, Vec3, Vec3, Vec3, Vec3]
@@ -96,7 +96,7 @@ def degenerate(points, what: str) -> str | None:
 
 def _six_sps_geometry():
     from pydantic import Field, model_validator
-    from .base import Geometry
+    from fkopt.mechanisms.base import Geometry
 
     class SixSPSGeometry(Geometry):
         base: Points6 = Field(DIETMAIER_BASE, description="six base joints b_i [x, y, z] (base frame)")
@@ -175,7 +175,7 @@ class SixSPS(ParallelMechanism):
         """Leg lengths (..., 6) for poses (..., 6) = (x, y, z, alpha, beta, gamma).
 
         Lean on purpose (it is the swarm's fitness): one transposing copy of the poses, the
-        rotation from :func:`fkopt.rotations.zyx`, then every leg accumulated in place in two
+        rotation from :func:`fkopt.numerics.rotations.zyx`, then every leg accumulated in place in two
         scratch arrays. The result is a view of a leg-major (6, ...) array, so the residual
         and the sum over legs in :class:`fkopt.problems.FKProblem` run on contiguous rows.
         """
@@ -328,7 +328,7 @@ SixSPS.default_bounds = general_bounds(np.array(DIETMAIER_BASE), np.array(DIETMA
 
 def _six_sps_cmm_geometry():
     from pydantic import Field, model_validator
-    from .base import Geometry
+    from fkopt.mechanisms.base import Geometry
 
     class SixSPSCMMGeometry(Geometry):
         Rb: float = Field(0.5, gt=0, description="base joint circle radius R_b (m)")

@@ -15,7 +15,7 @@ them through any angle and ``fkopt.inverse`` wraps the answer into [-180, 180). 
 bounds can be overridden by the config's ``mechanism.bounds`` as for every mechanism (a
 continuous joint given bounds is no longer periodic). In an experiment file, a relative
 ``geometry.file`` is relative to the config file's folder (see
-:func:`fkopt.experiment.runner.build_mechanism`); from Python, to the working directory.
+:func:`fkopt.kinds.experiment.runner.build_mechanism`); from Python, to the working directory.
 Without ``file`` the mechanism is wang7dof's arm written as URDF (``mechanisms/data/wang7dof.urdf``),
 which gives the same poses as ``7dof-arm`` with lengths in metres instead of millimetres.
 
@@ -39,10 +39,10 @@ from typing import Any
 import numpy as np
 from pydantic import Field, ValidationError
 
-from ..errors import FkoptError, did_you_mean
-from ..files import MAX_MAGNITUDE, check_geometry_file, read_input, short_token
-from ..numerics.chain import frame_jacobian1, from_terms
-from .base import FrameArm, Geometry, describe_validation_error
+from fkopt.errors import FkoptError, did_you_mean
+from fkopt.files import MAX_MAGNITUDE, check_geometry_file, read_input, short_token
+from fkopt.numerics.chain import frame_jacobian1, from_terms
+from fkopt.mechanisms.base import FrameArm, Geometry, describe_validation_error
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.urdf"
 #: Bounds of continuous joints unless the config gives them (deg).

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 #: Length unit of an arm's poses -> metres.
 LENGTH_SCALE = {"m": 1.0, "mm": 1e-3}

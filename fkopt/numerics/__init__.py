@@ -12,4 +12,4 @@ joint-limit handling of ``fkopt.inverse``, its options, and the compiled fast pa
 * :mod:`.path` -- which path runs (``FKOPT_NUMERICS=numpy`` forces the numpy/Python reference)
   and what ``env.json`` records about it.
 """
-from .options import InverseOptions  # noqa: F401
+from fkopt.numerics.options import InverseOptions  # noqa: F401

@@ -1,4 +1,4 @@
-"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.dls` compiled by
+"""The compiled fast path: :mod:`fkopt.numerics.chain` and :mod:`fkopt.numerics.damped_least_squares` compiled by
 numba, operation for operation in the reference's order (numba compiles without fast-math, so no
 reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` are the C library's,
 as Python's ``math``). Importing this module imports numba, which costs a noticeable part of a
@@ -16,9 +16,9 @@ load the cache.
   ``error_model="numpy"``: a float division by zero gives numpy's inf/NaN instead of a Python
   exception, so no check guards each division (half of the fitness' time, measured: 57 -> 29 ns
   per point); the values are the same wherever the divisor is not zero;
-* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.dls.inverse_candidates`, every
+* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.damped_least_squares.inverse_candidates`, every
   start (given start, start-table neighbours, seeded hash draws) and restart inside;
-* :func:`fill_uniforms` -- the refill of :class:`fkopt.streams.RunStreams`' buffer, every run in one
+* :func:`fill_uniforms` -- the refill of :class:`fkopt.numerics.streams.RunStreams`' buffer, every run in one
   call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits);
 """
 from __future__ import annotations
@@ -148,7 +148,7 @@ def _rotation_error(R, T, e):
 
 @njit(cache=True)
 def _dls_step(J, r, mu, free, d, A, L, y, x):
-    """:func:`fkopt.numerics.dls.dls_step` into d; J's columns with free[i] = False count as zero.
+    """:func:`fkopt.numerics.damped_least_squares.dls_step` into d; J's columns with free[i] = False count as zero.
     Returns False when not positive definite or not finite."""
     n = J.shape[1]
     for a in range(6):
@@ -193,7 +193,7 @@ def _dls_step(J, r, mu, free, d, A, L, y, x):
 
 @njit(cache=True)
 def _uniform_hash(seed, row, draw, out):
-    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics._uniform_hash` (SplitMix64's finaliser)."""
+    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.solvers._uniform_hash` (SplitMix64's finaliser)."""
     c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
     for k in range(out.shape[0]):
         z = c + np.uint64(k + 1) * _M2
@@ -226,7 +226,7 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
 @njit(cache=True)
 def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr, iterations, damping, down, up,
                  step_cap, lo, hi, glo, ghi, best_q):
-    """:func:`fkopt.numerics.dls.inverse_candidates` compiled; the j-th start is q0 (j < own0),
+    """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
     (starts used, evaluations)."""
@@ -340,7 +340,7 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
 @njit(cache=True)
 def _nearest_into(Ft, norms, f, idx, best):
     """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx:
-    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics._nearest`'s brute force; the dot product
+    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics.solvers._nearest`'s brute force; the dot product
     summed feature by feature, rows side by side, from ``Ft`` = F transposed), the k smallest kept
     sorted by insertion (ties: the lower row first)."""
     c, N = Ft.shape
@@ -377,14 +377,14 @@ def _nearest_into(Ft, norms, f, idx, best):
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics._zyz_matrix1`, for
+    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics.solvers._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
     start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
     used, evaluations). Releases the GIL (``nogil``; the same arithmetic), so that a control
-    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.InverseSolver`
+    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.solvers.InverseSolver`
     calls it directly)."""
     n = q0.shape[0]
     d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
@@ -442,9 +442,9 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
 
 def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
     """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
-    :func:`fkopt.kinematics._fast_context`) and the options bound once: a function
+    :func:`fkopt.kinematics.solvers._fast_context`) and the options bound once: a function
     (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
-    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.InverseSolver`) keeps it, so
+    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.solvers.InverseSolver`) keeps it, so
     a control loop's call does no dictionary lookups."""
     chain, n = ctx["chain"], ctx["n"]
     head = (L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn)

@@ -1,11 +1,11 @@
-"""Options of ``fkopt.inverse`` (documented in :func:`fkopt.kinematics.inverse`)."""
+"""Options of ``fkopt.inverse`` (documented in :func:`fkopt.kinematics.solvers.inverse`)."""
 from __future__ import annotations
 
 import math
 import numbers
 from dataclasses import asdict, dataclass, fields
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 #: (option, smallest allowed value) of the integer options; the rest are numbers or flags.
 _INTEGERS = {"restarts": 0, "starts": 1, "iterations": 0, "fill": 1, "table": 0, "neighbours": 0, "tail": 1}

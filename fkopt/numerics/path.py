@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from contextlib import contextmanager
 
-from ..errors import FkoptError
+from fkopt.errors import FkoptError
 
 ENV = "FKOPT_NUMERICS"
 _STATE: dict = {}
@@ -43,7 +43,7 @@ def compiled(want: bool | None = None):
         return None
     if "module" not in _STATE:
         try:
-            from . import compiled as mod
+            from fkopt.numerics import compiled as mod
         except ImportError as err:
             if mode == "compiled" or want:
                 raise FkoptError(f"the compiled numerics path needs numba ({err}); pip install numba, "

@@ -1,7 +1,7 @@
 """All assembly modes (not a paper): forward solutions of a 6-6 platform, counted."""
 from __future__ import annotations
 
-from .claims import Claim, g, missing, verdict
+from fkopt.reproduce.claims import Claim, g, missing, verdict
 
 TITLE = "Beyond the papers: all real forward solutions (assembly modes) of a parallel mechanism"
 EXPERIMENTS = ["dietmaier"]
@@ -9,7 +9,7 @@ NOTES = [
     "A swarm returns one pose; a parallel mechanism may have many that reproduce the same inputs. "
     "`fkopt fk MECH --joints ... --all-solutions` (and `kind: assembly` files) find them all by "
     "batched multi-start damped Newton from uniform random rotations, deduplicated with a stated "
-    "tolerance (1e-6 in the normalised pose space, rotations compared as matrices); see fkopt/assembly.py.",
+    "tolerance (1e-6 in the normalised pose space, rotations compared as matrices); see fkopt/kinematics/assembly_modes.py.",
     "Dietmaier (1998) constructed a 6-6 Stewart-Gough platform with 40 real forward solutions, the "
     "maximum for a general platform.",
 ]

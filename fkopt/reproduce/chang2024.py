@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .store import mechanism_of
+from fkopt.reproduce.store import mechanism_of
 
 #: The printed inputs of the case (alpha, beta, gamma, z) = (25, 34, 23, 360) (Sec. 3.3).
 CASE_POSE = {"alpha": 25.0, "beta": 34.0, "gamma": 23.0, "z": 360.0}
@@ -43,7 +43,7 @@ def figures(exp) -> list[str]:
     """Figures drawn from the model alone at report time: Fig. 3 (inputs along the trajectory)."""
     if exp.name != "tab1_fig7":
         return []
-    from ..experiment import plotting
+    from fkopt.run import plotting
     df = fig3_inputs()
     mech = _mechanism()
     plt = plotting.plt()

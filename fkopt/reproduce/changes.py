@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..files import read_stored
-from ..outputs import deterministic_files, sha256
-from .claims import CLAIMS_FILE
-from .store import Store
+from fkopt.files import read_stored
+from fkopt.run.writers import deterministic_files, sha256
+from fkopt.reproduce.claims import CLAIMS_FILE
+from fkopt.reproduce.store import Store
 
 CHANGES_FILE = "CHANGES.md"
 #: Summary columns whose move is reported (the others follow from them or are settings).
@@ -73,8 +73,8 @@ def load_snapshot(path: str | Path) -> Snapshot:
     """A snapshot kept by :func:`save_snapshot`; one line naming the file when it is not one."""
     import json
 
-    from ..errors import FkoptError
-    from ..files import read_text
+    from fkopt.errors import FkoptError
+    from fkopt.files import read_text
     try:
         data = json.loads(read_text(path, 256 << 20))
         snap = Snapshot(dict(data["files"]), dict(data["summaries"]), dict(data["claims"]))
@@ -195,14 +195,14 @@ def describe(before: Snapshot, root: str | Path, after: Snapshot | None = None) 
 def agreement(before: Snapshot, root: str | Path, after: Snapshot | None = None) -> str:
     """One line for the end of ``fkopt reproduce``: how many deterministic files moved against
     the tree before it (timings never count) and whether ``fkopt check``'s cross-platform rules
-    (:mod:`fkopt.compare`) accept the new files against the old. On the platform that made the
+    (:mod:`fkopt.run.compare`) accept the new files against the old. On the platform that made the
     stored results nothing moves; on another CPU (another SIMD width in numpy's kernels, another
     BLAS) the last digits of path-dependent runs move and the rules decide whether that is all.
     Needs a snapshot taken with ``keep``. ``after``: the tree's snapshot the caller already took
     for :func:`describe` (``fkopt reproduce`` threads the one :func:`write_changes` took, so the
     tree is hashed once at its end), default: taken here."""
-    from ..compare import ANY, compare_folders
-    from .check import rules_for
+    from fkopt.run.compare import ANY, compare_folders
+    from fkopt.reproduce.check import rules_for
     root = Path(root)
     after = snapshot(root) if after is None else after
     moved: dict[str, list[str]] = {}
@@ -239,7 +239,7 @@ def agreement(before: Snapshot, root: str | Path, after: Snapshot | None = None)
 def write_changes(root: str | Path, before: Snapshot) -> tuple[Path, Snapshot]:
     """Write CHANGES.md at the root of the regenerated tree; returns its path and the snapshot of
     the tree it compared (for :func:`agreement`, without hashing the tree again)."""
-    from ..files import write_file_atomically
+    from fkopt.files import write_file_atomically
     path = Path(root) / CHANGES_FILE
     after = snapshot(root)
     text = describe(before, root, after)

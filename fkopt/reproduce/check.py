@@ -9,12 +9,12 @@ results folder ``<paper>/<name>/``:
    written (``files``), and no recorded file may be missing -- any edit of any stored table is
    caught, on any platform;
 3. on every platform: ``summary.csv`` must hold the statistics of the stored ``runs.csv``
-   (:func:`fkopt.compare.summary_consistency`), and the fitness of every stored run, recomputed
+   (:func:`fkopt.run.compare.summary_consistency`), and the fitness of every stored run, recomputed
    from its stored ``x`` (:func:`recomputed_fitness`), must equal the stored fitness within what
    the CSV's 10 significant digits of ``x`` allow;
 4. the config is validated and rerun in this process into a scratch folder; the deterministic
    files (all CSVs but the timing files, and ``meta.json``) are compared by the rules of the
-   platform tier (:func:`fkopt.provenance.platform_tier`, :mod:`fkopt.compare`): byte for byte
+   platform tier (:func:`fkopt.run.provenance.platform_tier`, :mod:`fkopt.run.compare`): byte for byte
    where the stored fingerprint equals this machine's, BLAS-free rows exactly and the rest by the
    cross-platform rules where only the BLAS part differs, the cross-platform rules elsewhere
    (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier); the rerun takes the
@@ -36,13 +36,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
-from ..errors import FkoptError
-from ..files import odd_entries, parse_json, read_stored
-from ..experiment.kinds import from_dict, rerun_files
-from ..numerics import path as numerics_path
-from ..provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
-from .store import Experiment, Store
+from fkopt.run.compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
+from fkopt.errors import FkoptError
+from fkopt.files import odd_entries, parse_json, read_stored
+import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+from fkopt.run.pipeline import config_kind, from_dict, rerun_files
+from fkopt.numerics import path as numerics_path
+from fkopt.run.provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
+from fkopt.reproduce.store import Experiment, Store
 
 #: Compared first (so the first mismatch is the most telling), then the rest, meta.json last.
 FIRST = ("summary.csv", "values.csv", "inputs.csv")
@@ -97,7 +98,7 @@ def rules_for(exp: Experiment, tier: str) -> Rules:
     """The comparison rules of ``exp``: which algorithm labels are path-dependent (a BLAS call may
     lie on their path: see ``Algorithm.blas_free`` and ``Mechanism.blas_free_fitness``), and the
     fitness at which a run counts as reached (the config's threshold)."""
-    from ..registry import algorithm_class, mechanism_class
+    from fkopt.registry import algorithm_class, mechanism_class
     cfg = exp.config if isinstance(exp.config, dict) else {}
     mechs = [p.get("mechanism") or {} for p in cfg.get("problems") or []] or [cfg.get("mechanism") or {}]
     try:                # a suite has several problems: its rows are BLAS-free only if every fitness is
@@ -127,11 +128,11 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     f(x)|, |f(x - d_i e_i) - f(x)|) (first order, with a factor 2 for the curvature of a squared
     residual and 2 for safety), plus the stored fitness' own rounding (5e-10 relative).
     """
-    from ..experiment.kinds import config_kind
     kind = config_kind(config).name
     if kind not in ("experiment", "study") or not (exp.folder / "runs.csv").is_file():
         return []
-    from ..experiment.runner import build_cases, build_mechanism, build_problem, make_problem
+    from fkopt.kinds.experiment.runner import build_cases, build_problem
+    from fkopt.run.solving import build_mechanism, make_problem
     label = _label(exp)
     try:
         runs = pd.read_csv(io.BytesIO(read_stored(exp.folder, "runs.csv")))
@@ -142,9 +143,9 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
         groups = [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
                   for case in build_cases(config, mech)]
     else:                               # a study: one problem per pose of its pose set
-        from ..study.poses import build_poses
+        from fkopt.kinds.study.poses import build_poses
         poses = build_poses(config, mech)
-        # poses count from 0 (fkopt.record); a folder written before the run record counted from 1
+        # poses count from 0 (fkopt.run.record); a folder written before the run record counted from 1
         first = 1 if len(runs) and runs["pose"].min() >= 1 else 0
         groups = [(f"pose {i}", runs["pose"] == i + first, lambda i=i: make_problem(config, mech, poses.inputs[i]))
                   for i in range(len(poses))]
@@ -182,7 +183,7 @@ def check_experiment(exp: Experiment, config=None, exact: bool | None = None, ti
     """Mismatches of one stored result (any kind) against a rerun; ``[]`` when it matches.
 
     ``tier`` forces the comparison rules (``"exact"``, ``"blas"``, ``"any"``; see
-    :func:`fkopt.provenance.platform_tier`); ``exact=True``/``False`` is ``"exact"``/``"any"``. By
+    :func:`fkopt.run.provenance.platform_tier`); ``exact=True``/``False`` is ``"exact"``/``"any"``. By
     default the tier follows the stored platform fingerprint.
 
     The stored config names its mechanism and algorithms: only built-in names, adapters and
@@ -190,7 +191,7 @@ def check_experiment(exp: Experiment, config=None, exact: bool | None = None, ti
     someone else's meta.json is refused, not imported -- unless ``allow_plugins``
     (:func:`fkopt.registry.registered_only`).
     """
-    from ..registry import registered_only
+    from fkopt.registry import registered_only
     with registered_only(not allow_plugins):
         return _check_experiment(exp, config, exact, tier)
 
@@ -206,7 +207,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         return [Mismatch(label, name, "-", "file", what, "a regular file of the folder", "regular files only")
                 for name, what in odd]
     out = integrity(exp)
-    from ..experiment.tasks import task_file_problems     # kept task files: digests of tasks/manifest.json
+    from fkopt.run.tasks import task_file_problems     # kept task files: digests of tasks/manifest.json
     out += [Mismatch(label, name, "-", "sha256", why, "recorded in tasks/manifest.json", "unchanged since written")
             for name, why in task_file_problems(exp.folder)]
     if config is None:
@@ -231,7 +232,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
         order += ["meta.json"]
         out += compare_folders(label, exp.folder, tmp, rules_for(exp, tier), files=order)
-        from .drift import rerun_verdict_drift   # a claim's verdict must not change either
+        from fkopt.reproduce.drift import rerun_verdict_drift   # a claim's verdict must not change either
         out += rerun_verdict_drift(exp, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -244,7 +245,7 @@ def board_from_answers(label: str, exp: Experiment, config) -> list[Mismatch]:
     themselves are never compared with a rerun's."""
     if getattr(config, "kind", None) != "suite" or getattr(config, "tracks", None) is None:
         return []
-    from ..kinbench.verify import reverify
+    from fkopt.kinbench.verify import reverify
     if config._folder is None and exp.meta.get("config_file"):
         config._folder = Path(exp.meta["config_file"]).parent
     return [Mismatch(label, *row) for row in reverify(exp.folder, config)]
@@ -254,11 +255,11 @@ def missing_claims(exp: Experiment) -> list[Mismatch]:
     """In a results tree written by ``fkopt reproduce`` (REPORT.md at its root), the folder of a
     paper with claims must keep its claims.csv: deleting it would hide the verdicts from check.
     (A single experiment folder copied elsewhere has no REPORT.md beside its paper folder.)"""
-    from . import paper_module
-    from .claims import CLAIMS_FILE
+    from fkopt.reproduce import paper_module
+    from fkopt.reproduce.claims import CLAIMS_FILE
     if not (exp.folder.parents[1] / "REPORT.md").is_file():
         return []
-    from .engine import load
+    from fkopt.reproduce.engine import load
     module = paper_module(exp.paper)
     has_claims = load(exp.paper) is not None or hasattr(module, "claims")
     if not has_claims or (exp.folder.parent / CLAIMS_FILE).is_file():
@@ -271,8 +272,8 @@ def timing_verdicts(exp: Experiment) -> list[Mismatch]:
     """The stored timing verdicts of ``exp``'s paper (``timing_claims.csv``) must be those its stored
     timed runs give. Check's rerun measures no time, so this compares the stored verdicts with the
     stored measurements: on every platform, and it catches an edited timing verdict."""
-    from .claims import TIMING_CLAIMS_FILE, claims_frame
-    from .engine import judge_paper
+    from fkopt.reproduce.claims import TIMING_CLAIMS_FILE, claims_frame
+    from fkopt.reproduce.engine import judge_paper
     file = exp.folder.parent / TIMING_CLAIMS_FILE
     if not file.is_file():
         return []

@@ -185,7 +185,7 @@ def accepted_trace(fitness: np.ndarray, selection: str) -> np.ndarray:
     f = np.asarray(fitness, float)
     if selection != "karaboga" or f.size == 0:
         return f
-    from ..algorithms.abc import quality
+    from fkopt.algorithms.abc import quality
     q = quality(f)
     rose = np.r_[True, q[1:] > np.maximum.accumulate(q)[:-1]]
     idx = np.maximum.accumulate(np.where(rose, np.arange(f.size), 0))
@@ -343,8 +343,8 @@ def read_claims(file: str | Path) -> pd.DataFrame:
     UTF-8, too large, not a CSV or without ``claim`` and ``verdict`` columns is one
     :class:`~fkopt.errors.FkoptError` line naming it."""
     import io
-    from ..errors import FkoptError
-    from ..files import read_text
+    from fkopt.errors import FkoptError
+    from fkopt.files import read_text
     text = read_text(file, MAX_CLAIMS_BYTES)
     try:
         df = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)

@@ -41,8 +41,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from . import paper_module
-from .claims import (ALPHA, CONDITIONAL, HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, Claim, compare, equal_budget,
+from fkopt.reproduce import paper_module
+from fkopt.reproduce.claims import (ALPHA, CONDITIONAL, HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, Claim, compare, equal_budget,
                      faster_claim, first_below, g, missing, p_text, verdict, within_of_final)
 
 CLAIMS_YAML = "claims.yaml"
@@ -220,7 +220,7 @@ def per_run(exp, mod, algo: str, quantity: str, spec: dict) -> tuple[np.ndarray,
     if quantity == "within_1pct_of_final":
         return within_of_final(exp, algo, 0.01)
     if quantity == "log10_change":
-        from .claims import at_iteration
+        from fkopt.reproduce.claims import at_iteration
         a, b = spec["window"]
         f0, f1 = at_iteration(exp, algo, a), at_iteration(exp, algo, b)
         return np.log10(np.maximum(f1, 1e-300)) - np.log10(np.maximum(f0, 1e-300)), None

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .claims import g
+from fkopt.reproduce.claims import g
 
 #: Printed leg lengths of Tab. 3 (m) and the printed pose (m, deg).
 PRINTED_LEGS = (0.750, 0.780, 0.800, 0.900, 0.870, 0.850)
@@ -19,7 +19,7 @@ PRINTED_HALF_UNIT = 5e-7
 
 def _printed_pose_legs() -> pd.DataFrame:
     """Legs of the printed pose under fkopt's model vs the printed legs."""
-    from ..mechanisms.sps6 import SixSPSCMM
+    from fkopt.mechanisms.sps6 import SixSPSCMM
     legs = SixSPSCMM().ik(np.array([PRINTED_POSE]))[0]
     return pd.DataFrame({"leg": [f"l{i + 1}" for i in range(6)], "printed_m": PRINTED_LEGS,
                          "of_printed_pose_m": legs, "difference_um": (legs - np.array(PRINTED_LEGS)) * 1e6})

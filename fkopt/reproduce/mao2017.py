@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .claims import g
+from fkopt.reproduce.claims import g
 
 POSE = {"alpha": 9.0, "beta": 13.0, "z": 622.0}
 PRINTED_ACO = {"alpha": 8.85983, "beta": 13.0018, "z": 621.999}   # Tab. 2's ACO row

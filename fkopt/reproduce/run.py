@@ -2,7 +2,7 @@
 
 :func:`plan` loads and validates every file and checks every output folder before anything
 runs (one bad file: nothing is computed); :func:`run_all` runs them through the one pipeline
-(:func:`fkopt.experiment.kinds.run_config`; each result is written aside and swapped into place;
+(:func:`fkopt.run.pipeline.run_config`; each result is written aside and swapped into place;
 studies keep no task files) and :func:`fkopt.reproduce.report.write_report` writes REPORT.md,
 TIMING.md and index.csv. ``reproduce`` regenerates results by design: a stored result of a
 changed config is replaced (``force``).
@@ -14,9 +14,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from ..errors import FkoptError
-from ..experiment.kinds import load_any, plan_config, prepare_output, run_config
-from ..files import output_folder
+from fkopt.errors import FkoptError
+import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+from fkopt.run.pipeline import config_kind, load_any, plan_config, prepare_output, run_config
+from fkopt.files import output_folder
 
 
 @dataclass
@@ -24,7 +25,7 @@ class Planned:
     path: Path
     config: Any
     tasks: int
-    plan: Any = None       # the validated plan (fkopt.experiment.kinds.plan_config), run as it is
+    plan: Any = None       # the validated plan (fkopt.run.pipeline.plan_config), run as it is
 
 
 @dataclass
@@ -39,7 +40,7 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     configs = Path(configs)
     if not configs.is_dir():
         raise FkoptError(f"--configs: {configs} is not a folder")
-    from .engine import is_claims_file
+    from fkopt.reproduce.engine import is_claims_file
     files = sorted(f for f in configs.rglob("*.yaml") if not is_claims_file(f))   # claims are no experiment
     if not files:
         raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
@@ -87,13 +88,12 @@ def solve_in_parallel(planned: list[Planned], jobs: int,
 
     Only such tasks run there: they are deterministic (each (case, run) has its own stream), so
     the numbers are those of a serial run. Everything measured in seconds that the report judges
-    -- the single-run timing samples of :mod:`fkopt.experiment.timing`, and whole studies and
+    -- the single-run timing samples of :mod:`fkopt.run.timing`, and whole studies and
     assembly searches, whose times are claims -- runs afterwards in this process, one at a
     time, with the workers gone; only the batch's amortised time (``amortised_ms_per_run``, for
     information) is measured in a worker next to another.
     """
-    from ..experiment.executors import execute
-    from ..experiment.kinds import config_kind
+    from fkopt.run.executors import execute
     if jobs <= 1:
         return {}
     items = []
@@ -119,7 +119,7 @@ def solve_in_parallel(planned: list[Planned], jobs: int,
 
 def _run_indexed(pair):
     """Worker: one task of config ``index`` -> (index, (task id, record))."""
-    from ..experiment.tasks import run_remote
+    from fkopt.run.tasks import run_remote
     index, item = pair
     return index, run_remote(item)
 

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..errors import FkoptError
-from ..files import parse_json, read_stored
+from fkopt.errors import FkoptError
+from fkopt.files import parse_json, read_stored
 
 
 @dataclass
@@ -60,7 +60,7 @@ class Experiment:
         """A CSV of the experiment by stem (``summary``) or file name."""
         file = name if name.endswith((".csv", ".csv.gz")) else f"{name}.csv"
         if not (self.folder / file).exists() and (self.folder / f"{file}.gz").exists():
-            file += ".gz"      # trace.csv.gz (fkopt.experiment.traces)
+            file += ".gz"      # trace.csv.gz (fkopt.run.trace)
         # bounded: inside the folder, a regular file, a gzip bomb one line, not the memory
         return pd.read_csv(io.BytesIO(read_stored(self.folder, file)), keep_default_na=True)
 
@@ -124,7 +124,7 @@ class Store:
 
 def mechanism_of(exp_or_name):
     """The mechanism of a stored experiment (from its recorded config), or a registered name's default."""
-    from .. import registry
+    from fkopt import registry
     if isinstance(exp_or_name, str):
         return registry.mechanism_class(exp_or_name)()
     m = exp_or_name.config["mechanism"]

@@ -1,6 +1,6 @@
 """studies: fkopt's own workspace studies (not a paper): many poses, statistics, tracking.
 
-Configs ``configs/studies/*.yaml`` (``kind: study``, see :mod:`fkopt.study`). The "claims"
+Configs ``configs/studies/*.yaml`` (``kind: study``, see :mod:`fkopt.kinds.study`). The "claims"
 below are findings of fkopt's runs, each judged against an expectation stated in advance
 (in the claim's text), from the seed-determined tables only; timing findings are in
 :func:`timing_claims`.
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .claims import Claim, g, missing, verdict
+from fkopt.reproduce.claims import Claim, g, missing, verdict
 
 TITLE = ("fkopt workspace studies: success rates, evaluations-to-target ECDFs and Wilcoxon-Holm "
          "tests over many poses, a 2-D slice heat map, and trajectory tracking with warm starts")

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .claims import compare, g
-from .store import mechanism_of
+from fkopt.reproduce.claims import compare, g
+from fkopt.reproduce.store import mechanism_of
 
 EXAMPLE = {"x": 20.0, "y": 30.0, "theta": 15.0}
 PRINTED_D = {"d1": -14.8355, "d2": 65.3984, "d3": 70.1170}
@@ -27,7 +27,7 @@ def _mechanism(exp=None):
 
 
 def _fitness(mech, target, poses) -> np.ndarray:
-    from ..problems import fk_problem
+    from fkopt.problems import fk_problem
     return fk_problem(mech, mech.ik(np.asarray(target, dtype=float))).fitness(np.asarray(poses, dtype=float))
 
 
@@ -178,7 +178,7 @@ def pheromone_table(exp) -> pd.DataFrame:
 
 
 def _rho(exp) -> float:
-    from .. import registry
+    from fkopt import registry
     for a in exp.config["algorithms"]:
         if a["name"] == "aco":
             return float((a.get("params") or {}).get("rho", registry.algorithm_class("aco").Params().rho))

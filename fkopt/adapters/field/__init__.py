@@ -21,6 +21,8 @@ given (no global RNG); a package whose internal restarts draw from its own RNG s
 packages with only iteration limits (roboticstoolbox) run to their limits -- the clock track
 (:mod:`fkopt.kinbench.clock`) counts any answer later than the timeout as a failure at the timeout.
 
+The wrappers are registered, with their package, track and timing rule, in the one solver
+registry (:data:`fkopt.registry.SOLVERS`; :func:`fkopt.registry.clock_solver` builds one).
 Modules, one per outside package: :mod:`.tracik` (pytracik), :mod:`.rtb`
 (roboticstoolbox-python ``ik_LM``, ``ik_NR``), :mod:`.pin` (pinocchio's CLIK), :mod:`.ikpy`;
 black-box optimisers on :func:`pose_objective` (:class:`BlackBoxIK`, restarts until the
@@ -31,7 +33,6 @@ it decomposes; elsewhere :class:`NotApplicable`); FK of parallel mechanisms: :mo
 """
 from __future__ import annotations
 
-import importlib
 import tempfile
 import time
 from contextlib import contextmanager
@@ -41,33 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import FkoptError
-
-#: name -> (module, class) of every IK wrapper; black-box ones minimise :func:`pose_objective`.
-IK_SOLVERS = {
-    "tracik": ("tracik", "TracIK"),
-    "rtb-ik_LM": ("rtb", "RtbLM"),
-    "rtb-ik_NR": ("rtb", "RtbNR"),
-    "pin-clik": ("pin", "PinCLIK"),
-    "ikpy": ("ikpy", "IkPy"),
-    "cma-es": ("cmaes", "CmaES"),
-    "scipy-lbfgsb": ("lbfgsb", "LBFGSB"),
-    "nevergrad-ngopt": ("nevergrad_ngopt", "NGOpt"),
-    "eaik": ("eaik", "EAIK"),
-    "optik": ("optik", "OptIK"),
-    "pink": ("pink", "Pink"),
-    "pytorch-kinematics": ("torchkin", "TorchIK"),
-}
-#: The outside package each wrapper needs (for the one-line message when it is missing).
-PACKAGES = {"tracik": "pytracik", "rtb-ik_LM": "roboticstoolbox-python", "rtb-ik_NR": "roboticstoolbox-python",
-            "pin-clik": "pin", "ikpy": "ikpy", "cma-es": "cma", "scipy-lbfgsb": "scipy",
-            "nevergrad-ngopt": "nevergrad", "eaik": "eaik",
-            "optik": "optik-py", "pink": "pin-pink", "pytorch-kinematics": "pytorch-kinematics"}
-#: Where each wrapper's package is installed from, when not ``.[field]`` (torch is gigabytes).
-EXTRAS = {"pytorch-kinematics": "torch"}
-#: Wrappers that only see the objective (the black-box track); the others use Jacobians.
-BLACK_BOX = ("cma-es", "scipy-lbfgsb", "nevergrad-ngopt")
-
+from fkopt.errors import FkoptError
 
 class NotApplicable(FkoptError):
     """The package cannot take this arm by design (EAIK on a 7-joint arm): the board shows a
@@ -127,8 +102,8 @@ class ArmURDF:
         """A URDF file as it stands, for files fkopt did not take from a user (example-robot-data's
         robots in ``fkopt bench``): read bounded and refused with one line unless
         :func:`check_expression_free` proves nothing in it would be evaluated."""
-        from ...files import read_text
-        from ...mechanisms.urdf import MAX_URDF_BYTES
+        from fkopt.files import read_text
+        from fkopt.mechanisms.urdf import MAX_URDF_BYTES
         text = read_text(path, MAX_URDF_BYTES, field="urdf geometry.file")
         check_expression_free(text, str(path))
         return cls(text, base_link, tip_link, tuple(joint_names), str(path))
@@ -164,7 +139,7 @@ def arm_urdf(arm) -> ArmURDF:
     (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, names made safe, FK-checked against MuJoCo
     in tests/test_urdf_writer.py), never the robot's own file (module docstring); checked once
     more by :func:`check_expression_free` before any package sees it."""
-    from ...mechanisms.urdf_writer import chain_urdf
+    from fkopt.mechanisms.urdf_writer import chain_urdf
     w = chain_urdf(arm)
     source = f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}"
     check_expression_free(w.text, source)
@@ -187,25 +162,6 @@ class IKAnswers:
     settings: dict = field(default_factory=dict)
 
 
-def make_ik(name: str, arm, *, timeout: float, rng: np.random.Generator) -> FieldIK:
-    """The wrapper ``name`` of :data:`IK_SOLVERS` built on ``arm``; a missing package or an arm the
-    package cannot read is one line (:class:`FkoptError`)."""
-    if name not in IK_SOLVERS:
-        raise FkoptError(f"unknown field solver '{name}'; allowed: {', '.join(IK_SOLVERS)}")
-    module, cls = IK_SOLVERS[name]
-    try:
-        mod = importlib.import_module(f"{__name__}.{module}")
-        return getattr(mod, cls)(arm, timeout=timeout, rng=rng)
-    except ImportError as err:
-        raise FkoptError(f"field solver '{name}' needs {PACKAGES[name]} (pip install -e \".[{EXTRAS.get(name, 'field')}]\"): "
-                         f"{err}") from None
-    except FkoptError:       # NotApplicable included: the caller decides what a cell says
-        raise
-    except Exception as err:     # the outside package refused this arm: one line, not its traceback
-        raise FkoptError(f"field solver '{name}' ({PACKAGES[name]}) cannot read {getattr(arm, 'path', 'this arm')}: "
-                         f"{type(err).__name__}: {str(err).splitlines()[0][:160] if str(err) else ''}") from None
-
-
 def timed1(solver: FieldIK, T: np.ndarray) -> tuple[np.ndarray, float, bool]:
     """One query: joints (NaN when none), wall time (s), the solver's claim."""
     t0 = time.perf_counter()
@@ -226,7 +182,7 @@ def solve(solver: FieldIK, targets: np.ndarray) -> IKAnswers:
 def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
     """Position error (m) and geodesic rotation error (rad) of rows q (k, dof) against one
     target T, from fkopt's FK: shape (k, 2)."""
-    from ...rotations import geodesic_angle
+    from fkopt.numerics.rotations import geodesic_angle
     F = arm.fk_matrix(q_public)
     pe = np.linalg.norm(F[:, :3, 3] - T[:3, 3], axis=-1)
     re = geodesic_angle(soa(F[:, :3, :3]), soa(np.broadcast_to(T[:3, :3], (len(F), 3, 3))))
@@ -234,7 +190,7 @@ def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
 
 
 def soa(R: np.ndarray):
-    """A (..., 3, 3) stack as :data:`fkopt.rotations.Matrix` (nested tuples of arrays)."""
+    """A (..., 3, 3) stack as :data:`fkopt.numerics.rotations.Matrix` (nested tuples of arrays)."""
     return tuple(tuple(R[..., i, j] for j in range(3)) for i in range(3))
 
 
@@ -250,14 +206,14 @@ class BlackBoxIK(FieldIK):
 
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
-        from .restarts import SETTINGS
+        from fkopt.adapters.field.restarts import SETTINGS
         self.settings.update(SETTINGS, objective="|dp|^2 (m^2) + angle^2 (rad^2) on fkopt's FK", ftarget=self.FTARGET)
 
     def search(self, f, x0: np.ndarray, deadline: float) -> tuple[np.ndarray, float]:
         raise NotImplementedError
 
     def solve1(self, T):
-        from .restarts import restart
+        from fkopt.adapters.field.restarts import restart
         f = pose_objective(self.arm, T)
 
         def one(x0, deadline):

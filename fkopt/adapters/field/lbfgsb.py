@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from . import BlackBoxIK
+from fkopt.adapters.field import BlackBoxIK
 
 
 class LBFGSB(BlackBoxIK):

@@ -24,7 +24,7 @@ import warnings
 
 import numpy as np
 
-from . import BlackBoxIK
+from fkopt.adapters.field import BlackBoxIK
 
 
 class NGOpt(BlackBoxIK):

@@ -33,8 +33,8 @@ import warnings
 
 import numpy as np
 
-from ...errors import FkoptError
-from . import FieldIK, NotApplicable, arm_urdf
+from fkopt.errors import FkoptError
+from fkopt.adapters.field import FieldIK, NotApplicable, arm_urdf
 
 
 def optik_version() -> str:

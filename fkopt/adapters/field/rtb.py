@@ -28,8 +28,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from ...errors import FkoptError
-from . import FieldIK, arm_urdf, check_expression_free
+from fkopt.errors import FkoptError
+from fkopt.adapters.field import FieldIK, arm_urdf, check_expression_free
 
 
 def chain_ets(urdf):

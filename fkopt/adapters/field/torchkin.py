@@ -28,13 +28,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import FkoptError
-from . import FieldIK, arm_urdf
+from fkopt.errors import FkoptError
+from fkopt.adapters.field import FieldIK, arm_urdf
 
 
 class TorchIK(FieldIK):
     name = "pytorch-kinematics"
     package = "pytorch-kinematics"
+    extra = "torch"
     TOL, RETRIES = 0.99e-5, 10
 
     def __init__(self, arm, *, timeout, rng):

@@ -1,0 +1,338 @@
+"""``fkopt bench --section ik-one-pose`` and ``--section ik-batch``: ``fkopt.inverse`` on real arms
+beside roboticstoolbox's ETS ``ik_LM`` (C++), the answers of both verified by an FK independent of
+fkopt's: pinocchio's for the URDF arms, roboticstoolbox's ``DHRobot`` for the DH arm.
+
+Arms (:data:`ARMS`): chains of :data:`fkopt.mechanisms.urdf.EXAMPLE_ROBOTS` in example-robot-data
+(Panda, UR3, UR5, UR10, Kinova j2s6s200, xArm7, Unitree Z1, Baxter's two arms, PR2's left arm,
+Romeo's left arm, TIAGo's arm, Talos's left arm, Unitree G1's left arm; 6 and 7 joints) and the
+wang7dof arm (:data:`DH_ARM`): fkopt's DH model ``7dof-arm`` in mm, checked by rtb's ``DHRobot`` of
+the paper's DH table (:data:`fkopt.mechanisms.dh_arm.WANG7DOF`, standard DH, in m), rtb's ETS read
+from ``mechanisms/data/wang7dof.urdf`` (its q1 is continuous there: answers wrapped into
+[-180, 180) deg before the limits are checked). An arm whose rtb ETS disagrees with the check's FK
+when read (iCub's arm: rtb misreads its URDF) or whose check disagrees with fkopt's FK is left out
+with a message.
+
+Per arm ``n`` poses: joints uniform inside the limits (generator seeded per arm), target frame =
+the independent FK of those joints (not fkopt's, not rtb's ETS). Tolerance 1e-6 m and 1e-6 rad for
+both: fkopt gets ``tol=(1e-6, 1e-6)`` in the arm's length unit (1e-3 mm for the DH arm); rtb stops
+at E = 1/2 |e|^2 < tol (e = position error, rotation vector) and gets tol = 1/2 (1e-6)^2, which
+implies both (and is no looser). rtb: ``ilimit=30``, ``slimit=100`` (its defaults),
+``joint_limits=True``, first start q0 uniform in the limits from a seeded generator. An answer
+counts as solved only when the independent FK of it (continuous joints wrapped) is within both
+tolerances of the target and it is inside the limits; neither library's own verdict is counted
+(``ik-batch`` also reports how many of fkopt's answers it called solved but were not).
+
+* ``ik-one-pose``: one pose per call, fkopt (a prepared ``fkopt.InverseSolver(arm, tol=...)``
+  called per pose -- ``fkopt.inverse(arm, pose)``'s answers bit for bit with its per-call set-up
+  done once; the compiled one-pose loop unless ``FKOPT_NUMERICS=numpy``) and rtb alternating query
+  by query in this process (which of the two goes first alternates too), after one warm-up call
+  each (making the solver, numba's cache load and the arm's start table happen there, reported as
+  "first call"). ``fkopt.inverse(arm, pose)`` itself is timed in the same rotation (three callers,
+  each first in turn), reported per arm and as the row "prepared / fkopt.inverse" (the median over
+  arms of the ratio of their median times), with the count of poses where both gave the same joints;
+  and the three again on the first arm with cold caches (16 MB of other memory summed before every
+  call), the row "cold: prepared / fkopt.inverse". Per arm: median ms of each,
+  the ratio of the medians fkopt/rtb, solved fraction of each; then the median ratio over arms and
+  the largest (targets <= 1 and <= 2, issue 29).
+* ``ik-batch``: all ``n`` poses (1000; 200 in quick mode) in one ``fkopt.inverse`` call beside rtb
+  called per pose on the same poses, alternating call by call (best of 2; 1 in quick mode); per
+  arm µs per pose of each and their ratio; median over arms (target <= 0.5, none above 1).
+
+Timings are wall-clock on whatever else the machine is doing: read the ratios, not the times.
+Skipped with a message when roboticstoolbox-python or pinocchio is missing; without
+example-robot-data only the DH arm is measured.
+"""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+
+import numpy as np
+
+ARMS = ("panda", "ur3", "ur5", "ur10", "kinova", "xarm7", "z1", "baxter-left", "baxter-right", "pr2-left",
+        "romeo-left", "tiago", "talos-left", "g1-left", "icub-left", "wang7dof")
+#: Quick mode: a subset (6 and 7 joints, the slowest arms of the last measurement included).
+QUICK_ARMS = ("panda", "ur5", "ur10", "kinova", "xarm7", "romeo-left", "wang7dof")
+#: The DH arm: fkopt's ``7dof-arm`` (mm), checked by rtb's DHRobot of the paper's table.
+DH_ARM = "wang7dof"
+TOL = (1e-6, 1e-6)                # m, rad
+RTB_TOL = 0.5 * TOL[0] ** 2       # E = 1/2 |e|^2 < tol  =>  |e| < 1e-6, both errors below their tolerances
+
+
+class PinocchioFK:
+    """Frame of the tip in the base of an arm's URDF chain by pinocchio's own reader and FK
+    (Carpentier et al., SII 2019): the independent check of every answer here. Continuous joints
+    are pinocchio's (cos, sin) pairs; joints outside the chain stay at pinocchio's neutral."""
+
+    name = "pinocchio FK"
+
+    def __init__(self, arm):
+        import pinocchio as pin
+        self.pin = pin
+        self.model = pin.buildModelFromUrdf(str(arm.path))
+        self.data = self.model.createData()
+        self.base = self.model.getFrameId(arm.base_link, pin.FrameType.BODY)
+        self.tip = self.model.getFrameId(arm.tip_link, pin.FrameType.BODY)
+        js = [self.model.joints[self.model.getJointId(n)] for n in arm.joint_names]
+        self.idx = [(j.idx_q, j.nq) for j in js]
+        self.x0 = self.pin.neutral(self.model)
+
+    def frame(self, q_rad) -> np.ndarray:
+        """4x4 tip-in-base frame at chain joints ``q_rad`` (n,), SI units."""
+        x = self.x0.copy()
+        for (i, nq), v in zip(self.idx, q_rad):
+            if nq == 2:
+                x[i], x[i + 1] = math.cos(v), math.sin(v)
+            else:
+                x[i] = v
+        self.pin.framesForwardKinematics(self.model, self.data, x)
+        return (self.data.oMf[self.base].inverse() * self.data.oMf[self.tip]).homogeneous
+
+
+class DHRobotFK:
+    """Frame of the tip of wang7dof's arm by roboticstoolbox's ``DHRobot`` (Corke and Haviland,
+    ICRA 2021) of the paper's standard DH table (:data:`fkopt.mechanisms.dh_arm.WANG7DOF`, lengths
+    in m): the independent check of fkopt's DH model (its own DH code, in mm)."""
+
+    name = "rtb DHRobot FK"
+
+    def __init__(self):
+        import roboticstoolbox as rtb
+        from fkopt.mechanisms.dh_arm import WANG7DOF
+        self.robot = rtb.DHRobot([rtb.RevoluteDH(a=a / 1000, alpha=math.radians(al), d=d / 1000)
+                                  for a, al, d in zip(WANG7DOF["a"], WANG7DOF["alpha"], WANG7DOF["d"])])
+
+    def frame(self, q_rad) -> np.ndarray:
+        """4x4 tip-in-base frame at joints ``q_rad`` (n,), SI units."""
+        return self.robot.fkine(np.asarray(q_rad, dtype=float)).A
+
+
+def frame_errors(T, Tt) -> tuple[float, float]:
+    """(position error, geodesic rotation error in rad) of frame T against target Tt (4x4):
+    the angle from atan2(|vee(M - M^T)| / 2, (tr M - 1) / 2), M = R^T Rt, accurate near 0."""
+    M = T[:3, :3].T @ Tt[:3, :3]
+    s = 0.5 * math.sqrt((M[2, 1] - M[1, 2]) ** 2 + (M[0, 2] - M[2, 0]) ** 2 + (M[1, 0] - M[0, 1]) ** 2)
+    c = 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)
+    return float(np.linalg.norm(T[:3, 3] - Tt[:3, 3])), math.atan2(s, c)
+
+
+class _Arm:
+    """One arm of the bench: fkopt's model, rtb's ETS, the independent check, poses and targets.
+    ``scale``: the arm's length unit per m (1000 for the DH arm in mm); ``tol``: :data:`TOL` in it."""
+
+    def __init__(self, name, n, seed):
+        from fkopt.adapters.field import ArmURDF
+        from fkopt.adapters.field.rtb import chain_ets
+        from fkopt.mechanisms import urdf
+        self.name = name
+        if name == DH_ARM:
+            from fkopt import mechanism
+            self.m = m = mechanism("7dof-arm")
+            self.check = DHRobotFK()
+            source = ArmURDF.from_file(urdf.DEFAULT_FILE, "link0", "tool")     # fkopt's URDF of the paper's table
+            self.scale = 1000.0
+            self.periodic = mechanism("urdf").periodic_mask()      # the URDF's q1 is continuous
+        else:
+            self.m = m = urdf.example_robot(name)
+            self.check = PinocchioFK(m)
+            # example-robot-data's own file as people use it (not a user's: from_file proves it
+            # holds nothing xacro would evaluate)
+            source = ArmURDF.from_file(m.path, m.base_link, m.tip_link, m.joint_names)
+            self.scale = 1.0
+            self.periodic = m.periodic_mask()
+        self.tol = (TOL[0] * self.scale, TOL[1])
+        self.ets, self.rtb_version = chain_ets(source)
+        rng = np.random.default_rng(seed)
+        self.Q = m.bounds[:, 0] + rng.random((n, m.dof)) * (m.bounds[:, 1] - m.bounds[:, 0])
+        self.T = np.array([self.check.frame(np.radians(q)) for q in self.Q])
+        self.P = m.fk(self.Q)                                  # the same targets as fkopt's poses
+        lo, hi = np.radians(m.bounds[:, 0]), np.radians(m.bounds[:, 1])
+        self.q0 = lo + rng.random((n, m.dof)) * (hi - lo)     # rtb's first start per pose
+
+    def fkopt_frame(self, q_deg) -> np.ndarray:
+        """fkopt's FK of joints (n, dof) in deg, lengths in m."""
+        T = self.m.fk_matrix(q_deg)
+        T[..., :3, 3] /= self.scale
+        return T
+
+    def problem(self) -> str | None:
+        """Why this arm cannot be compared (readers disagree), or None."""
+        m = self.m
+        if self.ets.n != m.dof:
+            return f"{self.name}: rtb's chain has {self.ets.n} joints, fkopt's {m.dof}"
+        q = np.radians(self.Q[0])
+        mine = self.fkopt_frame(self.Q[:1])[0]
+        gap_rtb = np.abs(self.ets.fkine(q).A - self.T[0]).max()
+        gap_check = np.abs(self.T[0] - mine).max()
+        if not gap_check < 1e-9:
+            return f"{self.name}: {self.check.name} differs from fkopt's by {gap_check:.2g} m"
+        if not gap_rtb < 1e-9:
+            return (f"{self.name}: rtb's ETS FK differs from {self.check.name} and fkopt's by {gap_rtb:.2g} "
+                    "(rtb misreads it)")
+        return None
+
+    def rtb(self, k):
+        sol = self.ets.ik_LM(self.T[k], q0=self.q0[k], ilimit=30, slimit=100, tol=RTB_TOL, joint_limits=True)
+        return np.degrees(sol.q if hasattr(sol, "q") else sol[0])
+
+    def verified(self, q_deg, k) -> bool:
+        """The independent check of one answer (deg) to pose k: both tolerances, inside the limits."""
+        q = np.array(q_deg, dtype=float)
+        if not np.isfinite(q).all():
+            return False
+        q[self.periodic] = (q[self.periodic] + 180.0) % 360.0 - 180.0
+        b = self.m.bounds
+        if not ((q >= b[:, 0]) & (q <= b[:, 1])).all():
+            return False
+        pe, re = frame_errors(self.check.frame(np.radians(q)), self.T[k])
+        return pe <= TOL[0] and re <= TOL[1]
+
+
+def _arms(names, n, messages):
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            import pinocchio  # noqa: F401
+            import roboticstoolbox  # noqa: F401
+    except Exception as err:
+        messages.append(f"ik sections skipped: {type(err).__name__}: {err} (pip install roboticstoolbox-python pin)")
+        return []
+    from fkopt.mechanisms import urdf
+    if urdf.example_robots_folder() is None:
+        messages.append("ik sections: example-robot-data not installed (pip install example-robot-data): "
+                        f"the {DH_ARM} arm only")
+        names = [k for k in names if k == DH_ARM]
+    out = []
+    for i, name in enumerate(names):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            a = _Arm(name, n, 2026 + i)
+        why = a.problem()
+        if why:
+            messages.append(f"ik sections: {why}; left out")
+        else:
+            out.append(a)
+    return out
+
+
+def _summary(rows, sec, ratios, target_median, target_max, what):
+    names = list(ratios)
+    r = np.array([ratios[k] for k in names])
+    worst = names[int(np.argmax(r))]
+    rows.add(sec, "median over arms", float(np.median(r)), "x rtb",
+             f"{what}; {len(r)} arms; target <= {target_median}: {'met' if np.median(r) <= target_median else 'NOT met'}")
+    rows.add(sec, "largest", float(r.max()), "x rtb",
+             f"{worst}; target <= {target_max}: {'met' if r.max() <= target_max else 'NOT met'}; "
+             f"arms above: {', '.join(k for k in names if ratios[k] > target_max) or 'none'}")
+
+
+def bench_ik_one_pose(rows, quick: bool, messages: list[str]) -> None:
+    from fkopt.kinematics import solvers as kinematics
+    from fkopt.numerics import path
+    sec = "ik-one-pose"
+    n = 20 if quick else 100
+    arms = _arms(QUICK_ARMS if quick else ARMS, n, messages)
+    if not arms:
+        return
+    fast = path.compiled()
+    ratios, unprepared = {}, {}
+    for a in arms:
+        t = time.perf_counter()
+        solver = kinematics.InverseSolver(a.m, tol=a.tol)     # set-up once, as a control loop would
+        solver(a.P[0])
+        t_first = time.perf_counter() - t
+        a.rtb(0)
+        tf, tr, ti, okf, okr, same = [], [], [], 0, 0, 0
+        for k in range(n):
+            for who in np.roll((0, 1, 2), k % 3):     # solver, rtb, fkopt.inverse: each goes first in turn
+                if who == 0:
+                    t = time.perf_counter()
+                    res = solver(a.P[k])
+                    tf.append(time.perf_counter() - t)
+                    okf += a.verified(res.joints, k)
+                elif who == 1:
+                    t = time.perf_counter()
+                    q = a.rtb(k)
+                    tr.append(time.perf_counter() - t)
+                    okr += a.verified(q, k)
+                else:
+                    t = time.perf_counter()
+                    plain = kinematics.inverse(a.m, a.P[k], tol=a.tol)
+                    ti.append(time.perf_counter() - t)
+            same += bool(np.array_equal(plain.joints, res.joints))
+        f_ms, r_ms, i_ms = float(np.median(tf)) * 1e3, float(np.median(tr)) * 1e3, float(np.median(ti)) * 1e3
+        ratios[a.name] = f_ms / r_ms
+        unprepared[a.name] = i_ms / r_ms
+        rows.add(sec, a.name, f_ms / r_ms, "x rtb",
+                 f"{a.m.dof} joints; fkopt median {f_ms:.3f} ms (mean {np.mean(tf) * 1e3:.3f}), rtb median "
+                 f"{r_ms:.3f} ms (mean {np.mean(tr) * 1e3:.3f}); solved ({a.check.name}, 1e-6 m, 1e-6 rad, limits) "
+                 f"fkopt {okf}/{n}, rtb {okr}/{n}; first call {t_first * 1e3:.0f} ms; fkopt.inverse per call "
+                 f"{i_ms:.3f} ms ({i_ms / r_ms:.2f} x rtb), same joints as the solver {same}/{n}")
+    _summary(rows, sec, ratios, 1, 2, f"ratio of median times per pose, {n} poses per arm, "
+             f"fkopt path {'compiled' if fast is not None else 'numpy'}, rtb {arms[0].rtb_version}")
+    _cold_one_pose(rows, sec, arms[0], min(n, 50))
+    r = np.array([ratios[k] / unprepared[k] for k in ratios])
+    rows.add(sec, "prepared / fkopt.inverse", float(np.median(r)), "x",
+             f"median over arms of the solver's median time per pose over fkopt.inverse's (the same calls, "
+             f"interleaved; range {r.min():.2f}-{r.max():.2f}); fkopt.inverse alone: median "
+             f"{float(np.median(list(unprepared.values()))):.2f} x rtb")
+
+
+#: Bytes summed before each call of the cold measurement: several times a last-level cache.
+EVICT_BYTES = 16 << 20
+
+
+def _cold_one_pose(rows, sec, a, n) -> None:
+    """The three callers of ``ik-one-pose`` on arm ``a`` when the caches are cold, as in a control
+    loop that does other work between its IK calls: before every call a sum over
+    :data:`EVICT_BYTES` of other memory; the three alternate pose by pose, each first in turn.
+    One row: the solver's median time over ``fkopt.inverse``'s, both in ms and over rtb's."""
+    from fkopt.kinematics import solvers as kinematics
+    junk = np.ones(EVICT_BYTES // 8)
+    solver = kinematics.InverseSolver(a.m, tol=a.tol)
+    calls = (lambda k: solver(a.P[k]), lambda k: kinematics.inverse(a.m, a.P[k], tol=a.tol), a.rtb)
+    times = ([], [], [])
+    for k in range(n):
+        for who in np.roll((0, 1, 2), k % 3):
+            junk.sum()
+            t = time.perf_counter()
+            calls[who](k)
+            times[who].append(time.perf_counter() - t)
+    s_ms, i_ms, r_ms = (float(np.median(t)) * 1e3 for t in times)
+    rows.add(sec, "cold: prepared / fkopt.inverse", s_ms / i_ms, "x",
+             f"{a.name}, {n} poses, {EVICT_BYTES >> 20} MB of other memory summed before every call: solver "
+             f"median {s_ms:.3f} ms ({s_ms / r_ms:.2f} x rtb), fkopt.inverse {i_ms:.3f} ms ({i_ms / r_ms:.2f} x rtb), "
+             f"rtb {r_ms:.3f} ms")
+
+
+def bench_ik_batch(rows, quick: bool, messages: list[str]) -> None:
+    from fkopt.kinematics import solvers as kinematics
+    sec = "ik-batch"
+    n = 200 if quick else 1000
+    reps = 1 if quick else 2
+    arms = _arms(QUICK_ARMS if quick else ARMS, n, messages)
+    if not arms:
+        return
+    ratios = {}
+    for a in arms:
+        kinematics.inverse(a.m, a.P[:64], tol=a.tol)              # warm: start table, tree, compile
+        best_f = best_r = np.inf
+        for _ in range(reps):
+            t = time.perf_counter()
+            res = kinematics.inverse(a.m, a.P, tol=a.tol)
+            best_f = min(best_f, time.perf_counter() - t)
+            t = time.perf_counter()
+            qr = [a.rtb(k) for k in range(n)]
+            best_r = min(best_r, time.perf_counter() - t)
+        okf_rows = np.array([a.verified(res.joints[k], k) for k in range(n)])
+        okf = int(okf_rows.sum())
+        lie = int((np.asarray(res.solved, bool) & ~okf_rows).sum())
+        okr = sum(a.verified(qr[k], k) for k in range(n))
+        f_us, r_us = best_f / n * 1e6, best_r / n * 1e6
+        ratios[a.name] = f_us / r_us
+        rows.add(sec, a.name, f_us / r_us, "x rtb",
+                 f"{a.m.dof} joints; fkopt {f_us:.0f} µs/pose in one call of {n}, rtb {r_us:.0f} µs/pose "
+                 f"(one call per pose); best of {reps}; solved ({a.check.name}) fkopt {okf}/{n}, rtb {okr}/{n}; "
+                 f"fkopt reported solved but not: {lie}")
+    _summary(rows, sec, ratios, 0.5, 1, f"µs per pose, fkopt batched ({n} poses) / rtb per pose")

@@ -1,0 +1,1 @@
+"""``kind: assembly``: every real assembly mode of a parallel mechanism (:mod:`.kind`)."""

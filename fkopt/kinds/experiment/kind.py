@@ -1,0 +1,59 @@
+"""Experiments as a kind of the one config pipeline (:mod:`fkopt.run.pipeline`)."""
+from __future__ import annotations
+
+from fkopt.run.memory import algorithm_resources
+from fkopt.solve import batch_bytes, chunk_size
+from fkopt.kinds.experiment.config import ExperimentConfig, experiment_from_dict
+from fkopt.kinds.experiment.runner import experiment_plan, keeps_x_history, merge_experiment
+from fkopt.kinds.experiment import reports
+from fkopt.run.kinds import register
+from fkopt.run.tasks import Kind
+from fkopt.run.trace import trace_table
+from fkopt.run.writers import CURVES, FIGURE, RUNS, STEPS, TABLE, TIMING, Output
+
+# -- experiments -----------------------------------------------------------------------------------
+def _experiment_validate(config, plan) -> int:
+    mech, cases = plan.context.mech, plan.context.cases     # validated by experiment_plan
+    dim, keep_x = len(mech.unknown_names), keeps_x_history(config, mech)
+    need = 0   # every algorithm's records stay in memory until the folder is written: the solves' sum
+    for spec in config.algorithms:
+        pop = spec.population or config.population
+        its = spec.iterations or config.iterations
+        size = chunk_size(len(cases), config.runs, pop, its, dim, batch=config.batch,
+                          snapshots=len(config.snapshots), x_history=keep_x)
+        need += batch_bytes(len(cases) * config.runs, size, pop, its, dim, len(config.snapshots), keep_x)
+        need += algorithm_resources(spec, pop, its, dim)
+    return need
+
+
+def _experiment_merge(config, plan, ran, *, source=None, **_):
+    return merge_experiment(config, plan, ran, source=source)
+
+
+def _experiment_from_dict(data: dict, where: str):
+    if "kind" in data:
+        data = {k: v for k, v in data.items() if k != "kind"}
+    return experiment_from_dict(data, where)
+
+
+#: The files of an experiment's folder, in the order they are written.
+OUTPUTS = (
+    Output("summary.csv", reports.summary_table, TABLE),
+    Output("timing.csv", reports.timing_table, TIMING),
+    Output("timing_runs.csv", reports.timing_runs_table, TIMING),
+    Output("values.csv", reports.values_table, TABLE),
+    Output("inputs.csv", reports.inputs_table, TABLE),
+    Output("runs.csv", reports.runs_table, CURVES, rows=RUNS),
+    Output("trace.csv.gz", trace_table, CURVES, rows=STEPS),
+    Output("convergence.csv", reports.convergence_table, CURVES, rows=STEPS),
+    Output("convergence", reports.convergence_figure, FIGURE),
+    Output("variables", reports.variables_figure, FIGURE),
+    Output("snapshots", reports.snapshot_figures, FIGURE),
+    Output("extras", reports.extras_figure, FIGURE),
+    Output("cases", reports.cases_figures, FIGURE),
+    Output("time", reports.time_figure, FIGURE),
+    Output("position_error", reports.position_error_figure, FIGURE),
+)
+
+EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
+                           _experiment_merge, OUTPUTS, reports.meta, ExperimentConfig))

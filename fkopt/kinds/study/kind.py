@@ -1,0 +1,48 @@
+"""Studies as a kind of the one config pipeline (:mod:`fkopt.run.pipeline`)."""
+from __future__ import annotations
+
+from fkopt.run.memory import algorithm_resources
+from fkopt.kinds.study import reports
+from fkopt.run.kinds import register
+from fkopt.run.tasks import Kind
+from fkopt.run.writers import CURVES, FIGURE, RUNS, STEPS, TABLE, TIMING, Output
+from fkopt.solve import batch_bytes, chunk_size
+from fkopt.kinds.study.config import StudyConfig, study_from_dict
+from fkopt.kinds.study.runner import merge_study, study_plan
+
+
+def _validate(config: StudyConfig, plan) -> int:
+    mech, poses = plan.context.mech, plan.context.poses     # validated by study_plan
+    dim, n = len(mech.unknown_names), len(poses)
+    # rows of one solve: a chunk of poses x runs, or (tracking) the trajectories x runs of a step
+    cases = len(poses.segments) if config.mode == "tracking" else min(config.chunk, n)
+    work = kept = 0
+    for spec in config.algorithms:
+        pop = spec.population or config.population
+        its = spec.iterations or config.iterations
+        size = chunk_size(cases, config.runs, pop, its, dim)      # refuses a solve over the per-solve limit
+        work = max(work, batch_bytes(cases * config.runs, size, pop, its, dim)
+                   + algorithm_resources(spec, pop, its, dim))
+        # kept for every (pose, run): fitness, counts, solution, as JSON task records (~10x)
+        kept += n * config.runs * (dim + 6) * 8 * 10
+    return work + kept
+
+
+#: The files of a study's folder, in the order they are written.
+OUTPUTS = (
+    Output("summary.csv", reports.summary_table, TABLE),
+    Output("timing.csv", reports.timing_table, TIMING),
+    Output("poses.csv", reports.poses_table, CURVES),
+    Output("runs.csv", reports.runs_table, CURVES, rows=RUNS),
+    Output("ecdf.csv", reports.ecdf_of, CURVES, rows=STEPS),
+    Output("stats.csv", reports.stats_of, CURVES),
+    Output("heatmap.csv", reports.heatmap_table, CURVES),
+    Output("tracking.csv", reports.tracking_table, CURVES),
+    Output("tracking_timing.csv", reports.tracking_timing_table, TIMING),
+    Output("ecdf", reports.ecdf_figure, FIGURE),
+    Output("heatmap", reports.heatmap_figure, FIGURE),
+    Output("tracking", reports.tracking_figure, FIGURE),
+    Output("tracking_time", reports.tracking_time_figure, FIGURE),
+)
+
+STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig))
