@@ -812,6 +812,19 @@ def report(results: Path = typer.Argument(Path("results"), help="results root"),
 
 
 @app.command()
+def pages(results: Path = typer.Argument(Path("results"), help="results root, or one suite's folder "
+                                         "(results/kinbench/kinbench-v3-robots)"),
+          figures: bool = typer.Option(True, "--figures/--no-figures", help="also redraw the suites' figures "
+                                       "(ECDFs, clock, scaling) from their stored tables")):
+    """Rewrite every kinbench suite's pages (index.html, arms.html, rankings.html) and figures from
+    its stored tables, config and meta.json: no solver runs, no table is written."""
+    from fkopt.kinbench.pages import regenerate, suite_folders
+    for folder in suite_folders(results):
+        names = regenerate(folder, figures=figures)
+        typer.echo(f"{folder}: {len(names)} files ({', '.join(n for n in names if n.endswith('.html'))})")
+
+
+@app.command()
 def check(results: Path = typer.Argument(Path("results"), help="results root, a paper folder "
                                          "(results/mao2017) or one experiment folder"),
           subset: str = typer.Option("all", "--subset", help="all | ci"),

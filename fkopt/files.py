@@ -32,6 +32,8 @@ Every config file, geometry file and results folder of fkopt goes through this m
   reading, ``.gz`` streamed with a cap on the unpacked size; :func:`read_text`,
   :func:`parse_json` / :func:`read_json` (strict JSON) on top. :func:`odd_entries` lists what a
   results folder must not hold (links, FIFOs, devices).
+* :func:`parse_xml` -- the one XML reader of robot files (URDF, MJCF): nesting bounded by
+  :data:`MAX_XML_DEPTH` while parsing.
 * :func:`file_names` -- collision-free file-name stems for user-given names.
 * :func:`strict_json` and :func:`md_text` -- strict JSON output and Markdown-escaped text.
 * :func:`error_line` -- one line from a pydantic ``ValidationError`` (field path and message).
@@ -245,6 +247,43 @@ def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str |
     except UnicodeDecodeError as err:
         raise FkoptError(f"{_where(Path(path), field)}: not UTF-8 text (byte 0x{data[err.start]:02x} at offset "
                          f"{err.start})") from None
+
+
+#: Deepest element nesting of an XML robot file (URDF, MJCF and every file an MJCF includes):
+#: URDF is 3-4 deep, MJCF nests one body per link (real arms and humanoids: under 40). Checked
+#: while parsing, before any outside library reads the file: TRAC-IK's parser crashed (exit 139)
+#: on a URDF nested 100,000 deep outside the chain.
+MAX_XML_DEPTH = 256
+
+
+def parse_xml(data: bytes | str, where: str, max_depth: int = MAX_XML_DEPTH):
+    """The root element of an XML document (the standard library's parser, streamed), refused
+    with one line naming ``where`` once an element lies deeper than ``max_depth`` (the rest is
+    never parsed) or the XML is malformed."""
+    import xml.etree.ElementTree as ET
+    parser = ET.XMLPullParser(events=("start", "end"))
+    depth, root, step = 0, None, 1 << 16
+
+    def events():
+        nonlocal depth, root
+        for event, element in parser.read_events():
+            if root is None:
+                root = element
+            depth += 1 if event == "start" else -1
+            if depth > max_depth:
+                raise FkoptError(f"{where}: elements nested deeper than {max_depth} levels; refused "
+                                 "before any parser of an outside package reads it")
+    try:
+        for i in range(0, len(data), step):
+            parser.feed(data[i:i + step])
+            events()
+        parser.close()
+        events()
+    except ET.ParseError as err:
+        raise FkoptError(f"{where}: malformed XML ({err})") from None
+    if root is None:
+        raise FkoptError(f"{where}: malformed XML (no element)")
+    return root
 
 
 def parse_json(data: bytes, where: str) -> Any:

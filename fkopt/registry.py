@@ -73,6 +73,7 @@ from fkopt.adapters.field.torchkin import TorchIK
 from fkopt.adapters.field.tracik import TracIK
 from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS
 from fkopt.algorithms.abc import ABC
+from fkopt.algorithms.abc_wang7dof import ABCWang7dof
 from fkopt.algorithms.aco import ACO
 from fkopt.algorithms.base import Algorithm
 from fkopt.algorithms.dls import DLS
@@ -125,6 +126,7 @@ def _field(cls, role=IK, display=""):
 #: their own packages (the library adapters are :data:`ADAPTER_FAMILIES`).
 SOLVERS: dict[str, SolverEntry] = {e.name: e for e in (
     _optimiser("abc", ABC, "black-box", "ABC"),
+    _optimiser("abc-wang7dof", ABCWang7dof, "black-box", "ABC (wang7dof eqs. 7-8)"),   # the ABC as wang7dof prints it
     _optimiser("gabc", GABC, "black-box", "GABC"),
     _optimiser("aco", ACO, "black-box", "ACO"),
     _optimiser("pso", PSO, "black-box", "PSO"),

@@ -847,7 +847,8 @@ def test_a_result_written_meanwhile_by_another_run_is_not_replaced(tmp_path, cli
     computes; meanwhile run B (seed 99) publishes into the same paper/name. A must not replace
     B's result without --force: it is refused at publish time, one line."""
     import contextlib
-    from fkopt.kinds.experiment import kind as experiment_kind, kinds
+    from fkopt.kinds.experiment import kind as experiment_kind
+    from fkopt.run import pipeline as kinds
     from fkopt.run.pipeline import from_dict, run_config
     monkeypatch.setattr(kinds, "run_lock", lambda out, folder: contextlib.nullcontext())
     out = tmp_path / "out"
@@ -889,7 +890,13 @@ def _interrupt(tmp_path, prev, slow, command, how):
     p = subprocess.Popen([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q",
                           "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True, env=env)
-    time.sleep(3.0)                  # imports and validation take about a second; then it computes
+    # interrupt once it computes: its lock file (OUT/<paper>/.<name>.lock) appears after imports and
+    # validation (about a second on an idle machine, far longer on a loaded one), then half a second
+    lock = out / slow["paper"] / f".{slow['name']}.lock"
+    deadline = time.monotonic() + 240
+    while not lock.exists() and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)
     assert p.poll() is None, "the rerun finished before it could be interrupted; make SLOW slower"
     os.killpg(p.pid, how)
     _, err = p.communicate(timeout=60)
@@ -1591,7 +1598,7 @@ def test_leaderboard_md_escapes_what_it_copies(tmp_path):
 def test_disk_full_names_the_file_and_keeps_the_previous_result(victim, tmp_path, cli, monkeypatch):
     import errno
     import pandas as pd
-    import fkopt.files
+    import fkopt.run.writers
     cfg = tmp_path / "e.yaml"
     cfg.write_text(with_(BASE, name="full", runs=1, iterations=2))
     out = tmp_path / "out"
@@ -1605,7 +1612,7 @@ def test_disk_full_names_the_file_and_keeps_the_previous_result(victim, tmp_path
         monkeypatch.setattr(pd.DataFrame, "to_csv", lambda self, path=None, *a, **k: full() if Path(str(path)).name
                             == victim else real(self, path, *a, **k))
     else:
-        monkeypatch.setattr(fkopt.files, "write_json", lambda path, data: full())
+        monkeypatch.setattr(fkopt.run.writers, "write_json", lambda path, data: full())
     line = one_line_error(cli("run", cfg, "--out", out, "-q"), "No space left on device", "previous result is kept")
     assert f"{out / 'test' / 'full' / victim}: cannot write" in line       # the file as the user knows it
     assert snapshot(out) == before

@@ -15,12 +15,19 @@ from fkopt.kinematics import solvers as kinematics
 from fkopt.errors import FkoptError
 from fkopt.mechanisms.urdf import example_robot, example_robots_folder
 from fkopt.numerics import InverseOptions
+from fkopt.run import provenance
 
 HERE = Path(__file__).parent / "inverse_bits"
 sys.path.insert(0, str(HERE))
 from cases import arms, calls  # noqa: E402
 
 RECORDED = json.loads((HERE / "one_pose.json").read_text())
+#: Bit for bit on the platform that recorded them (fkopt.run.provenance's fingerprint); on another
+#: platform numpy's SIMD kernels may round the targets' FK in the last bits, so the answers follow
+#: the cross-platform rule: the same verdict, restarts and Jacobian evaluations, joints within
+#: JOINT_ATOL (deg or m) -- the last-digit differences the recorded solves can show.
+RECORDED_ON = json.loads((HERE / "platform.json").read_text())["fingerprint"]
+JOINT_ATOL = 1e-9
 HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
 
 
@@ -44,6 +51,16 @@ def _split(kw):
     return InverseOptions(**kw), tol, mask, seed, start
 
 
+def _same(got: dict, want: dict) -> bool:
+    """``got == want`` on the recording platform; elsewhere the cross-platform rule above."""
+    if provenance.platform_tier(RECORDED_ON) == provenance.EXACT:
+        return got == want
+    a, b = (np.frombuffer(bytes.fromhex(d["joints"])) for d in (got, want))
+    rest = ("restarts", "evaluations", "solved")
+    return all(got[k] == want[k] for k in rest) and a.shape == b.shape and bool(np.allclose(a, b, rtol=0,
+                                                                                           atol=JOINT_ATOL))
+
+
 def _bits(r):
     return {"joints": np.asarray(r.joints, dtype=float).tobytes().hex(), "restarts": int(r.restarts),
             "evaluations": int(r.evaluations["jacobian"]), "solved": bool(r.solved)}
@@ -59,10 +76,11 @@ def test_solver_and_inverse_give_the_answers_recorded_before_the_solver(all_arms
             options = InverseOptions(**{**options.as_dict(), "compiled": compiled})
             solver = fkopt.InverseSolver(arm, options, tol=tol, mask=mask)
             want = RECORDED[name][k]
-            assert _bits(solver(target, seed=seed, start=start)) == want, (name, k)
-            assert _bits(solver(target, seed=seed, start=start)) == want, (name, k)     # a second call alike
+            first = _bits(solver(target, seed=seed, start=start))
+            assert _same(first, want), (name, k)
+            assert _bits(solver(target, seed=seed, start=start)) == first, (name, k)     # a second call alike
             assert _bits(fkopt.inverse(arm, target, options=options, tol=tol, mask=mask, seed=seed,
-                                       start=start)) == want, (name, k)
+                                       start=start)) == first, (name, k)
     assert {"7dof-arm", "urdf", "mjcf", "mjcf-anchored"} <= seen
 
 

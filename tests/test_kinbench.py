@@ -1,6 +1,7 @@
 """kinbench: suite configs, frozen pose sets, COCO measures, leaderboard files, plug-ins."""
 import hashlib
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -215,8 +216,10 @@ def test_fkopt_suite_writes_the_leaderboard_and_fkopt_check_reruns_it(tmp_path):
     assert len(runs) == 2 * 2 * (4 * 2) * 2     # problems x solvers x (4 sets x 2 poses) x runs
     assert (runs["evaluations"] <= runs["budget"]).all()
     page = (folder / "index.html").read_text()
-    assert "data:image/png;base64," in page and "http://" not in page and "https://" not in page
-    assert "<script src" not in page and "<link" not in page
+    assert "http://" not in page and "https://" not in page and "<script src" not in page and "<link" not in page
+    images = re.findall(r'<img [^>]*src="([^"]+)"', page)          # the figures beside the page, by name
+    assert "ecdf_all.png" in images and all((folder / src).is_file() for src in images)
+    assert "Which solver for which problem class" in page and ">Ranking overall<" in (folder / "rankings.html").read_text()
     assert "## Per track" in (folder / "leaderboard.md").read_text()
     chk = cli("check", folder)
     assert chk.returncode == 0, chk.stdout + chk.stderr

@@ -127,7 +127,8 @@ def test_a_subset_suite_writes_one_board_per_subset(written):
         in md.split("## ERT ratio to the virtual best solver")[1]      # pso beside gabc; lm alone in its track: none
     assert "Boards: each compares only the solvers that ran every cell" in md
     page = (folder / "index.html").read_text()
-    assert "board:swarms/overall" in page and "Boards: each compares" in page and "data:image/png;base64," in page
+    assert "Boards: each compares" in page and 'src="ecdf_full_all.png"' in page
+    assert "Ranking board:swarms/overall" in (folder / "rankings.html").read_text()
     assert json.loads((folder / "meta.json").read_text())["config"]["subsets"][0]["name"] == "swarms"
 
 

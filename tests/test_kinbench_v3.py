@@ -125,7 +125,9 @@ def test_a_suite_with_tracks_writes_the_robot_board_and_every_answer(tmp_path):
     assert any("fkopt.inverse" in line and "success 100 / 100 / 100 / 100 %" in line for line in lines)
     assert "Per robot, on the clock" in (folder / "leaderboard.md").read_text()
     page = (folder / "index.html").read_text()
-    assert page.index("Per robot, on the clock") < page.index('alt="clock_ur5"') < page.index("<h2>overall")
+    assert page.index("Which solver for my arm") < page.index("Summary per solver") < page.index('alt="clock_all"')
+    arms = (folder / "arms.html").read_text()
+    assert arms.index('id="arm-ur5"') < arms.index('alt="clock_ur5"') < arms.index('id="arm-panda"')
     assert (folder / "clock_panda.png").exists() and (folder / "clock_panda.pdf").exists()
 
 
@@ -246,14 +248,14 @@ def fk_submission(tmp_path, make_rows):
     return load_suite(path), arms
 
 
-def least_squares_rows(mech, generating, starts=4):
+def least_squares_rows(mech, generating, starts=4, seed=7):
     """The outside artefact: scipy.optimize.least_squares (trf, its defaults but tolerances 1e-15)
     on each frozen query's leg lengths, from ``starts`` random starts in the mechanism's bounds
     (seeded), the first start's wall time as the answer's and the second's as the reference's
     (scipy least_squares is the FK reference), the pose of the smallest residual returned."""
     import time
     from scipy.optimize import least_squares
-    rng = np.random.default_rng(7)
+    rng = np.random.default_rng(seed)
     lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
     rows = []
     for i, x in enumerate(generating):
@@ -285,7 +287,16 @@ def test_fk_answers_of_scipy_least_squares_submitted_are_verified_by_the_mechani
     SPOILT = 2
 
     def rows(mech, generating):
-        df = least_squares_rows(mech, generating)
+        # scipy's seeded starts must reach the generating pose once and another assembly mode once
+        # (both counts are tested below); which seeds do depends on the platform's LAPACK, so the
+        # first seed from 7 that does is taken
+        for seed in range(7, 47):
+            df = least_squares_rows(mech, generating, seed=seed)
+            keep = df.index != SPOILT
+            near = np.linalg.norm(df[[f"x{d}" for d in range(3)]].to_numpy() - generating[:, :3], axis=1) <= 1e-6
+            solved = df["residual_by_scipy"].to_numpy() <= 1e-5
+            if (near & keep).any() and (solved & ~near & keep).any():
+                break
         made["scipy"] = df.copy()
         df.loc[SPOILT, "x0"] += 1e-3                # Dietmaier's platform is in m: 1 mm off, claimed
         df.loc[SPOILT, "claimed"] = True
@@ -388,7 +399,7 @@ def test_a_missing_field_package_is_one_line_naming_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "pytracik", None)          # import pytracik -> ImportError
     with pytest.raises(FkoptError, match=r"field solver 'tracik' needs pytracik \(pip install -e \"\.\[field\]\"\)"):
         make_ik("tracik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
-    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: tracik, rtb-ik_LM"):
+    with pytest.raises(FkoptError, match="unknown field solver 'trac-ik'; allowed: fkopt.inverse, tracik, rtb-ik_LM"):
         make_ik("trac-ik", ur5(), timeout=0.005, rng=np.random.default_rng(0))
 
 

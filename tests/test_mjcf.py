@@ -100,6 +100,9 @@ def test_unknown_body_tendon_and_uncompilable_file_are_one_line(tmp_path):
     with pytest.raises(FkoptError, match="tendon equality"):
         fkopt.mechanism("mjcf", file=str(f))
     f.write_text("<mujoco><worldbody>")
+    with pytest.raises(FkoptError, match="malformed XML"):          # fkopt's bounded parser, before MuJoCo
+        fkopt.mechanism("mjcf", file=str(f))
+    f.write_text('<mujoco><worldbody><body><joint type="bogus"/></body></worldbody></mujoco>')
     with pytest.raises(FkoptError, match="MuJoCo cannot compile"):
         fkopt.mechanism("mjcf", file=str(f))
 

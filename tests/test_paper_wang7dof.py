@@ -33,7 +33,8 @@ def _config(stem):
 
 def test_configs_validate_and_cover_the_paper():
     names = {p.stem for p in CONFIGS}
-    assert set(info("wang7dof")["experiments"]) == names == {"tab2_tab3_fig5_fig6", "pso_eq10", "fig7", "baselines"}
+    assert set(info("wang7dof")["experiments"]) == names == {"tab2_tab3_fig5_fig6", "abc_printed", "pso_eq10", "fig7",
+                                                            "baselines"}
     assert PAPERS["wang7dof"] == "fkopt.reproduce.wang7dof"
     for path in CONFIGS:
         cfg = load_config(path)
@@ -125,8 +126,33 @@ def test_claims_and_report_run_on_small_results(small_results):
     assert "reconstructed PSO (constriction)" in other.condition and "lower_pso" in other.numbers
     assert "position error" in precise.text
     timing = _timing("wang7dof", store)
-    assert len(timing) == 8 and all(c.verdict.removeprefix("conditional: ") in (HELD, NOT_HELD, WITHIN_NOISE)
+    assert len(timing) == 10 and all(c.verdict.removeprefix("conditional: ") in (HELD, NOT_HELD, WITHIN_NOISE)
                                     for c in timing)
     report, timing, _ = build_report(small_results)
     assert "## wang7dof" in report and "printed joint solutions" in report
     assert "objective `paper`" in report
+
+
+def test_the_abc_as_printed_moves_by_phi_in_0_1_and_picks_onlookers_on_1_over_f():
+    """wang7dof eq. (7): v = x + phi (x - x_k), phi = rand(0, 1), from ABC's own draw phi' = 2u - 1; eq. (8):
+    the onlooker roulette on 1/f (a source of f = 0 takes every onlooker). A different algorithm from
+    fkopt's ABC on the same seed, and reproducible."""
+    from fkopt.algorithms.abc_wang7dof import ABCWang7dof
+    from fkopt.registry import algorithm_class
+    from fkopt.solve import solve
+    from fkopt.numerics.streams import RunStreams
+    from types import SimpleNamespace
+    algo = algorithm_class("abc-wang7dof")()
+    assert isinstance(algo, ABCWang7dof) and algo.compiled_rule() is None
+    xs, xk, phi = np.array([[1.0, 2.0]]), np.array([[0.0, 4.0]]), np.array([[-1.0, 0.5]])
+    np.testing.assert_array_equal(algo.move(None, xs, xk, None, phi, None), [[1.0, 2.0 - 0.75 * 2.0]])
+    state = SimpleNamespace(f=np.array([[4.0, 1.0, 2.0, 0.0], [1.0, 1.0, 1.0, 1e12]]))
+    picked = algo._choose_sources(state, None, RunStreams(7, [0, 1]))
+    assert (picked[0] == 3).all()                                   # f = 0: every onlooker
+    assert set(np.unique(picked[1])) <= {0, 1, 2}                   # 1/f of 1e12: ~never
+    mech = SevenDofArm()
+    pr = ik_problem(mech, mech.fk(TARGET[None])[0], objective="paper")
+    kw = dict(population=20, iterations=30, runs=3, seed=5)
+    printed, again, fkopts = solve(pr, "abc-wang7dof", **kw), solve(pr, "abc-wang7dof", **kw), solve(pr, "abc", **kw)
+    np.testing.assert_array_equal(printed.fitness, again.fitness)
+    assert not np.array_equal(printed.fitness, fkopts.fitness)

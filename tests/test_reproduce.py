@@ -259,6 +259,8 @@ def test_edits_of_path_dependent_rows_and_of_runs_are_caught_in_every_tier(tmp_p
     import pandas as pd
     dst = tmp_path / "results" / "chang2024"
     shutil.copytree(RESULTS / "chang2024" / "baselines", dst / "baselines")
+    # an experiment the paper's claims are judged on: the tree has verdicts of chang2024, so a claims.csv
+    shutil.copytree(RESULTS / "chang2024" / "tab1_fig7", dst / "tab1_fig7")
     folder = dst / "baselines"
     summary = pd.read_csv(folder / "summary.csv")
     row = int(summary.index[summary["algorithm"] == "lm"][0])
@@ -344,15 +346,15 @@ def test_an_edited_timing_verdict_is_caught_on_any_platform(tmp_path):
     """Stored timing verdicts must be those of the stored timed runs (check measures no time)."""
     import pandas as pd
 
-    from fkopt.reproduce.check import timing_verdicts
+    from fkopt.reproduce.check import verdict_files
     shutil.copytree(RESULTS / "mao2017", tmp_path / "results" / "mao2017")
     exp = Store(tmp_path / "results").get("mao2017", "tab6")
-    assert timing_verdicts(exp) == []
+    assert verdict_files(exp) == []
     file = tmp_path / "results" / "mao2017" / "timing_claims.csv"
     df = pd.read_csv(file, keep_default_na=False)
     df.loc[0, "verdict"] = "not held" if df.loc[0, "verdict"] != "not held" else "held"
     df.to_csv(file, index=False)
-    bad = timing_verdicts(exp)
+    bad = verdict_files(Store(tmp_path / "results").get("mao2017", "tab6"))
     assert [(m.file, m.column) for m in bad] == [("timing_claims.csv", "verdict")]
     assert "every platform" in bad[0].rule
 

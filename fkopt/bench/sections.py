@@ -666,7 +666,7 @@ def bench_cli_process(rows: _Rows, quick: bool) -> None:
 
 #: The compiled reference of section ``cases``: the same GABC on the same 3-RPS fitness as a plain
 #: C loop (one run after the other), compiled with the system's C compiler when the bench runs.
-REFERENCE_C = Path(__file__).parent / "bench_ref" / "gabc_3rps.c"
+REFERENCE_C = Path(__file__).parent / "ref" / "gabc_3rps.c"
 #: Compiler flags tried in order (the first that compiles is used).
 REFERENCE_FLAGS = (("-O3", "-march=native"), ("-O2",))
 

@@ -37,7 +37,7 @@ OUTPUTS = (
     Output("scaling", reports.scaling_figures, FIGURE),
     Output("clock", reports.clock_figures, FIGURE),
     Output("leaderboard.md", reports.leaderboard_markdown, FIGURE),   # never compared
-    Output("index.html", reports.html_page, FIGURE),                  # inlines the figures
+    Output("index.html", reports.html_page, FIGURE),     # and arms.html, rankings.html (kinbench.pages)
 )
 
 SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig))

@@ -155,14 +155,69 @@ def robots_board_table(sr) -> pd.DataFrame | None:
     return board[lead + [c for c in board.columns if c not in lead]].reset_index(drop=True)
 
 
-def spread_labels(ys, gap: float) -> list[float]:
-    """Label heights near ``ys`` at least ``gap`` apart (in the order of ``ys``), so that the
-    names at the right end of ECDF lines that end together do not overlap."""
+def spread_labels(ys, gap: float, lo: float = -np.inf, hi: float = np.inf) -> list[float]:
+    """Label heights near ``ys`` at least ``gap`` apart (in the order of ``ys``) and inside
+    [``lo``, ``hi``], so that the names at the right end of ECDF lines that end together overlap
+    neither each other nor, above the axes, the title (too many names for the span: evenly spread
+    over it)."""
+    ys = np.asarray(ys, dtype=float)
+    if len(ys) == 0:
+        return []
     order = np.argsort(ys, kind="stable")
-    out = np.asarray(ys, dtype=float).copy()
-    for a, b in zip(order[:-1], order[1:]):
+    if np.isfinite(hi) and np.isfinite(lo) and len(ys) > 1:
+        gap = min(gap, (hi - lo) / (len(ys) - 1))
+    out = np.clip(ys, lo, hi)
+    for a, b in zip(order[:-1], order[1:]):          # upwards, apart
         out[b] = max(out[b], out[a] + gap)
+    if out[order[-1]] > hi:                           # pushed past the top: back down, apart
+        out[order[-1]] = hi
+        for a, b in zip(order[::-1][:-1], order[::-1][1:]):
+            out[b] = min(out[b], out[a] - gap)
     return out.tolist()
+
+
+def end_labels(ax, ends, gap: float = 0.045, lo: float = 0.0, hi: float = 1.0) -> None:
+    """Name each line at its right end (COCO), ``ends`` = [(name, x, y, colour)], the names
+    spread apart inside the axes' height (:func:`spread_labels`), clear of title and legend."""
+    for (name, x_end, _, color), y in zip(ends, spread_labels([e[2] for e in ends], gap, lo, hi)):
+        ax.annotate(name, (x_end, y), xytext=(4, 0), textcoords="offset points", fontsize=7, color=color,
+                    va="center", annotation_clip=False)
+
+
+def wrapped_title(ax, text: str, width: int = 72) -> None:
+    """The title in lines of at most ``width`` characters (a long one ran past the figure)."""
+    import textwrap
+    ax.set_title("\n".join(textwrap.wrap(text, width)), fontsize=8)
+
+
+def legend_below(ax, fontsize: int = 7) -> None:
+    """The legend (the tracks' line styles) under the x-axis label, in columns: the right
+    margin is the lines' end labels'."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=min(3, len(handles)),
+                  borderaxespad=0.0, fontsize=fontsize)
+
+
+def pooled_clock_curves(answers: pd.DataFrame, clock) -> tuple[list, float, int]:
+    """Per solver over every IK arm at the largest timeout: the sorted times (ms) of answers
+    right at the board's rung within the timeout, and the number of queries it was given;
+    the virtual best (per query the fastest right answer of any solver) last."""
+    from fkopt.kinbench.clock import rung_success
+    ik = answers
+    if "leg_residual" in answers:           # FK of parallel mechanisms: another ladder of timeouts
+        fk = answers.groupby("robot", sort=False)["leg_residual"].transform(lambda v: v.notna().any())
+        ik = answers[~fk.to_numpy(bool)]
+    t = max(clock.timeouts_ms)
+    a = ik[(ik["given_timeout_ms"].isna() | (ik["given_timeout_ms"] == t)) & (ik["source"] == "run")]
+    ok = rung_success(a)[:, clock.rung] & (a["seconds"].to_numpy() <= t / 1e3)
+    a = a.assign(_ms=np.where(ok, 1e3 * a["seconds"].to_numpy(), np.inf))
+    curves = []
+    for solver, g in a.groupby("solver", sort=False):
+        per_query = g.groupby(["robot", "query"])["_ms"].min()
+        curves.append((solver, per_query, g["robot"].nunique()))
+    curves.append(("virtual best", a.groupby(["robot", "query"])["_ms"].min(), a["robot"].nunique()))
+    return curves, t, a["robot"].nunique()
 
 
 def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
@@ -172,6 +227,7 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     any solver run here), the timeout marked; names at the right end, spread apart."""
     from fkopt.run.plotting import plt, save
     from fkopt.kinbench.clock import rung_success
+    from fkopt.kinbench.html import rung_words
     from fkopt.kinbench.physical import LADDER, rung_label
     answers = tables.get("answers.csv.gz")
     if answers is None or answers.empty:
@@ -179,7 +235,7 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     clock = sr.config.tracks.clock
     pyplot = plt()
     names = []
-    stems = file_names(answers["robot"].unique())        # two distinct robots never share a file
+    stems = file_names(answers["robot"].unique(), reserved=("all",))   # distinct robots, and clock_all
     for robot, a in answers.groupby("robot", sort=False):
         fk = a["leg_residual"].notna().any()
         t = max(clock.fk_timeouts_ms if fk else clock.timeouts_ms)
@@ -188,32 +244,47 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
         ok = rung_success(a)[:, clock.rung] & (a["seconds"].to_numpy() <= t / 1e3)
         ms = np.where(ok, 1e3 * a["seconds"].to_numpy(), np.inf)
         a = a.assign(_ms=ms)
-        fig, ax = pyplot.subplots(figsize=(5.6, 3.6))
-        ends = []
-        curves = [(solver, g.groupby("query")["_ms"].min()) for solver, g in a.groupby("solver", sort=False)]
-        curves.append(("virtual best", a.groupby("query")["_ms"].min()))
-        for solver, per_query in curves:
-            x = np.sort(per_query.to_numpy())
-            x = x[np.isfinite(x)]
-            y = np.arange(1, len(x) + 1) / n
-            xs, ys = np.concatenate([[1e-3], x, [t]]), np.concatenate([[0.0], y, [y[-1] if len(y) else 0.0]])
-            style = {"color": "black", "linestyle": ":"} if solver == "virtual best" else {}
-            line, = ax.step(xs, ys, where="post", **style)
-            ends.append((solver, ys[-1], line.get_color()))
-        for (solver, _, color), y in zip(ends, spread_labels([e[1] for e in ends], 0.045)):
-            ax.annotate(solver, (t, y), xytext=(4, 0), textcoords="offset points", fontsize=7, color=color,
-                        va="center", annotation_clip=False)
-        ax.axvline(t, color="grey", linewidth=0.8)
-        ax.set_xscale("log")
-        ax.set_xlim(1e-2, t * 1.05)
-        ax.set_ylim(-0.02, 1.02)
-        ax.set_xlabel(f"time to an answer (ms); timeout {t:g} ms marked")
-        ax.set_ylabel(f"share of {n} queries")
-        ax.set_title(f"{sr.config.name}: {robot}, answers at {rung_label(LADDER[clock.rung])} (kinbench's FK)",
-                     fontsize=8)
+        curves = [(solver, g.groupby("query")["_ms"].min(), n) for solver, g in a.groupby("solver", sort=False)]
+        curves.append(("virtual best", a.groupby("query")["_ms"].min(), n))
+        fig = _clock_figure(pyplot, curves, t, f"share of {n} queries",
+                            f"{sr.config.name}: {robot}, answers right at {rung_words(rung_label(LADDER[clock.rung]))} "
+                            "(kinbench's FK)")
         names += save(fig, folder / f"clock_{stems[robot]}.png")
         pyplot.close(fig)
+    curves, t, arms = pooled_clock_curves(answers, clock)
+    if arms:
+        curves = [(solver if n_arms == arms else f"{solver} ({n_arms} arms)", per_query, len(per_query))
+                  for solver, per_query, n_arms in curves]
+        fig = _clock_figure(pyplot, curves, t, "share of the queries it was given",
+                            f"{sr.config.name}: IK of all {arms} arms, answers right at "
+                            f"{rung_words(rung_label(LADDER[clock.rung]))} (kinbench's FK)")
+        names += save(fig, folder / "clock_all.png")
+        pyplot.close(fig)
     return names
+
+
+def _clock_figure(pyplot, curves, t: float, ylabel: str, title: str):
+    """One clock ECDF: per (name, per-query time in ms (inf: no right answer), queries) a step
+    line of the share answered against the time (log), named at its right end."""
+    fig, ax = pyplot.subplots(figsize=(5.6, 3.6))
+    ends = []
+    for solver, per_query, n in curves:
+        x = np.sort(per_query.to_numpy())
+        x = x[np.isfinite(x)]
+        y = np.arange(1, len(x) + 1) / n
+        xs, ys = np.concatenate([[1e-3], x, [t]]), np.concatenate([[0.0], y, [y[-1] if len(y) else 0.0]])
+        style = {"color": "black", "linestyle": ":"} if solver.startswith("virtual best") else {}
+        line, = ax.step(xs, ys, where="post", **style)
+        ends.append((solver, t, ys[-1], line.get_color()))
+    end_labels(ax, ends)
+    ax.axvline(t, color="grey", linewidth=0.8)
+    ax.set_xscale("log")
+    ax.set_xlim(1e-2, t * 1.05)
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel(f"time to an answer (ms); timeout {t:g} ms marked")
+    ax.set_ylabel(ylabel)
+    wrapped_title(ax, title)
+    return fig
 
 
 def board_top_lines(folder: Path, top: int = 3) -> list[str]:
@@ -260,7 +331,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
     named at its right end as COCO does; tracks told apart by line style."""
-    from fkopt.run.plotting import legend_off_data, plt, save
+    from fkopt.run.plotting import plt, save
     df = tables.get("ecdf.csv")
     if df is None or df.empty:
         return []
@@ -297,10 +368,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
                 {"linestyle": styles.get(track, "-")}
             line, = ax.step(x, y, where="post", label=f"{solver} ({track})" if track != "best" else solver, **style)
             ends.append((solver, x[-1], y[-1], line.get_color()))
-        # names at the right end (COCO), spread apart where lines end together
-        for (solver, x_end, _, color), y in zip(ends, spread_labels([e[2] for e in ends], 0.045)):
-            ax.annotate(solver, (x_end, y), xytext=(3, 0), textcoords="offset points", fontsize=7, color=color,
-                        va="center", annotation_clip=False)
+        end_labels(ax, ends)          # names at the right end (COCO), apart, inside the axes' height
         ax.axvline(np.log10(top), color="grey", linewidth=0.8)     # the budget
         ax.set_xlabel(f"log10(evaluations / dimension); budget {top:g} x dimension marked")
         ax.set_ylabel("fraction of (problem, pose, target, run)")
@@ -309,8 +377,8 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         what = "all problems" if within == "all" else within.split(":", 1)[1]
         if board is not None:
             what = f"board {board} (the cells all its solvers ran), {what}"
-        ax.set_title(f"{sr.config.name}: {what}; targets {targets}", fontsize=8)
-        legend_off_data(ax, fontsize=7)
+        wrapped_title(ax, f"{sr.config.name}: {what}; targets {targets}")
+        legend_below(ax)
         stem = "ecdf_all" if scope == "all" else f"ecdf_{stems[short(scope)]}"
         names += save(fig, folder / f"{stem}.png")
         pyplot.close(fig)
@@ -496,54 +564,11 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
 
 
 def html_page(sr, folder: Path, tables: dict) -> list[str]:
-    """index.html: the leaderboards (sortable), the ECDF figures inline, the per-problem tables."""
-    import html
-    from fkopt.kinbench.html import img, page, table_html
-    lb = tables.get("leaderboard.csv")
-    if lb is None:
-        return []
-    c = sr.config
-    cols = leaderboard_columns(lb)
-    body = [f"<h1>{html.escape(c.title or c.name)}</h1>",
-            f"<p>{html.escape(preamble(c))} Click a column header to sort.</p>"]
-    robots = tables.get("leaderboard-robots.csv")
-    if robots is not None:
-        body += ["<h2>Per robot, on the clock</h2>", f"<p>{html.escape(ROBOTS_PREAMBLE)}</p>",
-                 table_html(robots, robot_columns(robots), "robots")]
-        body += [img(p) for p in sorted(folder.glob("clock_*.png"))]
-    if c.subsets:
-        body.append(f"<p>{html.escape(boards_preamble(c))}</p>")
-    for k, (scope, g) in enumerate(leaderboard_sections(tables)):
-        body += [f"<h2>{html.escape(scope)}</h2>", table_html(g, cols, "leaderboard" if k == 0 else f"lb-{k}")]
-    ratios = ert_ratio_sections(tables)
-    if ratios:
-        body += ["<h2>ERT ratio to the virtual best solver</h2>", f"<p>{html.escape(ERT_RATIO_NOTE)}</p>"]
-        for k, (scope, g) in enumerate(ratios):
-            body += [f"<h3>{html.escape(scope)}</h3>", table_html(g, list(g.columns), f"er-{k}")]
-    figs = sorted(folder.glob("ecdf_*.png"))
-    if figs:
-        body += ["<h2>Runtime distributions (ECDF)</h2>"] + [img(p) for p in figs]
-    sc = tables.get("scaling.csv")
-    if sc is not None:
-        target = scaling_target(c.targets)
-        body.append(f"<h2>Cost against dimension (target {target:.0e})</h2>")
-        body += [img(p) for p in sorted(folder.glob("scaling_*.png"))]
-        by = ["board", "class"] if "board" in sc.columns else "class"
-        for k, (cls, g) in enumerate(sc[np.isclose(sc["target"], target)].groupby(by, sort=True)):
-            name = "/".join(cls) if isinstance(cls, tuple) else cls
-            body += [f"<h3>{html.escape(name)}</h3>", table_html(g, SCALING, f"sc-{k}")]
-    ms = tables.get("measures.csv")
-    if ms is not None and "board" in ms.columns:
-        # every problem on every board is ~5 MB of HTML tables for kinbench v3 (92 problems): the
-        # page keeps to the boards and figures, the per-problem tables are in leaderboard.md
-        body += ["<h2>Per problem</h2>", "<p>Success rate and ERT per board, problem, set, solver and target: "
-                 "measures.csv and the per-problem section of leaderboard.md.</p>"]
-    elif ms is not None:
-        body.append("<h2>Per problem</h2>")
-        for k, (problem, g) in enumerate(ms.groupby("problem", sort=False)):
-            body += [f"<h3>{html.escape(problem)}</h3>", table_html(g, PER_PROBLEM, f"pp-{k}")]
-    (folder / "index.html").write_text(page(f"{c.name} leaderboard", body), encoding="utf-8")
-    return ["index.html"]
+    """index.html and its detail pages (:mod:`fkopt.kinbench.pages`): which solver per arm family
+    or problem class, the summary per solver, the figures, every entry's settings, the machine's
+    load; per-arm tables and every ranking on pages of their own."""
+    from fkopt.kinbench.pages import write_pages
+    return write_pages(sr, folder, tables)
 
 
 def meta(sr) -> dict:

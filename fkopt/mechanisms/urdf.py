@@ -40,7 +40,7 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from fkopt.errors import FkoptError, did_you_mean
-from fkopt.files import MAX_MAGNITUDE, check_geometry_file, read_input, short_token
+from fkopt.files import MAX_MAGNITUDE, check_geometry_file, parse_xml, read_input, short_token
 from fkopt.numerics.chain import frame_jacobian1, from_terms
 from fkopt.mechanisms.base import FrameArm, Geometry, describe_validation_error
 
@@ -68,9 +68,20 @@ def _floats(text, count: int, default, what: str, path: Path) -> tuple:
         values = ()
     if len(values) != count or not all(map(math.isfinite, values)):
         raise FkoptError(f"urdf {path}: malformed URDF ({what}: expected {count} numbers, got '{short_token(text)}')")
+    return check_numbers(values, what, f"urdf {path}")
+
+
+def check_numbers(values, what: str, where: str) -> tuple[float, ...]:
+    """The rule every number of a robot file meets (URDF's, and MJCF's as MuJoCo compiled it):
+    finite and |v| <= :data:`MAX_URDF_VALUE` (m, rad); else one line naming ``where`` (format
+    and file) and ``what`` (element and field). Checked before any cast or product."""
+    values = tuple(float(v) for v in values)
+    shown = short_token(" ".join(f"{v:g}" for v in values))
+    if not all(map(math.isfinite, values)):
+        raise FkoptError(f"{where}: {what}: {shown} is not finite; a robot file's numbers must be")
     if any(abs(v) > MAX_URDF_VALUE for v in values):
-        raise FkoptError(f"urdf {path}: {what}: {short_token(text)} is past the bound |v| <= {MAX_URDF_VALUE:g} "
-                         "(m, rad) accepted for a URDF number")
+        raise FkoptError(f"{where}: {what}: {shown} is past the bound |v| <= {MAX_URDF_VALUE:g} "
+                         "(m, rad) accepted for a robot file's number")
     return values
 
 
@@ -94,12 +105,12 @@ def load_urdf(path: Path) -> SimpleNamespace:
     naming the file. ``name``: the robot's; each joint keeps its XML ``element`` too (the cutter of
     kinbench's robot copies, :func:`fkopt.kinbench.robots.cut_urdf`, copies its attribute strings
     verbatim)."""
-    import xml.etree.ElementTree as ET
     check_geometry_file(path, "urdf", MAX_URDF_BYTES, "a URDF file")
+    data = read_input(path, MAX_URDF_BYTES, field="urdf geometry.file")
     try:
-        root = ET.fromstring(read_input(path, MAX_URDF_BYTES, field="urdf geometry.file"))
-    except ET.ParseError as err:
-        raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
+        root = parse_xml(data, f"urdf {path}")           # nesting bounded (MAX_XML_DEPTH)
+    except FkoptError as err:
+        raise FkoptError(str(err).replace("malformed XML", "malformed URDF")) from None
     links = {e.get("name"): e for e in root.findall("link")}
     if root.tag != "robot" or not links or None in links:
         raise FkoptError(f"urdf {path}: malformed URDF (no <robot> with named links)")
@@ -283,6 +294,10 @@ class URDFArm(FrameArm):
             if j.mimic is None:
                 names.append(j.name)
                 units.append("m" if j.type == "prismatic" else "deg")
+        from collections import Counter
+        twice = sorted(n for n, c in Counter(j.name for j in moving).items() if c > 1)
+        if twice:      # two joints answering to one name: one answer column would stand for both
+            raise FkoptError(f"{self.name} {path}: two joints of the chain are named '{twice[0]}'; names must be unique")
         index = {n: i for i, n in enumerate(names)}
         to_si = [math.pi / 180.0 if u == "deg" else 1.0 for u in units]
 

@@ -20,8 +20,9 @@ results folder ``<paper>/<name>/``:
    (``tier=`` forces one: ``fkopt check --tolerant`` is the "blas" tier); the rerun takes the
    numerics mode recorded in ``env.json`` (``FKOPT_NUMERICS`` set from it: :func:`stored_numerics`);
 5. the paper's claims recomputed with the rerun in place must keep the verdicts stored in
-   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.drift.rerun_verdict_drift`), and a paper
-   folder whose paper has claims must have its ``claims.csv``.
+   ``<paper>/claims.csv`` (:func:`fkopt.reproduce.drift.rerun_verdict_drift`), and the stored
+   verdict files must be what the current engine writes from the stored results, columns and
+   rows (:func:`verdict_files`): a file an older engine wrote fails.
 
 A mismatch names the experiment, the file, the row, the column and both values. Figures are
 not compared (they depend on the plotting library's version).
@@ -221,8 +222,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         raise FkoptError(f"tier: '{tier}' unknown; allowed: {EXACT}, {BLAS}, {ANY}")
     out += summary_consistency(label, exp.folder)
     out += recomputed_fitness(exp, config)
-    out += missing_claims(exp)
-    out += timing_verdicts(exp)
+    out += verdict_files(exp)
     out += board_from_answers(label, exp, config)
     tmp = Path(tempfile.mkdtemp(prefix="fkopt-check-"))
     try:
@@ -251,47 +251,88 @@ def board_from_answers(label: str, exp: Experiment, config) -> list[Mismatch]:
     return [Mismatch(label, *row) for row in reverify(exp.folder, config)]
 
 
-def missing_claims(exp: Experiment) -> list[Mismatch]:
-    """In a results tree written by ``fkopt reproduce`` (REPORT.md at its root), the folder of a
-    paper with claims must keep its claims.csv: deleting it would hide the verdicts from check.
-    (A single experiment folder copied elsewhere has no REPORT.md beside its paper folder.)"""
-    from fkopt.reproduce import paper_module
-    from fkopt.reproduce.claims import CLAIMS_FILE
-    if not (exp.folder.parents[1] / "REPORT.md").is_file():
-        return []
-    from fkopt.reproduce.engine import load
-    module = paper_module(exp.paper)
-    has_claims = load(exp.paper) is not None or hasattr(module, "claims")
-    if not has_claims or (exp.folder.parent / CLAIMS_FILE).is_file():
-        return []
-    return [Mismatch(exp.paper, CLAIMS_FILE, "-", "file", "missing", "present",
-                     f"{exp.paper} has claims: its {CLAIMS_FILE} is part of the stored result")]
+#: The engine's verdict files of a paper folder, judged once per check however many of its experiments
+#: are checked: (paper folder, the stat of its verdict files and meta.json files) -> {file: frame}.
+_JUDGED: dict = {}
 
 
-def timing_verdicts(exp: Experiment) -> list[Mismatch]:
-    """The stored timing verdicts of ``exp``'s paper (``timing_claims.csv``) must be those its stored
-    timed runs give. Check's rerun measures no time, so this compares the stored verdicts with the
-    stored measurements: on every platform, and it catches an edited timing verdict."""
-    from fkopt.reproduce.claims import TIMING_CLAIMS_FILE, claims_frame
+def engine_verdict_files(root: Path, paper: str) -> dict[str, pd.DataFrame]:
+    """{file name: rows} of the verdict files the current engine writes for ``paper`` from the results
+    stored under ``root`` (:func:`fkopt.reproduce.report.claims_files`'s rule: claims.csv where the
+    paper's claims are judged here, timing_claims.csv when it has timing claims)."""
+    from fkopt.reproduce.claims import CLAIMS_FILE, TIMING_CLAIMS_FILE, claims_frame
     from fkopt.reproduce.engine import judge_paper
-    file = exp.folder.parent / TIMING_CLAIMS_FILE
-    if not file.is_file():
-        return []
+    folder = root / paper
+    stats = tuple(sorted((str(f), f.stat().st_mtime_ns, f.stat().st_size)
+                         for f in [*folder.glob("*.csv"), *folder.glob("*/meta.json")] if f.is_file()))
+    key = (str(folder.resolve()), stats)
+    if key not in _JUDGED:
+        judged = judge_paper(paper, Store(root))
+        files = {}
+        if judged is not None:
+            files[CLAIMS_FILE] = claims_frame(judged[0])
+            if judged[1]:
+                files[TIMING_CLAIMS_FILE] = claims_frame(judged[1])
+        _JUDGED.clear()
+        _JUDGED[key] = files
+    return _JUDGED[key]
+
+
+def verdict_files(exp: Experiment) -> list[Mismatch]:
+    """The stored verdict files of ``exp``'s paper (``claims.csv``, ``timing_claims.csv``) must be, with
+    their columns and row for row (id, claim, verdict, condition), what the current engine writes from
+    the stored results. A file an older engine wrote fails: other columns (the stale results/peers
+    files had only claim, verdict), a claim added, renamed or dropped, a changed verdict or condition, a
+    file the engine writes none of in this tree (a paper's claims are judged only where one of their
+    experiments is stored: :func:`fkopt.reproduce.engine.judged_here`), or a missing one in a tree
+    written by ``fkopt reproduce`` (REPORT.md at its root). Judged from the stored runs, so on every
+    platform (timing verdicts from the stored timed runs: check measures no time); a rerun's verdicts
+    are :func:`fkopt.reproduce.drift.rerun_verdict_drift`'s. The fix is ``fkopt report RESULTS``."""
+    from fkopt.reproduce.claims import COLUMNS, TIMING_CLAIMS_FILE
+    root = exp.folder.parents[1]
+    folder = exp.folder.parent
+    names = ("claims.csv", TIMING_CLAIMS_FILE)
+    stored_any = any((folder / n).is_file() for n in names)
+    if not stored_any and not (root / "REPORT.md").is_file():
+        return []          # one experiment folder copied elsewhere: no verdict files expected
+    paper = exp.paper
     try:
-        stored = pd.read_csv(io.BytesIO(read_stored(file.parent, file.name)), keep_default_na=False)
-        judged = judge_paper(exp.paper, Store(exp.folder.parents[1]), timing_only=True)
+        expected = engine_verdict_files(root, paper)
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
-        return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, "-", "file", f"unreadable ({err})", "readable",
-                         "readable CSV")]
-    if judged is None:
-        return []
-    now = claims_frame(judged[1])
-    key = "id" if "id" in stored.columns and "id" in now.columns else "claim"
-    a = dict(zip(stored[key].astype(str), stored["verdict"].astype(str)))
-    b = dict(zip(now[key].astype(str), now["verdict"].astype(str)))
-    return [Mismatch(exp.paper, TIMING_CLAIMS_FILE, k[:90], "verdict", a.get(k, "(absent)"), b.get(k, "(absent)"),
-                     "the verdict of the stored timed runs (every platform)")
-            for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+        return [Mismatch(paper, "claims.csv", "-", "file", f"unjudgeable ({err})", "judged", "readable results")]
+    fix = "what this engine writes from the stored results (every platform; fkopt report RESULTS rewrites it)"
+    out = []
+    for name in names:
+        file = folder / name
+        want = expected.get(name)
+        if not file.is_file():
+            if want is not None:
+                out.append(Mismatch(paper, name, "-", "file", "missing", "present",
+                                    f"{paper} has claims: its {name} is part of the stored result"))
+            continue
+        if want is None:
+            out.append(Mismatch(paper, name, "-", "file", "present", "absent",
+                                f"written by an older engine: this engine writes no {name} for {paper} in this tree "
+                                "(its claims are judged where their experiments are stored)"))
+            continue
+        try:
+            stored = pd.read_csv(io.BytesIO(read_stored(folder, name)), dtype=str, keep_default_na=False)
+        except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
+            out.append(Mismatch(paper, name, "-", "file", f"unreadable ({err})", "readable", "readable CSV"))
+            continue
+        if list(stored.columns) != COLUMNS:
+            out.append(Mismatch(paper, name, "-", "columns", ", ".join(map(str, stored.columns)), ", ".join(COLUMNS),
+                                "written by an older engine: " + fix))
+            continue
+        a = {r["id"]: r for r in stored.to_dict("records")}
+        b = {r["id"]: r for r in want.astype(str).to_dict("records")}
+        for key in sorted(set(a) | set(b)):
+            for col in ("verdict", "condition", "claim"):
+                old, new = a.get(key, {}).get(col, "(absent)"), b.get(key, {}).get(col, "(absent)")
+                if old != new:
+                    out.append(Mismatch(paper, name, key[:90], col, old[:120], new[:120], fix))
+                    break
+    return out
 
 
 def select(store: Store, subset: str = "all", paper: str | None = None, name: str | None = None) -> list[Experiment]:

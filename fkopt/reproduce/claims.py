@@ -33,8 +33,9 @@ RULES = [
     "*conditional: held* / *conditional: not held*: the same, judged under a reconstruction or one "
     "reading of an ambiguous equation, named in the claim's *condition*; a claim with several readings "
     "has one row per reading. Every verdict that rests on a reconstruction (the paper's `provenance`: "
-    "lost equations, unprinted constants, departures from the print) is conditional and names it, "
-    "whichever way it goes; an absolute time is conditional on fkopt's machine.",
+    "lost equations, unprinted settings such as a search box, a limit or constants, departures from the "
+    "print; a setting is printed only where SPEC.md cites it) is conditional and names it, whichever way "
+    "it goes; an absolute time is conditional on fkopt's machine.",
     "*not checkable*: the claim rests on something the paper does not print (lost tables, an error "
     "measure that was lost), or is circular (a model fitted to the very numbers it would confirm); "
     "fkopt's numbers are shown anyway.",

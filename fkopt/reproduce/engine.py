@@ -16,12 +16,15 @@ that kind:
   went below ``level`` within ``tolerance`` of ``printed``, and (``faster_than``) significantly
   fewer than the other's;
 * ``timing`` -- ``faster`` takes less time than ``than`` (interleaved single runs; within noise
-  inside the spread; :func:`~.claims.faster_claim`), or every run ``below_ms``; TIMING.md only;
+  inside the spread; :func:`~.claims.faster_claim`), the times of ``close: [a, b]`` do not differ
+  significantly, or every run ``below_ms``; TIMING.md only;
 * ``value`` -- a number measured by the paper module (``quantity`` names a function of its
   ``QUANTITIES``), against the same rules as a magnitude.
 
-The paper's ``provenance`` records every algorithm, comparator and mechanism as ``printed`` or a
-``reconstruction`` (with what fkopt ``chose``); :func:`judge` makes every verdict resting on a
+The paper's ``printed`` table holds the settings SPEC.md cites; its ``provenance`` records every
+algorithm, comparator and mechanism with the printed settings it uses and what fkopt ``chose``
+beyond them, and is ``printed`` or a ``reconstruction`` by that (:func:`derive_provenance`, never
+by hand); :func:`judge` makes every verdict resting on a
 reconstruction conditional, naming it, and a reconstruction fitted to a claim (``circular``) makes
 that claim not checkable. ``hardware`` names the paper's machine for absolute times; kind
 ``statement`` is a claim no number decides (``not_checkable`` says why).
@@ -67,7 +70,58 @@ def load(paper: str) -> dict | None:
     assert len(ids) == len(set(ids)), f"{file}: duplicate claim ids"
     for c in data.get("claims", []):
         assert c.get("kind") in KINDS, f"{file}: {c['id']}: kind {c.get('kind')!r} not in {KINDS}"
+    data["provenance"] = derive_provenance(data, file)
     return data
+
+
+def printed_settings(data: dict) -> dict[str, str]:
+    """The paper's printed settings: key -> the words of SPEC.md that cite it (``printed.settings``)."""
+    return dict(((data.get("printed") or {}).get("settings") or {}))
+
+
+def uncited_settings(data: dict, spec_text: str) -> list[str]:
+    """The printed settings of a claims file whose words SPEC.md (``spec_text``) does not hold under
+    their section (``printed.spec``, or the setting's own ``section``), whitespace aside: each is a
+    setting called printed that SPEC.md does not cite."""
+    sections, heading = {}, ""
+    for line in spec_text.splitlines():
+        if line.startswith("## "):
+            heading = line[3:].strip()
+        sections[heading] = sections.get(heading, "") + " " + line
+    flat = {k: " ".join(v.split()) for k, v in sections.items()}
+    default = str((data.get("printed") or {}).get("spec") or "")
+    out = []
+    for key, cite in printed_settings(data).items():
+        section, words = (cite.get("section", default), cite.get("words", "")) if isinstance(cite, dict) \
+            else (default, cite)
+        if " ".join(str(words).split()) not in flat.get(section, "") or not str(words).strip():
+            out.append(f"{key}: {section!r} has no {str(words)[:60]!r}")
+    return out
+
+
+def derive_provenance(data: dict, where="claims.yaml") -> dict[str, dict]:
+    """Each ``provenance`` entry with its ``as`` derived, never written by hand (issue 41).
+
+    What a paper printed is data: ``printed.settings`` maps a setting to the words of
+    /work/shared/SPEC.md that cite it, under the section ``printed.spec``. An entry lists the
+    settings it uses (``printed: [keys]``, each one of those) and what fkopt had to choose where
+    SPEC.md cites nothing (``chosen``: a search box, a limit, lost equations, a stopping rule, a
+    method the paper never ran). It is ``printed`` when it chose nothing and ``reconstruction``
+    otherwise, so an unprinted setting makes every verdict resting on it conditional by the one rule.
+    """
+    settings = printed_settings(data)
+    out = {}
+    for key, entry in (data.get("provenance") or {}).items():
+        entry = dict(entry or {})
+        assert "as" not in entry, (f"{where}: provenance {key}: 'as' is derived (printed only where "
+                                   "SPEC.md cites every setting: printed.settings), not written by hand")
+        cited = _list(entry.get("printed"))
+        unknown = [s for s in cited if s not in settings]
+        assert not unknown, f"{where}: provenance {key}: {unknown} not in printed.settings ({sorted(settings)})"
+        assert cited or entry.get("chosen"), f"{where}: provenance {key}: cites no printed setting and chose nothing"
+        entry["as"] = RECONSTRUCTION if str(entry.get("chosen") or "").strip() else PRINTED
+        out[key] = entry
+    return out
 
 
 def info(paper: str) -> dict:
@@ -90,6 +144,8 @@ def judge_paper(paper: str, store, timing_only: bool = False) -> tuple[list[Clai
             return None
         timing = mod.timing_claims(store) if hasattr(mod, "timing_claims") else []
         return ([] if timing_only else mod.claims(store)), timing
+    if not judged_here(paper, store):
+        return None
     plain, timing = [], []
     for spec in data.get("claims", []):
         if timing_only and spec["kind"] != "timing":
@@ -97,6 +153,26 @@ def judge_paper(paper: str, store, timing_only: bool = False) -> tuple[list[Clai
         for c in judge(paper, spec, store, mod):
             (timing if spec["kind"] == "timing" else plain).append(c)
     return plain, timing
+
+
+def claim_experiments(paper: str) -> set[str]:
+    """The paper's own experiments its claims are judged on (``experiment``, a reading's ``set``)."""
+    out = set()
+    for spec in (load(paper) or {}).get("claims", []):
+        for reading in spec.get("readings") or [{}]:
+            name = str(((reading.get("set") or {}).get("experiment")) or spec.get("experiment") or "")
+            if name and "/" not in name:
+                out.add(name)
+    return out
+
+
+def judged_here(paper: str, store) -> bool:
+    """Are ``paper``'s claims judged in this results tree? Only where it stores at least one of the
+    experiments they are judged on: a tree of other runs of the paper's mechanisms (results/peers)
+    would give every claim "no stored result", so it gets no verdict files (``fkopt check`` fails on
+    one there: :func:`fkopt.reproduce.check.verdict_files`)."""
+    names = claim_experiments(paper)
+    return not names or any(e.name in names for e in store.experiments(paper))
 
 
 def judge(paper: str, spec: dict, store, mod=None) -> list[Claim]:
@@ -144,7 +220,7 @@ RECONSTRUCTION, PRINTED = "reconstruction", "printed"
 HARDWARE_CONDITION = ("an absolute time, measured on fkopt's machine (TIMING.md's platform), not on the paper's "
                       "({hardware})")
 #: The claim fields that name the algorithms a verdict rests on (``also``: shown beside, never judged).
-ALGORITHM_FIELDS = ("better", "than", "algorithms", "algorithm", "faster_than", "faster")
+ALGORITHM_FIELDS = ("better", "than", "algorithms", "algorithm", "faster_than", "faster", "close")
 
 
 def _absolute_time(spec: dict) -> bool:
@@ -247,8 +323,12 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
     basis = spec.get("basis", "iterations")
     nm = lambda a: names.get(a, a)   # noqa: E731
     parts, numbers, held = [], {}, {"iterations": True, "evaluations": True}
+    # a final per-run value that is not traced (position error): the bases are compared on the objective f
+    # at both, like with like (issue 41), while the verdict stays on the quantity at the paper's basis
+    proxy_iterations = None
     for other in than + [use(a) for a in _list(spec.get("also"))]:
         beside = other not in than
+        it_f = None
         if quantity == "final_fitness":
             it, ev, budget = equal_budget(exp, better, other, names, iteration=spec.get("iteration"))
             ev_label = f"equal evaluations ({budget:.0f})"
@@ -259,9 +339,11 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
             ev = compare(nm(better), va_ev, nm(other), vb_ev) if va_ev is not None else None
             ev_label = "in evaluations"
             if ev is None and quantity in TRACED_PROXY and exp.has("trace.csv.gz"):
-                # a final per-run value (e.g. position error) is not traced: the objective stands in
-                _, ev, budget = equal_budget(exp, better, other, names)
-                ev_label = f"the objective f at equal evaluations ({budget:.0f}; {quantity} is not traced)"
+                # a final per-run value (e.g. position error) is not traced: the objective stands in, at
+                # equal evaluations and (to compare the bases like with like) at equal iterations
+                it_f, ev, budget = equal_budget(exp, better, other, names)
+                ev_label = (f"the objective f ({quantity} is not traced) at equal iterations: {it_f.text()}; "
+                            f"f at equal evaluations ({budget:.0f})")
         tag = f"{nm(better)} vs {nm(other)}" + (" (fkopt's variant, beside)" if beside else "")
         ev_text = ev.text() if ev is not None else "n/a (a final per-run value; not in the trace)"
         parts.append(f"{tag}: equal iterations: {it.text()}; {ev_label}: {ev_text}")
@@ -270,8 +352,12 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
                         f"median_{other}": it.median_b})
         if ev is not None:
             numbers.update({f"p_evaluations_{key}": ev.p, f"lower_evaluations_{key}": ev.lower})
+        if it_f is not None:
+            numbers.update({f"p_f_iterations_{key}": it_f.p, f"lower_f_iterations_{key}": it_f.lower})
         if beside:
             continue
+        if it_f is not None:
+            proxy_iterations = (True if proxy_iterations is None else proxy_iterations) and it_f.lower == nm(better)
         held["iterations"] &= it.lower == nm(better)
         held["evaluations"] = held["evaluations"] and (ev.lower == nm(better) if ev is not None else None)
         if spec.get("min_orders") is not None:
@@ -287,7 +373,13 @@ def _comparison(text, spec, exp, use, names, store, mod) -> Claim:
     decisive = held[basis] if held[basis] is not None else held["iterations"]
     other_basis = "evaluations" if basis == "iterations" else "iterations"
     note = ""
-    if held[other_basis] is not None and bool(held[other_basis]) != bool(decisive):
+    if proxy_iterations is not None:
+        # the bases on the objective f, like with like: f at equal iterations against f at equal evaluations
+        if held["evaluations"] is not None and bool(held["evaluations"]) != bool(proxy_iterations):
+            note = (f"; **bases disagree** on the objective f: at equal iterations {verdict(proxy_iterations)}, at "
+                    f"equal evaluations {verdict(held['evaluations'])}")
+            numbers["bases_disagree"] = True
+    elif held[other_basis] is not None and bool(held[other_basis]) != bool(decisive):
         note = f"; **bases disagree**: at equal {other_basis} the verdict would be {verdict(held[other_basis])}"
         numbers["bases_disagree"] = True
     on_basis = {o: numbers.get(f"lower_{o}" if basis == "iterations" else f"lower_evaluations_{o}",
@@ -416,13 +508,15 @@ def _timing(text, spec, exp, use, names, store, mod) -> Claim:
     t = exp.table("timing_runs")
     if "below_ms" in spec or "above_ms" in spec:
         return _time_limit(text, spec, t, use, names)
-    a, b = use(spec["faster"]), use(spec["than"])
+    a, b = (use(x) for x in _list(spec["close"])) if spec.get("close") else (use(spec["faster"]), use(spec["than"]))
     ms = {x: t[t.algorithm == x].ms.to_numpy(float) for x in (a, b)}
     if not all(v.size for v in ms.values()):
         raise _Missing(f"{exp.paper}/{exp.name}/timing_runs.csv: timed runs of {a} and {b}")
     if spec.get("time_to_best"):
         return _time_to_best(text, spec, exp, mod, a, b, ms, names)
     cmp = compare(names.get(a, a), ms[a], names.get(b, b), ms[b])
+    if spec.get("close"):
+        return _close(text, cmp)
     c = faster_claim(text, names.get(a, a), cmp, tuple(spec["printed_ms"]) if "printed_ms" in spec else None)
     if "saving" in spec and c.verdict == "held":
         saving = 1.0 - cmp.median_a / cmp.median_b
@@ -430,6 +524,19 @@ def _timing(text, spec, exp, use, names, store, mod) -> Claim:
         c.verdict = verdict(abs(saving - spec["saving"]) <= 0.1)
         c.evidence = (f"{100 * saving:.1f} % shorter, {'within' if c.verdict == HELD else 'more than'} 10 points of "
                       f"the printed {100 * spec['saving']:.2f} % (rule: within 10 points); " + c.evidence)
+    return c
+
+
+def _close(text, cmp) -> Claim:
+    """'the times of ``a`` and ``b`` are close' (``close: [a, b]``), by the one timing rule: the rank
+    test of the interleaved single-run times at ALPHA (:func:`~.claims.faster_claim`) decides; held when
+    it finds no significant difference, not held when it finds one, either way."""
+    c = faster_claim(text, cmp.a, cmp)
+    shifted = c.verdict != WITHIN_NOISE
+    c.verdict = verdict(not shifted)
+    c.evidence = ("significantly different, so not close: " if shifted else "no significant difference: ") + \
+        c.evidence.replace("within noise only without a significant difference",
+                           "close (held) only without a significant difference")
     return c
 
 

@@ -119,7 +119,8 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "seed": ("Seed of the draw (independent of the experiment's seed).", "", 7),
     },
     "AlgorithmSpec": {
-        "name": ("An algorithm (`fkopt list`): abc, gabc, aco, pso, pabc, nr, lm, dls, abc+lm, gabc+lm, "
+        "name": ("An algorithm (`fkopt list`): abc, abc-wang7dof (wang7dof eqs. 7-8 as printed), gabc, aco, pso, "
+                 "pabc, nr, lm, dls, abc+lm, gabc+lm, "
                  "pso+lm, the exact solvers forward, inverse and exact (fkopt.forward / fkopt.inverse), "
                  "`scipy:`/`pymoo:`/`niapy:` optimisers, or `package.module:Class`.", "", "gabc"),
         "label": ("Name in the tables; needed when one algorithm appears twice. Default: the name.", "",
@@ -491,5 +492,5 @@ def write(root: Path = Path(".")) -> list[Path]:
 
 if __name__ == "__main__":
     import fkopt.kinbench  # noqa: F401  (the script's entry: registers every built-in kind)
-    for p in write(Path(__file__).resolve().parent.parent):
+    for p in write(Path(__file__).resolve().parents[2]):
         print(p)

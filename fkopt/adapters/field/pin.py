@@ -1,9 +1,9 @@
 """pinocchio's FK and Jacobian (Carpentier et al., SII 2019) in kinbench's closed-loop inverse
 kinematics (CLIK): pinocchio publishes no IK solver, only the CLIK loop of its documentation
 ("Inverse kinematics (clik)", examples/inverse-kinematics.py). ``pin-clik`` is that loop on
-pinocchio's own model of the URDF (:func:`fkopt.adapters.field.arm_urdf`: the robot's file, or for an
-MJCF arm the URDF written from fkopt's chain, FK-checked against MuJoCo in
-tests/test_urdf_writer.py), with the three things a random start needs that the example (which
+pinocchio's own model of the URDF written from fkopt's chain
+(:func:`fkopt.adapters.field.arm_urdf`, for every arm: no outside package reads the robot's own
+file, docs/reliability.md section 10; FK-checked against MuJoCo in tests/test_urdf_writer.py), with the three things a random start needs that the example (which
 starts at the neutral configuration of a reachable target) does not have, in the board's one
 restart loop (:mod:`fkopt.adapters.field.restarts`, shared with ikpy, pink and the black-box
 entries):

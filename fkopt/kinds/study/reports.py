@@ -331,7 +331,7 @@ def meta(sr: StudyResult) -> dict:
     return {
         "kind": "study", "experiment": sr.config.name, "paper": sr.config.paper, "title": sr.config.title,
         "config_file": sr.source, "config": sr.config.model_dump(mode="json"), "seed": sr.config.seed,
-        "task_seeds": "pose (or step) i of algorithm L: fkopt.kinds.experiment.runner.task_seed(seed, i, L); "
+        "task_seeds": "pose (or step) i of algorithm L: fkopt.run.solving.task_seed(seed, i, L); "
                       "run k: child k of that seed (fkopt.numerics.streams)",
         "fingerprint": sr.config.fingerprint(), "poses": len(sr.poses),
         "mechanism": sr.mechanism.describe(), "objective": objective,

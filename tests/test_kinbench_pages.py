@@ -1,0 +1,245 @@
+"""kinbench's pages a roboticist reads in a minute (issue 37): index.html opens with which solver
+per arm family and the summary per solver beside a figure, under a table of contents; per-arm
+tables and every ranking on pages of their own, each under 500 kB; headers in words with units;
+every entry's settings and the machine's load on the page; all of it made again from a stored
+folder without running a solver (`fkopt pages`). And the ECDF figures' end-of-line names clear
+of title and legend (a newcomer's finding, issue 41)."""
+import hashlib
+from html import unescape
+import json
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fkopt.kinbench import html as H
+from fkopt.kinbench.pages import PAGE_LIMIT, stored_suite, write_pages
+
+ROOT = Path(__file__).resolve().parent.parent
+QUICK = ROOT / "results" / "kinbench" / "kinbench-v3-robots-quick"
+
+
+# -- headers -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("column, header", [
+    ("success_1e-05m_1e-05rad", "success at 1e-5 m and 1e-5 rad (%)"),
+    ("success_5mm_0.05rad", "success at 5 mm and 0.05 rad (%)"),
+    ("success_1e-06", "success at fitness 1e-6 (%)"),
+    ("success_1e+00", "success at fitness 1 (%)"),
+    ("time_ms_median", "median time to an answer (ms)"),
+    ("cpu_ms_median", "median CPU time per call (ms)"),
+    ("ert_ratio_1e-08", "ERT ratio to the virtual best at fitness 1e-8"),
+    ("queue_wait_ms", "queue wait (ms)"),              # a column a newer board adds: its name, unit apart
+])
+def test_headers_are_words_with_units(column, header):
+    assert H.words(column) == header
+
+
+def test_a_table_keeps_the_csv_name_in_the_tooltip_and_shows_shares_in_per_cent():
+    df = pd.DataFrame({"solver": ["a"], "success_1e-05m_1e-05rad": [0.975], "time_ms_median": [0.1901]})
+    text = H.table_html(df, list(df.columns), "t")
+    assert 'title="success_1e-05m_1e-05rad">success at 1e-5 m and 1e-5 rad (%)</th>' in re.sub(r"</?span[^>]*>", "", text)
+    assert ">97.5<" in text and ">0.1901<" in text
+
+
+# -- figures -------------------------------------------------------------------------------------
+def test_end_labels_stay_inside_the_axes_and_apart():
+    from fkopt.kinbench.reports import spread_labels
+    ys = spread_labels([1.0, 1.0, 1.0, 0.99, 0.0], 0.05, 0.0, 1.0)
+    assert max(ys) <= 1.0 and min(ys) >= 0.0
+    assert np.diff(sorted(ys)).min() >= 0.05 - 1e-12
+    many = spread_labels([1.0] * 30, 0.05, 0.0, 1.0)      # more names than fit: evenly over the height
+    assert max(many) <= 1.0 and min(many) >= 0.0 and np.diff(sorted(many)).min() > 0
+
+
+def _overlap(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures a maker saves, measured before they are written: every end-of-line name's
+    box against the title's and the legend's, and the title's width against the figure's."""
+    import importlib
+    plotting = importlib.import_module("fkopt.run.plotting")
+    seen = []
+    original = plotting.save
+
+    def save(fig, path, vector=True):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        for ax in fig.axes:
+            names = [t.get_window_extent(renderer) for t in ax.texts]
+            title = ax.title.get_window_extent(renderer)
+            legend = ax.get_legend().get_window_extent(renderer) if ax.get_legend() else None
+            seen.append({"path": Path(path).name, "names": names, "title": title, "legend": legend,
+                         "figure_width": fig.bbox.width})
+        return original(fig, path, vector=False)
+    monkeypatch.setattr(plotting, "save", save)
+    return seen
+
+
+def _clear(fig):
+    assert fig["title"].width <= fig["figure_width"], fig["path"]          # the title fits the figure
+    for box in fig["names"]:
+        assert not _overlap(box, fig["title"]), fig["path"]
+        assert fig["legend"] is None or not _overlap(box, fig["legend"]), fig["path"]
+
+
+def test_ecdf_end_labels_clear_the_title_and_the_legend(tmp_path, drawn):
+    from types import SimpleNamespace
+    from fkopt.kinbench.reports import ecdf_figures
+    solvers = [("exact", "exact"), ("lm", "jacobian"), ("dls", "jacobian"), ("pso", "black-box"), ("abc", "black-box")]
+    rows = [{"scope": "board:full/all", "solver": s, "track": t, "evals_per_dim": e, "reached": 1, "pairs": 1,
+             "fraction": f} for s, t in solvers for e, f in ((2.0, 0.5), (50.0, 1.0))]
+    targets = [1.0, 0.1, 0.01, 1e-4, 1e-6, 1e-8, 1e-10]
+    sr = SimpleNamespace(config=SimpleNamespace(targets=targets, budget_per_dim=2000, name="kinbench-v3", subsets=[]),
+                         runs=pd.DataFrame({"class": []}))
+    ecdf_figures(sr, tmp_path, {"ecdf.csv": pd.DataFrame(rows)})
+    assert drawn and all(len(f["names"]) == len(solvers) for f in drawn)
+    for fig in drawn:
+        _clear(fig)
+
+
+def test_clock_end_labels_clear_the_title(tmp_path, drawn):
+    from fkopt.kinbench.reports import clock_figures
+    sr, tables = stored_suite(QUICK)
+    answers = tables["answers.csv.gz"]
+    names = clock_figures(sr, tmp_path, {"answers.csv.gz": answers[answers["robot"].isin(["ur5", "panda"])]})
+    assert "clock_all.png" in names and "clock_ur5.png" in names
+    for fig in drawn:
+        _clear(fig)
+
+
+# -- pages ---------------------------------------------------------------------------------------
+def _newer_board(tables):
+    """The stored quick board as the next board version might be: a new outside solver and new
+    columns (cpu_ms_median and one this code has never heard of)."""
+    board = tables["leaderboard-robots.csv"].copy()
+    new = board[board["solver"] == "tracik"].assign(solver="eaik")
+    board = pd.concat([board, new], ignore_index=True)
+    board["cpu_ms_median"] = board["time_ms_median"] * 0.5
+    board["queue_wait_ms"] = 0.0
+    answers = tables["answers.csv.gz"]
+    answers = pd.concat([answers, answers[answers["solver"] == "tracik"].assign(solver="eaik")], ignore_index=True)
+    return {**tables, "leaderboard-robots.csv": board, "answers.csv.gz": answers}
+
+
+def _anchors(text):
+    return set(re.findall(r'id="([^"]+)"', text))
+
+
+def _toc_targets(text):
+    nav = re.search(r'<nav class="toc" id="toc">(.*?)</nav>', text, re.S).group(1)
+    return re.findall(r'href="#([^"]+)"', nav)
+
+
+def test_the_board_page_opens_with_the_advice_and_takes_new_solvers_and_columns(tmp_path):
+    sr, tables = stored_suite(QUICK)
+    folder = tmp_path / "board"
+    folder.mkdir()
+    names = write_pages(sr, folder, _newer_board(tables))
+    index = (folder / "index.html").read_text()
+    assert names[0] == "index.html" and "arms.html" in names and "rankings.html" in names
+    for name in names:
+        assert (folder / name).stat().st_size < PAGE_LIMIT, name
+        text = (folder / name).read_text()
+        targets = _toc_targets(text)
+        assert targets and set(targets) <= _anchors(text), name            # every contents link lands
+        ids = re.findall(r'id="([^"]+)"', text)
+        assert len(ids) == len(set(ids)), name                              # each lands on one place
+    order = [index.index(f'id="{i}"') for i in ("toc", "advice", "summary", "figures", "settings", "machine")]
+    assert order == sorted(order)
+    summary = index[index.index('id="summary"'):index.index('id="figures"')]
+    assert ">eaik<" in summary and "median CPU time per call (ms)" in summary
+    assert "success at 1e-5 m and 1e-5 rad (%)" in re.sub(r"</?span[^>]*>", "", index)
+    assert "success_1e-05m_1e-05rad" in index
+    arms = (folder / "arms.html").read_text()
+    assert "queue wait (ms)" in arms and ">eaik<" in arms and 'href="index.html"' in arms
+    settings = index[index.index('id="settings"'):index.index('id="machine"')]
+    for solver in set(tables["answers.csv.gz"]["solver"]) | {"eaik"}:
+        assert f">{solver}<" in settings, solver
+    assert "eps = 1e-5" in settings                 # TRAC-IK's, as its wrapper documents it
+    assert "not recorded (this board was stored before kinbench recorded the machine's load)" in unescape(index)
+    assert "data:image" not in index and "http://" not in index and "https://" not in index
+
+
+def test_an_arm_a_package_cannot_take_is_left_out_not_counted_as_zero(tmp_path):
+    from fkopt.kinbench.advice import summarise_board
+    sr, tables = stored_suite(QUICK)
+    tables = _newer_board(tables)
+    board = tables["leaderboard-robots.csv"]
+    success = [c for c in board.columns if c.startswith("success_")]
+    board[success] = board[success].astype(object)
+    board.loc[(board["solver"] == "eaik") & (board["robot"] == "panda"), success] = "not applicable: no decomposition"
+    summary = summarise_board(board, 20.0).set_index("solver")
+    ik_arms = board.loc[board["other_mode"].isna(), "robot"].nunique()
+    assert summary.loc["eaik", "arms"] == ik_arms - 1 and summary.loc["tracik", "arms"] == ik_arms
+    rung = "success_1e-05m_1e-05rad"              # eaik's rows are tracik's: its mean is tracik's without panda
+    others = board[(board["solver"] == "tracik") & (board["timeout_ms"] == 20.0) & board["other_mode"].isna()
+                   & (board["robot"] != "panda")]
+    assert summary.loc["eaik", rung] == pytest.approx(100 * others[rung].astype(float).mean())
+    write_pages(sr, tmp_path, {**tables, "leaderboard-robots.csv": board})
+    assert "not applicable: no decomposition" in (tmp_path / "arms.html").read_text()
+
+
+def test_the_page_shows_the_load_and_settings_a_board_recorded(tmp_path):
+    sr, tables = stored_suite(QUICK)
+    sr.meta = {**sr.meta, "load_avg": {"start": [1.25, 0.5, 0.25], "end": [2.0, 1.0, 0.5]},
+               "settings": {"tracik": {"eps": 5.77e-06, "solve_type": "Speed"}}}
+    write_pages(sr, tmp_path, tables)
+    index = (tmp_path / "index.html").read_text()
+    assert "at its start: 1.25 / 0.50 / 0.25; at its end: 2.00 / 1.00 / 0.50" in index
+    assert "eps = 5.77e-06; solve_type = Speed" in index and "recorded with the board (meta.json)" in index
+
+
+def test_the_advice_per_family_is_the_summary_of_its_arms():
+    """The opening table's row of a family is robots_summary's first row over that family's arms."""
+    from fkopt.kinbench.advice import family_advice, summarise_board
+    board = pd.read_csv(QUICK / "leaderboard-robots.csv")
+    sr, _ = stored_suite(QUICK)
+    families = {p.name: p.problem_class for p in sr.config.problems}
+    advice = family_advice(board, families)
+    assert set(advice["family"]) == {families[r] for r in board["robot"]}
+    for row in advice.itertuples():
+        arms = row.arms.split(", ")
+        best = summarise_board(board[board["robot"].isin(arms)], row.timeout_ms, fk=row.family.startswith("parallel"))
+        assert best.iloc[0]["solver"] == row.solver
+
+
+def test_fkopt_pages_refuses_what_is_not_a_suite_in_one_line(tmp_path):
+    (tmp_path / "exp").mkdir()
+    (tmp_path / "exp" / "meta.json").write_text(json.dumps({"kind": "experiment"}))
+    for target, fragment in ((tmp_path / "exp", "kind: 'experiment' (allowed: suite"),
+                             (tmp_path / "none", "no such folder")):
+        proc = subprocess.run([sys.executable, "-m", "fkopt.cli", "pages", str(target)], capture_output=True,
+                              text=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+        assert proc.returncode == 2 and fragment in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+        assert "Traceback" not in proc.stderr
+
+
+def _digests(folder):
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in folder.iterdir()
+            if p.name.endswith((".csv", ".csv.gz")) or p.name in ("meta.json", "env.json")}
+
+
+def test_fkopt_pages_remakes_a_stored_board_from_its_files_alone(tmp_path):
+    """From a copy of the stored quick board: figures and pages written again, no table touched
+    (no solver runs: the stored answers are all there is)."""
+    folder = tmp_path / "kinbench-v3-robots-quick"
+    shutil.copytree(QUICK, folder)
+    before = _digests(folder)
+    for name in [p.name for p in folder.glob("*.png")] + ["index.html"]:
+        (folder / name).unlink()
+    proc = subprocess.run([sys.executable, "-m", "fkopt.cli", "pages", str(folder)], capture_output=True, text=True,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    assert proc.returncode == 0, proc.stderr
+    assert _digests(folder) == before
+    assert {"index.html", "arms.html", "rankings.html", "clock_all.png", "clock_ur5.png", "ecdf_all.png"} <= \
+        {p.name for p in folder.iterdir()}
+    index = (folder / "index.html").read_text()
+    assert all((folder / src).is_file() for src in re.findall(r'<img [^>]*src="([^"]+)"', index))
