@@ -31,7 +31,7 @@ reproduce:
 # The peer configs (peers/*.yaml: fkopt beside NiaPy, pymoo and scipy at equal evaluations).
 # Slow (NiaPy evaluates one point per call) and outside `make reproduce`; needs install-peers.
 reproduce-peers:
-	$(FKOPT) reproduce --configs peers --out results/peers
+	$(FKOPT) reproduce --configs peers --out results/peers --compare-with results/peers
 	$(PYTHON) -m fkopt.tools.peers results/peers
 
 # kinbench (docs/kinbench.md): v1, v2 and v3's evaluations track in full (v3: exact and lm on every

@@ -28,7 +28,9 @@ _LAZY = {"ForwardResult": "kinematics", "InverseResult": "kinematics", "forward"
          "inverse": "kinematics", "InverseSolver": "kinematics", "inverse_solver": "kinematics",
          "InverseOptions": "numerics", "FKProblem": "problems", "IKProblem": "problems",
          "fk_problem": "problems", "ik_problem": "problems", "Result": "solve", "solve": "solve",
-         "MECHANISMS": "registry", "ALGORITHMS": "registry", "SOLVERS": "registry"}
+         "MECHANISMS": "registry", "ALGORITHMS": "registry", "SOLVERS": "registry",
+         "inverse_path": "kinematics.branches", "AllSolutions": "kinematics.branches",
+         "PathResult": "kinematics.branches"}
 
 
 def __getattr__(name: str):
@@ -79,6 +81,6 @@ def algorithm(name: str, **params):
 
 
 __all__ = ["FkoptError", "FKProblem", "IKProblem", "Result", "algorithm", "fk_problem", "ik_problem",
-           "mechanism", "solve", "forward", "inverse", "InverseSolver", "inverse_solver",
+           "mechanism", "solve", "forward", "inverse", "inverse_path", "AllSolutions", "PathResult", "InverseSolver", "inverse_solver",
            "InverseOptions", "ForwardResult", "InverseResult",
            "MECHANISMS", "ALGORITHMS", "SOLVERS", "__version__"]

@@ -49,7 +49,8 @@ def _flags_without_type_tag() -> None:
 def _version(value: bool) -> None:
     if value:
         from fkopt import __version__
-        typer.echo(f"fkopt {__version__}")
+        from fkopt.numerics.path import version_line
+        typer.echo(f"fkopt {__version__}; {version_line()}")
         raise typer.Exit()
 
 
@@ -129,8 +130,12 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
                                                      "overrides (for urdf also the .urdf file itself)"),
              as_json: bool = typer.Option(False, "--json", help="print one JSON object instead of "
                                           "tables: {mechanisms, algorithms, origins}, or with MECH its "
-                                          "geometry, bounds, units and names")):
-    """List the mechanisms and algorithms fkopt knows, and where each comes from."""
+                                          "geometry, bounds, units and names"),
+             long: bool = typer.Option(False, "--long", "-l", help="the full tables: each mechanism's pose, "
+                                       "joints and paper, each algorithm's parameters with their defaults, "
+                                       "and where each comes from")):
+    """List the mechanisms and algorithms fkopt knows: their names by kind (--long: pose, joints,
+    parameters and where each comes from)."""
     if mech is not None:
         return _list_mechanism(mech, as_json, geometry)
     if geometry is not None:
@@ -141,6 +146,8 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
                                "origins": {"mechanisms": {e.name: e.origin for e in mechs},
                                            "algorithms": {e.name: e.origin for e in algos}}}))
         return
+    if not long:
+        return _list_names(mechs, algos)
     from rich import box
     from rich.markup import escape
     from rich.table import Table
@@ -178,6 +185,60 @@ def list_cmd(mech: Optional[str] = typer.Argument(None, help="a mechanism: show 
     con.print(table)
     typer.echo("Also: any package.module:Class subclassing fkopt's Mechanism or Algorithm\n"
                "(see docs/plugins.md).")
+
+
+def _list_names(mechs, algos) -> None:
+    """``fkopt list`` without --long: the names, one line per kind, to fit a screen."""
+    import textwrap
+    groups: dict[str, list[str]] = {}
+    notes = []
+    for e in mechs:
+        try:   # class attributes only: listing builds no mechanism
+            m = registry.mechanism_class(e.name)
+        except FkoptError as err:
+            notes.append(f"{e.name}: {err}")
+            continue
+        label = {"parallel": "parallel (fk)", "serial": "serial (ik)"}.get(m.kind, m.kind)
+        groups.setdefault(label, []).append(e.name + ("*" if m.reconstruction else ""))
+    lines = ["mechanisms (fkopt list MECH: its geometry, bounds, units and names)"]
+    lines += _name_lines(groups)
+    groups = {}
+    for e in algos:
+        if e.origin.startswith("adapter"):
+            library = e.name.partition(":")[0]
+            optional = " (optional)" if "optional" in e.origin else ""
+            groups.setdefault(f"{library}{optional}", []).append(e.name)
+            continue
+        if not e.origin.startswith("built-in"):
+            groups.setdefault("plug-ins", []).append(e.name)
+            continue
+        try:
+            cls = registry.algorithm_class(e.name)
+        except FkoptError as err:
+            notes.append(f"{e.name}: {err}")
+            continue
+        entry = getattr(registry, "SOLVERS", {}).get(e.name)       # the registry's facts of the solver
+        kind = ("exact" if getattr(entry, "track", None) == "exact" else "swarm + local" if "+" in e.name
+                else "local" if getattr(cls, "local", False) else "swarm")
+        groups.setdefault(kind, []).append(e.name)
+    lines += ["algorithms (fkopt list --long: their parameters and defaults)"]
+    lines += _name_lines(groups)
+    lines.append("* a reconstruction: the paper does not print the whole model (docs/models.md). Also any "
+                 "package.module:Class subclassing Mechanism or Algorithm (docs/plugins.md).")
+    lines += [f"error: {n}" for n in notes]
+    width = 80
+    out = []
+    for line in lines:
+        indent = " " * (line.index(":") + 2) if line.startswith("  ") and ":" in line else "  "
+        out += textwrap.wrap(line, width, subsequent_indent=indent, break_on_hyphens=False) or [""]
+    typer.echo("\n".join(out))
+
+
+def _name_lines(groups: dict[str, list[str]]) -> list[str]:
+    if not groups:
+        return []
+    wide = max(len(k) for k in groups) + 1
+    return [f"  {(k + ':').ljust(wide)} " + ", ".join(v) for k, v in groups.items()]
 
 
 def unit_groups(names, units) -> str:
@@ -238,7 +299,8 @@ def _list_mechanism(name: str, as_json: bool, geometry: Optional[Path] = None) -
             chain.add_row(escape(j["name"]), j["type"], *(f"{v:g}" if v != "-" else v for v in lim), j["unit"],
                           escape(j["unknown"]), f"{j['multiplier']:g}", f"{j['offset']:g}")
         con.print(chain)
-    geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)")
+    geo = Table(title="default geometry (override with geometry: in YAML or keyword arguments)" if geometry is None
+                else f"geometry: the defaults with the values of {geometry}")
     for col in ("key", "value", "description"):
         geo.add_column(col)
     fields = type(m.geometry).model_fields
@@ -279,9 +341,35 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
                scheduler=scheduler, resume=resume, force=force, quiet=quiet)
 
 
+#: What Ctrl-C ends and how to continue it: set while a config runs, printed by :func:`main`.
+_INTERRUPTED = {"hint": None}
+
+
+def resume_hint(command: str, path, config, out: Path, quick: bool = False) -> str:
+    """The command that continues an interrupted run of ``config``, as it works: studies and
+    suites keep their finished tasks (``.<name>.partial``) and the command the user ran, with
+    ``--resume``, reuses them; an experiment or assembly search keeps none and starts again."""
+    kind = getattr(config, "kind", None) or "experiment"
+    where = "" if out == DEFAULT_OUT else f" --out {out}"
+    if kind in ("study", "suite"):
+        again = f"fkopt {command} {path}{' --quick' if quick else ''}{where} --resume"
+        return f"the finished tasks of this {kind} are kept: {again} continues"
+    return f"an {kind} keeps no finished tasks: fkopt {command} {path}{where} starts it again"
+
+
 def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
-               force: bool, quiet: bool) -> None:
-    """Validate every (path, config) and check every output folder, then run them in order."""
+               force: bool, quiet: bool, command: str = "run", quick: bool = False) -> None:
+    """Validate every (path, config) and check every output folder, then run them in order.
+    Interrupted or failed, it leaves no folder it created empty (``OUT/<paper>/``)."""
+    from fkopt.files import no_empty_folders_left
+    folders = [out, *{out / config.folder_parts[0] for _, config in files}]
+    with no_empty_folders_left(folders):
+        _run_checked(files, out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, force=force,
+                     quiet=quiet, command=command, quick=quick)
+
+
+def _run_checked(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
+                 force: bool, quiet: bool, command: str, quick: bool) -> None:
     from fkopt.run.executors import validate_executor
     import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
     from fkopt.run.pipeline import plan_config, prepare_output, run_config
@@ -300,9 +388,11 @@ def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | N
         planned.append((path, config, plan, tasks))
     con = _console()
     for path, config, plan, tasks in planned:
+        _INTERRUPTED["hint"] = resume_hint(command, path, config, out, quick)
         with _progress(con, config.name, tasks, quiet) as progress:
             outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True,
                                  jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, plan=plan)
+        _INTERRUPTED["hint"] = None
         if not quiet:
             _print_outcome(con, outcome, tasks)
 
@@ -424,7 +514,7 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
     if getattr(cfg, "kind", None) != "study":
         raise FkoptError(f"{config}: not a study file (kind: study); run it with: fkopt run {config}")
     _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler,
-               resume=resume, force=force, quiet=quiet)
+               resume=resume, force=force, quiet=quiet, command="study")
 
 
 @app.command()
@@ -448,7 +538,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
     if quick:
         cfg = cfg.quick_tier(str(config))
     _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,
-               force=force, quiet=quiet)
+               force=force, quiet=quiet, command="suite", quick=quick)
 
 
 SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": "std f",
@@ -456,13 +546,33 @@ SHORT = {"median_fitness": "median f", "mean_fitness": "mean f", "std_fitness": 
          "mean_evaluations": "mean evals"}
 
 
+def summary_rows(df, cols: list[str]) -> tuple[list[list[str]], list[str]]:
+    """The printed cells of a summary and the notes under it. Many cases (more than 8): one row
+    per algorithm, its success the fraction of all runs (the mean of the cases' rates: every
+    case has the same runs) and the other columns medians over the cases -- a median of the
+    cases' success rates printed 0 beside a median iterations to the threshold of the few cases
+    that reached it. A cell with no value (no run reached the threshold) is "-", not nan."""
+    import pandas as pd
+    notes = []
+    if df["case"].nunique() > 8:   # many cases: one line per algorithm
+        cases = df["case"].nunique()
+        how = {c: ("mean" if c == "success_rate" else "median") for c in cols[2:]}
+        df = df.groupby("algorithm", sort=False).agg(how).reset_index()
+        df.insert(0, "case", f"all {cases} cases")
+        notes.append(f"over all {cases} cases: success is the fraction of all runs, the other columns "
+                     "the median over the cases" + (" (med. it→thr: of the cases some run reached the "
+                                                    "threshold in)" if "median_iterations_to_threshold" in cols else ""))
+    rows = [["-" if isinstance(v, float) and pd.isna(v) else f"{v:.3g}" if isinstance(v, float) else str(v)
+             for v in row[cols]] for _, row in df.iterrows()]
+    if any("-" == cell for row in rows for cell in row[2:]):
+        notes.append("-: no value (no run reached the threshold)")
+    return rows, notes
+
+
 def _print_summary(con, df, folder: Path, wall: float) -> None:
     from rich.table import Table
     cols = [c for c in ("case", "algorithm", *SHORT) if c in df]
-    if df["case"].nunique() > 8:   # many cases: one line per algorithm
-        df = df.groupby("algorithm", sort=False).agg({c: "median" for c in cols[2:]}).reset_index()
-        df.insert(0, "case", "median over cases")
-    rows = [[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row[cols]] for _, row in df.iterrows()]
+    rows, notes = summary_rows(df, cols)
     table = Table(title=f"{folder}  ({wall:.2f} s)")
     for j, c in enumerate(cols):
         # values are never cut ("1.54e-…", "succe…"): each column is as wide as its widest value
@@ -472,6 +582,8 @@ def _print_summary(con, df, folder: Path, wall: float) -> None:
     for r in rows:
         table.add_row(*r)
     _print_wide(con, table)
+    for note in notes:
+        con.print(note, markup=False, highlight=False)
 
 
 def _print_wide(con, renderable) -> None:
@@ -494,9 +606,69 @@ def _not_solved(message: str, data: dict, as_json: bool, units) -> None:
     raise typer.Exit(1)
 
 
+#: The rotations ``fkopt ik`` takes for a serial arm's target, by name (degrees; a quaternion unitless).
+ARM_ROTATIONS = {
+    ("alpha", "beta", "gamma"): "Z-Y-Z Euler angles, R = Rz(alpha) Ry(beta) Rz(gamma) (fkopt fk prints these)",
+    ("roll", "pitch", "yaw"): "R = Rz(yaw) Ry(pitch) Rx(roll), as URDF composes rpy",
+    ("qw", "qx", "qy", "qz"): "a unit quaternion (normalised)",
+}
+
+
+def _rotation_counts(mask: Optional[str]) -> bool:
+    """Whether the orientation is part of the task (--mask names rx, ry or rz, or no --mask)."""
+    return mask is None or any(part.strip() in ("rx", "ry", "rz") for part in mask.split(","))
+
+
+def arm_target(m, given: dict[str, float], rotation: bool) -> np.ndarray:
+    """The tip frame (4, 4) of a serial arm's ``--pose``: x, y, z and one rotation of
+    :data:`ARM_ROTATIONS` by name (none when ``rotation`` is False: the identity, which no
+    error then counts). Every refusal is one line naming what is allowed."""
+    from fkopt.numerics import rotations
+    names = set(given)
+    allowed = ["x", "y", "z", *(n for group in ARM_ROTATIONS for n in group)]
+    unknown = sorted(names - set(allowed))
+    if unknown:
+        from fkopt.files import did_you_mean
+        raise FkoptError(f"--pose: unknown name '{unknown[0]}'{did_you_mean(unknown[0], allowed)}; {m.name} takes "
+                         "x, y, z and one rotation: " + "; ".join(", ".join(g) for g in ARM_ROTATIONS))
+    missing = [n for n in ("x", "y", "z") if n not in names]
+    if missing:
+        raise FkoptError(f"--pose: missing {', '.join(missing)} (the tip position, {m.pose_units[0]})")
+    groups = [g for g in ARM_ROTATIONS if names & set(g)]
+    if len(groups) > 1:
+        raise FkoptError("--pose: give one rotation, not " + " and ".join("/".join(g) for g in groups))
+    if not groups and rotation:
+        raise FkoptError("--pose: missing the rotation: " + "; or ".join(", ".join(g) for g in ARM_ROTATIONS)
+                         + " (or --mask x,y,z for the position only)")
+    T = np.eye(4)
+    T[:3, 3] = [given["x"], given["y"], given["z"]]
+    if groups:
+        group = groups[0]
+        absent = [n for n in group if n not in names]
+        if absent:
+            raise FkoptError(f"--pose: {', '.join(group)} go together; missing {', '.join(absent)}")
+        v = [given[n] for n in group]
+        if group[0] == "qw":
+            if not math.isclose(math.sqrt(sum(c * c for c in v)), 1.0, abs_tol=1e-3):
+                raise FkoptError(f"--pose: qw, qx, qy, qz must be a unit quaternion (norm 1 within 1e-3), "
+                                 f"got norm {math.sqrt(sum(c * c for c in v)):.6g}")
+            R = rotations.quaternion_matrix(*v)
+        elif group[0] == "roll":
+            R = rotations.zyx(*np.radians(v))
+        else:
+            R = rotations.zyz(*np.radians(v))
+        T[:3, :3] = rotations.to_array(R)
+    return T
+
+
 @app.command()
 def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
-       pose: str = typer.Option(..., "--pose", help="e.g. alpha=9,beta=13,z=622"),
+       pose: str = typer.Option(..., "--pose", help="parallel mechanism: its pose names (fkopt list MECH), e.g. "
+                                "alpha=9,beta=13,z=622. Serial arm: x, y, z (its length unit) and one rotation "
+                                "in degrees: alpha, beta, gamma (Z-Y-Z Euler, R = Rz(alpha) Ry(beta) Rz(gamma), "
+                                "as fkopt fk prints), or roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll), as "
+                                "URDF composes rpy), or qw, qx, qy, qz (a unit quaternion); no rotation with "
+                                "--mask x,y,z"),
        geometry: Optional[Path] = typer.Option(None, "--geometry", help="YAML file of geometry overrides "
                                                "(urdf: also the .urdf itself)"),
        algorithm: Optional[str] = typer.Option(None, "--algorithm", help="a registered swarm/local solver for "
@@ -511,13 +683,27 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
        orientation_tol: float = typer.Option(1e-6, "--orientation-tol", help="largest accepted geodesic "
                                              "orientation error (radians)"),
        as_json: bool = typer.Option(False, "--json", help="print one JSON object: joints, position_error "
-                                    "(length unit of the arm), rotation_error_rad, solved, ...")):
+                                    "(length unit of the arm), rotation_error_rad, solved, ..."),
+       all_solutions: bool = typer.Option(False, "--all-solutions", help="every solution of the pose inside "
+                                          "the limits (fkopt.inverse solutions='all'; tolerances 1e-9 unless "
+                                          "given)"),
+       fixed: Optional[str] = typer.Option(None, "--fixed", help="with --all-solutions: joints locked at "
+                                           "values, e.g. q3=20 (a redundant arm)"),
+       spread: Optional[int] = typer.Option(None, "--spread", min=1, help="with --all-solutions: samples "
+                                            "per locked joint of a redundant arm's self-motion")):
     """Inverse kinematics: closed form for a parallel mechanism, fkopt.inverse for a serial arm.
 
     Exit 1 (one line on stderr) when the answer is not a solution within the tolerances; exit 2
     for bad input (non-finite values, a pose outside the workspace or beyond the arm's reach)."""
     m = _mechanism(mech, geometry)
-    values = m.as_values(parse_assignments(pose, "--pose"), m.pose_names, "--pose")
+    given = parse_assignments(pose, "--pose")
+    serial_frame = m.kind != "parallel" and tuple(m.pose_names[3:]) == ("alpha", "beta", "gamma")
+    rotation = _rotation_counts(mask)
+    if serial_frame:
+        target = arm_target(m, given, rotation)
+        values = m.as_values(np.concatenate([target[:3, 3], [0.0, 0.0, 0.0]]), m.pose_names, "--pose")
+    else:
+        values = m.as_values(given, m.pose_names, "--pose")
     if m.kind == "parallel":
         if algorithm:
             raise FkoptError(f"--algorithm: '{mech}' has a closed-form inverse map; no solver is used")
@@ -534,8 +720,20 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
             raise FkoptError(f"{name}: must be a positive number, got {value}")
     if algorithm and (start or mask):
         raise FkoptError(f"{'--start' if start else '--mask'}: only with fkopt.inverse (drop --algorithm)")
+    if (fixed or spread) and not all_solutions:
+        raise FkoptError(f"{'--fixed' if fixed else '--spread'}: only with --all-solutions")
+    if all_solutions:
+        if algorithm or start:
+            raise FkoptError(f"{'--algorithm' if algorithm else '--start'}: not with --all-solutions")
+        _ik_all(m, target if serial_frame else values, seed, mask, position_tol, orientation_tol, fixed, spread,
+                as_json)
+        return
     if algorithm:
         from fkopt.kinematics.by_algorithm import inverse_by
+        if serial_frame:       # the swarms' objective takes Z-Y-Z angles: the target's, exactly as given
+            from fkopt.numerics.rotations import zyz_angles
+            R = target[:3, :3]
+            values = np.concatenate([target[:3, 3], np.degrees(zyz_angles(tuple(tuple(r) for r in R)))])
         out = inverse_by(m, values, algorithm, tol=(position_tol, orientation_tol), seed=seed).as_dict()
         out.pop("restarts")
         out["objective"] = "geodesic"
@@ -546,19 +744,47 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         q0 = None if start is None else m.as_values(parse_assignments(start, "--start"), m.joint_names, "--start")
         # One pose per process: loading numba and its cache (~0.7 s) costs more than the compiled
         # loop saves, so the command keeps the reference path (fkopt.numerics.path).
-        r = inverse(m, values, tol=(position_tol, orientation_tol), seed=seed, start=q0, mask=mask,
-                    compiled=False)
+        r = inverse(m, target if serial_frame else values, tol=(position_tol, orientation_tol), seed=seed,
+                    start=q0, mask=mask, compiled=False)
         out = r.as_dict()
         out["algorithm"] = "inverse"
         perr, rerr = out["position_error"], out["rotation_error_rad"]
     unit = m.pose_units[0]
+    if not rotation:            # --mask without rx, ry, rz: no rotation was sought, so none is reported
+        out.pop("rotation_error_rad", None)
     if not out["solved"]:
-        _not_solved(f"no joints within the limits reach this pose: best position error {perr:.3g} {unit}, "
-                    f"orientation error {rerr:.3g} rad (tolerances {position_tol:g} {unit}, "
-                    f"{orientation_tol:g} rad)", out, as_json, m.joint_units)
+        turn = f", orientation error {rerr:.3g} rad" if rotation else ""
+        tols = f"{position_tol:g} {unit}" + (f", {orientation_tol:g} rad" if rotation else "")
+        _not_solved(f"no joints within the limits reach this pose: best position error {perr:.3g} {unit}"
+                    f"{turn} (tolerance{'s' if rotation else ''} {tols})", out, as_json, m.joint_units)
     _emit(out, as_json, m.joint_units,
           notes={"position_error": f"{unit} (residual: tool position |fk(q) - target|)",
                  "rotation_error_rad": "rad (residual: geodesic orientation error)"})
+
+
+def _ik_all(m, values, seed, mask, position_tol, orientation_tol, fixed, spread, as_json) -> None:
+    """``fkopt ik --all-solutions``: every solution (fkopt.kinematics.branches), one line each or one JSON
+    object; exit 1 when there is none inside the limits."""
+    from fkopt.kinematics import inverse
+    given = (position_tol, orientation_tol) != (1e-6, 1e-6)          # the command's defaults
+    locked = None if fixed is None else parse_assignments(fixed, "--fixed")
+    extra = {k: v for k, v in (("fixed", locked), ("spread", spread)) if v is not None}
+    r = inverse(m, values, solutions="all", tol=(position_tol, orientation_tol) if given else None, mask=mask,
+                seed=seed, **extra)
+    data = r.as_dict()
+    data["count"] = len(r)
+    if not len(r):
+        _not_solved(f"no solution of this pose inside the joint limits (searched {r.search['starts']} starts; "
+                    f"{r.search['out_of_limits']} solutions outside the limits)", data, as_json, m.joint_units)
+    if as_json:
+        typer.echo(strict_json(data))
+        return
+    unit = m.pose_units[0]
+    typer.echo(f"{len(r)} solutions inside the limits ({', '.join(m.joint_names)}; "
+               f"{', '.join(m.joint_units)}), each verified to {r.tol[0]:g} {unit} / {r.tol[1]:g} rad:")
+    for row, pe, re in zip(r.solutions, r.position_error, r.rotation_error):
+        typer.echo("  " + "  ".join(f"{v:11.6f}" for v in row) + f"   ({pe:.1e} {unit}, {re:.1e} rad)")
+    typer.echo(f"search: {r.search['rule']}; {r.search['starts']} starts")
 
 
 @app.command()
@@ -670,7 +896,7 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
                                    "(the committed measurements are rewritten only with --out bench)"),
           section: list[str] = typer.Option([], "--section", help="run only these sections (repeatable): "
                                             "throughput, mao2017, peers, adapters, exact, kinematics, "
-                                            "ik-one-pose, ik-batch, cases, swarms, scaling (default: all but peers "
+                                            "ik-one-pose, ik-batch, cases, swarms, fksgp, scaling (default: all but peers "
                                             "and adapters)")):
     """Measure fkopt's speed (and peers') on this machine.
 
@@ -697,14 +923,24 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
 
 @app.command()
 def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="folder of experiment files"),
-              out: Path = typer.Option(Path("results"), "--out", help="results root"),
+              out: Path = typer.Option(DEFAULT_OUT / "reproduce", "--out", help="results root written (default: a "
+                                       "git-ignored folder of its own; --out results rewrites the stored "
+                                       "results, as make reproduce does)"),
+              stored: Path = typer.Option(Path("results"), "--compare-with", help="the stored results the new "
+                                          "files are compared with (the closing line and OUT/CHANGES.md)"),
               jobs: Optional[int] = typer.Option(None, "--jobs", "-j", help="worker processes for the "
                                                  "experiments' solves (default: the CPUs available; "
                                                  "1: all in this process); timings are measured "
                                                  "afterwards, one at a time"),
               quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress bars and no "
                                          "closing table; errors are still printed")):
-    """Run every experiment under CONFIGS, rewrite OUT and its REPORT.md, TIMING.md, index.csv."""
+    """Run every experiment under CONFIGS into OUT (REPORT.md, TIMING.md, index.csv, CHANGES.md) and
+    compare them with the stored results.
+
+    By default OUT is fkopt-results/reproduce/ (git-ignored), so the tracked results/ stay as
+    they are; the last line says how many deterministic files moved from the stored ones and
+    whether fkopt check's cross-platform rules accept them. --out results rewrites the stored
+    results (make reproduce)."""
     import time
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
@@ -718,8 +954,14 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     from fkopt.reproduce.changes import agreement
     planned = plan(configs, out)        # every file validated, every output checked: nothing run yet
     kept = tempfile.TemporaryDirectory(prefix="fkopt-reproduce-")   # the old files, to judge what moved
-    before = snapshot(out, keep=Path(kept.name))    # what the tree held, for CHANGES.md
+    in_place = out.resolve() == stored.resolve()
+    # what the stored tree held, for CHANGES.md and the closing line: in place, the whole tree;
+    # into a folder of its own, the stored results of the configs rerun (nothing else is compared)
+    before = snapshot(stored, keep=Path(kept.name),
+                      only=None if in_place else {"/".join(p.config.folder_parts) for p in planned})
     con = _console()
+    _INTERRUPTED["hint"] = ("the configs finished so far are written; fkopt reproduce"
+                            + ("" if out == DEFAULT_OUT / "reproduce" else f" --out {out}") + " starts again")
     start = time.perf_counter()
     heart = _Heartbeat(con, quiet=quiet)
     with Progress(TextColumn("{task.fields[name]}"), BarColumn(), MofNCompleteColumn(),
@@ -776,6 +1018,9 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
         con.print(table)
         con.print("report: " + ", ".join(str(p) for p in paths))
     con.print(agreement(before, out, written.after), highlight=False, markup=False)   # even with -q: what a newcomer must know
+    if not in_place:
+        con.print(f"reproduce: wrote {out}/ (REPORT.md, CHANGES.md); the stored {stored}/ is unchanged "
+                  f"(fkopt reproduce --out {stored} rewrites it)", highlight=False, markup=False)
     kept.cleanup()
 
 
@@ -898,8 +1143,9 @@ _reflowed_help()
 
 def main() -> None:
     """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
-    interrupted = ("fkopt: interrupted (previous results are kept; the finished tasks of a "
-                   "study are kept too: fkopt study CONFIG --resume continues)")
+    def interrupted() -> str:
+        hint = _INTERRUPTED["hint"]
+        return "fkopt: interrupted (previous results are kept" + (f"; {hint})" if hint else ")")
 
     def fail(message: str) -> None:
         from fkopt.files import one_line
@@ -913,7 +1159,7 @@ def main() -> None:
     except FkoptError as err:
         fail(str(err))
     except KeyboardInterrupt:
-        print(interrupted, file=sys.stderr)
+        print(interrupted(), file=sys.stderr)
         sys.exit(130)
     except MemoryError:
         fail("out of memory; reduce runs, population, iterations or cases")
@@ -929,13 +1175,13 @@ def main() -> None:
         if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
             fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
         if kind == "Abort":
-            print("fkopt: interrupted", file=sys.stderr)
+            print(interrupted(), file=sys.stderr)
             sys.exit(130)
         if callable(getattr(err, "format_message", None)):
             fail(f"{err.format_message()} (see fkopt --help)")
         raise
     if code == 130:   # typer (>= 0.12) turns Ctrl-C into a returned 130 when not standalone
-        print(interrupted, file=sys.stderr)
+        print(interrupted(), file=sys.stderr)
         sys.exit(130)
     if isinstance(code, int) and code:
         sys.exit(code)

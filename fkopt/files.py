@@ -118,9 +118,23 @@ def _loader():
                         None, None, f"duplicate key '{key}' (first at line {seen[key] + 1})",
                         key_node.start_mark)
                 seen[key] = key_node.start_mark.line
+            for key_node, value_node in node.value:      # a non-finite number names its field
+                if value_node.tag == "tag:yaml.org,2002:float":
+                    try:
+                        self.construct_yaml_float(value_node)
+                    except yaml.constructor.ConstructorError as err:
+                        raise yaml.constructor.ConstructorError(
+                            None, None, f"{self.construct_object(key_node, deep=True)}: {err.problem}",
+                            value_node.start_mark) from None
             return super().construct_mapping(node, deep=deep)
 
     Loader.add_constructor("tag:yaml.org,2002:float", Loader.construct_yaml_float)
+    # YAML 1.2's floats without a dot (1e-10, 2E5), which PyYAML (YAML 1.1) reads as text: a file
+    # writes `threshold: 1e-10` and means a number, and text is refused where a number belongs
+    # (no_quoted_numbers), so a quoted "300" stays text and is refused with one line
+    import re as _re
+    Loader.add_implicit_resolver("tag:yaml.org,2002:float", _re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"),
+                                 list("-+0123456789"))
     return Loader
 
 
@@ -236,6 +250,121 @@ def read_input(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str
         what = "truncated gzip (ends early)" if isinstance(err, EOFError) else "not a valid gzip file"
         raise FkoptError(f"{where}: {what}") from None
     return b"".join(chunks)
+
+
+#: Most columns of a CSV fkopt reads (the header's fields and any row's): pandas spends ~4.5 kB per
+#: header column before it reads a row, so a 256 KiB line of commas took ~1.3 GB (issue 42). fkopt's
+#: widest CSV has 36 columns.
+MAX_CSV_COLUMNS = 1024
+#: Longest line of a CSV fkopt reads (bytes); fkopt's longest is 590 bytes.
+MAX_CSV_LINE = 64 * 1024
+#: Most cells (fields over all rows) of a CSV fkopt reads: bounds pandas' memory (8 bytes per
+#: number, one object per distinct text cell) whatever the bytes; kinbench v3's trace, the
+#: largest fkopt writes, holds 8.7 million.
+MAX_CSV_CELLS = 24_000_000
+
+
+def check_csv_shape(data: bytes, where: str) -> None:
+    """Refuse, with one line naming ``where``, CSV bytes whose parsing would take memory out of
+    proportion to their size, before pandas sees them: a line longer than :data:`MAX_CSV_LINE`
+    bytes, a line (the header or a row: pandas turns a row wider than the header into index
+    levels, 4.6 GB for 2,000 rows of 65,000 commas) of more than :data:`MAX_CSV_COLUMNS` fields,
+    a quoted field spanning lines (a row of many lines would escape both bounds), more than
+    :data:`MAX_CSV_CELLS` cells. Scanned with numpy in blocks of whole lines (a few bytes of
+    scratch per byte of a block, never of the whole file)."""
+    arr = np.frombuffer(data, dtype=np.uint8)
+    size = len(arr)
+    start, line_no, cells = 0, 1, 0      # first byte of the block (a line start), its line number
+    block = 1 << 23
+    while start < size:
+        stop = min(size, start + block)
+        if stop < size:                  # end the block after a newline (a line is at most MAX_CSV_LINE)
+            cut = np.flatnonzero(arr[stop: min(size, stop + MAX_CSV_LINE + 1)] == 10)
+            if not len(cut):
+                raise FkoptError(f"{where}: line near {line_no}: longer than {MAX_CSV_LINE} bytes, the longest "
+                                 "accepted in a CSV; refused (memory stays bounded)")
+            stop += int(cut[0]) + 1
+        chunk = arr[start:stop]
+        ends = np.flatnonzero(chunk == 10)
+        if not len(ends) or ends[-1] != len(chunk) - 1:
+            ends = np.append(ends, len(chunk))          # the last line has no newline
+        starts = np.concatenate(([0], ends[:-1] + 1))
+        lengths = ends - starts
+        too_long = np.flatnonzero(lengths > MAX_CSV_LINE)
+        if len(too_long):
+            raise FkoptError(f"{where}: line {line_no + int(too_long[0])}: {int(lengths[too_long[0]])} bytes, longer "
+                             f"than the {MAX_CSV_LINE} accepted in a CSV; refused (memory stays bounded)")
+        # only a line of at least MAX_CSV_COLUMNS - 1 bytes can hold that many commas: count those alone
+        for k in np.flatnonzero(lengths >= MAX_CSV_COLUMNS - 1):
+            fields = int(np.count_nonzero(chunk[starts[k]:ends[k]] == 44)) + 1
+            if fields > MAX_CSV_COLUMNS:
+                what = "header" if line_no + k == 1 else f"line {line_no + int(k)}"
+                raise FkoptError(f"{where}: {what}: {fields} fields, more than the {MAX_CSV_COLUMNS} columns "
+                                 "accepted in a CSV; refused (memory stays bounded)")
+        quotes = np.flatnonzero(chunk == 34)
+        if len(quotes):                                 # none may leave a field open across lines
+            per_line = np.bincount(np.searchsorted(ends, quotes), minlength=len(ends))
+            odd = np.flatnonzero(per_line % 2)
+            if len(odd):
+                raise FkoptError(f"{where}: unreadable CSV (line {line_no + int(odd[0])}: a quoted field spans "
+                                 "lines, which fkopt does not accept)")
+        cells += int(np.count_nonzero(chunk == 44)) + int(np.count_nonzero(lengths))
+        if cells > MAX_CSV_CELLS:
+            raise FkoptError(f"{where}: more than {MAX_CSV_CELLS} cells, the most accepted in a CSV; refused "
+                             "(memory stays bounded)")
+        line_no += len(ends)
+        start = stop
+
+
+def parse_csv(data: bytes, where: str, **options):
+    """A pandas DataFrame of the CSV bytes of a file fkopt did not write in this run (``where``
+    names it), after :func:`check_csv_shape`: the one way fkopt parses such a CSV. Empty or
+    malformed CSV is one line naming ``where``; ``options`` go to ``pandas.read_csv``."""
+    import pandas as pd
+    check_csv_shape(data, where)
+    try:
+        return pd.read_csv(io.BytesIO(data), **options)
+    except pd.errors.EmptyDataError:
+        raise FkoptError(f"{where}: unreadable CSV (empty: no header)") from None
+    except (ValueError, OverflowError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        raise FkoptError(f"{where}: unreadable CSV ({type(err).__name__}: {one_line(str(err), 120)})") from None
+
+
+def read_csv(path: str | Path, max_bytes: int = MAX_INPUT_BYTES, *, field: str | None = None,
+             within: str | Path | None = None, unpacked: int | None = None, **options):
+    """A CSV (``.csv`` or ``.csv.gz``) fkopt did not write in this run, bounded in bytes
+    (:func:`read_input`) and in memory (:func:`parse_csv`); every refusal one line naming it."""
+    data = read_input(path, max_bytes, field=field, within=within, unpacked=unpacked)
+    return parse_csv(data, _where(Path(path), field), **options)
+
+
+def read_stored_csv(folder: str | Path, name: str | Path, **options):
+    """A CSV of a stored result (``folder/name``) read back: :func:`read_stored`'s bounds, then
+    :func:`parse_csv`'s."""
+    return parse_csv(read_stored(folder, name), str(Path(folder) / name), **options)
+
+
+def csv_numbers(column) -> np.ndarray:
+    """A CSV column as float64, never raising: text and empty cells become NaN, an integer too
+    long for a double (400 digits) +-inf -- so the caller's range check refuses it with one line
+    (``pd.to_numeric`` raises OverflowError on such an integer once pandas made it a Python int)."""
+    import pandas as pd
+    s = column if isinstance(column, pd.Series) else pd.Series(column)
+    if s.dtype == object:
+        s = s.map(lambda v: v if isinstance(v, str) or v is None or isinstance(v, float) else str(v))
+    try:
+        return pd.to_numeric(s, errors="coerce").to_numpy(dtype=float)
+    except (OverflowError, TypeError, ValueError):
+        return np.array([_to_float(v) for v in s], dtype=float)
+
+
+def _to_float(value) -> float:
+    try:
+        return float(value)
+    except OverflowError:
+        return float("inf") if value > 0 else float("-inf")
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str | None = None,
@@ -412,6 +541,76 @@ def field_names_at(model, loc: list[str]) -> list[str]:
     return sorted(set(names))
 
 
+def _numeric_only(annotation) -> bool:
+    """Whether a field's type takes numbers (int, float, bool; Optional of them) and no text."""
+    import typing
+    if annotation in (int, float, bool):
+        return True
+    args = typing.get_args(annotation)
+    origin = typing.get_origin(annotation)
+    if origin is typing.Annotated:
+        return _numeric_only(args[0])
+    if origin in (typing.Union, getattr(__import__("types"), "UnionType", None)) and args:
+        kinds = [a for a in args if a is not type(None)]
+        return bool(kinds) and all(_numeric_only(a) for a in kinds)
+    return False
+
+
+def no_quoted_numbers(cls, value, info):
+    """A pydantic ``field_validator("*", mode="before")``: text where a number belongs is refused
+    (``iterations: "300"``), as a YAML file means a number only unquoted; pydantic's lax mode
+    would turn "300" into 300 silently. Lists of numbers are checked item by item. Fields that
+    also take text (a union with str or a Literal) keep it."""
+    import typing
+    field = cls.model_fields.get(info.field_name) if info.field_name else None
+    if field is None:
+        return value
+    annotation = field.annotation
+    items = None
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if typing.get_origin(annotation) is typing.Union or type(None) in args:    # Optional[list[float]]
+        kinds = [a for a in args if a is not type(None)]
+        if len(kinds) == 1:
+            annotation = kinds[0]
+            origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if origin in (list, tuple) and args:
+        inner = [a for a in args if a is not Ellipsis]
+        if inner and all(_numeric_only(a) for a in inner) and isinstance(value, (list, tuple)):
+            items = value
+    elif origin is dict and len(args) == 2 and _numeric_only(args[1]) and isinstance(value, dict):
+        items = list(value.values())
+    if isinstance(value, str) and _numeric_only(annotation):
+        raise ValueError(_text_for_number(value, "a number"))
+    for v in items or ():
+        if isinstance(v, str):
+            raise ValueError(_text_for_number(v, "numbers"))
+    return value
+
+
+def _text_for_number(text: str, wanted: str) -> str:
+    import math
+    try:
+        number = float(text)
+    except ValueError:
+        return f"needs {wanted}, got the text {short_token(repr(text))}"
+    if not math.isfinite(number):
+        return f"needs {wanted} (finite), got the text {short_token(repr(text))}"
+    return f"needs {wanted}, got the text {short_token(repr(text))} (write it without quotes)"
+
+
+def field_path(loc) -> str:
+    """A field's path as every message of fkopt writes it: names joined by dots, list items by
+    index in brackets (``cases[0].pose``, ``algorithms[1].params.limit``), from a pydantic
+    error's ``loc`` (list indices are ints there)."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
 def did_you_mean(word: str, names) -> str:
     """`` (did you mean 'x'?)`` for the closest of ``names`` (difflib, as the CLI's options), else ``""``."""
     import difflib
@@ -454,11 +653,12 @@ def error_line(err, branches: dict[str, dict[str, str]] | None = None, data: dic
             union = branch in tags or branch.startswith("list[")
             if union and not branch.startswith(wanted[loc[0]]):
                 continue
-        loc = [p for p in loc if p not in tags and not p.startswith(("function-", "list[", "literal["))]
+        loc = [p for p in e["loc"] if isinstance(p, int)
+               or (p not in tags and not str(p).startswith(("function-", "list[", "literal[")))]
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
             msg = "unknown field" + (hint.get(id(e)) or "")
-        return f"{'.'.join(loc)}: {msg}" if loc else msg
+        return f"{field_path(loc)}: {msg}" if loc else msg
     return str(err).splitlines()[0]
 
 
@@ -547,6 +747,23 @@ def output_folder(out: str | Path, *parts: str, option: str = "--out") -> Path:
     except OSError as err:
         raise FkoptError(f"{option}: cannot write into {parent} ({err.strerror or err})") from None
     return target
+
+
+@contextlib.contextmanager
+def no_empty_folders_left(folders):
+    """Run the block; if it fails (an error, Ctrl-C), remove those of ``folders`` that did not
+    exist before it and are empty after it (deepest first): an interrupted fresh run leaves no
+    empty ``OUT/<paper>/`` behind. A folder holding anything is never touched."""
+    fresh = sorted({Path(f) for f in folders if not Path(f).exists()}, key=lambda p: -len(p.parts))
+    try:
+        yield
+    except BaseException:
+        for folder in fresh:
+            try:
+                folder.rmdir()            # only an empty folder: rmdir refuses anything else
+            except OSError:
+                pass
+        raise
 
 
 # -- atomic writes ---------------------------------------------------------------------------------

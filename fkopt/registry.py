@@ -349,7 +349,8 @@ def _load(table: dict[str, type], kind: str, name: str):
                              "--allow-plugins imports it, if you trust the results folder)")
         return check_class(_import_target(name, kind, name), kind, name)
     allowed = did_you_mean(name, [*table, *eps])
-    raise FkoptError(f"unknown {kind} '{name}'; allowed: {allowed}, "
+    from fkopt.files import did_you_mean as closest     # the one "did you mean" of field names too
+    raise FkoptError(f"unknown {kind} '{name}'{closest(name, [*table, *eps])}; allowed: {allowed}, "
                      + ("scipy:NAME, pymoo:NAME, niapy:NAME, " if kind == "algorithm" else "")
                      + "or package.module:Class of an installed plug-in")
 

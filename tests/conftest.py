@@ -72,9 +72,16 @@ def cli(monkeypatch, capsys):
 # that no longer exists in its (collected) file is a usage error, not a silent no-op.
 FAST_TIER = "not slow and not stored and not external and not browser"
 TIERS = {
+    "tests/test_bench_fksgp.py::test_beside_fksgp_every_platform_gives_the_same_real_solutions": ("external",),
+    "tests/test_numerics_fallback.py::test_every_kind_of_corrupted_cache_file_is_set_aside_and_rebuilt": ("slow",),
+    "tests/test_all_solutions.py::test_all_solutions_recall_against_eaik_on_the_ur5": ("external",),
     "tests/test_bench_ik.py::test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones": ("external",),
     "tests/test_bench_ik.py::test_ik_sections_report_every_arm_ratios_and_verified_counts": ("external",),
     "tests/test_kinbench_v3.py::test_fkopt_check_rejudges_every_stored_answer_and_recomputes_the_board": ("slow",),
+    "tests/test_hostile_readers.py::test_check_fails_a_board_whose_answers_are_missing_duplicated_extra_or_unreadable":
+        ("slow",),
+    "tests/test_hostile_readers.py::test_fkopt_check_of_a_board_whose_answers_are_not_gzip_names_the_file_and_exits_1":
+        ("slow",),
     "tests/test_kinbench_v3.py::test_a_suite_with_tracks_writes_the_robot_board_and_every_answer": ("slow",),
     "tests/test_kinbench_v3.py::test_fk_of_a_parallel_mechanism_on_the_clock_counts_other_assembly_modes_apart":
         ("slow",),
@@ -124,6 +131,9 @@ TIERS = {
     "tests/test_urdf.py::test_real_robot_jacobian_matches_finite_differences": ("external",),
     "tests/test_cli.py::test_run_is_deterministic": ("slow",),
     "tests/test_kinbench_pages.py::test_fkopt_pages_remakes_a_stored_board_from_its_files_alone": ("slow", "stored"),
+    "tests/test_newcomer.py::test_ctrl_c_of_a_fresh_experiment_names_a_rerun_and_leaves_no_empty_folder":
+        ("external",),
+    "tests/test_newcomer.py::test_ctrl_c_of_a_study_names_the_command_that_resumes_it": ("external",),
     "tests/test_export.py::test_export_refuses_what_it_must_not_touch": ("slow",),
 }
 TIER_MARKERS = ("slow", "stored", "external", "browser")

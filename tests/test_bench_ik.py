@@ -85,4 +85,12 @@ def test_ik_sections_report_every_arm_ratios_and_verified_counts(ur5, monkeypatc
     assert "same joints as the solver 20/20" in got[("ik-one-pose", "ur5")]["note"]
     assert "rtb DHRobot FK" in got[("ik-batch", "wang7dof")]["note"]
     assert got[("ik-batch", "ur5")]["note"].endswith("fkopt reported solved but not: 0")
+    # issue 38: the rates of the batch, wall and per CPU-second, with the load they were measured under
+    for arm in ("ur5", "wang7dof"):
+        wall, cpu = got[("ik-batch", f"{arm} IK/s wall")], got[("ik-batch", f"{arm} IK per CPU-second")]
+        assert wall["unit"] == cpu["unit"] == "IK/s" and wall["value"] > 0 and cpu["value"] > 0
+        assert "load average" in wall["note"] and "verified" in wall["note"]
+    assert "load average" in got[("ik-one-pose", "median over arms")]["note"]
+    assert got[("ik-one-pose", "median over arms")]["note"].startswith("fkopt.inverse(arm, pose) per call")
+    assert ("ik-one-pose", "prepared solver: median over arms") in got
     assert not msgs

@@ -120,7 +120,7 @@ def test_run_is_deterministic(tmp_path):
     ({"mechanism": {"name": "4-rps"}}, ["unknown mechanism '4-rps'", "3-rps"]),
     ({"algorithms": [{"name": "bee"}]}, ["unknown algorithm 'bee'", "gabc"]),
     ({"algorithms": [{"name": "abc", "params": {"limit": -1}}]}, ["'limit'", "parameters: limit"]),
-    ({"algorithms": [{"name": "abc", "colour": 1}]}, ["algorithms.0.colour", "unknown field"]),
+    ({"algorithms": [{"name": "abc", "colour": 1}]}, ["algorithms[0].colour", "unknown field"]),
     ({"mechanism": {"name": "3-rps", "bounds": {"z": [700, 400]}}}, ["bounds.z", "lower 700"]),
     ({"cases": [{"pose": {"alpha": 9, "beta": 13, "z": 900}}]}, ["cases[0].pose", "z=900", "[400, 700]"]),
     ({"cases": [{"pose": {"alpha": 9, "beta": 13}}]}, ["missing z"]),

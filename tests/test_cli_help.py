@@ -17,8 +17,8 @@ ROOT = Path(__file__).resolve().parent.parent
 COMMANDS = typer.main.get_command(cli.app).commands
 
 
-def fkopt(*args, cwd=None, columns=200):
-    env = dict(os.environ, COLUMNS=str(columns), PYTHONPATH=os.pathsep.join(
+def fkopt(*args, cwd=None, columns=200, env=None):
+    env = dict(os.environ, **(env or {}), COLUMNS=str(columns), PYTHONPATH=os.pathsep.join(
         filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
     return subprocess.run([sys.executable, "-m", "fkopt.cli", *args], capture_output=True, text=True,
                           cwd=cwd, env=env, timeout=300)
@@ -26,8 +26,14 @@ def fkopt(*args, cwd=None, columns=200):
 
 def test_version():
     import fkopt as package
-    proc = fkopt("--version")
-    assert proc.returncode == 0 and proc.stdout.strip() == f"fkopt {package.__version__}"
+    proc = fkopt("--version", env={"FKOPT_NUMERICS": "auto"})
+    from importlib.metadata import version
+    assert proc.returncode == 0, proc.stderr
+    # the version, the numerics path a default call takes here and the compiler's version (issue 38)
+    assert proc.stdout.strip() == (f"fkopt {package.__version__}; numerics: compiled (numba {version('numba')}, "
+                                   f"llvmlite {version('llvmlite')})")
+    proc = fkopt("--version", env={"FKOPT_NUMERICS": "numpy"})
+    assert proc.stdout.strip() == f"fkopt {package.__version__}; numerics: numpy (FKOPT_NUMERICS=numpy)"
 
 
 def test_bare_fkopt_prints_help_and_succeeds():
@@ -83,11 +89,13 @@ def test_fk_says_which_stage_found_the_pose():
 
 
 def test_list_fits_80_columns():
-    proc = fkopt("list", columns=80)
-    assert proc.returncode == 0
-    wide = [line for line in proc.stdout.splitlines() if len(line) > 80]
-    assert not wide, wide[:2]
-    assert "3-rpupc-ups" in proc.stdout and "q1..q7 [deg]" in proc.stdout
+    for args in (["list"], ["list", "--long"]):
+        proc = fkopt(*args, columns=80)
+        assert proc.returncode == 0
+        wide = [line for line in proc.stdout.splitlines() if len(line) > 80]
+        assert not wide, wide[:2]
+        assert "3-rpupc-ups" in proc.stdout
+    assert "q1..q7 [deg]" in proc.stdout                      # --long: the units of each name
 
 
 def test_unit_groups():

@@ -102,7 +102,7 @@ def test_ticks_map_a_chunk_onto_its_share_of_the_batch():
 @pytest.mark.parametrize("edit, expected", [
     ({"algoritms": [{"name": "gabc"}]}, "algoritms: unknown field (did you mean 'algorithms'?)"),
     ({"algorithms": [{"name": "gabc", "populaton": 3}]},
-     "algorithms.0.populaton: unknown field (did you mean 'population'?)"),
+     "algorithms[0].populaton: unknown field (did you mean 'population'?)"),
     ({"cases": {"random": 3, "sed": 2}}, "cases.sed: unknown field (did you mean 'seed'?)"),
     ({"cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}, {"random": 3}]},
      "cases: item 1 is {random: ...}: cases is either a list of cases"),
@@ -141,4 +141,4 @@ def test_a_rerun_with_another_config_names_the_field_that_changed(cli, tmp_path)
     config["algorithms"][0]["population"] = 6
     path.write_text(yaml.safe_dump(config))
     code, out, err = cli("run", path, "--out", tmp_path / "out", "-q")
-    assert code == 2 and "algorithms.0.population: 4 -> 6; runs: 2 -> 3); rerun with --force" in err, err
+    assert code == 2 and "algorithms[0].population: 4 -> 6; runs: 2 -> 3); rerun with --force" in err, err

@@ -68,7 +68,7 @@ def test_refusals_are_one_line(monkeypatch):
     with pytest.raises(FkoptError, match=r"t.yaml: .*mechanism 'urdf' has no geometry instances") as err:
         suite([{"name": "u", "problem_class": "c", "instances": 2, "mechanism": {"name": "urdf"}}])
     assert "\n" not in str(err.value)
-    with pytest.raises(FkoptError, match=r"t.yaml: problems.0.extra: unknown field"):
+    with pytest.raises(FkoptError, match=r"t.yaml: problems\[0\]\.extra: unknown field"):
         suite([one("mao2017-3rps", extra=1)])
     with pytest.raises(FkoptError, match="own workspace box; drop mechanism.bounds"):
         suite([one("mao2017-3rps", mechanism={**PAPERS["mao2017-3rps"], "bounds": {"z": [400, 600]}})])

@@ -32,7 +32,7 @@ def subset_suite(tmp_path, **over):
     ({**SWARMS, "poses": 3}, "subsets[0].poses: 3 (allowed: 1 to the suite's poses, 2)"),
     ({**SWARMS, "runs": 5}, "subsets[0].runs: 5 (allowed: 1 to the suite's runs, 2)"),
     ({**SWARMS, "name": "full"}, "subsets[0].name: 'full' is taken"),
-    ({**SWARMS, "sets": ["sideways"]}, "subsets.0.sets.0"),
+    ({**SWARMS, "sets": ["sideways"]}, "subsets[0].sets[0]"),
     ({**SWARMS, "budget_per_dim": 10}, "budget_per_dim"),
 ])
 def test_a_bad_subset_is_one_line_naming_the_file_the_field_and_what_is_allowed(tmp_path, subset, fragment):

@@ -269,7 +269,7 @@ def test_dh_arm_from_lists():
     (dict(a=[1], alpha=[0], d=[0], limits=[[0, 1]], theta_offset=[0, 0]), "equal lengths.*theta_offset=2"),
     (dict(a=[1], alpha=[0], d=[0], limits=[[5, 5]]), r"limits\[0\].*lower 5 must be below upper 5"),
     (dict(a=[1], alpha=[0], d=[0], limits=[[0, 1]], link=[2]), "link"),
-    (dict(a=["x"], alpha=[0], d=[0], limits=[[0, 1]]), r"geometry\.a\.0"),
+    (dict(a=["x"], alpha=[0], d=[0], limits=[[0, 1]]), r"geometry\.a: needs numbers, got the text 'x'"),
 ])
 def test_malformed_dh_tables(bad, message):
     with pytest.raises(fkopt.FkoptError, match=message) as err:

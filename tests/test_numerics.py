@@ -100,7 +100,8 @@ def test_env_json_records_the_numerics_path_and_numbas_version(monkeypatch):
     from fkopt.run.provenance import environment
     monkeypatch.delenv(numerics_path.ENV, raising=False)
     got = environment()["numerics"]
-    assert got == {"path": "compiled", "mode": "auto", "compiled_fitness": False, "numba": version("numba"), "env": ""}
+    assert got == {"path": "compiled", "mode": "auto", "compiled_fitness": False, "numba": version("numba"),
+                   "llvmlite": version("llvmlite"), "env": ""}
     monkeypatch.setenv(numerics_path.ENV, "numpy")
     assert environment()["numerics"]["path"] == "numpy"
     monkeypatch.setenv(numerics_path.ENV, "compiled")
@@ -348,3 +349,33 @@ def test_compiled_refill_reuses_a_buffer_only_when_no_view_of_it_is_alive(monkey
     assert np.array_equal(kept, copy)
     assert 2 <= len(s._stores) <= 4
     assert np.array_equal(s.uniform(7)[3], _generator(5, 3).random(300 + 4000 + 7)[-7:])
+
+
+@pytest.mark.parametrize("k", [1, 4, 64])
+def test_screened_nearest_rows_are_the_full_passes_rows_ties_included(k):
+    """The compiled one-pose IK's start-table lookup (float32 screen, then float64 distances of
+    the rows the screen cannot rule out) gives the rows of the float64 pass over every row, in
+    the same order: on an arm's real table, with exact duplicate rows (ties go to the lower row),
+    near-ties one ulp apart, masked-out features and targets on and off the table's rows."""
+    from fkopt.kinematics.solvers import _fast_context
+    from fkopt.numerics import compiled as c
+    arm = fkopt.mechanism("7dof-arm")
+    ctx = _fast_context(arm, 4096, None)
+    F = ctx["Ft"].T.copy()
+    F[100] = F[7]                                       # exact ties
+    F[200] = np.nextafter(F[7], np.inf)                 # a near-tie
+    F[300:310] = F[310:320]
+    norms = np.einsum("ij,ij->i", F, F)
+    table = c.start_screen(np.ascontiguousarray(F.T), norms)
+    rng = np.random.default_rng(5)
+    targets = [F[7], F[310], F[200] * (1 + 1e-12)] + [F[i] + rng.normal(scale=s, size=12)
+                                                      for i, s in zip(rng.integers(0, len(F), 40), np.geomspace(1e-9, 1, 40))]
+    for f in targets:
+        for mask in (np.ones(12), np.r_[np.ones(3), np.zeros(9)], np.r_[np.zeros(3), np.ones(9)]):
+            fm = np.ascontiguousarray(f * mask)
+            want, got = np.empty(k, np.int64), np.empty(k, np.int64)
+            c._nearest_into(table[0], table[1], fm, want, np.empty(k))
+            v32 = np.empty(len(F), np.float32)
+            c._screen32(table, fm, v32)
+            c._nearest_screened(table, fm, v32, got, np.empty(k))
+            assert np.array_equal(want, got), (k, mask)

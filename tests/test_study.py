@@ -71,7 +71,7 @@ def same_files(a: Path, b: Path, names=DETERMINISTIC):
     ({"threshold": -1}, "threshold"),
     ({"colour": "red"}, "colour: unknown field"),
     ({"algorithms": [{"name": "lm"}, {"name": "lm"}]}, "'lm' repeats"),
-    ({"algorithms": [{"name": "lm", "start": "middle"}]}, "algorithms.0.start"),
+    ({"algorithms": [{"name": "lm", "start": "middle"}]}, "algorithms[0].start"),
 ])
 def test_config_errors_name_the_field(over, fragment):
     with pytest.raises(FkoptError) as err:
@@ -362,7 +362,7 @@ def test_tracking_several_trajectories_report(tmp_path):
     (TWO_TRAJECTORIES, "independent", "a list of trajectories needs mode: tracking"),
     ([{"uniform": 5}], "tracking", "poses[0]: a trajectory needs exactly one of waypoints, circle"),
     ([TWO_TRAJECTORIES[0], {"waypoints": [{"alpha": 0, "beta": 0, "z": 500}], "points": 3}], "tracking",
-     "poses.1.waypoints"),
+     "poses[1].waypoints"),
     ([], "tracking", "poses: 1 to 1000 trajectories"),
 ])
 def test_trajectory_list_errors(poses, mode, fragment):

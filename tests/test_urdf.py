@@ -345,7 +345,7 @@ def test_cli_list_and_ik_on_a_urdf_arm(tmp_path):
     np.testing.assert_allclose(m.fk(list(got["joints"].values())), m.fk(q), atol=1e-6)
     masked = json.loads(_cli("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose,
                              "--mask", "x,y,z", "--json").stdout)
-    assert masked["solved"] and masked["rotation_error_rad"] == 0.0
+    assert masked["solved"] and "rotation_error_rad" not in masked     # no rotation sought, none reported
     bad = _cli("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose, "--mask", "x,y,w")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "inverse mask" in bad.stderr
 

@@ -22,9 +22,10 @@ from functools import lru_cache
 from typing import Any, ClassVar
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
 from fkopt.errors import FkoptError
+from fkopt.files import no_quoted_numbers
 from fkopt.numerics.path import ENV as _NUMERICS_ENV
 from fkopt.progress import tick
 from fkopt.numerics.streams import RunStreams
@@ -34,6 +35,8 @@ class Params(BaseModel):
     """Base of every algorithm's parameter model (unknown keys are rejected)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
+    #: ``limit: "3"`` is refused, not read as 3 (fkopt.files.no_quoted_numbers)
+    _numbers = field_validator("*", mode="before")(no_quoted_numbers)
 
 
 @dataclass(eq=False, kw_only=True)
@@ -259,10 +262,14 @@ class Algorithm:
         try:
             self.params = self.Params(**params)
         except ValidationError as err:
+            from fkopt.files import did_you_mean, field_path
             first = err.errors()[0]
-            loc = ".".join(str(p) for p in first["loc"])
+            loc = field_path(first["loc"])
             allowed = ", ".join(self.Params.model_fields) or "(none)"
-            raise FkoptError(f"algorithm '{self.name}' parameter '{loc}': {first['msg']} "
+            msg = first["msg"].removeprefix("Value error, ")
+            if first["type"] == "extra_forbidden":
+                msg = "unknown parameter" + did_you_mean(loc, self.Params.model_fields)
+            raise FkoptError(f"algorithm '{self.name}' parameter '{loc}': {msg} "
                              f"(parameters: {allowed})") from None
 
     def __repr__(self) -> str:

@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fkopt.files import read_stored_csv
+
 
 def success_by_problem(runs: pd.DataFrame, timing: pd.DataFrame, targets: list[str]) -> pd.DataFrame:
     """Columns problem, class, solver, success_<target> (share of (pose, run) pairs of the
@@ -34,8 +36,8 @@ def advice_table(folder: str | Path, target: str = "1e-06", top: int = 3) -> pd.
     """Columns problem, class, solver, success (share reached ``target``), ms_per_solve; the
     ``top`` solvers of each problem, best first, problems in the order runs.csv lists them."""
     folder = Path(folder)
-    runs = pd.read_csv(folder / "runs.csv")
-    timing = pd.read_csv(folder / "timing.csv")
+    runs = read_stored_csv(folder, "runs.csv")
+    timing = read_stored_csv(folder, "timing.csv")
     try:
         table = success_by_problem(runs, timing, [target]).rename(columns={f"success_{target}": "success"})
     except ValueError as err:
@@ -82,7 +84,7 @@ def robots_summary(folder: str | Path, timeout_ms: float = 20.0) -> pd.DataFrame
     arm at the board's rung) and its median time and median time ratio to the reference (median
     over arms); best first (mean success at the rung, then ratio). FK rows (the parallel
     mechanisms, another timeout ladder) are left out."""
-    return summarise_board(pd.read_csv(Path(folder) / "leaderboard-robots.csv"), timeout_ms)
+    return summarise_board(read_stored_csv(folder, "leaderboard-robots.csv"), timeout_ms)
 
 
 def fk_robots(board: pd.DataFrame) -> set:
@@ -162,7 +164,7 @@ def fk_sentence(folder: str | Path, timeout_ms: float = 500.0) -> str:
     """The FK rows of a stored per-robot board at ``timeout_ms`` as README's one sentence: per
     parallel mechanism, each solver's success at the generating pose (the board's rung) and, in
     brackets, the share solved in another assembly mode; best first."""
-    board = pd.read_csv(Path(folder) / "leaderboard-robots.csv")
+    board = read_stored_csv(folder, "leaderboard-robots.csv")
     board = board[board["robot"].isin(fk_robots(board)) & np.isclose(board["timeout_ms"], timeout_ms)]
     parts = []
     for robot, rows in board.groupby("robot", sort=False):

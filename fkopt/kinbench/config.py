@@ -58,6 +58,11 @@ TARGETS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
 MAX_BUDGET_PER_DIM = 10_000_000
 
 
+#: Longest name of a suite with a ``quick:`` block: ``<name>-quick`` (its --quick result) stays a
+#: folder name of at most 64 characters, never cut back to the full result's name.
+MAX_QUICK_NAME = 64 - len("-quick")
+
+
 def default_track(name: str) -> str | None:
     """The track of a built-in solver or an adapter (the registry's entry); None for a plug-in."""
     return track_of(name)
@@ -182,8 +187,11 @@ class ClockTrack(Strict):
         for name in [*self.solvers, self.reference]:
             if name not in known:
                 raise ValueError(f"solver '{name}' is not a clock-track solver (allowed: {', '.join(known)})")
-        if len(set(self.solvers)) != len(self.solvers) or len(set(self.problems)) != len(self.problems):
-            raise ValueError("problems and solvers must not repeat")
+        for field in ("problems", "solvers", "fk_solvers"):      # each list alike: a repeat is refused
+            values = getattr(self, field)
+            if len(set(values)) != len(values):
+                raise ValueError(f"{field}: '{next(v for v in values if values.count(v) > 1)}' repeats; "
+                                 "problems, solvers and fk_solvers must not repeat")
         for field in ("timeouts_ms", "fk_timeouts_ms"):
             ts = getattr(self, field)
             if any(t <= 0 or t > 10_000 for t in ts) or sorted(set(ts)) != ts:
@@ -282,6 +290,13 @@ class SuiteConfig(Located):
         problems = [p.model_dump(mode="json") if isinstance(p, SuiteProblem) else p for p in data["problems"]]
         if not any(isinstance(p, dict) and p.get("instances") for p in problems):
             return data
+        from fkopt.kinbench.instances import MAX_SUITE_INSTANCES
+        counts = [p.get("instances") for p in problems if isinstance(p, dict)]
+        total = sum(c for c in counts if isinstance(c, int) and not isinstance(c, bool) and c > 0)
+        if total > MAX_SUITE_INSTANCES:     # bounded before any geometry is drawn (~0.3 s per instance)
+            raise ValueError(f"problems: {total} geometry instances in all; allowed: at most {MAX_SUITE_INSTANCES} "
+                             "per suite (instances: K of every problem added up; each is drawn and checked "
+                             "for degeneracy before the run)")
         seed = data.get("seed", cls.model_fields["seed"].default)
         out = []
         for i, p in enumerate(problems):
@@ -291,7 +306,7 @@ class SuiteConfig(Located):
             try:                                                       # its fields first, then the draws
                 checked = SuiteProblem(**p).model_dump(mode="json")
             except ValidationError as err:
-                raise ValueError(f"problems.{i}.{error_line(err, None, p)}") from None
+                raise ValueError(f"problems[{i}].{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
             from fkopt.kinbench.instances import expand
@@ -342,6 +357,10 @@ class SuiteConfig(Located):
     def _quick_names(self):
         if self.quick is None:
             return self
+        if len(self.name) > MAX_QUICK_NAME:
+            raise ValueError(f"name: {len(self.name)} characters; a suite with a quick: block takes at most "
+                             f"{MAX_QUICK_NAME}, so that its --quick result '<name>-quick' is a folder name of at "
+                             "most 64 characters (a shorter name, or no quick: block)")
         for field, known in (("problems", [p.name for p in self.problems]),
                              ("solvers", [s.key for s in self.solvers])):
             for name in getattr(self.quick, field) or []:
@@ -437,9 +456,14 @@ class SuiteConfig(Located):
         q = self.quick
         data = self.model_dump(mode="json")
         # the quick tier is itself a small subset: every quick solver on every quick cell
-        data.update(name=f"{self.name}-quick"[:64], quick=None, check="ci", subsets=[])
+        if len(self.name) > MAX_QUICK_NAME:      # never cut: name-quick cut to 64 would be the full result's name
+            raise FkoptError(f"{where}: name: '{self.name}' is {len(self.name)} characters; --quick writes "
+                             f"'<name>-quick', so a suite with a quick: block takes at most {MAX_QUICK_NAME}")
+        data.update(name=f"{self.name}-quick", quick=None, check="ci", subsets=[])
         if q.problems:
             data["problems"] = [p for p in data["problems"] if p["name"] in q.problems]
+        if data.get("title"):     # the suite's title counts the suite's arms, not the tier's
+            data["title"] = f"{data['title']} -- quick tier: {len(data['problems'])} of its {len(self.problems)} problems"
         if q.solvers:
             data["solvers"] = [s for s in data["solvers"] if (s.get("label") or s["name"]) in q.solvers]
         for key in ("sets", "poses", "runs", "budget_per_dim"):

@@ -51,6 +51,10 @@ CHECK_POSES = 2000
 MAX_CENTRE_KAPPA = 1e6
 ATTEMPTS = 20
 MAX_INSTANCES = 100
+#: Most geometry instances of one suite, all problems' ``instances`` added up, checked before any
+#: is drawn: each takes ~0.3 s (up to ATTEMPTS draws, a degeneracy check of CHECK_POSES poses), so a
+#: small suite file cannot keep fkopt busy for minutes before a cheap error (issue 42). v3 has 50.
+MAX_SUITE_INSTANCES = 100
 
 
 def instance_rng(seed: int, problem: str, k: int) -> np.random.Generator:

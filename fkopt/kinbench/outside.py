@@ -35,14 +35,13 @@ have at least one run, so all solvers are ranked on the same instances. The SHA-
 from __future__ import annotations
 
 import hashlib
-import io
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.files import MAX_INPUT_BYTES, read_input
+from fkopt.files import MAX_INPUT_BYTES, csv_numbers, read_csv, read_input
 from fkopt.run.config_base import files_folder
 from fkopt.run.record import run_record
 from fkopt.kinbench.budget import at_budget, budget_of
@@ -81,11 +80,7 @@ def read_csv_columns(path: Path, where: str, columns, dtype: dict, needs: str | 
     lists what is needed)."""
     if not path.exists() and not path.is_symlink():
         raise FkoptError(f"{where}: not found")
-    data = read_input(path, MAX_INPUT_BYTES, field=where.partition(": ")[0])
-    try:
-        df = pd.read_csv(io.BytesIO(data), dtype=dtype)         # read_input unpacked a .gz
-    except (OSError, ValueError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
-        raise FkoptError(f"{where}: unreadable CSV ({type(err).__name__})") from None
+    df = read_csv(path, MAX_INPUT_BYTES, field=where.partition(": ")[0], dtype=dtype)   # bytes and memory bounded
     missing = [c for c in columns if c not in df.columns]
     if missing:
         raise FkoptError(f"{where}: missing column '{missing[0]}'; needs {needs or ', '.join(columns)}")
@@ -130,7 +125,7 @@ def logged_runs(config, k: int, instances: set[tuple[str, str, int]], files: Pat
     where = f"outside[{k}].{'file' if entry.file else 'ioh'}: {path}"
     df = _csv_log(path, where) if entry.file else _ioh_log(path, where, entry.algorithm)
     for col in ("pose", "run", "evaluations", "best_so_far"):
-        vals = pd.to_numeric(df[col], errors="coerce")
+        vals = pd.Series(csv_numbers(df[col]), index=df.index)     # a 400-digit integer: inf, refused below
         integer = col != "best_so_far"
         bad = vals.isna() | (vals < 0) | (~np.isfinite(vals.fillna(0)))
         if integer:       # range-checked before any cast to int

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
+from fkopt.files import parse_json, read_stored, read_stored_csv
 from fkopt.kinbench import html as H
 
 #: Every page's size in bytes stays below this (issue 37: a page loads in a moment).
@@ -446,7 +447,6 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
 def stored_suite(folder: str | Path):
     """(result, tables) of a stored suite folder: its config (meta.json), meta.json and env.json,
     and every table file it holds, read back -- what the figures and pages are made of."""
-    from fkopt.files import parse_json, read_stored
     from fkopt.kinbench.config import SuiteConfig
     from fkopt.kinbench.kind import OUTPUTS
     from fkopt.run.writers import FIGURE
@@ -473,8 +473,8 @@ def stored_suite(folder: str | Path):
         path = folder / out.file
         if out.role != FIGURE and path.is_file():
             try:
-                df = pd.read_csv(path, dtype={k: v for k, v in text.items()}, keep_default_na=True)
-            except (ValueError, pd.errors.ParserError) as err:
+                df = read_stored_csv(folder, out.file, dtype={k: v for k, v in text.items()}, keep_default_na=True)
+            except (OSError, ValueError, pd.errors.ParserError) as err:
                 raise FkoptError(f"{path}: not a readable table ({err})") from None
             if "better_than" in df:
                 df["better_than"] = df["better_than"].fillna("")

@@ -102,6 +102,24 @@ def condition_numbers(problem, folder: Path | None, points: np.ndarray) -> np.nd
         return np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
 
 
+def drawing_box(mech) -> tuple[np.ndarray, np.ndarray]:
+    """The box the pose sets are drawn in: the mechanism's bounds, except that a URDF arm's
+    (or MJCF arm's) bounds in degrees are rounded to the nearest 9th decimal, as fkopt read every limit
+    when kinbench v2 and v3 were released. The arm's own bounds now never lie outside the
+    file's limits in radians (:func:`fkopt.mechanisms.urdf._inward`, issue 41: rounding to the
+    nearest moved them outward by up to 8.7e-12 rad), so :func:`generate` draws in this box --
+    the released sets regenerate bit for bit -- and clips every point to the arm's bounds: a
+    point in the sliver between the two (at most 5e-10 deg wide) moves onto the limit. No
+    frozen set holds one (tests/test_newcomer.py checks every frozen joint against the limits)."""
+    lo, hi = mech.bounds[:, 0].copy(), mech.bounds[:, 1].copy()
+    from fkopt.mechanisms.urdf import URDFArm
+    if isinstance(mech, URDFArm):             # URDF and MJCF arms (MJCFArm reads its limits the same way)
+        for i, unit in enumerate(mech.unknown_units):
+            if unit == "deg":
+                lo[i], hi[i] = round(float(lo[i]), 9), round(float(hi[i]), 9)
+    return lo, hi
+
+
 def generate(problem, seed: int, n: int = POSES, folder: Path | None = None,
              measure: str = "condition") -> tuple[dict, dict]:
     """Points of every set of ``problem`` and what the manifest records of their generation.
@@ -109,13 +127,14 @@ def generate(problem, seed: int, n: int = POSES, folder: Path | None = None,
     Jacobian above its 95th percentile) or ``"sigma"`` (v3: the unit-free smallest singular value
     of :func:`fkopt.kinbench.measures.unit_free_sigma_min` below its 5th percentile)."""
     mech, _ = problem_mechanism(problem, folder)
-    lo, hi = mech.bounds[:, 0], mech.bounds[:, 1]
+    lo, hi = drawing_box(mech)
+    inside = lambda pts: np.clip(pts, mech.bounds[:, 0], mech.bounds[:, 1])   # noqa: E731 (bit-identical inside)
     dim = len(lo)
     out, info = {}, {}
     rng = set_rng(seed, problem.name, "uniform")
-    out["uniform"] = lo + rng.random((n, dim)) * (hi - lo)
+    out["uniform"] = inside(lo + rng.random((n, dim)) * (hi - lo))
     rng = set_rng(seed, problem.name, "near-singular")
-    cand = lo + rng.random((CANDIDATES, dim)) * (hi - lo)
+    cand = inside(lo + rng.random((CANDIDATES, dim)) * (hi - lo))
     if measure == "condition":
         kappa = condition_numbers(problem, folder, cand)
         bound = float(np.quantile(kappa[np.isfinite(kappa)], SINGULAR_QUANTILE))
@@ -143,7 +162,7 @@ def generate(problem, seed: int, n: int = POSES, folder: Path | None = None,
     depth = u[:, dim + 2] * BOUNDARY_SHARE * (hi - lo)[coord]
     rows = np.arange(n)
     pts[rows, coord] = np.where(upper, hi[coord] - depth, lo[coord] + depth)
-    out["boundary"] = pts
+    out["boundary"] = inside(pts)
     info["boundary"] = {"share_of_range": BOUNDARY_SHARE}
     printed = PRINTED.get(problem.name, [])
     out["printed"] = (np.array([mech.vector(p, mech.unknown_names, f"printed pose of {problem.name}")
@@ -243,7 +262,8 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     """The points of a pose-set CSV: ASCII, a header of exactly ``unknowns``, every row that
     many finite numbers; anything else one line naming the file, the line and what is allowed
     (no cell of the file is quoted beyond a short sanitised token)."""
-    from fkopt.files import short_token
+    from fkopt.files import check_csv_shape, short_token
+    check_csv_shape(data, str(path))        # line length and fields bounded before any split
     try:
         text = data.decode("ascii")
     except UnicodeDecodeError as err:

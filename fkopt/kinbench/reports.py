@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.run import record
-from fkopt.files import file_names, md_text
+from fkopt.files import file_names, md_text, read_stored_csv
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.outside import digest
 from fkopt.kinbench.submissions import submission_digest
@@ -294,14 +294,14 @@ def board_top_lines(folder: Path, top: int = 3) -> list[str]:
     lines = []
     lb_path = folder / "leaderboard.csv"
     if lb_path.exists():
-        lb = pd.read_csv(lb_path)
+        lb = read_stored_csv(folder, "leaderboard.csv")
         for scope, g in lb.groupby("scope", sort=False):
             if split_scope(scope)[1].startswith("track:"):
                 best = ", ".join(f"{r.solver} {r.score:.3f}" for r in g.head(top).itertuples())
                 lines.append(f"{scope} (score, evaluations): {best}")
     robots = folder / "leaderboard-robots.csv"
     if robots.exists():
-        lines += robots_top_lines(pd.read_csv(robots), top)
+        lines += robots_top_lines(read_stored_csv(folder, robots.name), top)
     return lines
 
 

@@ -143,6 +143,11 @@ def track_cases(config: SuiteConfig, sets: dict, files: Path | None = None) -> l
     if config.poses is not None:
         sets, _ = load_pose_sets(config.model_copy(update={"poses": None}), files)
     index = {p.name: k for k, p in enumerate(config.problems)}
+    for name in clock.problems:     # never silently fewer queries than asked for
+        have = len(sets[(name, clock.set)])
+        if clock.queries is not None and clock.queries > have:
+            raise FkoptError(f"tracks.clock.queries: {clock.queries}, but set '{clock.set}' of problem {name} holds "
+                             f"{have} poses; allowed: 1 to {have} (or omit it: every pose of the set)")
     return [(index[name], np.asarray(sets[(name, clock.set)][:clock.queries], dtype=float)) for name in clock.problems]
 
 
@@ -309,17 +314,20 @@ def record_problem(task, rec) -> str | None:
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
     if task.payload.get("track"):
+        from fkopt.kinbench.answer_checks import clock_record_problem
         try:
-            if int(rec["problem"]) != task.payload["problem"] or rec["track"] != task.payload["track"]:
+            if type(rec["problem"]) is not int or rec["problem"] != task.payload["problem"] \
+                    or rec["track"] != task.payload["track"]:
                 return "its problem/track are not its file name's"
             if not isinstance(rec["answers"], dict) or not all(isinstance(v, list) for v in rec["answers"].values()):
                 return "answers: not a table of answers"
-            float(rec["wall_s"])
+            if _numbers([rec["wall_s"]], "wall_s", 0, float(np.finfo(float).max)):
+                return "wall_s: not a non-negative finite number"
+            return clock_record_problem(task, rec)      # every answer counted and judged again
         except KeyError as err:
-            return f"field {err.args[0]!r} is missing"
-        except (TypeError, ValueError) as err:
+            return f"field {str(err.args[0])[:40]!r} is missing"
+        except (TypeError, ValueError, IndexError, AttributeError, FkoptError) as err:
             return f"{type(err).__name__}: {str(err)[:120]}"
-        return None
     payload = task.payload
     try:
         if rec["problem"] != payload["problem"] or rec["solver"] != payload["solver"] \

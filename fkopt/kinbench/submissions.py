@@ -66,11 +66,15 @@ import pandas as pd
 
 from fkopt.errors import FkoptError
 from fkopt.run.config_base import files_folder
-from fkopt.files import MAX_INPUT_BYTES, read_input
+from fkopt.files import MAX_INPUT_BYTES, csv_numbers, read_input
 from fkopt.kinbench.clock import answer_prefix, answer_rows, is_ik, targets_of, track_settings
 from fkopt.kinbench.outside import read_csv_columns
 
 REQUIRED = ("robot", "query", "seconds", "reference_seconds")
+#: The optional columns; with REQUIRED and the answers' q0, q1, ... / x0..x5 the only ones allowed.
+OPTIONAL = ("claimed", "given_timeout_ms")
+#: The largest given_timeout_ms: the tracks' own bound on a timeout (``timeouts_ms`` in (0, 10000]).
+MAX_TIMEOUT_MS = 10_000.0
 #: A wall time beyond an hour per query is no clock-track answer (the longest timeout is 10 s).
 MAX_SECONDS = 3600.0
 #: The largest |joint| (deg / m) or |pose component| (length unit / deg) a submission may give.
@@ -97,14 +101,15 @@ def _line(g: pd.DataFrame, k: int) -> int:
 
 def _check_numbers(g: pd.DataFrame, where: str, n: int, timed: bool) -> None:
     for col in ("query", "seconds", "reference_seconds") + (("given_timeout_ms",) if timed else ()):
-        v = pd.to_numeric(g[col], errors="coerce").to_numpy(float)
+        v = csv_numbers(g[col])       # never raises: a 400-digit integer is inf, refused here
         with np.errstate(invalid="ignore"):
             if col == "query":
                 bad = ~np.isfinite(v) | (v < 0) | (v != np.round(v)) | (v >= n)
                 allowed = f"an integer 0..{n - 1}"
             else:
-                bad = ~np.isfinite(v) | (v <= 0) | (v > MAX_SECONDS)
-                allowed = f"a positive number of {'ms' if col == 'given_timeout_ms' else 's'} up to {MAX_SECONDS:g}"
+                top = MAX_TIMEOUT_MS if col == "given_timeout_ms" else MAX_SECONDS
+                bad = ~np.isfinite(v) | (v <= 0) | (v > top)
+                allowed = f"a positive number of {'ms' if col == 'given_timeout_ms' else 's'} up to {top:g}"
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
             raise FkoptError(f"{where}: line {_line(g, k)}: {col} = {g[col].astype(str).iloc[k]}; allowed: {allowed}")
@@ -140,7 +145,7 @@ def _answers(g: pd.DataFrame, where: str, robot: str, mech, dim: int) -> np.ndar
         raise FkoptError(f"{where}: robot {robot}: column {extra[0]} must be empty ({robot} answers with "
                          f"{what}: columns {cols[0]}..{cols[-1]})")
     raw = g[cols]
-    values = raw.apply(pd.to_numeric, errors="coerce").to_numpy(float)
+    values = np.stack([csv_numbers(raw[c]) for c in cols], axis=-1) if len(raw) else np.zeros((0, dim))
     with np.errstate(invalid="ignore"):
         bad = (raw.notna().to_numpy() & ~np.isfinite(values)) | (np.abs(values) > MAX_ANSWER)
     if bad.any():
@@ -167,6 +172,11 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
     where = f"tracks.clock.submissions[{entry.solver}]: {path}"
     df = read_csv_columns(path, where, REQUIRED, {"robot": str},
                           f"{', '.join(REQUIRED)}, q0, q1, ... (IK) or x0..x5 (FK)")
+    stray = [c for c in df.columns if c not in (*REQUIRED, *OPTIONAL)
+             and not (str(c)[:1] in "qx" and str(c)[1:].isdigit() and str(c)[1:] == str(int(str(c)[1:])))]
+    if stray:      # a typo ('given_timeout', 'clamed') would otherwise be ignored without a word
+        raise FkoptError(f"{where}: stray column '{str(stray[0])[:40]}'; allowed: {', '.join(REQUIRED + OPTIONAL)}, "
+                         "q0, q1, ... (IK) or x0..x5 (FK)")
     if df.empty:
         raise FkoptError(f"{where}: no rows; needs one per query of each robot it answers "
                          f"(robots: {', '.join(arms)})")
@@ -189,8 +199,8 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
         n, dim = len(queries), queries.shape[1]
         _, _, timeouts = track_settings(clock, mech)
         _check_numbers(g, where, n, timed)
-        query = pd.to_numeric(g["query"]).to_numpy(float).astype(int)
-        given = pd.to_numeric(g["given_timeout_ms"]).to_numpy(float) if timed else np.zeros(len(g))
+        query = csv_numbers(g["query"]).astype(int)          # range-checked above
+        given = csv_numbers(g["given_timeout_ms"]) if timed else np.zeros(len(g))
         have = list(zip(query, given))
         seen: set = set()
         for key in have:
@@ -212,8 +222,8 @@ def read_submission(config, k: int, arms: dict, files: Path | None = None) -> pd
                              + f" ({n} queries) needs one")
         answers = _answers(g, where, robot, mech, dim)
         frame = answer_rows(mech, robot, entry.solver, "outside", "submitted", query,
-                            g["given_timeout_ms"].to_numpy(float) if timed else np.nan,
-                            g["seconds"].to_numpy(float), g["reference_seconds"].to_numpy(float),
+                            given if timed else np.nan,
+                            csv_numbers(g["seconds"]), csv_numbers(g["reference_seconds"]),
                             _claims(g, where) if "claimed" in g else False, answers, queries[query],
                             targets_of(mech, queries[query]))
         frame.insert(1, "set", clock.set)

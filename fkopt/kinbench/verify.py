@@ -30,47 +30,78 @@ def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
     """(file, row, column, stored, recomputed, rule) of every disagreement; [] when the stored
-    board follows from the stored answers."""
-    from fkopt.kinbench.clock import answer_prefix, targets_of, verdicts
+    board follows from the stored answers. The answers are counted first
+    (:func:`fkopt.kinbench.answer_checks.key_problems`): one per (query, solver, timeout) the
+    config implies, so a failure deleted, a success repeated or a solver dropped is a mismatch
+    naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`)."""
+    from fkopt.errors import FkoptError
+    from fkopt.files import csv_numbers, read_stored_csv
+    from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
+    from fkopt.kinbench.clock import answer_prefix, targets_of, track_settings, verdicts
     from fkopt.kinbench.posesets import load_pose_sets
     from fkopt.kinbench.reports import robots_board_table
     from fkopt.kinbench.runner import track_arm, track_cases
     folder = Path(folder)
-    path = folder / "answers.csv.gz"
-    if config.tracks is None or config.tracks.clock is None or not path.exists():
+    if config.tracks is None or config.tracks.clock is None:
         return []
-    answers = pd.read_csv(path, dtype={"robot": str, "solver": str})
+    clock = config.tracks.clock
+    try:
+        answers = read_stored_csv(folder, "answers.csv.gz", dtype={"robot": str, "solver": str})
+    except FkoptError as err:
+        missing = not (folder / "answers.csv.gz").exists() and not (folder / "answers.csv.gz").is_symlink()
+        return [("answers.csv.gz", "-", "file", "missing" if missing else str(err), None,
+                 "every answer of the clock track, read to recompute the board")]
+    lacking = [c for c in ("robot", "query", "solver", "given_timeout_ms", "position_m", "rotation_rad",
+                           "leg_residual", "in_limits") if c not in answers.columns]
+    if lacking:
+        return [("answers.csv.gz", "-", lacking[0], "missing", None, "a column of every answers row")]
     sets, _ = load_pose_sets(config)
     out = []
     index = {p.name: k for k, p in enumerate(config.problems)}
     queries = dict(track_cases(config, sets))
     rule = "recomputed from the stored answer with fkopt's FK"
-    for robot, g in answers.groupby("robot", sort=False):
-        if robot not in index or index[robot] not in queries:
-            out.append(("answers.csv.gz", robot, "robot", robot, None, "a problem of tracks.clock.problems"))
-            continue
+    submitted = [s.solver for s in clock.submissions]
+    for robot in clock.problems:                         # every robot of the track answered, counted
+        g = answers[answers["robot"] == robot]
         mech = track_arm(config, index[robot])
         Q = queries[index[robot]]
-        q = g["query"].to_numpy(int)
-        if (q < 0).any() or (q >= len(Q)).any():
-            out.append(("answers.csv.gz", robot, "query", int(q.max()), len(Q) - 1, "a query of the track"))
+        _, _, timeouts = track_settings(clock, mech)
+        why = key_problems(g, robot, len(Q), expected_solvers(clock, mech), timeouts, submitted)
+        if why:
+            out.append(("answers.csv.gz", robot, "answers", why, None, RULE))
             continue
+        q = csv_numbers(g["query"]).astype(int)          # range-checked by key_problems
         cols = [f"{answer_prefix(mech)}{d}" for d in range(Q.shape[1])]
-        v = verdicts(mech, g[cols].to_numpy(float), Q[q], targets_of(mech, Q[q]))
+        if any(c not in g.columns for c in cols):
+            out.append(("answers.csv.gz", robot, cols[0], "missing", None, "the answer's columns"))
+            continue
+        answer = np.stack([csv_numbers(g[c]) for c in cols], axis=-1) if len(g) else np.zeros((0, len(cols)))
+        v = verdicts(mech, answer, Q[q], targets_of(mech, Q[q]))
         for col in ("position_m", "rotation_rad", "leg_residual", "in_limits"):
-            bad = ~_close(g[col].to_numpy(float), np.asarray(v[col], float))
+            stored = g[col].to_numpy(float) if g[col].dtype == bool else csv_numbers(g[col])
+            bad = ~_close(stored, np.asarray(v[col], float))
             for k in np.flatnonzero(bad)[:3]:
                 r = g.iloc[k]
                 out.append(("answers.csv.gz", f"{robot}/{r['solver']}/query {r['query']}", col, r[col],
                             np.asarray(v[col])[k], rule))
-    tp_path = folder / "throughput.csv"
-    throughput = pd.read_csv(tp_path) if tp_path.exists() else None
-    board = robots_board_table(SimpleNamespace(config=config, answers=answers, throughput=throughput))
-    stored_path = folder / "leaderboard-robots.csv"
-    if board is None or not stored_path.exists():
-        return out
-    key = ["solver", "robot", "timeout_ms"]
-    stored = pd.read_csv(stored_path, dtype={"solver": str, "robot": str}).astype({"timeout_ms": float})
+    strays = sorted(set(answers["robot"].astype(str)) - set(clock.problems))
+    if strays:
+        out.append(("answers.csv.gz", strays[0][:40], "robot", strays[0][:40], None,
+                    "a problem of tracks.clock.problems"))
+    if out:
+        return out          # the board of uncounted or misjudged answers means nothing
+    try:
+        throughput = read_stored_csv(folder, "throughput.csv") if (folder / "throughput.csv").exists() else None
+        board = robots_board_table(SimpleNamespace(config=config, answers=answers, throughput=throughput))
+        key = ["solver", "robot", "timeout_ms"]
+        if board is None:
+            return out
+        if not (folder / "leaderboard-robots.csv").exists():
+            return [("leaderboard-robots.csv", "-", "file", "missing", None, "the board of the stored answers")]
+        stored = read_stored_csv(folder, "leaderboard-robots.csv", dtype={"solver": str, "robot": str})
+        stored["timeout_ms"] = csv_numbers(stored["timeout_ms"])
+    except (FkoptError, KeyError) as err:
+        return [("leaderboard-robots.csv", "-", "file", str(err)[:200], None, "a readable board")]
     board = board.astype({"timeout_ms": float})
     if len(stored) != len(board) or set(map(tuple, stored[key].values)) != set(map(tuple, board[key].values)):
         return out + [("leaderboard-robots.csv", "-", "rows", len(stored), len(board),
@@ -79,7 +110,7 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     for col in board.columns:
         if col in key or f"{col}_recomputed" not in merged or not pd.api.types.is_numeric_dtype(board[col]):
             continue
-        bad = ~_close(merged[col].to_numpy(float), merged[f"{col}_recomputed"].to_numpy(float))
+        bad = ~_close(csv_numbers(merged[col]), merged[f"{col}_recomputed"].to_numpy(float))
         for k in np.flatnonzero(bad)[:3]:
             r = merged.iloc[k]
             out.append(("leaderboard-robots.csv", f"{r['solver']}/{r['robot']}/{r['timeout_ms']:g} ms", col, r[col],

@@ -111,6 +111,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fkopt.algorithms.hybrid import GABCLM
+from fkopt.api_bounds import MAX_API_VALUE, MAX_SEED, check_array, check_integer, check_options
 from fkopt.errors import FkoptError, did_you_mean
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from fkopt.mechanisms.catalog import MECHANISMS
@@ -202,6 +203,9 @@ def _mechanism(mechanism, kind: type, what: str) -> Mechanism:
             raise FkoptError(f"unknown mechanism '{mechanism}'; allowed: {did_you_mean(mechanism, list(MECHANISMS))} "
                              "(a plug-in: pass fkopt.mechanism(name))")
         mechanism = MECHANISMS[mechanism]()
+    if not isinstance(mechanism, Mechanism):           # None, a number, a path: one line, not AttributeError
+        raise FkoptError(f"{what}: expected a registered mechanism name or a mechanism object, got "
+                         f"{type(mechanism).__name__}")
     if not isinstance(mechanism, kind):
         other = "inverse" if what == "forward" else "forward"
         raise FkoptError(f"{what} needs a {'parallel mechanism' if kind is ParallelMechanism else 'serial arm'}; "
@@ -218,7 +222,9 @@ def _targets(m, poses) -> np.ndarray:
     (..., 12) = (x, y, z, R row-major); a frame needs a finite, orthonormal rotation and the
     last row (0, 0, 0, 1)."""
     try:
-        a = np.asarray(poses, dtype=float)
+        a = np.asarray(poses)
+        if a.dtype != np.float64 or a.size == 0:      # complex, text, empty: api_bounds says why in one line
+            a = check_array(a, f"{m.name} target pose")
     except (TypeError, ValueError):
         raise FkoptError(f"{m.name} target pose: expected numbers, (..., {len(m.pose_names)}) values "
                          f"({', '.join(m.pose_names)}) or (..., 4, 4) tip frames; got {type(poses).__name__}") from None
@@ -230,10 +236,11 @@ def _targets(m, poses) -> np.ndarray:
         gap = max(abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0), abs(b0 * b0 + b1 * b1 + b2 * b2 - 1.0),
                   abs(c0 * c0 + c1 * c1 + c2 * c2 - 1.0), abs(a0 * b0 + a1 * b1 + a2 * b2),
                   abs(a0 * c0 + a1 * c1 + a2 * c2), abs(b0 * c0 + b1 * c1 + b2 * c2))
-        if math.isfinite(sum(f)) and gap <= FRAME_ORTHONORMAL_TOL and f[12:] == [0.0, 0.0, 0.0, 1.0]:
+        if abs(x) + abs(y) + abs(z) <= MAX_API_VALUE and gap <= FRAME_ORTHONORMAL_TOL \
+                and f[12:] == [0.0, 0.0, 0.0, 1.0]:
             return np.array([x, y, z, a0, a1, a2, b0, b1, b2, c0, c1, c2])
-    if not np.isfinite(a).all():
-        raise FkoptError(f"{m.name} target frame: values must be finite")
+    if not (np.abs(a) <= MAX_API_VALUE).all():
+        raise FkoptError(f"{m.name} target frame: values must be finite and within +-{MAX_API_VALUE:g}")
     R = a[..., :3, :3]
     gap = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max()
     if not gap <= FRAME_ORTHONORMAL_TOL or not (a[..., 3, :] == (0.0, 0.0, 0.0, 1.0)).all():
@@ -243,7 +250,11 @@ def _targets(m, poses) -> np.ndarray:
 
 
 def _values(mechanism: Mechanism, values, names, what: str) -> np.ndarray:
-    a = np.asarray(values, dtype=float)
+    if isinstance(values, np.ndarray) and values.dtype == np.float64 and values.shape == (len(names),):
+        row = values.tolist()          # a control loop's call: one real row, checked on Python floats
+        if math.isfinite(sum(row)) and max(map(abs, row)) <= MAX_API_VALUE:
+            return values
+    a = check_array(values, f"{mechanism.name} {what}")        # real, not empty, |v| <= 1e9
     if a.ndim == 0 or a.shape[-1] != len(names):
         raise FkoptError(f"{mechanism.name} {what}: expected (..., {len(names)}) values "
                          f"({', '.join(names)}), got shape {a.shape}")
@@ -567,11 +578,8 @@ def forward(mechanism, joints, *, start=None, tol: float = FORWARD_TOL, seed: in
     :func:`_jacobian_volume`; 1: the first that solves). See the module docstring.
     """
     m = _mechanism(mechanism, ParallelMechanism, "forward")
-    if not (np.isfinite(tol) and tol > 0):
-        raise FkoptError(f"forward tol: must be a positive number, got {tol}")
-    if int(table) < 0 or int(neighbours) < 0 or int(candidates) < 1:
-        raise FkoptError(f"forward table, neighbours, candidates: must be >= 0, >= 0, >= 1, "
-                         f"got {table}, {neighbours}, {candidates}")
+    opts = check_options("forward", tol=tol, seed=seed, table=table, neighbours=neighbours, candidates=candidates)
+    tol, seed, table, neighbours, candidates = (opts[k] for k in ("tol", "seed", "table", "neighbours", "candidates"))
     J0 = _values(m, joints, m.joint_names, "joints")
     shape = J0.shape[:-1]
     L = J0.reshape(-1, J0.shape[-1])
@@ -984,12 +992,15 @@ def _fast_context(m, table: int, W) -> dict:
         got = c[key] = {
             "n": n, "chain": m.chain().arrays(), "tq": np.ascontiguousarray(tq, dtype=float),
             "Ft": np.ascontiguousarray(F.T, dtype=float), "norms": np.ascontiguousarray(norms, dtype=float), "w": w,
+
             "fmask": np.ascontiguousarray(fmask, dtype=float), "W": np.ones(6) if W is None else np.asarray(W, float),
             "slo": np.asarray(c["slo"], dtype=float), "shi": np.asarray(c["shi"], dtype=float),
             "lo": np.asarray(c["lo"], dtype=float), "hi": np.asarray(c["hi"], dtype=float),
             "angle": np.array(c["angle"], dtype=np.bool_), "periodic": np.array(c["periodic"], dtype=np.bool_),
             "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
             "mid": np.array(c["mid"], dtype=float)}
+        from fkopt.numerics.compiled import start_screen  # the compiled nearest-neighbour search's arguments
+        got["table"] = start_screen(got["Ft"], got["norms"])
     return got
 
 
@@ -1130,8 +1141,8 @@ def _tolerance(tol) -> tuple[float, float]:
             tp, tr = (float(t) for t in np.broadcast_to(np.asarray(tol, dtype=float), (2,)))
     except (TypeError, ValueError):
         raise FkoptError(f"inverse tol: expected (position, orientation), got {tol!r}") from None
-    if not (tp > 0 and tr > 0 and math.isfinite(tp) and math.isfinite(tr)):
-        raise FkoptError(f"inverse tol: both tolerances must be positive, got {tol!r}")
+    if not (0 < tp <= MAX_API_VALUE and 0 < tr <= MAX_API_VALUE):
+        raise FkoptError(f"inverse tol: both tolerances must be positive and at most {MAX_API_VALUE:g}, got {tol!r}")
     return tp, tr
 
 
@@ -1209,11 +1220,8 @@ class InverseSolver:
     def _one(self, pose: np.ndarray, start, seed) -> InverseResult:
         """One checked target row (6,) or (12,): the compiled kernel straight away when there is no
         start (the common call), else :func:`_inverse_one` with the prepared options."""
-        if type(seed) is not int:
-            try:
-                seed = int(seed)
-            except (TypeError, ValueError):
-                raise FkoptError(f"inverse seed: expected an integer, got {seed!r}") from None
+        if type(seed) is not int or not 0 <= seed <= MAX_SEED:
+            seed = check_integer("seed", seed, "inverse")
         if self._kernel is not None and start is None:
             if not pose.flags.c_contiguous:         # a strided view would compile another specialisation
                 pose = np.ascontiguousarray(pose)
@@ -1308,6 +1316,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         tail, compiled = o["tail"], o["compiled"]
     m = _inverse_arm(arm)
     tp, tr = _tolerance(tol)
+    seed = check_integer("seed", seed, "inverse")
     P0 = _targets(m, poses)
     if P0.ndim == 1 and rest <= 0 and not exact_rotation:
         # one pose: through the prepared solver (cached per arm, options, tol and mask), the one code path

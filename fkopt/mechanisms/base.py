@@ -35,7 +35,7 @@ from fkopt.errors import FkoptError, did_you_mean
 def _geometry_base():
     from pydantic import BaseModel, ConfigDict, field_validator
 
-    from fkopt.files import MAX_MAGNITUDE
+    from fkopt.files import MAX_MAGNITUDE, no_quoted_numbers
 
     class Geometry(BaseModel):
         """Base of every mechanism's geometry model (unknown keys are rejected; every number,
@@ -43,6 +43,7 @@ def _geometry_base():
         geometry's units: past it FK and IK overflow to inf instead of failing)."""
 
         model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)   # "1e400" from YAML is inf
+        _numbers = field_validator("*", mode="before")(no_quoted_numbers)          # ra: "450" is text
 
         @field_validator("*", mode="after", check_fields=False)
         @classmethod
@@ -100,7 +101,8 @@ def validate_geometry(model: type, geometry: dict[str, Any], where: str, clean=l
 def describe_validation_error(err, where: str) -> str:
     """Collapse a pydantic error into one line: ``where.field: message``."""
     first = err.errors()[0]
-    loc = ".".join(str(p) for p in first["loc"])
+    from fkopt.files import field_path
+    loc = field_path(first["loc"])
     msg = first["msg"].removeprefix("Value error, ")
     return f"{where}.{loc}: {msg}" if loc else f"{where}: {msg}"
 
@@ -186,9 +188,12 @@ class Mechanism:
         bounds = dict(self.default_bounds)
         for key, value in overrides.items():
             if key not in names:
-                raise FkoptError(f"{self.name} bounds: unknown variable '{key}'; "
+                from fkopt.files import did_you_mean as closest
+                raise FkoptError(f"{self.name} bounds: unknown variable '{key}'{closest(key, names)}; "
                                  f"allowed: {', '.join(names)}")
             try:
+                if any(isinstance(v, str) for v in value):     # "1" in YAML is text, not a number
+                    raise TypeError
                 lo, hi = (float(v) for v in value)
             except (TypeError, ValueError):
                 raise FkoptError(f"{self.name} bounds.{key}: expected [lower, upper], got {value!r}") from None
@@ -207,7 +212,9 @@ class Mechanism:
         unknown = set(values) - set(names)
         missing = [n for n in names if n not in values]
         if unknown:
-            raise FkoptError(f"{self.name} {what}: unknown variable '{sorted(unknown)[0]}'; "
+            from fkopt.files import did_you_mean as closest
+            word = sorted(unknown)[0]
+            raise FkoptError(f"{self.name} {what}: unknown variable '{word}'{closest(word, names)}; "
                              f"allowed: {', '.join(names)}")
         if missing:
             raise FkoptError(f"{self.name} {what}: missing {', '.join(missing)} "

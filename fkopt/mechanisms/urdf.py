@@ -32,6 +32,7 @@ recursion on Python floats for a single configuration.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -98,6 +99,41 @@ MAX_URDF_VALUE = MAX_MAGNITUDE
 MAX_URDF_BYTES = 4 << 20
 
 
+#: An attribute or element name with a namespace prefix (``drake:acceleration``).
+_PREFIXED = re.compile(rb"[<\s/]([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*")
+#: Prefixes already warned about, per file: the warning is one line per file and process.
+_WARNED: set[tuple[str, tuple[str, ...]]] = set()
+
+
+def _with_undeclared_prefixes(data: bytes, path: Path, err) -> Any:
+    """The URDF parsed with its undeclared namespace prefixes bound to placeholder namespaces,
+    after one warning line on stderr. Robot files written for one tool carry that tool's
+    extensions without declaring them (airo-models' UR3e: ``<limit drake:acceleration=...>``);
+    pinocchio's and yourdfpy's readers ignore such attributes and read the file, so fkopt does
+    too -- it reads no prefixed attribute or element, so the kinematics are the file's.
+    XML 1.0 names (https://www.w3.org/TR/xml-names/#ns-decl): ``xml`` is bound by definition."""
+    import sys
+    declared = {m.decode() for m in re.findall(rb"xmlns:([A-Za-z_][\w.-]*)\s*=", data)} | {"xml", "xmlns"}
+    used = sorted({m.decode() for m in _PREFIXED.findall(data)} - declared)
+    if not used:
+        raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
+    root_tag = re.search(rb"<robot\b", data)
+    if root_tag is None:
+        raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
+    bindings = b"".join(b' xmlns:%s="urn:fkopt:undeclared:%s"' % (p.encode(), p.encode()) for p in used)
+    patched = data[:root_tag.end()] + bindings + data[root_tag.end():]
+    try:
+        root = parse_xml(patched, f"urdf {path}")
+    except FkoptError:
+        raise FkoptError(f"urdf {path}: malformed URDF ({err})") from None
+    key = (str(path), tuple(used))
+    if key not in _WARNED:
+        _WARNED.add(key)
+        print(f"fkopt: warning: urdf {path}: undeclared XML prefix {', '.join(repr(p + ':') for p in used)}; "
+              "its attributes and elements are ignored (as pinocchio and yourdfpy read the file)", file=sys.stderr)
+    return root
+
+
 def load_urdf(path: Path) -> SimpleNamespace:
     """The links and joints of a URDF file (what a kinematic chain needs: no meshes, inertias
     or transmissions), read bounded (:func:`fkopt.files.read_input`) with the standard library's
@@ -110,7 +146,9 @@ def load_urdf(path: Path) -> SimpleNamespace:
     try:
         root = parse_xml(data, f"urdf {path}")           # nesting bounded (MAX_XML_DEPTH)
     except FkoptError as err:
-        raise FkoptError(str(err).replace("malformed XML", "malformed URDF")) from None
+        if "unbound prefix" not in str(err):
+            raise FkoptError(str(err).replace("malformed XML", "malformed URDF")) from None
+        root = _with_undeclared_prefixes(data, path, str(err).split("malformed XML (", 1)[-1].rstrip(")"))
     links = {e.get("name"): e for e in root.findall("link")}
     if root.tag != "robot" or not links or None in links:
         raise FkoptError(f"urdf {path}: malformed URDF (no <robot> with named links)")
@@ -151,6 +189,32 @@ def load_urdf(path: Path) -> SimpleNamespace:
         joints[name] = SimpleNamespace(name=name, type=kind, parent=parent.get("link"), child=child.get("link"),
                                        origin=origin, axis=np.array(axis), limit=limit, mimic=mimic, element=e)
     return SimpleNamespace(name=root.get("name", "robot"), link_map=links, joint_map=joints)
+
+
+def _inward(a: float, b: float, joint, lo_si: float, hi_si: float) -> tuple[float, float]:
+    """Bounds [a, b] of an unknown in degrees, from a joint's limits [lo_si, hi_si] in radians,
+    that never lie outside them: rounded to 9 decimals (so +-pi reads as +-180) only where that
+    moves a bound inward, else kept as computed; then stepped inward by ulps until the joint
+    value ``joint(bound)`` -- the conversion every check of an answer makes -- is within the
+    limits. Rounding to the nearest moved a limit outward by up to 8.7e-12 rad (dexmate's
+    Vega-1 arm: an exact answer at a limit failed a strict check by 5.6e-12 rad)."""
+    def fits(v):
+        q = joint(v)
+        return lo_si <= q <= hi_si
+    out = []
+    for v, toward in ((a, math.inf), (b, -math.inf)):
+        if not math.isfinite(v):
+            out.append(v)
+            continue
+        r = round(v, 9)
+        if (r < v) if toward > 0 else (r > v):      # rounding moved it outward: keep the computed value
+            r = v
+        for _ in range(64):                         # a few ulps at most (one multiply and add)
+            if fits(r):
+                break
+            r = math.nextafter(r, toward)
+        out.append(r)
+    return out[0], out[1]
 
 
 def urdf_chain(robot, path: Path, base: str | None, tip: str | None) -> list:
@@ -344,7 +408,7 @@ class URDFArm(FrameArm):
             a, b = sorted(((lo_si - off) / mult, (hi_si - off) / mult))
             a, b = a / to_si[var], b / to_si[var]
             if units[var] == "deg":
-                a, b = (round(v, 9) if math.isfinite(v) else v for v in (a, b))
+                a, b = _inward(a, b, lambda v: mult * (v * to_si[var]) + off, lo_si, hi_si)
             lo, hi = limits.get(names[var], (-math.inf, math.inf))
             limits[names[var]] = (max(lo, a), min(hi, b))
         periodic = []

@@ -9,6 +9,8 @@ joint-limit handling of ``fkopt.inverse``, its options, and the compiled fast pa
 * :mod:`.options` -- :class:`InverseOptions`, the documented options of ``fkopt.inverse``.
 * :mod:`.compiled` -- the same kernels and the whole one-pose IK loop (restarts included)
   compiled by numba (imported lazily, only when first used; cached on disk).
+* :mod:`.jit` -- numba's ``njit`` with a cache an unreadable file cannot break (set aside and
+  rebuilt); :mod:`.notice` -- the one-line, once-per-process notices about the path.
 * :mod:`.path` -- which path runs (``FKOPT_NUMERICS=numpy`` forces the numpy/Python reference)
   and what ``env.json`` records about it.
 """

@@ -4,10 +4,11 @@ reassociation or fused multiply-add; ``cos``, ``sin``, ``atan2`` and ``sqrt`` ar
 as Python's ``math``). Importing this module imports numba, which costs a noticeable part of a
 second; :mod:`fkopt.numerics.path` imports it only when a compiled kernel is first asked for.
 
-Compiled code is cached on disk (``cache=True``): in the ``__pycache__`` folder beside this file,
-or, when that is not writable, numba's user-wide cache (``~/.cache/numba`` style; ``NUMBA_CACHE_DIR``
-overrides both). The first call after installing compiles (several seconds); later processes
-load the cache.
+Compiled code is cached on disk (``cache=True``, through :func:`fkopt.numerics.jit.njit`: an
+unreadable cache file is set aside and rebuilt, an unwritable folder only costs the cache): in the
+``__pycache__`` folder beside this file, or, when that is not writable, numba's user-wide cache
+(``~/.cache/numba`` style; ``NUMBA_CACHE_DIR`` overrides both). The first call after installing
+compiles (tens of seconds for all kernels, docs/performance.md); later processes load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
 * :func:`rps3_fitness`, :func:`pso_rps3`, :func:`abc_rps3` -- the 3-RPS swarm fitness and the PSO
@@ -27,9 +28,11 @@ import math
 import threading
 
 import numpy as np
-from llvmlite import ir
-from numba import njit, types
+from numba import types               # numba first: without it, the ImportError names numba (not llvmlite)
 from numba.core.extending import intrinsic
+from llvmlite import ir
+
+from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
 _M2 = np.uint64(0xBF58476D1CE4E5B9)
@@ -146,17 +149,11 @@ def _rotation_error(R, T, e):
     e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
 
 
-@njit(cache=True)
-def _dls_step(J, r, mu, free, d, A, L, y, x):
-    """:func:`fkopt.numerics.damped_least_squares.dls_step` into d; J's columns with free[i] = False count as zero.
-    Returns False when not positive definite or not finite."""
+@njit(inline="always")
+def _cholesky_solve(J, r, A, L, y, x, d, free, masked):
+    """The rest of :func:`_dls_step` once A = J J^T + mu I is built: Cholesky of A, x = A^{-1} (-r),
+    d = J^T x (J's columns with free[i] False as zero when ``masked``)."""
     n = J.shape[1]
-    for a in range(6):
-        for b in range(a, 6):
-            acc = (J[a, 0] if free[0] else 0.0) * (J[b, 0] if free[0] else 0.0)
-            for i in range(1, n):
-                acc = acc + (J[a, i] if free[i] else 0.0) * (J[b, i] if free[i] else 0.0)
-            A[a, b] = acc + mu if a == b else acc
     for i in range(6):
         for j in range(i + 1):
             acc = 0.0
@@ -182,13 +179,48 @@ def _dls_step(J, r, mu, free, d, A, L, y, x):
     for i in range(6):
         if not math.isfinite(x[i]):
             return False
-    for i in range(n):
-        ji = J[0, i] if free[i] else 0.0
-        acc = ji * x[0]
-        for a in range(1, 6):
-            acc = acc + (J[a, i] if free[i] else 0.0) * x[a]
-        d[i] = acc
+    if masked:
+        for i in range(n):
+            ji = J[0, i] if free[i] else 0.0
+            acc = ji * x[0]
+            for a in range(1, 6):
+                acc = acc + (J[a, i] if free[i] else 0.0) * x[a]
+            d[i] = acc
+    else:
+        for i in range(n):
+            acc = J[0, i] * x[0]
+            for a in range(1, 6):
+                acc = acc + J[a, i] * x[a]
+            d[i] = acc
     return True
+
+
+@njit(cache=True)
+def _dls_step(J, r, mu, free, d, A, L, y, x):
+    """:func:`fkopt.numerics.damped_least_squares.dls_step` into d; J's columns with free[i] = False count as zero.
+    Returns False when not positive definite or not finite."""
+    n = J.shape[1]
+    for a in range(6):
+        for b in range(a, 6):
+            acc = (J[a, 0] if free[0] else 0.0) * (J[b, 0] if free[0] else 0.0)
+            for i in range(1, n):
+                acc = acc + (J[a, i] if free[i] else 0.0) * (J[b, i] if free[i] else 0.0)
+            A[a, b] = acc + mu if a == b else acc
+    return _cholesky_solve(J, r, A, L, y, x, d, free, True)
+
+
+@njit(cache=True)
+def _dls_step_all(J, r, mu, free, d, A, L, y, x):
+    """:func:`_dls_step` with every column free (``free`` is not read): the same operations
+    without the masks (a free column's value is itself, so the bits are the same)."""
+    n = J.shape[1]
+    for a in range(6):
+        for b in range(a, 6):
+            acc = J[a, 0] * J[b, 0]
+            for i in range(1, n):
+                acc = acc + J[a, i] * J[b, i]
+            A[a, b] = acc + mu if a == b else acc
+    return _cholesky_solve(J, r, A, L, y, x, d, free, False)
 
 
 @njit(cache=True)
@@ -204,17 +236,19 @@ def _uniform_hash(seed, row, draw, out):
 
 
 @njit(cache=True)
-def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
-    """Residual r (6), scaled Jacobian J (6, n) at t; returns (pe, re, S)."""
+def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e, wone=False):
+    """Residual r (6), scaled Jacobian J (6, n) at t; returns (pe, re, S). ``wone``: W is all
+    ones, whose products change no bit (x * 1.0 == x), so they are skipped."""
     prismatic, C, v, var, mult, off, tC, tv = chain
     _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax)
     _rotation_error(R, T, e)
     d0, d1, d2 = (p[0] - pt[0]) * W[0], (p[1] - pt[1]) * W[1], (p[2] - pt[2]) * W[2]
     e0, e1, e2 = e[0] * W[3], e[1] * W[4], e[2] * W[5]
     n = J.shape[1]
-    for a in range(6):
-        for i in range(n):
-            J[a, i] = J[a, i] * W[a]
+    if not wone:
+        for a in range(6):
+            for i in range(n):
+                J[a, i] = J[a, i] * W[a]
     r[0], r[1], r[2], r[3], r[4], r[5] = d0, d1, d2, Lw * e0, Lw * e1, Lw * e2
     for a in range(3, 6):
         for i in range(n):
@@ -224,12 +258,15 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e):
 
 
 @njit(cache=True)
-def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr, iterations, damping, down, up,
-                 step_cap, lo, hi, glo, ghi, best_q):
+def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq, seed, row, budget, tp, tr, iterations,
+                 damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
     """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
-    (starts used, evaluations)."""
+    (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
+    called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``,
+    features ``feat``, the screen ``v32``, joints ``tq``), looked up only if a start reaches them
+    (most poses are solved from their first or second start)."""
     n = q0.shape[0]
     m = chain[0].shape[0]
     nn = near.shape[0]
@@ -241,19 +278,24 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr,
     fixed_val = np.empty(n)
     fixed_order = np.empty(n, dtype=np.int64)
     free = np.ones(n, dtype=np.bool_)
-    allfree = np.ones(n, dtype=np.bool_)
+    wone = True
+    for a in range(6):
+        wone = wone and W[a] == 1.0
     evals = 0
     best_m = math.inf
     for j in range(budget):
         if j < own0:
             q[:] = q0
         elif j < own0 + nn:
+            if j - own0 >= have:
+                _near_rows(table, feat, v32, tq, near)  # the top `have` of these are the rows already there
+                have = nn
             q[:] = near[j - own0]
         else:
             _uniform_hash(seed, row, j - own0 - nn, u)
             for i in range(n):
                 q[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
-        pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e)
+        pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e, wone)
         evals += 1
         lam = damping
         for _ in range(iterations):
@@ -264,7 +306,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr,
                 for i in range(n):
                     acc = acc + J[a, i] * J[a, i]
             mu = lam * (acc / 6.0)
-            if not _dls_step(J, r, mu, allfree, d, A, Lc, y, x):
+            if not _dls_step_all(J, r, mu, free, d, A, Lc, y, x):
                 break
             big = abs(d[0])
             for i in range(1, n):
@@ -306,7 +348,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, row, budget, tp, tr,
                         break
                 for i in range(n):
                     qn[i] = min(max(qn[i], lo[i]), hi[i])
-            pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e)
+            pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e, wone)
             evals += 1
             if Sn < S:
                 q[:] = qn
@@ -331,20 +373,20 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
                 step_cap, lo, hi, glo, ghi):
     """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
     best = np.empty(chain.dof)
-    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, int(seed), 0, int(budget),
+    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], NO_TABLE,
+                               np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, chain.dof)), int(seed), 0,
+                               int(budget),
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
                                float(up), float(step_cap), lo, hi, glo, ghi, best)
     return best, used, evals
 
 
 @njit(cache=True)
-def _nearest_into(Ft, norms, f, idx, best):
-    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx:
-    d2 = |F_i|^2 - 2 F_i . f (as :func:`fkopt.kinematics.solvers._nearest`'s brute force; the dot product
-    summed feature by feature, rows side by side, from ``Ft`` = F transposed), the k smallest kept
-    sorted by insertion (ties: the lower row first)."""
+def _table_distances(Ft, norms, f, v):
+    """v[i] = |F_i|^2 - 2 F_i . f (= |F_i - f|^2 - |f|^2) for every row of the start table, as
+    :func:`fkopt.kinematics.solvers._nearest`'s brute force: the dot product summed feature by feature,
+    rows side by side, from ``Ft`` = F transposed."""
     c, N = Ft.shape
-    k = idx.shape[0]
     d2 = np.zeros(N)
     for j in range(c):
         fj = f[j]
@@ -355,31 +397,161 @@ def _nearest_into(Ft, norms, f, idx, best):
             continue
         for i in range(N):
             d2[i] += Ft[j, i] * fj
-    m = 0
     for i in range(N):
-        v = norms[i] - 2.0 * d2[i]
+        v[i] = norms[i] - 2.0 * d2[i]
+
+
+@njit(cache=True)
+def _smallest(v, idx, best):
+    """The k = len(idx) rows of the smallest v, smallest first, into idx (values into best): kept
+    sorted by insertion in row order (ties: the lower row first)."""
+    k = idx.shape[0]
+    m = 0
+    for i in range(v.shape[0]):
+        x = v[i]
         if m < k:
             pos = m
             m += 1
-        elif v < best[k - 1]:
+        elif x < best[k - 1]:
             pos = k - 1
         else:
             continue
-        while pos > 0 and best[pos - 1] > v:
+        while pos > 0 and best[pos - 1] > x:
             best[pos] = best[pos - 1]
             idx[pos] = idx[pos - 1]
             pos -= 1
-        best[pos] = v
+        best[pos] = x
         idx[pos] = i
 
 
+@njit(cache=True)
+def _nearest_into(Ft, norms, f, idx, best):
+    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx
+    (:func:`_table_distances`, then :func:`_smallest`)."""
+    v = np.empty(Ft.shape[1])
+    _table_distances(Ft, norms, f, v)
+    _smallest(v, idx, best)
+
+
+#: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
+NO_TABLE = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0)
+
+#: Neighbours looked up before the first start; the rest only when a start reaches them. Most
+#: poses are solved from their first or second start, and the nearest four cost about half of
+#: the nearest 64 (the screening pass is the same, computed once; the exact rows are not).
+NEAR_FIRST = 4
+#: The float32 screen's error bound, relative to the sizes in :func:`start_screen`: float32's
+#: unit roundoff is 2^-24, a 12-term dot product and the conversions need at most ~16 of them;
+#: 2^-16 leaves a factor 16 more.
+SCREEN_ROUNDOFF = 2.0 ** -16
+
+
+def start_screen(Ft, norms):
+    """The start table for :func:`_nearest_screened`: (Ft float64 (12, N), norms float64, Ft and
+    norms as float32, max |F_i|^2)."""
+    return (Ft, norms, np.ascontiguousarray(Ft, dtype=np.float32), np.ascontiguousarray(norms, dtype=np.float32),
+            float(norms.max()) if norms.shape[0] else 0.0)
+
+
+@njit(cache=True)
+def _screen32(table, f, v32):
+    """v32[i] = |F_i|^2 - 2 F_i . f in float32 for every row (half the bytes of the float64 pass,
+    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values."""
+    Ft32, n32 = table[2], table[3]
+    c, N = Ft32.shape
+    for i in range(N):
+        v32[i] = 0.0
+    for j in range(c):
+        fj = np.float32(f[j])
+        if f[j] == 0.0:
+            continue
+        for i in range(N):
+            v32[i] += Ft32[j, i] * fj
+    two = np.float32(2.0)
+    for i in range(N):
+        v32[i] = n32[i] - two * v32[i]
+
+
+@njit(cache=True)
+def _nearest_screened(table, f, v32, idx, best):
+    """:func:`_nearest_into`'s k = len(idx) nearest rows, the same rows in the same order: the
+    float32 screen v32 (:func:`_screen32`) bounds every row's float64 value v within B (sizes
+    times :data:`SCREEN_ROUNDOFF`), so with s_k the k-th smallest screen value, the k-th smallest
+    v is at most s_k + B and a row of the k nearest has v32 <= s_k + 2B; only those rows get the
+    float64 value of :func:`_table_distances` (the same operations), in row order, and the same
+    sorted insertion (ties: the lower row first)."""
+    Ft, norms, _, _, nmax = table
+    k = idx.shape[0]
+    c, N = Ft.shape
+    ff = 0.0
+    for j in range(c):
+        ff += f[j] * f[j]
+    B = SCREEN_ROUNDOFF * (1.0 + nmax + 2.0 * math.sqrt(nmax * ff) + ff)
+    # the k smallest screen values (sorted insertion; k is small)
+    sk = np.empty(k)
+    m = 0
+    for i in range(N):
+        x = np.float64(v32[i])
+        if m < k:
+            pos = m
+            m += 1
+        elif x < sk[k - 1]:
+            pos = k - 1
+        else:
+            continue
+        while pos > 0 and sk[pos - 1] > x:
+            sk[pos] = sk[pos - 1]
+            pos -= 1
+        sk[pos] = x
+    limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
+    m = 0
+    for i in range(N):
+        if not np.float64(v32[i]) <= limit:
+            continue
+        acc = 0.0
+        first = True
+        for j in range(c):
+            fj = f[j]
+            if fj == 0.0:
+                continue
+            # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
+            # |F_i|^2 - 2 d2 does not see)
+            acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
+            first = False
+        x = norms[i] - 2.0 * acc
+        if m < k:
+            pos = m
+            m += 1
+        elif x < best[k - 1]:
+            pos = k - 1
+        else:
+            continue
+        while pos > 0 and best[pos - 1] > x:
+            best[pos] = best[pos - 1]
+            idx[pos] = idx[pos - 1]
+            pos -= 1
+        best[pos] = x
+        idx[pos] = i
+
+
+@njit(cache=True)
+def _near_rows(table, f, v32, tq, near):
+    """The table joints of the len(near) rows nearest to f (:func:`_nearest_screened`) into near."""
+    k = near.shape[0]
+    idx = np.empty(k, dtype=np.int64)
+    _nearest_screened(table, f, v32, idx, np.empty(k))
+    for i in range(k):
+        near[i, :] = tq[idx[i]]
+
+
 @njit(cache=True, nogil=True)
-def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
     the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics.solvers._zyz_matrix1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
-    start table's ``nn`` nearest configurations (:func:`_nearest_into`), the loop
+    start table's ``nn`` nearest configurations (:func:`_nearest_screened`, its float32 screen once; the first
+    :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
     (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
     [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
     target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
@@ -402,21 +574,21 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, se
         T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
     pt = pose[:3].copy()
     near = np.empty((nn, n))
+    v32 = np.empty(tq.shape[0] if nn > 0 else 0, dtype=np.float32)
+    have = min(nn, NEAR_FIRST)
+    f = np.empty(12)
     if nn > 0:
-        f = np.empty(12)
         f[0], f[1], f[2] = pt[0], pt[1], pt[2]
         for r in range(3):
             for c in range(3):
                 f[3 + 3 * r + c] = wf * T[r, c]
         for j in range(12):
             f[j] = f[j] * fmask[j]
-        idx = np.empty(nn, dtype=np.int64)
-        _nearest_into(Ft, norms, f, idx, np.empty(nn))
-        for k in range(nn):
-            near[k, :] = tq[idx[k]]
+        _screen32(table, f, v32)
+        _near_rows(table, f, v32, tq, near[:have])
     best = np.empty(n)
-    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, seed, 0, budget, tp, tr, iterations, damping,
-                               down, up, step_cap, slo, shi, lo, hi, best)
+    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, f, v32, tq, seed, 0, budget, tp, tr,
+                               iterations, damping, down, up, step_cap, slo, shi, lo, hi, best)
     t = np.empty(n)
     inside = True
     for i in range(n):
@@ -447,7 +619,7 @@ def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping
     kernel's arguments; a prepared solver (:class:`fkopt.kinematics.solvers.InverseSolver`) keeps it, so
     a control loop's call does no dictionary lookups."""
     chain, n = ctx["chain"], ctx["n"]
-    head = (L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn)
+    head = (L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn)
     tail = (budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"], ctx["lo"],
             ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
 
@@ -465,13 +637,13 @@ def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, d
 
 
 @njit(cache=True, nogil=True)
-def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr, iterations,
+def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
     """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
     ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
     share a batch (:func:`inverse_rows`)."""
     for k in range(first, poses.shape[0], step):
-        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, Ft, norms, wf, fmask, nn, seed, budget, tp, tr,
+        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, table, wf, fmask, nn, seed, budget, tp, tr,
                       iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
                       out[k], info[k])
 
@@ -488,7 +660,7 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
     import os
     k = poses.shape[0]
     out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
-    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], nn,
+    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn,
             seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
             ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
     threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
@@ -1093,3 +1265,14 @@ def store_pcg64_states(generators, S) -> None:
         st = g.bit_generator.state
         st["state"] = {"state": lo | (hi << 64), "inc": ilo | (ihi << 64)}
         g.bit_generator.state = st
+
+
+@njit(cache=True)
+def _probe(x):
+    return math.sqrt(x * x) + 1.0
+
+
+def probe(x: float) -> float:
+    """x + 1 (x >= 0) through a compiled kernel: :func:`fkopt.numerics.path.compiled` calls it once
+    per process to learn that numba compiles (or loads its cache) here before choosing this path."""
+    return _probe(float(x))

@@ -1,16 +1,11 @@
 """Options of ``fkopt.inverse`` (documented in :func:`fkopt.kinematics.solvers.inverse`)."""
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import asdict, dataclass, fields
 
 from fkopt.errors import FkoptError
 
-#: (option, smallest allowed value) of the integer options; the rest are numbers or flags.
-_INTEGERS = {"restarts": 0, "starts": 1, "iterations": 0, "fill": 1, "table": 0, "neighbours": 0, "tail": 1}
-#: Float options that must be positive (``orientation_scale`` too, unless None).
-_POSITIVE = ("damping", "step_cap", "down", "up")
 
 
 @dataclass(frozen=True)
@@ -41,30 +36,17 @@ class InverseOptions:
 
     def validated(self) -> InverseOptions:
         """These options when every one is of its type and range, else FkoptError naming the
-        first bad one and what it allows."""
+        first bad one and what it allows; the ranges, upper bounds included, are
+        :mod:`fkopt.api_bounds`'s (``table`` at most 1,000,000: its memory)."""
+        from fkopt.api_bounds import check_options
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name in _INTEGERS:
-                low = _INTEGERS[f.name]
-                if isinstance(v, bool) or not (isinstance(v, numbers.Integral) or isinstance(v, float) and v.is_integer()) \
-                        or v < low:
-                    raise FkoptError(f"inverse options {f.name}: expected an integer >= {low}, got {v!r}")
-            elif f.name in ("exact_rotation",):
+            if f.name in ("exact_rotation",):
                 if not isinstance(v, (bool, numbers.Integral)) or v not in (0, 1):
                     raise FkoptError(f"inverse options {f.name}: expected true or false, got {v!r}")
             elif f.name == "compiled":
                 if v not in (None, True, False) or not isinstance(v, (bool, type(None))):
                     raise FkoptError(f"inverse options compiled: expected None, true or false, got {v!r}")
             else:
-                ok = not isinstance(v, bool) and isinstance(v, numbers.Real) and math.isfinite(v)
-                if f.name == "orientation_scale":
-                    ok = v is None or (ok and v > 0)
-                elif f.name == "rest":
-                    ok = ok and v >= 0
-                else:
-                    ok = ok and v > 0
-                if not ok:
-                    allowed = {"orientation_scale": "None or a number > 0", "rest": "a number >= 0"}.get(
-                        f.name, "a number > 0")
-                    raise FkoptError(f"inverse options {f.name}: expected {allowed}, got {v!r}")
+                check_options("inverse options", **{f.name: v})
         return self

@@ -72,6 +72,20 @@ def zyz_angles(R: Matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return alpha, beta, gamma
 
 
+def quaternion_matrix(w, x, y, z) -> Matrix:
+    """R of the unit quaternion w + xi + yj + zk (Hamilton convention, active; the convention of
+    URDF tools, ROS' geometry_msgs/Quaternion and pinocchio's Quaternion(w, x, y, z)); the
+    quaternion is normalised first. Shoemake, "Animating rotation with quaternion curves",
+    SIGGRAPH 1985, eq. for Rot(q)."""
+    n = np.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return (
+        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
+    )
+
+
 def relative_quaternion(Ra: Matrix, Rb: Matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Unit quaternion (w, x, y, z), w >= 0, of the relative rotation M = Ra^T Rb.
 

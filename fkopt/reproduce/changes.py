@@ -8,12 +8,12 @@ last regeneration moved, and nobody writes that list by hand.
 """
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
 
+from fkopt.errors import FkoptError
 from fkopt.files import read_stored
 from fkopt.run.writers import deterministic_files, sha256
 from fkopt.reproduce.claims import CLAIMS_FILE
@@ -35,17 +35,22 @@ class Snapshot:
     copies: Path | None = None
 
 
-def snapshot(root: str | Path, keep: Path | None = None) -> Snapshot:
+def snapshot(root: str | Path, keep: Path | None = None, only: set[str] | None = None) -> Snapshot:
     """The state of a results tree (empty when there is none yet). With ``keep`` (an empty
-    folder), its deterministic files are also copied there, for :func:`agreement`."""
+    folder), its deterministic files are also copied there, for :func:`agreement`. ``only``:
+    the results ("paper/name") to read, and their papers' claims (``fkopt reproduce`` into a
+    folder of its own compares only what it reruns with the stored tree)."""
     import shutil
     root = Path(root)
     snap = Snapshot(copies=keep)
     if not root.is_dir():
         return snap
     store = Store(root)
+    papers = None if only is None else {label.split("/")[0] for label in only}
     for exp in store.folders(None):
         label = f"{exp.paper}/{exp.name}"
+        if only is not None and label not in only:
+            continue
         names = deterministic_files(exp.folder)
         snap.files[label] = {f: sha256(exp.folder / f) for f in names if f != "meta.json"}
         if keep is not None:
@@ -55,6 +60,8 @@ def snapshot(root: str | Path, keep: Path | None = None) -> Snapshot:
         if (exp.folder / "summary.csv").is_file():
             snap.summaries[label] = read_stored(exp.folder, "summary.csv").decode("utf-8", errors="replace")
     for paper in store.papers():
+        if papers is not None and paper not in papers:
+            continue
         file = root / paper / CLAIMS_FILE
         if file.is_file():
             snap.claims[paper] = read_stored(file.parent, file.name).decode("utf-8", errors="replace")
@@ -88,9 +95,10 @@ def load_snapshot(path: str | Path) -> Snapshot:
 def _table(text: str | None) -> pd.DataFrame | None:
     if not text:
         return None
+    from fkopt.files import parse_csv
     try:
-        return pd.read_csv(io.StringIO(text))
-    except (ValueError, pd.errors.ParserError):
+        return parse_csv(text.encode("utf-8"), "stored table")
+    except (FkoptError, ValueError, pd.errors.ParserError):
         return None
 
 

@@ -29,7 +29,6 @@ not compared (they depend on the plotting library's version).
 """
 from __future__ import annotations
 
-import io
 import shutil
 import tempfile
 from pathlib import Path
@@ -39,7 +38,7 @@ import pandas as pd
 
 from fkopt.run.compare import Mismatch, Rules, compare_folders, deterministic_files, sha256, summary_consistency
 from fkopt.errors import FkoptError
-from fkopt.files import odd_entries, parse_json, read_stored
+from fkopt.files import odd_entries, parse_json, read_stored, read_stored_csv
 import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
 from fkopt.run.pipeline import config_kind, from_dict, rerun_files
 from fkopt.numerics import path as numerics_path
@@ -136,7 +135,7 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     from fkopt.run.solving import build_mechanism, make_problem
     label = _label(exp)
     try:
-        runs = pd.read_csv(io.BytesIO(read_stored(exp.folder, "runs.csv")))
+        runs = read_stored_csv(exp.folder, "runs.csv")
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(label, "runs.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
     mech = build_mechanism(config)
@@ -316,7 +315,7 @@ def verdict_files(exp: Experiment) -> list[Mismatch]:
                                 "(its claims are judged where their experiments are stored)"))
             continue
         try:
-            stored = pd.read_csv(io.BytesIO(read_stored(folder, name)), dtype=str, keep_default_na=False)
+            stored = read_stored_csv(folder, name, dtype=str, keep_default_na=False)
         except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
             out.append(Mismatch(paper, name, "-", "file", f"unreadable ({err})", "readable", "readable CSV"))
             continue

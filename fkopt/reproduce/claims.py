@@ -343,12 +343,11 @@ def read_claims(file: str | Path) -> pd.DataFrame:
     """A stored ``claims.csv`` (or ``timing_claims.csv``) as text columns; a file that is not
     UTF-8, too large, not a CSV or without ``claim`` and ``verdict`` columns is one
     :class:`~fkopt.errors.FkoptError` line naming it."""
-    import io
     from fkopt.errors import FkoptError
-    from fkopt.files import read_text
+    from fkopt.files import parse_csv, read_text
     text = read_text(file, MAX_CLAIMS_BYTES)
     try:
-        df = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
+        df = parse_csv(text.encode("utf-8"), str(file), dtype=str, keep_default_na=False)
     except (ValueError, pd.errors.ParserError) as err:
         raise FkoptError(f"{file}: not a CSV table ({(str(err).splitlines() or [''])[0][:200]})") from None
     if not {"claim", "verdict"} <= set(df.columns):

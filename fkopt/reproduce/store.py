@@ -1,7 +1,6 @@
 """Read access to a results tree ``RESULTS/<paper>/<experiment>/``."""
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -9,7 +8,7 @@ from pathlib import Path
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.files import parse_json, read_stored
+from fkopt.files import parse_json, read_stored, read_stored_csv
 
 
 @dataclass
@@ -62,7 +61,7 @@ class Experiment:
         if not (self.folder / file).exists() and (self.folder / f"{file}.gz").exists():
             file += ".gz"      # trace.csv.gz (fkopt.run.trace)
         # bounded: inside the folder, a regular file, a gzip bomb one line, not the memory
-        return pd.read_csv(io.BytesIO(read_stored(self.folder, file)), keep_default_na=True)
+        return read_stored_csv(self.folder, file, keep_default_na=True)
 
     def figures(self) -> list[str]:
         return sorted(p.name for p in self.folder.glob("*.png"))

@@ -12,7 +12,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
 
 from fkopt.errors import FkoptError
-from fkopt.files import MAX_COMPONENT, check_component
+from fkopt.files import MAX_COMPONENT, check_component, no_quoted_numbers
 
 #: Documented upper limits (docs/cli.md, "Bad input"); a memory estimate refuses smaller jobs that
 #: still cannot fit (:func:`fkopt.run.memory.check_memory`).
@@ -29,8 +29,9 @@ def Seed(default: int = 0):
 
 
 class Strict(BaseModel):
-    #: Unknown fields are errors; NaN and inf are never accepted as numbers.
+    #: Unknown fields are errors; NaN and inf are never accepted as numbers, nor text as a number.
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    _numbers = field_validator("*", mode="before")(no_quoted_numbers)
 
 
 def safe_component(value, field: str):

@@ -125,7 +125,7 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
                  "`scipy:`/`pymoo:`/`niapy:` optimisers, or `package.module:Class`.", "", "gabc"),
         "label": ("Name in the tables; needed when one algorithm appears twice. Default: the name.", "",
                   "gabc_zhu2010"),
-        "params": ("The algorithm's parameters (`fkopt list` shows them with their defaults); unknown keys "
+        "params": ("The algorithm's parameters (`fkopt list --long` shows them with their defaults); unknown keys "
                    "are refused.", "", {"rule": "zhu2010"}),
         "population": ("This algorithm's population (number of starts for nr/lm), instead of the file's.",
                        "agents", 1),

@@ -164,7 +164,7 @@ def changed_fields(old, new, path: str = "") -> list[str]:
                 out += changed_fields(old[key], new[key], where)
         return out
     if isinstance(old, list) and isinstance(new, list) and len(old) == len(new):
-        return [c for i, (a, b) in enumerate(zip(old, new)) for c in changed_fields(a, b, f"{path}.{i}")]
+        return [c for i, (a, b) in enumerate(zip(old, new)) for c in changed_fields(a, b, f"{path}[{i}]")]
     return [] if old == new else [f"{path or 'config'}: {_short(old)} -> {_short(new)}"]
 
 

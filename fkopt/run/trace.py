@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from fkopt.files import MAX_UNPACKED, read_input
+from fkopt.files import MAX_UNPACKED, check_csv_shape, csv_numbers, read_input
 
 FILE = "trace.csv.gz"
 COLUMNS = ("case", "algorithm", "run", "iteration", "evaluations", "best_fitness")
@@ -112,6 +112,7 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
     labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
     # bounded: a regular file inside the folder, unpacked size measured by streaming before parsing
     data = read_input(path, MAX_UNPACKED, within=folder, unpacked=MAX_UNPACKED if limit is None else limit)
+    check_csv_shape(data, str(path))
     try:
         table = pd.read_csv(io.BytesIO(data), dtype=dict.fromkeys(labels, "category"))
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as err:
@@ -125,14 +126,14 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
             i = int(np.flatnonzero(table[col].isna().to_numpy())[0])
             raise FkoptError(f"{path}: row {i + 1} column {col}: empty")
     for col in (c for c in INTEGER_COLUMNS if c in columns):
-        num = pd.to_numeric(table[col], errors="coerce")
+        num = pd.Series(csv_numbers(table[col]), index=table.index)   # a 400-digit integer: inf, refused here
         low = 1 if col == "evaluations" else 0
-        bad = (num.isna() | (num != np.floor(num)) | (num < low)).to_numpy()
+        bad = (num.isna() | (num != np.floor(num)) | (num < low) | (num > 2 ** 53)).to_numpy()
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise FkoptError(f"{path}: row {i + 1} column {col}: {table[col].iloc[i]!r} is not an integer >= {low}")
         table[col] = num.astype(np.int64)
-    num = pd.to_numeric(table["best_fitness"], errors="coerce")
+    num = pd.Series(csv_numbers(table["best_fitness"]), index=table.index)
     bad = num.isna().to_numpy()
     if bad.any():
         i = int(np.flatnonzero(bad)[0])

@@ -37,7 +37,6 @@ input file has been read and checked, and only over a folder that ``fkopt export
 """
 from __future__ import annotations
 
-import io
 import json
 import re
 from dataclasses import dataclass, field
@@ -47,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.files import file_names, parse_json, read_stored
+from fkopt.files import csv_numbers, file_names, parse_json, read_stored, read_stored_csv
 from fkopt.tools.iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
@@ -119,7 +118,7 @@ def _meta(folder: Path) -> dict:
 def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
     path = folder / "runs.csv"
     try:
-        runs = pd.read_csv(io.BytesIO(read_stored(folder, "runs.csv")), dtype=dict.fromkeys(labels, str))
+        runs = read_stored_csv(folder, "runs.csv", dtype=dict.fromkeys(labels, str))
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError) as err:
         raise FkoptError(f"{path}: cannot read ({str(err).strip().splitlines()[0] if str(err).strip() else err})") from None
     missing = [c for c in columns if c not in runs.columns]
@@ -127,8 +126,8 @@ def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
         raise FkoptError(f"{path}: missing column(s) {', '.join(missing)}")
     for col in ("run", "pose", "dim"):
         if col in columns:
-            num = pd.to_numeric(runs[col], errors="coerce")
-            if num.isna().any() or (num != np.floor(num)).any():
+            num = pd.Series(csv_numbers(runs[col]), index=runs.index)     # never raises; range-checked here
+            if num.isna().any() or (num != np.floor(num)).any() or (num.abs() > 2 ** 53).any():
                 raise FkoptError(f"{path}: column {col}: {col} ids must be integers")
             runs[col] = num.astype(np.int64)
     return runs

@@ -14,7 +14,6 @@ Success rate is the share of runs below the threshold. Evaluations are the mean 
 """
 from __future__ import annotations
 
-import io
 import sys
 from pathlib import Path
 
@@ -22,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.files import parse_json, read_stored
+from fkopt.files import parse_json, read_stored, read_stored_csv
 
 #: Which fkopt algorithm each library algorithm is the counterpart of (by name).
 COUNTERPARTS = {"niapy:ArtificialBeeColonyAlgorithm": "abc", "niapy:ParticleSwarmAlgorithm": "pso",
@@ -48,7 +47,7 @@ def _verdict(a: float, b: float, name_a: str, name_b: str, thr: float | None) ->
 
 def paper_section(folder: Path) -> str:
     meta = parse_json(read_stored(folder, "meta.json"), str(folder / "meta.json"))
-    summary = pd.read_csv(io.BytesIO(read_stored(folder, "summary.csv")))
+    summary = read_stored_csv(folder, "summary.csv")
     config = meta["config"]
     thr = config.get("threshold")
     try:   # library versions are in env.json (fkopt.run.provenance), beside the timings

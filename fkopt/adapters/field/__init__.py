@@ -44,6 +44,7 @@ import numpy as np
 
 from fkopt.errors import FkoptError
 
+
 class NotApplicable(FkoptError):
     """The package cannot take this arm by design (EAIK on a 7-joint arm): the board shows a
     "not applicable: why" cell for it, never a zero; the message is the why."""

@@ -481,6 +481,8 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
             ax.set_yscale("log")
             if (table[col] <= 0).any():
                 plotting.mark_zero(ax, floor)
+        else:             # times on a linear axis from 0: a 32 vs 80 ms gap is not drawn as 1 to 25
+            ax.set_ylim(bottom=0)
         shown = int(table["case"].map(order).max())   # timings cover only the first timed cases
         _case_axis(ax, shown)
         ax.set_ylabel(ylabel)
@@ -529,6 +531,7 @@ def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
         ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
     ax.set_xticks(range(len(er.config.algorithms)), [names[s.key] for s in er.config.algorithms])
     ax.set_ylabel("time per run, one run at a time (ms)")
+    ax.set_ylim(bottom=0)                  # from 0: the ratio of two times is the ratio of their heights
     ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} of the {er.config.runs} runs per algorithm "
                  "timed one at a time (fkopt's timing sample, TIMING.md; bar: median)", fontsize=9)
     out = _save(fig, path)

@@ -1,0 +1,274 @@
+"""Compiled kernels of :mod:`fkopt.kinematics.branches`: every IK solution of one pose by seeded restarts of
+the one-pose loop, and branch following along a path.
+
+Both are built on :func:`fkopt.numerics.compiled._inverse_one` (the damped least-squares loop of
+``fkopt.inverse``), one start per call:
+
+* :func:`search` -- starts from the start table's configurations nearest to the target, then
+  seeded hash draws (revolute joints over one turn, prismatic joints inside their limits); each
+  start runs the loop without revolute limits (a solution is a solution modulo 2 pi; the limits
+  are applied by the caller, which maps every solution into them), converged answers are wrapped
+  into [-pi, pi) and merged when every joint agrees within ``merge_tol``; the search stops after
+  ``patience`` consecutive starts that found nothing new (the stopping rule, whose miss rate
+  docs/robots.md measures against EAIK's analytic sets), or after ``max_starts``.
+* :func:`track` -- one path: each waypoint's loop starts at the previous answer (no table, no
+  restarts), a waypoint passes when it converges and no joint moved more than ``max_step``; the
+  first waypoint that does not pass is returned for the caller to explain (limit, singularity,
+  unreachable) and re-seat.
+
+Importing this module imports numba (as :mod:`fkopt.numerics.compiled`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from fkopt.numerics.compiled import _evaluate, _inverse_one, _nearest_into, _uniform_hash
+
+TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def _wrap(x):
+    """x into [-pi, pi)."""
+    return (x + math.pi) % TWO_PI - math.pi
+
+
+@njit(cache=True)
+def _geodesic(R, T):
+    """The angle of R T^T in [0, pi] from both its skew part and its trace: the rotation vector
+    of :func:`fkopt.numerics.compiled._rotation_error` is zero at exactly pi (its skew part
+    vanishes there), so a turn by pi about the tool axis would pass a check on it."""
+    v0 = (R[2, 0] * T[1, 0] + R[2, 1] * T[1, 1] + R[2, 2] * T[1, 2]) - (R[1, 0] * T[2, 0] + R[1, 1] * T[2, 1] + R[1, 2] * T[2, 2])
+    v1 = (R[0, 0] * T[2, 0] + R[0, 1] * T[2, 1] + R[0, 2] * T[2, 2]) - (R[2, 0] * T[0, 0] + R[2, 1] * T[0, 1] + R[2, 2] * T[0, 2])
+    v2 = (R[1, 0] * T[0, 0] + R[1, 1] * T[0, 1] + R[1, 2] * T[0, 2]) - (R[0, 0] * T[1, 0] + R[0, 1] * T[1, 1] + R[0, 2] * T[1, 2])
+    c = 0.0
+    for a in range(3):
+        for b in range(3):
+            c += R[a, b] * T[a, b]
+    return math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (c - 1.0))
+
+
+@njit(cache=True)
+def _rotation_target(pose, T):
+    """The target rotation of a pose row into T: ZYZ Euler angles in deg (6,) as
+    :func:`fkopt.kinematics._zyz_matrix1`, or a frame row (12,) row-major as given."""
+    if pose.shape[0] == 12:
+        for r in range(3):
+            for c in range(3):
+                T[r, c] = pose[3 + 3 * r + c]
+    else:
+        d2r = math.pi / 180.0
+        a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
+        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+        T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+        T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+        T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
+
+
+@njit(cache=True)
+def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, patience, tp, tr, accept_p,
+            accept_r, iterations, damping, down, up, step_cap, slo, shi, glo, ghi, revolute, merge_tol, growth,
+            wfirst, wlast, held_draws, sols, found_at, info):
+    """Distinct converged solutions of one pose (internal units, revolute joints wrapped into
+    [-pi, pi)) into ``sols`` (cap, n); returns how many. ``info`` = (starts run, converged
+    starts, evaluations, starts after the last new solution, the start that found the last new
+    one); ``found_at[s]`` the start that found solution s (its gaps measure the stopping rule)."""
+    n = glo.shape[0]
+    m = chain[0].shape[0]
+    T = np.empty((3, 3))
+    _rotation_target(pose, T)
+    pt = pose[:3].copy()
+    near_idx = np.empty(nn, dtype=np.int64)
+    if nn > 0:
+        f = np.empty(12)
+        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
+        for r in range(3):
+            for c in range(3):
+                f[3 + 3 * r + c] = wf * T[r, c]
+        for j in range(12):
+            f[j] = f[j] * fmask[j]
+        _nearest_into(Ft, norms, f, near_idx, np.empty(nn))
+    q0, best, u, w = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    empty = np.empty((0, n))
+    r, J = np.empty(6), np.empty((6, n))
+    p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
+    cap = sols.shape[0]
+    k = 0
+    since = 0
+    converged = 0
+    evals = 0
+    last_new = -1
+    runs = 0
+    nw = wfirst.shape[0]                         # windows: joints wfirst[w] .. wlast[w] drawn afresh
+    hlo, hhi = np.empty(n), np.empty(n)
+    derived = 0                                  # (solution, window) pairs done
+    tries = 0                                    # draws of the current pair
+    nb = 0                                       # table neighbours run so far
+    draw = 0
+    for j in range(max_starts):
+        held = derived < k * nw
+        if held:
+            # a found solution with one window of joints drawn afresh and the others held at its
+            # values (their limits set to the value): the solutions that share the held joints
+            # with it (a wrist flip, an elbow flip of three parallel axes) are the window's own
+            # small subproblem, reached in a few steps, where uniform starts rarely land
+            # (the window's values: the farthest from the solution's of 4 hash draws, so that the
+            # start leaves its basin)
+            s_, w_ = derived // nw, derived % nw
+            far = -1.0
+            for c in range(4):
+                _uniform_hash(seed, 1 + w_ + nw * (4 * tries + c), s_, u)
+                acc = 0.0
+                for i in range(wfirst[w_], wlast[w_] + 1):
+                    d = glo[i] + (ghi[i] - glo[i]) * u[i] - sols[s_, i]
+                    if revolute[i]:
+                        d = _wrap(d)
+                    acc += d * d
+                if acc > far:
+                    far = acc
+                    for i in range(n):
+                        q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
+            for i in range(n):
+                if wfirst[w_] <= i <= wlast[w_]:
+                    hlo[i], hhi[i] = slo[i], shi[i]
+                else:
+                    q0[i] = sols[s_, i]
+                    hlo[i], hhi[i] = q0[i], q0[i]
+            if wfirst[w_] == 0 and wlast[w_] == n - 1 and revolute[0]:
+                # the whole arm free, from the solution's first joint turned by pi: the other
+                # shoulder side (its solutions share no joint with this one)
+                q0[0] = sols[s_, 0] + math.pi
+            tries += 1
+        elif nb < nn:
+            q0[:] = tq[near_idx[nb]]
+            nb += 1
+        else:
+            _uniform_hash(seed, 0, draw, u)
+            draw += 1
+            for i in range(n):
+                q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
+        if held:
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
+                                 up, step_cap, hlo, hhi, glo, ghi, best)
+        else:
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
+                                 up, step_cap, slo, shi, glo, ghi, best)
+        pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
+        if W[3] * W[4] * W[5] != 0.0:
+            re = max(re, _geodesic(R, T))
+        evals += ev + 1
+        runs += 1
+        new = False
+        if pe <= accept_p and re <= accept_r:
+            converged += 1
+            for i in range(n):
+                w[i] = _wrap(best[i]) if revolute[i] else best[i]
+            dup = False
+            for s in range(k):
+                same = True
+                for i in range(n):
+                    d = w[i] - sols[s, i]
+                    if revolute[i]:
+                        d = _wrap(d)
+                    if abs(d) > merge_tol:
+                        same = False
+                        break
+                if same:
+                    dup = True
+                    break
+            if not dup and k < cap:
+                sols[k, :] = w
+                found_at[k] = j
+                k += 1
+                new = True
+                last_new = j
+        if held and (new or tries >= held_draws):     # next pair after a new solution or held_draws draws
+            derived += 1
+            tries = 0
+        # the stopping rule counts the neighbour and hash-draw starts only: the derived starts are
+        # bounded (windows per solution) and run before them
+        since = 0 if new else (since if held else since + 1)
+        # nothing found yet: four times the patience before giving a pose up
+        if since >= (patience if k > 0 else 4 * patience) and since >= growth * (last_new + 1):
+            break
+    info[0], info[1], info[2], info[3], info[4] = runs, converged, evals, since, last_new
+    return k
+
+
+def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up, step_cap,
+           glo, ghi, revolute, merge_tol, cap, growth, windows, held_draws=4):
+    """:func:`_search` of one pose row with the per-arm constants ``ctx``
+    (:func:`fkopt.kinematics._fast_context`) and the unlimited saturation bounds of the search:
+    (solutions (k, n) internal units, the start that found each (k,), info (5,))."""
+    n = ctx["n"]
+    wfirst = np.array([w[0] for w in windows], dtype=np.int64)
+    wlast = np.array([w[1] for w in windows], dtype=np.int64)
+    sols, info, found_at = np.empty((cap, n)), np.zeros(5), np.zeros(cap, dtype=np.int64)
+    slo = np.where(revolute, -np.inf, ctx["lo"])
+    shi = np.where(revolute, np.inf, ctx["hi"])
+    k = _search(ctx["chain"], pose, float(L), W, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], int(nn),
+                int(seed), int(max_starts), int(patience), float(tol[0]), float(tol[1]), float(accept[0]),
+                float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap), slo, shi,
+                glo, ghi, revolute, float(merge_tol), float(growth), wfirst, wlast, int(held_draws), sols,
+                found_at, info)
+    return sols[:k].copy(), found_at[:k].copy(), info
+
+
+@njit(cache=True)
+def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up, step_cap, lo, hi, slo, shi,
+           max_step, predict, out, errs):
+    """Follow the branch through waypoints first, first + 1, ... of ``poses`` from joints ``q``
+    (internal units, updated in place): each waypoint's loop starts at the previous answer plus
+    the previous step (a linear predictor), saturating at [slo, shi] (a redundant arm's self-motion then keeps off its limits; +-inf
+    for a non-redundant arm, which has none), the limits [lo, hi] checked after. Answers into ``out`` rows and their
+    (position, rotation) errors into ``errs``; returns the first waypoint that did not pass
+    (no convergence within tol, a joint step above ``max_step``, or a joint outside [lo, hi]),
+    or len(poses) when all passed. ``out`` of the failing row holds the loop's answer."""
+    n = q.shape[0]
+    m = chain[0].shape[0]
+    T = np.empty((3, 3))
+    best = np.empty(n)
+    empty = np.empty((0, n))
+    r, J = np.empty(6), np.empty((6, n))
+    p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
+    vel = np.zeros(n)
+    q0 = np.empty(n)
+    for k in range(first, poses.shape[0]):
+        _rotation_target(poses[k], T)
+        pt = poses[k, :3].copy()
+        # predictor: the previous step continued (zero on the first waypoint of a call), then the
+        # loop corrects; where two branches meet at a singularity (an elbow passing straight) the
+        # predicted start lies on the branch the path was on, where the previous answer alone is
+        # as near to the other
+        for i in range(n):
+            q0[i] = q[i] + vel[i]
+        _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, 0, 1, tp, tr, iterations, damping, down, up, step_cap,
+                     slo, shi, lo, hi, best)
+        pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
+        if W[3] * W[4] * W[5] != 0.0:
+            re = max(re, _geodesic(R, T))
+        out[k, :] = best
+        errs[k, 0], errs[k, 1] = pe, re
+        big = 0.0
+        inside = True
+        for i in range(n):
+            big = max(big, abs(best[i] - q[i]))
+            inside = inside and lo[i] <= best[i] <= hi[i]
+        if not (pe <= tp and re <= tr) or big > max_step or not inside:
+            return k
+        if predict:
+            for i in range(n):
+                vel[i] = best[i] - q[i]
+        q[:] = best
+    return poses.shape[0]
+
+
+def track(chain, poses, first, q, L, W, tol, iterations, damping, down, up, step_cap, lo, hi, slo, shi, max_step,
+          out, errs, predict=True):
+    """:func:`_track` with typed arguments; returns the first waypoint that did not pass."""
+    return _track(chain, poses, int(first), q, float(L), W, float(tol[0]), float(tol[1]), int(iterations),
+                  float(damping), float(down), float(up), float(step_cap), lo, hi, slo, shi, float(max_step),
+                  bool(predict), out, errs)

@@ -1,0 +1,124 @@
+"""numba's ``njit`` with an on-disk cache that cannot break a run, and fkopt's one-line notices
+about the compiled path.
+
+numba's own ``cache=True`` unpickles the cache's index (``.nbi``) and data (``.nbc``) files
+without a guard: a garbage, empty or truncated file (a full disk, a killed process, a copied
+folder) raises ``UnpicklingError``, ``EOFError`` or ``ValueError`` out of the first call of that
+kernel in every later process, until someone deletes the folder (issue 42, break 14); a cache
+folder that turns read-only after it was found writable raises ``PermissionError`` out of the
+save. :func:`njit` compiles as ``numba.njit`` and caches through :class:`GuardedCache` instead:
+
+* a file that does not load is set aside (moved into ``set-aside-<time>-<pid>/`` beside it, one
+  line on stderr once per process) and the kernel is compiled again and saved afresh: the next
+  process loads the rebuilt cache;
+* a folder that cannot be read or written (gone, replaced, read-only) keeps the compiled code for
+  this process only (one line once per process);
+* no usable cache folder at all (numba's locators find none writable) compiles without a cache
+  (one line once per process), where ``numba.njit(cache=True)`` raises at import.
+
+The cache object is numba's own ``FunctionCache`` (its locators, index keys and file format), set
+on the dispatcher as ``Dispatcher.enable_caching`` does (``dispatcher._cache``); only its load and
+save are guarded.
+"""
+from __future__ import annotations
+
+import os
+import threading
+import time
+
+import numba
+from numba.core.caching import FunctionCache
+
+from fkopt.numerics.notice import notice
+
+_LOCK = threading.Lock()
+_ASIDE: dict[str, str] = {}          # cache folder -> the folder its bad files went to (this process)
+
+
+def _describe(err: BaseException) -> str:
+    text = str(err).strip().splitlines()[0][:120] if str(err).strip() else ""
+    return f"{type(err).__name__}: {text}" if text else type(err).__name__
+
+
+class GuardedCache(FunctionCache):
+    """numba's per-function cache whose load sets unreadable files aside (and returns None, so
+    numba compiles and saves afresh) and whose save failing only disables the cache."""
+
+    def load_overload(self, sig, target_context):
+        try:
+            return super().load_overload(sig, target_context)
+        except OSError as err:          # the folder itself unreadable or gone: no cache, nothing to set aside
+            self._no_cache(err)
+            return None
+        except Exception as err:        # garbage, empty, truncated, foreign content: set it aside
+            self._set_aside(err)
+            return None
+
+    def save_overload(self, sig, data):
+        try:
+            super().save_overload(sig, data)
+        except Exception as err:
+            self._no_cache(err)
+
+    def _no_cache(self, err: BaseException) -> None:
+        self.disable()
+        notice("cache-io", f"cannot use numba's compiled-code cache in {self._cache_path} ({_describe(err)}); "
+                           f"compiled code is kept for this process only")
+
+    def _files(self) -> list[str]:
+        """This function's index file and its data files (``<base>.nbi``, ``<base>.<k>.nbc``)."""
+        index = self._cache_file._index_path
+        base = os.path.basename(index)[:-len(".nbi")]
+        try:
+            names = os.listdir(self._cache_path)
+        except OSError:
+            names = []
+        data = [os.path.join(self._cache_path, n) for n in names
+                if n.startswith(base + ".") and n.endswith(".nbc") and n[len(base) + 1:-len(".nbc")].isdigit()]
+        return [index] + sorted(data)
+
+    def _set_aside(self, err: BaseException) -> None:
+        folder = self._cache_path
+        files = [f for f in self._files() if os.path.lexists(f)]
+        with _LOCK:
+            aside = _ASIDE.get(folder)
+            if aside is None:
+                aside = os.path.join(folder, f"set-aside-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}")
+                _ASIDE[folder] = aside
+        try:
+            os.makedirs(aside, exist_ok=True)
+            for f in files:
+                try:
+                    os.replace(f, os.path.join(aside, os.path.basename(f)))
+                except FileNotFoundError:      # another process set it aside first
+                    pass
+        except OSError as move_err:
+            # cannot move them (a read-only folder): leave the files, compile in memory
+            self.disable()
+            notice("cache-bad", f"numba's compiled-code cache in {folder} holds an unreadable file "
+                                f"({os.path.basename(files[0]) if files else '?'}: {_describe(err)}) that cannot "
+                                f"be set aside ({_describe(move_err)}); compiling in memory for this process "
+                                f"(delete the folder to rebuild it)")
+            return
+        notice("cache-bad", f"numba's compiled-code cache in {folder} held an unreadable file "
+                            f"({os.path.basename(files[0]) if files else '?'}: {_describe(err)}); set aside in "
+                            f"{aside}, compiling afresh (seconds, once)")
+
+
+def njit(*args, cache: bool = False, **options):
+    """``numba.njit(**options)``, with ``cache=True`` meaning :class:`GuardedCache`; used as
+    ``@njit`` or ``@njit(cache=True, ...)``."""
+    def decorate(fn):
+        dispatcher = numba.njit(**options)(fn)
+        if cache:
+            try:
+                dispatcher._cache = GuardedCache(fn)
+            except Exception as err:    # no writable cache folder anywhere (numba: "no locator available")
+                notice("cache-none", f"no writable folder for numba's compiled-code cache ({_describe(err)}); "
+                                     f"compiled code is kept for this process only (set NUMBA_CACHE_DIR)")
+        return dispatcher
+    if args and callable(args[0]) and len(args) == 1 and not options and not cache:
+        return decorate(args[0])
+    if args:
+        raise TypeError("njit takes keyword options only")
+    return decorate
