@@ -60,12 +60,16 @@ from typing import Callable
 
 from fkopt.adapters import adapter_class
 from fkopt.adapters.field.cmaes import CmaES
+from fkopt.adapters.field.eaik import EAIK
 from fkopt.adapters.field.ikpy import IkPy
 from fkopt.adapters.field.lbfgsb import LBFGSB
 from fkopt.adapters.field.nevergrad_ngopt import NGOpt
+from fkopt.adapters.field.optik import OptIK
 from fkopt.adapters.field.pin import PinCLIK
+from fkopt.adapters.field.pink import Pink
 from fkopt.adapters.field.rtb import RtbLM, RtbNR
 from fkopt.adapters.field.scipy_fk import LeastSquaresFK
+from fkopt.adapters.field.torchkin import TorchIK
 from fkopt.adapters.field.tracik import TracIK
 from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS
 from fkopt.algorithms.abc import ABC
@@ -147,6 +151,10 @@ SOLVERS: dict[str, SolverEntry] = {e.name: e for e in (
     _field(CmaES),
     _field(LBFGSB),
     _field(NGOpt),
+    _field(EAIK),                                # analytic; "not applicable" where it cannot decompose
+    _field(OptIK),
+    _field(Pink),
+    _field(TorchIK),                             # batched: the throughput track (tracks.throughput.solvers)
 )}
 
 #: fkopt's optimisers by name (what ``fkopt.solve`` and config files name).
@@ -200,9 +208,10 @@ def clock_solver(name: str, mechanism, *, timeout: float, rng):
     try:
         return entry.make(mechanism, timeout=timeout, rng=rng)
     except ImportError as err:
-        raise FkoptError(f"field solver '{name}' needs {entry.package} (pip install -e \".[field]\"): "
+        extra = getattr(entry.make, "extra", "field")       # torch is an extra of its own
+        raise FkoptError(f"field solver '{name}' needs {entry.package} (pip install -e \".[{extra}]\"): "
                          f"{err}") from None
-    except FkoptError:
+    except FkoptError:       # NotApplicable included: the board shows a "not applicable: why" cell
         raise
     except Exception as err:     # the outside package refused this arm: one line, not its traceback
         raise FkoptError(f"field solver '{name}' ({entry.package}) cannot read "

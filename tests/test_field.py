@@ -60,14 +60,17 @@ def test_wrong_or_out_of_limit_answer_is_a_failure_whatever_is_claimed():
 
 
 #: Share of 10 random poses each wrapper must solve at (1 mm, 0.01 rad) within its timeout (s);
-#: measured on this machine: TRAC-IK 5 ms 51-90 %, ikpy 20 ms 50-60 % (one start is ~25 ms).
+#: measured on this machine: TRAC-IK 5 ms 51-90 %, ikpy 20 ms 50-60 % (one start is ~25 ms). The
+#: timeouts are wall-clock and these tests check answers, not speed (the board measures speed): the
+#: restart loops get 0.1 s (at load 15 on 2 cores pin-clik solved 6 of 10 UR5 poses in 20 ms).
 JACOBIAN_FLOOR = {"tracik": (0.02, 0.7), "rtb-ik_LM": (0.02, 0.7), "rtb-ik_NR": (0.02, 0.7),
-                  "pin-clik": (0.02, 0.7), "ikpy": (0.1, 0.5)}
+                  "pin-clik": (0.1, 0.7), "ikpy": (0.1, 0.5), "optik": (0.02, 0.7), "pink": (0.1, 0.5)}
 
 
 def _needs(solver):
     from fkopt.registry import SOLVERS
-    module = {"pytracik": "pytracik", "roboticstoolbox-python": "roboticstoolbox", "pin": "pinocchio"}
+    module = {"pytracik": "pytracik", "roboticstoolbox-python": "roboticstoolbox", "pin": "pinocchio",
+              "optik-py": "optik", "pin-pink": "pink", "pytorch-kinematics": "pytorch_kinematics"}
     package = SOLVERS[solver].package
     pytest.importorskip(module.get(package, package))
 
@@ -151,7 +154,8 @@ def test_black_box_wrappers_improve_on_their_start_and_never_leave_the_limits(so
         f = pose_objective(m, T[k])
         random = np.median(f(np.radians(lo + np.random.default_rng(k).random((200, m.dof)) * (hi - lo))))
         assert f(np.radians(a.joints[k]))[0] < 0.25 * random
-    assert (v["success"][a.claimed].all(axis=-1)).all()
+    # a claim (objective <= RUNG^2) is one kinbench confirms at every rung down to the board's 1e-5
+    assert (v["success"][a.claimed][:, :3].all(axis=-1)).all()
 
 
 def test_least_squares_fk_answers_are_judged_in_both_assembly_modes():
@@ -216,10 +220,10 @@ def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits(
     fkopt's FK to 1e-9, the generating configuration is among them (up to whole turns), and the
     board's one answer is one of them."""
     pytest.importorskip("eaik")
-    from fkopt.adapters.field.eaik import EAIK
+    from fkopt.registry import clock_solver as make_ik
     m = stored("ur5")
     q, T = targets(m, 10, 7)
-    w = EAIK(m, timeout=0.02, rng=np.random.default_rng(0))
+    w = make_ik("eaik", m, timeout=0.02, rng=np.random.default_rng(0))
     for k in range(len(q)):
         s = w.solutions(T[k])
         exact = ~s.least_squares & s.in_limits
@@ -234,9 +238,151 @@ def test_eaik_gives_every_analytic_solution_and_the_board_one_inside_the_limits(
 
 @pytest.mark.parametrize("name, why", [("panda", "7 joints: EAIK solves 1-6R")])
 def test_eaik_is_not_applicable_to_an_arm_it_cannot_decompose(name, why):
-    """A 7-joint arm is a "not applicable: why" cell, not a zero: the wrapper raises NotApplicable."""
+    """A 7-joint arm is a "not applicable: why" cell, not a zero: make_ik raises NotApplicable."""
     pytest.importorskip("eaik")
     from fkopt.adapters.field import NotApplicable
-    from fkopt.adapters.field.eaik import EAIK
+    from fkopt.registry import clock_solver as make_ik
     with pytest.raises(NotApplicable, match=why):
-        EAIK(stored(name), timeout=0.02, rng=np.random.default_rng(0))
+        make_ik("eaik", stored(name), timeout=0.02, rng=np.random.default_rng(0))
+
+
+def test_optik_is_not_applicable_to_a_prismatic_joint_which_would_abort_the_process():
+    """OptIK 0.5's Jacobian panics on a prismatic joint and the panic aborts Python: the TIAGo's
+    torso lift makes it a "not applicable" cell before any call."""
+    pytest.importorskip("optik")
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.registry import clock_solver as make_ik
+    with pytest.raises(NotApplicable, match="prismatic joint torso_lift_joint"):
+        make_ik("optik", stored("tiago-torso"), timeout=0.02, rng=np.random.default_rng(0))
+
+
+def test_optik_reads_the_written_urdf_with_its_inner_fixed_joints_folded():
+    """OptIK's FK of the written UR5 is 1.0 off past the fixed joint between wrist_2 and wrist_3;
+    with it folded into wrist_3 (fold_fixed) its FK is fkopt's everywhere."""
+    optik = pytest.importorskip("optik")
+    from fkopt.adapters.field import arm_urdf
+    from fkopt.adapters.field.optik import fold_fixed
+    m = stored("ur5")
+    u = arm_urdf(m)
+    q, T = targets(m, 5, 11)
+    for text, close in ((u.text, False), (fold_fixed(u.text), True)):
+        with u.as_file(text) as path:
+            robot = optik.Robot.from_urdf_file(str(path), u.base_link, u.tip_link)
+        err = max(np.abs(np.asarray(robot.fk(np.radians(x))) - t).max() for x, t in zip(q, T))
+        assert (err < 1e-12) == close, err
+
+
+def test_pytorch_kinematics_answers_a_batch_judged_by_kinbench():
+    """pytorch-kinematics' batched IK (the [torch] extra) answers 20 UR5 poses in one call; kinbench
+    confirms most at the board's rung (measured here: 100 %)."""
+    pytest.importorskip("torch", reason="torch is in the [torch] extra, outside [test]")
+    pytest.importorskip("pytorch_kinematics", reason="pytorch-kinematics is in the [torch] extra, outside [test]")
+    from fkopt.registry import clock_solver as make_ik
+    m = stored("ur5")
+    _, T = targets(m, 20, 12)
+    w = make_ik("pytorch-kinematics", m, timeout=0.02, rng=np.random.default_rng(3))
+    q = w.solve_batch(T)
+    v = ik_verdicts(m, q, T)
+    assert q.shape == (20, m.dof) and v["success"][:, 2].mean() >= 0.8
+
+
+# -- reproduction checks: each outside package's own published protocol, on this machine ---------
+
+#: TRAC-IK's README (traclabs/trac_ik, "IK success and average speed", tag v1.4.6; Speed mode, eps
+#: 1e-5 per component, 5 ms, seeded at the middle of the limits): its published success (%).
+TRACIK_README = {"panda": 99.70, "kinova-j2s6s200": 99.78, "iiwa-mj": 99.84, "baxter-left": 99.62}
+
+
+@pytest.mark.parametrize("name", list(TRACIK_README))
+def test_tracik_readme_protocol_reproduces_its_published_success(name):
+    """TRAC-IK's README protocol (1000 random in-limit configurations, seed at the middle of the
+    limits, eps 1e-5, 5 ms, Speed; success as TRAC-IK reports it, mean time over successes) on
+    the README's arms that example-robot-data carries (Panda, Jaco2 j2s6s200, Baxter; not the
+    iiwa 14): within 1.5 points of the published figure. A wall-clock protocol on a busy machine
+    measures the machine: judged only when the 1-minute load is below 1.5."""
+    import os
+    import time
+    pytest.importorskip("pytracik")
+    if name == "iiwa-mj":
+        pytest.skip("the README's figure is for the LBR iiwa 14 R820; robosuite's iiwa is the iiwa 7 R800 "
+                    "(links 0.34 / 0.40 / 0.40 m) and example-robot-data carries none")
+    from fkopt.adapters.field.cores import pinned
+    from fkopt.adapters.field.tracik import TracIK, quat_xyzw
+    load = os.getloadavg()[0]
+    if load >= 1.5:
+        pytest.skip(f"1-minute load {load:.2f} >= 1.5: TRAC-IK's 5 ms wall-clock protocol would measure the machine")
+
+    class Readme(TracIK):
+        EPS = 1e-5                                   # the README's eps (per twist component)
+    m = stored(name)
+    w = Readme(m, timeout=0.005, rng=np.random.default_rng(0))
+    q, T = targets(m, 1000, 2015)
+    mid = (w.lo_rad + w.hi_rad) / 2
+    ok, secs = np.zeros(len(T), bool), np.zeros(len(T))
+    for k in range(len(T)):
+        x, y, z, qw = quat_xyzw(T[k].tolist())
+        with pinned():
+            t0 = time.perf_counter()
+            out = w._pt.ik(w._solver, mid, T[k, 0, 3], T[k, 1, 3], T[k, 2, 3], x, y, z, qw)
+            secs[k] = time.perf_counter() - t0
+        ok[k] = out[0] > 0
+    rate = 100 * ok.mean()
+    print(f"{name}: {rate:.2f} % (README {TRACIK_README[name]} %), mean {1e3 * secs[ok].mean():.3f} ms over "
+          f"successes, load {load:.2f} -> {os.getloadavg()[0]:.2f}")
+    assert abs(rate - TRACIK_README[name]) <= 1.5
+
+
+def test_pinocchio_clik_example_converges_as_documented():
+    """pinocchio publishes no IK solver, only its CLIK example ("Inverse kinematics (clik)",
+    examples/inverse-kinematics.py: DT 0.1, damp 1e-12, eps 1e-4, IT_MAX 1000, from neutral),
+    which converges on its sample manipulator towards (1, 0, 1). The example as documented
+    converges; and pin-clik's loop with the example's settings (no step cap, no stall test, no
+    limits) converges from the middle of the UR5's limits to a pose near it, as the example does:
+    the board's settings differ only where a random start needs them (docs/kinbench.md)."""
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildSampleModelManipulator()
+    data = model.createData()
+    JOINT_ID, oMdes = 6, pin.SE3(np.eye(3), np.array([1.0, 0.0, 1.0]))
+    q = pin.neutral(model)
+    eps, IT_MAX, DT, damp = 1e-4, 1000, 1e-1, 1e-12
+    for i in range(IT_MAX):
+        pin.forwardKinematics(model, data, q)
+        iMd = data.oMi[JOINT_ID].actInv(oMdes)
+        err = pin.log(iMd).vector
+        if np.linalg.norm(err) < eps:
+            break
+        J = pin.computeJointJacobian(model, data, q, JOINT_ID)
+        J = -np.dot(pin.Jlog6(iMd.inverse()), J)
+        v = -J.T.dot(np.linalg.solve(J.dot(J.T) + damp * np.eye(6), err))
+        q = pin.integrate(model, q, v * DT)
+    assert np.linalg.norm(err) < eps and i < IT_MAX - 1
+    from fkopt.registry import clock_solver as make_ik
+    m = stored("ur5")
+    w = make_ik("pin-clik", m, timeout=1.0, rng=np.random.default_rng(0))
+    mid = m.bounds.mean(axis=1)
+    T = m.fk_matrix((mid + 20.0)[None])[0]
+    oMdes = w._oMbase * pin.SE3(T[:3, :3].copy(), T[:3, 3].copy())
+    q, err, ok = w.clik(oMdes, np.radians(mid), float("inf"), dt=0.1, damp=1e-12, eps=1e-4, it_max=1000,
+                        step_max=0, stall=False, limits=False)
+    assert ok and err < 1e-4
+
+
+def test_ikpy_tutorial_protocol_on_baxter():
+    """ikpy's quickstart protocol (its defaults: ``inverse_kinematics`` of a target position, start at
+    zeros, symbolic chain) on example-robot-data's Baxter left arm: ikpy publishes no success
+    figure, so the check is that its answers, judged by kinbench's FK, reach most reachable
+    positions to 1 mm from its single start (docs/kinbench.md has the share measured here)."""
+    pytest.importorskip("ikpy")
+    import warnings
+    from fkopt.registry import clock_solver as make_ik
+    m = stored("baxter-left")
+    w = make_ik("ikpy", m, timeout=1.0, rng=np.random.default_rng(0))
+    q, T = targets(m, 30, 8)
+    reached = []
+    for k in range(len(T)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            x = w.chain.inverse_kinematics(T[k, :3, 3])
+        F = m.fk_matrix(w.public(x[w._active])[None])[0]
+        reached.append(np.linalg.norm(F[:3, 3] - T[k, :3, 3]) <= 1e-3)
+    assert np.mean(reached) >= 0.6

@@ -120,12 +120,14 @@ def _newer_board(tables):
     """The stored quick board as the next board version might be: a new outside solver and new
     columns (cpu_ms_median and one this code has never heard of)."""
     board = tables["leaderboard-robots.csv"].copy()
-    new = board[board["solver"] == "tracik"].assign(solver="eaik")
-    board = pd.concat([board, new], ignore_index=True)
+    answers = tables["answers.csv.gz"]
+    # a stored board of version 2 has eaik already: the stand-in replaces its rows by tracik's
+    board = pd.concat([board[board["solver"] != "eaik"], board[board["solver"] == "tracik"].assign(solver="eaik")],
+                      ignore_index=True)
     board["cpu_ms_median"] = board["time_ms_median"] * 0.5
     board["queue_wait_ms"] = 0.0
-    answers = tables["answers.csv.gz"]
-    answers = pd.concat([answers, answers[answers["solver"] == "tracik"].assign(solver="eaik")], ignore_index=True)
+    answers = pd.concat([answers[answers["solver"] != "eaik"], answers[answers["solver"] == "tracik"].assign(solver="eaik")],
+                        ignore_index=True)
     return {**tables, "leaderboard-robots.csv": board, "answers.csv.gz": answers}
 
 
@@ -164,7 +166,11 @@ def test_the_board_page_opens_with_the_advice_and_takes_new_solvers_and_columns(
     for solver in set(tables["answers.csv.gz"]["solver"]) | {"eaik"}:
         assert f">{solver}<" in settings, solver
     assert "eps = 1e-5" in settings                 # TRAC-IK's, as its wrapper documents it
-    assert "not recorded (this board was stored before kinbench recorded the machine's load)" in unescape(index)
+    if sr.meta.get("load_avg"):                     # board version 2 records the machine's load
+        from fkopt.kinbench.pages import load_text
+        assert load_text(sr.meta) in unescape(index) and "not recorded (this board" not in unescape(index)
+    else:
+        assert "not recorded (this board was stored before kinbench recorded the machine's load)" in unescape(index)
     assert "data:image" not in index and "http://" not in index and "https://" not in index
 
 

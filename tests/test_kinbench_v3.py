@@ -541,3 +541,108 @@ def test_an_fk_submission_reaches_the_suites_board_judged_by_the_mechanisms_ik(t
     assert len(sub) == 3 and sub["position_m"].iloc[0] >= 1e-3 - 1e-9
     rung = f"success_{rung_label(LADDER[2])}"         # 1e-5 m: the 1 mm spoilt answer fails it
     assert (mine[rung] <= 2 / 3 + 1e-12).all()
+
+
+# -- board version 2: the fair entries' shared machinery (fkopt/adapters/field/restarts.py, cores.py) --
+
+def test_a_not_applicable_solver_gets_a_cell_saying_why_never_a_zero_and_is_counted_apart(tmp_path):
+    """A package that cannot take an arm by design (EAIK on a 7-joint arm) has answers rows without
+    answers that say why; its board rows carry the why and no success (NaN, not 0), and README's
+    summary counts the arm apart from the arms it ran on."""
+    from fkopt.kinbench.advice import robots_summary
+    ref = answers_frame([1e-3] * 2, [True] * 2, solver="ref")
+    ran = answers_frame([1e-3] * 2, [True, False], solver="s", robot="a6")
+    ref6 = answers_frame([1e-3] * 2, [True] * 2, solver="ref", robot="a6")
+    na = answers_frame([np.nan] * 2, [False] * 2, solver="s").assign(not_applicable="7 joints: 1-6R only")
+    board = clock_board(pd.concat([ref, na, ref6, ran]), timeouts_ms=(20.0,), reference="ref")
+    cell = board[(board.solver == "s") & (board.robot == "r")].iloc[0]
+    assert cell["not_applicable"] == "not applicable: 7 joints: 1-6R only"
+    assert np.isnan(cell["success_5mm_0.05rad"]) and np.isnan(cell["time_ms_median"])
+    assert board[(board.solver == "s") & (board.robot == "a6")].iloc[0]["success_5mm_0.05rad"] == 0.5
+    board.assign(rung=rung_label(LADDER[2]), other_mode=np.nan).to_csv(tmp_path / "leaderboard-robots.csv", index=False)
+    s = robots_summary(tmp_path).set_index("solver").loc["s"]
+    assert s["arms"] == 1 and s["not_applicable"] == 1 and s["success_5mm_0.05rad"] == 50.0
+
+
+def test_cpu_time_per_call_is_stored_beside_wall_time_and_its_median_is_on_the_board():
+    m = ur5()
+    a = run_clock(m, "ur5", queries(m, 4, 2), ["fkopt.inverse"], reference="fkopt.inverse", timeouts_ms=(20.0,))
+    assert (a["cpu_seconds"] > 0).all() and (a["not_applicable"] == "").all()
+    row = clock_board(a, timeouts_ms=(20.0,), reference="fkopt.inverse").iloc[0]
+    assert row["cpu_ms_median"] == pytest.approx(1e3 * np.median(a["cpu_seconds"]))
+
+
+def test_the_clock_runs_every_entry_on_one_core_and_gives_the_cores_back():
+    import os
+    from fkopt.adapters.field.cores import pinned
+    if not hasattr(os, "sched_setaffinity"):
+        pytest.skip("no CPU affinity on this OS")
+    before = os.sched_getaffinity(0)
+    with pinned() as ok:
+        inside = os.sched_getaffinity(0)
+    assert ok and len(inside) == 1 and inside <= before and os.sched_getaffinity(0) == before
+
+
+def test_tracik_quaternion_without_scipy_matches_scipy_everywhere_including_half_turns():
+    from scipy.spatial.transform import Rotation
+    from fkopt.adapters.field.tracik import quat_xyzw
+    R = Rotation.random(200, random_state=3).as_matrix()
+    R = np.concatenate([R, Rotation.from_rotvec(np.pi * np.eye(3)).as_matrix(),          # w = 0: x, y, z branches
+                        Rotation.from_rotvec(np.pi * np.array([[1, 1, 0], [0, 1, 1]]) / np.sqrt(2)).as_matrix()])
+    for r in R:
+        mine, theirs = np.array(quat_xyzw(r.tolist())), Rotation.from_matrix(r).as_quat()
+        assert min(np.abs(mine - theirs).max(), np.abs(mine + theirs).max()) < 1e-12
+
+
+def test_tracik_eps_per_component_implies_the_boards_rung():
+    """TRAC-IK's eps bounds each of the three position and three rotation components: at
+    eps = 1e-5/sqrt(3) the Euclidean errors are within 1e-5 (the rung); at 1e-5 they are not."""
+    from fkopt.adapters.field.restarts import RUNG
+    from fkopt.adapters.field.tracik import TracIK
+    assert np.sqrt(3) * TracIK.EPS <= RUNG * (1 + 1e-15) and np.sqrt(3) * 1e-5 > RUNG
+
+
+def test_the_restart_loop_restarts_until_a_start_meets_its_test_and_keeps_the_best_otherwise():
+    from fkopt.adapters.field.restarts import restart
+    errors = iter([3.0, 1.0, 2.0, 0.0])
+
+    def search(x0, deadline):
+        e = next(errors)
+        return x0 + e, e, e == 0.0
+    starts = iter(np.arange(10.0))
+    x, ok, n = restart(search, lambda: np.array([next(starts)]), timeout=10.0)
+    assert ok and n == 4 and x[0] == 3.0
+    errors = iter([3.0, 1.0, 2.0] + [5.0] * 10**6)
+    starts = iter(np.arange(10.0**6))
+    x, ok, n = restart(search, lambda: np.array([next(starts)]), timeout=0.0)   # past the deadline: one start
+    assert not ok and n == 1 and x[0] == 3.0
+
+
+def test_a_stepped_search_stalls_when_its_error_has_not_halved_in_ten_steps():
+    from fkopt.adapters.field.restarts import STALL_WINDOW, Stall
+    s = Stall()
+    assert not any(s(0.5 ** k) for k in range(30))                        # halves every step: never stalls
+    s = Stall()
+    flags = [s(1.0) for _ in range(STALL_WINDOW + 2)]                      # stuck at a limit
+    assert not any(flags[:STALL_WINDOW]) and flags[STALL_WINDOW]
+
+
+def test_a_board_names_its_frozen_version_and_its_quick_tier_the_same():
+    from fkopt.kinbench.releases import BOARDS, board_version
+    assert board_version("kinbench-v3-robots") == board_version("kinbench-v3-robots-quick") == \
+        f"kinbench-v3-robots/{max(BOARDS['kinbench-v3-robots'], key=int)}"
+    assert board_version("kinbench-v2") is None
+
+
+def test_check_compares_meta_json_but_for_the_machines_load_during_the_run(tmp_path):
+    """A per-robot board's meta.json stores the load averages at its start and end: a rerun's differ,
+    so fkopt check compares every other key (the exact tier too) and never those."""
+    import json
+    from fkopt.run.compare import META_RUN, compare_meta
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    meta = {"board_version": "kinbench-v3-robots/2", "load_avg": {"start": [0.5, 0.4, 0.3], "end": [0.6, 0.4, 0.3]}}
+    a.write_text(json.dumps(meta))
+    b.write_text(json.dumps({**meta, "load_avg": {"start": [9.0, 8.0, 7.0], "end": [9.0, 8.0, 7.0]}}))
+    assert compare_meta("x", a, b, variable=META_RUN) == []
+    b.write_text(json.dumps({**meta, "board_version": "kinbench-v3-robots/1"}))
+    assert [m.column for m in compare_meta("x", a, b, variable=META_RUN)] == ["board_version"]

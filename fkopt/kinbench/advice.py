@@ -106,11 +106,14 @@ def summarise_board(board: pd.DataFrame, timeout_ms: float, fk: bool = False) ->
     # is left out of the entry's mean and count, never read as a zero
     numbers = [*success, "time_ms_median", "time_ratio_median", *(["cpu_ms_median"] if "cpu_ms_median" in board else [])]
     board = board.assign(**{c: pd.to_numeric(board[c], errors="coerce") for c in numbers})
+    na = board[board[rung].isna()]                   # "not applicable" arms, counted apart
     board = board[board[rung].notna()]
     g = board.groupby(["solver", "entry"], sort=False)
     out = g[success].mean().mul(100)
     out["worst_arm"] = g[rung].min().mul(100)
     out["arms"] = g["robot"].nunique()
+    out["not_applicable"] = na.groupby(["solver", "entry"], sort=False)["robot"].nunique() \
+        .reindex(out.index).fillna(0).astype(int)
     out["median_ms"] = g["time_ms_median"].median()
     if "cpu_ms_median" in board:
         out["cpu_ms_median"] = g["cpu_ms_median"].median()
@@ -143,12 +146,17 @@ def robots_markdown(table: pd.DataFrame, timeout_ms: float = 20.0) -> str:
     """The summary as README prints it."""
     success = [c for c in table.columns if c.startswith("success_")]
     rungs = " / ".join(c.removeprefix("success_").replace("_", ", ") for c in success)
+    cpu = "cpu_ms_median" in table
     lines = [f"| solver | entry | arms | success % at {rungs} (mean over arms) | worst arm % | median ms | "
-             "median ratio to rtb `ik_LM` |", "|---|---|---|---|---|---|---|"]
+             + ("median CPU ms per call | " if cpu else "") + "median ratio to rtb `ik_LM` |",
+             "|---|---|---|---|---|---|---|" + ("---|" if cpu else "")]
     for _, r in table.iterrows():
         pct = " / ".join(f"{r[c]:.0f}" for c in success)
-        lines.append(f"| {r['solver']} | {r['entry']} | {r['arms']} | {pct} | {r['worst_arm']:.0f} | "
-                     f"{r['median_ms']:.3g} | {r['median_ratio']:.3g} |")
+        na = int(r.get("not_applicable", 0) or 0)
+        arms = f"{r['arms']}" + (f" (not applicable: {na})" if na else "")
+        lines.append(f"| {r['solver']} | {r['entry']} | {arms} | {pct} | {r['worst_arm']:.0f} | "
+                     f"{r['median_ms']:.3g} | " + (f"{r['cpu_ms_median']:.3g} | " if cpu else "")
+                     + f"{r['median_ratio']:.3g} |")
     return "\n".join(lines)
 
 

@@ -116,28 +116,63 @@ def _uses_timeout(solver) -> bool:
 
 
 def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *, timeouts_ms=TIMEOUTS_MS,
-              reference: str = REFERENCE, seed: int = 0, reference_repeats: int = REFERENCE_REPEATS) -> pd.DataFrame:
+              reference: str = REFERENCE, seed: int = 0, reference_repeats: int = REFERENCE_REPEATS,
+              settings: dict | None = None) -> pd.DataFrame:
     """Every answer of the clock track on one arm (IK) or parallel mechanism (FK): one row per
     (query, solver, timeout given) with the answer (joints ``q0..`` or pose ``x0..``), the wall
     time, the reference's wall time on the same query (``reference_seconds``), the claim and the
     verdict (``position_m``, ``rotation_rad``, ``in_limits``, ``leg_residual``). ``queries``:
     joints (IK) or poses (FK) in public units, the frozen pose set's points;
-    ``given_timeout_ms`` is NaN for a solver without a wall-clock limit (run once)."""
+    ``given_timeout_ms`` is NaN for a solver without a wall-clock limit (run once); a solver that
+    cannot take the mechanism by design (:class:`fkopt.adapters.field.NotApplicable`) gets rows
+    without answers that say why (``not_applicable``). ``settings``, when given, is filled with
+    each solver's settings (its wrapper at the largest timeout)."""
+    from fkopt.adapters.field import NotApplicable
+    from fkopt.adapters.field.cores import pinned
     targets = targets_of(mechanism, queries)
     runs: list[tuple[str, float | None, object]] = []         # (solver name, timeout given, wrapper)
+    not_applicable: dict[str, str] = {}                       # solver -> why (a cell, never a zero)
     for name in dict.fromkeys([reference, *solvers]):
-        first = make_solver(name, mechanism, timeout=max(timeouts_ms) / 1e3, rng=np.random.default_rng(0))
+        try:
+            first = make_solver(name, mechanism, timeout=max(timeouts_ms) / 1e3, rng=np.random.default_rng(0))
+        except NotApplicable as why:
+            not_applicable[name] = str(why)
+            if settings is not None:
+                settings[name] = {"not_applicable": str(why)}
+            continue
         if _uses_timeout(first):
             runs += [(name, t, make_solver(name, mechanism, timeout=t / 1e3, rng=np.random.default_rng(0)))
                      for t in timeouts_ms]
         else:
             runs.append((name, None, first))
+        if settings is not None:
+            settings[name] = dict(runs[-1][2].settings)
     n, k, dim = len(queries), len(runs), queries.shape[1]
     answers = np.full((n, k, dim), np.nan)
-    seconds, claimed = np.zeros((n, k)), np.zeros((n, k), bool)
+    seconds, cpu_seconds, claimed = np.zeros((n, k)), np.zeros((n, k)), np.zeros((n, k), bool)
     # a reference with a wall-clock limit is timed by its run at the largest timeout
     j_ref = [j for j, r in enumerate(runs) if r[0] == reference][-1]
     ref_seconds = np.full(n, np.inf)
+    with pinned():                      # every entry on the same single core (fkopt/adapters/field/cores.py)
+        _clock_loop(runs, targets, seed, robot, j_ref, reference_repeats, answers, seconds, cpu_seconds, claimed,
+                    ref_seconds)
+    rows = [answer_rows(mechanism, robot, name, entry_of(name), "run", np.arange(n), np.nan if t is None else t,
+                        seconds[:, j], ref_seconds, claimed[:, j], answers[:, j], queries, targets,
+                        cpu_seconds=cpu_seconds[:, j])
+            for j, (name, t, solver) in enumerate(runs)]
+    rows += [answer_rows(mechanism, robot, name, entry_of(name), "run", np.arange(n), np.nan, np.full(n, np.nan),
+                         ref_seconds, np.zeros(n, bool), np.full((n, dim), np.nan), queries, targets,
+                         not_applicable=why)
+             for name, why in not_applicable.items()]
+    return pd.concat(rows, ignore_index=True)
+
+
+def _clock_loop(runs, targets, seed, robot, j_ref, reference_repeats, answers, seconds, cpu_seconds, claimed,
+                ref_seconds) -> None:
+    """The interleaved queries of :func:`run_clock`, filling its arrays: wall time by
+    ``perf_counter``, CPU time of the whole process (every thread a package starts) by
+    ``process_time``."""
+    n, k = seconds.shape
     for i in range(n):
         order = [(int(j), 0) for j in np.roll(np.arange(k), -(i % k))]     # interleaved, rotated
         at = order.index((j_ref, 0))
@@ -146,37 +181,47 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
         for j, rep in order:
             name, t, solver = runs[j]
             solver.rng = query_rng(seed, robot, name, t, i)                # the reference: the same start
+            c0 = time.process_time()
             t0 = time.perf_counter()
             q, ok = solver.solve1(targets[i])
             dt = time.perf_counter() - t0
+            dc = time.process_time() - c0
             if rep == 0:
-                seconds[i, j], claimed[i, j] = dt, bool(ok)
+                seconds[i, j], cpu_seconds[i, j], claimed[i, j] = dt, dc, bool(ok)
                 if q is not None:
                     answers[i, j] = q
             if j == j_ref:
                 ref_seconds[i] = min(ref_seconds[i], dt)
-    return pd.concat([answer_rows(mechanism, robot, name, entry_of(name), "run", np.arange(n),
-                                  np.nan if t is None else t, seconds[:, j], ref_seconds, claimed[:, j],
-                                  answers[:, j], queries, targets)
-                      for j, (name, t, solver) in enumerate(runs)], ignore_index=True)
 
 
 def answer_rows(mechanism, robot: str, solver: str, entry: str, source: str, query, given_timeout_ms, seconds,
                 reference_seconds, claimed, answers: np.ndarray, queries: np.ndarray,
-                targets: np.ndarray) -> pd.DataFrame:
+                targets: np.ndarray, *, cpu_seconds=np.nan, not_applicable: str = "") -> pd.DataFrame:
     """One solver's answers on one arm (IK) or parallel mechanism (FK) as answers rows, each
     judged by kinbench (:func:`verdicts`), never by what the solver says: the rows of
-    :func:`run_clock` (``source`` = run) and of a submission (``source`` = submitted)."""
+    :func:`run_clock` (``source`` = run) and of a submission (``source`` = submitted).
+    ``cpu_seconds``: the call's CPU time (NaN for a submission); ``not_applicable``: why the
+    package cannot take this arm (its rows hold no answer, and the board a "not applicable" cell)."""
     v = verdicts(mechanism, answers, queries, targets)
     frame = pd.DataFrame({"robot": robot, "query": query, "solver": solver, "entry": entry, "source": source,
-                          "given_timeout_ms": given_timeout_ms, "seconds": seconds,
+                          "given_timeout_ms": given_timeout_ms, "seconds": seconds, "cpu_seconds": cpu_seconds,
                           "reference_seconds": reference_seconds, "claimed": claimed,
                           "position_m": v["position_m"], "rotation_rad": v["rotation_rad"],
-                          "in_limits": v["in_limits"], "leg_residual": v["leg_residual"]})
+                          "in_limits": v["in_limits"], "leg_residual": v["leg_residual"],
+                          "not_applicable": not_applicable})
     prefix = answer_prefix(mechanism)
     for d in range(answers.shape[1]):
         frame[f"{prefix}{d}"] = answers[:, d]
     return frame
+
+
+def _not_applicable(rows: pd.DataFrame) -> str:
+    """The "not applicable: why" of a solver's rows on one arm ('' when it ran there)."""
+    if "not_applicable" not in rows:
+        return ""
+    why = rows["not_applicable"].dropna().astype(str)
+    why = why[why != ""]
+    return f"not applicable: {why.iloc[0]}" if len(why) else ""
 
 
 def rung_success(answers: pd.DataFrame, ladder=LADDER) -> np.ndarray:
@@ -202,7 +247,13 @@ def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: st
         ref = a[a["solver"] == ref_name]
         ref_ms = 1e3 * float(ref.groupby("query")["seconds"].first().median()) if len(ref) else np.nan
         for name, s in a.groupby("solver", sort=False):
+            why = _not_applicable(s)
             for t in timeouts_ms:
+                if why:
+                    rows.append({"solver": name, "robot": robot, "timeout_ms": t, "entry": entry_of(name),
+                                 "queries": int(s["query"].nunique()), "not_applicable": why, "reference": ref_name,
+                                 "reference_ms_median": ref_ms, "source": s["source"].iloc[0] if "source" in s else "run"})
+                    continue
                 g = s[s["given_timeout_ms"].isna() | (s["given_timeout_ms"] == t)].sort_values("query")
                 ok = rung_success(g, ladder) & (g["seconds"].to_numpy() <= t / 1e3)[:, None]
                 tta = np.where(ok[:, rung], g["seconds"].to_numpy(), t / 1e3)
@@ -214,7 +265,10 @@ def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: st
                     solved = (leg <= ladder[rung][0]) & (g["seconds"].to_numpy() <= t / 1e3)
                     row["other_mode"] = float((solved & ~ok[:, rung]).mean())
                 row.update({f"success_{rung_label(r)}": float(ok[:, k].mean()) for k, r in enumerate(ladder)})
-                row.update({"time_ms_median": 1e3 * float(np.median(tta)), "time_ms_p95": 1e3 * float(np.percentile(tta, 95)),
+                cpu = g["cpu_seconds"].to_numpy(float) if "cpu_seconds" in g else np.full(len(g), np.nan)
+                row.update({"time_ms_median": 1e3 * float(np.median(tta)),
+                            "cpu_ms_median": 1e3 * float(np.median(cpu)) if np.isfinite(cpu).all() else np.nan,
+                            "time_ms_p95": 1e3 * float(np.percentile(tta, 95)),
                             "time_ratio_median": float(np.median(ratio)), "time_ratio_p95": float(np.percentile(ratio, 95)),
                             "reference": ref_name, "reference_ms_median": ref_ms,
                             "source": g["source"].iloc[0] if "source" in g else "run"})
@@ -232,8 +286,12 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
     ref = make_solver(reference, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, reference, -1, 0))
     rows = []
     m = min(reference_queries, len(targets))
+    from fkopt.adapters.field import NotApplicable
     for name in solvers:
-        solver = make_solver(name, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, name, -1, 0))
+        try:
+            solver = make_solver(name, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, name, -1, 0))
+        except NotApplicable:           # the clock track's rows say why
+            continue
         if not hasattr(solver, "solve_batch"):
             continue
         for b in batches:

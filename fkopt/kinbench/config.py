@@ -217,6 +217,20 @@ class ThroughputTrack(Strict):
     #: batch sizes for FK of parallel mechanisms (fkopt.forward: ~0.1 s per pose on Dietmaier's platform)
     fk_batches: list[int] = Field(default_factory=lambda: [1, 10, 100], min_length=1)
     repeats: int = Field(3, ge=1, le=100)
+    #: IK solvers on this track only, besides the clock's batch-taking ones: batched packages whose
+    #: per-query call is not how their authors use them (pytorch-kinematics)
+    solvers: list[str] = Field(default_factory=list)
+
+    @field_validator("solvers")
+    @classmethod
+    def _solvers(cls, solvers):
+        known = clock_solvers()
+        for name in solvers:
+            if name not in known:
+                raise ValueError(f"solver '{name}' is not a clock-track solver (allowed: {', '.join(known)})")
+        if len(set(solvers)) != len(solvers):
+            raise ValueError("solvers must not repeat")
+        return solvers
 
     @field_validator("batches", "fk_batches")
     @classmethod

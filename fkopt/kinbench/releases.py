@@ -570,3 +570,29 @@ def check_release(config, manifest: dict, files: Path | None = None) -> None:
     for rel in problem_files(config):
         if rel not in expected:
             raise FkoptError(f"{base / rel}: problem file not part of released {name}{new}")
+
+
+#: Frozen per-robot board versions (a suite's clock track): what the entries are and how they run.
+#: A changed entry (a new wrapper, another tolerance, another restart loop) is a new board version,
+#: never an edit of one; meta.json names the version a stored board was made with, CITATION.cff
+#: lists them so a paper can cite the board it compared against.
+BOARDS: dict[str, dict[str, str]] = {
+    "kinbench-v3-robots": {
+        "1": "the first per-robot board: TRAC-IK, pinocchio's CLIK and ikpy through kinbench's first wrappers "
+             "(TRAC-IK's two threads unpinned, eps 1e-5 per twist component, scipy quaternion in the call; CLIK "
+             "undamped full steps; ikpy symbolic=False)",
+        "2": "every outside entry as its authors run it (docs/kinbench.md, 'Outside entries'): TRAC-IK eps 1e-5/sqrt(3) "
+             "pinned to one core, pin-clik/ikpy/pink/black boxes in one restart loop "
+             "(fkopt/adapters/field/restarts.py), ikpy at its defaults; new entries eaik, optik, pink; CPU time per "
+             "call and the load average stored",
+    },
+}
+
+
+def board_version(suite: str) -> str | None:
+    """The current board version of suite ``suite`` ("kinbench-v3-robots/2"; its quick tier,
+    ``<name>-quick``, has its suite's), None when it has none."""
+    name = suite.removesuffix("-quick")
+    versions = BOARDS.get(name)
+    return f"{name}/{max(versions, key=int)}" if versions else None
+

@@ -463,7 +463,9 @@ ROBOTS_PREAMBLE = ("IK of real arms, every answer checked by fkopt's FK (positio
 
 def robot_columns(board: pd.DataFrame) -> list[str]:
     return (["solver", "robot", "timeout_ms", "entry"] + [c for c in board.columns if c.startswith("success_")]
-            + ["time_ms_median", "time_ratio_median", "time_ratio_p95", "throughput_qps"])
+            + ["time_ms_median"] + (["cpu_ms_median"] if "cpu_ms_median" in board else [])
+            + ["time_ratio_median", "time_ratio_p95", "throughput_qps"]
+            + (["not_applicable"] if "not_applicable" in board else []))
 
 
 PER_PROBLEM = ["set", "solver", "track", "target", "trials", "success_rate", "ert"]
@@ -570,7 +572,22 @@ def meta(sr) -> dict:
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
             "outside": {o.solver: digest(c, o, sr.files) for o in c.outside},
             "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)",
-            **submissions_meta(c, sr.files)}
+            **board_meta(sr), **submissions_meta(c, sr.files)}
+
+
+def board_meta(sr) -> dict:
+    """meta.json's record of a per-robot board (only for a suite with a clock track): its frozen
+    board version (:data:`fkopt.kinbench.releases.BOARDS`), the machine's load averages at the
+    clock track's start and end, and every entry's settings."""
+    if getattr(sr, "answers", None) is None:
+        return {}
+    from fkopt.kinbench.releases import board_version
+    out = {"board_version": board_version(sr.config.name)}
+    if getattr(sr, "load_avg", None):
+        out["load_avg"] = sr.load_avg
+    if getattr(sr, "entries", None):
+        out["entries"] = sr.entries
+    return {k: v for k, v in out.items() if v is not None}
 
 
 def submissions_meta(c, files=None) -> dict:

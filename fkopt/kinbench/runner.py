@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import math
 import time
 from dataclasses import dataclass, field
@@ -65,6 +66,8 @@ class SuiteResult:
     files: Path | None = None            # where its relative files are (pose sets, outside logs)
     answers: pd.DataFrame | None = None  # answers.csv.gz: every answer of the clock track (v3)
     throughput: pd.DataFrame | None = None   # throughput.csv: queries/s per batch size (v3)
+    load_avg: dict | None = None         # the load averages at the clock track's start and end (meta.json)
+    entries: dict | None = None          # the clock track's entries' settings (meta.json)
 
     @property
     def runs(self) -> pd.DataFrame:
@@ -148,12 +151,15 @@ def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> 
 def validate_track(config: SuiteConfig, p: int, files: Path | None = None) -> None:
     """Every clock-track solver built once on arm ``p``: a missing package or an arm a package
     misreads is one line before any work."""
+    from fkopt.adapters.field import NotApplicable
     from fkopt.kinbench.clock import make_solver, track_settings
     arm = track_arm(config, p, files)
     solvers, reference, timeouts = track_settings(config.tracks.clock, arm)
     for name in dict.fromkeys([reference, *solvers]):
         try:
             make_solver(name, arm, timeout=max(timeouts) / 1e3, rng=np.random.default_rng(0))
+        except NotApplicable:             # by design (EAIK on a 7-joint arm): a "not applicable" cell
+            continue
         except FkoptError as err:
             raise FkoptError(f"tracks.clock.solvers[{name}] on problems[{config.problems[p].name}]: {err}") from None
 
@@ -168,17 +174,32 @@ def solve_track(payload: dict) -> dict:
     name = config.problems[p].name
     queries = np.asarray(payload["queries"], dtype=float)
     start = time.perf_counter()
+    load_start = load_average()
     solvers, reference, timeouts = track_settings(clock, arm)
-    answers = run_clock(arm, name, queries, solvers, timeouts_ms=timeouts, reference=reference, seed=config.seed)
+    settings: dict = {}
+    answers = run_clock(arm, name, queries, solvers, timeouts_ms=timeouts, reference=reference, seed=config.seed,
+                        settings=settings)
     answers.insert(1, "set", clock.set)
     rate = None
     if tp is not None:
         from fkopt.kinbench.clock import is_ik
         batches = tp.batches if is_ik(arm) else tp.fk_batches
-        rate = run_throughput(arm, name, queries, solvers, batches=tuple(batches), repeats=tp.repeats,
+        batched = list(dict.fromkeys([*solvers, *(tp.solvers if is_ik(arm) else [])]))
+        rate = run_throughput(arm, name, queries, batched, batches=tuple(batches), repeats=tp.repeats,
                               reference=reference, seed=config.seed).to_dict(orient="list")
     return {"fingerprint": payload["fingerprint"], "track": "clock", "problem": p,
-            "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start}
+            "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start,
+            "load_avg": {"start": load_start, "end": load_average()},
+            "settings": json.loads(json.dumps(settings, default=str))}
+
+
+def load_average() -> list[float] | None:
+    """The machine's 1-, 5- and 15-minute load averages (None where the OS has none): stored in
+    meta.json at the board's start and end, so anyone can see a run the scheduler distorted."""
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except (AttributeError, OSError):
+        return None
 
 
 def solve_task(payload: dict) -> dict:
@@ -392,8 +413,15 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
                                           "solver": config.solvers[r["solver"]].key, "runs": r["solves"],
                                           "seconds": r["wall_s"], "mode": BATCH}) for r in done])
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
+    loads = [r["load_avg"] for r in tracked if r.get("load_avg")]
+    load_avg = {"start": loads[0]["start"], "end": loads[-1]["end"]} if loads else None
+    entries: dict = {}                # each entry's settings as on its first arm (less the arm's own file)
+    for r in tracked:
+        for solver, st in (r.get("settings") or {}).items():
+            entries.setdefault(solver, {k: v for k, v in st.items() if k not in ("urdf", "urdf_note", "family")})
     return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
-                       suite_trace(config, done, runs, ctx.files), ctx.files, answers, throughput)
+                       suite_trace(config, done, runs, ctx.files), ctx.files, answers, throughput, load_avg,
+                       entries or None)
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,

@@ -276,6 +276,8 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "batches": ("Batch sizes (the queries repeated when fewer).", "queries per call", [1, 10, 100, 1000]),
         "repeats": ("Calls per batch size; the fastest counts.", "calls", 3),
         "fk_batches": ("Batch sizes for FK of parallel mechanisms.", "queries per call", [1, 10, 100]),
+        "solvers": ("IK solvers on this track only, besides the clock's batch-taking ones (batched packages).", "",
+                    ["pytorch-kinematics"]),
     },
     "SuiteProblem": {
         "name": ("Name of the problem in the tables.", "", "mao2017-3rps"),

@@ -222,33 +222,32 @@ def soa(R: np.ndarray):
 
 
 class BlackBoxIK(FieldIK):
-    """A black-box optimiser on :func:`pose_objective` (fkopt's FK as the black box), restarted
-    from random in-limit starts until the objective is below ``FTARGET`` or the wall-clock
-    ``timeout`` has passed; subclasses supply :meth:`search` (one start, stopping by itself at
-    the deadline). FTARGET = 1e-17 m^2 puts both errors within 3.2e-9 (m, rad): every rung of
-    the ladder."""
+    """A black-box optimiser on :func:`pose_objective` (fkopt's FK as the black box), in the
+    board's one restart loop (:func:`fkopt.adapters.field.restarts.restart`): random in-limit
+    starts until the objective is below ``FTARGET`` or the wall-clock ``timeout`` has passed;
+    subclasses supply :meth:`search` (one start, stopping by itself at the deadline). FTARGET =
+    RUNG^2 = 1e-10 (m^2 + rad^2) implies both errors within the board's rung of 1e-5 (m, rad),
+    the stopping test of every entry (docs/kinbench.md)."""
 
-    FTARGET = 1e-17
+    FTARGET = 1e-10
 
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
-        self.settings.update(objective="|dp|^2 (m^2) + angle^2 (rad^2) on fkopt's FK", ftarget=self.FTARGET,
-                             start="uniform in limits (wrapper's generator), restarts until the timeout",
-                             wall_clock_limit=True)
+        from fkopt.adapters.field.restarts import SETTINGS
+        self.settings.update(SETTINGS, objective="|dp|^2 (m^2) + angle^2 (rad^2) on fkopt's FK", ftarget=self.FTARGET)
 
     def search(self, f, x0: np.ndarray, deadline: float) -> tuple[np.ndarray, float]:
         raise NotImplementedError
 
     def solve1(self, T):
+        from fkopt.adapters.field.restarts import restart
         f = pose_objective(self.arm, T)
-        deadline = time.perf_counter() + self.timeout
-        best_x, best_f = None, np.inf
-        while True:
-            x, fx = self.search(f, self.random_start(), deadline)
-            if fx < best_f:
-                best_x, best_f = np.clip(x, self.lo_rad, self.hi_rad), fx
-            if best_f <= self.FTARGET or time.perf_counter() > deadline:
-                return self.public(best_x), bool(best_f <= self.FTARGET)
+
+        def one(x0, deadline):
+            x, fx = self.search(f, x0, deadline)
+            return np.clip(x, self.lo_rad, self.hi_rad), fx, bool(fx <= self.FTARGET)
+        x, ok, _ = restart(one, self.random_start, self.timeout)
+        return self.public(x), ok
 
 
 def pose_objective(arm, T: np.ndarray):

@@ -10,9 +10,9 @@ Two calls:
 * :meth:`EAIK.solutions` -- every solution EAIK returns for a pose (:class:`Solutions`: joints,
   its least-squares flags, and which lie inside the limits), for "every IK solution".
 
-How it reads the arm, as its README does: :class:`eaik.IK_URDF.UrdfRobot` on a URDF file. It
+Quirks worked around -- how it reads the arm, as its README does: :class:`eaik.IK_URDF.UrdfRobot` on a URDF file. It
 takes *every* actuated joint of the file (the Panda's fingers too), so it is given the URDF
-written from fkopt's chain (:func:`fkopt.adapters.field.arm_urdf`, which always writes it now): the
+written from fkopt's chain (:func:`fkopt.adapters.field.arm_urdf`): the
 chain's joints only. Its end effector is the last joint's child link origin with the base's
 orientation at q = 0 (its ``P``'s last column is zero, ``R6T`` the identity); the arm's tip is
 rigidly attached to that link, so the tip frame is EAIK's frame times one constant transform
@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import FieldIK, NotApplicable, arm_urdf
+from fkopt.adapters.field import FieldIK, NotApplicable, arm_urdf
 
 
 @dataclass
@@ -72,7 +72,7 @@ class EAIK(FieldIK):
         self._C = np.linalg.solve(self._robot.fwdKin(mid * arm._to_si), arm.fk_matrix(mid[None])[0])
         other = arm.bounds[:, 0] + 0.3 * (arm.bounds[:, 1] - arm.bounds[:, 0])
         if np.abs(self._robot.fwdKin(other * arm._to_si) @ self._C - arm.fk_matrix(other[None])[0]).max() > 1e-9:
-            from ...errors import FkoptError
+            from fkopt.errors import FkoptError
             raise FkoptError(f"eaik: its FK of {urdf.source} differs from fkopt's (joints read in another order?)")
         self._Cinv = np.linalg.inv(self._C)
         self._revolute = np.asarray(arm.unknown_units) == "deg"

@@ -3,7 +3,7 @@ starts on :func:`fkopt.adapters.field.pose_objective`: a bounded quasi-Newton me
 only the objective (gradients by scipy's forward differences, n + 1 evaluations each).
 
 Settings: ``bounds`` = the joint limits, ``maxiter`` = 200 per start, ``ftol`` = 0 and ``gtol``
-= 1e-14 (stop on the gradient, not on a small relative decrease, so it can reach 1e-17),
+= 1e-14 (stop on the gradient, not on a small relative decrease, so it can reach FTARGET),
 ``eps`` = 1e-8 (scipy's difference step), random starts from the wrapper's generator until
 FTARGET or the deadline; a start past the deadline is stopped by a callback raising
 ``StopIteration`` (scipy >= 1.11 returns the point reached).

@@ -1,10 +1,22 @@
 """TRAC-IK through ``pytracik`` (Beeson and Ames, Humanoids 2015): KDL's Newton and an SQP solve
-run in two threads until either meets ``eps`` or the wall-clock ``timeout`` passes.
+run in two threads until either meets ``eps`` or the wall-clock ``timeout`` passes, as its
+README runs it.
 
-Settings: solve type ``Speed`` (return the first solution), ``eps`` = 1e-5 (TRAC-IK's default:
-a twist-error bound, m and rad), timeout = the wrapper's timeout; the start is a random in-limit
-configuration from the wrapper's generator; TRAC-IK's own restarts draw from its own unseeded RNG
-and its timeout is wall-clock, so its outcomes vary run to run (compare them by timing rules).
+Settings: solve type ``Speed`` (return the first solution, TRAC-IK's default), ``eps`` = 1e-5 / sqrt(3):
+TRAC-IK's eps bounds each component of the twist error (m and rad), so the Euclidean position
+error and the rotation angle are within sqrt(3) eps = 1e-5, the board's rung (its default eps of
+1e-5 lets answers it accepts fail that rung: 5-14 % of queries on the first board);
+timeout = the wrapper's timeout; the start is a random in-limit configuration from the
+wrapper's generator (the README's protocol seeds at the middle of the limits; the board's
+queries are random poses and every entry starts at random); TRAC-IK's own restarts draw from its
+own unseeded RNG and its timeout is wall-clock, so its outcomes vary run to run (compare them by
+timing rules).
+
+Inside the timed call only pytracik's call, pinned to the caller's core
+(:func:`fkopt.adapters.field.cores.pinned`: its two threads share that core, as every entry of the
+clock track runs on one core), and the target's quaternion by Shepperd's method on floats
+(:func:`quat_xyzw`, a few microseconds; the first wrapper's scipy conversion took 50-107 us,
+20-35 % of a call).
 
 Quirks worked around: pytracik reads some URDF limits as [0, 0] (the Panda: KDL's URDF parser
 misses limits on a root link with an inertia), so the wrapper sets the limits itself from
@@ -15,15 +27,41 @@ the status (> 0: found).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fkopt.adapters.field import FieldIK, arm_urdf
+from fkopt.adapters.field.cores import pinned
+
+
+def quat_xyzw(R) -> tuple[float, float, float, float]:
+    """Unit quaternion (x, y, z, w) of a rotation matrix by Shepperd's method (Shepperd, J.
+    Guidance and Control 1(3), 1978): the largest of w, x, y, z taken from the diagonal, the others
+    from the off-diagonal sums, so no division by a small number."""
+    (a, b, c), (d, e, f), (g, h, i) = R[0][:3], R[1][:3], R[2][:3]
+    tr = a + e + i
+    if tr >= a and tr >= e and tr >= i:
+        w = 0.5 * math.sqrt(max(0.0, 1.0 + tr))
+        s = 0.25 / w
+        return (h - f) * s, (c - g) * s, (d - b) * s, w
+    if a >= e and a >= i:
+        x = 0.5 * math.sqrt(max(0.0, 1.0 + a - e - i))
+        s = 0.25 / x
+        return x, (b + d) * s, (c + g) * s, (h - f) * s
+    if e >= i:
+        y = 0.5 * math.sqrt(max(0.0, 1.0 - a + e - i))
+        s = 0.25 / y
+        return (b + d) * s, y, (f + h) * s, (c - g) * s
+    z = 0.5 * math.sqrt(max(0.0, 1.0 - a - e + i))
+    s = 0.25 / z
+    return (c + g) * s, (f + h) * s, z, (d - b) * s
 
 
 class TracIK(FieldIK):
     name = "tracik"
     package = "pytracik"
-    EPS = 1e-5
+    EPS = 1e-5 / math.sqrt(3.0)
 
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
@@ -40,12 +78,13 @@ class TracIK(FieldIK):
         hi32 = np.nextafter(self.hi_rad.astype(np.float32), np.float32(-np.inf))
         pytracik.set_joint_limits(self._solver, lo32.astype(float).tolist(), hi32.astype(float).tolist())
         self.settings.update(urdf=urdf.source, solve_type="Speed", eps=self.EPS, limits="fkopt's, float32 rounded inward",
-                             start="uniform in limits (wrapper's generator)", internal_rng="TRAC-IK's own, unseeded")
+                             start="uniform in limits (wrapper's generator)", internal_rng="TRAC-IK's own, unseeded",
+                             threads="two per call, pinned to the caller's core", quaternion="Shepperd, on floats")
 
     def solve1(self, T):
-        from scipy.spatial.transform import Rotation
-        x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
-        out = self._pt.ik(self._solver, self.random_start(), *T[:3, 3], x, y, z, w)
+        x, y, z, w = quat_xyzw(T.tolist())
+        with pinned():
+            out = self._pt.ik(self._solver, self.random_start(), T[0, 3], T[1, 3], T[2, 3], x, y, z, w)
         if out[0] <= 0:
             return None, False
         return self.public(out[1:]), True
