@@ -23,9 +23,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from fkopt.numerics.compiled import _evaluate, _inverse_one, _nearest_into, _uniform_hash
+from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 TWO_PI = 2.0 * math.pi
 
@@ -93,6 +93,10 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
         _nearest_into(Ft, norms, f, near_idx, np.empty(nn))
     q0, best, u, w = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     empty = np.empty((0, n))
+    # no start table inside these loops: _inverse_one's table arguments left empty (compiled.NO_TABLE)
+    no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
+                0.0)
+    no_feat, no_v32, no_tq = np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
     r, J = np.empty(6), np.empty((6, n))
     p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
     cap = sols.shape[0]
@@ -151,10 +155,12 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
             for i in range(n):
                 q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
         if held:
-            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
+                                 tp, tr, iterations, damping, down,
                                  up, step_cap, hlo, hhi, glo, ghi, best)
         else:
-            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, seed, 0, 1, tp, tr, iterations, damping, down,
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
+                                 tp, tr, iterations, damping, down,
                                  up, step_cap, slo, shi, glo, ghi, best)
         pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
         if W[3] * W[4] * W[5] != 0.0:
@@ -232,6 +238,10 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
     T = np.empty((3, 3))
     best = np.empty(n)
     empty = np.empty((0, n))
+    # no start table inside these loops: _inverse_one's table arguments left empty (compiled.NO_TABLE)
+    no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
+                0.0)
+    no_feat, no_v32, no_tq = np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
     r, J = np.empty(6), np.empty((6, n))
     p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
     vel = np.zeros(n)
@@ -245,7 +255,8 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
         # as near to the other
         for i in range(n):
             q0[i] = q[i] + vel[i]
-        _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, 0, 1, tp, tr, iterations, damping, down, up, step_cap,
+        _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, 0, 0, 1, tp, tr,
+                     iterations, damping, down, up, step_cap,
                      slo, shi, lo, hi, best)
         pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
         if W[3] * W[4] * W[5] != 0.0:
