@@ -14,7 +14,7 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
     assert len(np.unique(img.reshape(-1, img.shape[-1]), axis=0)) > 10
     assert len(csv) == len(df)
     core = {"throughput", "mao2017", "exact", "kinematics", "cases", "scaling"}
-    assert core <= set(csv.section) <= core | {"ik-one-pose", "ik-batch", "swarms"}   # when rtb, pinocchio, a C compiler are there
+    assert core <= set(csv.section) <= core | {"ik-one-pose", "ik-batch", "swarms", "fksgp"}   # when rtb, pinocchio, a C compiler, fkSGP are there
     assert np.all(np.isfinite(csv.value)) and np.all(csv.value >= 0)
     # every registered mechanism has a throughput row
     for name in fkopt.MECHANISMS:

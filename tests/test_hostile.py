@@ -893,9 +893,8 @@ def _interrupt(tmp_path, prev, slow, command, how):
                          start_new_session=True, env=env)
     # interrupt once it computes: its lock file (OUT/<paper>/.<name>.lock) appears after imports and
     # validation (about a second on an idle machine, far longer on a loaded one), then half a second
-    lock = out / slow["paper"] / f".{slow['name']}.lock"
     deadline = time.monotonic() + 240
-    while not lock.exists() and p.poll() is None and time.monotonic() < deadline:
+    while not list(out.glob(f"*/.{slow['name']}.lock")) and p.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     time.sleep(0.5)
     assert p.poll() is None, "the rerun finished before it could be interrupted; make SLOW slower"

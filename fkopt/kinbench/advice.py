@@ -101,6 +101,9 @@ def summarise_board(board: pd.DataFrame, timeout_ms: float, fk: bool = False) ->
     fk_set = fk_robots(board)
     board = board[np.isclose(board["timeout_ms"], timeout_ms) & (board["robot"].isin(fk_set) == fk)]
     success = [c for c in board.columns if c.startswith("success_")]
+    if board.empty:                      # no arm of this kind (IK or FK) at this timeout
+        return pd.DataFrame(columns=["solver", "entry", *success, "worst_arm", "arms", "not_applicable",
+                                     "median_ms", "median_ratio"])
     rung = f"success_{board['rung'].iloc[0]}"
     # a cell such as "not applicable: ..." (an arm a package cannot take) is no number: that arm
     # is left out of the entry's mean and count, never read as a zero

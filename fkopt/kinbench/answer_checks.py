@@ -33,7 +33,8 @@ def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 #: The columns of every answers row (:func:`fkopt.kinbench.clock.answer_rows`, ``set`` added by
 #: the runner), before the answer's own ``q0..`` / ``x0..``.
 ANSWER_COLUMNS = ("robot", "set", "query", "solver", "entry", "source", "given_timeout_ms", "seconds",
-                  "reference_seconds", "claimed", "position_m", "rotation_rad", "in_limits", "leg_residual")
+                  "cpu_seconds", "reference_seconds", "claimed", "position_m", "rotation_rad", "in_limits",
+                  "leg_residual", "not_applicable")
 RULE = "one answer per (query, solver, timeout) the config implies"
 
 
@@ -141,12 +142,15 @@ def clock_record_problem(task, rec: dict) -> str | None:
         return f"answers.entry: row {int(np.flatnonzero(wrong)[0])} is not its solver's entry"
     if any(not isinstance(v, bool) for v in g["claimed"]) or any(not isinstance(v, bool) for v in g["in_limits"]):
         return "answers.claimed, in_limits: not true/false"
-    for col in ("seconds", "reference_seconds", "given_timeout_ms", "position_m", "rotation_rad", "leg_residual",
-                *cols[len(ANSWER_COLUMNS):]):
+    if any(not isinstance(v, str) for v in g["not_applicable"]):
+        return "answers.not_applicable: not text"
+    for col in ("seconds", "cpu_seconds", "reference_seconds", "given_timeout_ms", "position_m", "rotation_rad",
+                "leg_residual", *cols[len(ANSWER_COLUMNS):]):
         if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in g[col]):
             return f"answers.{col}: not numbers"
     big = float(np.finfo(float).max)
     why = (_numbers(g["seconds"], "seconds", 0, big) or _numbers(g["reference_seconds"], "reference_seconds", 0, big)
+           or _numbers(g["cpu_seconds"], "cpu_seconds", 0, big, nan=True)
            or next(filter(None, (_numbers(g[c], c, -MAX_MAGNITUDE, MAX_MAGNITUDE, nan=True)
                                  for c in cols[len(ANSWER_COLUMNS):])), None))
     if why:

@@ -233,11 +233,14 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
         "<details><summary>arms of each family</summary>" + "".join(
             _p(f"{r.family}: {r.arms}", "note") for r in fam.itertuples()) + "</details>"])
     ik_timeouts = sorted(board.loc[~board["robot"].isin(fk_robots(board)), "timeout_ms"].unique())
+    fk_only = not ik_timeouts            # a board of parallel mechanisms only: its FK rows are the summary
     t = float(ik_timeouts[-1]) if ik_timeouts else float(board["timeout_ms"].max())
-    summary = summarise_board(board, t)
+    summary = summarise_board(board, t, fk=fk_only)
     cols = ["solver", "entry", "arms", *success, "worst_arm", "median_ms",
             *(["cpu_ms_median"] if "cpu_ms_median" in summary else []), "median_ratio"]
-    body = [_p(f"IK at a {t:g} ms timeout, success mean over the arms an entry ran (README's table).", "note"),
+    note = (f"FK at a {t:g} ms timeout, success mean over the mechanisms an entry ran." if fk_only else
+            f"IK at a {t:g} ms timeout, success mean over the arms an entry ran (README's table).")
+    body = [_p(note, "note"),
             H.table_html(summary, cols, "summary-table", shares=False,
                          labels={"median_ratio": f"median time ratio to {clock.reference}"})]
     fk = [r for r in board["robot"].unique() if r in fk_robots(board)]
