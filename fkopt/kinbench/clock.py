@@ -277,7 +277,8 @@ def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: st
 
 
 def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, batches=BATCHES, repeats: int = 3,
-                   reference: str = REFERENCE, seed: int = 0, reference_queries: int = 100) -> pd.DataFrame:
+                   reference: str = REFERENCE, seed: int = 0, reference_queries: int = 100,
+                   optional=()) -> pd.DataFrame:
     """Queries per second of every batch-taking solver at each batch size (best of ``repeats``
     calls), beside the reference's rate one query per call on the first ``reference_queries``
     queries (timed right after each batch size), and the share of answers passing each
@@ -291,6 +292,13 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
         try:
             solver = make_solver(name, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, name, -1, 0))
         except NotApplicable:           # the clock track's rows say why
+            continue
+        except FkoptError:
+            # a throughput-only entry whose package is an extra of its own (pytorch-kinematics: .[torch])
+            # is left out where it is not installed (fkopt check's rerun in a test install; the
+            # throughput table is a timing file, never compared); any other entry's failure stands
+            if name not in optional:
+                raise
             continue
         if not hasattr(solver, "solve_batch"):
             continue

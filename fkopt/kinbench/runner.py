@@ -186,7 +186,8 @@ def solve_track(payload: dict) -> dict:
         batches = tp.batches if is_ik(arm) else tp.fk_batches
         batched = list(dict.fromkeys([*solvers, *(tp.solvers if is_ik(arm) else [])]))
         rate = run_throughput(arm, name, queries, batched, batches=tuple(batches), repeats=tp.repeats,
-                              reference=reference, seed=config.seed).to_dict(orient="list")
+                              reference=reference, seed=config.seed,
+                              optional=set(tp.solvers) - set(solvers)).to_dict(orient="list")
     return {"fingerprint": payload["fingerprint"], "track": "clock", "problem": p,
             "answers": answers.to_dict(orient="list"), "throughput": rate, "wall_s": time.perf_counter() - start,
             "load_avg": {"start": load_start, "end": load_average()},
