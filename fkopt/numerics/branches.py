@@ -69,6 +69,15 @@ def _rotation_target(pose, T):
 
 
 @njit(cache=True)
+def _no_start_table(n):
+    """_inverse_one's start arguments with no start table (these loops give their own starts):
+    no neighbour rows, the table's arrays empty (compiled.NO_TABLE), no features, screen or joints."""
+    no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
+                0.0)
+    return np.empty((0, n)), no_table, np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
+
+
+@njit(cache=True)
 def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, patience, tp, tr, accept_p,
             accept_r, iterations, damping, down, up, step_cap, slo, shi, glo, ghi, revolute, merge_tol, growth,
             wfirst, wlast, held_draws, sols, found_at, info):
@@ -92,11 +101,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
             f[j] = f[j] * fmask[j]
         _nearest_into(Ft, norms, f, near_idx, np.empty(nn))
     q0, best, u, w = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    empty = np.empty((0, n))
-    # no start table inside these loops: _inverse_one's table arguments left empty (compiled.NO_TABLE)
-    no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
-                0.0)
-    no_feat, no_v32, no_tq = np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
+    empty, no_table, no_feat, no_v32, no_tq = _no_start_table(n)
     r, J = np.empty(6), np.empty((6, n))
     p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
     cap = sols.shape[0]
@@ -237,11 +242,7 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
     m = chain[0].shape[0]
     T = np.empty((3, 3))
     best = np.empty(n)
-    empty = np.empty((0, n))
-    # no start table inside these loops: _inverse_one's table arguments left empty (compiled.NO_TABLE)
-    no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
-                0.0)
-    no_feat, no_v32, no_tq = np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
+    empty, no_table, no_feat, no_v32, no_tq = _no_start_table(n)
     r, J = np.empty(6), np.empty((6, n))
     p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
     vel = np.zeros(n)
