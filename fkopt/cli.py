@@ -323,8 +323,8 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
         executor: str = typer.Option("local", "--executor", help="local | dask"),
         scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of an existing Dask "
                                                 "scheduler (with --executor dask)"),
-        resume: bool = typer.Option(False, "--resume", help="studies and suites: keep the finished tasks of an "
-                                    "interrupted run of the same config and run only the others"),
+        resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted run of the "
+                                    "same config and run only the others (assembly searches keep none)"),
         force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
                                    "whose result-changing fields differ"),
         quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
@@ -345,13 +345,13 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
 _INTERRUPTED = {"hint": None}
 
 
-def resume_hint(command: str, path, config, out: Path, quick: bool = False) -> str:
-    """The command that continues an interrupted run of ``config``, as it works: studies and
-    suites keep their finished tasks (``.<name>.partial``) and the command the user ran, with
-    ``--resume``, reuses them; an experiment or assembly search keeps none and starts again."""
+def resume_hint(command: str, path, config, out: Path, quick: bool = False, stored: bool = True) -> str:
+    """The command that continues an interrupted run of ``config``, as it works: a kind whose plan
+    keeps task files (``stored``: experiments, studies, suites; ``.<name>.partial``) reuses them with
+    the command the user ran and ``--resume``; an assembly search keeps none and starts again."""
     kind = getattr(config, "kind", None) or "experiment"
     where = "" if out == DEFAULT_OUT else f" --out {out}"
-    if kind in ("study", "suite"):
+    if stored:
         again = f"fkopt {command} {path}{' --quick' if quick else ''}{where} --resume"
         return f"the finished tasks of this {kind} are kept: {again} continues"
     return f"an {kind} keeps no finished tasks: fkopt {command} {path}{where} starts it again"
@@ -388,7 +388,7 @@ def _run_checked(files, out: Path, *, jobs: int, executor: str, scheduler: str |
         planned.append((path, config, plan, tasks))
     con = _console()
     for path, config, plan, tasks in planned:
-        _INTERRUPTED["hint"] = resume_hint(command, path, config, out, quick)
+        _INTERRUPTED["hint"] = resume_hint(command, path, config, out, quick, plan.stored)
         with _progress(con, config.name, tasks, quiet) as progress:
             outcome = run_config(config, out, source=str(path), progress=progress, force=force, checked=True,
                                  jobs=jobs, executor=executor, scheduler=scheduler, resume=resume, plan=plan)
@@ -467,22 +467,17 @@ class _progress:
 
 
 def _print_outcome(con, outcome, tasks: int) -> None:
-    from fkopt.kinds.experiment.runner import ExperimentResult
-    from fkopt.kinds.study.runner import StudyResult
+    from fkopt.run.kinds import config_kind
     result = outcome.result
-    if isinstance(result, ExperimentResult):
-        from fkopt.kinds.experiment.reports import summary_table
-        _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
-    elif isinstance(result, StudyResult):
-        from fkopt.kinds.study.reports import summary_table
-        _print_summary(con, summary_table(result), outcome.folder, outcome.wall_s)
-    elif getattr(result.config, "kind", None) == "suite":
-        from fkopt.kinbench.reports import board_top_lines
-        con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s): leaderboard.md, index.html")
-        for line in board_top_lines(outcome.folder):
-            con.print(line, markup=False, highlight=False, soft_wrap=True)
+    shown = config_kind(result.config).console          # what the kind prints after a run
+    said = shown(result, outcome.folder) if shown is not None else None
+    if hasattr(said, "columns"):                        # a summary table
+        _print_summary(con, said, outcome.folder, outcome.wall_s)
     else:
-        con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s)")
+        head, *lines = said or [""]
+        con.print(f"{outcome.folder}  ({outcome.wall_s:.2f} s){head}")
+        for line in lines:
+            con.print(line, markup=False, highlight=False, soft_wrap=True)
     reused = tasks - len(outcome.computed)
     if 0 < reused <= tasks:
         con.print(f"resumed: {reused} finished task(s) reused, {len(outcome.computed)} computed")

@@ -131,8 +131,10 @@ TIERS = {
     "tests/test_urdf.py::test_real_robot_jacobian_matches_finite_differences": ("external",),
     "tests/test_cli.py::test_run_is_deterministic": ("slow",),
     "tests/test_kinbench_pages.py::test_fkopt_pages_remakes_a_stored_board_from_its_files_alone": ("slow", "stored"),
-    "tests/test_newcomer.py::test_ctrl_c_of_a_fresh_experiment_names_a_rerun_and_leaves_no_empty_folder":
+    "tests/test_newcomer.py::test_ctrl_c_of_a_fresh_experiment_names_the_command_that_resumes_it":
         ("external",),
+    "tests/test_run_result.py::test_ctrl_c_of_an_experiment_keeps_its_tasks_and_resume_finishes_it": ("external",),
+    "tests/test_run_result.py::test_run_tasks_hands_the_same_records_to_a_worker_process": ("external",),
     "tests/test_newcomer.py::test_ctrl_c_of_a_study_names_the_command_that_resumes_it": ("external",),
     "tests/test_export.py::test_export_refuses_what_it_must_not_touch": ("slow",),
 }

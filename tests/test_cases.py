@@ -142,12 +142,13 @@ def test_experiment_batches_cases_with_the_task_seeds():
                            algorithms=[{"name": "gabc"}, {"name": "pso", "label": "p"}],
                            population=4, iterations=12, runs=2, seed=9)
     er = run_experiment(cfg)
-    assert [(r.case.index, r.spec.key) for r in er.records] == [(c, a) for c in range(3) for a in ("gabc", "p")]
-    for rec in er.records:
+    assert [(r.case.index, r.spec.key) for r in er.own.solves] == [(c, a) for c in range(3) for a in ("gabc", "p")]
+    for rec in er.own.solves:
         seed = task_seed(9, rec.case.index, rec.spec.key)
         ref = fkopt.solve(fkopt.fk_problem(M, rec.case.inputs), rec.spec.name, population=4, iterations=12,
                           runs=2, seed=seed)
-        assert rec.seed == seed and rec.result.seed == seed
+        mine = er.record[(er.record["pose"] == rec.case.index) & (er.record["solver"] == rec.spec.key)]
+        assert set(mine["task_seed"]) == {seed} and rec.result.seed == seed
         for name in ARRAYS:
             np.testing.assert_array_equal(getattr(rec.result, name), getattr(ref, name), err_msg=name)
 

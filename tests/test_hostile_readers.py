@@ -133,7 +133,7 @@ def _forged(rec, edit):
     elif edit == "answer-repeated":
         rec["answers"] = {k: [v[0]] + v[:-1] for k, v in a.items()}
     elif edit == "other-robot":
-        a["robot"] = ["panda"] * len(a["robot"])
+        a["problem"] = ["panda"] * len(a["problem"])
     elif edit == "answers-text":
         a["position_m"] = ["x"] * len(a["position_m"])
     elif edit == "answers-dict":
@@ -191,10 +191,10 @@ def stored_board(tmp_path_factory):
 
 def _board_again(folder, cfg, answers):
     """Write ``answers`` and the board that follows from them, as a forger would."""
-    from fkopt.kinbench.reports import robots_board_table
+    from fkopt.kinbench.reports import robots_board
     answers.to_csv(folder / "answers.csv.gz", index=False, float_format="%.17g")
     tp = pd.read_csv(folder / "throughput.csv")
-    board = robots_board_table(SimpleNamespace(config=cfg, answers=answers, throughput=tp))
+    board = robots_board(cfg, answers, tp)
     if board is not None:
         board.to_csv(folder / "leaderboard-robots.csv", index=False)
 
@@ -215,9 +215,9 @@ def test_check_fails_a_board_whose_answers_are_missing_duplicated_extra_or_unrea
     elif tamper == "duplicates":                   # one answer replaced by a copy of another
         _board_again(folder, cfg, pd.concat([answers.iloc[1:2], answers.iloc[1:]], ignore_index=True))
     elif tamper == "solver-dropped":
-        _board_again(folder, cfg, answers[~((answers.robot == "panda") & (answers.solver == "fkopt.inverse"))])
+        _board_again(folder, cfg, answers[~((answers.problem == "panda") & (answers.solver == "fkopt.inverse"))])
     elif tamper == "robot-dropped":
-        _board_again(folder, cfg, answers[answers.robot != "panda"])
+        _board_again(folder, cfg, answers[answers.problem != "panda"])
     elif tamper == "extra-answer":
         _board_again(folder, cfg, pd.concat([answers, answers.iloc[:1].assign(query=3)], ignore_index=True))
     elif tamper == "emptied":

@@ -237,8 +237,8 @@ def test_fkopt_run_accepts_a_suite_and_numbers_do_not_depend_on_other_solvers(tm
     path = tiny(tmp_path)
     one = load_any(tiny(tmp_path / "b", solvers=[{"name": "lm"}]))
     both = load_any(path)
-    a = run_config(both, tmp_path / "o1", source=str(path)).result.runs
-    b = run_config(one, tmp_path / "o2", source=str(tmp_path / "b" / "tiny.yaml")).result.runs
+    a = run_config(both, tmp_path / "o1", source=str(path)).result.record
+    b = run_config(one, tmp_path / "o2", source=str(tmp_path / "b" / "tiny.yaml")).result.record
     pd.testing.assert_frame_equal(a[a.solver == "lm"].reset_index(drop=True), b.reset_index(drop=True))
 
 
@@ -355,7 +355,7 @@ def test_runs_logged_by_iohexperimenter_are_ranked(tmp_path):
     logger.close()
     path = tiny(tmp_path / "s", outside=[{"solver": "ioh-rs", "track": "black-box", "ioh": "../ioh-runs"}])
     res = run_config(load_any(path), tmp_path / "out", source=str(path))
-    runs = res.result.runs
+    runs = res.result.record
     got = runs[runs.solver == "ioh-rs"]
     assert len(got) == len(best)
     for r in got.itertuples():
@@ -378,7 +378,7 @@ def test_a_urdf_arm_joins_as_a_problem_with_pose_sets_of_its_own(tmp_path):
     cfg = load_suite(path)
     write_pose_sets(cfg, tmp_path / "kb-urdf")
     res = run_config(load_any(path), tmp_path / "out", source=str(path))
-    runs = res.result.runs
+    runs = res.result.record
     assert len(runs) == 3 and set(runs["set"]) == {"uniform", "near-singular", "boundary"}
     assert (runs["dim"] == 7).all() and (runs["evaluations"] <= 200 * 7).all()
 

@@ -98,7 +98,7 @@ def test_ecdf_end_labels_clear_the_title_and_the_legend(tmp_path, drawn):
              "fraction": f} for s, t in solvers for e, f in ((2.0, 0.5), (50.0, 1.0))]
     targets = [1.0, 0.1, 0.01, 1e-4, 1e-6, 1e-8, 1e-10]
     sr = SimpleNamespace(config=SimpleNamespace(targets=targets, budget_per_dim=2000, name="kinbench-v3", subsets=[]),
-                         runs=pd.DataFrame({"class": []}))
+                         record=pd.DataFrame({"class": []}))
     ecdf_figures(sr, tmp_path, {"ecdf.csv": pd.DataFrame(rows)})
     assert drawn and all(len(f["names"]) == len(solvers) for f in drawn)
     for fig in drawn:
@@ -109,7 +109,7 @@ def test_clock_end_labels_clear_the_title(tmp_path, drawn):
     from fkopt.kinbench.reports import clock_figures
     sr, tables = stored_suite(QUICK)
     answers = tables["answers.csv.gz"]
-    names = clock_figures(sr, tmp_path, {"answers.csv.gz": answers[answers["robot"].isin(["ur5", "panda"])]})
+    names = clock_figures(sr, tmp_path, {"answers.csv.gz": answers[answers["problem"].isin(["ur5", "panda"])]})
     assert "clock_all.png" in names and "clock_ur5.png" in names
     for fig in drawn:
         _clear(fig)

@@ -172,8 +172,8 @@ def test_a_subset_solver_gets_the_numbers_it_gets_on_the_whole_suite(written, tm
     """A subset cuts cells, it does not change them: pso's rows on its cells are those of pso run
     on every cell (seeds per case and run, not per task)."""
     from fkopt.kinbench.runner import run_suite
-    cut = written[3].runs
-    every = run_suite(load_any(tiny(tmp_path, solvers=[{"name": "pso"}], budget_per_dim=300))).runs
+    cut = written[3].record
+    every = run_suite(load_any(tiny(tmp_path, solvers=[{"name": "pso"}], budget_per_dim=300))).record
     key = ["problem", "set", "pose", "run"]
     a = cut[cut.solver == "pso"].reset_index(drop=True)
     b = every.merge(a[key], on=key).reset_index(drop=True)

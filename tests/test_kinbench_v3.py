@@ -26,7 +26,7 @@ def queries(m, n, seed=0):
 def answers_frame(seconds, ok, solver="s", timeout=None, robot="r", ref=None):
     n = len(seconds)
     ref = seconds if ref is None else ref
-    return pd.DataFrame({"robot": robot, "query": np.arange(n), "solver": solver, "entry": "outside",
+    return pd.DataFrame({"problem": robot, "pose": np.arange(n), "solver": solver, "entry": "outside",
                          "given_timeout_ms": np.nan if timeout is None else timeout, "seconds": seconds,
                          "reference_seconds": ref, "source": "run",
                          "claimed": True, "position_m": np.where(ok, 0.0, 1.0), "rotation_rad": 0.0,
@@ -304,7 +304,7 @@ def test_fk_answers_of_scipy_least_squares_submitted_are_verified_by_the_mechani
     cfg, arms = fk_submission(tmp_path, rows)
     mech, generating = arms["dietmaier-6sps"]
     got = read_submission(cfg, 0, arms)
-    assert set(got["robot"]) == {"dietmaier-6sps"} and (got["source"] == "submitted").all()
+    assert set(got["problem"]) == {"dietmaier-6sps"} and (got["source"] == "submitted").all()
     assert (got["entry"] == "outside").all() and {f"x{d}" for d in range(6)} <= set(got.columns)
     scipy = made["scipy"]
     kept = np.arange(len(got)) != SPOILT
@@ -537,7 +537,7 @@ def test_an_fk_submission_reaches_the_suites_board_judged_by_the_mechanisms_ik(t
     mine = board[(board.solver == "my-fk") & (board.robot == "dietmaier-6sps")]
     assert len(mine) and (mine["entry"] == "outside").all() and (mine["source"] == "submitted").all()
     answers = pd.read_csv(folder / "answers.csv.gz")
-    sub = answers[answers.solver == "my-fk"].sort_values("query")
+    sub = answers[answers.solver == "my-fk"].sort_values("pose")
     assert len(sub) == 3 and sub["position_m"].iloc[0] >= 1e-3 - 1e-9
     rung = f"success_{rung_label(LADDER[2])}"         # 1e-5 m: the 1 mm spoilt answer fails it
     assert (mine[rung] <= 2 / 3 + 1e-12).all()

@@ -68,16 +68,16 @@ def _interrupted(tmp_path, command, config, *extra):
     return p.returncode, err, cfg, out
 
 
-def test_ctrl_c_of_a_fresh_experiment_names_a_rerun_and_leaves_no_empty_folder(tmp_path):
+def test_ctrl_c_of_a_fresh_experiment_names_the_command_that_resumes_it(tmp_path):
     code, err, cfg, out = _interrupted(tmp_path, "run", {
         "name": "slow", "paper": "mine", "mechanism": {"name": "3-rps"}, "seed": 1,
         "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}], "algorithms": [{"name": "abc"}, {"name": "pso"}],
         "population": 40, "iterations": 3000, "runs": 60})
     assert code == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err[-500:]
-    assert f"an experiment keeps no finished tasks: fkopt run {cfg} --out {out} starts it again" in err
-    assert "--resume" not in err
-    assert not (out / "mine").exists()          # no empty OUT/<paper>/ left behind
-    assert not out.exists() or not any(out.iterdir())
+    # experiments keep their finished tasks like studies and suites (issue 39)
+    assert f"the finished tasks of this experiment are kept: fkopt run {cfg} --out {out} --resume continues" in err
+    assert (out / "mine" / ".slow.partial").is_dir()      # what --resume reuses
+    assert not (out / "mine" / "slow").exists()
 
 
 def test_ctrl_c_of_a_study_names_the_command_that_resumes_it(tmp_path):
@@ -96,7 +96,7 @@ def test_resume_hint_names_the_suite_command_with_its_tier():
     suite = SimpleNamespace(kind="suite")
     assert resume_hint("suite", "s.yaml", suite, DEFAULT_OUT, quick=True) == \
         "the finished tasks of this suite are kept: fkopt suite s.yaml --quick --resume continues"
-    assert resume_hint("run", "a.yaml", SimpleNamespace(kind="assembly"), Path("o")) == \
+    assert resume_hint("run", "a.yaml", SimpleNamespace(kind="assembly"), Path("o"), stored=False) == \
         "an assembly keeps no finished tasks: fkopt run a.yaml --out o starts it again"
 
 

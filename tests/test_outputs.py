@@ -71,8 +71,8 @@ def test_a_new_output_is_one_line(tmp_path, monkeypatch):
     from fkopt.kinds.experiment.config import experiment_from_dict
 
     def extra_table(er):
-        return pd.DataFrame({"case": [r.case.label for r in er.records],
-                             "best": [float(r.result.fitness.min()) for r in er.records]})
+        return pd.DataFrame({"case": [r.case.label for r in er.own.solves],
+                             "best": [float(r.result.fitness.min()) for r in er.own.solves]})
     experiment = KINDS["experiment"]
     monkeypatch.setitem(KINDS, "experiment", dataclasses.replace(
         experiment, outputs=experiment.outputs + (outputs.Output("extra.csv", extra_table, outputs.TABLE),)))

@@ -292,8 +292,8 @@ def test_tracking_warm_starts_from_previous_solution(tmp_path):
     res = run_study(config, tmp_path)
     runs = pd.read_csv(res.folder / "runs.csv")
     names = ("alpha", "beta", "z")
-    centre = res.mechanism.bounds.mean(axis=1)
-    width = res.mechanism.bounds[:, 1] - res.mechanism.bounds[:, 0]
+    centre = res.own.mechanism.bounds.mean(axis=1)
+    width = res.own.mechanism.bounds[:, 1] - res.own.mechanism.bounds[:, 0]
     for algo in ("lm", "gabc"):
         d = runs[runs.algorithm == algo].sort_values(["run", "pose"])
         for _, g in d.groupby("run"):
@@ -353,7 +353,7 @@ def test_tracking_several_trajectories_report(tmp_path):
     assert (res.folder / "tracking.png").exists()
     runs = pd.read_csv(res.folder / "runs.csv")
     first = runs[(runs.algorithm == "lm") & (runs.pose == 6)]     # trajectory 1, step 0: from the centre
-    centre = res.mechanism.bounds.mean(axis=1)
+    centre = res.own.mechanism.bounds.mean(axis=1)
     np.testing.assert_array_equal(first[["start_alpha", "start_beta", "start_z"]].to_numpy(),
                                   np.broadcast_to(centre, (2, 3)))
 

@@ -96,8 +96,8 @@ def test_yaml_file_path_is_relative_to_the_config_folder(tmp_path, monkeypatch):
     (sub / "rp.yaml").write_text(yaml.safe_dump(cfg))
     monkeypatch.chdir(tmp_path)            # not the config's folder
     er = run_experiment(load_config(sub / "rp.yaml"))
-    assert er.mechanism.bounds[0].tolist() == [-90.0, 90.0]
-    assert er.records[0].result.fitness[0] < 1e-8
+    assert er.own.mechanism.bounds[0].tolist() == [-90.0, 90.0]
+    assert er.own.solves[0].result.fitness[0] < 1e-8
     assert DEFAULT_FILE.is_file()
 
 

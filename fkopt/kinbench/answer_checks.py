@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.files import csv_numbers
+from fkopt.kinbench.clock import ANSWER_COLUMNS  # noqa: F401 (the one list of answers columns)
 
 #: Relative tolerance of recomputed floats against the stored CSV's (written with 10 digits;
 #: answers with 17).
@@ -30,11 +31,6 @@ def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         return same_inf | np.isclose(a, b, rtol=RTOL, atol=1e-12)
 
-#: The columns of every answers row (:func:`fkopt.kinbench.clock.answer_rows`, ``set`` added by
-#: the runner), before the answer's own ``q0..`` / ``x0..``.
-ANSWER_COLUMNS = ("robot", "set", "query", "solver", "entry", "source", "given_timeout_ms", "seconds",
-                  "cpu_seconds", "reference_seconds", "claimed", "position_m", "rotation_rad", "in_limits",
-                  "leg_residual", "not_applicable")
 RULE = "one answer per (query, solver, timeout) the config implies"
 
 
@@ -48,11 +44,11 @@ def key_problems(g: pd.DataFrame, robot: str, n: int, solvers, timeouts, optiona
     if extra:
         return f"{robot}: answers of solver '{str(extra[0])[:40]}', which the config does not run on it " \
                f"(it runs {', '.join(allowed)})"
-    query = csv_numbers(g["query"])
+    query = csv_numbers(g["pose"])
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(query) | (query < 0) | (query >= n) | (query % 1 != 0)
     if bad.any():
-        return f"{robot}: query {g['query'].astype(str).iloc[int(np.flatnonzero(bad)[0])][:30]} is not a query " \
+        return f"{robot}: pose {g['pose'].astype(str).iloc[int(np.flatnonzero(bad)[0])][:30]} is not a query " \
                f"of the track (0..{n - 1})"
     given = csv_numbers(g["given_timeout_ms"])
     for name in allowed:
@@ -129,7 +125,7 @@ def clock_record_problem(task, rec: dict) -> str | None:
         if any(isinstance(v, (dict, list)) for v in answers[col]):
             return f"answers.{col}: not a column of plain values"
     g = pd.DataFrame(answers)
-    for col, want in (("robot", robot), ("set", clock.set), ("source", "run")):
+    for col, want in (("problem", robot), ("set", clock.set), ("source", "run")):
         wrong = g[col] != want
         if wrong.any():
             return f"answers.{col}: row {int(np.flatnonzero(wrong)[0])} is not {want!r}"
@@ -155,14 +151,14 @@ def clock_record_problem(task, rec: dict) -> str | None:
                                  for c in cols[len(ANSWER_COLUMNS):])), None))
     if why:
         return why
-    q = g["query"].to_numpy(int)
+    q = g["pose"].to_numpy(int)
     answer = g[cols[len(ANSWER_COLUMNS):]].to_numpy(float)
     v = verdicts(arm, answer, queries[q], targets_of(arm, queries[q]))
     for col in ("position_m", "rotation_rad", "leg_residual", "in_limits"):
         bad = ~_close(g[col].to_numpy(float), np.asarray(v[col], float))
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
-            return f"answers.{col}: row {k} ({g['solver'].iloc[k]}, query {q[k]}) is {g[col].iloc[k]!r}, " \
+            return f"answers.{col}: row {k} ({g['solver'].iloc[k]}, pose {q[k]}) is {g[col].iloc[k]!r}, " \
                    f"recomputed from its answer {np.asarray(v[col])[k]!r}"
     return _throughput_problem(config, arm, robot, rec.get("throughput"))
 

@@ -194,16 +194,29 @@ def _clock_loop(runs, targets, seed, robot, j_ref, reference_repeats, answers, s
                 ref_seconds[i] = min(ref_seconds[i], dt)
 
 
-def answer_rows(mechanism, robot: str, solver: str, entry: str, source: str, query, given_timeout_ms, seconds,
+#: The columns of every answers row (``answers.csv.gz``, a clock-track task file), before the
+#: answer's own ``q0..`` / ``x0..``: the run record's names where they mean the same thing
+#: (``problem``: the arm or parallel mechanism, ``pose``: the query's index in the set, from 0;
+#: :mod:`fkopt.run.record`). ``set`` is added by the suite's track task
+#: (:func:`fkopt.kinbench.runner.solve_track`) and by a submission's reader.
+ANSWER_COLUMNS = ("problem", "set", "pose", "solver", "entry", "source", "given_timeout_ms", "seconds",
+                  "cpu_seconds", "reference_seconds", "claimed", "position_m", "rotation_rad", "in_limits",
+                  "leg_residual", "not_applicable")
+#: What those columns were called before issue 39 (an answers file written then: re-store the board).
+OLD_ANSWER_COLUMNS = {"robot": "problem", "query": "pose"}
+
+
+def answer_rows(mechanism, problem: str, solver: str, entry: str, source: str, pose, given_timeout_ms, seconds,
                 reference_seconds, claimed, answers: np.ndarray, queries: np.ndarray,
                 targets: np.ndarray, *, cpu_seconds=np.nan, not_applicable: str = "") -> pd.DataFrame:
-    """One solver's answers on one arm (IK) or parallel mechanism (FK) as answers rows, each
-    judged by kinbench (:func:`verdicts`), never by what the solver says: the rows of
-    :func:`run_clock` (``source`` = run) and of a submission (``source`` = submitted).
-    ``cpu_seconds``: the call's CPU time (NaN for a submission); ``not_applicable``: why the
-    package cannot take this arm (its rows hold no answer, and the board a "not applicable" cell)."""
+    """One solver's answers on one arm (IK) or parallel mechanism (FK) ``problem`` as answers
+    rows (:data:`ANSWER_COLUMNS`; ``pose``: the queries' indices), each judged by kinbench
+    (:func:`verdicts`), never by what the solver says: the rows of :func:`run_clock` (``source``
+    = run) and of a submission (``source`` = submitted). ``cpu_seconds``: the call's CPU time
+    (NaN for a submission); ``not_applicable``: why the package cannot take this arm (its rows
+    hold no answer, and the board a "not applicable" cell)."""
     v = verdicts(mechanism, answers, queries, targets)
-    frame = pd.DataFrame({"robot": robot, "query": query, "solver": solver, "entry": entry, "source": source,
+    frame = pd.DataFrame({"problem": problem, "pose": pose, "solver": solver, "entry": entry, "source": source,
                           "given_timeout_ms": given_timeout_ms, "seconds": seconds, "cpu_seconds": cpu_seconds,
                           "reference_seconds": reference_seconds, "claimed": claimed,
                           "position_m": v["position_m"], "rotation_rad": v["rotation_rad"],
@@ -242,19 +255,19 @@ def clock_board(answers: pd.DataFrame, *, timeouts_ms=TIMEOUTS_MS, reference: st
     ``leg_residual``) also get ``other_mode``: the share of answers within the timeout whose legs
     solve the equations to the rung's tolerance in another assembly mode."""
     rows = []
-    for robot, a in answers.groupby("robot", sort=False):
+    for robot, a in answers.groupby("problem", sort=False):     # the board's rows are per robot
         ref_name = reference.get(robot, REFERENCE) if isinstance(reference, dict) else reference
         ref = a[a["solver"] == ref_name]
-        ref_ms = 1e3 * float(ref.groupby("query")["seconds"].first().median()) if len(ref) else np.nan
+        ref_ms = 1e3 * float(ref.groupby("pose")["seconds"].first().median()) if len(ref) else np.nan
         for name, s in a.groupby("solver", sort=False):
             why = _not_applicable(s)
             for t in timeouts_ms:
                 if why:
                     rows.append({"solver": name, "robot": robot, "timeout_ms": t, "entry": entry_of(name),
-                                 "queries": int(s["query"].nunique()), "not_applicable": why, "reference": ref_name,
+                                 "queries": int(s["pose"].nunique()), "not_applicable": why, "reference": ref_name,
                                  "reference_ms_median": ref_ms, "source": s["source"].iloc[0] if "source" in s else "run"})
                     continue
-                g = s[s["given_timeout_ms"].isna() | (s["given_timeout_ms"] == t)].sort_values("query")
+                g = s[s["given_timeout_ms"].isna() | (s["given_timeout_ms"] == t)].sort_values("pose")
                 ok = rung_success(g, ladder) & (g["seconds"].to_numpy() <= t / 1e3)[:, None]
                 tta = np.where(ok[:, rung], g["seconds"].to_numpy(), t / 1e3)
                 ratio = tta / g["reference_seconds"].to_numpy()

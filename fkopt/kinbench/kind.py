@@ -3,11 +3,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fkopt.kinbench import pages, reports, traces
+from fkopt.kinbench import pages, reports
 from fkopt.run.kinds import register
 from fkopt.run.tasks import Kind
 from fkopt.run.tasks import work_folder  # noqa: F401 (where a suite's task files live; tests)
-from fkopt.run.writers import CURVES, FIGURE, RUNS, STEPS, TABLE, TIMING, Output
+from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, TRACE_FILE, Output
 from fkopt.kinbench.config import SuiteConfig, suite_from_dict
 from fkopt.kinbench.runner import merge_suite, suite_plan, validate_suite
 
@@ -26,8 +26,8 @@ OUTPUTS = (
     Output("scaling.csv", reports.scaling_table, TABLE),      # classes of several dimensions only
     Output("ert_ratio.csv", reports.ert_ratio_table, TABLE),  # suites with subsets (v3) only
     Output("ecdf.csv", reports.ecdf_table, CURVES, rows=STEPS),
-    Output("runs.csv", reports.runs_table, CURVES, rows=RUNS),
-    Output("trace.csv.gz", traces.trace_table, CURVES, rows=STEPS),
+    RUNS_FILE,
+    TRACE_FILE,
     Output("timing.csv", reports.timing_table, TIMING),
     # kinbench v3's tracks on the clock: wall times (and TRAC-IK's wall-clock outcomes) vary
     Output("answers.csv.gz", reports.answers_table, TIMING, float_format="%.17g"),
@@ -40,4 +40,10 @@ OUTPUTS = (
     Output("index.html", pages.html_page, FIGURE),     # and arms.html, rankings.html (kinbench.pages)
 )
 
-SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig))
+def _console(result, folder: Path) -> list[str]:
+    """After a run: the files to open, then the board's top lines."""
+    return [": leaderboard.md, index.html", *reports.board_top_lines(folder)]
+
+
+SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig,
+                      _console))

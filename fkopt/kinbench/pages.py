@@ -32,6 +32,7 @@ from fkopt.errors import FkoptError
 from fkopt.files import parse_json, read_stored, read_stored_csv
 from fkopt.run.kinds import KINDS
 from fkopt.kinbench import html as H
+from fkopt.kinbench.runner import SuiteOwn
 
 #: Every page's size in bytes stays below this (issue 37: a page loads in a moment).
 PAGE_LIMIT = 500_000
@@ -483,9 +484,9 @@ def stored_suite(folder: str | Path):
             if "better_than" in df:
                 df["better_than"] = df["better_than"].fillna("")
             tables[out.file] = df
+    own = SuiteOwn(files=folder, answers=tables.get("answers.csv.gz"), throughput=tables.get("throughput.csv"))
     sr = SimpleNamespace(config=config, meta=meta, env=env if isinstance(env, dict) else {},
-                         runs=tables.get("runs.csv"), answers=tables.get("answers.csv.gz"),
-                         throughput=tables.get("throughput.csv"), files=folder, source=meta.get("config_file"))
+                         record=tables.get("runs.csv"), own=own, source=meta.get("config_file"))
     return sr, tables
 
 
@@ -500,7 +501,7 @@ def regenerate(folder: str | Path, figures: bool = True) -> list[str]:
     for out in OUTPUTS:
         if out.role != FIGURE or out.file in ("leaderboard.md", INDEX):
             continue
-        if figures and sr.runs is not None:
+        if figures and sr.record is not None:
             written += out.make(sr, folder, tables)
     return written + write_pages(sr, folder, tables)
 

@@ -30,9 +30,9 @@ def suite_boards(sr) -> list[tuple[str | None, pd.DataFrame]]:
     all its solvers ran (:func:`fkopt.kinbench.measures.boards`). Cut once per result: every
     table and the ECDF figures ask for them."""
     got = sr.__dict__.get("_boards")
-    if got is None or got[0] is not sr.runs:
-        boards = [(None, sr.runs)] if not sr.config.subsets else M.boards(sr.runs, sr.config.board_cells())
-        got = sr.__dict__["_boards"] = (sr.runs, boards)
+    if got is None or got[0] is not sr.record:
+        boards = [(None, sr.record)] if not sr.config.subsets else M.boards(sr.record, sr.config.board_cells())
+        got = sr.__dict__["_boards"] = (sr.record, boards)
     return got[1]
 
 
@@ -60,11 +60,6 @@ def _per_board(sr, table, column: str) -> pd.DataFrame | None:
                 t.insert(0, "board", name)
         frames.append(t)
     return pd.concat(frames, ignore_index=True) if frames else None
-
-
-def runs_table(sr) -> pd.DataFrame:
-    """One row per run: the run record's (:func:`fkopt.run.record.runs_table`)."""
-    return record.runs_table(sr.record)
 
 
 def measures_table(sr) -> pd.DataFrame:
@@ -109,14 +104,19 @@ def scaling_target(targets) -> float:
 def answers_table(sr) -> pd.DataFrame | None:
     """answers.csv.gz: every answer of the clock track (joints q0.., wall time, claim, and
     fkopt's verdict), so anyone can re-verify the board."""
-    return getattr(sr, "answers", None)
+    return sr.own.answers
 
 
 def throughput_table(sr) -> pd.DataFrame | None:
-    return getattr(sr, "throughput", None)
+    return sr.own.throughput
 
 
 def robots_board_table(sr) -> pd.DataFrame | None:
+    """leaderboard-robots.csv of a suite's result (:func:`robots_board` of its clock-track answers)."""
+    return robots_board(sr.config, sr.own.answers, sr.own.throughput)
+
+
+def robots_board(config, answers: pd.DataFrame | None, tp: pd.DataFrame | None) -> pd.DataFrame | None:
     """leaderboard-robots.csv: per (solver, robot, timeout) the success share at every rung of
     the ladder within the timeout, the time to an answer at the track's rung (median/p95, ms
     and as a ratio to the reference on the same query), the throughput at the largest batch
@@ -125,20 +125,18 @@ def robots_board_table(sr) -> pd.DataFrame | None:
     then by median ratio."""
     from fkopt.kinbench.clock import clock_board
     from fkopt.kinbench.physical import LADDER, rung_label
-    answers = getattr(sr, "answers", None)
     if answers is None or answers.empty:
         return None
-    clock = sr.config.tracks.clock
-    fk = answers.groupby("robot", sort=False)["leg_residual"].apply(lambda v: v.notna().any())
+    clock = config.tracks.clock
+    fk = answers.groupby("problem", sort=False)["leg_residual"].apply(lambda v: v.notna().any())
     parts = []
     for is_fk, timeouts, reference in ((False, clock.timeouts_ms, clock.reference),
                                        (True, clock.fk_timeouts_ms, clock.fk_reference)):
         robots = [r for r, f in fk.items() if bool(f) == is_fk]
         if robots:
-            parts.append(clock_board(answers[answers["robot"].isin(robots)], timeouts_ms=tuple(timeouts),
+            parts.append(clock_board(answers[answers["problem"].isin(robots)], timeouts_ms=tuple(timeouts),
                                      reference=reference, rung=clock.rung))
     board = pd.concat(parts, ignore_index=True)
-    tp = getattr(sr, "throughput", None)
     board["throughput_batch"], board["throughput_qps"], board["throughput_ratio"] = np.nan, np.nan, np.nan
     if tp is not None and not tp.empty:
         top = tp.sort_values("batch").groupby(["solver", "robot"], sort=False).last()
@@ -206,7 +204,7 @@ def pooled_clock_curves(answers: pd.DataFrame, clock) -> tuple[list, float, int]
     from fkopt.kinbench.clock import rung_success
     ik = answers
     if "leg_residual" in answers:           # FK of parallel mechanisms: another ladder of timeouts
-        fk = answers.groupby("robot", sort=False)["leg_residual"].transform(lambda v: v.notna().any())
+        fk = answers.groupby("problem", sort=False)["leg_residual"].transform(lambda v: v.notna().any())
         ik = answers[~fk.to_numpy(bool)]
     t = max(clock.timeouts_ms)
     a = ik[(ik["given_timeout_ms"].isna() | (ik["given_timeout_ms"] == t)) & (ik["source"] == "run")]
@@ -214,10 +212,10 @@ def pooled_clock_curves(answers: pd.DataFrame, clock) -> tuple[list, float, int]
     a = a.assign(_ms=np.where(ok, 1e3 * a["seconds"].to_numpy(), np.inf))
     curves = []
     for solver, g in a.groupby("solver", sort=False):
-        per_query = g.groupby(["robot", "query"])["_ms"].min()
-        curves.append((solver, per_query, g["robot"].nunique()))
-    curves.append(("virtual best", a.groupby(["robot", "query"])["_ms"].min(), a["robot"].nunique()))
-    return curves, t, a["robot"].nunique()
+        per_query = g.groupby(["problem", "pose"])["_ms"].min()
+        curves.append((solver, per_query, g["problem"].nunique()))
+    curves.append(("virtual best", a.groupby(["problem", "pose"])["_ms"].min(), a["problem"].nunique()))
+    return curves, t, a["problem"].nunique()
 
 
 def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
@@ -235,17 +233,17 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     clock = sr.config.tracks.clock
     pyplot = plt()
     names = []
-    stems = file_names(answers["robot"].unique(), reserved=("all",))   # distinct robots, and clock_all
-    for robot, a in answers.groupby("robot", sort=False):
+    stems = file_names(answers["problem"].unique(), reserved=("all",))   # distinct robots, and clock_all
+    for robot, a in answers.groupby("problem", sort=False):
         fk = a["leg_residual"].notna().any()
         t = max(clock.fk_timeouts_ms if fk else clock.timeouts_ms)
         a = a[(a["given_timeout_ms"].isna() | (a["given_timeout_ms"] == t)) & (a["source"] == "run")]
-        n = a["query"].nunique()
+        n = a["pose"].nunique()
         ok = rung_success(a)[:, clock.rung] & (a["seconds"].to_numpy() <= t / 1e3)
         ms = np.where(ok, 1e3 * a["seconds"].to_numpy(), np.inf)
         a = a.assign(_ms=ms)
-        curves = [(solver, g.groupby("query")["_ms"].min(), n) for solver, g in a.groupby("solver", sort=False)]
-        curves.append(("virtual best", a.groupby("query")["_ms"].min(), n))
+        curves = [(solver, g.groupby("pose")["_ms"].min(), n) for solver, g in a.groupby("solver", sort=False)]
+        curves.append(("virtual best", a.groupby("pose")["_ms"].min(), n))
         fig = _clock_figure(pyplot, curves, t, f"share of {n} queries",
                             f"{sr.config.name}: {robot}, answers right at {rung_words(rung_label(LADDER[clock.rung]))} "
                             "(kinbench's FK)")
@@ -565,28 +563,28 @@ def leaderboard_markdown(sr, folder: Path, tables: dict) -> list[str]:
 
 def meta(sr) -> dict:
     c = sr.config
-    manifest = sr.manifest or {}
+    manifest = sr.own.manifest or {}
     canonical = hashlib.sha256(json.dumps(manifest, sort_keys=True).encode()).hexdigest()
     return {"kind": "suite", "name": c.name, "paper": c.paper, "config": c.stored_dump(),
             "config_file": sr.source,
             "pose_sets": {"version": manifest.get("version"), "manifest_canonical_sha256": canonical},
-            "outside": {o.solver: digest(c, o, sr.files) for o in c.outside},
+            "outside": {o.solver: digest(c, o, sr.own.files) for o in c.outside},
             "measures": "fkopt.kinbench.measures (COCO: success rate, ERT, ECDF; bootstrap ranking, Holm)",
-            **board_meta(sr), **submissions_meta(c, sr.files)}
+            **board_meta(sr), **submissions_meta(c, sr.own.files)}
 
 
 def board_meta(sr) -> dict:
     """meta.json's record of a per-robot board (only for a suite with a clock track): its frozen
     board version (:data:`fkopt.kinbench.releases.BOARDS`), the machine's load averages at the
     clock track's start and end, and every entry's settings."""
-    if getattr(sr, "answers", None) is None:
+    if sr.own.answers is None:
         return {}
     from fkopt.kinbench.releases import board_version
     out = {"board_version": board_version(sr.config.name)}
-    if getattr(sr, "load_avg", None):
-        out["load_avg"] = sr.load_avg
-    if getattr(sr, "entries", None):
-        out["entries"] = sr.entries
+    if sr.own.load_avg:
+        out["load_avg"] = sr.own.load_avg
+    if sr.own.entries:
+        out["entries"] = sr.own.entries
     return {k: v for k, v in out.items() if v is not None}
 
 

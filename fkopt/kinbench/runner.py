@@ -30,6 +30,7 @@ import pandas as pd
 
 from fkopt.errors import FkoptError
 from fkopt.run.record import BATCH, concat, run_record, timing_record
+from fkopt.run.result import RunResult
 from fkopt.run.config_base import RunConfig, files_folder
 from fkopt.run.solving import make_problem, solve_cases, start_point, task_seed
 from fkopt.run.tasks import Plan, Ran, Task, run_tasks
@@ -55,24 +56,17 @@ def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
 
 
 @dataclass
-class SuiteResult:
-    config: SuiteConfig
-    record: pd.DataFrame                 # the run record (:mod:`fkopt.run.record`): one row per (problem, set, pose, solver, run)
-    timing: pd.DataFrame                 # the timing record (:mod:`fkopt.run.record`): one batch per (problem, solver)
-    manifest: dict
-    wall_s: float
-    source: str | None = None
-    trace: pd.DataFrame | None = None    # trace.csv.gz: each run's best-so-far within the budget
+class SuiteOwn:
+    """What only a suite has (the :attr:`fkopt.run.result.RunResult.own` slot): its pose sets'
+    manifest, where its relative files are, and the clock track's answers and throughput with the
+    load averages and entries' settings meta.json records (kinbench v3)."""
+
+    manifest: dict | None = None
     files: Path | None = None            # where its relative files are (pose sets, outside logs)
     answers: pd.DataFrame | None = None  # answers.csv.gz: every answer of the clock track (v3)
     throughput: pd.DataFrame | None = None   # throughput.csv: queries/s per batch size (v3)
     load_avg: dict | None = None         # the load averages at the clock track's start and end (meta.json)
     entries: dict | None = None          # the clock track's entries' settings (meta.json)
-
-    @property
-    def runs(self) -> pd.DataFrame:
-        """The run record (what the measures, the ECDF and the leaderboard are computed from)."""
-        return self.record
 
 
 def _cases(config: SuiteConfig, sets: dict, problem, solver=None):
@@ -391,8 +385,10 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
                 name=f"suite '{config.name}'")
 
 
-def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> SuiteResult:
-    """The run rows of every task, then the imported outside results, and the timing table."""
+def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> RunResult:
+    """The suite's :class:`~fkopt.run.result.RunResult`: the run rows of every task, then the
+    imported outside results, the timing record, the trace, and the clock track's answers
+    (:class:`SuiteOwn`)."""
     merging = time.perf_counter()
     ctx: _Context = plan.context
     done = [{**ran.records[t.id], "rows": rows_of(ran.records[t.id])} for t in plan.tasks
@@ -420,13 +416,13 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     for r in tracked:
         for solver, st in (r.get("settings") or {}).items():
             entries.setdefault(solver, {k: v for k, v in st.items() if k not in ("urdf", "urdf_note", "family")})
-    return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
-                       suite_trace(config, done, runs, ctx.files), ctx.files, answers, throughput, load_avg,
-                       entries or None)
+    own = SuiteOwn(ctx.manifest, ctx.files, answers, throughput, load_avg, entries or None)
+    return RunResult(config, runs, tim, suite_trace(config, done, runs, ctx.files), own, wall, source,
+                     list(ran.computed))
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,
-              executor: str = "local", scheduler: str | None = None) -> SuiteResult:
+              executor: str = "local", scheduler: str | None = None) -> RunResult:
     """Every (problem, solver) task computed (no task files, nothing written), then the
     imported outside results: the suite's result (``fkopt suite`` runs it through
     :func:`fkopt.run.pipeline.run_config`, which keeps task files and resumes)."""

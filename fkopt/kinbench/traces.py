@@ -36,7 +36,7 @@ from fkopt.errors import FkoptError
 from fkopt.run.trace import FILE, run_trace
 from fkopt.kinbench.budget import budget_of, last_within
 
-__all__ = ["FILE", "COLUMNS", "budget_trace", "task_trace", "outside_trace", "suite_trace", "trace_table"]
+__all__ = ["FILE", "COLUMNS", "budget_trace", "task_trace", "outside_trace", "suite_trace"]
 
 COLUMNS = ("problem", "set", "pose", "solver", "run", "evaluations", "best_fitness")
 #: the columns that name a run
@@ -117,8 +117,3 @@ def suite_trace(config, done: list[dict], runs: pd.DataFrame, files=None) -> pd.
     if not frames:
         return pd.DataFrame(columns=list(COLUMNS))
     return pd.concat(frames, ignore_index=True)[list(COLUMNS)]
-
-
-def trace_table(sr) -> pd.DataFrame | None:
-    """``trace.csv.gz`` of a :class:`~fkopt.kinbench.runner.SuiteResult`."""
-    return sr.trace

@@ -11,12 +11,12 @@ solver never earned.
 from __future__ import annotations
 
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 
 from fkopt.kinbench.answer_checks import RTOL, _close  # noqa: F401 (RTOL: the recomputation's tolerance)
+from fkopt.kinbench.clock import OLD_ANSWER_COLUMNS
 
 
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
@@ -30,18 +30,23 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
     from fkopt.kinbench.clock import answer_prefix, targets_of, track_arm, track_cases, track_settings, verdicts
     from fkopt.kinbench.posesets import load_pose_sets
-    from fkopt.kinbench.reports import robots_board_table
+    from fkopt.kinbench.reports import robots_board
     folder = Path(folder)
     if config.tracks is None or config.tracks.clock is None:
         return []
     clock = config.tracks.clock
     try:
-        answers = read_stored_csv(folder, "answers.csv.gz", dtype={"robot": str, "solver": str})
+        answers = read_stored_csv(folder, "answers.csv.gz", dtype={"problem": str, "robot": str, "solver": str})
     except FkoptError as err:
         missing = not (folder / "answers.csv.gz").exists() and not (folder / "answers.csv.gz").is_symlink()
         return [("answers.csv.gz", "-", "file", "missing" if missing else str(err), None,
                  "every answer of the clock track, read to recompute the board")]
-    lacking = [c for c in ("robot", "query", "solver", "given_timeout_ms", "position_m", "rotation_rad",
+    old = [c for c in OLD_ANSWER_COLUMNS if c in answers.columns and OLD_ANSWER_COLUMNS[c] not in answers.columns]
+    if old:       # written before the record's names (issue 39): one line, never a KeyError
+        return [("answers.csv.gz", "-", "columns", ", ".join(old),
+                 ", ".join(OLD_ANSWER_COLUMNS[c] for c in old),
+                 "answers written before the columns were renamed to the run record's names: re-store this board")]
+    lacking = [c for c in ("problem", "pose", "solver", "given_timeout_ms", "position_m", "rotation_rad",
                            "leg_residual", "in_limits") if c not in answers.columns]
     if lacking:
         return [("answers.csv.gz", "-", lacking[0], "missing", None, "a column of every answers row")]
@@ -52,7 +57,7 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     rule = "recomputed from the stored answer with fkopt's FK"
     submitted = [s.solver for s in clock.submissions]
     for robot in clock.problems:                         # every robot of the track answered, counted
-        g = answers[answers["robot"] == robot]
+        g = answers[answers["problem"] == robot]
         mech = track_arm(config, index[robot])
         Q = queries[index[robot]]
         _, _, timeouts = track_settings(clock, mech)
@@ -60,7 +65,7 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
         if why:
             out.append(("answers.csv.gz", robot, "answers", why, None, RULE))
             continue
-        q = csv_numbers(g["query"]).astype(int)          # range-checked by key_problems
+        q = csv_numbers(g["pose"]).astype(int)          # range-checked by key_problems
         cols = [f"{answer_prefix(mech)}{d}" for d in range(Q.shape[1])]
         if any(c not in g.columns for c in cols):
             out.append(("answers.csv.gz", robot, cols[0], "missing", None, "the answer's columns"))
@@ -72,17 +77,17 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
             bad = ~_close(stored, np.asarray(v[col], float))
             for k in np.flatnonzero(bad)[:3]:
                 r = g.iloc[k]
-                out.append(("answers.csv.gz", f"{robot}/{r['solver']}/query {r['query']}", col, r[col],
+                out.append(("answers.csv.gz", f"{robot}/{r['solver']}/pose {r['pose']}", col, r[col],
                             np.asarray(v[col])[k], rule))
-    strays = sorted(set(answers["robot"].astype(str)) - set(clock.problems))
+    strays = sorted(set(answers["problem"].astype(str)) - set(clock.problems))
     if strays:
-        out.append(("answers.csv.gz", strays[0][:40], "robot", strays[0][:40], None,
+        out.append(("answers.csv.gz", strays[0][:40], "problem", strays[0][:40], None,
                     "a problem of tracks.clock.problems"))
     if out:
         return out          # the board of uncounted or misjudged answers means nothing
     try:
         throughput = read_stored_csv(folder, "throughput.csv") if (folder / "throughput.csv").exists() else None
-        board = robots_board_table(SimpleNamespace(config=config, answers=answers, throughput=throughput))
+        board = robots_board(config, answers, throughput)
         key = ["solver", "robot", "timeout_ms"]
         if board is None:
             return out

@@ -99,7 +99,7 @@ def solve_in_parallel(planned: list[Planned], jobs: int,
     items = []
     for i, p in enumerate(planned):
         plan = p.plan if p.plan is not None else config_kind(p.config).plan(p.config, str(p.path))
-        if plan.anywhere and not plan.stored:
+        if plan.anywhere:
             items += [(_cost(p.config) / len(plan.tasks), i, (plan.solve, t.id, t.payload)) for t in plan.tasks]
     if len({i for _, i, _ in items}) < 2:
         return {}

@@ -215,6 +215,7 @@ def _run_locked(kind: Kind, plan: Plan, config, out, folder: Path, *, source, pr
     ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, store=store, resume=resume,
                     progress=progress, done=solved)
     result = kind.merge(config, plan, ran, source=source, timing=True, folder=folder)
+    result.folder = folder
     wall = getattr(result, "wall_s", None)        # the kind's own account (solves made elsewhere too)
     wall = time.perf_counter() - start if wall is None else wall
 

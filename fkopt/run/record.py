@@ -15,7 +15,7 @@ class                       str       a suite problem's class (``parallel-fk-3do
 set                         str       a suite's pose set (``uniform``, ``near-singular``, ...)
 case                        str       an experiment's case label (``case-1``, ``random-3``, ...)
 pose                        int64     index of the pose in its pose set or case list, **from 0**
-                                      (the index the seed rule :func:`~fkopt.kinds.experiment.runner.task_seed` takes)
+                                      (the index the seed rule :func:`~fkopt.run.solving.task_seed` takes)
 solver                      str       the algorithm/solver entry's label (its key)
 track                       str       a suite solver's track (``black-box``, ``jacobian``, ``exact``)
 run                         int64     run index, from 0 (the run's stream: :mod:`fkopt.numerics.streams`)
@@ -49,9 +49,15 @@ from it (:mod:`fkopt.kinbench.measures`). Measured times are a second table next
 timing record (:data:`TIMING_COLUMNS`), which :func:`timing_table` and
 :func:`timing_runs_table` write for every kind.
 
-Still read from a kind's own arrays: an experiment's values, inputs, convergence and trace
-files and its figures (per-iteration histories, which the flat record does not hold), a study's
-poses/heatmap/tracking tables and figures (per-pose medians), an assembly's solutions.
+Every worker returns JSON (a task file): an experiment's and a suite's solve task its rows of the
+record (columns of lists) and trace, a study's task the same numbers under the names its stored
+task files use (per pose and run), a clock-track task its answers, an assembly search its
+solutions; every kind's merge puts the record in one :class:`~fkopt.run.result.RunResult`, so a study's
+poses/heatmap/tracking tables are read from the record too. Still read from a kind's own slot
+(``RunResult.own``): an experiment's inputs, its values, convergence table and figures (the
+per-iteration curves of each (case, algorithm), which the flat record does not hold, and its
+median and best runs' points), a study's pose set (points, grid, trajectories), an assembly's
+solutions, a suite's clock-track answers.
 """
 from __future__ import annotations
 

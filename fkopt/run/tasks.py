@@ -8,8 +8,8 @@ process, a local worker process or on a Dask worker; :mod:`.executors`). A task'
 depend on where or next to what it ran: each carries its own seeds.
 
 :func:`run_tasks` runs the tasks a caller has not already computed and hands every record to
-``progress``. With a :class:`TaskStore` (the kinds whose plans say ``stored``: studies and
-suites) each finished record is written at once as ``tasks/<task id>.json`` in the hidden work
+``progress``. With a :class:`TaskStore` (the kinds whose plans say ``stored``: experiments,
+studies and suites) each finished record is written at once as ``tasks/<task id>.json`` in the hidden work
 folder ``OUT/<paper>/.<name>.partial/`` (:func:`work_folder`; a temporary file renamed into
 place, so a file is complete or absent), with its SHA-256 in ``tasks/manifest.json``. An
 interrupted run therefore loses at most the tasks that were running, and ``resume=True`` keeps
@@ -91,7 +91,8 @@ class Kind:
     plan: Callable[..., Plan]
     #: (config, plan) -> estimated bytes of the run, from what the plan built (nothing built again)
     validate: Callable[[Any, Plan], int]
-    #: (config, plan, ran, source=, timing=, folder=) -> the result object the writers read
+    #: (config, plan, ran, source=, timing=, folder=) -> the :class:`fkopt.run.result.RunResult`
+    #: the writers read (what only this kind has in its ``own`` slot)
     merge: Callable[..., Any]
     #: the files of its results folder, in the order they are written (:class:`fkopt.run.writers.Output`,
     #: function objects: tables before the figures drawn from them)
@@ -100,6 +101,9 @@ class Kind:
     meta: Callable[[Any], dict] | None = None
     #: the pydantic model of its file (the config reference, fkopt.run.config_reference)
     model: type | None = None
+    #: (result, folder) -> what the command line prints after a run: a summary table, or lines
+    #: (the first continues the folder's line); None: the folder alone
+    console: Callable[[Any, Any], Any] | None = None
 
 
 @dataclass

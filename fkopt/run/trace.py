@@ -1,4 +1,5 @@
-"""Each run's best-so-far trace, compactly: ``trace.csv.gz`` in every experiment folder.
+"""Each run's best-so-far trace, compactly: ``trace.csv.gz`` in every experiment folder (the
+:attr:`~fkopt.run.result.RunResult.trace` of its result, computed by each task).
 
 One row per improvement of a run's best-so-far fitness, at the exact evaluation at which it
 happened -- the data IOHanalyzer's ``.dat`` files hold (see :mod:`fkopt.tools.export`):
@@ -76,21 +77,29 @@ def run_trace(events, evaluations: np.ndarray, done: np.ndarray | None = None):
     return r, np.minimum(it, n - 1), e, f
 
 
-def trace_table(er) -> pd.DataFrame:
-    """The trace of every run of an :class:`~fkopt.kinds.experiment.runner.ExperimentResult`."""
-    frames = []
-    for rec in er.records:
-        res = rec.result
-        ev = np.asarray(res.evaluation_history).reshape(-1, res.evaluation_history.shape[-1])
-        events = res.events if res.events is not None else history_events(
-            np.asarray(res.history).reshape(ev.shape), ev)
-        r, it, e, f = run_trace(events, ev, np.asarray(res.iterations_done).reshape(-1))
-        frames.append(pd.DataFrame({"case": rec.case.label, "algorithm": rec.spec.key,
-                                    "run": np.asarray(res.run_ids)[r % len(res.run_ids)], "iteration": it,
-                                    "evaluations": e, "best_fitness": f}))
-    if not frames:
-        return pd.DataFrame(columns=list(COLUMNS))
-    return pd.concat(frames, ignore_index=True)
+def case_trace(case: str, algorithm: str, res) -> pd.DataFrame:
+    """The trace rows of one algorithm's runs on one case (a single-target
+    :class:`~fkopt.solve.Result`): computed by the task that solved them (:func:`run_trace`)."""
+    ev = np.asarray(res.evaluation_history).reshape(-1, res.evaluation_history.shape[-1])
+    events = res.events if res.events is not None else history_events(np.asarray(res.history).reshape(ev.shape), ev)
+    r, it, e, f = run_trace(events, ev, np.asarray(res.iterations_done).reshape(-1))
+    return pd.DataFrame({"case": case, "algorithm": algorithm, "run": np.asarray(res.run_ids)[r % len(res.run_ids)],
+                         "iteration": it, "evaluations": e, "best_fitness": f})
+
+
+#: dtypes of a trace's columns (a task file's lists read back).
+DTYPES = {"case": object, "algorithm": object, "run": np.int64, "iteration": np.int64, "evaluations": np.int64,
+          "best_fitness": np.float64}
+
+
+def trace_frame(columns: dict) -> pd.DataFrame:
+    """A task file's trace (column -> list) as trace rows, dtypes restored."""
+    return pd.DataFrame({c: np.asarray(columns[c], dtype=DTYPES[c]) for c in COLUMNS})
+
+
+def concat_traces(frames: list[pd.DataFrame]) -> pd.DataFrame:
+    """The traces of several tasks as one (``trace.csv.gz``), in the order given."""
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=list(COLUMNS))
 
 
 #: Largest decompressed ``trace.csv.gz`` :func:`read_trace` accepts (:data:`fkopt.files.MAX_UNPACKED`).

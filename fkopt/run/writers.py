@@ -47,6 +47,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from fkopt.files import naming_the_file, output_folder, stored_sha256, write_atomically, write_json
+from fkopt.run import record
 from fkopt.run.kinds import KINDS
 from fkopt.run.provenance import environment
 
@@ -64,6 +65,32 @@ class Output:
     role: str                 # TABLE, CURVES, TIMING or FIGURE
     float_format: str = FLOAT
     rows: str = STATS         # STATS, RUNS or STEPS: what one row is
+
+
+# -- the files every kind's result makes the same way (from RunResult's record, timing, trace) --------
+def runs_file(result):
+    """``runs.csv``: the run record, one row per run (:func:`fkopt.run.record.runs_table`)."""
+    return None if result.record is None else record.runs_table(result.record)
+
+
+def trace_file(result):
+    """``trace.csv.gz``: each run's best-so-far where it improved (the result's trace)."""
+    return result.trace
+
+
+def timing_runs_file(result):
+    """``timing_runs.csv``: every run timed alone (ms), what timing claims test for a difference
+    (:func:`fkopt.run.record.timing_runs_table`); None when the result has no timing record."""
+    if result.timing is None:
+        return None
+    return record.timing_runs_table(result.timing, names=record.FILE_NAMES.get(result.kind))
+
+
+#: The shared files, each made by one function for every kind whose result has what it reads;
+#: a kind lists them among its outputs where they belong in its folder.
+RUNS_FILE = Output("runs.csv", runs_file, CURVES, rows=RUNS)
+TRACE_FILE = Output("trace.csv.gz", trace_file, CURVES, rows=STEPS)
+TIMING_RUNS_FILE = Output("timing_runs.csv", timing_runs_file, TIMING)
 
 
 def outputs_of(kind) -> tuple[Output, ...]:

@@ -24,6 +24,7 @@ from pydantic import Field, ValidationError
 from fkopt.errors import FkoptError
 from fkopt.files import error_line
 from fkopt.run.record import BATCH, timing_record, timing_table as record_timing_table
+from fkopt.run.result import RunResult
 from fkopt.run.tasks import Kind, Plan, Task
 from fkopt.run.config_base import MAX_ITERATIONS, MAX_POPULATION, Located, MechanismSpec, Seed, files_folder
 from fkopt.run.kinds import register
@@ -60,67 +61,73 @@ def assembly_from_dict(data: dict, where: str) -> AssemblyConfig:
 
 
 @dataclass
-class AssemblyResult:
-    config: AssemblyConfig
+class AssemblyOwn:
+    """What only an assembly search has (the :attr:`fkopt.run.result.RunResult.own` slot): its
+    mechanism and the solutions it found (one row each: pose, residual, hits) with the search's
+    counts."""
+
     mechanism: object
-    solutions: Any                  # fkopt.kinematics.assembly_modes.Solutions
-    wall_s: float
-    source: str | None = None
+    solutions: pd.DataFrame         # pose variables, residual, hits; most hits first
+    starts: int
+    outside: int                    # distinct real solutions found outside the bounds
+    round_size: int
+    solver_time_s: float            # the search's own account of its time
 
 
-def run_assembly(config: AssemblyConfig, source: str | None = None, mech=None) -> AssemblyResult:
-    """The search; ``mech``: the config's mechanism, already built (else built here, its
-    relative files beside ``source``)."""
-    from fkopt.kinematics.assembly_modes import all_solutions
+def search(config: AssemblyConfig, source: str | None = None, mech=None) -> dict:
+    """The search; its record, JSON-able: every solution found (pose, residual, hits), the
+    search's counts and its wall time. ``mech``: the config's mechanism, already built (else
+    built here, its relative files beside ``source``)."""
+    from fkopt.kinematics.assembly_modes import all_solutions, solutions_to_dict
     mech = build_mechanism(config, files_folder(config, source)) if mech is None else mech
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
                          tol=config.tol, dedup=config.dedup, iterations=config.iterations)
-    return AssemblyResult(config, mech, sols, time.perf_counter() - start, source)
+    wall = time.perf_counter() - start
+    found = solutions_to_dict(sols)
+    return {"solutions": [{**s["pose"], "residual": s["residual"], "hits": s["hits"]} for s in found["solutions"]],
+            "starts": found["starts"], "outside": found["outside"], "time_s": found["time_s"],
+            "round_size": int(sols.settings["round_size"]), "wall_s": wall}
 
 
 # -- files (listed in OUTPUTS below) -------------------------------------------
-def solutions_table(ar: AssemblyResult) -> pd.DataFrame:
-    rows = [{**{n: float(v) for n, v in s.pose.items()}, "residual": float(s.residual), "hits": int(s.hits)}
-            for s in ar.solutions]
-    solutions = pd.DataFrame(rows, columns=[*ar.mechanism.pose_names, "residual", "hits"])
-    solutions = solutions.sort_values(list(ar.mechanism.pose_names), kind="stable").reset_index(drop=True)
+def solutions_table(ar: RunResult) -> pd.DataFrame:
+    names = list(ar.own.mechanism.pose_names)
+    solutions = ar.own.solutions.sort_values(names, kind="stable").reset_index(drop=True)
     solutions.insert(0, "solution", np.arange(1, len(solutions) + 1))
     return solutions
 
 
-def summary_table(ar: AssemblyResult) -> pd.DataFrame:
-    config, sols = ar.config, ar.solutions
-    res = solutions_table(ar)["residual"].to_numpy()
+def summary_table(ar: RunResult) -> pd.DataFrame:
+    config, own = ar.config, ar.own
+    res = own.solutions["residual"].to_numpy(float)
     res = res if len(res) else np.array([np.nan])
     return pd.DataFrame([{
         "case": "given joints", "algorithm": "all_solutions", "method": "newton-multistart",
-        "population": int(sols.settings["round_size"]),
+        "population": own.round_size,
         "iterations": config.iterations, "runs": 1,
-        "solutions_found": len(sols), "expected": config.expected if config.expected is not None else np.nan,
-        "starts": int(sols.starts), "outside_bounds": int(getattr(sols, "outside", 0)),
+        "solutions_found": len(own.solutions), "expected": config.expected if config.expected is not None else np.nan,
+        "starts": own.starts, "outside_bounds": own.outside,
         "median_fitness": float(np.median(res)), "mean_fitness": float(np.mean(res)),
         "best_fitness": float(np.min(res)), "worst_fitness": float(np.max(res)),
-        "mean_evaluations": float(sols.starts),
+        "mean_evaluations": float(own.starts),
     }])
 
 
-def timing_table(ar: AssemblyResult) -> pd.DataFrame:
+def timing_table(ar: RunResult) -> pd.DataFrame:
     """The search's wall time, one batch of the timing record (the one timing writer,
     :func:`fkopt.run.record.timing_table`), with the solver's own time and the printed ones."""
     key = ("given joints", "all_solutions")
-    timing = timing_record(KIND, {"problem": ar.config.name, "case": key[0], "solver": key[1], "runs": 1,
-                                  "seconds": ar.wall_s, "mode": BATCH})
-    settings = {key: {"runs": 1, "total_s": ar.wall_s, "solver_time_s": float(ar.solutions.time_s),
+    settings = {key: {"runs": 1, "total_s": ar.wall_s, "solver_time_s": ar.own.solver_time_s,
                       **{f"printed_{k}": v for k, v in sorted(ar.config.printed.items()) if k.endswith("_s")}}}
-    return record_timing_table(timing, settings, names={"solver": "algorithm"})
+    return record_timing_table(ar.timing, settings, names={"solver": "algorithm"})
 
 
-def meta(ar: AssemblyResult) -> dict:
+def meta(ar: RunResult) -> dict:
     config = ar.config
     return {"experiment": config.name, "paper": config.paper, "title": config.title, "kind": KIND,
             "config_file": ar.source, "config": config.model_dump(mode="json"), "seed": config.seed,
-            "mechanism": ar.mechanism.describe(), "objective": "all real solutions (multi-start Newton)"}
+            "mechanism": ar.own.mechanism.describe(), "objective": "all real solutions (multi-start Newton)"}
 
 
 # -- the pipeline kind (fkopt.run.pipeline) ------------------------------------------------------
@@ -138,16 +145,24 @@ def _plan(config: AssemblyConfig, source: str | None, timing: bool = True):
     mech = build_mechanism(config, files_folder(config, source))
     payload = {"config": config.model_dump(mode="json"), "source": source}
     return Plan([Task("search", payload, "all solutions")], solve_task,
-                local=lambda _: run_assembly(config, source, mech), context=mech, name=config.name)
+                local=lambda _: search(config, source, mech), context=mech, name=config.name)
 
 
-def solve_task(payload: dict) -> AssemblyResult:
+def solve_task(payload: dict) -> dict:
     """Worker: the search, rebuilt from the payload."""
-    return run_assembly(assembly_from_dict(payload["config"], "assembly task"), payload["source"])
+    return search(assembly_from_dict(payload["config"], "assembly task"), payload["source"])
 
 
-def _merge(config: AssemblyConfig, plan, ran, **_) -> AssemblyResult:
-    return ran.records["search"]
+def _merge(config: AssemblyConfig, plan, ran, *, source: str | None = None, **_) -> RunResult:
+    """The search's :class:`~fkopt.run.result.RunResult`: no run record (one search, no runs), its
+    wall time as one batch of the timing record, the solutions in ``own`` (:class:`AssemblyOwn`)."""
+    mech, rec = plan.context, ran.records["search"]
+    solutions = pd.DataFrame(rec["solutions"], columns=[*mech.pose_names, "residual", "hits"])
+    timing = timing_record(KIND, {"problem": config.name, "case": "given joints", "solver": "all_solutions",
+                                  "runs": 1, "seconds": rec["wall_s"], "mode": BATCH})
+    own = AssemblyOwn(mech, solutions, int(rec["starts"]), int(rec["outside"]), int(rec["round_size"]),
+                      float(rec["time_s"]))
+    return RunResult(config, None, timing, None, own, rec["wall_s"], source, list(ran.computed))
 
 
 #: The files of an assembly search's folder, in the order they are written.

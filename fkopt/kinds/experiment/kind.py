@@ -8,8 +8,7 @@ from fkopt.kinds.experiment.runner import experiment_plan, keeps_x_history, merg
 from fkopt.kinds.experiment import reports
 from fkopt.run.kinds import register
 from fkopt.run.tasks import Kind
-from fkopt.run.trace import trace_table
-from fkopt.run.writers import CURVES, FIGURE, RUNS, STEPS, TABLE, TIMING, Output
+from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, TIMING_RUNS_FILE, TRACE_FILE, Output
 
 # -- experiments -----------------------------------------------------------------------------------
 def _experiment_validate(config, plan) -> int:
@@ -26,10 +25,6 @@ def _experiment_validate(config, plan) -> int:
     return need
 
 
-def _experiment_merge(config, plan, ran, *, source=None, **_):
-    return merge_experiment(config, plan, ran, source=source)
-
-
 def _experiment_from_dict(data: dict, where: str):
     if "kind" in data:
         data = {k: v for k, v in data.items() if k != "kind"}
@@ -40,11 +35,11 @@ def _experiment_from_dict(data: dict, where: str):
 OUTPUTS = (
     Output("summary.csv", reports.summary_table, TABLE),
     Output("timing.csv", reports.timing_table, TIMING),
-    Output("timing_runs.csv", reports.timing_runs_table, TIMING),
+    TIMING_RUNS_FILE,
     Output("values.csv", reports.values_table, TABLE),
     Output("inputs.csv", reports.inputs_table, TABLE),
-    Output("runs.csv", reports.runs_table, CURVES, rows=RUNS),
-    Output("trace.csv.gz", trace_table, CURVES, rows=STEPS),
+    RUNS_FILE,
+    TRACE_FILE,
     Output("convergence.csv", reports.convergence_table, CURVES, rows=STEPS),
     Output("convergence", reports.convergence_figure, FIGURE),
     Output("variables", reports.variables_figure, FIGURE),
@@ -56,4 +51,5 @@ OUTPUTS = (
 )
 
 EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
-                           _experiment_merge, OUTPUTS, reports.meta, ExperimentConfig))
+                           merge_experiment, OUTPUTS, reports.meta, ExperimentConfig,
+                           console=lambda result, folder: reports.summary_table(result)))

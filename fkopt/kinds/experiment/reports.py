@@ -1,4 +1,6 @@
-"""Reports: turn an :class:`ExperimentResult` into CSV tables, figures and ``meta.json``.
+"""Reports: turn an experiment's :class:`~fkopt.run.result.RunResult` into CSV tables, figures and
+``meta.json`` (its run record, timing record and trace; its cases and per-iteration curves in
+``own``: :class:`~fkopt.kinds.experiment.runner.ExperimentOwn`).
 
 The makers below are listed, with each file's role (table, curves, timing, figure), in
 :data:`fkopt.run.writers.OUTPUTS`, and :func:`fkopt.run.writers.write_outputs` writes them. Files of one
@@ -43,9 +45,10 @@ import pandas as pd
 
 from fkopt.registry import algorithm_class
 from fkopt.run import record
+from fkopt.run.result import RunResult
 from fkopt.run.writers import FLOAT, write_outputs, write_result
 from fkopt.run import plotting
-from fkopt.kinds.experiment.runner import ExperimentResult, pose_error
+from fkopt.kinds.experiment.runner import outputs_of, pose_error
 
 #: Fitness of exactly 0 cannot be drawn on a log axis; it is drawn at this floor (and said so).
 LOG_FLOOR = 1e-32
@@ -53,10 +56,10 @@ LOG_FLOOR = 1e-32
 MAX_CASE_CURVES = 6
 
 # -- tables ------------------------------------------------------------------------------------
-def summary_table(er: ExperimentResult) -> pd.DataFrame:
+def summary_table(er: RunResult) -> pd.DataFrame:
     """Per case and algorithm, over its runs (the one summary writer, :func:`fkopt.run.record.summary_table`)."""
     settings = {}
-    for rec in er.records:
+    for rec in er.own.solves:
         r, spec = rec.result, rec.spec
         # sorted: a config reloaded from meta.json has sorted keys
         printed = {f"printed_{k}": v for k, v in sorted(spec.printed.items()) if not k.endswith("_ms")}
@@ -65,42 +68,38 @@ def summary_table(er: ExperimentResult) -> pd.DataFrame:
     return record.summary_table(er.record, settings, er.config.threshold)
 
 
-def timing_table(er: ExperimentResult) -> pd.DataFrame:
+def timing_table(er: RunResult) -> pd.DataFrame:
     """Time per run measured one run at a time on a sample of runs (:mod:`.timing`), per timed
     case and algorithm (the one timing writer, :func:`fkopt.run.record.timing_table`)."""
     settings = {(rec.case.label, rec.spec.key): {
-        "runs": rec.result.runs, "total_s": rec.wall_s,
-        **{f"printed_{k}": v for k, v in sorted(rec.spec.printed.items()) if k.endswith("_ms")}} for rec in er.records}
+        "runs": rec.result.runs, "total_s": er.own.solve_s[rec.spec.key],
+        **{f"printed_{k}": v for k, v in sorted(rec.spec.printed.items()) if k.endswith("_ms")}} for rec in er.own.solves}
     return record.timing_table(er.timing, settings, names=record.FILE_NAMES["experiment"], timed_alone=True)
 
 
-def timing_runs_table(er: ExperimentResult) -> pd.DataFrame:
-    """Every timed single run (ms): what timing claims test for a difference."""
-    return record.timing_runs_table(er.timing, names=record.FILE_NAMES["experiment"])
-
-
-def values_table(er: ExperimentResult) -> pd.DataFrame:
-    mech = er.mechanism
+def values_table(er: RunResult) -> pd.DataFrame:
+    mech = er.own.mechanism
     rows = []
-    for rec in er.records:
+    for rec in er.own.solves:
         r, case = rec.result, rec.case
+        outputs = outputs_of(mech, r.x)
         med, best = r.median_run, r.best_run
         target = case.target if case.target is not None else case.reference
         printed = case.printed.get(rec.spec.key, {})
-        for j, (name, unit) in enumerate(zip(er.compared_names, er.compared_units)):
+        for j, (name, unit) in enumerate(zip(er.own.compared_names, er.own.compared_units)):
             row = {"case": case.label, "algorithm": rec.spec.key, "variable": name, "unit": unit,
                    "target": float(target[j]) if target is not None else np.nan,
-                   "median_run": int(r.run_ids[med]), "median_run_value": float(rec.outputs[med, j]),
-                   "best_run_value": float(rec.outputs[best, j])}
+                   "median_run": int(r.run_ids[med]), "median_run_value": float(outputs[med, j]),
+                   "best_run_value": float(outputs[best, j])}
             if target is not None:
-                err = pose_error(mech, rec.outputs, target)[:, j]
+                err = pose_error(mech, outputs, target)[:, j]
                 row["median_run_abs_error"] = float(err[med])
                 row["best_run_abs_error"] = float(err[best])
                 row["mean_abs_error"] = float(np.mean(err))
             if case.reference is not None:
                 row[case.reference_label] = float(case.reference[j])
                 row[f"median_run_error_vs_{case.reference_label}"] = float(
-                    pose_error(mech, rec.outputs[med], case.reference)[j])
+                    pose_error(mech, outputs[med], case.reference)[j])
             if name in printed:
                 row["printed_value"] = printed[name]
                 if f"{name}_error" in printed:   # the paper's error column, transcribed, never recomputed
@@ -116,10 +115,10 @@ def _abs_diff(unit: str, a: float, b: float) -> float:
     return float(abs((d + 180.0) % 360.0 - 180.0) if unit == "deg" else abs(d))
 
 
-def inputs_table(er: ExperimentResult) -> pd.DataFrame | None:
-    mech = er.mechanism
+def inputs_table(er: RunResult) -> pd.DataFrame | None:
+    mech = er.own.mechanism
     rows = []
-    for case in er.cases:
+    for case in er.own.cases:
         if case.given_joints is None or case.joints_from_pose is None:
             continue
         for name, unit, g, c in zip(mech.joint_names, mech.joint_units, case.given_joints, case.joints_from_pose):
@@ -128,12 +127,7 @@ def inputs_table(er: ExperimentResult) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
-def runs_table(er: ExperimentResult) -> pd.DataFrame:
-    """One row per run: the run record's (:func:`fkopt.run.record.runs_table`)."""
-    return record.runs_table(er.record)
-
-
-def convergence_table(er: ExperimentResult) -> pd.DataFrame:
+def convergence_table(er: RunResult) -> pd.DataFrame:
     frames = []
     for label, algo, hist, evals, pos in _curves(er):
         q25, med, q75 = np.percentile(hist, [25, 50, 75], axis=0)
@@ -146,16 +140,16 @@ def convergence_table(er: ExperimentResult) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-def _curves(er: ExperimentResult):
+def _curves(er: RunResult):
     """(case label, algorithm, history, evaluation history, position error history) per curve."""
-    pooled = len(er.cases) > MAX_CASE_CURVES
+    pooled = len(er.own.cases) > MAX_CASE_CURVES
     if not pooled:
-        for rec in er.records:
+        for rec in er.own.solves:
             yield (rec.case.label, rec.spec.key, rec.result.history, rec.result.evaluation_history,
                    rec.position_error_history)
         return
     for spec in er.config.algorithms:
-        recs = [r for r in er.records if r.spec.key == spec.key]
+        recs = [r for r in er.own.solves if r.spec.key == spec.key]
         pos = [r.position_error_history for r in recs]
         yield ("all", spec.key, np.concatenate([r.result.history for r in recs]),
                np.concatenate([r.result.evaluation_history for r in recs]),
@@ -172,12 +166,12 @@ def _save(fig, path: Path) -> list[str]:
     return plotting.save(fig, path)
 
 
-def figure_file(er: ExperimentResult, kind: str) -> str:
+def figure_file(er: RunResult, kind: str) -> str:
     """The PNG name of a figure kind: the paper figure it mirrors (config ``figure_names``) or the kind."""
     return er.config.figure_names.get(kind, kind) + ".png"
 
 
-def _spec_names(er: ExperimentResult) -> dict[str, str]:
+def _spec_names(er: RunResult) -> dict[str, str]:
     """Legend names; algorithms that share a paper name (wu2015's five Newton starts) add their label."""
     names = {spec.key: plotting.spec_name(spec) for spec in er.config.algorithms}
     counts = pd.Series(list(names.values())).value_counts()
@@ -185,16 +179,16 @@ def _spec_names(er: ExperimentResult) -> dict[str, str]:
             else names[spec.key] for spec in er.config.algorithms}
 
 
-def _curve_sets(er: ExperimentResult):
+def _curve_sets(er: RunResult):
     """(name, spec, history, evaluations, position errors, iterations done) per drawn curve; with
     more than MAX_CASE_CURVES cases the runs of all cases are pooled per algorithm."""
     names = _spec_names(er)
-    pooled = len(er.cases) > MAX_CASE_CURVES
+    pooled = len(er.own.cases) > MAX_CASE_CURVES
     for spec in er.config.algorithms:
-        recs = [r for r in er.records if r.spec.key == spec.key]
+        recs = [r for r in er.own.solves if r.spec.key == spec.key]
         groups = [recs] if pooled else [[r] for r in recs]
         for grp in groups:
-            name = names[spec.key] if pooled or len(er.cases) == 1 else f"{names[spec.key]} · {grp[0].case.label}"
+            name = names[spec.key] if pooled or len(er.own.cases) == 1 else f"{names[spec.key]} · {grp[0].case.label}"
             pos = [r.position_error_history for r in grp]
             yield (name, spec, np.concatenate([r.result.history for r in grp]),
                    np.concatenate([r.result.evaluation_history for r in grp]),
@@ -219,7 +213,7 @@ def _band(ax, xs, values, floor, name, color=None, end=None):
     return line
 
 
-def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def convergence_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far fitness vs iteration and vs function evaluations (median and quartiles of the
     runs, or the run itself). Runs that stop at the threshold end where (the median run) stopped
     (a bar); P-ABC's switch from PSO to ABC is marked with a triangle."""
@@ -245,7 +239,7 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
             axes[0].annotate(phases, (sw, y), textcoords="offset points", xytext=(4, 8), fontsize=7,
                              color=line.get_color())
     runs = curves[0][2].shape[0]
-    what = "best-so-far " + plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))
+    what = "best-so-far " + plotting.fitness_label(er.own.mechanism, getattr(er.own.solves[0].problem, "objective", None))
     axes[0].set_ylabel(what)
     threshold = er.config.threshold
     for ax, xl in zip(axes, ("iteration", "function evaluations (mean over runs)")):
@@ -269,7 +263,7 @@ def convergence_figure(er: ExperimentResult, folder: Path, tables: dict) -> list
     return names
 
 
-def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def variables_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far value of each unknown vs iteration for the median run (liu2008 Fig. 4a, wang7dof
     Fig. 4), with the true value dashed (for a redundant arm: the joints that defined the target,
     one of many solutions)."""
@@ -277,9 +271,9 @@ def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         return []
     path = folder / figure_file(er, "variables")
     plt = _plt()
-    recs = [r for r in er.records if r.case.index == 0]
+    recs = [r for r in er.own.solves if r.case.index == 0]
     names = recs[0].result.variable_names
-    units = er.mechanism.unknown_units
+    units = er.own.mechanism.unknown_units
     spec_names = _spec_names(er)
     cols = min(len(names), 4)
     rows = int(np.ceil(len(names) / cols))
@@ -292,7 +286,7 @@ def variables_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         for j, ax in enumerate(flat[:len(names)]):
             ax.plot(np.arange(end), xh[:end, j], label=spec_names[rec.spec.key], lw=1.1)
     case = recs[0].case
-    if er.mechanism.kind == "parallel":
+    if er.own.mechanism.kind == "parallel":
         truth, what = ((case.target, "true value") if case.target is not None
                        else (case.reference, case.reference_label.replace("_", " ")))
     else:
@@ -334,7 +328,7 @@ def _shading(problem, bounds, i, j, k, n=121, m=41):
     return gi, gj, np.log10(np.maximum(f, 1e-12))
 
 
-def snapshot_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def snapshot_figures(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Population at the snapshot iterations, first case, run 0 (wu2015 Figs. 4-6): two projections
     shaded by log10 of the fitness (minimised over the third variable), the true pose and, where the
     mechanism has several exact forward solutions, the mirror solution(s)."""
@@ -342,7 +336,7 @@ def snapshot_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         return []
     plt = _plt()
     written = []
-    recs = [r for r in er.records if r.case.index == 0]
+    recs = [r for r in er.own.solves if r.case.index == 0]
     names_of = _spec_names(er)
     for t in er.config.snapshots:
         panels = []
@@ -355,13 +349,13 @@ def snapshot_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[s
         for row, rec in zip(axes, panels):
             pts = rec.result.snapshots[t][0]
             names = rec.result.variable_names
-            units = er.mechanism.unknown_units
+            units = er.own.mechanism.unknown_units
             b = np.asarray(rec.problem.bounds, float)
-            truth = rec.case.target if er.mechanism.kind == "parallel" else None
+            truth = rec.case.target if er.own.mechanism.kind == "parallel" else None
             others = []
-            if truth is not None and hasattr(er.mechanism, "fk_exact"):
-                sols = np.atleast_2d(er.mechanism.fk_exact(rec.case.inputs))
-                others = [sol for sol in sols if np.max(np.abs(sol - truth)) > 1e-6 and er.mechanism.in_bounds(sol)]
+            if truth is not None and hasattr(er.own.mechanism, "fk_exact"):
+                sols = np.atleast_2d(er.own.mechanism.fk_exact(rec.case.inputs))
+                others = [sol for sol in sols if np.max(np.abs(sol - truth)) > 1e-6 and er.own.mechanism.in_bounds(sol)]
             for ax, (i, j, k) in zip(row, ((0, 1, 2), (0, 2, 1))):
                 gi, gj, z = _shading(rec.problem, b, i, j, k)
                 im = ax.pcolormesh(gi, gj, z, cmap="Greys_r", shading="auto", rasterized=True)
@@ -386,10 +380,10 @@ def snapshot_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[s
     return written
 
 
-def extras_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def extras_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Median over runs of each algorithm record vs iteration (wu2015 Fig. 7). Pheromone is
     tau = -f <= 0, so it is drawn as -tau on a log axis (the best pheromone's -tau is the best f)."""
-    recs = [r for r in er.records if r.case.index == 0 and r.result.extras]
+    recs = [r for r in er.own.solves if r.case.index == 0 and r.result.extras]
     if "extras" not in er.config.figures or not recs:
         return []
     path = folder / figure_file(er, "extras")
@@ -397,7 +391,7 @@ def extras_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
     names = _spec_names(er)
     keys = sorted({k for r in recs for k in r.result.extras})
     fig, axes = plt.subplots(1, len(keys), figsize=(4.2 * len(keys), 3.4), squeeze=False)
-    unit = plotting.fitness_label(er.mechanism, getattr(recs[0].problem, "objective", None)).split("(")[-1].rstrip(")")
+    unit = plotting.fitness_label(er.own.mechanism, getattr(recs[0].problem, "objective", None)).split("(")[-1].rstrip(")")
     for rec in recs:
         for ax, k in zip(axes[0], keys):
             if k not in rec.result.extras:
@@ -422,9 +416,9 @@ def extras_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
     return out
 
 
-def position_error_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def position_error_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far position error (the arm's length unit) vs iteration (wang7dof Figs. 5/6a), serial arms."""
-    curves = [c for c in _curve_sets(er) if c[4] is not None] if er.mechanism.kind == "serial" else []
+    curves = [c for c in _curve_sets(er) if c[4] is not None] if er.own.mechanism.kind == "serial" else []
     if not curves:
         return []
     path = folder / figure_file(er, "position_error")
@@ -438,7 +432,7 @@ def position_error_figure(er: ExperimentResult, folder: Path, tables: dict) -> l
         plotting.mark_zero(ax, floor)
     ax.set_xlabel("iteration")
     runs = curves[0][4].shape[0]
-    ax.set_ylabel(f"position error of the best-so-far ({plotting.position_unit(er.mechanism)})")
+    ax.set_ylabel(f"position error of the best-so-far ({plotting.position_unit(er.own.mechanism)})")
     ax.set_title(f"{er.config.title or er.config.name}\n"
                  + ("one run" if runs == 1 else f"median of {runs} runs, band: quartiles"), fontsize=9)
     plotting.legend_off_data(ax)
@@ -452,7 +446,7 @@ def _case_axis(ax, n: int) -> None:
     ax.set_xlim(0.3, n + 0.7)
 
 
-def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def cases_figures(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Per case (independent poses: markers, no lines): final fitness (deterministic), time per run
     (timed single runs) and, for serial arms, the final position error (wang7dof Fig. 7)."""
     if "cases" not in er.config.figures:
@@ -464,8 +458,8 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
     runs = er.config.runs
     agg = "median over runs of the " if runs > 1 else ""
     written = []
-    fit_label = plotting.fitness_label(er.mechanism, getattr(er.records[0].problem, "objective", None))
-    order = {c.label: c.index + 1 for c in er.cases}
+    fit_label = plotting.fitness_label(er.own.mechanism, getattr(er.own.solves[0].problem, "objective", None))
+    order = {c.label: c.index + 1 for c in er.own.cases}
     panels = [("cases", summary, "median_fitness", f"{agg}final {fit_label}", True)]
     if timing is not None and len(timing):
         panels.append(("cases_time", timing, "median_ms_per_run", "time per run, one run at a time (ms)", False))
@@ -487,16 +481,16 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
         _case_axis(ax, shown)
         ax.set_ylabel(ylabel)
         ax.set_title((er.config.title or er.config.name)
-                     + (f"\ntimed poses only: the first {shown} of {len(er.cases)}" if shown < len(er.cases) else ""),
+                     + (f"\ntimed poses only: the first {shown} of {len(er.own.cases)}" if shown < len(er.own.cases) else ""),
                      fontsize=9)
         plotting.legend_off_data(ax)
         written += _save(fig, folder / figure_file(er, kind))
         plt.close(fig)
-    if er.mechanism.kind == "serial":   # wang7dof Fig. 7a: final position error per pose
+    if er.own.mechanism.kind == "serial":   # wang7dof Fig. 7a: final position error per pose
         fig, ax = plt.subplots(figsize=(7, 3.4))
         ys = []
         for n, spec in enumerate(er.config.algorithms):
-            recs = [r for r in er.records if r.spec.key == spec.key and r.position_error_history is not None]
+            recs = [r for r in er.own.solves if r.spec.key == spec.key and r.position_error_history is not None]
             if recs:
                 y = np.array([float(np.median(r.position_error_history[:, -1])) for r in recs])
                 ys.append(y)
@@ -506,8 +500,8 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
         for line in ax.get_lines():
             line.set_ydata(np.maximum(line.get_ydata(), floor))
         ax.set_yscale("log")
-        _case_axis(ax, len(er.cases))
-        ax.set_ylabel(f"{agg}final position error ({plotting.position_unit(er.mechanism)})")
+        _case_axis(ax, len(er.own.cases))
+        ax.set_ylabel(f"{agg}final position error ({plotting.position_unit(er.own.mechanism)})")
         ax.set_title(er.config.title or er.config.name, fontsize=9)
         plotting.legend_off_data(ax)
         written += _save(fig, folder / figure_file(er, "cases_position_error"))
@@ -515,17 +509,17 @@ def cases_figures(er: ExperimentResult, folder: Path, tables: dict) -> list[str]
     return written
 
 
-def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
+def time_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Time of every timed single run per algorithm (wang7dof Fig. 6b): points and their median."""
-    recs = [r for r in er.records if r.single_run_s is not None]
-    if "time" not in er.config.figures or not recs:
+    alone = er.timing[er.timing["mode"] == record.ALONE] if er.timing is not None else None
+    if "time" not in er.config.figures or alone is None or alone.empty:
         return []
     path = folder / figure_file(er, "time")
     plt = _plt()
     names = _spec_names(er)
     fig, ax = plt.subplots(figsize=(5, 3.4))
     for n, spec in enumerate(er.config.algorithms):
-        ms = np.concatenate([r.single_run_s for r in recs if r.spec.key == spec.key]) * 1e3
+        ms = alone.loc[alone["solver"] == spec.key, "seconds"].to_numpy(float) * 1e3
         x = n + np.linspace(-0.15, 0.15, len(ms)) if len(ms) > 1 else np.array([float(n)])
         ax.plot(x, ms, ls="none", marker="o", ms=4, alpha=0.7)
         ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
@@ -540,23 +534,25 @@ def time_figure(er: ExperimentResult, folder: Path, tables: dict) -> list[str]:
 
 
 # -- folder --------------------------------------------------------------------------------------
-def meta(er: ExperimentResult) -> dict:
+def meta(er: RunResult) -> dict:
     """What the config and the seed fix (nothing about the machine: that is :func:`environment`)."""
+    seeds = er.record.groupby(["pose", "solver"], sort=False)["task_seed"].first()
     return {
         "experiment": er.config.name, "paper": er.config.paper, "title": er.config.title,
         "config_file": er.source, "config": er.config.model_dump(mode="json"),
         "seed": er.config.seed,
-        "task_seeds": [{"case": r.case.label, "algorithm": r.spec.key, "seed": r.seed} for r in er.records],
-        "mechanism": er.mechanism.describe(),
-        "objective": getattr(er.records[0].problem, "objective", None),
+        "task_seeds": [{"case": r.case.label, "algorithm": r.spec.key, "seed": int(seeds[(r.case.index, r.spec.key)])}
+                       for r in er.own.solves],
+        "mechanism": er.own.mechanism.describe(),
+        "objective": getattr(er.own.solves[0].problem, "objective", None),
     }
 
 
-def write_tables(er: ExperimentResult, folder: Path, figures: bool = True) -> list[str]:
+def write_tables(er: RunResult, folder: Path, figures: bool = True) -> list[str]:
     """Every file of the experiment (:data:`fkopt.run.writers.OUTPUTS`) into ``folder`` (which must exist)."""
     return write_outputs("experiment", er, folder, figures=figures)
 
 
-def write_experiment(er: ExperimentResult, out: Path) -> Path:
+def write_experiment(er: RunResult, out: Path) -> Path:
     """Write the experiment's folder aside, then swap it into place."""
     return write_result("experiment", er, out)

@@ -9,23 +9,23 @@ these per-case seeds, and the result is sliced back into one record per (case, a
 """
 from __future__ import annotations
 
+import hashlib
 import json
+import math
 import time
-import zlib
 from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
-from fkopt import registry
 from fkopt.errors import FkoptError
 from fkopt.run.record import ALONE, BATCH, concat, run_record, timing_record
-from fkopt.problems import fk_problem, ik_problem
-from fkopt.numerics.rotations import wrap_degrees
-from fkopt.solve import Result, chunk_size, make_algorithm, solve
+from fkopt.run.result import RunResult, dataclass_from_json, dataclass_to_json
+from fkopt.run.trace import COLUMNS as TRACE_COLUMNS, case_trace, concat_traces, trace_frame
+from fkopt.solve import Result, chunk_size, make_algorithm
 from fkopt.kinds.experiment.config import ExperimentConfig, RandomCases
-from fkopt.run.config_base import AlgorithmSpec, files_folder
+from fkopt.run.config_base import AlgorithmSpec, files_folder, numeric_fields
 from fkopt.run.solving import (_check_in_bounds, build_mechanism, make_problem, outputs_of, pose_error, solve_cases,  # noqa: F401
                                start_point, task_seed)
 from fkopt.run.tasks import Plan, Ran, Task, run_tasks
@@ -48,29 +48,29 @@ class Case:
 
 
 @dataclass
-class TaskRecord:
+class CaseSolve:
+    """One algorithm's runs on one case, with their per-iteration curves: what the flat run record
+    (one row per run, :mod:`fkopt.run.record`) cannot hold and the convergence table and figures
+    draw (best-so-far fitness, evaluations and points per iteration, snapshots, an algorithm's own
+    records). A view of the task's :class:`~fkopt.solve.Result`, built at merge time."""
+
     case: Case
     spec: AlgorithmSpec
     problem: object
     result: Result
-    seed: int
-    wall_s: float
-    outputs: np.ndarray                # (runs, n_pose) the pose each run's answer corresponds to
-    position_error_history: np.ndarray | None = None
-    single_run_ids: np.ndarray | None = None   # runs timed alone (see .timing)
-    single_run_s: np.ndarray | None = None
+    position_error_history: np.ndarray | None = None   # serial arms: (runs, iterations + 1)
 
 
 @dataclass
-class ExperimentResult:
-    config: ExperimentConfig
+class ExperimentOwn:
+    """What only an experiment has (the :attr:`fkopt.run.result.RunResult.own` slot): its
+    mechanism, its cases and every (case, algorithm)'s curves, case by case (every algorithm of
+    case 1, then case 2, ...), and each algorithm's solve time per case (amortised)."""
+
     mechanism: object
     cases: list[Case]
-    records: list[TaskRecord]
-    wall_s: float
-    source: str | None = None
-    record: object = None              # the run record (:mod:`fkopt.run.record`): one row per (case, algorithm, run)
-    timing: object = None              # the timing record (:mod:`fkopt.run.record`): its timed samples
+    solves: list[CaseSolve]
+    solve_s: dict[str, float]
 
     @property
     def compared_names(self) -> tuple[str, ...]:
@@ -155,16 +155,6 @@ def batched_problem(config: ExperimentConfig, mech, cases: list[Case]):
     return make_problem(config, mech, np.stack([c.inputs for c in cases]))
 
 
-@dataclass
-class Solved:
-    """What solving one algorithm on every case produced: the batched result and the wall time
-    of the solve per case (amortised). Picklable, so another process can compute it
-    (``fkopt reproduce --jobs N``); it holds no mechanism or problem."""
-
-    result: Result
-    wall_s: float
-
-
 def _prepare(config: ExperimentConfig, folder: Path | None):
     mech, cases, problems = validate_experiment(config, folder)
     one = len(cases) == 1         # a single case keeps the single-target problem (no case axis)
@@ -176,12 +166,32 @@ def _seeds(config: ExperimentConfig, cases: list[Case], spec: AlgorithmSpec) -> 
     return [task_seed(config.seed, case.index, spec.key) for case in cases]
 
 
-def _solve_one(config: ExperimentConfig, mech, cases, batched, spec: AlgorithmSpec) -> Solved:
+def fingerprint(config: ExperimentConfig, mech) -> str:
+    """Hash of everything that changes a task's numbers: the config's result-changing fields and
+    the mechanism as built (a resumed experiment must match it)."""
+    text = json.dumps([numeric_fields(config.model_dump(mode="json")), mech.describe()], sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _solve_one(config: ExperimentConfig, mech, cases, problems, batched, a: int, fp: str) -> dict:
+    """One algorithm on every case in one solve; its task record, JSON-able (a task file): the
+    rows of the run record and the trace of every case (case by case), the solve's per-iteration
+    arrays (``curves``: :class:`~fkopt.solve.Result`, for the convergence table and figures) and
+    its wall time per case (amortised)."""
+    spec = config.algorithms[a]
     seeds = _seeds(config, cases, spec)
     start = time.perf_counter()
     result = solve_cases(config, spec, batched, seeds[0] if len(cases) == 1 else seeds, x0=start_point(spec, mech),
                          batch=config.batch, snapshots=config.snapshots, x_history=keeps_x_history(config, mech))
-    return Solved(result, (time.perf_counter() - start) / len(cases))    # amortised over the cases
+    wall = (time.perf_counter() - start) / len(cases)     # amortised over the cases
+    rows, traces = [], []
+    for i, (case, problem) in enumerate(zip(cases, problems)):
+        r = result if len(cases) == 1 else result.case(i)
+        pos = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
+        rows.append(case_rows(config, mech, case, spec, r, seeds[i], pos).to_dict(orient="list"))
+        traces.append(case_trace(case.label, spec.key, r).to_dict(orient="list"))
+    return {"fingerprint": fp, "algorithm": a, "solver": spec.key, "wall_s": wall, "rows": rows, "trace": traces,
+            "curves": dataclass_to_json(result)}
 
 
 @dataclass
@@ -196,7 +206,8 @@ class _Context:
 def experiment_plan(config: ExperimentConfig, source: str | None = None, timing: bool = True) -> Plan:
     """An experiment as tasks of the one runner (:mod:`fkopt.run.tasks`): one task per
     algorithm, solving every case in one call (an experiment is a suite of one problem with
-    listed poses), and (``timing``) one timing task per timed case (:mod:`.timing`'s sample:
+    listed poses), kept as a task file while the experiment runs (``--resume``), not in the
+    published folder; and (``timing``) one timing task per timed case (:mod:`.timing`'s sample:
     every algorithm's runs solved alone, interleaved), run after the solves, in this process
     (:attr:`~fkopt.run.tasks.Plan.timed`). In this process a task uses the live mechanism
     and cases; a worker process rebuilds them from the payload (:func:`solve_task`), with the
@@ -204,9 +215,10 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None, timing:
     started = time.perf_counter()
     folder = files_folder(config, source)        # relative files resolve beside the config
     mech, cases, problems, batched = _prepare(config, folder)
+    fp = fingerprint(config, mech)
     data = config.model_dump_json()
-    tasks = [Task(f"a{a:02d}", {"config": data, "folder": None if folder is None else str(folder), "algorithm": a},
-                  spec.key)
+    tasks = [Task(f"a{a:02d}", {"config": data, "folder": None if folder is None else str(folder), "algorithm": a,
+                                "fingerprint": fp}, spec.key)
              for a, spec in enumerate(config.algorithms)]
     timed_cases, per = sample_plan(len(cases), config.runs)
     timed = [Task(f"t{c:02d}", {"timing": c, "runs": per}, f"timing · {cases[c].label}")
@@ -214,98 +226,148 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None, timing:
 
     def local(payload: dict):
         if "timing" in payload:
-            c = payload["timing"]
-            entries = [(spec, problems[c], task_seed(config.seed, cases[c].index, spec.key))
-                       for spec in config.algorithms]
-            return time_case(config, entries, payload["runs"])
-        return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
-    return Plan(tasks, solve_task, local=local, anywhere=True, timed=timed,
-                context=_Context(mech, cases, problems, batched, time.perf_counter() - started), name=config.name)
+            return _time_one(config, cases, problems, payload["timing"], payload["runs"])
+        return _solve_one(config, mech, cases, problems, batched, payload["algorithm"], fp)
+    return Plan(tasks, solve_task, fingerprint=fp, stored=True,
+                check=lambda task, rec: record_problem(task, rec, config, len(cases)),
+                local=local, anywhere=True, timed=timed,
+                context=_Context(mech, cases, problems, batched, time.perf_counter() - started),
+                name=f"experiment '{config.name}'")
 
 
-def solve_task(payload: dict) -> Solved:
+def _time_one(config: ExperimentConfig, cases: list[Case], problems: list, c: int, per: int) -> dict:
+    """A timing task: every algorithm's runs ``0 .. per-1`` of case ``c`` solved alone,
+    interleaved (:func:`fkopt.run.timing.time_case`); its rows of the timing record."""
+    entries = [(spec, problems[c], task_seed(config.seed, cases[c].index, spec.key)) for spec in config.algorithms]
+    seconds = time_case(config, entries, per)
+    return concat([timing_record("experiment", {"problem": config.name, "case": cases[c].label, "pose": cases[c].index,
+                                                "solver": spec.key, "run": np.arange(len(s)), "runs": 1,
+                                                "seconds": np.asarray(s, dtype=float), "mode": ALONE})
+                   for spec, s in zip(config.algorithms, seconds)]).to_dict(orient="list")
+
+
+def solve_task(payload: dict) -> dict:
     """Worker: one algorithm of an experiment on all its cases, rebuilt from the payload."""
     from fkopt.kinds.experiment.config import experiment_from_dict
     config = experiment_from_dict(json.loads(payload["config"]), "experiment task")
-    mech, cases, _, batched = _prepare(config, Path(payload["folder"]) if payload.get("folder") else None)
-    return _solve_one(config, mech, cases, batched, config.algorithms[payload["algorithm"]])
+    mech, cases, problems, batched = _prepare(config, Path(payload["folder"]) if payload.get("folder") else None)
+    return _solve_one(config, mech, cases, problems, batched, payload["algorithm"], payload["fingerprint"])
+
+
+def record_problem(task: Task, rec, config: ExperimentConfig, n_cases: int) -> str | None:
+    """Why ``rec`` (a task file read back by ``--resume``) is not the finished record of
+    ``task``: its algorithm, one table of run rows and one trace per case, each row this
+    task's case, solver and run, and per-iteration arrays of the runs' shape."""
+    if not isinstance(rec, dict):
+        return f"holds a JSON {type(rec).__name__}, not a task record"
+    a = task.payload["algorithm"]
+    spec = config.algorithms[a]
+    try:
+        if rec["algorithm"] != a or rec["solver"] != spec.key or isinstance(rec["algorithm"], bool):
+            return "its algorithm is not the one its file name names"
+        rows, traces = rec["rows"], rec["trace"]
+        if not isinstance(rows, list) or len(rows) != n_cases or not isinstance(traces, list) or len(traces) != n_cases:
+            return f"rows, trace: not one table per case ({n_cases})"
+        runs = config.runs
+        for i, (cols, trace) in enumerate(zip(rows, traces)):
+            if not isinstance(cols, dict) or any(not isinstance(v, list) or len(v) != runs for v in cols.values()):
+                return f"rows[{i}]: not a table of {runs} run rows"
+            if cols.get("solver") != [spec.key] * runs or cols.get("pose") != [i] * runs \
+                    or cols.get("run") != list(range(runs)):
+                return f"rows[{i}]: its solver, pose or runs are not this task's"
+            if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in cols.get("final_fitness", [None])):
+                return f"rows[{i}].final_fitness: not numbers"
+            if not isinstance(trace, dict) or sorted(trace) != sorted(TRACE_COLUMNS) \
+                    or len({len(v) for v in trace.values() if isinstance(v, list)}) != 1:
+                return f"trace[{i}]: not the columns {', '.join(TRACE_COLUMNS)} of equal length"
+        result = dataclass_from_json(Result, rec["curves"])
+        want = (runs,) if n_cases == 1 else (n_cases, runs)
+        if np.shape(result.fitness) != want or np.shape(result.history)[:-1] != want:
+            return f"curves: runs of shape {np.shape(result.fitness)}, expected {want}"
+        if not math.isfinite(float(rec["wall_s"])) or float(rec["wall_s"]) < 0:
+            return "wall_s: not a non-negative finite number"
+    except KeyError as err:
+        return f"field {str(err.args[0])[:40]!r} is missing"
+    except (TypeError, ValueError, IndexError, AttributeError) as err:
+        return f"{type(err).__name__}: {str(err)[:120]}"
+    return None
 
 
 def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: str | None = None,
-                     **_) -> ExperimentResult:
-    """The experiment's records from its tasks' :class:`Solved` s and the single-run times of
-    its timing tasks (none when the plan has none: ``fkopt check``)."""
+                     **_) -> RunResult:
+    """The experiment's :class:`~fkopt.run.result.RunResult` from its tasks' records: the run
+    record and the trace, case by case (every algorithm of case 1, then case 2, ...), the
+    timing record (each batch's share per run and the runs its timing tasks timed alone; none
+    when the plan has none: ``fkopt check``) and the curves (:class:`ExperimentOwn`)."""
     merging = time.perf_counter()
     ctx: _Context = plan.context
     mech, cases, problems = ctx.mech, ctx.cases, ctx.problems
-    by_algorithm: list[list[TaskRecord]] = []
-    for task, spec in zip(plan.tasks, config.algorithms):
-        done: Solved = ran.records[task.id]
-        seeds = _seeds(config, cases, spec)
-        recs = []
-        for i, (case, problem) in enumerate(zip(cases, problems)):
-            r = done.result if len(cases) == 1 else done.result.case(i)
-            pos_hist = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
-            recs.append(TaskRecord(case, spec, problem, r, seeds[i], done.wall_s, outputs_of(mech, r.x), pos_hist))
-        by_algorithm.append(recs)
-    # case-major order, as the reports expect (every algorithm of case 1, then case 2, ...)
-    records = [recs[i] for i in range(len(cases)) for recs in by_algorithm]
-    for task in plan.timed:               # seconds per algorithm of one timed case
-        for recs, seconds in zip(by_algorithm, ran.records[task.id]):
-            rec = recs[task.payload["timing"]]
-            rec.single_run_ids, rec.single_run_s = np.arange(len(seconds)), np.asarray(seconds)
+    done = [ran.records[t.id] for t in plan.tasks]                  # one per algorithm, in config order
+    results = [dataclass_from_json(Result, rec["curves"]) for rec in done]
+    solves, rows, traces = [], [], []
+    for i, (case, problem) in enumerate(zip(cases, problems)):    # case-major, as the reports expect
+        for spec, rec, result in zip(config.algorithms, done, results):
+            r = result if len(cases) == 1 else result.case(i)
+            pos = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
+            solves.append(CaseSolve(case, spec, problem, r, pos))
+            rows.append(run_record("experiment", {k: v for k, v in rec["rows"][i].items() if k != "kind"}))
+            traces.append(trace_frame(rec["trace"][i]))
+    batches = [timing_record("experiment", {"problem": config.name, "case": s.case.label, "pose": s.case.index,
+                                            "solver": s.spec.key, "run": s.result.run_ids, "runs": 1,
+                                            "seconds": s.result.time_per_run, "mode": BATCH}) for s in solves]
+    alone = [timing_record("experiment", {k: v for k, v in ran.records[t.id].items() if k != "kind"})
+             for t in plan.timed]
     # the run's own time, wherever and however long before the plan was built
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)
-    # solves computed elsewhere (fkopt reproduce's workers): their own time, measured where they ran
-    wall += sum(ran.records[t.id].wall_s * len(cases) for t in plan.tasks if t.id not in ran.computed)
-    return ExperimentResult(config, mech, cases, records, wall, source, experiment_record(config, mech, records),
-                            experiment_timing(config, records))
+    # solves computed elsewhere (fkopt reproduce's workers) or resumed: their own time, measured where they ran
+    wall += sum(ran.records[t.id]["wall_s"] * len(cases) for t in plan.tasks if t.id not in ran.computed)
+    own = ExperimentOwn(mech, cases, solves, {rec["solver"]: float(rec["wall_s"]) for rec in done})
+    return RunResult(config, concat(rows), _timing_in_order(alone, batches, solves), concat_traces(traces), own,
+                     wall, source, list(ran.computed))
 
 
-def experiment_timing(config: ExperimentConfig, records: list[TaskRecord]):
-    """The timing record (:mod:`fkopt.run.record`): every run timed alone, and every run's share
-    of its batch (the amortised time, for information)."""
+def _timing_in_order(alone: list, batches: list, solves: list[CaseSolve]):
+    """The timing record as it always was ordered: per (case, algorithm), its runs timed alone,
+    then its batch."""
+    timed = concat(alone) if alone else None
     frames = []
-    for rec in records:
-        common = {"problem": config.name, "case": rec.case.label, "pose": rec.case.index, "solver": rec.spec.key}
-        if rec.single_run_s is not None:
-            frames.append(timing_record("experiment", {**common, "run": rec.single_run_ids, "runs": 1,
-                                                       "seconds": rec.single_run_s, "mode": ALONE}))
-        frames.append(timing_record("experiment", {**common, "run": rec.result.run_ids, "runs": 1,
-                                                   "seconds": rec.result.time_per_run, "mode": BATCH}))
-    return concat(frames)
+    for s, batch in zip(solves, batches):
+        if timed is not None:
+            mine = timed[(timed["case"] == s.case.label) & (timed["solver"] == s.spec.key)]
+            if len(mine):
+                frames.append(mine)
+        frames.append(batch)
+    return concat(frames).reset_index(drop=True)
 
 
-def experiment_record(config: ExperimentConfig, mech, records: list[TaskRecord]):
-    """The run record (:mod:`fkopt.run.record`) of an experiment's task records, in their order."""
+def case_rows(config: ExperimentConfig, mech, case: Case, spec: AlgorithmSpec, r: Result, seed: int,
+              position_error_history: np.ndarray | None):
+    """The run record's rows (:mod:`fkopt.run.record`) of one algorithm's runs on one case."""
     thr = config.threshold
-    frames = []
-    for rec in records:
-        r, case = rec.result, rec.case
-        cols = {"problem": config.name, "case": case.label, "pose": case.index, "solver": rec.spec.key,
-                "run": r.run_ids, "task_seed": rec.seed, "final_fitness": r.fitness, "evaluations": r.evaluations,
-                "iterations_done": r.iterations_done,
-                # first iteration at which the run's final best-so-far fitness was reached
-                "iterations_to_best": np.argmax(r.history <= r.history[:, -1:], axis=1)}
-        if thr is not None:
-            cols["iterations_to_threshold"] = r.iterations_to(thr)
-            cols["evaluations_to_threshold"] = r.evaluations_to(thr)
-        cols.update({f"x_{name}": r.x[:, j] for j, name in enumerate(r.variable_names)})
-        if mech.kind == "serial":
-            cols.update({f"pose_{name}": rec.outputs[:, j] for j, name in enumerate(mech.pose_names)})
-        if rec.position_error_history is not None:
-            cols["position_error"] = rec.position_error_history[:, -1]
-        target = case.target if case.target is not None else case.reference
-        if target is not None:
-            err = pose_error(mech, rec.outputs, target)
-            cols.update({f"abs_error_{name}": err[:, j] for j, name in enumerate(mech.pose_names)})
-        cols.update({f"final_{key}": r.extras[key][:, -1] for key in r.extras})
-        frames.append(run_record("experiment", cols))
-    return concat(frames)
+    outputs = outputs_of(mech, r.x)
+    cols = {"problem": config.name, "case": case.label, "pose": case.index, "solver": spec.key,
+            "run": r.run_ids, "task_seed": seed, "final_fitness": r.fitness, "evaluations": r.evaluations,
+            "iterations_done": r.iterations_done,
+            # first iteration at which the run's final best-so-far fitness was reached
+            "iterations_to_best": np.argmax(r.history <= r.history[:, -1:], axis=1)}
+    if thr is not None:
+        cols["iterations_to_threshold"] = r.iterations_to(thr)
+        cols["evaluations_to_threshold"] = r.evaluations_to(thr)
+    cols.update({f"x_{name}": r.x[:, j] for j, name in enumerate(r.variable_names)})
+    if mech.kind == "serial":
+        cols.update({f"pose_{name}": outputs[:, j] for j, name in enumerate(mech.pose_names)})
+    if position_error_history is not None:
+        cols["position_error"] = position_error_history[:, -1]
+    target = case.target if case.target is not None else case.reference
+    if target is not None:
+        err = pose_error(mech, outputs, target)
+        cols.update({f"abs_error_{name}": err[:, j] for j, name in enumerate(mech.pose_names)})
+    cols.update({f"final_{key}": r.extras[key][:, -1] for key in r.extras})
+    return run_record("experiment", cols)
 
 
 def run_experiment(config: ExperimentConfig, *, progress: Callable[[str, int, int], None] | None = None,
-                   source: str | None = None, timing: bool = True) -> ExperimentResult:
+                   source: str | None = None, timing: bool = True) -> RunResult:
     """Run every (case, algorithm) task in this process; ``progress(label, done, total)`` is
     called after each algorithm (one task of the one runner, :func:`experiment_plan`).
 

@@ -15,14 +15,14 @@ from typing import Callable
 
 from fkopt.kinds.study.config import StudyConfig, load_study, study_from_dict
 from fkopt.kinds.study.kind import STUDY  # noqa: F401 (registers the kind)
-from fkopt.kinds.study.runner import StudyResult
+from fkopt.run.result import RunResult
 from fkopt.run.pipeline import run_config, run_in_memory
 
 
 def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1, executor: str = "local",
               scheduler: str | None = None, resume: bool = False,
               progress: Callable[[str, int, int], None] | None = None, source: str | None = None,
-              keep_tasks: bool = True) -> StudyResult:
+              keep_tasks: bool = True) -> RunResult:
     """Run (or resume) a study into ``OUT/<paper>/<name>/`` through the one pipeline
     (:func:`fkopt.run.pipeline.run_config`; the library call replaces an earlier result of
     any config, as ``--force`` does).
@@ -37,9 +37,9 @@ def run_study(config: StudyConfig, out: str | Path = "results", *, jobs: int = 1
                       scheduler=scheduler, resume=resume, keep_tasks=keep_tasks).result
 
 
-def rerun_in_memory(config: StudyConfig) -> StudyResult:
+def rerun_in_memory(config: StudyConfig) -> RunResult:
     """Every task computed in this process, nothing written (for checks and tests)."""
     return run_in_memory(config)
 
 
-__all__ = ["StudyConfig", "StudyResult", "load_study", "run_study", "study_from_dict"]
+__all__ = ["StudyConfig", "load_study", "run_study", "study_from_dict"]

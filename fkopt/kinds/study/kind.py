@@ -5,7 +5,7 @@ from fkopt.run.memory import algorithm_resources
 from fkopt.kinds.study import reports
 from fkopt.run.kinds import register
 from fkopt.run.tasks import Kind
-from fkopt.run.writers import CURVES, FIGURE, RUNS, STEPS, TABLE, TIMING, Output
+from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, Output
 from fkopt.solve import batch_bytes, chunk_size
 from fkopt.kinds.study.config import StudyConfig, study_from_dict
 from fkopt.kinds.study.runner import merge_study, study_plan
@@ -33,7 +33,7 @@ OUTPUTS = (
     Output("summary.csv", reports.summary_table, TABLE),
     Output("timing.csv", reports.timing_table, TIMING),
     Output("poses.csv", reports.poses_table, CURVES),
-    Output("runs.csv", reports.runs_table, CURVES, rows=RUNS),
+    RUNS_FILE,
     Output("ecdf.csv", reports.ecdf_of, CURVES, rows=STEPS),
     Output("stats.csv", reports.stats_of, CURVES),
     Output("heatmap.csv", reports.heatmap_table, CURVES),
@@ -45,4 +45,5 @@ OUTPUTS = (
     Output("tracking_time", reports.tracking_time_figure, FIGURE),
 )
 
-STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig))
+STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig,
+                      console=lambda result, folder: reports.summary_table(result)))

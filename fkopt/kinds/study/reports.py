@@ -34,128 +34,142 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from types import SimpleNamespace
+
 from fkopt.run import record
 from fkopt.run import plotting
+from fkopt.run.result import RunResult
 from fkopt.run.plotting import plt as _plt, save as _save
 from fkopt.files import nanmedian as _nanmedian
 from fkopt.kinds.study.statistics import ecdf_table, pairwise_tests
 
-# StudyResult (fkopt.kinds.study.runner) is only named in annotations: the runner imports this module.
+
+def _algorithms(sr: RunResult) -> list[SimpleNamespace]:
+    """Per algorithm (config order), its columns of the run record as (pose, run) arrays and its
+    per-pose times from the timing record: the views the per-pose tables and figures read."""
+    n, runs = len(sr.own.poses), sr.config.runs
+    out = []
+    for spec in sr.config.algorithms:
+        mine = sr.record[sr.record["solver"] == spec.key]
+        per_pose = lambda col: mine[col].to_numpy(float).reshape(n, runs)   # noqa: E731
+        errors = np.stack([per_pose(f"abs_error_{name}") for name in sr.own.mechanism.pose_names], axis=-1)
+        out.append(SimpleNamespace(
+            key=spec.key, spec=spec, population=spec.population or sr.config.population,
+            iterations=spec.iterations or sr.config.iterations, fitness=per_pose("final_fitness"),
+            evaluations=per_pose("evaluations"), evaluations_to=per_pose("evaluations_to_threshold"), errors=errors,
+            time_s=sr.timing.loc[sr.timing["solver"] == spec.key, "seconds"].to_numpy(float),
+            wall_s=sr.own.solve_s[spec.key]))
+    return out
 
 
-def case_label(sr: StudyResult) -> str:
+def case_label(sr: RunResult) -> str:
     return "trajectory" if sr.config.mode == "tracking" else "all"
 
 
 # -- tables --------------------------------------------------------------------------------------
-def summary_table(sr: StudyResult) -> pd.DataFrame:
+def summary_table(sr: RunResult) -> pd.DataFrame:
     """Per algorithm over every (pose, run) (the one summary writer, :func:`fkopt.run.record.summary_table`)."""
     settings = {ar.key: {"method": ar.spec.name, "population": ar.population, "iterations": ar.iterations,
-                         "runs": sr.config.runs} for ar in sr.algorithms}
+                         "runs": sr.config.runs} for ar in _algorithms(sr)}
     return record.summary_table(sr.record, settings, sr.config.threshold, by=("solver",), case=case_label(sr),
-                                extra={"poses": len(sr.poses)})
+                                extra={"poses": len(sr.own.poses)})
 
 
-def _pose_columns(sr: StudyResult, i: np.ndarray | int) -> dict:
-    cols = {f"{n}": sr.poses.points[i, j] for j, n in enumerate(sr.poses.names)}
-    if sr.mechanism.kind == "serial":
-        cols.update({f"target_{n}": sr.poses.targets[i, j] for j, n in enumerate(sr.compared_names)})
+def _pose_columns(sr: RunResult, i: np.ndarray | int) -> dict:
+    cols = {f"{n}": sr.own.poses.points[i, j] for j, n in enumerate(sr.own.poses.names)}
+    if sr.own.mechanism.kind == "serial":
+        cols.update({f"target_{n}": sr.own.poses.targets[i, j] for j, n in enumerate(sr.own.mechanism.pose_names)})
     return cols
 
 
-def poses_table(sr: StudyResult) -> pd.DataFrame:
+def poses_table(sr: RunResult) -> pd.DataFrame:
     thr = sr.config.threshold
-    n = len(sr.poses)
+    n = len(sr.own.poses)
     idx = np.arange(n)
     frames = []
-    for ar in sr.algorithms:
+    for ar in _algorithms(sr):
         med_ev = np.array([_nanmedian(row) for row in ar.evaluations_to])
-        df = pd.DataFrame({"pose": idx, "label": [sr.poses.label(i) for i in idx], **_pose_columns(sr, idx),
+        df = pd.DataFrame({"pose": idx, "label": [sr.own.poses.label(i) for i in idx], **_pose_columns(sr, idx),
                            "algorithm": ar.key, "median_fitness": np.median(ar.fitness, axis=1),
                            "best_fitness": np.min(ar.fitness, axis=1),
                            "success_rate": np.mean(ar.fitness < thr, axis=1),
                            "median_evaluations_to_threshold": med_ev,
                            "mean_evaluations": np.mean(ar.evaluations, axis=1)})
-        for j, name in enumerate(sr.compared_names):
+        for j, name in enumerate(sr.own.mechanism.pose_names):
             df[f"median_abs_error_{name}"] = np.median(ar.errors[:, :, j], axis=1)
         frames.append(df)
     return pd.concat(frames, ignore_index=True)
 
 
-def runs_table(sr: StudyResult) -> pd.DataFrame:
-    """One row per (pose, algorithm, run), poses from 0: the run record's (:func:`fkopt.run.record.runs_table`)."""
-    return record.runs_table(sr.record)
-
-
-def timing_table(sr: StudyResult) -> pd.DataFrame:
+def timing_table(sr: RunResult) -> pd.DataFrame:
     """Per algorithm, ms per run of each pose (its share of the batch; the one timing writer,
     :func:`fkopt.run.record.timing_table`)."""
-    settings = {(case_label(sr), ar.key): {"runs": sr.config.runs, "poses": len(sr.poses), "total_s": float(ar.wall_s)}
-                for ar in sr.algorithms}
+    settings = {(case_label(sr), ar.key): {"runs": sr.config.runs, "poses": len(sr.own.poses), "total_s": float(ar.wall_s)}
+                for ar in _algorithms(sr)}
     return record.timing_table(sr.timing, settings, names=record.FILE_NAMES["study"])
 
 
-def _per_algorithm(sr: StudyResult, column: str) -> dict[str, np.ndarray]:
+def _per_algorithm(sr: RunResult, column: str) -> dict[str, np.ndarray]:
     """A run-record column pooled over every (pose, run) of each algorithm, in config order."""
     return {key: g[column].to_numpy(float) for key, g in sr.record.groupby("solver", sort=False)}
 
 
-def ecdf_of(sr: StudyResult) -> pd.DataFrame:
+def ecdf_of(sr: RunResult) -> pd.DataFrame:
     """Fraction of (pose, run) pairs solved vs evaluations, from the run record."""
     return ecdf_table(_per_algorithm(sr, "evaluations_to_threshold"))
 
 
-def stats_of(sr: StudyResult) -> pd.DataFrame:
+def stats_of(sr: RunResult) -> pd.DataFrame:
     """Pairwise rank tests over the run record's (pose, run) samples (Holm per metric)."""
     samples = {metric: _per_algorithm(sr, metric) for metric in ("final_fitness", "evaluations_to_threshold")}
     return pairwise_tests(samples, sr.config.alpha)
 
 
-def heatmap_table(sr: StudyResult) -> pd.DataFrame | None:
-    axes = sr.poses.grid_axes
+def heatmap_table(sr: RunResult) -> pd.DataFrame | None:
+    axes = sr.own.poses.grid_axes
     if axes is None:
         return None
-    names = sr.poses.names
+    names = sr.own.poses.names
     j1, j2 = names.index(axes[0]), names.index(axes[1])
     thr = sr.config.threshold
     frames = []
-    for ar in sr.algorithms:
+    for ar in _algorithms(sr):
         frames.append(pd.DataFrame({
-            axes[0]: sr.poses.points[:, j1], axes[1]: sr.poses.points[:, j2], "algorithm": ar.key,
+            axes[0]: sr.own.poses.points[:, j1], axes[1]: sr.own.poses.points[:, j2], "algorithm": ar.key,
             "median_fitness": np.median(ar.fitness, axis=1), "success_rate": np.mean(ar.fitness < thr, axis=1),
             "median_evaluations_to_threshold": [_nanmedian(row) for row in ar.evaluations_to],
             **{f"median_abs_error_{n}": np.median(ar.errors[:, :, j], axis=1)
-               for j, n in enumerate(sr.compared_names)}}))
+               for j, n in enumerate(sr.own.mechanism.pose_names)}}))
     return pd.concat(frames, ignore_index=True)
 
 
-def tracking_table(sr: StudyResult) -> pd.DataFrame | None:
+def tracking_table(sr: RunResult) -> pd.DataFrame | None:
     if sr.config.mode != "tracking":
         return None
     thr = sr.config.threshold
-    step = sr.poses.step
+    step = sr.own.poses.step
     frames = []
-    for ar in sr.algorithms:
+    for ar in _algorithms(sr):
         warm = (step > 0) & ar.spec.warm_start
-        df = pd.DataFrame({"trajectory": sr.poses.trajectory, "step": step, "algorithm": ar.key,
+        df = pd.DataFrame({"trajectory": sr.own.poses.trajectory, "step": step, "algorithm": ar.key,
                            "warm_start": warm,
-                           **{n_: sr.poses.points[:, j] for j, n_ in enumerate(sr.poses.names)},
+                           **{n_: sr.own.poses.points[:, j] for j, n_ in enumerate(sr.own.poses.names)},
                            "median_fitness": np.median(ar.fitness, axis=1),
                            "success_rate": np.mean(ar.fitness < thr, axis=1),
                            "median_evaluations": np.median(ar.evaluations, axis=1)})
-        for j, name in enumerate(sr.compared_names):
+        for j, name in enumerate(sr.own.mechanism.pose_names):
             df[f"max_abs_error_{name}"] = ar.errors[:, :, j].max(axis=1)
         frames.append(df)
     return pd.concat(frames, ignore_index=True)
 
 
-def tracking_timing_table(sr: StudyResult) -> pd.DataFrame | None:
+def tracking_timing_table(sr: RunResult) -> pd.DataFrame | None:
     if sr.config.mode != "tracking":
         return None
     runs = sr.config.runs
-    return pd.concat([pd.DataFrame({"trajectory": sr.poses.trajectory, "step": sr.poses.step,
+    return pd.concat([pd.DataFrame({"trajectory": sr.own.poses.trajectory, "step": sr.own.poses.step,
                                     "algorithm": ar.key, "ms_per_run": ar.time_s / runs * 1e3})
-                      for ar in sr.algorithms], ignore_index=True)
+                      for ar in _algorithms(sr)], ignore_index=True)
 
 
 # -- figures -------------------------------------------------------------------------------------
@@ -171,20 +185,20 @@ def _name(ar) -> str:
 _STYLES = ("-", "--", ":", "-.")
 
 
-def _axis(sr: StudyResult, var: str) -> str:
-    units = dict(zip(sr.mechanism.unknown_names, sr.mechanism.unknown_units))
+def _axis(sr: RunResult, var: str) -> str:
+    units = dict(zip(sr.own.mechanism.unknown_names, sr.own.mechanism.unknown_units))
     return f"{var} ({units[var]})" if var in units else var
 
 
-def ecdf_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+def ecdf_figure(sr: RunResult, folder: Path, tables: dict) -> list[str]:
     """Fraction of (pose, run) pairs solved vs evaluations (log x), per algorithm."""
     ecdf = tables.get("ecdf.csv")
     if ecdf is None:
         return []
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
-    xmax = float(np.nanmax([np.nanmax(ar.evaluations) for ar in sr.algorithms] + [1.0]))
-    for ar in sr.algorithms:
+    xmax = float(np.nanmax([np.nanmax(ar.evaluations) for ar in _algorithms(sr)] + [1.0]))
+    for ar in _algorithms(sr):
         d = ecdf[(ecdf.algorithm == ar.key) & ecdf.evaluations.notna()]
         if d.empty:
             ax.plot([], [], label=f"{_name(ar)} (none solved)")
@@ -198,21 +212,21 @@ def ecdf_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     ax.set_ylabel(f"fraction of (pose, run) pairs with fitness < {sr.config.threshold:g}")
     ax.grid(True, which="major", alpha=0.3)
     plotting.legend_off_data(ax, fontsize=7)
-    ax.set_title(f"{sr.config.title or sr.config.name}: {len(sr.poses)} poses x {sr.config.runs} runs",
+    ax.set_title(f"{sr.config.title or sr.config.name}: {len(sr.own.poses)} poses x {sr.config.runs} runs",
                  fontsize=9)
     names = _save(fig, folder / "ecdf.png")
     plt.close(fig)
     return names
 
 
-def heatmap_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+def heatmap_figure(sr: RunResult, folder: Path, tables: dict) -> list[str]:
     """Rows: log10 median final fitness, success rate, median evaluations to the threshold."""
     table = tables.get("heatmap.csv")
     if table is None:
         return []
     plt = _plt()
-    a1, a2 = sr.poses.grid_axes
-    n = len(sr.algorithms)
+    a1, a2 = sr.own.poses.grid_axes
+    n = len(_algorithms(sr))
     from matplotlib.colors import LogNorm
     fig, axes = plt.subplots(3, n, figsize=(3.0 * n + 1.2, 8.0), squeeze=False, layout="constrained")
     u1, u2 = np.unique(table[a1]), np.unique(table[a2])
@@ -230,7 +244,7 @@ def heatmap_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
                          np.nanmax(ev) if np.isfinite(ev).any() else 1.0))]
     for r, (col, label, cmap, (vmin, vmax)) in enumerate(rows):
         im = None
-        for k, ar in enumerate(sr.algorithms):
+        for k, ar in enumerate(_algorithms(sr)):
             d = table[table.algorithm == ar.key]
             grid = np.full((u2.size, u1.size), np.nan)
             vals = d[col].to_numpy(dtype=float)
@@ -260,7 +274,7 @@ def heatmap_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     return names
 
 
-def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+def tracking_figure(sr: RunResult, folder: Path, tables: dict) -> list[str]:
     """Per trajectory step: median final fitness and evaluations (warm-started vs cold)."""
     table = tables.get("tracking.csv")
     if table is None:
@@ -269,7 +283,7 @@ def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     floor = plotting.floor_of(table.median_fitness.to_numpy(dtype=float))
     several = table.trajectory.nunique() > 1
-    for ar in sr.algorithms:
+    for ar in _algorithms(sr):
         name = _name(ar) + ("" if ar.spec.warm_start or "cold" in ar.key else " (cold)")
         color = None
         for traj, d in table[table.algorithm == ar.key].groupby("trajectory"):
@@ -296,14 +310,14 @@ def tracking_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
     return names
 
 
-def tracking_time_figure(sr: StudyResult, folder: Path, tables: dict) -> list[str]:
+def tracking_time_figure(sr: RunResult, folder: Path, tables: dict) -> list[str]:
     """Time per step and run (measured; TIMING.md)."""
     table = tables.get("tracking_timing.csv")
     if table is None:
         return []
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 3.6))
-    for ar in sr.algorithms:
+    for ar in _algorithms(sr):
         color = None
         for traj, d in table[table.algorithm == ar.key].groupby("trajectory"):
             line, = ax.plot(d.step, d.ms_per_run, marker=".", lw=1, color=color, ls=_STYLES[(traj - 1) % len(_STYLES)],
@@ -321,18 +335,18 @@ def tracking_time_figure(sr: StudyResult, folder: Path, tables: dict) -> list[st
 
 
 # -- folder --------------------------------------------------------------------------------------
-def meta(sr: StudyResult) -> dict:
+def meta(sr: RunResult) -> dict:
     """What the config and the seed fix (the environment goes to env.json)."""
     objective = sr.config.objective
     if objective is None:
         from fkopt.problems import fk_problem, ik_problem
-        make = ik_problem if sr.mechanism.kind == "serial" else fk_problem
-        objective = getattr(make(sr.mechanism, sr.poses.inputs[0]), "objective", None)
+        make = ik_problem if sr.own.mechanism.kind == "serial" else fk_problem
+        objective = getattr(make(sr.own.mechanism, sr.own.poses.inputs[0]), "objective", None)
     return {
         "kind": "study", "experiment": sr.config.name, "paper": sr.config.paper, "title": sr.config.title,
         "config_file": sr.source, "config": sr.config.model_dump(mode="json"), "seed": sr.config.seed,
         "task_seeds": "pose (or step) i of algorithm L: fkopt.run.solving.task_seed(seed, i, L); "
                       "run k: child k of that seed (fkopt.numerics.streams)",
-        "fingerprint": sr.config.fingerprint(), "poses": len(sr.poses),
-        "mechanism": sr.mechanism.describe(), "objective": objective,
+        "fingerprint": sr.config.fingerprint(), "poses": len(sr.own.poses),
+        "mechanism": sr.own.mechanism.describe(), "objective": objective,
     }

@@ -11,8 +11,9 @@
   keeps each finished one as a task file in ``OUT/<paper>/.<name>.partial/tasks/`` with its
   SHA-256, resumes (``fkopt study --resume``) from the files that still pass
   :func:`record_problem`, and publishes them in the result's ``tasks/``.
-* :func:`merge` reads the records back into a :class:`StudyResult`, which
-  :mod:`fkopt.kinds.study.reports` writes (through :mod:`fkopt.run.writers`).
+* :func:`merge_study` reads the records back into the run record of a
+  :class:`~fkopt.run.result.RunResult` (the pose set in its ``own`` slot, :class:`StudyOwn`),
+  which :mod:`fkopt.kinds.study.reports` writes (through :mod:`fkopt.run.writers`).
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ import math
 import os
 import re
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Callable
@@ -32,10 +33,11 @@ from fkopt.run.config_base import files_folder
 from fkopt.run.solving import build_mechanism, make_problem, solve_cases, start_point, task_seed
 from fkopt.problems import BoxedProblem
 from fkopt.run.record import BATCH, concat, run_record, timing_record
+from fkopt.run.result import RunResult
 from fkopt.solve import make_algorithm, pick_events
 from fkopt.numerics.streams import case_seed
 from fkopt.run.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder  # noqa: F401 (tests, API)
-from fkopt.kinds.study.config import StudyAlgorithmSpec, StudyConfig
+from fkopt.kinds.study.config import StudyConfig
 from fkopt.kinds.study.poses import PoseSet, build_poses
 
 
@@ -246,58 +248,24 @@ def record_problem(rec, ident: str, task: Task, config: StudyConfig, dim: int) -
 
 # -- merged result -------------------------------------------------------------------------------
 @dataclass
-class AlgorithmResult:
-    spec: StudyAlgorithmSpec
-    population: int
-    iterations: int
-    seeds: np.ndarray            # (n,)
-    fitness: np.ndarray          # (n, runs)
-    evaluations: np.ndarray      # (n, runs)
-    iterations_done: np.ndarray  # (n, runs)
-    iterations_to: np.ndarray    # (n, runs), NaN: never below the threshold
-    evaluations_to: np.ndarray   # (n, runs), NaN: never below the threshold
-    x: np.ndarray                # (n, runs, dim) solution in the unknowns
-    outputs: np.ndarray          # (n, runs, n_pose) the pose it corresponds to
-    errors: np.ndarray           # (n, runs, n_pose) |pose - target| (angles wrapped)
-    time_s: np.ndarray           # (n,) wall time of all runs of each pose/step
-    start: np.ndarray | None = None   # (n, runs, dim) tracking start points (NaN: cold swarm)
-    wall_s: float = 0.0
+class StudyOwn:
+    """What only a study has (the :attr:`fkopt.run.result.RunResult.own` slot): its mechanism,
+    its pose set (points, targets, grid axes, trajectories) and each algorithm's wall time (the
+    sum of its tasks'); the runs themselves are the run record's rows."""
 
-    @property
-    def key(self) -> str:
-        return self.spec.key
-
-
-@dataclass
-class StudyResult:
-    config: StudyConfig
     mechanism: object
     poses: PoseSet
-    algorithms: list[AlgorithmResult]
-    wall_s: float
-    source: str | None = None
-    computed: list[str] = field(default_factory=list)   # task ids computed by this invocation
-    folder: Path | None = None
-    record: object = None     # the run record (:mod:`fkopt.run.record`): one row per (algorithm, pose, run)
-    timing: object = None     # the timing record (:mod:`fkopt.run.record`): one batch per (algorithm, pose)
-
-    @property
-    def compared_names(self):
-        return self.mechanism.pose_names
-
-    @property
-    def compared_units(self):
-        return self.mechanism.pose_units
-
-    def get(self, label: str) -> AlgorithmResult:
-        return next(a for a in self.algorithms if a.key == label)
+    solve_s: dict[str, float]
 
 
-def merge(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]) -> list[AlgorithmResult]:
+def study_tables(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]):
+    """The run record, the timing record and each algorithm's wall time, from the task records:
+    algorithm by algorithm, pose by pose (from 0, the index its seed takes), run by run."""
     from fkopt.run.solving import outputs_of, pose_error
     n, runs, dim = len(poses), config.runs, len(mech.unknown_names)
     tasks = plan_tasks(config, n)
-    out = []
+    case = "trajectory" if config.mode == "tracking" else "all"
+    frames, timings, walls = [], [], {}
     for a, spec in enumerate(config.algorithms):
         arr = {k: np.full((n, runs), np.nan) for k in ("fitness", "evaluations", "iterations_done",
                                                          "iterations_to", "evaluations_to")}
@@ -317,15 +285,23 @@ def merge(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]) -
             seeds[idx] = rec["seeds"]
             time_s[idx] = rec["time_s"]
             wall += rec["wall_s"]
-        outputs = outputs_of(mech, x)
-        errors = pose_error(mech, outputs, poses.targets[:, None, :])
-        out.append(AlgorithmResult(
-            spec=spec, population=spec.population or config.population,
-            iterations=spec.iterations or config.iterations, seeds=seeds, fitness=arr["fitness"],
-            evaluations=arr["evaluations"], iterations_done=arr["iterations_done"],
-            iterations_to=arr["iterations_to"], evaluations_to=arr["evaluations_to"], x=x,
-            outputs=outputs, errors=errors, time_s=time_s, start=start, wall_s=wall))
-    return out
+        errors = pose_error(mech, outputs_of(mech, x), poses.targets[:, None, :])
+        cols = {"problem": config.name, "pose": np.repeat(np.arange(n), runs), "solver": spec.key,
+                "run": np.tile(np.arange(runs), n), "task_seed": np.repeat(seeds, runs),
+                "final_fitness": arr["fitness"].ravel(), "evaluations": arr["evaluations"].ravel(),
+                "iterations_done": arr["iterations_done"].ravel(), "iterations_to_threshold": arr["iterations_to"].ravel(),
+                "evaluations_to_threshold": arr["evaluations_to"].ravel()}
+        if start is not None:
+            cols.update({f"start_{name}": start[:, :, j].ravel() for j, name in enumerate(poses.names)})
+        cols.update({f"x_{name}": x[:, :, j].ravel() for j, name in enumerate(poses.names)})
+        cols.update({f"abs_error_{name}": errors[:, :, j].ravel() for j, name in enumerate(mech.pose_names)})
+        frames.append(run_record("study", cols))
+        # each pose's (or tracking step's) wall time over its runs: its share of the chunk's batched solve
+        timings.append(timing_record("study", {"problem": config.name, "case": case, "pose": np.arange(n),
+                                               "solver": spec.key, "runs": config.runs, "seconds": time_s,
+                                               "mode": BATCH}))
+        walls[spec.key] = wall
+    return concat(frames), concat(timings), walls
 
 
 # -- the one runner's view of a study -------------------------------------------------------------
@@ -357,41 +333,12 @@ def study_plan(config: StudyConfig, source: str | None = None, timing: bool = Tr
                 context=_Context(mech, poses, time.perf_counter() - started), name=f"study '{config.name}'")
 
 
-def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None = None,
-                folder: Path | None = None, **_) -> StudyResult:
+def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None = None, **_) -> RunResult:
+    """The study's :class:`~fkopt.run.result.RunResult`: run and timing records from its task
+    records, its pose set in ``own`` (:class:`StudyOwn`)."""
     merging = time.perf_counter()
     ctx: _Context = plan.context
-    algorithms = merge(config, ctx.mech, ctx.poses, ran.records)
+    runs, timing, walls = study_tables(config, ctx.mech, ctx.poses, ran.records)
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
-    return StudyResult(config, ctx.mech, ctx.poses, algorithms, wall, source,
-                       list(ran.computed), folder, study_record(config, ctx.mech, ctx.poses, algorithms),
-                       study_timing(config, ctx.poses, algorithms))
-
-
-def study_timing(config: StudyConfig, poses: PoseSet, algorithms: list[AlgorithmResult]):
-    """The timing record (:mod:`fkopt.run.record`) of a study: each pose's (or tracking step's) wall
-    time over its runs, per algorithm (its share of the chunk's batched solve)."""
-    case = "trajectory" if config.mode == "tracking" else "all"
-    return concat([timing_record("study", {"problem": config.name, "case": case, "pose": np.arange(len(poses)),
-                                           "solver": ar.key, "runs": config.runs, "seconds": ar.time_s,
-                                           "mode": BATCH}) for ar in algorithms])
-
-
-def study_record(config: StudyConfig, mech, poses: PoseSet, algorithms: list[AlgorithmResult]):
-    """The run record (:mod:`fkopt.run.record`) of a study: algorithm by algorithm, pose by pose (from
-    0, the index its seed takes), run by run."""
-    n, runs = len(poses), config.runs
-    frames = []
-    for ar in algorithms:
-        cols = {"problem": config.name, "pose": np.repeat(np.arange(n), runs), "solver": ar.key,
-                "run": np.tile(np.arange(runs), n), "task_seed": np.repeat(ar.seeds, runs),
-                "final_fitness": ar.fitness.ravel(), "evaluations": ar.evaluations.ravel(),
-                "iterations_done": ar.iterations_done.ravel(), "iterations_to_threshold": ar.iterations_to.ravel(),
-                "evaluations_to_threshold": ar.evaluations_to.ravel()}
-        if ar.start is not None:
-            cols.update({f"start_{name}": ar.start[:, :, j].ravel() for j, name in enumerate(poses.names)})
-        cols.update({f"x_{name}": ar.x[:, :, j].ravel() for j, name in enumerate(poses.names)})
-        cols.update({f"abs_error_{name}": ar.errors[:, :, j].ravel() for j, name in enumerate(mech.pose_names)})
-        frames.append(run_record("study", cols))
-    return concat(frames)
-
+    return RunResult(config, runs, timing, None, StudyOwn(ctx.mech, ctx.poses, walls), wall, source,
+                     list(ran.computed))
