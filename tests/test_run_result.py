@@ -172,3 +172,28 @@ def test_run_tasks_hands_the_same_records_to_a_worker_process():
         a.pop("wall_s"), b.pop("wall_s")
         a["curves"].pop("time_per_run"), b["curves"].pop("time_per_run")
         assert json.dumps(a) == json.dumps(b), t.id
+
+
+def test_answers_use_the_record_names_and_old_answers_ask_for_a_re_store(tmp_path):
+    """The clock track's answers.csv.gz says problem and pose (the run record's names); a board
+    stored before the rename fails fkopt check with one line naming the old columns."""
+    import shutil
+
+    import pandas as pd
+
+    from fkopt.kinbench.answer_checks import ANSWER_COLUMNS as checked
+    from fkopt.kinbench.clock import ANSWER_COLUMNS
+    from fkopt.kinbench.verify import reverify
+    from fkopt.run.pipeline import load_any
+    assert checked is ANSWER_COLUMNS and ANSWER_COLUMNS[:3] == ("problem", "set", "pose")
+    quick = ROOT / "results" / "kinbench" / "kinbench-v3-robots-quick"
+    stored = pd.read_csv(quick / "answers.csv.gz")
+    assert list(stored.columns[:len(ANSWER_COLUMNS)]) == list(ANSWER_COLUMNS)
+    folder = tmp_path / "board"
+    shutil.copytree(quick, folder)
+    stored.rename(columns={"problem": "robot", "pose": "query"}).to_csv(
+        folder / "answers.csv.gz", index=False, float_format="%.17g")
+    config = load_any(ROOT / "configs" / "suites" / "kinbench-v3-robots.yaml").quick_tier()
+    rows = reverify(folder, config)
+    assert len(rows) == 1 and rows[0][2] == "columns" and rows[0][3] == "robot, query"
+    assert "re-store this board" in rows[0][5]
