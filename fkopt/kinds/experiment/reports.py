@@ -49,6 +49,7 @@ from fkopt.run.result import RunResult
 from fkopt.run.writers import FLOAT, write_outputs, write_result
 from fkopt.run import plotting
 from fkopt.kinds.experiment.runner import outputs_of, pose_error
+from fkopt.run.solving import budget
 
 #: Fitness of exactly 0 cannot be drawn on a log axis; it is drawn at this floor (and said so).
 LOG_FLOOR = 1e-32
@@ -57,23 +58,25 @@ MAX_CASE_CURVES = 6
 
 # -- tables ------------------------------------------------------------------------------------
 def summary_table(er: RunResult) -> pd.DataFrame:
-    """Per case and algorithm, over its runs (the one summary writer, :func:`fkopt.run.record.summary_table`)."""
+    """Per case and algorithm, over its runs: the run record's (the one summary writer,
+    :func:`fkopt.run.record.summary_table`), with each algorithm's settings from the config."""
     settings = {}
-    for rec in er.own.solves:
-        r, spec = rec.result, rec.spec
+    for spec in er.config.algorithms:
+        b = budget(er.config, spec)
         # sorted: a config reloaded from meta.json has sorted keys
         printed = {f"printed_{k}": v for k, v in sorted(spec.printed.items()) if not k.endswith("_ms")}
-        settings[spec.key] = {"method": spec.name, "population": r.population, "iterations": r.iterations,
-                              "runs": r.runs, "printed": printed}
+        settings[spec.key] = {"method": spec.name, "population": b["population"], "iterations": b["iterations"],
+                              "runs": b["runs"], "printed": printed}
     return record.summary_table(er.record, settings, er.config.threshold)
 
 
 def timing_table(er: RunResult) -> pd.DataFrame:
     """Time per run measured one run at a time on a sample of runs (:mod:`.timing`), per timed
     case and algorithm (the one timing writer, :func:`fkopt.run.record.timing_table`)."""
-    settings = {(rec.case.label, rec.spec.key): {
-        "runs": rec.result.runs, "total_s": er.own.solve_s[rec.spec.key],
-        **{f"printed_{k}": v for k, v in sorted(rec.spec.printed.items()) if k.endswith("_ms")}} for rec in er.own.solves}
+    settings = {(case.label, spec.key): {
+        "runs": er.config.runs, "total_s": er.own.solve_s[spec.key],
+        **{f"printed_{k}": v for k, v in sorted(spec.printed.items()) if k.endswith("_ms")}}
+        for case in er.own.cases for spec in er.config.algorithms}
     return record.timing_table(er.timing, settings, names=record.FILE_NAMES["experiment"], timed_alone=True)
 
 
