@@ -212,8 +212,13 @@ def _run_locked(kind: Kind, plan: Plan, config, out, folder: Path, *, source, pr
     if plan.stored:
         store = TaskStore(out, work_folder(out, config), folder, plan.name,
                           config.model_dump(mode="json"), plan.fingerprint)
-    ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, store=store, resume=resume,
-                    progress=progress, done=solved)
+    try:
+        ran = run_tasks(plan, executor=executor, jobs=jobs, scheduler=scheduler, store=store, resume=resume,
+                        progress=progress, done=solved)
+    except Exception:
+        if store is not None and not store.digests:     # a failure before any task finished: nothing to resume
+            store.discard()
+        raise
     result = kind.merge(config, plan, ran, source=source, timing=True, folder=folder)
     result.folder = folder
     wall = getattr(result, "wall_s", None)        # the kind's own account (solves made elsewhere too)
