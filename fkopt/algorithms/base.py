@@ -169,7 +169,7 @@ def evaluated(state, f: np.ndarray, rows: np.ndarray | None = None) -> None:
 
 def log_arrays(state, runs: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The run's :class:`EvaluationLog` as the arrays a compiled iteration updates in place while
-    it reports its values (best, count, active: :func:`fkopt.numerics.compiled._log_points`, the
+    it reports its values (best, count, active: :func:`fkopt.algorithms.kernels.log_points`, the
     same rule as :meth:`EvaluationLog.add`); scratch arrays outside :meth:`Algorithm.minimize`.
     Hand the improvements it returns to :func:`log_kept`."""
     log = getattr(state, "log", None)
@@ -206,25 +206,28 @@ def rows_of(problem, rows: np.ndarray):
     return problem if getattr(problem, "cases", None) is None else problem.take(rows)
 
 
-def compiled_step(problem, kind: str):
-    """(compiled iteration, absolute objective) when the problem's mechanism offers one for the
-    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness unless
+def compiled_step(problem, make):
+    """(compiled iteration, absolute objective) when the problem's mechanism offers its fitness
+    compiled for swarm iterations (``compiled_swarm_fitness()``: a
+    :class:`fkopt.mechanisms.base.CompiledFitness`, the 3-RPS FK fitness, unless
     ``FKOPT_NUMERICS=numpy`` or numba is missing) and the problem is a plain FK problem of three
-    variables without angle-valued joints, else None. The same operations as the numpy
-    iteration, numpy's own ``np.tan`` included: the same bits (tests/test_numerics.py)."""
+    variables without angle-valued joints, else None. ``make(fitness)`` builds the algorithm's
+    iteration on it (:func:`fkopt.algorithms.pso_kernels.pso_iteration`,
+    :func:`fkopt.algorithms.abc_kernels.abc_iteration`): the same operations as the numpy
+    iteration, numpy's own ``np.tan`` included, so the same bits (tests/test_numerics.py)."""
     # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
     # or a caller may change the variable between iterations).
-    key = (kind, os.environ.get(_NUMERICS_ENV))
+    key = (make, os.environ.get(_NUMERICS_ENV))
     cache = getattr(problem, "_compiled_steps", None)
     if cache is not None and key in cache:
         return cache[key]
-    make = getattr(getattr(problem, "mechanism", None), f"compiled_{kind}_step", None)
+    offer = getattr(getattr(problem, "mechanism", None), "compiled_swarm_fitness", None)
     rows = getattr(problem, "_joint_rows", None)
-    if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
+    if offer is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
         got = None
     else:
-        step = make()
-        got = None if step is None else (step, problem.objective == "absolute")
+        fitness = offer()
+        got = None if fitness is None else (make(fitness), problem.objective == "absolute")
     if cache is None:
         try:
             cache = problem._compiled_steps = {}
