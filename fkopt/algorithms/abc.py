@@ -270,11 +270,12 @@ class ABC(Algorithm):
         C = getattr(self.params, "C", 0.0)
         # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
         # (a target per row: the numpy path evaluates the fresh scouts in a fitness call of their own)
-        scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
-                           problem.bounds, J, absolute, log_arrays(state, runs), problem.cases is not None)
+        evaluations, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
+                                 problem.bounds, J, absolute, log_arrays(state, runs), problem.cases is not None,
+                                 np.ascontiguousarray(state.evaluations, dtype=np.int64))
         log_kept(state, kept)
         state.best_x, state.best_f, state.best_folded = best_x, best_f, True
-        state.evaluations = state.evaluations + (2 * population + scout)
+        state.evaluations = evaluations         # + 2 SN, + 1 where a scout flew
 
     def step(self, state, xs, xk, phi, streams):
         """The move added to the chosen coordinate, on whole rows (overridden by GABC).

@@ -188,11 +188,12 @@ def _kernels(prepare, value):
 
     @njit(cache=True, error_model="numpy")
     def onlooker_finish(x, f, trial, J, params, absolute, src_all, jj_all, mv_all, out, fo, best_x, best_f, lbest,
-                        lcount, lactive, hr, he, hf, nh, block):
+                        lcount, lactive, hr, he, hf, nh, block, scout, evals, new_evals):
         """After the ufunc on the onlookers' candidates, for every run: their fitness into fo, the
         reports to the log, then the synchronous onlookers -- per source the lowest candidate, the
         first onlooker reaching it, if it beats the source; a trial per attempt -- and the sources
-        folded into the best-so-far (:func:`fold_best`, what minimize's update_best does next).
+        folded into the best-so-far (:func:`fold_best`, what minimize's update_best does next); the
+        runs' evaluations after the iteration (2 SN, one more where a scout flew) into new_evals.
         Returns nh."""
         runs, pop, dim = x.shape
         n = runs * pop
@@ -232,6 +233,7 @@ def _kernels(prepare, value):
                     f[a, s] = bs[s]
                     trial[a, s] = 0
             fold_best(a, x, f, best_x, best_f)
+            new_evals[a] = evals[a] + (2 * pop + (1 if scout[a] >= 0 else 0))
         return nh
 
     return employed_move, employed_finish, onlooker_finish
@@ -239,19 +241,19 @@ def _kernels(prepare, value):
 
 def abc_iteration(fitness):
     """One ABC or GABC iteration on ``fitness`` (a :class:`fkopt.mechanisms.base.CompiledFitness`):
-    ``step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate)`` runs
+    ``step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate, evaluations)`` runs
     :func:`employed_move`, the ufunc, :func:`employed_finish`, the ufunc, :func:`onlooker_finish` on
     the state arrays x, f, trial (C-contiguous, updated in place) and best_x, best_f (updated in
     place: pass copies; GABC's refresh between the phases and minimize's update_best after the
     iteration both folded in), reporting to ``log`` (best (runs,) float, count (runs,) int64, active
     (runs,) bool, updated in place). ``rule``: the move (0 ABC, 1 GABC mao2017, 2 GABC zhu2010);
     ``separate``: the numpy path evaluates the fresh scouts in a fitness call of their own (a target
-    per row). Returns (scout (runs,) 0/1, (rows, evaluation numbers, values) of the improvements
-    the log keeps)."""
+    per row); ``evaluations``: the runs' counts before the iteration. Returns (the counts after it,
+    a new array; (rows, evaluation numbers, values) of the improvements the log keeps)."""
     employed_move, employed_finish, onlooker_finish = _kernels(fitness.prepare, fitness.value)
     ufunc, width, block, params = fitness.ufunc, fitness.width, fitness.block, fitness.params
 
-    def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate):
+    def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate, evaluations):
         runs, pop = f.shape
         n = runs * pop
         separate = bool(separate)
@@ -274,7 +276,8 @@ def abc_iteration(fitness):
         nh = employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, params, absolute, separate, ns, jj,
                              mv, scout, out, fe, fo_src, fo_jj, fo_mv, arg, best, count, active, hr, he, hf, block)
         ufunc(arg, out, ((0, n),), block)
+        new_evals = np.empty(runs, dtype=np.int64)
         nh = onlooker_finish(x, f, trial, J, params, absolute, fo_src, fo_jj, fo_mv, out, fo, best_x, best_f, best,
-                             count, active, hr, he, hf, nh, block)
-        return (scout >= 0).astype(np.int64), kept(hr, he, hf, nh)
+                             count, active, hr, he, hf, nh, block, scout, evaluations, new_evals)
+        return new_evals, kept(hr, he, hf, nh)
     return step

@@ -16,7 +16,6 @@ iteration on, so its numbers do not depend on the other runs of the batch.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, ClassVar
@@ -26,7 +25,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
 from fkopt.errors import FkoptError
 from fkopt.files import no_quoted_numbers
-from fkopt.numerics.path import ENV as _NUMERICS_ENV
+from fkopt.numerics import path as numerics_path
 from fkopt.progress import tick
 from fkopt.numerics.streams import RunStreams
 
@@ -145,8 +144,8 @@ class EvaluationLog:
     def finish(self, evaluations: np.ndarray, best_f: np.ndarray) -> None:
         """Close the iteration: an improvement of ``best_f`` that no reported value reached
         is put at the iteration's last evaluation."""
-        gap = self.active & (best_f < self.best)
-        if gap.any():
+        gap = best_f < self.best
+        if gap.any() and (gap := gap & self.active).any():     # rarely: most iterations report every value
             r = np.flatnonzero(gap)
             self._keep(r, np.asarray(evaluations)[r], best_f[r])
             self.best = np.where(gap, best_f, self.best)
@@ -217,7 +216,7 @@ def compiled_step(problem, make):
     iteration, numpy's own ``np.tan`` included, so the same bits (tests/test_numerics.py)."""
     # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
     # or a caller may change the variable between iterations).
-    key = (make, os.environ.get(_NUMERICS_ENV))
+    key = (make, numerics_path.requested())
     cache = getattr(problem, "_compiled_steps", None)
     if cache is not None and key in cache:
         return cache[key]

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import threading
 
+import numpy as np
+
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 _scratch = threading.local()
@@ -30,8 +32,14 @@ def scratch_arrays(key, make):
     return got
 
 
+_NONE_KEPT = (np.empty(0, dtype=np.intp), np.empty(0, dtype=np.int64), np.empty(0))
+
+
 def kept(hr, he, hf, nh):
-    """The log's improvements (rows, evaluation numbers, values) out of the scratch arrays, as new arrays."""
+    """The log's improvements (rows, evaluation numbers, values) out of the scratch arrays, as new
+    arrays (most iterations keep none: then shared empty arrays, which the log never stores)."""
+    if nh == 0:
+        return _NONE_KEPT
     return hr[:nh].copy(), he[:nh].copy(), hf[:nh].copy()
 
 
