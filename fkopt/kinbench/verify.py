@@ -24,15 +24,24 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     board follows from the stored answers. The answers are counted first
     (:func:`fkopt.kinbench.answer_checks.key_problems`): one per (query, solver, timeout) the
     config implies, so a failure deleted, a success repeated or a solver dropped is a mismatch
-    naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`)."""
+    naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`).
+    The all-solutions and paths tracks: :func:`fkopt.kinbench.branch_tracks.reverify`."""
+    from fkopt.kinbench.branch_tracks import reverify as reverify_branch_tracks
+    folder = Path(folder)
+    if config.tracks is None:
+        return []
+    return _reverify_clock(folder, config) + reverify_branch_tracks(folder, config)
+
+
+def _reverify_clock(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
+    """:func:`reverify` of the clock track (module docstring)."""
     from fkopt.errors import FkoptError
     from fkopt.files import csv_numbers, read_stored_csv
     from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
     from fkopt.kinbench.clock import answer_prefix, targets_of, track_arm, track_cases, track_settings, verdicts
     from fkopt.kinbench.posesets import load_pose_sets
     from fkopt.kinbench.reports import robots_board_table
-    folder = Path(folder)
-    if config.tracks is None or config.tracks.clock is None:
+    if config.tracks.clock is None:
         return []
     clock = config.tracks.clock
     try:
