@@ -67,7 +67,7 @@ def path_figure(folder: Path, out: Path, problem: str = "ur5") -> None:
     failing = [k for k, g in a.groupby("path", sort=True)
                if any(not path_success(h) for _, h in g.groupby("solver", sort=False))]
     k = failing[0] if failing else int(a["path"].min())
-    qcols = [c for c in a.columns if c.startswith("q") and c[1:].isdigit()]
+    qcols = [c for c in a.columns if c.startswith("q") and c[1:].isdigit() and a[c].notna().any()]   # this arm's joints
     fig, axes = plt.subplots(1, len(solvers), figsize=(4.3 * len(solvers), 3.8), sharey=True)
     for ax, s in zip(np.atleast_1d(axes), solvers):
         g = a[(a["solver"] == s) & (a["path"] == k)].sort_values("waypoint")

@@ -41,7 +41,7 @@ import pandas as pd
 
 from fkopt.errors import FkoptError
 from fkopt.kinbench.physical import ik_verdicts
-from fkopt.kinbench.solution_sets import TOL, entry_of, pose_rng
+from fkopt.kinbench.solution_sets import TOL, entry_of, not_applicable_of, pose_rng
 
 #: Waypoints per path, largest joint step of the generating segment (rad), the margin kept
 #: from the limits at its start (rad), and the step bound of a successful path (rad).
@@ -220,7 +220,7 @@ def paths_board(answers: pd.DataFrame, *, reference: str) -> pd.DataFrame:
     waypoint (us, and as a ratio to the reference's on the same path: median, p95)."""
     rows = []
     for (problem, solver), a in answers.groupby(["problem", "solver"], sort=False):
-        why = str(a["not_applicable"].fillna("").iloc[0])
+        why = not_applicable_of(a)
         row = {"problem": problem, "solver": solver, "entry": entry_of(solver), "paths": int(a["path"].nunique()),
                "waypoints": WAYPOINTS, "reference": reference, "not_applicable": why}
         if not why:

@@ -63,6 +63,12 @@ def entry_of(name: str) -> str:
     return "organiser" if name in ORGANISER else "outside"
 
 
+def not_applicable_of(rows: pd.DataFrame) -> str:
+    """Why an entry's rows hold no answers ('' when it ran; a column read back empty is NaN)."""
+    why = rows["not_applicable"].iloc[0] if len(rows) else ""
+    return why if isinstance(why, str) else ""
+
+
 def pose_rng(seed: int, problem: str, solver: str, pose: int) -> np.random.Generator:
     key = zlib.crc32(f"{problem}/{solver}".encode())
     return np.random.default_rng(np.random.SeedSequence([int(seed), key, int(pose)]))
@@ -265,7 +271,7 @@ def solutions_board(answers: pd.DataFrame, arms: dict, *, reference: str, analyt
         arm = arms[problem]
         qcols = [f"q{d}" for d in range(arm.dof)]
         names = list(dict.fromkeys(a["solver"]))
-        na = {s: str(a.loc[a["solver"] == s, "not_applicable"].fillna("").iloc[0]) for s in names}
+        na = {s: not_applicable_of(a[a["solver"] == s]) for s in names}
         live = [s for s in names if not na[s]]
         tally = {s: dict(distinct=0, analytic_held=0, union_held=0, beyond=0) for s in names}
         total_analytic = total_union = 0
