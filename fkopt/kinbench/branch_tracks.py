@@ -14,9 +14,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fkopt.adapters.field import NotApplicable
+from fkopt.errors import FkoptError
+from fkopt.files import read_stored_csv
 from fkopt.kinbench import paths as path_track
 from fkopt.kinbench import solution_sets
 from fkopt.kinbench.config import suite_from_dict
+from fkopt.kinbench.posesets import problem_mechanism
+from fkopt.registry import clock_solver
+from fkopt.run.config_base import files_folder
 from fkopt.run.tasks import Task
 
 #: track -> (task-id prefix, answers file, board file)
@@ -83,9 +89,6 @@ def solve_task(payload: dict) -> dict:
 
 
 def _path_arm(config, name: str, files: Path | None):
-    from fkopt.errors import FkoptError
-    from fkopt.kinbench.posesets import problem_mechanism
-    from fkopt.run.config_base import files_folder
     arm, _ = problem_mechanism(next(p for p in config.problems if p.name == name),
                                files if files is not None else files_folder(config))
     if getattr(arm, "kind", None) != "serial" or not hasattr(arm, "chain"):
@@ -119,9 +122,6 @@ def _problems(config, track: str, name: str, answers: pd.DataFrame, files, froze
 def validate(config, files: Path | None = None) -> None:
     """Every entry of both tracks built once on each of its arms: a missing package or an arm a
     package misreads is one line before any work."""
-    from fkopt.adapters.field import NotApplicable
-    from fkopt.errors import FkoptError
-    from fkopt.registry import clock_solver
     for track in FILES:
         spec = _track(config, track)
         for name in (spec.problems if spec is not None else []):
@@ -192,8 +192,6 @@ def reverify(folder: Path, config) -> list[tuple]:
     not recomputed from the stored answers."""
     from types import SimpleNamespace
 
-    from fkopt.errors import FkoptError
-    from fkopt.files import read_stored_csv
     out, tables = [], {}
     for track, (_, answers_file, board_file) in FILES.items():
         spec = _track(config, track)

@@ -39,8 +39,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fkopt.adapters.field import NotApplicable
+from fkopt.adapters.field.cores import pinned
 from fkopt.errors import FkoptError
+from fkopt.files import csv_numbers, parse_json, read_input
+from fkopt.kinbench.answer_checks import _close
 from fkopt.kinbench.physical import ik_verdicts
+from fkopt.kinbench.posesets import csv_bytes, parse_set_csv, problem_mechanism, set_rng, sha256_bytes
+from fkopt.kinbench.releases import check_folder_release
+from fkopt.registry import clock_solver
+from fkopt.run.config_base import files_folder
 from fkopt.kinbench.solution_sets import TOL, entry_of, not_applicable_of, pose_rng
 
 #: Waypoints per path, largest joint step of the generating segment (rad), the margin kept
@@ -56,7 +64,6 @@ COLUMNS = ("problem", "path", "solver", "entry", "waypoint", "seconds", "cpu_sec
 # -- the frozen path set --------------------------------------------------------------------------
 def generate(arm, problem: str, seed: int, paths: int) -> np.ndarray:
     """(paths, 2, dof): each path's start and end configuration, public units (module docstring)."""
-    from fkopt.kinbench.posesets import set_rng
     rng = set_rng(seed, problem, "paths")
     to_si = np.asarray(arm._to_si, float) * np.ones(arm.dof)
     lo, hi = arm.bounds[:, 0] * to_si + MARGIN, arm.bounds[:, 1] * to_si - MARGIN
@@ -75,8 +82,6 @@ def waypoints(ends: np.ndarray) -> np.ndarray:
 
 def write_path_set(config, folder: Path, paths: int) -> Path:
     """The path set of every problem of ``tracks.paths`` into ``folder`` (frozen data: run once, commit)."""
-    from fkopt.kinbench.posesets import csv_bytes, problem_mechanism, sha256_bytes
-    from fkopt.run.config_base import files_folder
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     manifest = {"version": folder.name, "seed": config.seed, "paths_per_problem": paths, "waypoints": WAYPOINTS,
@@ -98,10 +103,6 @@ def load_path_sets(config, files: Path | None = None) -> dict[str, np.ndarray]:
     """{problem: (paths, 2, dof)} of ``tracks.paths`` (its first ``paths`` paths), every file
     checked against the manifest's SHA-256 and mechanism spec, and a released set against
     :data:`fkopt.kinbench.releases.RELEASES`; any mismatch one line naming the file."""
-    from fkopt.files import parse_json, read_input
-    from fkopt.kinbench.posesets import parse_set_csv, sha256_bytes
-    from fkopt.kinbench.releases import check_folder_release
-    from fkopt.run.config_base import files_folder
     track = config.tracks.paths
     base = Path(files if files is not None else (files_folder(config) or "."))
     folder = base / track.path_set
@@ -163,9 +164,6 @@ def path_verdicts(arm, J: np.ndarray, Q: np.ndarray) -> dict:
 def run_paths(arm, problem: str, ends: np.ndarray, solvers: list[str], *, reference: str, timeout_ms: float,
               seed: int = 0, settings: dict | None = None) -> pd.DataFrame:
     """Every entry on every path of one arm, interleaved (rotated per path), pinned to one core."""
-    from fkopt.adapters.field import NotApplicable
-    from fkopt.adapters.field.cores import pinned
-    from fkopt.registry import clock_solver
     Q = waypoints(ends)
     T = arm.fk_matrix(Q)
     names = list(dict.fromkeys([reference, *solvers]))
@@ -244,8 +242,6 @@ def table_problems(config, answers: pd.DataFrame, problem: str, arm, ends: np.nd
     """(row, column, stored, recomputed, rule) of every way one problem's rows of paths.csv.gz are
     not what the config implies: one row per (path, solver, waypoint) of the track, every verdict
     and step recomputed from the stored joints."""
-    from fkopt.files import csv_numbers
-    from fkopt.kinbench.answer_checks import _close
     track = config.tracks.paths
     qcols = [f"q{d}" for d in range(arm.dof)]
     lacking = [c for c in (*COLUMNS, *qcols) if c not in answers.columns]

@@ -44,8 +44,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fkopt.adapters.field import NotApplicable
+from fkopt.adapters.field.cores import pinned
+from fkopt.adapters.field.track_entries import locked_arm
 from fkopt.errors import FkoptError
+from fkopt.files import csv_numbers, read_stored_csv
+from fkopt.kinbench.answer_checks import _close, differing_numbers
 from fkopt.kinbench.physical import ik_verdicts
+from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
+from fkopt.registry import clock_solver
+from fkopt.run.config_base import files_folder
 
 #: Verification of every answer (m, rad): these tracks' tolerance.
 TOL = (1e-6, 1e-6)
@@ -140,9 +148,6 @@ def lock_of(arm, joint: str | None) -> dict[str, float]:
 def track_arms(config, name: str, files: Path | None = None):
     """(arm, fixed, solved): the problem's arm, its locked joints {name: value}, and the arm the
     answers are points of (the 6-joint chain left when a joint is locked)."""
-    from fkopt.adapters.field.track_entries import locked_arm
-    from fkopt.kinbench.posesets import problem_mechanism
-    from fkopt.run.config_base import files_folder
     problem = next(p for p in config.problems if p.name == name)
     arm, _ = problem_mechanism(problem, files if files is not None else files_folder(config))
     if getattr(arm, "kind", None) != "serial" or not hasattr(arm, "chain"):
@@ -153,7 +158,6 @@ def track_arms(config, name: str, files: Path | None = None):
 
 def full_sets(config, files: Path | None = None) -> dict:
     """The suite's pose sets, uncut by its ``poses`` (how many poses the swarms get)."""
-    from fkopt.kinbench.posesets import load_pose_sets
     return load_pose_sets(config.model_copy(update={"poses": None}), files)[0]
 
 
@@ -177,9 +181,6 @@ def run_solutions(arm, solved, fixed: dict, problem: str, queries: np.ndarray, s
     """Every entry on every query of one arm: the reference first over all queries (its median
     time per pose is the restart entries' budget), then the others pose by pose in a rotated
     order; every returned answer mapped into the limits, judged, and merged per (pose, solver)."""
-    from fkopt.adapters.field import NotApplicable
-    from fkopt.adapters.field.cores import pinned
-    from fkopt.registry import clock_solver
     T = arm.fk_matrix(queries)
     n = len(queries)
     found: dict[str, list] = {}
@@ -325,8 +326,6 @@ def table_problems(config, answers: pd.DataFrame, problem: str, arm, solved, Q: 
     """(row, column, stored, recomputed, rule) of every way ``answers`` (one problem's rows of
     solutions.csv.gz) are not what the config implies: every (pose, solver) of the track
     present, no other; every verdict recomputed from the stored joints with fkopt's FK."""
-    from fkopt.files import csv_numbers
-    from fkopt.kinbench.answer_checks import _close
     track = config.tracks.all_solutions
     out = []
     qcols = [f"q{d}" for d in range(solved.dof)]
@@ -360,8 +359,6 @@ def table_problems(config, answers: pd.DataFrame, problem: str, arm, solved, Q: 
 def board_mismatches(folder: Path, name: str, board: pd.DataFrame | None, key: list[str]) -> list[tuple]:
     """(file, row, column, stored, recomputed, rule) of every number of the stored board ``name``
     that differs from ``board`` (recomputed from the stored answers)."""
-    from fkopt.files import csv_numbers, read_stored_csv
-    from fkopt.kinbench.answer_checks import _close
     if board is None or board.empty:
         return []
     if not (Path(folder) / name).exists():
@@ -374,13 +371,5 @@ def board_mismatches(folder: Path, name: str, board: pd.DataFrame | None, key: l
             or set(map(tuple, stored[key].values)) != set(map(tuple, board[key].astype(str).values)):
         return [(name, "-", "rows", len(stored), len(board), "one row per (problem, solver) of the stored answers")]
     merged = stored.merge(board.astype({k: str for k in key}), on=key, suffixes=("", "_recomputed"))
-    out = []
-    for col in board.columns:
-        if col in key or f"{col}_recomputed" not in merged or not pd.api.types.is_numeric_dtype(board[col]):
-            continue
-        bad = ~_close(csv_numbers(merged[col]), merged[f"{col}_recomputed"].to_numpy(float))
-        for k in np.flatnonzero(bad)[:3]:
-            r = merged.iloc[k]
-            out.append((name, "/".join(str(r[c]) for c in key), col, r[col], r[f"{col}_recomputed"],
-                        "recomputed from the stored answers"))
-    return out
+    return [(name, "/".join(str(r[c]) for c in key), col, r[col], r[f"{col}_recomputed"],
+             "recomputed from the stored answers") for r, col in differing_numbers(merged, board, key)]

@@ -14,9 +14,8 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
-import pandas as pd
 
-from fkopt.kinbench.answer_checks import RTOL, _close  # noqa: F401 (RTOL: the recomputation's tolerance)
+from fkopt.kinbench.answer_checks import RTOL, _close, differing_numbers  # noqa: F401 (RTOL: the recomputation's tolerance)
 
 
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
@@ -106,12 +105,7 @@ def _reverify_clock(folder: Path, config) -> list[tuple[str, str, str, object, o
         return out + [("leaderboard-robots.csv", "-", "rows", len(stored), len(board),
                        "one row per (solver, robot, timeout) of the stored answers")]
     merged = stored.merge(board, on=key, suffixes=("", "_recomputed"))
-    for col in board.columns:
-        if col in key or f"{col}_recomputed" not in merged or not pd.api.types.is_numeric_dtype(board[col]):
-            continue
-        bad = ~_close(csv_numbers(merged[col]), merged[f"{col}_recomputed"].to_numpy(float))
-        for k in np.flatnonzero(bad)[:3]:
-            r = merged.iloc[k]
-            out.append(("leaderboard-robots.csv", f"{r['solver']}/{r['robot']}/{r['timeout_ms']:g} ms", col, r[col],
+    for r, col in differing_numbers(merged, board, key):
+        out.append(("leaderboard-robots.csv", f"{r['solver']}/{r['robot']}/{r['timeout_ms']:g} ms", col, r[col],
                         r[f"{col}_recomputed"], "recomputed from the stored answers"))
     return out

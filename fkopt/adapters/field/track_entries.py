@@ -45,6 +45,8 @@ from fkopt.adapters.field.eaik import EAIK
 from fkopt.adapters.field.rtb import RtbLM
 from fkopt.adapters.field.tracik import TracIK, quat_xyzw
 from fkopt.errors import FkoptError
+from fkopt.mechanisms.urdf import URDFArm
+from fkopt.mechanisms.urdf_writer import _rpy, _rz, chain_urdf
 
 #: The tracks' tolerance (m, rad): TRAC-IK's eps follows from it by the board's rule.
 TRACK_TOL = 1e-6
@@ -58,8 +60,6 @@ def locked_arm(arm, fixed: dict[str, float]):
     differs from ``arm``'s (1e-9) at a configuration inside the limits."""
     from scipy.spatial.transform import Rotation
 
-    from fkopt.mechanisms.urdf import URDFArm
-    from fkopt.mechanisms.urdf_writer import _rpy, _rz, chain_urdf
     w = chain_urdf(arm)
     root = ET.fromstring(w.text)
     index = {}
