@@ -150,3 +150,22 @@ def test_fkopt_check_rejudges_the_stored_answers_of_both_tracks(config, tmp_path
     found = reverify(copy, q)
     assert any(f[0] == "solutions.csv.gz" and f[2] in ("position_m", "rotation_rad") for f in found)
     assert any(f[0] == "paths.csv.gz" and f[2] == "rows" for f in found)
+
+
+@pytest.mark.skipif(not STORED.is_dir(), reason="the stored quick tier")
+def test_resume_accepts_a_track_task_file_only_when_every_answer_recomputes(config):
+    from fkopt.kinbench.runner import record_problem, suite_plan
+    q = config.quick_tier()
+    q._folder = SUITE.parent
+    plan = suite_plan(q)
+    for track, name, stem in (("all-solutions", "z1", "solutions"), ("paths", "z1", "paths")):
+        task = next(t for t in plan.tasks if t.payload.get("track") == track
+                    and q.problems[t.payload["problem"]].name == name)
+        rows = pd.read_csv(STORED / f"{stem}.csv.gz", keep_default_na=False, na_values=[""])
+        rows = rows[rows["problem"] == name].dropna(axis=1, how="all").reset_index(drop=True)
+        rows["not_applicable"] = ""
+        rec = {"fingerprint": plan.fingerprint, "track": track, "problem": task.payload["problem"], "wall_s": 1.0,
+               "answers": rows.to_dict(orient="list")}
+        assert record_problem(task, rec) is None
+        rows.loc[0, "position_m"] = 0.5                 # a verdict that its answer does not give
+        assert "position_m" in record_problem(task, {**rec, "answers": rows.to_dict(orient="list")})
