@@ -73,7 +73,7 @@ def path_figure(folder: Path, out: Path, problem: str = "ur5") -> None:
         g = a[(a["solver"] == s) & (a["path"] == k)].sort_values("waypoint")
         J = g[qcols].to_numpy(float)
         for j in range(J.shape[1]):
-            ax.plot(g["waypoint"], J[:, j], lw=1.5, label=f"joint {j + 1}")
+            ax.plot(g["waypoint"], J[:, j], lw=1.5, ls="-" if j % 2 == 0 else "--", label=f"joint {j + 1}")  # overlaps seen
         bad = (g["step_rad"] > BOUND) | (g["position_m"] > TOL[0]) | (g["rotation_rad"] > TOL[1]) | ~g["in_limits"]
         for wp in g["waypoint"][bad.to_numpy()]:
             ax.axvline(wp, color="tab:red", lw=0.6, alpha=0.5)
