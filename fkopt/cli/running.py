@@ -27,6 +27,13 @@ def _engine():
 
 
 JOBS_HELP = "worker processes (local) or LocalCluster workers (dask without --scheduler)"
+#: Options fkopt run, study and suite share (typer reads each as a declaration, never changes it).
+JOBS = typer.Option(1, "--jobs", "-j", help=JOBS_HELP)
+EXECUTOR = typer.Option("local", "--executor", help="local | dask")
+SCHEDULER = typer.Option(None, "--scheduler", help="address of an existing Dask scheduler (with --executor dask)")
+FORCE = typer.Option(False, "--force", help="replace a stored result made from a config whose result-changing "
+                     "fields differ")
+QUIET = typer.Option(False, "--quiet", "-q", help="no progress or tables")
 
 
 @app.command()
@@ -35,15 +42,10 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
         out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; each file writes "
                                  "OUT/<paper>/<name>/ (paper 'experiments' when the file names none); "
                                  "the tracked paper results are --out results"),
-        jobs: int = typer.Option(1, "--jobs", "-j", help=JOBS_HELP),
-        executor: str = typer.Option("local", "--executor", help="local | dask"),
-        scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of an existing Dask "
-                                                "scheduler (with --executor dask)"),
+        jobs: int = JOBS, executor: str = EXECUTOR, scheduler: Optional[str] = SCHEDULER,
         resume: bool = typer.Option(False, "--resume", help="studies and suites: keep the finished tasks of an "
                                     "interrupted run of the same config and run only the others"),
-        force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
-                                   "whose result-changing fields differ"),
-        quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
+        force: bool = FORCE, quiet: bool = QUIET):
     """Run config files of any kind and write their tables and figures.
 
     Every file is validated, and every output folder checked, before anything runs. Every kind
@@ -109,15 +111,10 @@ def _run_checked(files, out: Path, *, jobs: int, executor: str, scheduler: str |
 def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)"),
           out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; the study writes "
                                    "OUT/<paper>/<name>/ (paper: studies unless the file says otherwise)"),
-          jobs: int = typer.Option(1, "--jobs", "-j", help=JOBS_HELP),
-          executor: str = typer.Option("local", "--executor", help="local | dask"),
-          scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of an existing Dask "
-                                                  "scheduler (with --executor dask)"),
+          jobs: int = JOBS, executor: str = EXECUTOR, scheduler: Optional[str] = SCHEDULER,
           resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted "
                                       "run of the same study and run only the others"),
-          force: bool = typer.Option(False, "--force", help="replace a stored result made from a config "
-                                     "whose result-changing fields differ"),
-          quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress or tables")):
+          force: bool = FORCE, quiet: bool = QUIET):
     """Run a workspace study: algorithms x many poses x runs, with statistics (= fkopt run on it).
 
     A study file says kind: study and draws its poses (uniform, grid, waypoints, circle) instead
@@ -137,8 +134,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
           out: Path = typer.Option(DEFAULT_OUT, "--out", help="results root; writes OUT/<paper>/<name>/ "
                                    "(the tracked results/ only when asked: make bench-suite)"),
           quick: bool = typer.Option(False, "--quick", help="run the file's quick: tier (<name>-quick)"),
-          jobs: int = typer.Option(1, "--jobs", "-j", help=JOBS_HELP),
-          executor: str = typer.Option("local", "--executor", help="local | dask"),
+          jobs: int = JOBS, executor: str = EXECUTOR,
           scheduler: Optional[str] = typer.Option(None, "--scheduler", help="address of a Dask scheduler"),
           resume: bool = typer.Option(False, "--resume", help="keep the finished tasks of an interrupted run"),
           force: bool = typer.Option(False, "--force", help="replace a stored result of a different config"),
