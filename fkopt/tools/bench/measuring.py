@@ -70,7 +70,7 @@ def load_average() -> str:
     """The 1-, 5- and 15-minute load averages, for the notes of timed rows (this machine is shared)."""
     try:
         return " ".join(f"{v:.2f}" for v in os.getloadavg())
-    except OSError:                                  # pragma: no cover - not on Linux/macOS
+    except (AttributeError, OSError):                # pragma: no cover - not on Linux/macOS
         return "unknown"
 
 

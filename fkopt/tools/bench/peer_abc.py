@@ -58,9 +58,11 @@ def _peer_mealpy(problem, runs: int):
     return out, "mealpy OriginalABC(epoch=600, pop_size=10, n_limits=30)"
 
 
-def pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population: int = 10, limit: int = 30):
+def pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population: int = 10, limit: int = 30,
+                     clock=time.perf_counter, first: int = 0):
     """pygmo's C++ ``bee_colony`` on ``fitness_one`` (one point -> float), run ``runs`` times
-    (seed k for run k): per run (seconds of ``evolve``, evaluations, final fitness)."""
+    (seed k for run k from ``first``): per run (seconds of ``evolve`` by ``clock``, evaluations,
+    final fitness)."""
     import pygmo as pg
     lo, hi = np.asarray(bounds)[:, 0].tolist(), np.asarray(bounds)[:, 1].tolist()
 
@@ -72,12 +74,12 @@ def pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population:
             return (lo, hi)
 
     out = []
-    for k in range(runs):
+    for k in range(first, first + runs):
         prob = pg.problem(UDP())
         algo = pg.algorithm(pg.bee_colony(gen=gen, limit=limit, seed=k))
-        t = time.perf_counter()
+        t = clock()
         pop = algo.evolve(pg.population(prob, population, seed=k))
-        out.append((time.perf_counter() - t, pop.problem.get_fevals(), float(pop.champion_f[0])))
+        out.append((clock() - t, pop.problem.get_fevals(), float(pop.champion_f[0])))
     return out
 
 
