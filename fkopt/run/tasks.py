@@ -113,6 +113,17 @@ class Ran:
     wall_s: float = 0.0
 
 
+def reason_or_none(why: Callable[[], str | None]) -> str | None:
+    """``why()`` -- a plan's check of a record read back from a task file -- with a malformed
+    record's missing field or wrong type as the reason instead of an exception."""
+    try:
+        return why()
+    except KeyError as err:
+        return f"field {str(err.args[0])[:40]!r} is missing"
+    except (TypeError, ValueError, IndexError, AttributeError) as err:
+        return f"{type(err).__name__}: {str(err)[:120]}"
+
+
 def work_folder(out: str | Path, config) -> Path:
     """Where an unfinished run of ``config`` (any kind) keeps its task files:
     ``OUT/<paper>/.<name>.partial/`` (hidden: never taken for a result)."""

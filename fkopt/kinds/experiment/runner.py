@@ -28,7 +28,7 @@ from fkopt.kinds.experiment.config import ExperimentConfig, RandomCases
 from fkopt.run.config_base import AlgorithmSpec, files_folder, numeric_fields
 from fkopt.run.solving import (_check_in_bounds, build_mechanism, make_problem, outputs_of, pose_error, solve_cases,  # noqa: F401
                                start_point, task_seed)
-from fkopt.run.tasks import Plan, Ran, Task, run_tasks
+from fkopt.run.tasks import Plan, Ran, Task, reason_or_none, run_tasks
 from fkopt.run.timing import sample_plan, time_case
 
 
@@ -260,36 +260,35 @@ def record_problem(task: Task, rec, config: ExperimentConfig, n_cases: int) -> s
     task's case, solver and run, and per-iteration arrays of the runs' shape."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
+    return reason_or_none(lambda: _record_problem(task, rec, config, n_cases))
+
+
+def _record_problem(task: Task, rec: dict, config: ExperimentConfig, n_cases: int) -> str | None:
     a = task.payload["algorithm"]
     spec = config.algorithms[a]
-    try:
-        if rec["algorithm"] != a or rec["solver"] != spec.key or isinstance(rec["algorithm"], bool):
-            return "its algorithm is not the one its file name names"
-        rows, traces = rec["rows"], rec["trace"]
-        if not isinstance(rows, list) or len(rows) != n_cases or not isinstance(traces, list) or len(traces) != n_cases:
-            return f"rows, trace: not one table per case ({n_cases})"
-        runs = config.runs
-        for i, (cols, trace) in enumerate(zip(rows, traces)):
-            if not isinstance(cols, dict) or any(not isinstance(v, list) or len(v) != runs for v in cols.values()):
-                return f"rows[{i}]: not a table of {runs} run rows"
-            if cols.get("solver") != [spec.key] * runs or cols.get("pose") != [i] * runs \
-                    or cols.get("run") != list(range(runs)):
-                return f"rows[{i}]: its solver, pose or runs are not this task's"
-            if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in cols.get("final_fitness", [None])):
-                return f"rows[{i}].final_fitness: not numbers"
-            if not isinstance(trace, dict) or sorted(trace) != sorted(TRACE_COLUMNS) \
-                    or len({len(v) for v in trace.values() if isinstance(v, list)}) != 1:
-                return f"trace[{i}]: not the columns {', '.join(TRACE_COLUMNS)} of equal length"
-        result = dataclass_from_json(Result, rec["curves"])
-        want = (runs,) if n_cases == 1 else (n_cases, runs)
-        if np.shape(result.fitness) != want or np.shape(result.history)[:-1] != want:
-            return f"curves: runs of shape {np.shape(result.fitness)}, expected {want}"
-        if not math.isfinite(float(rec["wall_s"])) or float(rec["wall_s"]) < 0:
-            return "wall_s: not a non-negative finite number"
-    except KeyError as err:
-        return f"field {str(err.args[0])[:40]!r} is missing"
-    except (TypeError, ValueError, IndexError, AttributeError) as err:
-        return f"{type(err).__name__}: {str(err)[:120]}"
+    if rec["algorithm"] != a or rec["solver"] != spec.key or isinstance(rec["algorithm"], bool):
+        return "its algorithm is not the one its file name names"
+    rows, traces = rec["rows"], rec["trace"]
+    if not isinstance(rows, list) or len(rows) != n_cases or not isinstance(traces, list) or len(traces) != n_cases:
+        return f"rows, trace: not one table per case ({n_cases})"
+    runs = config.runs
+    for i, (cols, trace) in enumerate(zip(rows, traces)):
+        if not isinstance(cols, dict) or any(not isinstance(v, list) or len(v) != runs for v in cols.values()):
+            return f"rows[{i}]: not a table of {runs} run rows"
+        if cols.get("solver") != [spec.key] * runs or cols.get("pose") != [i] * runs \
+                or cols.get("run") != list(range(runs)):
+            return f"rows[{i}]: its solver, pose or runs are not this task's"
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in cols.get("final_fitness", [None])):
+            return f"rows[{i}].final_fitness: not numbers"
+        if not isinstance(trace, dict) or sorted(trace) != sorted(TRACE_COLUMNS) \
+                or len({len(v) for v in trace.values() if isinstance(v, list)}) != 1:
+            return f"trace[{i}]: not the columns {', '.join(TRACE_COLUMNS)} of equal length"
+    result = dataclass_from_json(Result, rec["curves"])
+    want = (runs,) if n_cases == 1 else (n_cases, runs)
+    if np.shape(result.fitness) != want or np.shape(result.history)[:-1] != want:
+        return f"curves: runs of shape {np.shape(result.fitness)}, expected {want}"
+    if not math.isfinite(float(rec["wall_s"])) or float(rec["wall_s"]) < 0:
+        return "wall_s: not a non-negative finite number"
     return None
 
 
