@@ -278,7 +278,7 @@ def _dls_step_all(J, r, mu, free, d, A, L, y, x):
 
 @njit(cache=True)
 def _uniform_hash(seed, row, draw, out):
-    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.solvers._uniform_hash` (SplitMix64's finaliser)."""
+    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.start_tables._uniform_hash` (SplitMix64's finaliser)."""
     c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
     for k in range(out.shape[0]):
         z = c + np.uint64(k + 1) * _M2

@@ -160,7 +160,7 @@ def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iteration
 @njit(cache=True)
 def _table_distances(Ft, norms, f, v):
     """v[i] = |F_i|^2 - 2 F_i . f (= |F_i - f|^2 - |f|^2) for every row of the start table, as
-    :func:`fkopt.kinematics.solvers._nearest`'s brute force: the dot product summed feature by feature,
+    :func:`fkopt.kinematics.start_tables._nearest`'s brute force: the dot product summed feature by feature,
     rows side by side, from ``Ft`` = F transposed."""
     c, N = Ft.shape
     d2 = np.zeros(N)
@@ -324,7 +324,7 @@ def _near_rows(table, f, v32, tq, near):
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
                   damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics.solvers._zyz_matrix1`, for
+    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.numerics.rotations.zyz1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
     start table's ``nn`` nearest configurations (:func:`_nearest_screened`, its float32 screen once; the first
     :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
@@ -381,7 +381,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
 
 def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
     """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
-    :func:`fkopt.kinematics.solvers._fast_context`) and the options bound once: a function
+    :func:`fkopt.kinematics.inverse_pose._fast_context`) and the options bound once: a function
     (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
     kernel's arguments; a prepared solver (:class:`fkopt.kinematics.solvers.InverseSolver`) keeps it, so
     a control loop's call does no dictionary lookups."""

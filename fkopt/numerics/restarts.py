@@ -14,8 +14,8 @@ solver's give-up test (a deadline) is spent.
   per-call cost is paid once per start, not once per row): ``fkopt.forward``'s starts (the given
   one, the start table's, the deterministic ones, then the global search).
 
-The compiled twin is :func:`fkopt.numerics.compiled._inverse_one` (the one-pose loop of
-``fkopt.inverse``, a local search :func:`fkopt.numerics.compiled._dls_candidate` per start); the
+The compiled twin is :func:`fkopt.numerics.compiled_ik._inverse_one` (the one-pose loop of
+``fkopt.inverse``, a local search :func:`fkopt.numerics.compiled_ik._dls_candidate` per start); the
 all-solutions and path kernels of serial arms run that candidate search one start at a time.
 ``fkopt.inverse``'s batched numpy loop restarts candidates in place among the rows of a batch
 (:mod:`fkopt.kinematics.inverse_batch`): its starts are the ones of this loop, in the same order.
