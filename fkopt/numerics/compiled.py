@@ -35,6 +35,7 @@ from numba import types               # numba first: without it, the ImportError
 from numba.core.extending import intrinsic
 from llvmlite import ir
 
+from fkopt.numerics import rotations
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 _M1 = np.uint64(0x9E3779B97F4A7C15)
@@ -136,8 +137,13 @@ def frame_jacobian_rows(chain, t):
     return _frame_jacobian_rows(*chain.arrays(), np.ascontiguousarray(t, dtype=float), chain.dof)
 
 
+#: :func:`fkopt.numerics.rotations.half_turn` compiled from its own source (the one rotation module).
+_half_turn = njit(cache=True)(rotations.half_turn)
+
+
 @njit(cache=True)
 def _rotation_error(R, T, e):
+    """:func:`fkopt.numerics.rotations.rotation_error1` into e, operation for operation."""
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2],
                                                    R[2, 0], R[2, 1], R[2, 2])
     t00, t01, t02, t10, t11, t12, t20, t21, t22 = (T[0, 0], T[0, 1], T[0, 2], T[1, 0], T[1, 1], T[1, 2],
@@ -151,23 +157,10 @@ def _rotation_error(R, T, e):
     if s > 1e-12 or c > 0.0:
         k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
         e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
-    else:   # a half turn (fkopt.numerics.damped_least_squares.half_turn, operation for operation)
-        m00 = r00 * t00 + r01 * t01 + r02 * t02
-        m11 = r10 * t10 + r11 * t11 + r12 * t12
-        m22 = r20 * t20 + r21 * t21 + r22 * t22
-        m01 = r00 * t10 + r01 * t11 + r02 * t12
-        m02 = r00 * t20 + r01 * t21 + r02 * t22
-        m12 = r10 * t20 + r11 * t21 + r12 * t22
-        if m00 >= m11 and m00 >= m22:
-            a0 = math.sqrt(max(0.5 * (m00 + 1.0), 0.0))
-            a1, a2 = m01 / (2.0 * a0), m02 / (2.0 * a0)
-        elif m11 >= m22:
-            a1 = math.sqrt(max(0.5 * (m11 + 1.0), 0.0))
-            a0, a2 = m01 / (2.0 * a1), m12 / (2.0 * a1)
-        else:
-            a2 = math.sqrt(max(0.5 * (m22 + 1.0), 0.0))
-            a0, a1 = m02 / (2.0 * a2), m12 / (2.0 * a2)
-        e[0], e[1], e[2] = math.pi * a0, math.pi * a1, math.pi * a2
+    else:   # a half turn: fkopt.numerics.rotations.half_turn itself, compiled
+        e[0], e[1], e[2] = _half_turn(r00 * t00 + r01 * t01 + r02 * t02, r10 * t10 + r11 * t11 + r12 * t12,
+                                      r20 * t20 + r21 * t21 + r22 * t22, r00 * t10 + r01 * t11 + r02 * t12,
+                                      r00 * t20 + r01 * t21 + r02 * t22, r10 * t20 + r11 * t21 + r12 * t22)
 
 
 @njit(cache=True)

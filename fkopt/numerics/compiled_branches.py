@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from fkopt.numerics.compiled import _evaluate, _geodesic, _rotation_target, _uniform_hash
-from fkopt.numerics.compiled_ik import _inverse_one, _nearest_into
+from fkopt.numerics.compiled_ik import _inverse_one, _nearest_into, _table_features
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 TWO_PI = 2.0 * math.pi
@@ -62,12 +62,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
     near_idx = np.empty(nn, dtype=np.int64)
     if nn > 0:
         f = np.empty(12)
-        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
-        for r in range(3):
-            for c in range(3):
-                f[3 + 3 * r + c] = wf * T[r, c]
-        for j in range(12):
-            f[j] = f[j] * fmask[j]
+        _table_features(pt, T, wf, fmask, f)
         _nearest_into(Ft, norms, f, near_idx, np.empty(nn))
     q0, best, u, w = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     empty, no_table, no_feat, no_v32, no_tq = _no_start_table(n)

@@ -177,27 +177,48 @@ def _table_distances(Ft, norms, f, v):
         v[i] = norms[i] - 2.0 * d2[i]
 
 
+@njit(inline="always")
+def _insert(best, idx, m, x, i):
+    """Row i of value x into the k = len(idx) smallest so far (``m`` of them held, sorted; ties: the
+    earlier row first); returns how many are held after it."""
+    k = idx.shape[0]
+    if m < k:
+        pos = m
+        m += 1
+    elif x < best[k - 1]:
+        pos = k - 1
+    else:
+        return m
+    while pos > 0 and best[pos - 1] > x:
+        best[pos] = best[pos - 1]
+        idx[pos] = idx[pos - 1]
+        pos -= 1
+    best[pos] = x
+    idx[pos] = i
+    return m
+
+
+@njit(cache=True)
+def _table_features(pt, T, wf, fmask, f):
+    """The start table's features of a target (position pt, rotation T) into f (12): position,
+    then wf times the rotation row-major, times the task mask's ``fmask``
+    (:func:`fkopt.kinematics.start_tables._start_table`'s features)."""
+    f[0], f[1], f[2] = pt[0], pt[1], pt[2]
+    for r in range(3):
+        for c in range(3):
+            f[3 + 3 * r + c] = wf * T[r, c]
+    for j in range(12):
+        f[j] = f[j] * fmask[j]
+
+
 @njit(cache=True)
 def _smallest(v, idx, best):
     """The k = len(idx) rows of the smallest v, smallest first, into idx (values into best): kept
     sorted by insertion in row order (ties: the lower row first)."""
-    k = idx.shape[0]
     m = 0
     for i in range(v.shape[0]):
         x = v[i]
-        if m < k:
-            pos = m
-            m += 1
-        elif x < best[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and best[pos - 1] > x:
-            best[pos] = best[pos - 1]
-            idx[pos] = idx[pos - 1]
-            pos -= 1
-        best[pos] = x
-        idx[pos] = i
+        m = _insert(best, idx, m, x, i)
 
 
 @njit(cache=True)
@@ -295,19 +316,7 @@ def _nearest_screened(table, f, v32, idx, best):
             acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
             first = False
         x = norms[i] - 2.0 * acc
-        if m < k:
-            pos = m
-            m += 1
-        elif x < best[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and best[pos - 1] > x:
-            best[pos] = best[pos - 1]
-            idx[pos] = idx[pos - 1]
-            pos -= 1
-        best[pos] = x
-        idx[pos] = i
+        m = _insert(best, idx, m, x, i)
 
 
 @njit(cache=True)
@@ -345,12 +354,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
     have = min(nn, NEAR_FIRST)
     f = np.empty(12)
     if nn > 0:
-        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
-        for r in range(3):
-            for c in range(3):
-                f[3 + 3 * r + c] = wf * T[r, c]
-        for j in range(12):
-            f[j] = f[j] * fmask[j]
+        _table_features(pt, T, wf, fmask, f)
         _screen32(table, f, v32)
         _near_rows(table, f, v32, tq, near[:have])
     best = np.empty(n)
