@@ -1,10 +1,10 @@
-"""The one restart loop (fkopt/numerics/restarts.py): its rules, and that the solvers that hand it
+"""The one restart loop (fkopt/numerics/restart_loop.py): its rules, and that the solvers that hand it
 their search give the answers they gave with their own loops."""
 import math
 
 import numpy as np
 
-from fkopt.numerics.restarts import restart, restart_rows
+from fkopt.numerics.restart_loop import restart, restart_rows
 
 
 def test_stops_at_the_first_answer_that_meets_the_test():

@@ -92,7 +92,7 @@ from fkopt.errors import FkoptError
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism
 from fkopt.kinematics.assembly_search import (_cluster, _euler_triple, _into_bounds, _kronecker, _model_for, _newton,
                                              _SixSPSModel)
-from fkopt.numerics.restarts import restart
+from fkopt.numerics.restart_loop import restart
 from fkopt.numerics.streams import RunStreams
 from fkopt.problems import FKProblem
 

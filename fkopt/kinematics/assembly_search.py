@@ -4,7 +4,7 @@ update, :class:`_GenericModel` on ``FKProblem``'s residuals), the damped Newton 
 over starts (:func:`_newton`: the local search each start runs), the low-discrepancy starts
 (:func:`_kronecker`), the deduplication (:func:`_cluster`) and the move of angles into the bounds
 (:func:`_into_bounds`). The rounds of starts and their stopping rule are the one restart loop's
-(:func:`fkopt.numerics.restarts.restart`); see :mod:`fkopt.kinematics.assembly_modes`.
+(:func:`fkopt.numerics.restart_loop.restart`); see :mod:`fkopt.kinematics.assembly_modes`.
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@ every row as its compiled one-pose call when it can (:func:`fkopt.numerics.compi
 rows on all cores), else the vectorised damped least-squares loop on numpy, candidates of many
 rows side by side (see :mod:`fkopt.kinematics.solvers`).
 
-Its restarts are the one restart loop's (:mod:`fkopt.numerics.restarts`) -- a row's starts in the
+Its restarts are the one restart loop's (:mod:`fkopt.numerics.restart_loop`) -- a row's starts in the
 same order (``start``, the start table's nearest, seeded draws), the first converged answer
 retiring the row, the best by max(pe / tol[0], re / tol[1]) kept -- but asynchronous: a candidate
 that stalls restarts in place while the others step on, and small batches run several candidates

@@ -4,9 +4,9 @@
 to compare algorithms. These two functions are the domain-level API: give joints (or poses),
 batched over any leading axes, get poses (or joints) back with a verdict per row.
 
-Both run their starts through the one restart loop, :mod:`fkopt.numerics.restarts` (forward's
-rows side by side: :func:`~fkopt.numerics.restarts.restart_rows`; inverse's one-pose candidates:
-:func:`~fkopt.numerics.restarts.restart`, compiled in :mod:`fkopt.numerics.compiled_ik`).
+Both run their starts through the one restart loop, :mod:`fkopt.numerics.restart_loop` (forward's
+rows side by side: :func:`~fkopt.numerics.restart_loop.restart_rows`; inverse's one-pose candidates:
+:func:`~fkopt.numerics.restart_loop.restart`, compiled in :mod:`fkopt.numerics.compiled_ik`).
 The pieces live beside this module: the argument checks (:mod:`.inputs`), the results
 (:mod:`.results`), the start tables (:mod:`.start_tables`), forward's Newton step
 (:mod:`.forward_newton`), inverse's one-pose and batched loops (:mod:`.inverse_pose`,
@@ -132,7 +132,7 @@ from fkopt.kinematics.start_tables import _TABLES, _forward_table, _joint_featur
 from fkopt.mechanisms.base import ParallelMechanism
 from fkopt.numerics import path as numerics_path
 from fkopt.numerics.options import InverseOptions
-from fkopt.numerics.restarts import restart_rows
+from fkopt.numerics.restart_loop import restart_rows
 from fkopt.problems import fk_problem
 
 #: The swarm budget of one pose: fkopt.forward's global stage (gabc+lm) and a forward solve by a

@@ -3,7 +3,7 @@ features, and the exact nearest-neighbour query that gives every row its nearest
 ``fkopt.inverse``'s table holds joint configurations and their tool features (:func:`_start_table`);
 ``fkopt.forward``'s holds poses of the bounds and their joints (:func:`_forward_table`). Both are
 cached per arm or mechanism geometry in :data:`_TABLES`; the starts they give run through the one
-restart loop (:mod:`fkopt.numerics.restarts`)."""
+restart loop (:mod:`fkopt.numerics.restart_loop`)."""
 from __future__ import annotations
 
 import numpy as np

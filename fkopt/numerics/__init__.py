@@ -6,8 +6,8 @@ joint-limit handling of ``fkopt.inverse``, its options, and the compiled fast pa
   geometric frame Jacobian of one configuration on Python floats (the reference).
 * :mod:`.damped_least_squares` -- the damped least-squares step d = J^T (J J^T + mu I)^{-1} (-r) by
   Cholesky on Python floats, the saturation of joint limits in the null space, and the candidate
-  search of one pose that :mod:`.restarts` repeats.
-* :mod:`.restarts` -- the one restart loop (after roboticstoolbox's ``IKSolver._solve``): solvers
+  search of one pose that :mod:`.restart_loop` repeats.
+* :mod:`.restart_loop` -- the one restart loop (after roboticstoolbox's ``IKSolver._solve``): solvers
   supply their starts, a local search and a stopping test.
 * :mod:`.rotations` -- every rotation helper, once (batched, stacked and on Python floats).
 * :mod:`.options` -- :class:`InverseOptions`, the documented options of ``fkopt.inverse``.

@@ -1,5 +1,5 @@
 """The compiled one-pose IK of ``fkopt.inverse`` (numba): the one restart loop
-(:func:`_inverse_one`, the twin of :func:`fkopt.numerics.restarts.restart` driving
+(:func:`_inverse_one`, the twin of :func:`fkopt.numerics.restart_loop.restart` driving
 :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, :func:`_dls_candidate`),
 the start table's nearest-neighbour search (a float32 screen, then the float64 rows it cannot rule
 out: :func:`_nearest_screened`), one pose from the public target to the public answer
@@ -121,7 +121,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq
     work = (r, rn, rr, J, Jn, p, R, ax, e, A, Lc, y, x, qn, d, ds, fixed_val, fixed_order, free)
     evals = 0
     best_m = math.inf
-    for j in range(budget):                     # the one restart loop (fkopt.numerics.restarts.restart)
+    for j in range(budget):                     # the one restart loop (fkopt.numerics.restart_loop.restart)
         if j < own0:
             q[:] = q0
         elif j < own0 + nn:

@@ -13,13 +13,13 @@ operation in the same order.
   after ``iterations`` steps, when lambda exceeds 1e6 (stalled) or when the system is singular;
 * restarts: candidates one after another in the order of their starts, stopping at the first that
   converges; the best (smallest max(pe / tol[0], re / tol[1])) is kept: the one restart loop,
-  :func:`fkopt.numerics.restarts.restart`, with this module's candidate search as its search.
+  :func:`fkopt.numerics.restart_loop.restart`, with this module's candidate search as its search.
 """
 from __future__ import annotations
 
 import math
 
-from fkopt.numerics.restarts import restart
+from fkopt.numerics.restart_loop import restart
 from fkopt.numerics.rotations import rotation_error1
 
 #: lambda above this: the candidate stalled and restarts.

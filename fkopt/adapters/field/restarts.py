@@ -1,5 +1,5 @@
 """The restart loop of kinbench's board, for every outside entry whose package has none of its
-own (fkopt's one restart loop, :func:`fkopt.numerics.restarts.restart`, with a deadline): pinocchio's CLIK (``pin-clik``), ikpy, pink and the black-box optimisers (cma-es,
+own (fkopt's one restart loop, :func:`fkopt.numerics.restart_loop.restart`, with a deadline): pinocchio's CLIK (``pin-clik``), ikpy, pink and the black-box optimisers (cma-es,
 scipy-lbfgsb, nevergrad-ngopt). TRAC-IK, optik and roboticstoolbox restart inside their own
 calls and keep their own loops; EAIK is analytic; fkopt.inverse is the organiser's.
 
@@ -27,7 +27,7 @@ from typing import Callable
 
 import numpy as np
 
-from fkopt.numerics.restarts import restart as one_loop
+from fkopt.numerics.restart_loop import restart as one_loop
 
 #: The board's rung (m, rad): every entry's stopping test implies it (docs/kinbench.md).
 RUNG = 1e-5
@@ -50,7 +50,7 @@ class Stall:
 
 def restart(search: Callable[[np.ndarray, float], tuple[np.ndarray, float, bool]],
             start: Callable[[], np.ndarray], timeout: float) -> tuple[np.ndarray, bool, int]:
-    """The restart loop (:func:`fkopt.numerics.restarts.restart`): ``search(x0, deadline)`` -> (answer, error, met its stopping test) from
+    """The restart loop (:func:`fkopt.numerics.restart_loop.restart`): ``search(x0, deadline)`` -> (answer, error, met its stopping test) from
     starts ``start()`` until one meets its test or ``timeout`` (s) has passed. Returns the best
     answer (the met one, else the smallest error), whether it met the test, and the number of
     starts."""
