@@ -291,7 +291,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                 ev_r[good] += extra
                 ev_j[good] += extra
     # verdict from the arm's own closed form (its elementwise frame), not the solver's products
-        qd = _public(m, best_q)
+    qd = _public(m, best_q)
     if periodic.any():                                 # continuous joints: into [-180, 180)
         qd = np.where(periodic, (qd + 180.0) % 360.0 - 180.0, qd)
     qd = np.clip(qd, m.bounds[:, 0], m.bounds[:, 1])
