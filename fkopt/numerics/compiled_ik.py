@@ -18,7 +18,7 @@ from fkopt.numerics.compiled import (_dls_step, _dls_step_all, _evaluate, _rotat
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 
-@njit(cache=True)
+@njit(inline="always")      # inlined into the loop: no call per start (the one-pose path is per-call cost)
 def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap, lo, hi, work):
     """One candidate of the one restart loop: the damped least-squares steps from start q (updated
     in place) -- :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, compiled,
