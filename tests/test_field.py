@@ -320,13 +320,13 @@ def test_tracik_readme_protocol_reproduces_its_published_success(name):
     q, T = targets(m, 1000, 2015)
     mid = (w.lo_rad + w.hi_rad) / 2
     ok, secs = np.zeros(len(T), bool), np.zeros(len(T))
-    for k in range(len(T)):
-        x, y, z, qw = quat_xyzw(T[k].tolist())
-        with pinned():
+    with pinned():                                   # the whole process on one core, as the clock track
+        for k in range(len(T)):
+            x, y, z, qw = quat_xyzw(T[k].tolist())
             t0 = time.perf_counter()
             out = w._pt.ik(w._solver, mid, T[k, 0, 3], T[k, 1, 3], T[k, 2, 3], x, y, z, qw)
             secs[k] = time.perf_counter() - t0
-        ok[k] = out[0] > 0
+            ok[k] = out[0] > 0
     rate = 100 * ok.mean()
     print(f"{name}: {rate:.2f} % (README {TRACIK_README[name]} %), mean {1e3 * secs[ok].mean():.3f} ms over "
           f"successes, load {load:.2f} -> {os.getloadavg()[0]:.2f}")
@@ -387,3 +387,37 @@ def test_ikpy_tutorial_protocol_on_baxter():
         F = m.fk_matrix(w.public(x[w._active])[None])[0]
         reached.append(np.linalg.norm(F[:3, 3] - T[k, :3, 3]) <= 1e-3)
     assert np.mean(reached) >= 0.6
+
+
+def test_clock_pin_holds_threads_started_before_it_and_the_blas_pool():
+    """The clock track's one core (fkopt/adapters/field/cores.py): a thread that existed before the
+    block (as OpenBLAS's pool or a Rust package's workers do) runs on the caller's core inside it,
+    the BLAS pool has one thread, and both are restored after."""
+    import os
+    import threading
+    from threadpoolctl import threadpool_info
+    from fkopt.adapters.field.cores import pinned
+    if not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("needs Linux affinity and two allowed cores")
+    ready, stop, tid = threading.Event(), threading.Event(), []
+
+    def worker():
+        tid.append(threading.get_native_id())
+        ready.set()
+        stop.wait()
+    t = threading.Thread(target=worker)
+    t.start()
+    ready.wait()
+    allowed = os.sched_getaffinity(0)
+    try:
+        with pinned() as ok:
+            assert ok
+            core = os.sched_getaffinity(0)
+            assert len(core) == 1 and os.sched_getaffinity(tid[0]) == core
+            assert all(i["num_threads"] == 1 for i in threadpool_info() if i.get("user_api") == "blas")
+        assert os.sched_getaffinity(0) == allowed and os.sched_getaffinity(tid[0]) == allowed
+        with pinned(whole_process=False):       # a wrapper's per-call pin: the caller's thread only
+            assert len(os.sched_getaffinity(0)) == 1 and os.sched_getaffinity(tid[0]) == allowed
+    finally:
+        stop.set()
+        t.join()

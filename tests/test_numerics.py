@@ -10,6 +10,7 @@ from fkopt.numerics import path as numerics_path
 from fkopt.mechanisms.urdf import example_robot, example_robots_folder
 
 compiled = pytest.importorskip("fkopt.numerics.compiled", reason="numba is not installed")
+rps3_kernels = pytest.importorskip("fkopt.mechanisms.rps3_kernels", reason="numba is not installed")
 TIPS = {"panda": "panda_hand_tcp", "ur5": "ee_link", "kinova": "j2s6s200_end_effector"}
 
 
@@ -168,7 +169,7 @@ def test_compiled_3rps_fitness_is_the_numpy_fitness_bit_for_bit(monkeypatch):
 def test_numpy_tan_layout_is_the_numpy_fitness_call_and_the_libm_tan_differs():
     """The compiled swarms take numpy's tangents in the layout ThreeRPS.ik_columns gives np.tan
     (per block: the block's alphas, then its betas, contiguous). Held here: the layout of
-    compiled._slot / numpy_tan against that construction, several blocks and a short last one;
+    rps3_kernels.slot / numpy_tan against that construction, several blocks and a short last one;
     and why it matters -- the C library's tan (math.tan) differs from numpy's on some inputs on
     SIMD builds (reported, not required: on builds without SIMD tan both are libm's)."""
     import math
@@ -176,11 +177,11 @@ def test_numpy_tan_layout_is_the_numpy_fitness_call_and_the_libm_tan_differs():
     n, block = 23, 5
     P = np.stack([rng.uniform(-20, 20, n), rng.uniform(-20, 20, n), rng.uniform(400, 700, n)], axis=1)
     arg = np.full(2 * n, np.nan)
-    compiled._rps3_args(P, arg, block)
+    rps3_kernels._arguments(P, arg, block)
     want = np.concatenate([np.concatenate([P[s:s + block, 0], P[s:s + block, 1]]) for s in range(0, n, block)])
     assert np.array_equal(arg, want * (math.pi / 360.0))
     tan = np.empty(2 * n)
-    compiled.numpy_tan(arg, tan, ((0, n),), block)
+    rps3_kernels.numpy_tan(arg, tan, ((0, n),), block)
     assert np.array_equal(tan, np.concatenate([np.tan(arg[2 * s:2 * min(s + block, n)]) for s in range(0, n, block)]))
     big = rng.uniform(-20, 20, 20000) * (math.pi / 360.0)
     differ = float(np.mean(np.tan(big) != np.array([math.tan(v) for v in big])))
@@ -203,7 +204,7 @@ SWARM_CASES = [("pso", {}, 10, {}), ("abc", {}, 10, {}), ("abc", {"limit": 3}, 1
 def test_compiled_swarms_give_the_numpy_paths_runs_bit_for_bit(monkeypatch, algorithm, params, population, options,
                                                                cases):
     """The default path (FKOPT_NUMERICS unset: auto) runs PSO, ABC and GABC on 3-RPS compiled
-    (fkopt.numerics.compiled.pso_rps3 / abc_rps3 around numpy's np.tan); through the real solver,
+    (fkopt.algorithms.pso_kernels / abc_kernels on fkopt.mechanisms.rps3_kernels, around numpy's np.tan); through the real solver,
     every record equals FKOPT_NUMERICS=numpy's bit for bit -- points, fitness, histories,
     evaluation counts and the evaluation log -- on two seeds, one and three cases (a target
     per row: the scouts' own fitness call), scouts included (small limits make them fly)."""
@@ -215,8 +216,8 @@ def test_compiled_swarms_give_the_numpy_paths_runs_bit_for_bit(monkeypatch, algo
     options = dict(options)
     p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints, objective=options.pop("objective", "squared"))
     ran = []
-    spy = compiled.numpy_tan
-    monkeypatch.setattr(compiled, "numpy_tan", lambda *a: ran.append(1) or spy(*a))
+    spy = rps3_kernels.numpy_tan
+    monkeypatch.setattr(rps3_kernels, "numpy_tan", lambda *a: ran.append(1) or spy(*a))
     for seed in (3, 4):
         got = {}
         for mode in (None, "numpy"):

@@ -59,7 +59,7 @@ winner written back as its one moved coordinate; the roulette as a dense count o
 integers either way). ``fkopt bench`` measures what an evaluation costs.
 
 On a 3-RPS FK problem with numba installed (unless ``FKOPT_NUMERICS=numpy``), fkopt's own ABC and
-GABC (raw selection) run each iteration compiled instead (:func:`fkopt.numerics.compiled.abc_rps3`:
+GABC (raw selection) run each iteration compiled instead (:func:`fkopt.algorithms.abc_kernels.abc_iteration`:
 the same draws in one block per iteration, the same operations, numpy's own ``np.tan``, the
 evaluation log's bookkeeping and the best-so-far inside); its records equal these phases bit for
 bit (tests/test_numerics.py).
@@ -205,6 +205,12 @@ def _aux(state: ABCState, problem) -> _Aux:
     return aux
 
 
+def _compiled_iteration(fitness):
+    """:func:`fkopt.algorithms.abc_kernels.abc_iteration` on a mechanism's compiled fitness."""
+    from fkopt.algorithms.abc_kernels import abc_iteration   # imports numba: only once the compiled path runs
+    return abc_iteration(fitness)
+
+
 class ABC(Algorithm):
     name = "abc"
     blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
@@ -244,11 +250,11 @@ class ABC(Algorithm):
     def _compiled_iteration(self, problem):
         """(compiled iteration, absolute objective, rule) or None (:func:`compiled_step`)."""
         rule = self.compiled_rule()
-        fused = None if rule is None else compiled_step(problem, "abc")
+        fused = None if rule is None else compiled_step(problem, _compiled_iteration)
         return None if fused is None else (*fused, rule)
 
     def _iterate_compiled(self, state, problem, streams, step, absolute, rule):
-        """:meth:`iterate` in one compiled pass (:func:`fkopt.numerics.compiled.abc_rps3`): the
+        """:meth:`iterate` in one compiled pass (:func:`fkopt.algorithms.abc_kernels.abc_iteration`): the
         same draws (one block per iteration holding the phases' draws in their order), the same
         operations (numpy's ``np.tan`` included), the same log reports, the best-so-far folded in."""
         _aux(state, problem)                        # x, f, trial: C-contiguous arrays of our own
@@ -264,11 +270,12 @@ class ABC(Algorithm):
         C = getattr(self.params, "C", 0.0)
         # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
         # (a target per row: the numpy path evaluates the fresh scouts in a fitness call of their own)
-        scout, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
-                           problem.bounds, J, absolute, log_arrays(state, runs), problem.cases is not None)
+        evaluations, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
+                                 problem.bounds, J, absolute, log_arrays(state, runs), problem.cases is not None,
+                                 np.ascontiguousarray(state.evaluations, dtype=np.int64))
         log_kept(state, kept)
         state.best_x, state.best_f, state.best_folded = best_x, best_f, True
-        state.evaluations = state.evaluations + (2 * population + scout)
+        state.evaluations = evaluations         # + 2 SN, + 1 where a scout flew
 
     def step(self, state, xs, xk, phi, streams):
         """The move added to the chosen coordinate, on whole rows (overridden by GABC).

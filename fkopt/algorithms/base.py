@@ -16,7 +16,6 @@ iteration on, so its numbers do not depend on the other runs of the batch.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, ClassVar
@@ -26,7 +25,7 @@ from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
 from fkopt.errors import FkoptError
 from fkopt.files import no_quoted_numbers
-from fkopt.numerics.path import ENV as _NUMERICS_ENV
+from fkopt.numerics import path as numerics_path
 from fkopt.progress import tick
 from fkopt.numerics.streams import RunStreams
 
@@ -145,8 +144,8 @@ class EvaluationLog:
     def finish(self, evaluations: np.ndarray, best_f: np.ndarray) -> None:
         """Close the iteration: an improvement of ``best_f`` that no reported value reached
         is put at the iteration's last evaluation."""
-        gap = self.active & (best_f < self.best)
-        if gap.any():
+        gap = best_f < self.best
+        if gap.any() and (gap := gap & self.active).any():     # rarely: most iterations report every value
             r = np.flatnonzero(gap)
             self._keep(r, np.asarray(evaluations)[r], best_f[r])
             self.best = np.where(gap, best_f, self.best)
@@ -169,7 +168,7 @@ def evaluated(state, f: np.ndarray, rows: np.ndarray | None = None) -> None:
 
 def log_arrays(state, runs: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The run's :class:`EvaluationLog` as the arrays a compiled iteration updates in place while
-    it reports its values (best, count, active: :func:`fkopt.numerics.compiled._log_points`, the
+    it reports its values (best, count, active: :func:`fkopt.algorithms.kernels.log_points`, the
     same rule as :meth:`EvaluationLog.add`); scratch arrays outside :meth:`Algorithm.minimize`.
     Hand the improvements it returns to :func:`log_kept`."""
     log = getattr(state, "log", None)
@@ -206,25 +205,28 @@ def rows_of(problem, rows: np.ndarray):
     return problem if getattr(problem, "cases", None) is None else problem.take(rows)
 
 
-def compiled_step(problem, kind: str):
-    """(compiled iteration, absolute objective) when the problem's mechanism offers one for the
-    algorithm ``kind`` ('pso', 'abc': its ``compiled_<kind>_step``, the 3-RPS FK fitness unless
+def compiled_step(problem, make):
+    """(compiled iteration, absolute objective) when the problem's mechanism offers its fitness
+    compiled for swarm iterations (``compiled_swarm_fitness()``: a
+    :class:`fkopt.mechanisms.base.CompiledFitness`, the 3-RPS FK fitness, unless
     ``FKOPT_NUMERICS=numpy`` or numba is missing) and the problem is a plain FK problem of three
-    variables without angle-valued joints, else None. The same operations as the numpy
-    iteration, numpy's own ``np.tan`` included: the same bits (tests/test_numerics.py)."""
+    variables without angle-valued joints, else None. ``make(fitness)`` builds the algorithm's
+    iteration on it (:func:`fkopt.algorithms.pso_kernels.pso_iteration`,
+    :func:`fkopt.algorithms.abc_kernels.abc_iteration`): the same operations as the numpy
+    iteration, numpy's own ``np.tan`` included, so the same bits (tests/test_numerics.py)."""
     # Asked every iteration: the answer is kept on the problem per FKOPT_NUMERICS value (a test
     # or a caller may change the variable between iterations).
-    key = (kind, os.environ.get(_NUMERICS_ENV))
+    key = (make, numerics_path.requested())
     cache = getattr(problem, "_compiled_steps", None)
     if cache is not None and key in cache:
         return cache[key]
-    make = getattr(getattr(problem, "mechanism", None), f"compiled_{kind}_step", None)
+    offer = getattr(getattr(problem, "mechanism", None), "compiled_swarm_fitness", None)
     rows = getattr(problem, "_joint_rows", None)
-    if make is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
+    if offer is None or rows is None or problem._angle.any() or problem.bounds.shape[0] != 3:
         got = None
     else:
-        step = make()
-        got = None if step is None else (step, problem.objective == "absolute")
+        fitness = offer()
+        got = None if fitness is None else (make(fitness), problem.objective == "absolute")
     if cache is None:
         try:
             cache = problem._compiled_steps = {}

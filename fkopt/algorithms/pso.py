@@ -64,6 +64,12 @@ class PSOState(State):
     clamp_box: tuple | None = None     # (velocity clamp, bounds) of the compiled iteration, made once
 
 
+def _compiled_iteration(fitness):
+    """:func:`fkopt.algorithms.pso_kernels.pso_iteration` on a mechanism's compiled fitness."""
+    from fkopt.algorithms.pso_kernels import pso_iteration   # imports numba: only once the compiled path runs
+    return pso_iteration(fitness)
+
+
 class PSO(Algorithm):
     name = "pso"
     blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
@@ -95,8 +101,8 @@ class PSO(Algorithm):
 
     @staticmethod
     def _compiled_step(problem):
-        """:func:`fkopt.algorithms.base.compiled_step` for PSO (``compiled_pso_step``)."""
-        return compiled_step(problem, "pso")
+        """:func:`fkopt.algorithms.base.compiled_step` for PSO (:func:`_compiled_iteration`)."""
+        return compiled_step(problem, _compiled_iteration)
 
     def iterate(self, state, problem, streams):
         p = self.params

@@ -204,9 +204,11 @@ def _peer_mealpy(problem, runs: int):
     return out, "mealpy OriginalABC(epoch=600, pop_size=10, n_limits=30)"
 
 
-def _pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population: int = 10, limit: int = 30):
+def _pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population: int = 10, limit: int = 30,
+                      clock=time.perf_counter, first: int = 0):
     """pygmo's C++ ``bee_colony`` on ``fitness_one`` (one point -> float), run ``runs`` times
-    (seed k for run k): per run (seconds of ``evolve``, evaluations, final fitness)."""
+    (seed k for run k from ``first``): per run (seconds of ``evolve`` by ``clock``, evaluations,
+    final fitness)."""
     import pygmo as pg
     lo, hi = np.asarray(bounds)[:, 0].tolist(), np.asarray(bounds)[:, 1].tolist()
 
@@ -218,12 +220,12 @@ def _pygmo_bee_colony(fitness_one, bounds, runs: int, gen: int = 600, population
             return (lo, hi)
 
     out = []
-    for k in range(runs):
+    for k in range(first, first + runs):
         prob = pg.problem(UDP())
         algo = pg.algorithm(pg.bee_colony(gen=gen, limit=limit, seed=k))
-        t = time.perf_counter()
+        t = clock()
         pop = algo.evolve(pg.population(prob, population, seed=k))
-        out.append((time.perf_counter() - t, pop.problem.get_fevals(), float(pop.champion_f[0])))
+        out.append((clock() - t, pop.problem.get_fevals(), float(pop.champion_f[0])))
     return out
 
 
@@ -696,15 +698,15 @@ def compile_reference(folder: Path) -> tuple[Path, str] | str:
 def run_reference(exe: Path, joints: np.ndarray, iterations: int, population: int, runs: int,
                   seed: int = 1, algorithm: str = "gabc") -> dict[str, float]:
     """Solve every row of ``joints`` (cases, 3) ``runs`` times with the compiled loop of
-    ``algorithm`` (gabc, abc or pso): evaluations, seconds (of the solves, timed inside the
-    program), median and largest final fitness."""
+    ``algorithm`` (gabc, abc or pso): evaluations, seconds and cpu_seconds (of the solves, wall
+    and CPU time, timed inside the program), median and largest final fitness."""
     import subprocess
     data = "\n".join(" ".join(repr(float(v)) for v in row) for row in np.atleast_2d(joints)) + "\n"
     p = subprocess.run([str(exe), str(iterations), str(population), str(runs), str(seed), algorithm], input=data,
                        capture_output=True, text=True, timeout=1800, check=True)
-    evals, seconds, median, worst = p.stdout.split()
+    evals, seconds, median, worst, cpu = p.stdout.split()
     return {"evaluations": float(evals), "seconds": float(seconds), "median": float(median),
-            "worst": float(worst)}
+            "worst": float(worst), "cpu_seconds": float(cpu)}
 
 
 def bench_cases(rows: _Rows, quick: bool, rng, messages: list[str] | None = None) -> None:
@@ -780,22 +782,31 @@ def bench_cases(rows: _Rows, quick: bool, rng, messages: list[str] | None = None
 SWARM_TARGETS = {1: 1.5, 100: 1.2}
 
 
+def _load_average() -> str:
+    """The load average (1, 5, 15 min) for a note: a shared machine's measurements say it beside them."""
+    try:
+        return "load " + "/".join(f"{v:.1f}" for v in os.getloadavg())
+    except (AttributeError, OSError):     # pragma: no cover - not on every platform
+        return "load unknown"
+
+
 def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
     """GABC, ABC and PSO on 3-RPS (population 10, 600 iterations; 100 in quick mode; 30 runs) at
     1 case and at 100 cases, beside the same algorithm as the plain C loop of
     :data:`REFERENCE_C` on the same cases; alternating fkopt solve on the default path, on
-    ``FKOPT_NUMERICS=numpy`` and the C run (best of 2 each; 1 in quick mode). Rows: ns per
-    evaluation and the ratio fkopt / C, against :data:`SWARM_TARGETS`, for the default path
-    (with numba: the whole iteration compiled around numpy's np.tan,
-    :func:`fkopt.numerics.compiled.abc_rps3`, ``pso_rps3``; the numpy path's bits, checked here
-    run for run) and the numpy path. Skipped with a message when there is no C compiler."""
+    ``FKOPT_NUMERICS=numpy`` and the C run, in CPU time (this process's, and the C program's own:
+    what a shared machine disturbs least; both on one core), best of 5 at 1 case and of 2 at 100
+    (1 in quick mode), the load average in every note. Rows: the ratio fkopt / C per evaluation,
+    against :data:`SWARM_TARGETS`, for the default path (with numba: the whole iteration compiled
+    around numpy's np.tan, :func:`fkopt.algorithms.abc_kernels.abc_iteration`, ``pso_iteration``;
+    the numpy path's bits, checked here run for run) and the numpy path. Skipped with a message
+    when there is no C compiler."""
     import tempfile
     from fkopt import mechanism
     from fkopt.solve import solve
     from fkopt.numerics import path as numerics_path
     m = mechanism("3-rps")
     iterations = 100 if quick else 600
-    reps = 1 if quick else 2
     joints = m.ik(_uniform(m.bounds, (100,), rng))
     try:
         with numerics_path.forced("compiled"):
@@ -814,22 +825,24 @@ def bench_swarms(rows: _Rows, quick: bool, rng, messages: list[str]) -> None:
             for n in SWARM_TARGETS:
                 problem = fk_problem(m, joints[:n])
                 f_ns, k_ns, c_ns = np.inf, np.inf, np.inf
+                reps = 1 if quick else (5 if n == 1 else 2)
+                load = _load_average()
                 for _ in range(reps):              # numpy path, default path, C loop
                     with numerics_path.forced("numpy"):
-                        t = time.perf_counter()
+                        t = time.process_time()
                         res = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
-                        f_ns = min(f_ns, (time.perf_counter() - t) / float(res.evaluations.sum()) * 1e9)
+                        f_ns = min(f_ns, (time.process_time() - t) / float(res.evaluations.sum()) * 1e9)
                     if fast:
                         with numerics_path.forced("auto"):
-                            t = time.perf_counter()
+                            t = time.process_time()
                             rk = solve(problem, alg, population=10, iterations=iterations, runs=30, seed=1)
-                            k_ns = min(k_ns, (time.perf_counter() - t) / float(rk.evaluations.sum()) * 1e9)
+                            k_ns = min(k_ns, (time.process_time() - t) / float(rk.evaluations.sum()) * 1e9)
                     ref = run_reference(built[0], joints[:n], iterations, 10, 30, algorithm=alg)
-                    c_ns = min(c_ns, ref["seconds"] / ref["evaluations"] * 1e9)
+                    c_ns = min(c_ns, ref["cpu_seconds"] / ref["evaluations"] * 1e9)
                 target = SWARM_TARGETS[n]
                 label = f"{alg} {n} case{'s' if n > 1 else ''} x 30 runs"
-                common = (f"C loop {c_ns:.0f} ns/eval ({built[1]}); {iterations} it, population 10; best of {reps}; "
-                          f"median final fitness C {ref['median']:.2g}")
+                common = (f"C loop {c_ns:.0f} ns/eval ({built[1]}); CPU time, {iterations} it, population 10; best of "
+                          f"{reps}; {load} -> {_load_average()}; median final fitness C {ref['median']:.2g}")
                 if fast:
                     same = all(np.array_equal(getattr(res, k), getattr(rk, k)) for k in ("x", "fitness", "history"))
                     rows.add("swarms", label, k_ns / c_ns, "x C loop",
@@ -851,14 +864,15 @@ PYGMO_TARGET = 10.0
 def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
     """pygmo's C++ ``bee_colony`` (gen 600, limit 30 = fkopt's default SN * dim, population 10)
     on mao2017's 3-RPS case with the fitness compiled by numba (the 3-RPS point of
-    :func:`fkopt.numerics.compiled._rps3_point`, called once per point as pygmo asks), beside
+    :func:`fkopt.mechanisms.rps3_kernels.point_fitness`, called once per point as pygmo asks), beside
     fkopt's ABC solving the 30 runs in one batch (``FKOPT_NUMERICS=numpy`` and the compiled default path);
-    alternating, best of 2 for fkopt, pygmo's median run; ratio pygmo / fkopt per run against
+    alternating (fkopt's two paths, then a third of pygmo's runs, three times), in CPU time, best of
+    3 for fkopt, pygmo's median run; ratio pygmo / fkopt per run against
     :data:`PYGMO_TARGET`. Quick mode: 100 iterations, 10 pygmo runs. Skipped with a message
     without pygmo or numba."""
     try:
         import pygmo  # noqa: F401
-        from fkopt.numerics import compiled as numerics_compiled
+        from fkopt.mechanisms import rps3_kernels
     except Exception as err:                        # pragma: no cover - depends on the machine
         messages.append(f"swarms: pygmo bee_colony row skipped: {err}; pip install 'fkopt[bench,fast]'")
         return
@@ -869,7 +883,7 @@ def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
     problem = mao_problem()
     j0, j1, j2 = (float(v) for v in problem.joints)
     ra, rb = float(m.geometry.ra), float(m.geometry.rb)
-    point = numerics_compiled._rps3_point
+    point = rps3_kernels.point_fitness
 
     def fitness_one(x):                             # numba-compiled; one call per point
         return point(x[0], x[1], x[2], j0, j1, j2, ra, rb, False)
@@ -880,16 +894,19 @@ def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
     best = {"numpy": np.inf, "compiled": np.inf}
     fk = {}
     peer = []
-    for rep in range(2):
+    reps = 3
+    load = _load_average()
+    for rep in range(reps):                         # fkopt's two paths and a third of pygmo's runs, in turn
         for mode in ("numpy", "compiled"):
             with numerics_path.forced(mode):
-                t = time.perf_counter()
+                t = time.process_time()
                 res = solve(problem, "abc", population=10, iterations=iterations, runs=30, seed=1)
-                per_run = (time.perf_counter() - t) / 30
+                per_run = (time.process_time() - t) / 30
             if per_run < best[mode]:
                 best[mode], fk[mode] = per_run, res
-        if rep == 0:
-            peer = _pygmo_bee_colony(fitness_one, problem.bounds, peer_runs, gen=iterations)
+        share = peer_runs // reps + (rep < peer_runs % reps)
+        peer += _pygmo_bee_colony(fitness_one, problem.bounds, share, gen=iterations, clock=time.process_time,
+                                  first=len(peer))
     p_run = float(np.median([r[0] for r in peer]))
     p_evals = float(np.median([r[1] for r in peer]))
     p_fit = float(np.median([r[2] for r in peer]))
@@ -898,9 +915,10 @@ def bench_pygmo_abc(rows: _Rows, quick: bool, messages: list[str]) -> None:
         res = fk[mode]
         rows.add("swarms", f"pygmo bee_colony (numba fitness) / fkopt abc per run, {label}", ratio, "x",
                  f"pygmo {p_run * 1e3:.2f} ms/run (median of {peer_runs}, {p_evals:.0f} evaluations, median final "
-                 f"fitness {p_fit:.2g}); fkopt {best[mode] * 1e3:.3f} ms/run (30 runs in one batch, best of 2, "
+                 f"fitness {p_fit:.2g}); fkopt {best[mode] * 1e3:.3f} ms/run (30 runs in one batch, best of {reps}, "
                  f"{float(res.evaluations.mean()):.0f} evaluations, median final fitness "
-                 f"{float(np.median(res.fitness)):.2g}); {iterations} it, population 10, limit 30; "
+                 f"{float(np.median(res.fitness)):.2g}); CPU time, alternating; {load} -> {_load_average()}; "
+                 f"{iterations} it, population 10, limit 30; "
                  f"target >= {PYGMO_TARGET:g}: {'met' if ratio >= PYGMO_TARGET else 'NOT met'}")
 
 

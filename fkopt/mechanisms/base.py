@@ -24,7 +24,7 @@ A mechanism module can build its model class on first use with :class:`lazy_mode
 from __future__ import annotations
 
 from types import SimpleNamespace
-from typing import Any, Callable, ClassVar
+from typing import Any, Callable, ClassVar, NamedTuple
 
 import numpy as np
 
@@ -258,6 +258,24 @@ class Mechanism:
             "bounds": {n: list(b) for n, b in zip(self.unknown_names, self.bounds.tolist())},
             "geometry": self.geometry.model_dump(),
         }
+
+
+class CompiledFitness(NamedTuple):
+    """A parallel mechanism's FK fitness as the compiled swarm iterations take it
+    (:mod:`fkopt.algorithms.pso_kernels`, :mod:`fkopt.algorithms.abc_kernels`; offered by
+    ``compiled_swarm_fitness()``, e.g. :meth:`fkopt.mechanisms.rps3.ThreeRPS.compiled_swarm_fitness`),
+    in three stages so that numpy's own ufunc runs between compiled code and the iterations keep
+    the numpy path's bits: an iteration's kernel writes each candidate pose's ufunc arguments
+    (``prepare``), the ufunc runs on the buffer as the numpy fitness calls it (``ufunc``), and the
+    next kernel reads each candidate's fitness (``value``). A pose is c of a fitness call over
+    poses [s0, s0 + sl); ``prepare`` and ``value`` are numba kernels the iterations inline."""
+
+    prepare: Callable   # njit (x0, x1, x2, arg, c, s0, sl, block): the pose's ufunc arguments into arg
+    ufunc: Callable     # (arg, out, segments, block): numpy's ufunc on arg into out, per (s0, sl) call
+    value: Callable     # njit (out, c, s0, sl, block, x0, x1, x2, j0, j1, j2, params, absolute) -> fitness
+    width: int          # ufunc arguments per pose (the buffers hold width * poses values)
+    block: int          # poses per block of the numpy fitness
+    params: tuple       # the geometry's floats ``value`` reads
 
 
 class ParallelMechanism(Mechanism):

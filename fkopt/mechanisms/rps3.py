@@ -23,7 +23,7 @@ from pydantic import Field
 
 from fkopt.numerics import rotations
 from fkopt.numerics import path as numerics_path
-from fkopt.mechanisms.base import Geometry, ParallelMechanism
+from fkopt.mechanisms.base import CompiledFitness, Geometry, ParallelMechanism
 
 
 _HALF_DEG = np.pi / 360.0          # degrees -> half-angle in radians
@@ -214,51 +214,29 @@ class ThreeRPS(ParallelMechanism):
 
     def compiled_fitness(self, poses, rows, absolute: bool):
         """The fitness of :meth:`fkopt.problems.FKProblem.fitness` of poses (n, 3) against leg rows
-        (3, 1) or (3, n) compiled (:func:`fkopt.numerics.compiled.rps3_fitness`: numpy's ``np.tan``
+        (3, 1) or (3, n) compiled (:func:`fkopt.mechanisms.rps3_kernels.fitness`: numpy's ``np.tan``
         in this method's layout, the rest compiled, so the numpy path's bits), or None unless
         ``FKOPT_NUMERICS=compiled`` asks for it: importing numba (~0.5-0.9 s) does not pay for
-        one fitness call (the swarm iterations compile on their own, :meth:`compiled_pso_step`)."""
+        one fitness call (the swarm iterations compile on their own, :meth:`compiled_swarm_fitness`)."""
         if numerics_path.requested() != "compiled":
             return None
-        mod = numerics_path.compiled(True)
-        return mod.rps3_fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute, BLOCK)
+        numerics_path.compiled(True)
+        from fkopt.mechanisms import rps3_kernels      # imports numba: only once the compiled path runs
+        return rps3_kernels.fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute, BLOCK)
 
-    def _swarm_kernels(self):
-        """:mod:`fkopt.numerics.compiled` for the compiled swarm iterations, or None: with
-        ``FKOPT_NUMERICS=numpy``, or without numba under the default (``auto``; ``compiled``
-        makes a missing numba an error). numba is imported here, on the first swarm iteration on
-        this mechanism, never for a single fitness call."""
-        return numerics_path.compiled()
-
-    def compiled_pso_step(self):
-        """A function (state arrays, ...) -> new arrays running one PSO iteration with this fitness
-        compiled (:func:`fkopt.numerics.compiled.pso_rps3`, same arguments after the fitness'
-        leg radii; numpy's ``np.tan`` in the numpy path's layout, so the numpy path's bits), or
-        None (:meth:`_swarm_kernels`)."""
-        mod = self._swarm_kernels()
-        if mod is None:
+    def compiled_swarm_fitness(self) -> CompiledFitness | None:
+        """This fitness in the three stages the compiled PSO, ABC and GABC iterations take
+        (:class:`fkopt.mechanisms.base.CompiledFitness` of :mod:`fkopt.mechanisms.rps3_kernels`:
+        numpy's ``np.tan`` in :meth:`ik_columns`' layout between compiled code, so the numpy path's
+        bits), or None: with ``FKOPT_NUMERICS=numpy``, or without numba under the default
+        (``auto``; ``compiled`` makes a missing numba an error). numba is imported here, on the
+        first swarm iteration on this mechanism, never for a single fitness call."""
+        if numerics_path.compiled() is None:
             return None
-        ra, rb = self.geometry.ra, self.geometry.rb
-
-        def step(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, absolute, log):
-            return mod.pso_rps3(x, fb, pos, vel, g, g_f, r, w, c1, c2, limit, bounds, J, ra, rb, absolute, log,
-                                BLOCK)
-        return step
-
-    def compiled_abc_step(self):
-        """A function (state arrays, ..., log arrays, separate) -> (scouts, log improvements),
-        running one ABC or GABC iteration with this fitness compiled
-        (:func:`fkopt.numerics.compiled.abc_rps3`, same arguments after the fitness' leg radii;
-        numpy's tangents as in :meth:`compiled_pso_step`), or None (:meth:`_swarm_kernels`)."""
-        mod = self._swarm_kernels()
-        if mod is None:
-            return None
-        ra, rb = self.geometry.ra, self.geometry.rb
-
-        def step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate):
-            return mod.abc_rps3(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, ra, rb, absolute, log,
-                                separate, BLOCK)
-        return step
+        from fkopt.mechanisms import rps3_kernels      # imports numba: only once the compiled path runs
+        k = rps3_kernels
+        return CompiledFitness(prepare=k.prepare, ufunc=k.numpy_tan, value=k.value, width=2, block=BLOCK,
+                               params=(float(self.geometry.ra), float(self.geometry.rb)))
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.

@@ -22,12 +22,15 @@ save are guarded.
 """
 from __future__ import annotations
 
+import hashlib
 import os
 import threading
 import time
 
 import numba
 from numba.core.caching import FunctionCache
+from numba.core.dispatcher import Dispatcher
+from numba.core.serialize import dumps
 
 from fkopt.numerics.notice import notice
 
@@ -53,6 +56,20 @@ class GuardedCache(FunctionCache):
         except Exception as err:        # garbage, empty, truncated, foreign content: set it aside
             self._set_aside(err)
             return None
+
+    def _index_key(self, sig, codegen):
+        """numba's key, but with a closure's compiled functions described by what they are (module,
+        name, bytecode, their source file's stamp, their own cells) where numba pickles them with
+        a per-process id: a kernel built by a factory on another module's kernels
+        (:mod:`fkopt.algorithms.pso_kernels` on :mod:`fkopt.mechanisms.rps3_kernels`) would get a
+        new key in every process (a compile every time), and an edit of the other file would not
+        change it (stale code)."""
+        closure = self._py_func.__closure__
+        if closure is None:
+            return super()._index_key(sig, codegen)
+        cells = tuple(_stable(c.cell_contents) for c in closure)
+        code = hashlib.sha256(self._py_func.__code__.co_code).hexdigest()
+        return sig, codegen.magic_tuple(), (code, hashlib.sha256(dumps(cells)).hexdigest())
 
     def save_overload(self, sig, data):
         try:
@@ -103,6 +120,22 @@ class GuardedCache(FunctionCache):
         notice("cache-bad", f"numba's compiled-code cache in {folder} held an unreadable file "
                             f"({os.path.basename(files[0]) if files else '?'}: {_describe(err)}); set aside in "
                             f"{aside}, compiling afresh (seconds, once)")
+
+
+def _stable(value):
+    """A closure cell as :meth:`GuardedCache._index_key` hashes it: a compiled function as its
+    module, name, bytecode, source file's (mtime, size) and cells; anything else as itself."""
+    py = getattr(value, "py_func", None)
+    if not isinstance(value, Dispatcher) or py is None:
+        return value
+    code = py.__code__
+    try:
+        st = os.stat(code.co_filename)
+        stamp = (st.st_mtime, st.st_size)
+    except OSError:
+        stamp = None
+    cells = tuple(_stable(c.cell_contents) for c in (py.__closure__ or ()))
+    return "compiled function", py.__module__, py.__qualname__, code.co_code, stamp, cells
 
 
 def njit(*args, cache: bool = False, **options):

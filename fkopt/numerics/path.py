@@ -7,7 +7,7 @@ first call that wants a compiled kernel, never at ``import fkopt`` (importing nu
 cache costs more than one pose saves, so a one-pose ``fkopt ik`` process keeps the reference:
 see ``fkopt/cli.py``); the 3-RPS swarm iterations (PSO, ABC, GABC) import it on their first
 iteration. Both paths give the same bits on those swarms (numpy's own ``np.tan`` inside the
-compiled iterations, :func:`fkopt.numerics.compiled.numpy_tan`), so stored results do not depend
+compiled iterations, :func:`fkopt.mechanisms.rps3_kernels.numpy_tan`), so stored results do not depend
 on the path.
 """
 from __future__ import annotations

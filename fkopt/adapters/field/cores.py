@@ -8,15 +8,22 @@ take turns on it and the call costs its CPU time. The clock track (:func:`fkopt.
 runs every entry pinned so, so every entry gets the same single core; the throughput track may
 use every core.
 
-``os.sched_setaffinity(0, ...)`` sets the calling thread's affinity (Linux), which threads it
-starts afterwards inherit; the caller's core is ``sched_getcpu`` (glibc). Where affinity is not
-available (not Linux) the block runs unpinned and :func:`pinned` says so (False).
+``os.sched_setaffinity(tid, ...)`` sets one thread's affinity (Linux), which threads it starts
+afterwards inherit; the caller's core is ``sched_getcpu`` (glibc). Threads a package started
+*before* the block (OpenBLAS's pool at numpy's import, a Rust package's worker pool) would keep
+both cores: a board stored with only the caller pinned showed entries using more CPU than wall
+time (CMA-ES 40 ms of CPU in a 20 ms call, OptIK 8x). So :func:`pinned` pins every thread of the
+process (``/proc/self/task``) and limits the BLAS and OpenMP pools to one thread
+(threadpoolctl) for the block, and restores both after. Where affinity is not available (not
+Linux) the block runs unpinned and :func:`pinned` says so (False).
 """
 from __future__ import annotations
 
 import ctypes
 import os
 from contextlib import contextmanager
+
+from threadpoolctl import threadpool_limits
 
 
 def _libc_getcpu():
@@ -37,10 +44,31 @@ def caller_core(allowed) -> int:
     return cpu if cpu in allowed else min(allowed)
 
 
+def _threads() -> list[int]:
+    """The ids of this process's threads (Linux ``/proc/self/task``); [0] (the caller) elsewhere."""
+    try:
+        return [int(t) for t in os.listdir("/proc/self/task")]
+    except OSError:
+        return [0]
+
+
+def _set(tid: int, cores) -> dict | None:
+    """``tid``'s affinity before it is set to ``cores``; None when the thread is gone or not ours."""
+    try:
+        before = os.sched_getaffinity(tid)
+        os.sched_setaffinity(tid, cores)
+        return before
+    except OSError:             # the thread ended meanwhile, or a sandbox forbids it
+        return None
+
+
 @contextmanager
-def pinned():
-    """The block runs with the calling thread (and the threads it starts) on one core: the one it
-    is on. Yields whether it is pinned (already on one core counts); restores the affinity after."""
+def pinned(whole_process: bool = True):
+    """The block runs on one core, the one the caller is on: every thread of the process (and the
+    threads they start) with the BLAS/OpenMP pools at one thread, or with ``whole_process=False``
+    only the calling thread and the threads it starts (cheap enough for a wrapper's every call:
+    TRAC-IK's two threads). Yields whether it is pinned (already on one core counts); restores
+    every affinity and pool size after."""
     if not hasattr(os, "sched_setaffinity"):
         yield False
         return
@@ -48,8 +76,15 @@ def pinned():
     if len(allowed) <= 1:
         yield True
         return
-    os.sched_setaffinity(0, {caller_core(allowed)})
+    core = {caller_core(allowed)}
+    before = {tid: _set(tid, core) for tid in (_threads() if whole_process else [0])}
     try:
-        yield True
+        if whole_process:
+            with threadpool_limits(limits=1):
+                yield True
+        else:
+            yield True
     finally:
-        os.sched_setaffinity(0, allowed)
+        for tid, cores in before.items():
+            if cores is not None:
+                _set(tid, cores)

@@ -61,7 +61,7 @@ class TracIK(FieldIK):
 
     def solve1(self, T):
         x, y, z, w = quaternion_xyzw1(T.tolist())
-        with pinned():
+        with pinned(whole_process=False):   # per call: only its own two threads
             out = self._pt.ik(self._solver, self.random_start(), T[0, 3], T[1, 3], T[2, 3], x, y, z, w)
         if out[0] <= 0:
             return None, False
