@@ -284,7 +284,8 @@ def _nearest_screened(table, f, v32, idx, best):
     for j in range(c):
         ff += f[j] * f[j]
     B = SCREEN_ROUNDOFF * (1.0 + nmax + 2.0 * math.sqrt(nmax * ff) + ff)
-    # the k smallest screen values (sorted insertion; k is small)
+    # the k smallest screen values (sorted insertion; k is small). Written out rather than through
+    # _insert: this pass runs over every row of the table, and with _insert it took 4x the time (measured)
     sk = np.empty(k)
     m = 0
     for i in range(N):
