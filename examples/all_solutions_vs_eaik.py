@@ -22,6 +22,7 @@ import numpy as np
 import fkopt
 from fkopt.adapters.field import NotApplicable
 from fkopt.adapters.field.eaik import EAIK
+from fkopt.adapters.field.track_entries import locked_arm
 from fkopt.kinbench.robots import ARMS
 
 ARMS_MEASURED = ("ur3", "ur5", "ur10", "z1", "kinova-j2s6s200", "so101", "ur5e-mj", "spot-arm-mj")
@@ -52,37 +53,7 @@ def errors(m, q, T):
     return dp, np.arctan2(s, c)
 
 
-def locked_arm(m, index: int, value: float, folder: Path):
-    """The 6-joint arm of 7-joint ``m`` with joint ``index`` locked at ``value`` (deg), for EAIK
-    (which takes 1-6R chains): the URDF written from fkopt's chain with that joint made fixed,
-    its rotation folded into the joint's origin; checked against m's FK."""
-    import math
-    import xml.etree.ElementTree as ET
-    from fkopt.mechanisms.urdf_writer import _rpy, _rz, chain_urdf
-    from scipy.spatial.transform import Rotation
-    w = chain_urdf(m)
-    root = ET.fromstring(w.text)
-    j = root.find(f"joint[@name='{m.joint_names[index]}']")
-    o, axis = j.find("origin"), j.find("axis")
-    r, p_, y = (float(v) for v in o.get("rpy").split())
-    R = Rotation.from_euler("xyz", [r, p_, y]).as_matrix() @ _rz(float(axis.get("xyz").split()[2]) * math.radians(value))
-    o.set("rpy", " ".join(repr(float(a)) for a in _rpy(R)))
-    j.set("type", "fixed")
-    j.remove(axis)
-    j.remove(j.find("limit"))
-    path = folder / f"{m.joint_names[index]}-locked.urdf"
-    path.write_text(ET.tostring(root, encoding="unicode"))
-    six = fkopt.mechanism("urdf", file=str(path), base=w.base_link, tip=w.tip_link)
-    q = m.bounds[:, 0] + 0.37 * (m.bounds[:, 1] - m.bounds[:, 0])
-    q[index] = value
-    gap = np.abs(six.fk_matrix(np.delete(q, index)[None]) - m.fk_matrix(q[None])).max()
-    if gap > 1e-9:
-        raise SystemExit(f"{m.name}: the locked URDF differs from the arm's FK by {gap:.2g}")
-    return six
-
-
 def measure(name: str, poses: int, seed: int, lock: int | None = None) -> dict:
-    import tempfile
     m = stored(name)
     fixed = {}
     rng = np.random.default_rng(seed)
@@ -96,9 +67,7 @@ def measure(name: str, poses: int, seed: int, lock: int | None = None) -> dict:
             q[:, lock] = value
             fixed = {m.joint_names[lock]: value}
             keep = np.delete(keep, lock)
-            with tempfile.TemporaryDirectory() as tmp:
-                ref = EAIK(locked_arm(m, lock, value, Path(tmp)), timeout=1.0,
-                              rng=np.random.default_rng(seed))
+            ref = EAIK(locked_arm(m, fixed), timeout=1.0, rng=np.random.default_rng(seed))
     except NotApplicable as err:
         return {"arm": name, "locked": fixed, "eaik": f"not applicable: {err}"}
     T = m.fk_matrix(q)

@@ -71,6 +71,7 @@ from fkopt.adapters.field.rtb import RtbLM, RtbNR
 from fkopt.adapters.field.scipy_fk import LeastSquaresFK
 from fkopt.adapters.field.torchkin import TorchIK
 from fkopt.adapters.field.tracik import TracIK
+from fkopt.adapters.field.track_entries import EAIKAll, RtbLMRestarts, RtbLMSeeded, TracIKRestarts, TracIKSeeded
 from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS
 from fkopt.algorithms.abc import ABC
 from fkopt.algorithms.abc_wang7dof import ABCWang7dof
@@ -86,11 +87,13 @@ from fkopt.algorithms.pso import PSO
 from fkopt.errors import FkoptError, did_you_mean
 from fkopt.kinematics.as_algorithms import Exact, Forward, Inverse
 from fkopt.kinematics.clock_entries import FkoptForward, FkoptInverse
+from fkopt.kinematics.track_entries import FkoptAllSolutions, FkoptPath
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from fkopt.mechanisms.catalog import MECHANISMS
 
-#: Roles of a solver: minimises a problem (fkopt.solve) / answers one IK or FK query (the clock).
-OPTIMISER, IK, FK = "optimiser", "ik", "fk"
+#: Roles of a solver: minimises a problem (fkopt.solve) / answers one IK or FK query (the clock) /
+#: gives every IK solution of a pose (``solutions(T)``) / follows a path (``path(T, start)``).
+OPTIMISER, IK, FK, ALL_SOLUTIONS, PATH = "optimiser", "ik", "fk", "all-solutions", "path"
 #: How kinbench times each role.
 COUNTED = "evaluations counted by fkopt; process time per run (timing.csv)"
 PER_QUERY = "one query per call, wall clock, on one core (kinbench's clock track)"
@@ -104,7 +107,8 @@ class SolverEntry:
     name: str
     make: Callable            # an Algorithm class (optimiser) or a one-query wrapper class (ik / fk)
     role: str                 # OPTIMISER, IK or FK
-    track: str | None         # kinbench's evaluations track of an optimiser; "clock" for ik / fk
+    track: str | None         # kinbench's evaluations track of an optimiser; "clock" for ik / fk; or
+                              # "all-solutions" / "paths" (fkopt.kinbench.solution_sets, .paths)
     package: str = "fkopt"    # the PyPI package it runs through
     timing: str = COUNTED
     display: str = ""         # the name on figures and tables ("" -> the name)
@@ -118,8 +122,8 @@ def _optimiser(name, cls, track, display=""):
     return SolverEntry(name, cls, OPTIMISER, track, "fkopt", COUNTED, display)
 
 
-def _field(cls, role=IK, display=""):
-    return SolverEntry(cls.name, cls, role, "clock", cls.package, PER_QUERY, display)
+def _field(cls, role=IK, display="", track="clock"):
+    return SolverEntry(cls.name, cls, role, track, cls.package, PER_QUERY, display)
 
 
 #: Every built-in solver: fkopt's algorithms and exact solvers, and the field's solvers through
@@ -155,6 +159,13 @@ SOLVERS: dict[str, SolverEntry] = {e.name: e for e in (
     _field(OptIK),
     _field(Pink),
     _field(TorchIK),                             # batched: the throughput track (tracks.throughput.solvers)
+    _field(FkoptAllSolutions, ALL_SOLUTIONS, track="all-solutions"),   # fkopt.inverse(solutions="all")
+    _field(EAIKAll, ALL_SOLUTIONS, track="all-solutions"),             # EAIK's analytic set
+    _field(RtbLMRestarts, ALL_SOLUTIONS, track="all-solutions"),       # ik_LM from random starts, fkopt's time
+    _field(TracIKRestarts, ALL_SOLUTIONS, track="all-solutions"),      # TRAC-IK from random starts, fkopt's time
+    _field(FkoptPath, PATH, track="paths"),                            # fkopt.inverse_path
+    _field(RtbLMSeeded, PATH, track="paths"),                          # ik_LM seeded with the previous answer
+    _field(TracIKSeeded, PATH, track="paths"),                         # TRAC-IK seeded with the previous answer
 )}
 
 #: fkopt's optimisers by name (what ``fkopt.solve`` and config files name).
@@ -162,6 +173,9 @@ ALGORITHMS: dict[str, type] = {n: e.make for n, e in SOLVERS.items() if e.role =
 #: The field's one-query IK and FK solvers by name (kinbench's clock track).
 IK_SOLVERS: tuple[str, ...] = tuple(n for n, e in SOLVERS.items() if e.role == IK)
 FK_SOLVERS: tuple[str, ...] = tuple(n for n, e in SOLVERS.items() if e.role == FK)
+#: The entries of kinbench's all-solutions and paths tracks.
+ALL_SOLUTIONS_SOLVERS: tuple[str, ...] = tuple(n for n, e in SOLVERS.items() if e.role == ALL_SOLUTIONS)
+PATH_SOLVERS: tuple[str, ...] = tuple(n for n, e in SOLVERS.items() if e.role == PATH)
 
 
 @dataclass(frozen=True)
@@ -199,14 +213,15 @@ def display_name(name: str) -> str:
     return entry.label if entry is not None else name
 
 
-def clock_solver(name: str, mechanism, *, timeout: float, rng):
-    """The one-query solver ``name`` (:data:`IK_SOLVERS`, :data:`FK_SOLVERS`) built on
-    ``mechanism``; a missing package or a mechanism the package cannot read is one line."""
+def clock_solver(name: str, mechanism, *, timeout: float, rng, **options):
+    """The one-query solver ``name`` (:data:`IK_SOLVERS`, :data:`FK_SOLVERS`; or an entry of the
+    all-solutions and paths tracks, ``options`` = its ``fixed`` joints) built on ``mechanism``; a
+    missing package or a mechanism the package cannot read is one line."""
     entry = SOLVERS.get(name)
     if entry is None or entry.role == OPTIMISER:
         raise FkoptError(f"unknown field solver '{name}'; allowed: {', '.join(IK_SOLVERS + FK_SOLVERS)}")
     try:
-        return entry.make(mechanism, timeout=timeout, rng=rng)
+        return entry.make(mechanism, timeout=timeout, rng=rng, **options)
     except ImportError as err:
         extra = getattr(entry.make, "extra", "field")       # torch is an extra of its own
         raise FkoptError(f"field solver '{name}' needs {entry.package} (pip install -e \".[{extra}]\"): "

@@ -162,7 +162,9 @@ def test_stored_configs_validate():
             pairs = sum(cfg.runs_problem(s.key, p.name) for p in cfg.problems for s in cfg.solvers)
             assert pairs <= len(cfg.problems) * len(cfg.solvers) and (pairs < len(cfg.problems) * len(cfg.solvers)
                                                                        or not cfg.subsets), f
-            assert tasks == pairs + (len(clock.problems) if clock else 0), f
+            branch = [t for t in (cfg.tracks.all_solutions, cfg.tracks.paths) if t is not None] \
+                if cfg.tracks is not None else []      # one task per arm of the all-solutions and paths tracks
+            assert tasks == pairs + (len(clock.problems) if clock else 0) + sum(len(t.problems) for t in branch), f
         elif isinstance(cfg, AssemblyConfig):
             assert tasks == 1, f
         elif isinstance(cfg, StudyConfig):   # every algorithm on every pose block

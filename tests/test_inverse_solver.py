@@ -1,6 +1,7 @@
 """``fkopt.InverseSolver``: the prepared one-pose IK of a control loop. Held to the one-pose
 answers ``fkopt.inverse`` gave before the solver existed (tests/inverse_bits/one_pose.json,
-recorded by tests/inverse_bits/record.py at commit 255c592), bit for bit, on a DH arm, URDF arms
+recorded by tests/inverse_bits/record.py at commit 255c592; the URDF and MJCF arms re-recorded
+after issue 41 moved their limits inward, as record.py says), bit for bit, on a DH arm, URDF arms
 and MJCF arms; bad targets are one line; options are validated once, when it is made."""
 import importlib.util
 import json

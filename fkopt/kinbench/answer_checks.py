@@ -30,6 +30,19 @@ def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         return same_inf | np.isclose(a, b, rtol=RTOL, atol=1e-12)
 
+def differing_numbers(merged: pd.DataFrame, board: pd.DataFrame, key) -> list[tuple[pd.Series, str]]:
+    """(row of ``merged``, column) of every numeric column of a recomputed ``board`` whose stored
+    value (``merged[col]``) differs from the recomputed one (``merged[col + "_recomputed"]``), at
+    most three per column."""
+    out = []
+    for col in board.columns:
+        if col in key or f"{col}_recomputed" not in merged or not pd.api.types.is_numeric_dtype(board[col]):
+            continue
+        bad = ~_close(csv_numbers(merged[col]), merged[f"{col}_recomputed"].to_numpy(float))
+        out += [(merged.iloc[k], col) for k in np.flatnonzero(bad)[:3]]
+    return out
+
+
 #: The columns of every answers row (:func:`fkopt.kinbench.clock.answer_rows`, ``set`` added by
 #: the runner), before the answer's own ``q0..`` / ``x0..``.
 ANSWER_COLUMNS = ("robot", "set", "query", "solver", "entry", "source", "given_timeout_ms", "seconds",

@@ -41,10 +41,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import Field, PrivateAttr, ValidationError, field_validator, model_validator
+from pydantic import ConfigDict, Field, PrivateAttr, ValidationError, field_validator, model_validator
 
 from fkopt.errors import FkoptError
-from fkopt.registry import IK_SOLVERS, track_of
+from fkopt.registry import ALL_SOLUTIONS_SOLVERS, IK_SOLVERS, PATH_SOLVERS, track_of
 from fkopt.run.config_base import MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict, unique_labels
 from fkopt.files import error_line, load_mapping
 
@@ -144,8 +144,11 @@ class QuickTier(Strict):
     poses: int | None = Field(None, ge=1)
     runs: int | None = Field(None, ge=1, le=MAX_RUNS)
     budget_per_dim: int | None = Field(None, ge=1, le=MAX_BUDGET_PER_DIM)
-    #: queries per arm of the clock track (its arms: those of tracks.clock.problems kept here)
+    #: queries per arm of the clock track (its arms: those of tracks.clock.problems kept here) and of
+    #: the all-solutions track
     queries: int | None = Field(None, ge=1)
+    #: paths per arm of the paths track
+    paths: int | None = Field(None, ge=1)
 
 
 #: Solvers the clock track knows: the organiser's and the field's (the registry's IK solvers).
@@ -240,9 +243,83 @@ class ThroughputTrack(Strict):
         return batches
 
 
+def _entries(names: list[str], known: tuple[str, ...], track: str) -> list[str]:
+    for name in names:
+        if name not in known:
+            raise ValueError(f"solver '{name}' is not an entry of the {track} track (allowed: {', '.join(known)})")
+    if len(set(names)) != len(names):
+        raise ValueError(f"solvers: '{next(v for v in names if names.count(v) > 1)}' repeats")
+    return names
+
+
+class SolutionsTrack(Strict):
+    """Every IK solution of a pose (:mod:`fkopt.kinbench.solution_sets`): recall against the
+    analytic sets and against the union of every entry's verified answers, time per pose as a
+    ratio to the reference's."""
+
+    problems: list[str] = Field(min_length=1)
+    solvers: list[str] = Field(min_length=1)
+    #: times are ratios to this entry's, pose by pose; its median time per pose on an arm is the
+    #: budget of the entries that restart until a time has passed
+    reference: str = "fkopt.inverse-all"
+    #: the entry whose sets are the analytic reference of recall ("not applicable" where it cannot take the arm)
+    analytic: str = "eaik-all"
+    #: problem -> the joint locked in every entry (at LOCK_SHARE of its range): a 7-joint arm's finite sets
+    locked: dict[str, str] = Field(default_factory=dict)
+    set: Literal["uniform", "near-singular", "boundary", "printed"] = "uniform"
+    queries: int | None = Field(None, ge=1, le=10_000)
+
+    @field_validator("solvers")
+    @classmethod
+    def _solvers(cls, solvers):
+        return _entries(solvers, ALL_SOLUTIONS_SOLVERS, "all-solutions")
+
+    @model_validator(mode="after")
+    def _known(self):
+        for field in ("reference", "analytic"):
+            if getattr(self, field) not in self.solvers:
+                raise ValueError(f"{field}: '{getattr(self, field)}' is not one of the track's solvers "
+                                 f"({', '.join(self.solvers)})")
+        for problem in self.locked:
+            if problem not in self.problems:
+                raise ValueError(f"locked: '{problem}' is not one of the track's problems ({', '.join(self.problems)})")
+        return self
+
+
+class PathsTrack(Strict):
+    """IK along frozen paths (:mod:`fkopt.kinbench.paths`): success (every waypoint within the
+    tolerance, no joint step above the bound) and time per waypoint as a ratio to the reference's."""
+
+    problems: list[str] = Field(min_length=1)
+    solvers: list[str] = Field(min_length=1)
+    reference: str = "fkopt.inverse_path"
+    #: the frozen path set: a folder beside the suite file (manifest.json + one CSV per problem)
+    path_set: str = Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.+-]{0,63}$")
+    #: paths per arm: the set's first N (all when omitted)
+    paths: int | None = Field(None, ge=1, le=10_000)
+    #: the wall-clock limit per waypoint of an entry that has one (TRAC-IK; MoveIt's default 5 ms)
+    timeout_ms: float = Field(5.0, gt=0, le=10_000)
+
+    @field_validator("solvers")
+    @classmethod
+    def _solvers(cls, solvers):
+        return _entries(solvers, PATH_SOLVERS, "paths")
+
+    @model_validator(mode="after")
+    def _known(self):
+        if self.reference not in self.solvers:
+            raise ValueError(f"reference: '{self.reference}' is not one of the track's solvers ({', '.join(self.solvers)})")
+        return self
+
+
 class Tracks(Strict):
+    # the YAML names the track `all-solutions`; dumped by that name too (a stored config reloads as read)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, validate_by_name=True, validate_by_alias=True,
+                              serialize_by_alias=True)
     clock: ClockTrack | None = None
     throughput: ThroughputTrack | None = None
+    all_solutions: SolutionsTrack | None = Field(None, alias="all-solutions")
+    paths: PathsTrack | None = None
 
     @model_validator(mode="after")
     def _needs_clock(self):
@@ -431,6 +508,19 @@ class SuiteConfig(Located):
                                      f"({', '.join(known)})")
             if clock.set not in self.sets:
                 raise ValueError(f"tracks.clock.set: '{clock.set}' is not one of the suite's sets ({', '.join(self.sets)})")
+        for key in ("all_solutions", "paths"):
+            track = getattr(self.tracks, key, None) if self.tracks is not None else None
+            if track is None:
+                continue
+            known = [p.name for p in self.problems]
+            where = f"tracks.{key.replace('_', '-')}"
+            for name in track.problems:
+                if name not in known:
+                    raise ValueError(f"{where}.problems: '{name}' is not one of the suite's problems ({', '.join(known)})")
+            if len(set(track.problems)) != len(track.problems):
+                raise ValueError(f"{where}.problems: '{next(v for v in track.problems if track.problems.count(v) > 1)}' repeats")
+            if key == "all_solutions" and track.set not in self.sets:
+                raise ValueError(f"{where}.set: '{track.set}' is not one of the suite's sets ({', '.join(self.sets)})")
         return self
 
     def stored_dump(self) -> dict:
@@ -439,10 +529,15 @@ class SuiteConfig(Located):
         data = self.model_dump(mode="json")
         if data.get("tracks") is None:
             data.pop("tracks", None)
+        else:                                           # v3's newer tracks, only when asked for
+            for key in ("all-solutions", "paths"):
+                if data["tracks"].get(key) is None:
+                    data["tracks"].pop(key, None)
         if not data.get("subsets"):                     # v3's solver subsets, only when there are any
             data.pop("subsets", None)
-        if isinstance(data.get("quick"), dict) and data["quick"].get("queries") is None:
-            data["quick"].pop("queries", None)
+        for key in ("queries", "paths"):
+            if isinstance(data.get("quick"), dict) and data["quick"].get(key) is None:
+                data["quick"].pop(key, None)
         for problem in data.get("problems") or []:      # v3's geometry instances, only when asked for
             if isinstance(problem, dict) and problem.get("instances") is None:
                 problem.pop("instances", None)
@@ -476,7 +571,22 @@ class SuiteConfig(Located):
             if q.queries is not None:
                 clock["queries"] = q.queries
             if not clock["problems"] or clock["set"] not in data["sets"]:
-                data["tracks"] = None
+                data["tracks"] = None if not data["tracks"].get("all-solutions") and not data["tracks"].get("paths") \
+                    else {**data["tracks"], "clock": None, "throughput": None}
+        for key, count in (("all-solutions", "queries"), ("paths", "paths")):
+            track = (data.get("tracks") or {}).get(key)
+            if track is None:
+                continue
+            kept = {p["name"] for p in data["problems"]}
+            track["problems"] = [p for p in track["problems"] if p in kept]
+            if "locked" in track:
+                track["locked"] = {p: j for p, j in track["locked"].items() if p in kept}
+            if getattr(q, count) is not None:
+                track[count] = getattr(q, count)
+            if not track["problems"]:
+                data["tracks"][key] = None
+        if data.get("tracks") is not None and not any(data["tracks"].get(k) for k in ("clock", "all-solutions", "paths")):
+            data["tracks"] = None
         out = SuiteConfig(**data)
         out._folder = self._folder
         return out

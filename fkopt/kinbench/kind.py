@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fkopt.kinbench import pages, reports, traces
+from fkopt.kinbench import branch_tracks, pages, reports, traces
 from fkopt.run.kinds import register
 from fkopt.run.tasks import Kind
 from fkopt.run.tasks import work_folder  # noqa: F401 (where a suite's task files live; tests)
@@ -33,6 +33,11 @@ OUTPUTS = (
     Output("answers.csv.gz", reports.answers_table, TIMING, float_format="%.17g"),
     Output("throughput.csv", reports.throughput_table, TIMING),
     Output("leaderboard-robots.csv", reports.robots_board_table, TIMING),
+    # the all-solutions and paths tracks (fkopt.kinbench.branch_tracks): timing files too
+    Output("solutions.csv.gz", branch_tracks.solutions_table, TIMING, float_format="%.17g"),
+    Output("leaderboard-solutions.csv", branch_tracks.solutions_board_table, TIMING),
+    Output("paths.csv.gz", branch_tracks.paths_table, TIMING, float_format="%.17g"),
+    Output("leaderboard-paths.csv", branch_tracks.paths_board_table, TIMING),
     Output("ecdf", reports.ecdf_figures, FIGURE),
     Output("scaling", reports.scaling_figures, FIGURE),
     Output("clock", reports.clock_figures, FIGURE),

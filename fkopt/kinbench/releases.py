@@ -499,6 +499,16 @@ RELEASES: dict[str, Release] = {
         "robots/xarm7.urdf": "2b99c1d4657a71c576b69c2537be21a9d4358b49bf02f0af1b1e8da569bd9762",
         "robots/z1.urdf": "08344afd14d43bb1fc2cb7249f8b90ddef756991ff64c9a9cee9ef0cb619ae38",
     }),
+    # the paths track's frozen path set (fkopt.kinbench.paths; python -m fkopt.kinbench.freeze paths SUITE.yaml):
+    # checked by check_folder_release (its fitness field is unused: a path set holds joints only)
+    "kinbench-v3-paths": Release(fitness=1, files={
+        "kinbench-v3-paths/iiwa-mj.csv": "81973a1acdc8293206834c9adcbd197f5ef938442801ae5e264eda86f08b8a2d",
+        "kinbench-v3-paths/kinova-j2s6s200.csv": "5423b8a5027f2f7de224823848a7046692ad3baec6ee2027384355ba11afbc1a",
+        "kinbench-v3-paths/manifest.json": "6ff061dff96d6a36df94f90bf87f6dcab49f7c8ddf3ded649891370d384ecf9f",
+        "kinbench-v3-paths/panda.csv": "850e09ffd0038d0a118992bfe538c72b457d52c14e142de13d1897d5dc52e92c",
+        "kinbench-v3-paths/ur5.csv": "a90cec4919ab9c8f2775895fc31741ae1e3c334975519a46b6c92fd8de2e6b40",
+        "kinbench-v3-paths/z1.csv": "51460f5fc2f17b0c79feda8d384f41fb252715b1f64f57aae2549b500e6f4a46",
+    }),
 }
 
 
@@ -552,9 +562,17 @@ def check_release(config, manifest: dict, files: Path | None = None) -> None:
         raise FkoptError(f"pose_sets: {name} was released with fitness definitions version {release.fitness}, "
                          f"this fkopt has version {FITNESS_VERSION} (CHANGES.md){new}")
     base = _base(config, files)
-    folder = base / config.pose_sets
-    # the release's pose sets are in the folder named as the version; a copy may be named otherwise
-    expected = {(f"{config.pose_sets}/{k.split('/', 1)[1]}" if k.startswith(name + "/") else k): v
+    expected = _check_files(name, release, base, base / config.pose_sets, new)
+    for rel in problem_files(config):
+        if rel not in expected:
+            raise FkoptError(f"{base / rel}: problem file not part of released {name}{new}")
+
+
+def _check_files(name: str, release: Release, base: Path, folder: Path, new: str) -> dict[str, str]:
+    """Refuse (one line) a file of released ``name`` in ``folder`` (relative to ``base``) that is
+    missing, changed or added; the expected {path: SHA-256}, the folder's name put for the
+    version's (a copy may be named otherwise)."""
+    expected = {(f"{folder.name}/{k.split('/', 1)[1]}" if k.startswith(name + "/") else k): v
                 for k, v in release.files.items()}
     for rel, digest in sorted(expected.items(), key=lambda kv: kv[0].endswith("/manifest.json")):  # data first
         path = base / rel
@@ -567,9 +585,16 @@ def check_release(config, manifest: dict, files: Path | None = None) -> None:
     for path in sorted(folder.rglob("*")):
         if path.is_file() and path.relative_to(base).as_posix() not in expected:
             raise FkoptError(f"{path}: not part of released {name}{new}")
-    for rel in problem_files(config):
-        if rel not in expected:
-            raise FkoptError(f"{base / rel}: problem file not part of released {name}{new}")
+    return expected
+
+
+def check_folder_release(name: str, base: Path, folder: Path) -> None:
+    """A frozen data folder of a track (``tracks.paths.path_set``) named as a released version
+    (:data:`RELEASES`): every file as released (nothing to check for an unreleased name)."""
+    release = RELEASES.get(name)
+    if release is not None:
+        _check_files(name, release, Path(base), Path(folder), "; a changed set must name itself a new version "
+                     "(a new folder)")
 
 
 #: Frozen per-robot board versions (a suite's clock track): what the entries are and how they run.

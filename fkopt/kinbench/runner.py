@@ -35,6 +35,7 @@ from fkopt.run.solving import make_problem, solve_cases, start_point, task_seed
 from fkopt.run.tasks import Plan, Ran, Task, run_tasks
 from fkopt.solve import chunk_size
 from fkopt.kinbench.clock import track_arm, track_cases  # noqa: F401 (the clock track's arms; tests)
+from fkopt.kinbench import branch_tracks
 from fkopt.kinbench.answer_checks import clock_record_problem
 from fkopt.kinbench.budget import at_budget, budget_of, target_column
 from fkopt.kinbench.config import SuiteConfig, suite_from_dict
@@ -68,6 +69,7 @@ class SuiteResult:
     throughput: pd.DataFrame | None = None   # throughput.csv: queries/s per batch size (v3)
     load_avg: dict | None = None         # the load averages at the clock track's start and end (meta.json)
     entries: dict | None = None          # the clock track's entries' settings (meta.json)
+    branch_answers: dict | None = None   # the all-solutions and paths tracks' answers (fkopt.kinbench.branch_tracks)
 
     @property
     def runs(self) -> pd.DataFrame:
@@ -133,6 +135,7 @@ def validate_suite(config: SuiteConfig, plan: Plan | None = None) -> int:
     for p, _ in tracks:
         validate_track(config, p, files)
     read_submissions(config, tracks, files)
+    branch_tracks.validate(config, files)
     return need
 
 
@@ -207,6 +210,8 @@ def solve_task(payload: dict) -> dict:
     """Worker: one (problem, solver) task on the cases (checked poses) the payload carries;
     returns its record, JSON-able (a task file): run rows as columns of lists, wall time. A
     track task (``payload["track"]``) goes to :func:`solve_track`."""
+    if payload.get("track") in branch_tracks.FILES:
+        return branch_tracks.solve_task(payload)
     if payload.get("track"):
         return solve_track(payload)
     config = suite_from_dict(payload["config"], "suite task")
@@ -293,6 +298,8 @@ def record_problem(task, rec) -> str | None:
                 return "answers: not a table of answers"
             if _numbers([rec["wall_s"]], "wall_s", 0, float(np.finfo(float).max)):
                 return "wall_s: not a non-negative finite number"
+            if task.payload["track"] in branch_tracks.FILES:
+                return branch_tracks.record_problem(task, rec)
             return clock_record_problem(task, rec)      # every answer counted and judged again
         except KeyError as err:
             return f"field {str(err.args[0])[:40]!r} is missing"
@@ -386,6 +393,7 @@ def suite_plan(config: SuiteConfig, source: str | None = None, timing: bool = Tr
     tasks += [Task(f"t{p}", {"config": data, "folder": folder, "problem": p, "track": "clock", "fingerprint": fp,
                              "queries": queries.tolist()}, f"{config.problems[p].name} / clock track")
               for p, queries in tracks]
+    tasks += branch_tracks.track_tasks(config, sets, files, data, fp)     # all-solutions, paths
     return Plan(tasks, solve_task, fingerprint=fp, stored=True, check=record_problem,
                 context=_Context(sets, manifest, time.perf_counter() - started, files, tracks),
                 name=f"suite '{config.name}'")
@@ -397,12 +405,13 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     ctx: _Context = plan.context
     done = [{**ran.records[t.id], "rows": rows_of(ran.records[t.id])} for t in plan.tasks
             if not t.payload.get("track")]
+    clocked = [ran.records[t.id] for t in plan.tasks if t.payload.get("track") == "clock"]
     tracked = [ran.records[t.id] for t in plan.tasks if t.payload.get("track")]
-    answers = pd.concat([pd.DataFrame(r["answers"]) for r in tracked], ignore_index=True) if tracked else None
-    submitted = read_submissions(config, ctx.tracks, ctx.files) if tracked else None
+    answers = pd.concat([pd.DataFrame(r["answers"]) for r in clocked], ignore_index=True) if clocked else None
+    submitted = read_submissions(config, ctx.tracks, ctx.files) if clocked else None
     if submitted is not None:
         answers = pd.concat([answers, submitted], ignore_index=True)
-    rates = [pd.DataFrame(r["throughput"]) for r in tracked if r.get("throughput")]
+    rates = [pd.DataFrame(r["throughput"]) for r in clocked if r.get("throughput")]
     throughput = pd.concat(rates, ignore_index=True) if rates else None
     frames = [r["rows"] for r in done]
     if config.outside:
@@ -422,7 +431,7 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
             entries.setdefault(solver, {k: v for k, v in st.items() if k not in ("urdf", "urdf_note", "family")})
     return SuiteResult(config, runs, tim, ctx.manifest, wall, source,
                        suite_trace(config, done, runs, ctx.files), ctx.files, answers, throughput, load_avg,
-                       entries or None)
+                       entries or None, branch_tracks.merge_tables(config, plan, ran))
 
 
 def run_suite(config: SuiteConfig, *, source: str | None = None, progress=None, jobs: int = 1,

@@ -14,9 +14,8 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
-import pandas as pd
 
-from fkopt.kinbench.answer_checks import RTOL, _close  # noqa: F401 (RTOL: the recomputation's tolerance)
+from fkopt.kinbench.answer_checks import RTOL, _close, differing_numbers  # noqa: F401 (RTOL: the recomputation's tolerance)
 
 
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
@@ -24,15 +23,24 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     board follows from the stored answers. The answers are counted first
     (:func:`fkopt.kinbench.answer_checks.key_problems`): one per (query, solver, timeout) the
     config implies, so a failure deleted, a success repeated or a solver dropped is a mismatch
-    naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`)."""
+    naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`).
+    The all-solutions and paths tracks: :func:`fkopt.kinbench.branch_tracks.reverify`."""
+    from fkopt.kinbench.branch_tracks import reverify as reverify_branch_tracks
+    folder = Path(folder)
+    if config.tracks is None:
+        return []
+    return _reverify_clock(folder, config) + reverify_branch_tracks(folder, config)
+
+
+def _reverify_clock(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
+    """:func:`reverify` of the clock track (module docstring)."""
     from fkopt.errors import FkoptError
     from fkopt.files import csv_numbers, read_stored_csv
     from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
     from fkopt.kinbench.clock import answer_prefix, targets_of, track_arm, track_cases, track_settings, verdicts
     from fkopt.kinbench.posesets import load_pose_sets
     from fkopt.kinbench.reports import robots_board_table
-    folder = Path(folder)
-    if config.tracks is None or config.tracks.clock is None:
+    if config.tracks.clock is None:
         return []
     clock = config.tracks.clock
     try:
@@ -97,12 +105,7 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
         return out + [("leaderboard-robots.csv", "-", "rows", len(stored), len(board),
                        "one row per (solver, robot, timeout) of the stored answers")]
     merged = stored.merge(board, on=key, suffixes=("", "_recomputed"))
-    for col in board.columns:
-        if col in key or f"{col}_recomputed" not in merged or not pd.api.types.is_numeric_dtype(board[col]):
-            continue
-        bad = ~_close(csv_numbers(merged[col]), merged[f"{col}_recomputed"].to_numpy(float))
-        for k in np.flatnonzero(bad)[:3]:
-            r = merged.iloc[k]
-            out.append(("leaderboard-robots.csv", f"{r['solver']}/{r['robot']}/{r['timeout_ms']:g} ms", col, r[col],
+    for r, col in differing_numbers(merged, board, key):
+        out.append(("leaderboard-robots.csv", f"{r['solver']}/{r['robot']}/{r['timeout_ms']:g} ms", col, r[col],
                         r[f"{col}_recomputed"], "recomputed from the stored answers"))
     return out

@@ -241,6 +241,12 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
                   "reference.", "", {"problems": ["ur5"], "solvers": ["fkopt.inverse", "tracik"]}),
         "throughput": ("Queries per second at each batch size, for the clock's solvers that take batches "
                        "(fkopt.inverse).", "", {"batches": [1, 10, 100, 1000]}),
+        "all_solutions": ("The all-solutions track (key `all-solutions`): every IK solution of a pose, recall "
+                          "against the analytic sets and the union of every entry's verified answers.", "",
+                          {"problems": ["ur5"], "solvers": ["fkopt.inverse-all", "eaik-all"]}),
+        "paths": ("The paths track: IK along frozen paths, success and time per waypoint.", "",
+                  {"problems": ["ur5"], "solvers": ["fkopt.inverse_path", "rtb-ik_LM-seeded"],
+                   "path_set": "kinbench-v3-paths"}),
     },
     "ClockTrack": {
         "problems": ("The suite's problems the track runs on (URDF arms: the field's packages read URDF).",
@@ -319,7 +325,31 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "poses": ("Poses per set.", "poses", 3),
         "runs": ("Runs per pose.", "runs", 3),
         "budget_per_dim": ("Budget per dimension.", "evaluations per dimension", 500),
-        "queries": ("Queries per arm of the clock track.", "poses", 5),
+        "queries": ("Queries per arm of the clock track and of the all-solutions track.", "poses", 5),
+        "paths": ("Paths per arm of the paths track.", "paths", 2),
+    },
+    "SolutionsTrack": {
+        "problems": ("The suite's serial arms the track runs on.", "", ["ur5", "z1"]),
+        "solvers": ("Entries of the track (fkopt.registry's all-solutions role).", "",
+                    ["fkopt.inverse-all", "eaik-all", "rtb-ik_LM-restarts", "tracik-restarts"]),
+        "reference": ("The entry every time is divided by, pose by pose; its median time per pose on an arm is "
+                      "the budget of the entries that restart until a time has passed.", "", "fkopt.inverse-all"),
+        "analytic": ("The entry whose sets are the analytic reference of recall.", "", "eaik-all"),
+        "locked": ("Per problem, a joint locked in every entry at 30 % of its range (a 7-joint arm's solutions "
+                   "are finite then).", "", {"panda": "panda_joint7"}),
+        "set": ("The pose set whose frozen configurations are the queries.", "", "uniform"),
+        "queries": ("Queries per arm: the set's first N; default all.", "poses", 40),
+    },
+    "PathsTrack": {
+        "problems": ("The suite's serial arms the track runs on.", "", ["ur5", "panda"]),
+        "solvers": ("Entries of the track (fkopt.registry's path role).", "",
+                    ["fkopt.inverse_path", "rtb-ik_LM-seeded", "tracik-seeded"]),
+        "reference": ("The entry every time is divided by, path by path.", "", "fkopt.inverse_path"),
+        "path_set": ("The frozen path set: a folder beside the suite file (python -m fkopt.kinbench.freeze "
+                     "paths SUITE.yaml writes it).", "", "kinbench-v3-paths"),
+        "paths": ("Paths per arm: the set's first N; default all.", "paths", 10),
+        "timeout_ms": ("Wall-clock limit per waypoint of an entry that has one (TRAC-IK); MoveIt's default.",
+                       "ms", 5),
     },
 }
 #: Fields documented once for every model that inherits them.
@@ -466,8 +496,9 @@ def markdown() -> str:
                       "|---|---|---|---|---|---|---|"]
             for name, field in m.model_fields.items():
                 text, unit, example = field_doc(m.__name__, name) or ("", "", None)
-                cells = [f"`{name}`", _type_text(field.annotation), _default(field), _limits(field) or "",
-                         unit, text, f"`{_example_yaml(name, example)}`"]
+                key = field.alias or name          # the name a file uses (tracks' `all-solutions`)
+                cells = [f"`{key}`", _type_text(field.annotation), _default(field), _limits(field) or "",
+                         unit, text, f"`{_example_yaml(key, example)}`"]
                 lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
             lines.append("")
     return "\n".join(lines).rstrip() + "\n"
