@@ -55,6 +55,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import lru_cache
+from importlib.metadata import entry_points as _eps
 from pathlib import Path
 from typing import Callable
 
@@ -85,6 +86,7 @@ from fkopt.algorithms.nr import NR
 from fkopt.algorithms.pabc import PABC
 from fkopt.algorithms.pso import PSO
 from fkopt.errors import FkoptError, did_you_mean
+from fkopt.files import did_you_mean as closest
 from fkopt.kinematics.as_algorithms import Exact, Forward, Inverse
 from fkopt.kinematics.clock_entries import FkoptForward, FkoptInverse
 from fkopt.kinematics.track_entries import FkoptAllSolutions, FkoptPath
@@ -329,7 +331,6 @@ def _import_target(target: str, kind: str, where: str):
 @lru_cache(maxsize=None)
 def entry_points(kind: str) -> dict[str, tuple[str, str, object]]:
     """Installed entry points of ``kind``: name -> (target, distribution, EntryPoint)."""
-    from importlib.metadata import entry_points as _eps
     out = {}
     for ep in _eps(group=GROUPS[kind]):
         dist = getattr(ep, "dist", None)
@@ -364,7 +365,7 @@ def _load(table: dict[str, type], kind: str, name: str):
                              "--allow-plugins imports it, if you trust the results folder)")
         return check_class(_import_target(name, kind, name), kind, name)
     allowed = did_you_mean(name, [*table, *eps])
-    from fkopt.files import did_you_mean as closest     # the one "did you mean" of field names too
+    # fkopt.files.did_you_mean: the one "did you mean" of field names too
     raise FkoptError(f"unknown {kind} '{name}'{closest(name, [*table, *eps])}; allowed: {allowed}, "
                      + ("scipy:NAME, pymoo:NAME, niapy:NAME, " if kind == "algorithm" else "")
                      + "or package.module:Class of an installed plug-in")

@@ -3,7 +3,8 @@ import numpy as np
 import pandas as pd
 
 import fkopt
-from fkopt.bench import sections as bench
+from fkopt.tools.bench import c_reference, sections as bench, swarms
+from fkopt.tools.bench.measuring import Rows
 def test_quick_run_writes_csv_and_plot(tmp_path):
     df = bench.run(quick=True, peers=False, out=tmp_path / "b")
     csv = pd.read_csv(tmp_path / "b" / "bench.csv")
@@ -67,13 +68,13 @@ def test_compiled_reference_solves_the_same_problem(tmp_path):
     evaluations, and it solves the poses as fkopt does (a broken loop would not)."""
     import shutil
     import pytest
-    built = bench.compile_reference(tmp_path)
+    built = c_reference.compile_reference(tmp_path)
     if isinstance(built, str):
         assert shutil.which("gcc") is None and shutil.which("cc") is None and shutil.which("clang") is None, built
         pytest.skip(built)
     m = fkopt.mechanism("3-rps")
     poses = m.bounds[:, 0] + np.random.default_rng(3).random((4, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
-    out = bench.run_reference(built[0], m.ik(poses), 200, 10, 5)
+    out = c_reference.run_reference(built[0], m.ik(poses), 200, 10, 5)
     r = fkopt.solve(fkopt.fk_problem(m, m.ik(poses)), "gabc", population=10, iterations=200, runs=5, seed=1)
     per_run = out["evaluations"] / 20
     assert 2 * 10 * 200 + 10 <= per_run <= 2 * 10 * 200 + 10 + 200        # + at most one scout per iteration
@@ -86,14 +87,14 @@ def test_compiled_reference_abc_and_pso_loops_solve_the_same_problem(tmp_path):
     """The swarms section's C loops of ABC and PSO: fkopt's budget in evaluations (PSO exactly
     population per iteration), and they solve the poses as fkopt does (a broken loop would not)."""
     import pytest
-    built = bench.compile_reference(tmp_path)
+    built = c_reference.compile_reference(tmp_path)
     if isinstance(built, str):
         pytest.skip(built)
     m = fkopt.mechanism("3-rps")
     poses = m.bounds[:, 0] + np.random.default_rng(4).random((4, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
     joints = m.ik(poses)
     for alg, iterations in (("abc", 300), ("pso", 300)):
-        out = bench.run_reference(built[0], joints, iterations, 10, 5, algorithm=alg)
+        out = c_reference.run_reference(built[0], joints, iterations, 10, 5, algorithm=alg)
         r = fkopt.solve(fkopt.fk_problem(m, joints), alg, population=10, iterations=iterations, runs=5, seed=1)
         per_run = out["evaluations"] / 20
         assert abs(per_run - r.evaluations.mean()) < 50, alg
@@ -109,9 +110,9 @@ def test_swarms_pygmo_row_compares_bee_colony_with_the_batched_abc():
     import pytest
     pytest.importorskip("pygmo")
     pytest.importorskip("numba")
-    rows = bench._Rows()
+    rows = Rows()
     messages = []
-    bench.bench_pygmo_abc(rows, True, messages)
+    swarms.bench_pygmo_abc(rows, True, messages)
     df = pd.DataFrame(rows.rows)
     got = df[df.item.str.startswith("pygmo bee_colony")]
     assert len(got) == 2 and not messages

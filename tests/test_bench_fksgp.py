@@ -3,13 +3,13 @@ snapshot on random general 6-6 platforms, or a one-line skip without it."""
 import numpy as np
 import pytest
 
-from fkopt.bench import fksgp
-from fkopt.bench.sections import _Rows
+from fkopt.tools.bench import fksgp
+from fkopt.tools.bench.measuring import Rows
 
 
 def test_without_the_vendored_snapshot_the_section_says_so_and_adds_no_row(monkeypatch):
     monkeypatch.setattr(fksgp, "fksgp_folder", lambda: None)
-    rows, msgs = _Rows(), []
+    rows, msgs = Rows(), []
     fksgp.bench_fksgp(rows, True, msgs)
     assert rows.rows == [] and len(msgs) == 1 and "no vendored fkSGP snapshot" in msgs[0]
 
@@ -18,7 +18,7 @@ def test_beside_fksgp_every_platform_gives_the_same_real_solutions(monkeypatch):
     if fksgp.fksgp_folder() is None:
         pytest.skip("no vendored fkSGP snapshot (../shared/vendor/fksgp or FKSGP_PATH)")
     monkeypatch.setattr(fksgp, "QUICK_PLATFORMS", 2)
-    rows, msgs = _Rows(), []
+    rows, msgs = Rows(), []
     fksgp.bench_fksgp(rows, True, msgs)
     got = {r["item"]: r for r in rows.rows}
     ratio = got["6-6 all real solutions / fkSGP"]

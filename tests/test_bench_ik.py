@@ -1,5 +1,6 @@
-"""fkopt.bench.ik: the IK sections' independent check (pinocchio's FK; rtb's DHRobot for the DH
-arm) and their rows, on the UR5 of example-robot-data and the wang7dof arm (no timing is asserted)."""
+"""fkopt.tools.bench.ik_arms, ik_one_pose, ik_batch: the IK sections' independent check (pinocchio's
+FK; rtb's DHRobot for the DH arm) and their rows, on the UR5 of example-robot-data and the wang7dof
+arm (no timing is asserted)."""
 import numpy as np
 import pytest
 
@@ -12,8 +13,8 @@ def ur5():
     from fkopt.mechanisms import urdf
     if urdf.example_robots_folder() is None:
         pytest.skip("example-robot-data is not installed")
-    from fkopt.bench.ik import _Arm
-    return _Arm("ur5", 4, 7)
+    from fkopt.tools.bench.ik_arms import Arm
+    return Arm("ur5", 4, 7)
 
 
 def test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones(ur5):
@@ -33,8 +34,8 @@ def test_pinocchio_check_accepts_the_drawn_joints_and_rejects_wrong_ones(ur5):
 def wang7dof():
     pytest.importorskip("pinocchio")
     pytest.importorskip("roboticstoolbox")
-    from fkopt.bench.ik import _Arm
-    return _Arm("wang7dof", 4, 7)
+    from fkopt.tools.bench.ik_arms import Arm
+    return Arm("wang7dof", 4, 7)
 
 
 def test_the_dh_arm_is_checked_by_rtbs_dhrobot_in_metres_and_rejects_wrong_or_out_of_limit_joints(wang7dof):
@@ -56,7 +57,7 @@ def test_the_dh_arm_is_checked_by_rtbs_dhrobot_in_metres_and_rejects_wrong_or_ou
 
 
 def test_frame_errors_of_a_known_rotation_and_offset():
-    from fkopt.bench.ik import frame_errors
+    from fkopt.tools.bench.ik_arms import frame_errors
     T = np.eye(4)
     U = np.eye(4)
     a = 1e-7
@@ -67,12 +68,13 @@ def test_frame_errors_of_a_known_rotation_and_offset():
 
 
 def test_ik_sections_report_every_arm_ratios_and_verified_counts(ur5, monkeypatch):
-    from fkopt.bench import ik as bench_ik
-    from fkopt.bench.sections import _Rows
-    monkeypatch.setattr(bench_ik, "QUICK_ARMS", ("ur5", "wang7dof"))
-    rows, msgs = _Rows(), []
-    bench_ik.bench_ik_one_pose(rows, True, msgs)
-    bench_ik.bench_ik_batch(rows, True, msgs)
+    from fkopt.tools.bench import ik_batch, ik_one_pose
+    from fkopt.tools.bench.measuring import Rows
+    for section in (ik_one_pose, ik_batch):
+        monkeypatch.setattr(section, "QUICK_ARMS", ("ur5", "wang7dof"))
+    rows, msgs = Rows(), []
+    ik_one_pose.bench_ik_one_pose(rows, True, msgs)
+    ik_batch.bench_ik_batch(rows, True, msgs)
     got = {(r["section"], r["item"]): r for r in rows.rows}
     for sec, n in (("ik-one-pose", 20), ("ik-batch", 200)):
         for arm in ("ur5", "wang7dof"):

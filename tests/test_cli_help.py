@@ -11,7 +11,9 @@ import typer.main
 import yaml
 
 from fkopt import cli
-from fkopt.bench import sections as bench
+from fkopt.cli.entry_point import DEFAULT_OUT
+from fkopt.cli.listing import unit_groups
+from fkopt.tools.bench import sections as bench
 
 ROOT = Path(__file__).resolve().parent.parent
 COMMANDS = typer.main.get_command(cli.app).commands
@@ -99,9 +101,9 @@ def test_list_fits_80_columns():
 
 
 def test_unit_groups():
-    assert cli.unit_groups(["x", "y", "z", "alpha"], ["m", "m", "m", "deg"]) == "x, y, z [m]\nalpha [deg]"
-    assert cli.unit_groups(["q1", "q2", "q3"], ["deg"] * 3) == "q1..q3 [deg]"
-    assert cli.unit_groups(["q1", "q3", "q4"], ["deg"] * 3) == "q1, q3, q4 [deg]"
+    assert unit_groups(["x", "y", "z", "alpha"], ["m", "m", "m", "deg"]) == "x, y, z [m]\nalpha [deg]"
+    assert unit_groups(["q1", "q2", "q3"], ["deg"] * 3) == "q1..q3 [deg]"
+    assert unit_groups(["q1", "q3", "q4"], ["deg"] * 3) == "q1, q3, q4 [deg]"
 
 
 def test_run_writes_under_fkopt_results_by_default(tmp_path):
@@ -114,7 +116,7 @@ def test_run_writes_under_fkopt_results_by_default(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "fkopt-results" / "experiments" / "tiny" / "summary.csv").is_file()
     assert not (tmp_path / "results").exists()
-    assert cli.DEFAULT_OUT == Path("fkopt-results")
+    assert DEFAULT_OUT == Path("fkopt-results")
     assert "/fkopt-results/" in (ROOT / ".gitignore").read_text().splitlines()
 
 

@@ -73,9 +73,9 @@ def test_progress_moves_inside_a_task_and_prints_plain_lines_without_a_terminal(
     """Issue 32: one task (one algorithm on all cases) used to leave the bar at 0/1 until it ended,
     and without a terminal nothing was printed. Inside the task the iterations tick
     (fkopt.progress), and a stdout that is not a terminal gets plain lines with the time left."""
-    import fkopt.cli
+    import fkopt.cli.display
     import fkopt.run.tasks
-    monkeypatch.setattr(fkopt.cli, "HEARTBEAT_S", 0.0)
+    monkeypatch.setattr(fkopt.cli.display, "HEARTBEAT_S", 0.0)
     monkeypatch.setattr(fkopt.run.tasks, "RUNNING_EVERY_S", 0.0)
     path = tmp_path / "p.yaml"
     path.write_text(yaml.safe_dump({"name": "p", "mechanism": {"name": "3-rps"}, "cases": {"random": 3, "seed": 1},

@@ -307,8 +307,8 @@ def test_an_eof_anywhere_is_an_error_not_an_interruption(monkeypatch, capsys, tm
 
 def test_check_refuses_a_stored_gzip_bomb_in_one_line(tmp_path, cli, monkeypatch):
     """fkopt check (and report) read stored .csv.gz files through the same cap as the export."""
-    import fkopt.files
-    monkeypatch.setattr(fkopt.files, "MAX_UNPACKED", 2 << 20)
+    import fkopt.files.reading
+    monkeypatch.setattr(fkopt.files.reading, "MAX_UNPACKED", 2 << 20)     # the module that reads the bound
     stored = Path(__file__).resolve().parents[1] / "results" / "mao2017" / "tab6"
     folder = _copy(stored, tmp_path / "results" / "mao2017" / "tab6")
     _bomb(folder / "trace.csv.gz", 3 << 20)

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fkopt.bench import sections as bench
+from fkopt.tools.bench import scaling
 from fkopt.kinds.experiment import reports
 from fkopt.kinds.experiment.config import ExperimentConfig
 from fkopt.kinds.experiment.runner import run_experiment
@@ -57,7 +57,7 @@ def test_variables_legend_outside_the_panels_and_log_iterations(drawn):
 def test_scaling_axes_differ_by_marker_style_label_and_title(tmp_path):
     curves = {"population": [(10, 0.5, 2000.0), (100, 1.0, 900.0), (1000, 3.0, 600.0)],
               "runs": [(1, 0.1, 20000.0), (100, 0.4, 900.0), (1000, 2.0, 500.0)]}
-    fig = bench.plot_scaling(curves, tmp_path / "scaling.png", 50)
+    fig = scaling.plot_scaling(curves, tmp_path / "scaling.png", 50)
     assert (tmp_path / "scaling.png").is_file()
     left = [ax for ax in fig.axes if ax.get_title()]
     assert len(left) == 2 and left[0].get_title() != left[1].get_title()

@@ -39,7 +39,7 @@ def test_gitignore_covers_what_readmes_first_command_writes():
     root = Path(__file__).resolve().parent.parent
     ignored = (root / ".gitignore").read_text().splitlines()
     assert "/fkopt-results/" in ignored
-    from fkopt.cli import DEFAULT_OUT
+    from fkopt.cli.entry_point import DEFAULT_OUT
     assert Path("fkopt-results/reproduce").parts[0] == DEFAULT_OUT.name
 
 
@@ -92,7 +92,8 @@ def test_ctrl_c_of_a_study_names_the_command_that_resumes_it(tmp_path):
 def test_resume_hint_names_the_suite_command_with_its_tier():
     from types import SimpleNamespace
 
-    from fkopt.cli import DEFAULT_OUT, resume_hint
+    from fkopt.cli.entry_point import DEFAULT_OUT
+    from fkopt.cli.running import resume_hint
     suite = SimpleNamespace(kind="suite")
     assert resume_hint("suite", "s.yaml", suite, DEFAULT_OUT, quick=True) == \
         "the finished tasks of this suite are kept: fkopt suite s.yaml --quick --resume continues"
@@ -289,7 +290,7 @@ def test_summary_rows_over_many_cases_say_the_success_of_all_runs_and_print_no_n
     import numpy as np
     import pandas as pd
 
-    from fkopt.cli import SHORT, summary_rows
+    from fkopt.cli.display import SHORT, summary_rows
     df = pd.DataFrame({"case": [f"c{i}" for i in range(10)], "algorithm": "gabc",
                        "median_fitness": 1.0, "success_rate": [0.5] + [0.0] * 9,
                        "median_iterations_to_threshold": [293.0] + [np.nan] * 9})

@@ -23,9 +23,8 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from fkopt.errors import FkoptError
-
 from fkopt.adapters.libraries import ADAPTERS, DISTRIBUTIONS  # noqa: F401  (re-exported)
+from fkopt.errors import FkoptError
 
 
 @lru_cache(maxsize=None)
@@ -35,16 +34,10 @@ def adapter_class(library: str, method: str):
     The library itself is imported here (so a missing optional install fails at validation,
     with the install hint), but no optimiser runs.
     """
-    from fkopt.adapters import base
-    if library == "scipy":
-        from fkopt.adapters.scipy_ import resolve
-    elif library == "pymoo":
-        from fkopt.adapters.pymoo_ import resolve
-    elif library == "niapy":
-        from fkopt.adapters.niapy_ import resolve
-    else:  # pragma: no cover - registry only routes the reserved prefixes here
+    from fkopt.adapters import base      # its pydantic models: not at every command's start-up (the registry)
+    if library not in base.LIBRARY_MODULES:  # pragma: no cover - registry only routes the reserved prefixes here
         raise FkoptError(f"no adapter for '{library}:'")
-    target = resolve(method)   # raises FkoptError for unknown names / missing installs
+    target = base.LIBRARY_MODULES[library].resolve(method)   # raises FkoptError for unknown names / missing installs
     return type(f"{library}_{method}", (base.ExternalAlgorithm,),
                 {"name": f"{library}:{method}", "library": library, "method": method,
                  "target": target, "per_point": library == "niapy",

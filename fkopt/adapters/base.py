@@ -43,15 +43,23 @@ run traces and evaluations-to-threshold read), including the first evaluation.
 """
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
+from importlib.metadata import version
 from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import ConfigDict, Field
 
+from fkopt.adapters import niapy_, pymoo_, scipy_
+from fkopt.adapters.libraries import DISTRIBUTIONS, library_version
 from fkopt.algorithms.base import Algorithm, Params, RunRecord
 from fkopt.errors import FkoptError
+from fkopt.files import available_cpus
 from fkopt.progress import tick
+
+#: The module of each library's adapter: its ``resolve``, ``check_params``, ``run``, ``library_population``.
+LIBRARY_MODULES = {"scipy": scipy_, "pymoo": pymoo_, "niapy": niapy_}
 
 
 class _Stop(Exception):
@@ -159,13 +167,7 @@ def run_seed(seed: int, run: int) -> np.random.SeedSequence:
 
 
 def _runner(library: str):
-    if library == "scipy":
-        from fkopt.adapters.scipy_ import run
-    elif library == "pymoo":
-        from fkopt.adapters.pymoo_ import run
-    else:
-        from fkopt.adapters.niapy_ import run
-    return run
+    return LIBRARY_MODULES[library].run
 
 
 def run_one(library: str, method: str, params: dict, problem, population: int, budget: int,
@@ -180,8 +182,6 @@ def run_one(library: str, method: str, params: dict, problem, population: int, b
     except FkoptError:
         raise
     except Exception as err:   # the library failed: one line naming it
-        from importlib.metadata import version
-        from fkopt.adapters.libraries import DISTRIBUTIONS
         msg = str(err).strip().splitlines()[0] if str(err).strip() else ""
         raise FkoptError(f"algorithm '{library}:{method}' ({library} {version(DISTRIBUTIONS[library])}) "
                          f"raised {type(err).__name__}: {msg}") from None
@@ -208,7 +208,6 @@ class Lockstep:
     kinbench problem). Only the order in which the runs' Python code interleaves changes."""
 
     def __init__(self, problem, members: int, batched: bool):
-        import threading
         self.problem = problem
         self.batched = batched                  # member k solves row k of the case axis
         self.active = int(members)
@@ -219,7 +218,6 @@ class Lockstep:
         self._sub: tuple[tuple[int, ...], Any] | None = None
 
     def member(self, k: int):
-        import threading
         gate = self._gates[k] = threading.Lock()
         gate.acquire()
 
@@ -278,7 +276,6 @@ def run_lockstep(args: list[tuple], problem, batched: bool) -> list[Trace]:
     """:func:`run_one` of every argument tuple, in groups of :data:`LOCKSTEP_RUNS` threads whose
     fitness calls are batched (:class:`Lockstep`); the traces in order. An error is raised once
     every thread of its group has finished (the first row's, as one run after the other would)."""
-    import threading
     traces: list[Trace | None] = [None] * len(args)
     errors: list[BaseException | None] = [None] * len(args)
     for start in range(0, len(args), LOCKSTEP_RUNS):
@@ -318,8 +315,7 @@ class ExternalAlgorithm(Algorithm):
     def __init__(self, **params: Any):
         super().__init__(**params)
         self.library_params = dict(self.params.model_extra or {})
-        from importlib import import_module
-        module = import_module(f"{__package__}.{self.library}_")
+        module = LIBRARY_MODULES[self.library]
         module.check_params(self.method, self.target, self.library_params)
         small = getattr(module, "probe_params", lambda *_: None)(self.method, self.library_params)
         if small is not None:
@@ -344,7 +340,6 @@ class ExternalAlgorithm(Algorithm):
         except FkoptError:
             raise
         except Exception as err:
-            from fkopt.adapters.libraries import library_version
             msg = (str(err).strip().splitlines() or [type(err).__name__])[0]
             raise FkoptError(f"algorithm '{self.library}:{self.method}' ({self.library} "
                              f"{library_version(self.library)}) rejected params {self.library_params}: "
@@ -358,15 +353,13 @@ class ExternalAlgorithm(Algorithm):
         refused when it exceeds the evaluation budget (its first generation could never be
         evaluated); else its estimated bytes (about 64 arrays of its points, per worker
         process), which the job's memory estimate adds to fkopt's own."""
-        from importlib import import_module
-        module = import_module(f"{__package__}.{self.library}_")
+        module = LIBRARY_MODULES[self.library]
         points = module.library_population(self.method, self.library_params, int(population), int(dim))
         budget = self.budget_for(population, iterations)
         if points > budget:
             raise FkoptError(f"algorithm '{self.library}:{self.method}': its population of {points} points per "
                              f"generation exceeds the run's budget of {budget} evaluations (population x "
                              "(iterations + 1), or params.evaluations); lower the library's population")
-        from fkopt.files import available_cpus
         workers = max(1, min(self.params.workers or 1, available_cpus()))
         return 64 * 8 * points * max(int(dim), 1) * workers
 
@@ -383,7 +376,6 @@ class ExternalAlgorithm(Algorithm):
                  population, budget, s, target, stop_at_target,
                  None if start is None else (start if start.ndim == 1 else start[i]))
                 for i, s in enumerate(seeds)]
-        from fkopt.files import available_cpus
         workers = min(self.params.workers or 1, len(runs), available_cpus())
         if workers <= 1 and self.per_point and len(args) > 1:
             traces = run_lockstep(args, problem, batched)      # batched fitness calls, same numbers
@@ -393,8 +385,8 @@ class ExternalAlgorithm(Algorithm):
                 traces.append(run_one(*a))
                 tick(len(traces), len(args))
         else:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
+            import multiprocessing      # worker processes: their modules (and logging) cost every command's
+            from concurrent.futures import ProcessPoolExecutor      # start-up (the registry loads this module)
             methods = multiprocessing.get_all_start_methods()
             ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
             with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:

@@ -2,6 +2,9 @@
 optional imports. Shared by :mod:`fkopt.adapters` and the per-library modules (no import loops)."""
 from __future__ import annotations
 
+from importlib import import_module
+from importlib.metadata import PackageNotFoundError, version
+
 from fkopt.errors import FkoptError
 
 #: Names listed by ``fkopt list`` (niapy accepts any algorithm class of niapy.algorithms).
@@ -27,7 +30,6 @@ def ceil_div(a: int, b: int) -> int:
 
 
 def library_version(library: str) -> str:
-    from importlib.metadata import PackageNotFoundError, version
     try:
         return version(DISTRIBUTIONS[library])
     except PackageNotFoundError:
@@ -36,7 +38,6 @@ def library_version(library: str) -> str:
 
 def require(library: str, module: str):
     """Import an optional library or fail with the install hint."""
-    from importlib import import_module
     try:
         return import_module(module)
     except ImportError as err:

@@ -14,6 +14,7 @@ ignores unknown keywords, fkopt refuses them).
 """
 from __future__ import annotations
 
+import importlib
 import inspect
 
 import numpy as np
@@ -27,7 +28,6 @@ RESERVED = {"seed", "callbacks", "individual_type", "initialization_function"}
 
 def resolve(method: str):
     require("niapy", "niapy")
-    import importlib
     from niapy.algorithms import Algorithm
     names = set()
     for mod in MODULES:

@@ -16,13 +16,12 @@ from functools import lru_cache
 import numpy as np
 
 from fkopt.errors import FkoptError
-from fkopt.adapters.libraries import refuse_unknown, require
+from fkopt.adapters.libraries import ADAPTERS, refuse_unknown, require
 
 RESERVED = {"termination", "seed", "verbose", "save_history", "callback", "display", "output"}
 
 
 def _table() -> dict[str, str]:
-    from fkopt.adapters.libraries import ADAPTERS
     return ADAPTERS["pymoo"]
 
 

@@ -30,12 +30,12 @@ import numpy as np
 
 from fkopt.numerics import rotations
 from fkopt.errors import FkoptError, did_you_mean
+from fkopt.files import MAX_MAGNITUDE, field_path, no_quoted_numbers
+from fkopt.files import did_you_mean as closest
 
 
 def _geometry_base():
     from pydantic import BaseModel, ConfigDict, field_validator
-
-    from fkopt.files import MAX_MAGNITUDE, no_quoted_numbers
 
     class Geometry(BaseModel):
         """Base of every mechanism's geometry model (unknown keys are rejected; every number,
@@ -64,11 +64,19 @@ def _geometry_base():
     return Geometry
 
 
-def __getattr__(name: str):
-    # ``Geometry`` (the pydantic base of every geometry model) is built on first import.
-    if name == "Geometry":
+def geometry_base() -> type:
+    """``Geometry``, the pydantic base of every geometry model, built on first use (so that
+    importing a mechanism module does not import pydantic)."""
+    cls = globals().get("Geometry")
+    if cls is None:
         cls = globals()["Geometry"] = _geometry_base()
-        return cls
+    return cls
+
+
+def __getattr__(name: str):
+    # ``from fkopt.mechanisms.base import Geometry`` builds it on first import.
+    if name == "Geometry":
+        return geometry_base()
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
@@ -101,7 +109,6 @@ def validate_geometry(model: type, geometry: dict[str, Any], where: str, clean=l
 def describe_validation_error(err, where: str) -> str:
     """Collapse a pydantic error into one line: ``where.field: message``."""
     first = err.errors()[0]
-    from fkopt.files import field_path
     loc = field_path(first["loc"])
     msg = first["msg"].removeprefix("Value error, ")
     return f"{where}.{loc}: {msg}" if loc else f"{where}: {msg}"
@@ -188,7 +195,6 @@ class Mechanism:
         bounds = dict(self.default_bounds)
         for key, value in overrides.items():
             if key not in names:
-                from fkopt.files import did_you_mean as closest
                 raise FkoptError(f"{self.name} bounds: unknown variable '{key}'{closest(key, names)}; "
                                  f"allowed: {', '.join(names)}")
             try:
@@ -212,7 +218,6 @@ class Mechanism:
         unknown = set(values) - set(names)
         missing = [n for n in names if n not in values]
         if unknown:
-            from fkopt.files import did_you_mean as closest
             word = sorted(unknown)[0]
             raise FkoptError(f"{self.name} {what}: unknown variable '{word}'{closest(word, names)}; "
                              f"allowed: {', '.join(names)}")
@@ -225,7 +230,6 @@ class Mechanism:
         """``values`` after checking |v| <= :data:`fkopt.files.MAX_MAGNITUDE` (1e9 in the
         mechanism's units; past it a square overflows in FK, IK or a Jacobian): one line naming
         the variable otherwise."""
-        from fkopt.files import MAX_MAGNITUDE
         big = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
         if big.size:
             i = int(big[0])

@@ -26,7 +26,8 @@ from typing import Any
 import numpy as np
 
 from fkopt.errors import FkoptError
-from fkopt.mechanisms.base import FrameArm, lazy_model, validate_geometry
+from fkopt.mechanisms.base import FrameArm, geometry_base, lazy_model, validate_geometry
+from fkopt.numerics.chain import from_dh
 
 #: Batch size from which :meth:`DHArm.frame_jacobian` works on the frame's columns rather than
 #: by batched 4x4 products (those cost about 1 µs per matrix, the columns a fixed ~20 array
@@ -44,9 +45,8 @@ WANG7DOF = dict(
 
 def _dh_geometry():
     from pydantic import Field, model_validator
-    from fkopt.mechanisms.base import Geometry
 
-    class DHGeometry(Geometry):
+    class DHGeometry(geometry_base()):
         a: list[float] = Field(default_factory=lambda: list(WANG7DOF["a"]),
                                description="link lengths a_i (mm)")
         alpha: list[float] = Field(default_factory=lambda: list(WANG7DOF["alpha"]),
@@ -281,7 +281,6 @@ class DHArm(FrameArm):
         """The DH table as a :class:`fkopt.numerics.chain.Chain` (same numbers as :meth:`frame_jacobian1`)."""
         got = self.__dict__.get("_chain_arrays")
         if got is None:
-            from fkopt.numerics.chain import from_dh
             got = self.__dict__["_chain_arrays"] = from_dh(self._a, self._d, self._ca, self._sa, self._offset_rad)
         return got
 

@@ -25,7 +25,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from fkopt.mechanisms.base import lazy_model
+from fkopt.mechanisms.base import geometry_base, lazy_model
 from fkopt.mechanisms.dh_arm import DHArm
 
 #: Reach bound of every member (mm): sum over the links of sqrt(a^2 + d^2).
@@ -54,9 +54,8 @@ def chain_table(joints: int, seed: int) -> dict:
 
 def _chain_geometry():
     from pydantic import Field
-    from fkopt.mechanisms.base import Geometry
 
-    class DHChainGeometry(Geometry):
+    class DHChainGeometry(geometry_base()):
         joints: int = Field(6, ge=1, le=MAX_JOINTS, description="number of revolute joints n")
         seed: int = Field(0, ge=0, le=2**63 - 1, description="seed of the DH table's stream")
 

@@ -47,7 +47,7 @@ import numpy as np
 from pydantic import Field
 
 from fkopt.errors import FkoptError, did_you_mean
-from fkopt.files import check_geometry_file, short_token
+from fkopt.files import check_geometry_file, check_within, open_input, parse_xml, read_input, short_token
 from fkopt.numerics import rotations
 from fkopt.mechanisms.urdf import URDFArm, URDFGeometry, check_numbers
 
@@ -91,7 +91,6 @@ def check_mjcf_files(path: Path) -> None:
     beside the top file and beside the file naming it, joined to the compiler's folders or not
     (``strippath``: the name without its folder), so every such candidate that exists is
     checked. One line naming the file."""
-    from fkopt.files import check_within, open_input, parse_xml, read_input
     folder = path.resolve().parent
     where = f"mjcf {path}"
     total, count = 0, 0

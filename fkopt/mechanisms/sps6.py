@@ -45,7 +45,7 @@ import math
 import numpy as np
 
 from fkopt.numerics import rotations
-from fkopt.mechanisms.base import ParallelMechanism, lazy_model
+from fkopt.mechanisms.base import ParallelMechanism, geometry_base, lazy_model
 
 Vec3 = tuple[float, float, float]
 Points6 = tuple[Vec3, Vec3, Vec3, Vec3, Vec3, Vec3]
@@ -96,9 +96,8 @@ def degenerate(points, what: str) -> str | None:
 
 def _six_sps_geometry():
     from pydantic import Field, model_validator
-    from fkopt.mechanisms.base import Geometry
 
-    class SixSPSGeometry(Geometry):
+    class SixSPSGeometry(geometry_base()):
         base: Points6 = Field(DIETMAIER_BASE, description="six base joints b_i [x, y, z] (base frame)")
         platform: Points6 = Field(DIETMAIER_PLATFORM,
                                   description="six platform joints p_i [x, y, z] (platform frame)")
@@ -328,9 +327,8 @@ SixSPS.default_bounds = general_bounds(np.array(DIETMAIER_BASE), np.array(DIETMA
 
 def _six_sps_cmm_geometry():
     from pydantic import Field, model_validator
-    from fkopt.mechanisms.base import Geometry
 
-    class SixSPSCMMGeometry(Geometry):
+    class SixSPSCMMGeometry(geometry_base()):
         Rb: float = Field(0.5, gt=0, description="base joint circle radius R_b (m)")
         Rp: float = Field(0.225, gt=0, description="platform joint circle radius R_p (m)")
         tb: float = Field(30.0, gt=0, lt=120, description="base short-side central angle theta_b (deg)")

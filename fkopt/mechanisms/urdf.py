@@ -33,6 +33,9 @@ from __future__ import annotations
 
 import math
 import re
+import sys
+from collections import Counter
+from importlib import metadata
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -113,7 +116,6 @@ def _with_undeclared_prefixes(data: bytes, path: Path, err) -> Any:
     pinocchio's and yourdfpy's readers ignore such attributes and read the file, so fkopt does
     too -- it reads no prefixed attribute or element, so the kinematics are the file's.
     XML 1.0 names (https://www.w3.org/TR/xml-names/#ns-decl): ``xml`` is bound by definition."""
-    import sys
     declared = {m.decode() for m in re.findall(rb"xmlns:([A-Za-z_][\w.-]*)\s*=", data)} | {"xml", "xmlns"}
     used = sorted({m.decode() for m in _PREFIXED.findall(data)} - declared)
     if not used:
@@ -348,7 +350,6 @@ class URDFArm(FrameArm):
             if j.mimic is None:
                 names.append(j.name)
                 units.append("m" if j.type == "prismatic" else "deg")
-        from collections import Counter
         twice = sorted(n for n, c in Counter(j.name for j in moving).items() if c > 1)
         if twice:      # two joints answering to one name: one answer column would stand for both
             raise FkoptError(f"{self.name} {path}: two joints of the chain are named '{twice[0]}'; names must be unique")
@@ -623,7 +624,6 @@ EXAMPLE_ROBOTS = {
 def example_robots_folder() -> Path | None:
     """The robots/ folder installed by the PyPI package example-robot-data (a cmeel prefix
     with no Python module, found through the package's file list), or None."""
-    from importlib import metadata
     try:
         files = metadata.files("example-robot-data") or []
     except metadata.PackageNotFoundError:

@@ -8,6 +8,8 @@
 * one module per paper (``mao2017.py``, ...) with its notes and its claims, registered in
   :data:`PAPERS`.
 """
+import importlib
+
 
 PAPERS: dict[str, str] = {
     "mao2017": "fkopt.reproduce.mao2017",
@@ -22,5 +24,4 @@ PAPERS: dict[str, str] = {
 
 def paper_module(key: str):
     """The module of a paper key (its notes and claims), or None for a folder that is no paper."""
-    import importlib
     return importlib.import_module(PAPERS[key]) if key in PAPERS else None

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.reproduce.store import mechanism_of
+from fkopt.run import plotting
 
 #: The printed inputs of the case (alpha, beta, gamma, z) = (25, 34, 23, 360) (Sec. 3.3).
 CASE_POSE = {"alpha": 25.0, "beta": 34.0, "gamma": 23.0, "z": 360.0}
@@ -43,7 +44,6 @@ def figures(exp) -> list[str]:
     """Figures drawn from the model alone at report time: Fig. 3 (inputs along the trajectory)."""
     if exp.name != "tab1_fig7":
         return []
-    from fkopt.run import plotting
     df = fig3_inputs()
     mech = _mechanism()
     plt = plotting.plt()

@@ -8,14 +8,18 @@ last regeneration moved, and nobody writes that list by hand.
 """
 from __future__ import annotations
 
+import json
+import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.files import read_stored
+from fkopt.files import parse_csv, read_stored, read_text, write_file_atomically
+from fkopt.run.compare import ANY, compare_folders
 from fkopt.run.writers import deterministic_files, sha256
+from fkopt.reproduce.check import rules_for
 from fkopt.reproduce.claims import CLAIMS_FILE
 from fkopt.reproduce.store import Store
 
@@ -40,7 +44,6 @@ def snapshot(root: str | Path, keep: Path | None = None, only: set[str] | None =
     folder), its deterministic files are also copied there, for :func:`agreement`. ``only``:
     the results ("paper/name") to read, and their papers' claims (``fkopt reproduce`` into a
     folder of its own compares only what it reruns with the stored tree)."""
-    import shutil
     root = Path(root)
     snap = Snapshot(copies=keep)
     if not root.is_dir():
@@ -71,17 +74,12 @@ def snapshot(root: str | Path, keep: Path | None = None, only: set[str] | None =
 def save_snapshot(snap: Snapshot, path: str | Path) -> None:
     """Keep a snapshot in a JSON file (``fkopt report --snapshot-to``), e.g. before ``make
     bench-suite`` reruns the suites, to say afterwards what they moved."""
-    import json
     Path(path).write_text(json.dumps({"files": snap.files, "summaries": snap.summaries, "claims": snap.claims},
                                      sort_keys=True), encoding="utf-8")
 
 
 def load_snapshot(path: str | Path) -> Snapshot:
     """A snapshot kept by :func:`save_snapshot`; one line naming the file when it is not one."""
-    import json
-
-    from fkopt.errors import FkoptError
-    from fkopt.files import read_text
     try:
         data = json.loads(read_text(path, 256 << 20))
         snap = Snapshot(dict(data["files"]), dict(data["summaries"]), dict(data["claims"]))
@@ -95,7 +93,6 @@ def load_snapshot(path: str | Path) -> Snapshot:
 def _table(text: str | None) -> pd.DataFrame | None:
     if not text:
         return None
-    from fkopt.files import parse_csv
     try:
         return parse_csv(text.encode("utf-8"), "stored table")
     except (FkoptError, ValueError, pd.errors.ParserError):
@@ -209,8 +206,6 @@ def agreement(before: Snapshot, root: str | Path, after: Snapshot | None = None)
     Needs a snapshot taken with ``keep``. ``after``: the tree's snapshot the caller already took
     for :func:`describe` (``fkopt reproduce`` threads the one :func:`write_changes` took, so the
     tree is hashed once at its end), default: taken here."""
-    from fkopt.run.compare import ANY, compare_folders
-    from fkopt.reproduce.check import rules_for
     root = Path(root)
     after = snapshot(root) if after is None else after
     moved: dict[str, list[str]] = {}
@@ -247,7 +242,6 @@ def agreement(before: Snapshot, root: str | Path, after: Snapshot | None = None)
 def write_changes(root: str | Path, before: Snapshot) -> tuple[Path, Snapshot]:
     """Write CHANGES.md at the root of the regenerated tree; returns its path and the snapshot of
     the tree it compared (for :func:`agreement`, without hashing the tree again)."""
-    from fkopt.files import write_file_atomically
     path = Path(root) / CHANGES_FILE
     after = snapshot(root)
     text = describe(before, root, after)

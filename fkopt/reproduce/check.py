@@ -40,9 +40,18 @@ from fkopt.run.compare import Mismatch, Rules, compare_folders, deterministic_fi
 from fkopt.errors import FkoptError
 from fkopt.files import odd_entries, parse_json, read_stored, read_stored_csv
 import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
+from fkopt.kinbench.verify import reverify
+from fkopt.kinds.experiment.runner import build_cases, build_problem
+from fkopt.kinds.study.poses import build_poses
+from fkopt.registry import algorithm_class, mechanism_class, registered_only
 from fkopt.run.pipeline import config_kind, from_dict, rerun_files
+from fkopt.run.solving import build_mechanism, make_problem
+from fkopt.run.tasks import task_file_problems
 from fkopt.numerics import path as numerics_path
 from fkopt.run.provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
+from fkopt.reproduce.claims import CLAIMS_FILE, COLUMNS, TIMING_CLAIMS_FILE, claims_frame
+from fkopt.reproduce.drift import rerun_verdict_drift
+from fkopt.reproduce.engine import judge_paper
 from fkopt.reproduce.store import Experiment, Store
 
 #: Compared first (so the first mismatch is the most telling), then the rest, meta.json last.
@@ -98,7 +107,6 @@ def rules_for(exp: Experiment, tier: str) -> Rules:
     """The comparison rules of ``exp``: which algorithm labels are path-dependent (a BLAS call may
     lie on their path: see ``Algorithm.blas_free`` and ``Mechanism.blas_free_fitness``), and the
     fitness at which a run counts as reached (the config's threshold)."""
-    from fkopt.registry import algorithm_class, mechanism_class
     cfg = exp.config if isinstance(exp.config, dict) else {}
     mechs = [p.get("mechanism") or {} for p in cfg.get("problems") or []] or [cfg.get("mechanism") or {}]
     try:                # a suite has several problems: its rows are BLAS-free only if every fitness is
@@ -131,8 +139,6 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     kind = config_kind(config).name
     if kind not in ("experiment", "study") or not (exp.folder / "runs.csv").is_file():
         return []
-    from fkopt.kinds.experiment.runner import build_cases, build_problem
-    from fkopt.run.solving import build_mechanism, make_problem
     label = _label(exp)
     try:
         runs = read_stored_csv(exp.folder, "runs.csv")
@@ -143,7 +149,6 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
         groups = [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
                   for case in build_cases(config, mech)]
     else:                               # a study: one problem per pose of its pose set
-        from fkopt.kinds.study.poses import build_poses
         poses = build_poses(config, mech)
         # poses count from 0 (fkopt.run.record); a folder written before the run record counted from 1
         first = 1 if len(runs) and runs["pose"].min() >= 1 else 0
@@ -191,7 +196,6 @@ def check_experiment(exp: Experiment, config=None, exact: bool | None = None, ti
     someone else's meta.json is refused, not imported -- unless ``allow_plugins``
     (:func:`fkopt.registry.registered_only`).
     """
-    from fkopt.registry import registered_only
     with registered_only(not allow_plugins):
         return _check_experiment(exp, config, exact, tier)
 
@@ -207,7 +211,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         return [Mismatch(label, name, "-", "file", what, "a regular file of the folder", "regular files only")
                 for name, what in odd]
     out = integrity(exp)
-    from fkopt.run.tasks import task_file_problems     # kept task files: digests of tasks/manifest.json
+    # kept task files: digests of tasks/manifest.json
     out += [Mismatch(label, name, "-", "sha256", why, "recorded in tasks/manifest.json", "unchanged since written")
             for name, why in task_file_problems(exp.folder)]
     if config is None:
@@ -231,8 +235,7 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
         order = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST and n != "meta.json"]
         order += ["meta.json"]
         out += compare_folders(label, exp.folder, tmp, rules_for(exp, tier), files=order)
-        from fkopt.reproduce.drift import rerun_verdict_drift   # a claim's verdict must not change either
-        out += rerun_verdict_drift(exp, tmp)
+        out += rerun_verdict_drift(exp, tmp)          # a claim's verdict must not change either
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return out
@@ -244,7 +247,6 @@ def board_from_answers(label: str, exp: Experiment, config) -> list[Mismatch]:
     themselves are never compared with a rerun's."""
     if getattr(config, "kind", None) != "suite" or getattr(config, "tracks", None) is None:
         return []
-    from fkopt.kinbench.verify import reverify
     if config._folder is None and exp.meta.get("config_file"):
         config._folder = Path(exp.meta["config_file"]).parent
     return [Mismatch(label, *row) for row in reverify(exp.folder, config)]
@@ -259,8 +261,6 @@ def engine_verdict_files(root: Path, paper: str) -> dict[str, pd.DataFrame]:
     """{file name: rows} of the verdict files the current engine writes for ``paper`` from the results
     stored under ``root`` (:func:`fkopt.reproduce.report.claims_files`'s rule: claims.csv where the
     paper's claims are judged here, timing_claims.csv when it has timing claims)."""
-    from fkopt.reproduce.claims import CLAIMS_FILE, TIMING_CLAIMS_FILE, claims_frame
-    from fkopt.reproduce.engine import judge_paper
     folder = root / paper
     stats = tuple(sorted((str(f), f.stat().st_mtime_ns, f.stat().st_size)
                          for f in [*folder.glob("*.csv"), *folder.glob("*/meta.json")] if f.is_file()))
@@ -287,7 +287,6 @@ def verdict_files(exp: Experiment) -> list[Mismatch]:
     written by ``fkopt reproduce`` (REPORT.md at its root). Judged from the stored runs, so on every
     platform (timing verdicts from the stored timed runs: check measures no time); a rerun's verdicts
     are :func:`fkopt.reproduce.drift.rerun_verdict_drift`'s. The fix is ``fkopt report RESULTS``."""
-    from fkopt.reproduce.claims import COLUMNS, TIMING_CLAIMS_FILE
     root = exp.folder.parents[1]
     folder = exp.folder.parent
     names = ("claims.csv", TIMING_CLAIMS_FILE)

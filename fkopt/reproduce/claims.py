@@ -22,6 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fkopt.algorithms.abc import quality
+from fkopt.errors import FkoptError
+from fkopt.files import parse_csv, read_text
+
 HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE = "held", "not held", "not checkable", "within noise"
 CONDITIONAL = "conditional: "
 VERDICTS = (HELD, NOT_HELD, NOT_CHECKABLE, WITHIN_NOISE, CONDITIONAL + HELD, CONDITIONAL + NOT_HELD,
@@ -186,7 +190,6 @@ def accepted_trace(fitness: np.ndarray, selection: str) -> np.ndarray:
     f = np.asarray(fitness, float)
     if selection != "karaboga" or f.size == 0:
         return f
-    from fkopt.algorithms.abc import quality
     q = quality(f)
     rose = np.r_[True, q[1:] > np.maximum.accumulate(q)[:-1]]
     idx = np.maximum.accumulate(np.where(rose, np.arange(f.size), 0))
@@ -343,8 +346,6 @@ def read_claims(file: str | Path) -> pd.DataFrame:
     """A stored ``claims.csv`` (or ``timing_claims.csv``) as text columns; a file that is not
     UTF-8, too large, not a CSV or without ``claim`` and ``verdict`` columns is one
     :class:`~fkopt.errors.FkoptError` line naming it."""
-    from fkopt.errors import FkoptError
-    from fkopt.files import parse_csv, read_text
     text = read_text(file, MAX_CLAIMS_BYTES)
     try:
         df = parse_csv(text.encode("utf-8"), str(file), dtype=str, keep_default_na=False)

@@ -5,8 +5,12 @@ Kept apart from :mod:`.claims` (the vocabulary the engine uses) so the two never
 """
 from __future__ import annotations
 
+import shutil
+import tempfile
 from pathlib import Path
 
+from fkopt.errors import FkoptError
+from fkopt.run.compare import Mismatch, timing_files
 from fkopt.reproduce.claims import CLAIMS_FILE, TIMING_CLAIMS_FILE, _key, claims_frame, read_claims
 from fkopt.reproduce.engine import judge_paper, load
 from fkopt.reproduce.store import Store
@@ -40,10 +44,6 @@ def verdict_changes(root: str | Path, timing: bool = False) -> list[tuple[str, s
 def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
     """Verdicts of ``exp``'s paper recomputed with the rerun of ``exp`` in place of the stored folder,
     against the stored ``claims.csv`` (``fkopt check``): one :class:`~.check.Mismatch` per change."""
-    import shutil
-    import tempfile
-    from fkopt.run.compare import Mismatch
-    from fkopt.errors import FkoptError
     if not (exp.folder.parent / CLAIMS_FILE).exists():
         return []
     try:
@@ -59,7 +59,7 @@ def rerun_verdict_drift(exp, rerun_folder: str | Path) -> list:
         for other in _other_papers_experiments(exp.paper):   # a claim judged on another paper's runs
             if (exp.folder.parents[1] / other).is_dir() and not (tmp / other).exists():
                 shutil.copytree(exp.folder.parents[1] / other, tmp / other)   # without that paper's claims.csv
-        from fkopt.run.compare import timing_files   # check's rerun measures no time: the stored timings stand in,
+        # check's rerun measures no time: the stored timings stand in,
         for name in timing_files():            # so judging the paper (timing claims included) can read them
             if (exp.folder / name).is_file() and not (tmp / exp.paper / exp.name / name).exists():
                 shutil.copy2(exp.folder / name, tmp / exp.paper / exp.name / name)

@@ -45,8 +45,9 @@ import pandas as pd
 import yaml
 
 from fkopt.reproduce import paper_module
-from fkopt.reproduce.claims import (ALPHA, CONDITIONAL, HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, Claim, compare, equal_budget,
-                     faster_claim, first_below, g, missing, p_text, verdict, within_of_final)
+from fkopt.reproduce.claims import (ALPHA, CONDITIONAL, HELD, NOT_CHECKABLE, NOT_HELD, WITHIN_NOISE, Claim,
+                                   at_iteration, compare, equal_budget, faster_claim, first_below, g, missing, p_text,
+                                   verdict, within_of_final)
 
 CLAIMS_YAML = "claims.yaml"
 #: Where the claims files live: the repository's configs/ (``FKOPT_CONFIGS`` points elsewhere).
@@ -296,7 +297,6 @@ def per_run(exp, mod, algo: str, quantity: str, spec: dict) -> tuple[np.ndarray,
     if quantity == "within_1pct_of_final":
         return within_of_final(exp, algo, 0.01)
     if quantity == "log10_change":
-        from fkopt.reproduce.claims import at_iteration
         a, b = spec["window"]
         f0, f1 = at_iteration(exp, algo, a), at_iteration(exp, algo, b)
         return np.log10(np.maximum(f1, 1e-300)) - np.log10(np.maximum(f0, 1e-300)), None

@@ -8,6 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from fkopt.mechanisms.sps6 import SixSPSCMM
+from fkopt.numerics.rotations import geodesic_angle, zyx
 from fkopt.reproduce.claims import g
 
 #: Printed leg lengths of Tab. 3 (m) and the printed pose (m, deg).
@@ -19,7 +21,6 @@ PRINTED_HALF_UNIT = 5e-7
 
 def _printed_pose_legs() -> pd.DataFrame:
     """Legs of the printed pose under fkopt's model vs the printed legs."""
-    from fkopt.mechanisms.sps6 import SixSPSCMM
     legs = SixSPSCMM().ik(np.array([PRINTED_POSE]))[0]
     return pd.DataFrame({"leg": [f"l{i + 1}" for i in range(6)], "printed_m": PRINTED_LEGS,
                          "of_printed_pose_m": legs, "difference_um": (legs - np.array(PRINTED_LEGS)) * 1e6})
@@ -41,7 +42,6 @@ def pose_distance(exp, runs: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     orientation, and Newton's unclipped steps land there (newton_starts run 263 of Newton: the Tab. 3
     pose written with alpha = -8472.7, beta = 173.6, gamma = -9164.9 deg).
     """
-    from fkopt.numerics.rotations import geodesic_angle, zyx
     refs = {str(c.get("label")): c.get("reference") for c in (exp.config.get("cases") or [])}
     missing = sorted({str(k) for k in runs["case"].astype(str)} - {k for k, v in refs.items() if v})
     if missing:

@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from fkopt.files import inside
 from fkopt.reproduce import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
-from fkopt.reproduce.changes import Snapshot
+from fkopt.reproduce.changes import Snapshot, write_changes
 from fkopt.reproduce.claims import CLAIMS_FILE, RULES, TIMING_CLAIMS_FILE, Claim, claims_frame
 from fkopt.reproduce.engine import claim_experiments, info, judge_paper
 from fkopt.run.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
@@ -281,7 +282,6 @@ def write_report(root: str | Path, changes_since=None) -> WrittenReport:
     Every file is checked before anything is computed or written: it must resolve (symbolic
     links included) inside ``root`` (:func:`fkopt.files.inside`), so a link planted in a
     results root cannot make ``fkopt report`` overwrite a file elsewhere."""
-    from fkopt.files import inside
     root = Path(root)
     paths = [root / "REPORT.md", root / "TIMING.md", root / "index.csv"]
     claims = [root / paper / name for paper in Store(root).papers() for name in (CLAIMS_FILE, TIMING_CLAIMS_FILE)]
@@ -298,7 +298,6 @@ def write_report(root: str | Path, changes_since=None) -> WrittenReport:
         paths.append(path)
     after = None
     if changes_since is not None:
-        from fkopt.reproduce.changes import write_changes
         changes_path, after = write_changes(root, changes_since)
         paths.append(changes_path)
     report, timing, index = build_report(root)

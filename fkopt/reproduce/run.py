@@ -18,6 +18,9 @@ from fkopt.errors import FkoptError
 import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
 from fkopt.run.pipeline import config_kind, load_any, plan_config, prepare_output, run_config
 from fkopt.files import output_folder
+from fkopt.reproduce.engine import is_claims_file
+from fkopt.run.executors import execute
+from fkopt.run.tasks import run_remote
 
 
 @dataclass
@@ -40,7 +43,6 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     configs = Path(configs)
     if not configs.is_dir():
         raise FkoptError(f"--configs: {configs} is not a folder")
-    from fkopt.reproduce.engine import is_claims_file
     files = sorted(f for f in configs.rglob("*.yaml") if not is_claims_file(f))   # claims are no experiment
     if not files:
         raise FkoptError(f"{configs}: no experiment files (*.yaml) found")
@@ -93,7 +95,6 @@ def solve_in_parallel(planned: list[Planned], jobs: int,
     time, with the workers gone; only the batch's amortised time (``amortised_ms_per_run``, for
     information) is measured in a worker next to another.
     """
-    from fkopt.run.executors import execute
     if jobs <= 1:
         return {}
     items = []
@@ -119,7 +120,6 @@ def solve_in_parallel(planned: list[Planned], jobs: int,
 
 def _run_indexed(pair):
     """Worker: one task of config ``index`` -> (index, (task id, record))."""
-    from fkopt.run.tasks import run_remote
     index, item = pair
     return index, run_remote(item)
 

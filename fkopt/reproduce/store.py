@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from fkopt import registry
 from fkopt.errors import FkoptError
 from fkopt.files import parse_json, read_stored, read_stored_csv
 
@@ -123,7 +124,6 @@ class Store:
 
 def mechanism_of(exp_or_name):
     """The mechanism of a stored experiment (from its recorded config), or a registered name's default."""
-    from fkopt import registry
     if isinstance(exp_or_name, str):
         return registry.mechanism_class(exp_or_name)()
     m = exp_or_name.config["mechanism"]

@@ -10,7 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from fkopt.kinds.experiment.config import ExperimentConfig
+from fkopt.kinds.experiment.runner import build_cases, build_problem
 from fkopt.reproduce.claims import g
+from fkopt.run.solving import build_mechanism
 
 #: Tab. 2's printed joint solutions (deg); the PSO column lost its decimal points ("48 282").
 PRINTED_JOINTS = {"pso": (48.282, -6.758, 47.497, 34.208, 50.654, -60.107, -30.0),
@@ -23,9 +26,6 @@ ORIENTATION_REQUIREMENT_DEG = float(np.degrees(1e-3))
 
 def _problems(exp):
     """(mechanism, {case label: IK problem}) rebuilt from the experiment's recorded config."""
-    from fkopt.kinds.experiment.config import ExperimentConfig
-    from fkopt.kinds.experiment.runner import build_cases, build_problem
-    from fkopt.run.solving import build_mechanism
     cfg = ExperimentConfig(**exp.config)
     mech = build_mechanism(cfg)
     return mech, {c.label: build_problem(cfg, mech, c) for c in build_cases(cfg, mech)}

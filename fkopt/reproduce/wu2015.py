@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from fkopt import registry
+from fkopt.problems import fk_problem
 from fkopt.reproduce.claims import compare, g
 from fkopt.reproduce.store import mechanism_of
 
@@ -27,7 +29,6 @@ def _mechanism(exp=None):
 
 
 def _fitness(mech, target, poses) -> np.ndarray:
-    from fkopt.problems import fk_problem
     return fk_problem(mech, mech.ik(np.asarray(target, dtype=float))).fitness(np.asarray(poses, dtype=float))
 
 
@@ -178,7 +179,6 @@ def pheromone_table(exp) -> pd.DataFrame:
 
 
 def _rho(exp) -> float:
-    from fkopt import registry
     for a in exp.config["algorithms"]:
         if a["name"] == "aco":
             return float((a.get("params") or {}).get("rho", registry.algorithm_class("aco").Params().rho))

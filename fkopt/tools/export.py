@@ -45,8 +45,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import fkopt
 from fkopt.errors import FkoptError
-from fkopt.files import csv_numbers, file_names, parse_json, read_stored, read_stored_csv
+from fkopt.files import (csv_numbers, file_names, output_folder, parse_json, read_stored, read_stored_csv,
+                         write_atomically)
+from fkopt.kinbench.traces import COLUMNS, KEYS
+from fkopt.run.trace import FILE, read_trace
 from fkopt.tools.iohformat import ATTRIBUTES, IOH_VERSION, read_ioh  # noqa: F401  (read_ioh: the reader, here as before)
 
 FORMATS = ("ioh",)
@@ -136,7 +140,6 @@ def _runs_csv(folder: Path, columns, labels) -> pd.DataFrame:
 def _checked_groups(folder: Path, trace: pd.DataFrame, runs: pd.DataFrame, keys: list[str], what) -> dict:
     """The trace rows of every run of ``runs`` (keyed by ``keys``), checked: every run has rows,
     starting at evaluation 1, with increasing evaluations. ``what(key)`` names a run in errors."""
-    from fkopt.run.trace import FILE
     for k in keys:                                       # labels compare as text, ids as integers
         if trace[k].dtype.name == "category":
             trace[k] = trace[k].astype(str)
@@ -161,7 +164,6 @@ def _checked_groups(folder: Path, trace: pd.DataFrame, runs: pd.DataFrame, keys:
 
 def _experiment(folder: Path, meta: dict) -> list[Function]:
     """An experiment folder as one function (every field the export uses checked)."""
-    from fkopt.run.trace import FILE, read_trace
     path, config = folder / "meta.json", meta["config"]
     bounds = (meta.get("mechanism") or {}).get("bounds") if isinstance(meta.get("mechanism"), dict) else None
     if not isinstance(bounds, dict) or not bounds:
@@ -180,11 +182,10 @@ def _experiment(folder: Path, meta: dict) -> list[Function]:
     cases = list(dict.fromkeys(runs["case"]))
     fn = Function(f"{config.get('paper') or 'experiments'}_{config['name']}", len(names), cases,
                   [{"variables": " ".join(names)}, {"source": str(folder)}])
-    from fkopt import __version__
     for label in dict.fromkeys(runs["algorithm"]):
         spec = next((a for a in config["algorithms"]
                      if isinstance(a, dict) and (a.get("label") or a.get("name")) == label), {})
-        info = {"name": spec.get("name", label), "params": spec.get("params", {}), "fkopt": __version__}
+        info = {"name": spec.get("name", label), "params": spec.get("params", {}), "fkopt": fkopt.__version__}
         runs_a = runs[runs["algorithm"] == label]
         out = []
         for inst, case in enumerate(cases, start=1):
@@ -199,8 +200,6 @@ def _experiment(folder: Path, meta: dict) -> list[Function]:
 def _suite(folder: Path, meta: dict) -> list[Function]:
     """A suite folder (:mod:`fkopt.kinbench`) as one function per problem, in the suite's order:
     one instance per (set, pose) in set-then-pose order, one algorithm per solver."""
-    from fkopt.run.trace import FILE, read_trace
-    from fkopt.kinbench.traces import COLUMNS, KEYS
     path, config = folder / "meta.json", meta["config"]
     problems, sets = config.get("problems"), config.get("sets")
     if not (isinstance(problems, list) and all(isinstance(p, dict) and isinstance(p.get("name"), str) for p in problems)
@@ -213,7 +212,6 @@ def _suite(folder: Path, meta: dict) -> list[Function]:
     runs = _runs_csv(folder, KEYS + ["dim", "track"], ("problem", "set", "solver", "track"))
     groups = _checked_groups(folder, trace, runs, KEYS, lambda k: f"run {k[4]} of solver '{k[3]}', problem "
                              f"'{k[0]}', set '{k[1]}', pose {k[2]}")
-    from fkopt import __version__
     specs = {(s.get("label") or s.get("name")): s for s in config.get("solvers") or [] if isinstance(s, dict)}
     outside = {o.get("solver"): o for o in config.get("outside") or [] if isinstance(o, dict)}
     set_order = {s: j for j, s in enumerate(sets)}
@@ -232,7 +230,7 @@ def _suite(folder: Path, meta: dict) -> list[Function]:
             spec = specs.get(label)
             info = ({"name": spec.get("name", label), "params": spec.get("params", {})} if spec is not None else
                     {"name": label, "outside": outside.get(label, {}).get("file") or outside.get(label, {}).get("ioh")})
-            info.update(track=str(rs["track"].iloc[0]), fkopt=__version__)
+            info.update(track=str(rs["track"].iloc[0]), fkopt=fkopt.__version__)
             order = sorted(zip(rs["set"], rs["pose"], rs["run"]), key=lambda k: (number[k[:2]], k[2]))
             runs_l = []
             for s, p, r in order:
@@ -295,14 +293,12 @@ def _write_function(tmp: Path, fid: int, fn: Function, folders: dict[str, str]) 
 def ioh_export(results: Path, out: Path) -> list[Path]:
     """Write the IOHprofiler files of every experiment and suite under ``results`` into ``out``;
     returns the index files written."""
-    from fkopt import __version__
-    from fkopt.files import write_atomically
     folders = experiment_folders(results)
     out = check_out(out, results)
     loaded = [(f, fns) for f in folders if (fns := _load(f)) is not None]
     if not loaded:
         raise FkoptError(f"{results}: only studies/assembly results, which have no per-run traces to export")
-    from fkopt.files import output_folder   # the shared checks (a folder, writable), once the inputs are good
+    # the shared checks of the output folder (a folder, writable), once the inputs are good
     output_folder(out)
 
     functions = [fn for _, fns in loaded for fn in fns]
@@ -312,7 +308,7 @@ def ioh_export(results: Path, out: Path) -> list[Path]:
         for fid, fn in enumerate(functions, start=1):
             _write_function(tmp, fid, fn, folders)
         (tmp / MARKER).write_text("fkopt export (IOHprofiler format; this file is the export's mark, "
-                                  "not data)\n" + f"format: ioh\nfkopt: {__version__}\nioh layout: {IOH_VERSION}\n"
+                                  "not data)\n" + f"format: ioh\nfkopt: {fkopt.__version__}\nioh layout: {IOH_VERSION}\n"
                                   + "results:\n" + "".join(f"  {f}\n" for f, _ in loaded))
 
     write_atomically(out, write)

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+import xml.parsers.expat
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +44,9 @@ from typing import Any
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.files import MAX_XML_DEPTH, read_text
+from fkopt.mechanisms.urdf import MAX_URDF_BYTES
+from fkopt.numerics.rotations import geodesic_angle
 
 
 class NotApplicable(FkoptError):
@@ -103,8 +107,6 @@ class ArmURDF:
         """A URDF file as it stands, for files fkopt did not take from a user (example-robot-data's
         robots in ``fkopt bench``): read bounded and refused with one line unless
         :func:`check_expression_free` proves nothing in it would be evaluated."""
-        from fkopt.files import read_text
-        from fkopt.mechanisms.urdf import MAX_URDF_BYTES
         text = read_text(path, MAX_URDF_BYTES, field="urdf geometry.file")
         check_expression_free(text, str(path))
         return cls(text, base_link, tip_link, tuple(joint_names), str(path))
@@ -122,8 +124,6 @@ def check_expression_free(text: str, where: str) -> None:
     ``xacro:`` prefix (macros, includes, properties), or ``${`` or ``$(`` in any attribute value
     or text. A namespace declaration alone (``xmlns:xacro`` on ``<robot>``, as most of
     example-robot-data's files have) holds nothing to act on and passes."""
-    import xml.parsers.expat
-    from fkopt.files import MAX_XML_DEPTH
     parser = xml.parsers.expat.ParserCreate()          # no namespace processing: names as xacro sees them
     depth = 0
 
@@ -166,7 +166,7 @@ def arm_urdf(arm) -> ArmURDF:
     (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, names made safe, FK-checked against MuJoCo
     in tests/test_urdf_writer.py), never the robot's own file (module docstring); checked once
     more by :func:`check_expression_free` before any package sees it."""
-    from fkopt.mechanisms.urdf_writer import chain_urdf
+    from fkopt.mechanisms.urdf_writer import chain_urdf   # only when an outside package reads an arm (start-up)
     w = chain_urdf(arm)
     source = f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}"
     check_expression_free(w.text, source)
@@ -209,7 +209,6 @@ def solve(solver: FieldIK, targets: np.ndarray) -> IKAnswers:
 def pose_errors_rad(arm, q_public: np.ndarray, T: np.ndarray) -> np.ndarray:
     """Position error (m) and geodesic rotation error (rad) of rows q (k, dof) against one
     target T, from fkopt's FK: shape (k, 2)."""
-    from fkopt.numerics.rotations import geodesic_angle
     F = arm.fk_matrix(q_public)
     pe = np.linalg.norm(F[:, :3, 3] - T[:3, 3], axis=-1)
     re = geodesic_angle(soa(F[:, :3, :3]), soa(np.broadcast_to(T[:3, :3], (len(F), 3, 3))))

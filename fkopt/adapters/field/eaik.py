@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fkopt.errors import FkoptError
 from fkopt.adapters.field import FieldIK, NotApplicable, arm_urdf
 
 
@@ -72,7 +73,6 @@ class EAIK(FieldIK):
         self._C = np.linalg.solve(self._robot.fwdKin(mid * arm._to_si), arm.fk_matrix(mid[None])[0])
         other = arm.bounds[:, 0] + 0.3 * (arm.bounds[:, 1] - arm.bounds[:, 0])
         if np.abs(self._robot.fwdKin(other * arm._to_si) @ self._C - arm.fk_matrix(other[None])[0]).max() > 1e-9:
-            from fkopt.errors import FkoptError
             raise FkoptError(f"eaik: its FK of {urdf.source} differs from fkopt's (joints read in another order?)")
         self._Cinv = np.linalg.inv(self._C)
         self._revolute = np.asarray(arm.unknown_units) == "deg"

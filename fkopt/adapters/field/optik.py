@@ -30,6 +30,8 @@ limits of a full turn either way (:func:`fold_fixed`).
 from __future__ import annotations
 
 import warnings
+import xml.etree.ElementTree as ET
+from importlib.metadata import version
 
 import numpy as np
 
@@ -38,7 +40,6 @@ from fkopt.adapters.field import FieldIK, NotApplicable, arm_urdf
 
 
 def optik_version() -> str:
-    from importlib.metadata import version
     return version("optik-py")
 
 
@@ -49,7 +50,6 @@ def fold_fixed(text: str) -> str:
     folded into that joint: the child joint's origin becomes fixed origin x its origin (URDF rpy
     is the extrinsic x-y-z rotation), its parent the fixed joint's parent; the fixed joint and its
     link go."""
-    import xml.etree.ElementTree as ET
     from scipy.spatial.transform import Rotation
     root = ET.fromstring(text)
 

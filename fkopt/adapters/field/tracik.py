@@ -31,6 +31,7 @@ import math
 
 import numpy as np
 
+from fkopt.errors import FkoptError
 from fkopt.adapters.field import FieldIK, arm_urdf
 from fkopt.adapters.field.cores import pinned
 from fkopt.numerics.rotations import quaternion_xyzw1
@@ -49,7 +50,6 @@ class TracIK(FieldIK):
         self._pt = pytracik
         self._solver = pytracik.TRAC_IK(urdf.base_link, urdf.tip_link, urdf.text, self.timeout, self.EPS, pytracik.Speed)
         if pytracik.get_num_joints(self._solver) != arm.dof:
-            from fkopt.errors import FkoptError
             raise FkoptError(f"tracik: {urdf.source} {urdf.base_link} -> {urdf.tip_link} has "
                              f"{pytracik.get_num_joints(self._solver)} joints in KDL, {arm.dof} in fkopt")
         lo32 = np.nextafter(self.lo_rad.astype(np.float32), np.float32(np.inf))

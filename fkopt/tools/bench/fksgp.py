@@ -31,6 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
+import fkopt
+from fkopt.tools.bench.measuring import load_average
+from fkopt.kinematics.assembly_modes import all_solutions
+from fkopt.numerics import rotations
+
 #: Platforms per full run (issue 38 asks for at least 30) and in quick mode.
 PLATFORMS = 30
 QUICK_PLATFORMS = 5
@@ -43,7 +48,7 @@ FKSGP_TARGET = 1.0
 def fksgp_folder() -> Path | None:
     """The vendored fkSGP snapshot: ``FKSGP_PATH``, else ``../shared/vendor/fksgp`` beside the
     repository or the working directory; None when there is none."""
-    here = Path(__file__).resolve().parents[2]
+    here = Path(__file__).resolve().parents[3]
     for p in filter(None, [os.environ.get("FKSGP_PATH"), here.parent / "shared/vendor/fksgp",
                            Path.cwd().parent / "shared/vendor/fksgp"]):
         p = Path(p)
@@ -59,7 +64,6 @@ def _cayley(p):
 
 def _rigid(pose):
     """(R, t) of a 6-sps pose (x, y, z, alpha, beta, gamma in deg, Z-Y-X)."""
-    from fkopt.numerics import rotations
     a, b, g = np.radians(pose[3:6])
     return np.array(rotations.zyx(a, b, g), dtype=float), np.asarray(pose[:3], dtype=float)
 
@@ -79,9 +83,6 @@ def _same_sets(ours, theirs, inside) -> tuple[int, int, int]:
 
 
 def bench_fksgp(rows, quick: bool, messages: list[str]) -> None:
-    from fkopt import mechanism
-    from fkopt.bench.ik import load_average
-    from fkopt.kinematics.assembly_modes import all_solutions
     folder = fksgp_folder()
     if folder is None:
         messages.append("fksgp: section skipped: no vendored fkSGP snapshot (../shared/vendor/fksgp beside the "
@@ -105,7 +106,7 @@ def bench_fksgp(rows, quick: bool, messages: list[str]) -> None:
         R0, t0 = _cayley(rng.standard_normal(3)), rng.standard_normal(3)
         A = R0 @ x.T + t0[:, None] - X.T
         L2 = np.sum(A * A, axis=0)
-        m = mechanism("6-sps", base=X.tolist(), platform=x.tolist())
+        m = fkopt.mechanism("6-sps", base=X.tolist(), platform=x.tolist())
         legs = np.sqrt(L2)
 
         def theirs():

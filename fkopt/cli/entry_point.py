@@ -1,0 +1,126 @@
+"""The typer application every command registers on, its global options (``--version``), the
+state Ctrl-C reads (:data:`INTERRUPTED`) and :func:`main`, the entry point: every user mistake
+ends as one line ``fkopt: error: ...`` on stderr and exit status 2, Ctrl-C with status 130,
+neither with a traceback."""
+from __future__ import annotations
+
+import inspect
+import sys
+from pathlib import Path
+
+import typer
+
+import fkopt
+from fkopt.errors import FkoptError
+from fkopt.files import one_line
+from fkopt.numerics.path import version_line
+
+try:
+    from typer.core import TyperOption
+except ImportError:           # an older typer has neither the type tags nor this class
+    TyperOption = None
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="Rerunnable swarm-optimisation experiments for robot mechanism kinematics. "
+                       "Start with: fkopt run configs/mao2017/tab2_tab3_fig2.yaml (writes "
+                       "./fkopt-results/); the files and commands are described in README.md and docs/.")
+
+#: Where ``fkopt run`` and ``fkopt study`` write unless given ``--out``: a git-ignored folder of the
+#: current directory, so a user's own experiment never lands in the tracked ``results/`` (which
+#: ``fkopt reproduce`` and ``fkopt check`` use) without asking for it with ``--out results``.
+DEFAULT_OUT = Path("fkopt-results")
+
+
+def _flags_without_type_tag() -> None:
+    """typer (>= 0.2x) tags every option with its type in ``--help``, flags too (``--json <bool>``);
+    a flag takes no value, so its tag only misleads. Options with a value keep theirs."""
+    shown = getattr(TyperOption, "display_type_rich", None)
+    if shown is None or getattr(shown, "_fkopt", False):
+        return
+
+    def display_type_rich(self, ctx):
+        return None if getattr(self, "is_flag", False) else shown(self, ctx)
+    display_type_rich._fkopt = True
+    TyperOption.display_type_rich = display_type_rich
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"fkopt {fkopt.__version__}; {version_line()}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main_options(version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                               help="print fkopt's version and exit")):
+    """Rerunnable swarm-optimisation experiments for robot mechanism kinematics."""
+
+
+_flags_without_type_tag()
+
+
+def console(stderr: bool = False):
+    """The console every command prints tables and progress to (rich is imported here, not at start-up:
+    ``fkopt ik --json`` and ``fkopt fk`` print no table; docs/design.md, "Start-up")."""
+    from rich.console import Console
+    return Console(stderr=stderr, highlight=False)
+
+
+#: What Ctrl-C ends and how to continue it: set while a config runs, printed by :func:`main`.
+INTERRUPTED = {"hint": None}
+
+
+def reflow_help() -> None:
+    """typer's rich help keeps the line breaks of a docstring's later paragraphs, so a paragraph
+    wrapped at 100 source columns broke mid-sentence in an 80-column terminal: each command's help
+    is its docstring with every paragraph on one line, for the terminal to wrap. Called once every
+    command is registered (:mod:`fkopt.cli`)."""
+    for info in app.registered_commands:
+        if info.help is None and info.callback is not None and info.callback.__doc__:
+            paragraphs = inspect.cleandoc(info.callback.__doc__).split("\n\n")
+            info.help = "\n\n".join(" ".join(p.split()) for p in paragraphs)
+
+
+def main() -> None:
+    """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
+    def interrupted() -> str:
+        hint = INTERRUPTED["hint"]
+        return "fkopt: interrupted (previous results are kept" + (f"; {hint})" if hint else ")")
+
+    def fail(message: str) -> None:
+        print(f"fkopt: error: {one_line(message)}", file=sys.stderr)
+        sys.exit(2)
+
+    if not sys.argv[1:]:     # bare `fkopt`: the help, and success (nothing went wrong)
+        sys.argv.append("--help")
+    try:
+        code = app(standalone_mode=False)
+    except FkoptError as err:
+        fail(str(err))
+    except KeyboardInterrupt:
+        print(interrupted(), file=sys.stderr)
+        sys.exit(130)
+    except MemoryError:
+        fail("out of memory; reduce runs, population, iterations or cases")
+    except RecursionError:
+        fail("input nested too deeply")
+    except OSError as err:   # the file system refused (disk full, permissions): not a bug of fkopt
+        where = f"{err.filename}: " if err.filename else ""
+        fail(f"{where}{err.strerror or err}")
+    except Exception as err:  # click's usage errors (typer vendors click): no traceback either
+        kind = type(err).__name__
+        if kind == "Exit":
+            sys.exit(getattr(err, "exit_code", 0))
+        if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
+            fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
+        if kind == "Abort":
+            print(interrupted(), file=sys.stderr)
+            sys.exit(130)
+        if callable(getattr(err, "format_message", None)):
+            fail(f"{err.format_message()} (see fkopt --help)")
+        raise
+    if code == 130:   # typer (>= 0.12) turns Ctrl-C into a returned 130 when not standalone
+        print(interrupted(), file=sys.stderr)
+        sys.exit(130)
+    if isinstance(code, int) and code:
+        sys.exit(code)
