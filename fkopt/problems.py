@@ -22,7 +22,7 @@ import numpy as np
 from fkopt.errors import FkoptError
 from fkopt.numerics import rotations
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
-from fkopt.numerics.rotations import wrap_degrees
+from fkopt.numerics.rotations import so3_right_jacobian_inverse, wrap_degrees
 
 #: Version of the fitness definitions below (residuals, objectives, the IK pose error and its
 #: weights). Every released kinbench version records the one it was ranked with
@@ -249,22 +249,6 @@ def fk_problem(mechanism: Mechanism, joints, **kwargs) -> FKProblem:
 #: Orientation errors of :class:`IKProblem`: "paper" = Euclidean norm of the wrapped Z-Y-Z Euler
 #: differences (wang7dof), "geodesic" = rotation angle of R_target^T R.
 IK_OBJECTIVES = ("paper", "geodesic")
-
-
-def so3_right_jacobian_inverse(e) -> np.ndarray:
-    """J_r^{-1}(e) (..., 3, 3) of rotation vectors e (..., 3): d log(M) = J_r^{-1} (M^T dM)^vee."""
-    e = np.asarray(e, dtype=float)
-    th2 = (e * e).sum(-1)
-    th = np.sqrt(th2)
-    small = th2 < 1e-8
-    ths = np.where(small, 1.0, th)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        c = np.where(small, 1.0 / 12.0 + th2 / 720.0,
-                     1.0 / (ths * ths) - (1.0 + np.cos(ths)) / (2.0 * ths * np.sin(ths)))
-    K = np.zeros(e.shape[:-1] + (3, 3))
-    K[..., 0, 1], K[..., 0, 2], K[..., 1, 2] = -e[..., 2], e[..., 1], -e[..., 0]
-    K[..., 1, 0], K[..., 2, 0], K[..., 2, 1] = e[..., 2], -e[..., 1], e[..., 0]
-    return np.eye(3) + 0.5 * K + c[..., None, None] * (K @ K)
 
 
 def _norm3(a, b, c):

@@ -307,7 +307,8 @@ def test_tracik_readme_protocol_reproduces_its_published_success(name):
         pytest.skip("the README's figure is for the LBR iiwa 14 R820; robosuite's iiwa is the iiwa 7 R800 "
                     "(links 0.34 / 0.40 / 0.40 m) and example-robot-data carries none")
     from fkopt.adapters.field.cores import pinned
-    from fkopt.adapters.field.tracik import TracIK, quat_xyzw
+    from fkopt.adapters.field.tracik import TracIK
+    from fkopt.numerics.rotations import quaternion_xyzw1 as quat_xyzw
     load = os.getloadavg()[0]
     if load >= 1.5:
         pytest.skip(f"1-minute load {load:.2f} >= 1.5: TRAC-IK's 5 ms wall-clock protocol would measure the machine")

@@ -1,4 +1,4 @@
-"""fkopt.forward's start table (joint space, :func:`fkopt.kinematics.solvers._forward_table`): built the
+"""fkopt.forward's start table (joint space, :func:`fkopt.kinematics.start_tables._forward_table`): built the
 same way every time, it solves Dietmaier's 6-6 platform where the centre start and the
 deterministic restarts do not, and its answers are checked by the mechanism's own closed form
 and by scipy's least_squares run from the table's start (an independent solver)."""

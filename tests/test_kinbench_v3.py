@@ -585,7 +585,7 @@ def test_the_clock_runs_every_entry_on_one_core_and_gives_the_cores_back():
 
 def test_tracik_quaternion_without_scipy_matches_scipy_everywhere_including_half_turns():
     from scipy.spatial.transform import Rotation
-    from fkopt.adapters.field.tracik import quat_xyzw
+    from fkopt.numerics.rotations import quaternion_xyzw1 as quat_xyzw
     R = Rotation.random(200, random_state=3).as_matrix()
     R = np.concatenate([R, Rotation.from_rotvec(np.pi * np.eye(3)).as_matrix(),          # w = 0: x, y, z branches
                         Rotation.from_rotvec(np.pi * np.array([[1, 1, 0], [0, 1, 1]]) / np.sqrt(2)).as_matrix()])

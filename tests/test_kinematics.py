@@ -156,7 +156,7 @@ def test_sps_scalar_jacobian_matches_the_vectorised_one(name):
 
 
 def test_small_solve_matches_numpy_and_refuses_singular():
-    from fkopt.kinematics.solvers import _solve_small
+    from fkopt.kinematics.forward_newton import _solve_small
     rng = np.random.default_rng(3)
     A, b = rng.normal(size=(6, 6)), rng.normal(size=6)
     np.testing.assert_allclose(_solve_small(A.tolist(), b.tolist()), np.linalg.solve(A, b), rtol=1e-10)

@@ -358,8 +358,8 @@ def test_screened_nearest_rows_are_the_full_passes_rows_ties_included(k):
     the rows the screen cannot rule out) gives the rows of the float64 pass over every row, in
     the same order: on an arm's real table, with exact duplicate rows (ties go to the lower row),
     near-ties one ulp apart, masked-out features and targets on and off the table's rows."""
-    from fkopt.kinematics.solvers import _fast_context
-    from fkopt.numerics import compiled as c
+    from fkopt.kinematics.inverse_pose import _fast_context
+    from fkopt.numerics import compiled_ik as c
     arm = fkopt.mechanism("7dof-arm")
     ctx = _fast_context(arm, 4096, None)
     F = ctx["Ft"].T.copy()

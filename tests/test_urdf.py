@@ -233,11 +233,11 @@ def test_continuous_joints_are_periodic_and_answers_wrapped():
 
 
 def test_tool_offset_is_the_tip_frame_times_the_tool_transform():
-    from fkopt.mechanisms.urdf import _rpy
+    from fkopt.numerics.rotations import zyx1
     m, t = robot("panda"), robot("panda", tool=TOOL)
     q = random_joints(m, 20, 4)
     X = np.eye(4)
-    X[:3, :3] = _rpy(*np.radians(TOOL[3:]))
+    X[:3, :3] = zyx1(*np.radians(TOOL[3:]))
     X[:3, 3] = TOOL[:3]
     np.testing.assert_allclose(t.fk_matrix(q), m.fk_matrix(q) @ X, atol=1e-14)
     assert t.reach > m.reach

@@ -2,7 +2,7 @@
 that stays on one branch (``fkopt.inverse_path``), for any frame arm fkopt reads (DH, URDF, MJCF).
 
 **All solutions.** A numeric search over the branches, built on ``fkopt.inverse``'s compiled
-one-pose loop (:mod:`fkopt.numerics.branches`): seeded starts, first the start table's
+one-pose loop (:mod:`fkopt.numerics.compiled_branches`): seeded starts, first the start table's
 configurations nearest to the target in tool pose, then counter-based hash draws (revolute
 joints over one turn, prismatic joints inside their limits); each start runs the damped
 least-squares loop without revolute limits to ``SEARCH_TOL`` (a solution is one modulo 2 pi per
@@ -62,7 +62,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.kinematics.inputs import (_internal, _inverse_arm, _public, _targets, _task_mask, _tolerance,
+                                     _unreachable, _values)
+from fkopt.kinematics.results import INVERSE_TOL
+from fkopt.kinematics.solvers import inverse
+from fkopt.kinematics.start_tables import _sumsq, _uniform_hash
 from fkopt.mechanisms.base import SerialMechanism
+from fkopt.numerics import rotations
+from fkopt.numerics.rotations import rotation_error1
 
 #: Tolerances of the solutions returned by ``solutions="all"`` unless ``tol`` is given
 #: (position in the arm's length unit, geodesic rotation in radians).
@@ -149,7 +156,6 @@ class PathResult:
 # per-arm context (the chain with locked joints, its start table)
 # ----------------------------------------------------------------------------------------------
 def _arm(arm) -> SerialMechanism:
-    from fkopt.kinematics.solvers import _inverse_arm
     m = _inverse_arm(arm)
     if not hasattr(m, "chain"):
         raise FkoptError(f"inverse solutions='all' needs a frame arm with a chain (DH, URDF, MJCF); "
@@ -214,7 +220,6 @@ def _context(m, locked: dict[int, float], W) -> dict:
     free joints' internal limits, revolute mask, draw box, and a start table of ``TABLE`` free
     configurations drawn by inverse's fixed hash inside the limits, with their tool features as inverse's table. Cached on
     the arm by (bounds, locked values, mask)."""
-    from fkopt.kinematics.solvers import _internal, _public, _sumsq, _uniform_hash
     key = (m.bounds.tobytes(), tuple(sorted(locked.items())), None if W is None else W.tobytes())
     cache = m.__dict__.setdefault("_branch_contexts", {})
     got = cache.get(key)
@@ -237,9 +242,8 @@ def _context(m, locked: dict[int, float], W) -> dict:
     for k, v in locked.items():
         full[:, k] = v
     p, R = m.frame(_public(m, full))
-    from fkopt.numerics.rotations import to_array
     wf = m.reach / (3.0 * np.sqrt(2.0))
-    feats = np.concatenate([np.stack(p, axis=-1), wf * to_array(R).reshape(TABLE, 9)], axis=-1)
+    feats = np.concatenate([np.stack(p, axis=-1), wf * rotations.to_array(R).reshape(TABLE, 9)], axis=-1)
     Wf = np.ones(6) if W is None else np.asarray(W, dtype=float)
     fmask = np.concatenate([Wf[:3], np.full(9, float(Wf[3:].all()))])
     feats = feats * fmask
@@ -260,8 +264,8 @@ def _kernels():
     if numerics_path.compiled(True) is None:          # FKOPT_NUMERICS=numpy
         raise FkoptError("inverse solutions='all' and inverse_path run on the compiled kernels; "
                          "they need numba (pip install numba) and FKOPT_NUMERICS other than numpy")
-    from fkopt.numerics import branches
-    return branches
+    from fkopt.numerics import compiled_branches     # numba, an optional package: imported on first use
+    return compiled_branches
 
 
 # ----------------------------------------------------------------------------------------------
@@ -291,13 +295,12 @@ def _in_limit_copies(w: np.ndarray, ctx: dict, copies: bool) -> list[np.ndarray]
 def _verify(m, ctx, pose_row: np.ndarray, public_full: np.ndarray, W) -> tuple[float, float]:
     """FK of a full public answer against the target row, with the arm's own one-configuration
     forward map (``frame_jacobian1``, the numbers ``fkopt.inverse`` verifies with)."""
-    from fkopt.kinematics.solvers import _rotation_error1, _zyz_matrix1
     angle = ctx["angle"]
     t = [math.radians(v) if a else v for v, a in zip(public_full.tolist(), angle)]
     p, R, _ = m.frame_jacobian1(t)
-    Rt = pose_row[3:].reshape(3, 3).tolist() if len(pose_row) == 12 else _zyz_matrix1(*pose_row[3:].tolist())
+    Rt = pose_row[3:].reshape(3, 3).tolist() if len(pose_row) == 12 else rotations.zyz1(*pose_row[3:].tolist())
     dp = [a - b for a, b in zip(p, pose_row[:3].tolist())]
-    e = _rotation_error1(R, Rt)
+    e = rotation_error1(R, Rt)
     if W is not None:
         dp, e = [v * w for v, w in zip(dp, W[:3])], [v * w for v, w in zip(e, W[3:])]
     re = math.hypot(*e)
@@ -339,7 +342,6 @@ def _spread_locks(m, spread, spread_joints, redundancy: int) -> list[dict[int, f
         if bad:
             raise FkoptError(f"{m.name} spread_joints: unknown joint {bad[0]!r}; joints: {', '.join(m.joint_names)}")
         idx = [m.joint_names.index(s) for s in names]
-    from fkopt.kinematics.solvers import _internal
     lo, hi = _internal(m, m.bounds[:, 0]), _internal(m, m.bounds[:, 1])
     axes = [[float(lo[i] + (hi[i] - lo[i]) * (s + 0.5) / K) for s in range(K)] for i in idx]
     return [dict(zip(idx, vals)) for vals in itertools.product(*axes)]
@@ -356,7 +358,6 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     ``growth`` times the starts that found the last new solution; 0 by default, measured no
     better); ``copies``: list every in-limit copy of a
     joint whose limits span more than 2 pi."""
-    from fkopt.kinematics.solvers import _public, _targets, _task_mask, _tolerance, _unreachable
     m = _arm(arm)
     tp, tr = _tolerance(ALL_TOL if tol is None else tol)
     P = _targets(m, pose)
@@ -453,7 +454,6 @@ ALL_OPTIONS = ("fixed", "spread", "spread_joints", "patience", "growth", "max_st
 def inverse_all(arm, poses, *, tol=None, mask=None, seed: int = 0, **options):
     """``fkopt.inverse(arm, poses, solutions="all")``: one pose -> :class:`AllSolutions`; a batch
     (..., 6) or (..., 4, 4) -> a list of them, rows in C order of the leading axes."""
-    from fkopt.kinematics.solvers import INVERSE_TOL, _targets
     bad = sorted(set(options) - set(ALL_OPTIONS))
     if bad:
         raise FkoptError(f"inverse solutions='all': option {bad[0]!r} is the one-answer solver's; "
@@ -479,12 +479,11 @@ def inverse_all(arm, poses, *, tol=None, mask=None, seed: int = 0, **options):
 # ----------------------------------------------------------------------------------------------
 def _frames(m, poses) -> np.ndarray:
     """Targets (..., w, 6) or (..., w, 4, 4) as rows (..., w, 12): x, y, z, R row-major."""
-    from fkopt.kinematics.solvers import _targets, _zyz_matrix
     P = _targets(m, poses)
     if P.shape[-1] == 12:
         return np.ascontiguousarray(P, dtype=float)
     flat = P.reshape(-1, 6)
-    out = np.concatenate([flat[:, :3], _zyz_matrix(flat[:, 3:]).reshape(-1, 9)], axis=1)
+    out = np.concatenate([flat[:, :3], rotations.zyz_rows(flat[:, 3:]).reshape(-1, 9)], axis=1)
     return np.ascontiguousarray(out.reshape(P.shape[:-1] + (12,)))
 
 
@@ -516,7 +515,6 @@ def inverse_path(arm, poses, *, start, tol=ALL_TOL, max_step: float = MAX_STEP, 
     inside the limits; ``tol``: a waypoint's (position, rotation) tolerance; ``max_step``: the
     largest joint change between waypoints (rad, or length unit for a prismatic joint) without a
     break; ``substeps``: intermediate poses tried across a waypoint the direct step misses."""
-    from fkopt.kinematics.solvers import _internal, _public, _tolerance, _values
     m = _arm(arm)
     tp, tr = _tolerance(tol)
     if not (isinstance(max_step, (int, float)) and not isinstance(max_step, bool) and max_step > 0
@@ -651,14 +649,12 @@ def _reseat(m, row, q, tp, tr) -> np.ndarray | str | None:
     """The solution of the waypoint (frame row) nearest to q (internal units), every in-limit
     copy considered; "outside" when its solutions all lie outside the limits; None when there is
     none."""
-    from fkopt.kinematics.solvers import _internal
     T = np.eye(4)
     T[:3, 3], T[:3, :3] = row[:3], row[3:].reshape(3, 3)
     tol = (max(tp, ALL_TOL[0]), max(tr, ALL_TOL[1]))
     if m.dof > 6:
         # a redundant arm: fkopt.inverse from q, then along the self-motion to the solution
         # locally nearest q (its ``start``); none found -> None
-        from fkopt.kinematics.solvers import _public, inverse
         try:
             one = inverse(m, T, start=np.clip(_public(m, q), m.bounds[:, 0], m.bounds[:, 1]), tol=tol)
         except FkoptError:

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from fkopt.kinematics.solvers import (FORWARD_SWARM, FORWARD_TOL, INVERSE_SWARM, INVERSE_TOL, ForwardResult, InverseResult,
-                         _mechanism)
+from fkopt.kinematics.inputs import _mechanism
+from fkopt.kinematics.results import FORWARD_TOL, INVERSE_TOL, ForwardResult, InverseResult
+from fkopt.kinematics.solvers import FORWARD_SWARM, INVERSE_SWARM
 from fkopt.mechanisms.base import ParallelMechanism, SerialMechanism
 from fkopt.problems import fk_problem, ik_problem
 from fkopt.solve import solve

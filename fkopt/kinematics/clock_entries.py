@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fkopt.kinematics.solvers import FORWARD_TABLE, InverseSolver, _forward_table, forward
+from fkopt.kinematics.solvers import FORWARD_TABLE, InverseSolver, forward
+from fkopt.kinematics.start_tables import _forward_table
 
 
 class FkoptInverse:

@@ -48,6 +48,7 @@ from pydantic import Field
 
 from fkopt.errors import FkoptError, did_you_mean
 from fkopt.files import check_geometry_file, check_within, open_input, parse_xml, read_input, short_token
+from fkopt.numerics import rotations
 from fkopt.mechanisms.urdf import URDFArm, URDFGeometry, check_numbers
 
 DEFAULT_FILE = Path(__file__).resolve().parent / "data" / "wang7dof.xml"
@@ -217,26 +218,12 @@ def _names(model, kind) -> list[str]:
     return [mujoco.mj_id2name(model, kind, i) or "" for i in range(count)]
 
 
-def _quat_matrix(q) -> np.ndarray:
-    """Rotation matrix of a unit quaternion (w, x, y, z), MuJoCo's convention (mju_quat2Mat)."""
-    w, x, y, z = (float(v) for v in q)
-    return np.array([[w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z]])
-
-
 def _frame(pos, rot=None) -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = pos
     if rot is not None:
         T[:3, :3] = rot
     return T
-
-
-def _axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation by ``angle`` (rad) about the unit ``axis`` (Rodrigues)."""
-    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    return np.eye(3) + math.sin(angle) * K + (1.0 - math.cos(angle)) * (K @ K)
 
 
 def read_chain(model, path: Path, base: str | None, tip: str | None) -> list:
@@ -294,7 +281,7 @@ def read_chain(model, path: Path, base: str | None, tip: str | None) -> list:
     for b in path_bodies:
         label = f"body '{bodies[b] or b}'"
         pending = pending @ _frame(checked(model.body_pos[b], f"{label} pos"),
-                                   _quat_matrix(checked(model.body_quat[b], f"{label} quat")))
+                                   rotations.mujoco_quaternion1(checked(model.body_quat[b], f"{label} quat")))
         for j in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
             kind = int(model.jnt_type[j])
             name = joints[j]
@@ -310,11 +297,11 @@ def read_chain(model, path: Path, base: str | None, tip: str | None) -> list:
             held = couplings.get(j)
             if held is not None and held.joint is None:          # held at q0 + a0 by an equality
                 d = held.offset
-                pending = pending @ (_frame(anchor) @ _frame(np.zeros(3), _axis_angle(axis, d)) @ _frame(-anchor)
+                pending = pending @ (_frame(anchor) @ _frame(np.zeros(3), rotations.axis_angle1(axis, d)) @ _frame(-anchor)
                                      if hinge else _frame(axis * d))
                 continue
             # the reference qpos0 goes into the fixed origin: Rot(axis, q - q0) = Rot(axis, -q0) Rot(axis, q)
-            origin = pending @ (_frame(anchor, _axis_angle(axis, -q0)) if hinge else _frame(-q0 * axis))
+            origin = pending @ (_frame(anchor, rotations.axis_angle1(axis, -q0)) if hinge else _frame(-q0 * axis))
             limited = bool(model.jnt_limited[j])
             lo, hi = checked(model.jnt_range[j], f"joint '{name}' range")
             if lo > hi:     # MuJoCo makes such a joint unlimited; URDF refuses lower > upper, so does fkopt
@@ -329,7 +316,7 @@ def read_chain(model, path: Path, base: str | None, tip: str | None) -> list:
     if site_id is not None:
         label = f"site '{sites[site_id]}'"
         pending = pending @ _frame(checked(model.site_pos[site_id], f"{label} pos"),
-                                   _quat_matrix(checked(model.site_quat[site_id], f"{label} quat")))
+                                   rotations.mujoco_quaternion1(checked(model.site_quat[site_id], f"{label} quat")))
     if not chain:
         raise FkoptError(f"mjcf {path}: no hinge or slide joint between '{bodies[base_id]}' and '{tip}'")
     chain.append(SimpleNamespace(name="(tip)", type="fixed", parent=prev,

@@ -45,6 +45,7 @@ from pydantic import Field, ValidationError
 
 from fkopt.errors import FkoptError, did_you_mean
 from fkopt.files import MAX_MAGNITUDE, check_geometry_file, parse_xml, read_input, short_token
+from fkopt.numerics import rotations
 from fkopt.numerics.chain import frame_jacobian1, from_terms
 from fkopt.mechanisms.base import FrameArm, Geometry, describe_validation_error
 
@@ -168,7 +169,7 @@ def load_urdf(path: Path) -> SimpleNamespace:
         o = e.find("origin")
         if o is not None:
             origin[:3, 3] = _floats(o.get("xyz"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin xyz", path)
-            origin[:3, :3] = _rpy(*_floats(o.get("rpy"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin rpy", path))
+            origin[:3, :3] = rotations.zyx1(*_floats(o.get("rpy"), 3, (0.0, 0.0, 0.0), f"joint '{name}' origin rpy", path))
         ax = e.find("axis")
         axis = _floats(None if ax is None else ax.get("xyz"), 3, (1.0, 0.0, 0.0), f"joint '{name}' axis", path)
         lim = e.find("limit")
@@ -271,15 +272,6 @@ def urdf_chain(robot, path: Path, base: str | None, tip: str | None) -> list:
 _SNAP = 1e-15
 
 
-def _rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll) (radians)."""
-    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
-                              math.cos(yaw), math.sin(yaw))
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
-
-
 def _align(axis: np.ndarray) -> np.ndarray:
     """A rotation A whose third column is the unit ``axis``, so that Rot(axis, t) = A Rz(t) A^T:
     a signed permutation for a coordinate axis (the common case), else completed by
@@ -327,8 +319,6 @@ def _offset(cols, v):
             t = cols[m] * v[m]
             acc = t if acc is None else acc + t
     return acc
-
-
 
 
 class URDFArm(FrameArm):
@@ -482,7 +472,7 @@ class URDFArm(FrameArm):
             acc, A_prev = np.eye(4), A
         if tool is not None:
             T = np.eye(4)
-            T[:3, :3] = _rpy(*np.radians(tool[3:]))
+            T[:3, :3] = rotations.zyx1(*np.radians(tool[3:]))
             T[:3, 3] = tool[:3]
             reach += float(np.linalg.norm(tool[:3]))
             acc = acc @ T

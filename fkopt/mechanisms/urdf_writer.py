@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.numerics import rotations
 
 #: Length unit of an arm's poses -> metres.
 LENGTH_SCALE = {"m": 1.0, "mm": 1e-3}
@@ -77,27 +78,11 @@ class WrittenURDF:
     joint_names: tuple[str, ...]
 
 
-def _rpy(R: np.ndarray) -> tuple[float, float, float]:
-    """URDF's roll, pitch, yaw of a rotation with |pitch| away from 90 deg."""
-    return (math.atan2(R[2, 1], R[2, 2]), math.atan2(-R[2, 0], math.hypot(R[0, 0], R[1, 0])),
-            math.atan2(R[1, 0], R[0, 0]))
-
-
-def _ry(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
 def _origins(C: np.ndarray, v: np.ndarray) -> list[tuple[tuple, tuple]]:
     """(xyz, rpy) of the one or two origins whose product is [C, v] (module docstring)."""
     if math.hypot(C[0, 0], C[1, 0]) >= GIMBAL_COS:
-        return [(tuple(v), _rpy(C))]
-    return [(tuple(v), _rpy(C @ _ry(math.pi / 2))), ((0.0, 0.0, 0.0), (0.0, -math.pi / 2, 0.0))]
-
-
-def _rz(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        return [(tuple(v), rotations.zyx_angles1(C))]
+    return [(tuple(v), rotations.zyx_angles1(C @ rotations.ry1(math.pi / 2))), ((0.0, 0.0, 0.0), (0.0, -math.pi / 2, 0.0))]
 
 
 def chain_urdf(arm) -> WrittenURDF:
@@ -144,7 +129,7 @@ def chain_urdf(arm) -> WrittenURDF:
         if prismatic:                                  # q = mult t + off along z: the offset moves the origin
             v, motion = v + off_si * C[:, 2], np.eye(3)
         else:
-            motion = _rz(off)
+            motion = rotations.rz1(off)
         if mult == 0.0:
             fixed(C @ motion, v)
             continue

@@ -11,8 +11,11 @@ unreadable cache file is set aside and rebuilt, an unwritable folder only costs 
 compiles (tens of seconds for all kernels, docs/performance.md); later processes load the cache.
 
 * :func:`frame_jacobian` -- FK and frame Jacobian of one configuration of a chain;
-* :func:`inverse_one` -- the one-pose loop of :func:`fkopt.numerics.damped_least_squares.inverse_candidates`, every
-  start (given start, start-table neighbours, seeded hash draws) and restart inside;
+* :func:`_rotation_error`, :func:`_rotation_target`, :func:`_geodesic` -- the compiled twins of
+  :mod:`fkopt.numerics.rotations`' one-rotation helpers (``rotation_error1``, ``zyz1``);
+* :func:`_evaluate`, :func:`_dls_step` -- the residual and the damped least-squares step of
+  :mod:`fkopt.numerics.damped_least_squares`; the one-pose restart loop built on them is
+  :mod:`fkopt.numerics.compiled_ik`, the all-solutions and path kernels :mod:`fkopt.numerics.compiled_branches`;
 * :func:`fill_uniforms` -- the refill of :class:`fkopt.numerics.streams.RunStreams`' buffer, every run in one
   call: numpy's PCG64 and ``next_double`` on the runs' states in one array (``Generator.random``'s bits).
 
@@ -132,6 +135,7 @@ def frame_jacobian_rows(chain, t):
 
 @njit(cache=True)
 def _rotation_error(R, T, e):
+    """:func:`fkopt.numerics.rotations.rotation_error1` into e, operation for operation."""
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2],
                                                    R[2, 0], R[2, 1], R[2, 2])
     t00, t01, t02, t10, t11, t12, t20, t21, t22 = (T[0, 0], T[0, 1], T[0, 2], T[1, 0], T[1, 1], T[1, 2],
@@ -145,7 +149,8 @@ def _rotation_error(R, T, e):
     if s > 1e-12 or c > 0.0:
         k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
         e[0], e[1], e[2] = v0 * k, v1 * k, v2 * k
-    else:   # a half turn (fkopt.numerics.damped_least_squares.half_turn, operation for operation)
+    else:   # a half turn: fkopt.numerics.rotations.half_turn, operation for operation (written out here:
+        # a call in this branch made the whole one-pose kernel ~5 % slower, measured)
         m00 = r00 * t00 + r01 * t01 + r02 * t02
         m11 = r10 * t10 + r11 * t11 + r12 * t12
         m22 = r20 * t20 + r21 * t21 + r22 * t22
@@ -162,6 +167,38 @@ def _rotation_error(R, T, e):
             a2 = math.sqrt(max(0.5 * (m22 + 1.0), 0.0))
             a0, a1 = m02 / (2.0 * a2), m12 / (2.0 * a2)
         e[0], e[1], e[2] = math.pi * a0, math.pi * a1, math.pi * a2
+
+
+@njit(cache=True)
+def _geodesic(R, T):
+    """The angle of R T^T in [0, pi] from both its skew part and its trace: the rotation vector
+    of :func:`_rotation_error` is zero at exactly pi (its skew part
+    vanishes there), so a turn by pi about the tool axis would pass a check on it."""
+    v0 = (R[2, 0] * T[1, 0] + R[2, 1] * T[1, 1] + R[2, 2] * T[1, 2]) - (R[1, 0] * T[2, 0] + R[1, 1] * T[2, 1] + R[1, 2] * T[2, 2])
+    v1 = (R[0, 0] * T[2, 0] + R[0, 1] * T[2, 1] + R[0, 2] * T[2, 2]) - (R[2, 0] * T[0, 0] + R[2, 1] * T[0, 1] + R[2, 2] * T[0, 2])
+    v2 = (R[1, 0] * T[0, 0] + R[1, 1] * T[0, 1] + R[1, 2] * T[0, 2]) - (R[0, 0] * T[1, 0] + R[0, 1] * T[1, 1] + R[0, 2] * T[1, 2])
+    c = 0.0
+    for a in range(3):
+        for b in range(3):
+            c += R[a, b] * T[a, b]
+    return math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (c - 1.0))
+
+
+@njit(cache=True)
+def _rotation_target(pose, T):
+    """The target rotation of a pose row into T: ZYZ Euler angles in deg (6,) as
+    :func:`fkopt.numerics.rotations.zyz1`, or a frame row (12,) row-major as given."""
+    if pose.shape[0] == 12:
+        for r in range(3):
+            for c in range(3):
+                T[r, c] = pose[3 + 3 * r + c]
+    else:
+        d2r = math.pi / 180.0
+        a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
+        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
+        T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
+        T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
+        T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
 
 
 @njit(inline="always")
@@ -240,7 +277,7 @@ def _dls_step_all(J, r, mu, free, d, A, L, y, x):
 
 @njit(cache=True)
 def _uniform_hash(seed, row, draw, out):
-    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.solvers._uniform_hash` (SplitMix64's finaliser)."""
+    """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.start_tables._uniform_hash` (SplitMix64's finaliser)."""
     c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
     for k in range(out.shape[0]):
         z = c + np.uint64(k + 1) * _M2
@@ -270,423 +307,6 @@ def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e, wone=False):
             J[a, i] = J[a, i] * Lw
     return (math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
             d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
-
-
-@njit(cache=True)
-def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq, seed, row, budget, tp, tr, iterations,
-                 damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
-    """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
-    near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
-    (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
-    (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
-    called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``,
-    features ``feat``, the screen ``v32``, joints ``tq``), looked up only if a start reaches them
-    (most poses are solved from their first or second start)."""
-    n = q0.shape[0]
-    m = chain[0].shape[0]
-    nn = near.shape[0]
-    r, rn, rr = np.empty(6), np.empty(6), np.empty(6)
-    J, Jn = np.empty((6, n)), np.empty((6, n))
-    p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
-    A, Lc, y, x = np.empty((6, 6)), np.empty((6, 6)), np.empty(6), np.empty(6)
-    q, qn, d, ds, u = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    fixed_val = np.empty(n)
-    fixed_order = np.empty(n, dtype=np.int64)
-    free = np.ones(n, dtype=np.bool_)
-    wone = True
-    for a in range(6):
-        wone = wone and W[a] == 1.0
-    evals = 0
-    best_m = math.inf
-    for j in range(budget):
-        if j < own0:
-            q[:] = q0
-        elif j < own0 + nn:
-            if j - own0 >= have:
-                _near_rows(table, feat, v32, tq, near)  # the top `have` of these are the rows already there
-                have = nn
-            q[:] = near[j - own0]
-        else:
-            _uniform_hash(seed, row, j - own0 - nn, u)
-            for i in range(n):
-                q[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
-        pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e, wone)
-        evals += 1
-        lam = damping
-        for _ in range(iterations):
-            if pe <= tp and re <= tr:
-                break
-            acc = 0.0
-            for a in range(6):
-                for i in range(n):
-                    acc = acc + J[a, i] * J[a, i]
-            mu = lam * (acc / 6.0)
-            if not _dls_step_all(J, r, mu, free, d, A, Lc, y, x):
-                break
-            big = abs(d[0])
-            for i in range(1, n):
-                big = max(big, abs(d[i]))
-            if big > step_cap:
-                f = step_cap / big
-                for i in range(n):
-                    d[i] = d[i] * f
-            anyout = False
-            for i in range(n):
-                qn[i] = q[i] + d[i]
-                if qn[i] < lo[i] or qn[i] > hi[i]:
-                    anyout = True
-            if anyout:                                  # saturation in the null space
-                nf = 0
-                for i in range(n):
-                    free[i] = True
-                for _pass in range(2):
-                    for i in range(n):
-                        if free[i] and (qn[i] < lo[i] or qn[i] > hi[i]):
-                            fixed_val[i] = min(max(qn[i], lo[i]), hi[i]) - q[i]
-                            fixed_order[nf] = i
-                            nf += 1
-                    for k in range(nf):
-                        free[fixed_order[k]] = False
-                    for a in range(6):
-                        acc = 0.0
-                        for k in range(nf):
-                            acc = acc + J[a, fixed_order[k]] * fixed_val[fixed_order[k]]
-                        rr[a] = r[a] + acc
-                    if not _dls_step(J, rr, mu, free, ds, A, Lc, y, x):
-                        break
-                    more = False
-                    for i in range(n):
-                        qn[i] = q[i] + (ds[i] if free[i] else fixed_val[i])
-                        if free[i] and (qn[i] < lo[i] or qn[i] > hi[i]):
-                            more = True
-                    if not more:
-                        break
-                for i in range(n):
-                    qn[i] = min(max(qn[i], lo[i]), hi[i])
-            pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e, wone)
-            evals += 1
-            if Sn < S:
-                q[:] = qn
-                r[:] = rn
-                J[:, :] = Jn
-                pe, re, S = pen, ren, Sn
-                lam = max(lam * down, 1e-12)
-            else:
-                lam *= up
-                if lam > 1e6:
-                    break
-        merit = max(pe / tp, re / tr)
-        if merit < best_m or j == 0:                # the reference keeps the first finite merit
-            best_m = min(merit, best_m)
-            best_q[:] = q
-        if pe <= tp and re <= tr:
-            return j + 1, evals
-    return budget, evals
-
-
-def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iterations, damping, down, up,
-                step_cap, lo, hi, glo, ghi):
-    """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
-    best = np.empty(chain.dof)
-    used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], NO_TABLE,
-                               np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, chain.dof)), int(seed), 0,
-                               int(budget),
-                               float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
-                               float(up), float(step_cap), lo, hi, glo, ghi, best)
-    return best, used, evals
-
-
-@njit(cache=True)
-def _table_distances(Ft, norms, f, v):
-    """v[i] = |F_i|^2 - 2 F_i . f (= |F_i - f|^2 - |f|^2) for every row of the start table, as
-    :func:`fkopt.kinematics.solvers._nearest`'s brute force: the dot product summed feature by feature,
-    rows side by side, from ``Ft`` = F transposed."""
-    c, N = Ft.shape
-    d2 = np.zeros(N)
-    for j in range(c):
-        fj = f[j]
-        if fj == 0.0:
-            # a feature the task mask leaves out (or an exact zero): each term would be +-0.0, which
-            # leaves every sum as it is (finite table, and -0.0 + 0.0 only changes a zero's sign,
-            # which |F_i|^2 - 2 d2 does not see), so skipping its pass keeps the bits
-            continue
-        for i in range(N):
-            d2[i] += Ft[j, i] * fj
-    for i in range(N):
-        v[i] = norms[i] - 2.0 * d2[i]
-
-
-@njit(cache=True)
-def _smallest(v, idx, best):
-    """The k = len(idx) rows of the smallest v, smallest first, into idx (values into best): kept
-    sorted by insertion in row order (ties: the lower row first)."""
-    k = idx.shape[0]
-    m = 0
-    for i in range(v.shape[0]):
-        x = v[i]
-        if m < k:
-            pos = m
-            m += 1
-        elif x < best[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and best[pos - 1] > x:
-            best[pos] = best[pos - 1]
-            idx[pos] = idx[pos - 1]
-            pos -= 1
-        best[pos] = x
-        idx[pos] = i
-
-
-@njit(cache=True)
-def _nearest_into(Ft, norms, f, idx, best):
-    """The k = len(idx) rows of the start table nearest to features f, nearest first, into idx
-    (:func:`_table_distances`, then :func:`_smallest`)."""
-    v = np.empty(Ft.shape[1])
-    _table_distances(Ft, norms, f, v)
-    _smallest(v, idx, best)
-
-
-#: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
-NO_TABLE = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0)
-
-#: Neighbours looked up before the first start; the rest only when a start reaches them. Most
-#: poses are solved from their first or second start, and the nearest four cost about half of
-#: the nearest 64 (the screening pass is the same, computed once; the exact rows are not).
-NEAR_FIRST = 4
-#: The float32 screen's error bound, relative to the sizes in :func:`start_screen`: float32's
-#: unit roundoff is 2^-24, a 12-term dot product and the conversions need at most ~16 of them;
-#: 2^-16 leaves a factor 16 more.
-SCREEN_ROUNDOFF = 2.0 ** -16
-
-
-def start_screen(Ft, norms):
-    """The start table for :func:`_nearest_screened`: (Ft float64 (12, N), norms float64, Ft and
-    norms as float32, max |F_i|^2)."""
-    return (Ft, norms, np.ascontiguousarray(Ft, dtype=np.float32), np.ascontiguousarray(norms, dtype=np.float32),
-            float(norms.max()) if norms.shape[0] else 0.0)
-
-
-@njit(cache=True)
-def _screen32(table, f, v32):
-    """v32[i] = |F_i|^2 - 2 F_i . f in float32 for every row (half the bytes of the float64 pass,
-    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values."""
-    Ft32, n32 = table[2], table[3]
-    c, N = Ft32.shape
-    for i in range(N):
-        v32[i] = 0.0
-    for j in range(c):
-        fj = np.float32(f[j])
-        if f[j] == 0.0:
-            continue
-        for i in range(N):
-            v32[i] += Ft32[j, i] * fj
-    two = np.float32(2.0)
-    for i in range(N):
-        v32[i] = n32[i] - two * v32[i]
-
-
-@njit(cache=True)
-def _nearest_screened(table, f, v32, idx, best):
-    """:func:`_nearest_into`'s k = len(idx) nearest rows, the same rows in the same order: the
-    float32 screen v32 (:func:`_screen32`) bounds every row's float64 value v within B (sizes
-    times :data:`SCREEN_ROUNDOFF`), so with s_k the k-th smallest screen value, the k-th smallest
-    v is at most s_k + B and a row of the k nearest has v32 <= s_k + 2B; only those rows get the
-    float64 value of :func:`_table_distances` (the same operations), in row order, and the same
-    sorted insertion (ties: the lower row first)."""
-    Ft, norms, _, _, nmax = table
-    k = idx.shape[0]
-    c, N = Ft.shape
-    ff = 0.0
-    for j in range(c):
-        ff += f[j] * f[j]
-    B = SCREEN_ROUNDOFF * (1.0 + nmax + 2.0 * math.sqrt(nmax * ff) + ff)
-    # the k smallest screen values (sorted insertion; k is small)
-    sk = np.empty(k)
-    m = 0
-    for i in range(N):
-        x = np.float64(v32[i])
-        if m < k:
-            pos = m
-            m += 1
-        elif x < sk[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and sk[pos - 1] > x:
-            sk[pos] = sk[pos - 1]
-            pos -= 1
-        sk[pos] = x
-    limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
-    m = 0
-    for i in range(N):
-        if not np.float64(v32[i]) <= limit:
-            continue
-        acc = 0.0
-        first = True
-        for j in range(c):
-            fj = f[j]
-            if fj == 0.0:
-                continue
-            # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
-            # |F_i|^2 - 2 d2 does not see)
-            acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
-            first = False
-        x = norms[i] - 2.0 * acc
-        if m < k:
-            pos = m
-            m += 1
-        elif x < best[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and best[pos - 1] > x:
-            best[pos] = best[pos - 1]
-            idx[pos] = idx[pos - 1]
-            pos -= 1
-        best[pos] = x
-        idx[pos] = i
-
-
-@njit(cache=True)
-def _near_rows(table, f, v32, tq, near):
-    """The table joints of the len(near) rows nearest to f (:func:`_nearest_screened`) into near."""
-    k = near.shape[0]
-    idx = np.empty(k, dtype=np.int64)
-    _nearest_screened(table, f, v32, idx, np.empty(k))
-    for i in range(k):
-        near[i, :] = tq[idx[i]]
-
-
-@njit(cache=True, nogil=True)
-def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
-    """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
-    the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.kinematics.solvers._zyz_matrix1`, for
-    a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
-    start table's ``nn`` nearest configurations (:func:`_nearest_screened`, its float32 screen once; the first
-    :data:`NEAR_FIRST` now, the rest when a start reaches them), the loop
-    (:func:`_inverse_one`), then the answer in public units (deg; continuous joints wrapped into
-    [-180, 180); clipped into [blo, bhi]) into ``out`` and its check, FK of the answer against the
-    target (masked by W), into ``info`` = (position error, rotation error, inside limits, starts
-    used, evaluations). Releases the GIL (``nogil``; the same arithmetic), so that a control
-    loop's other Python threads may take it while this solves (:class:`fkopt.kinematics.solvers.InverseSolver`
-    calls it directly)."""
-    n = q0.shape[0]
-    d2r = math.pi / 180.0                          # math.radians / math.degrees: x * (pi / 180), x * (180 / pi)
-    r2d = 180.0 / math.pi
-    T = np.empty((3, 3))
-    if pose.shape[0] == 12:                        # a frame row: the rotation as given, row-major
-        for r in range(3):
-            for c in range(3):
-                T[r, c] = pose[3 + 3 * r + c]
-    else:
-        a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
-        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
-        T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
-        T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
-        T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
-    pt = pose[:3].copy()
-    near = np.empty((nn, n))
-    v32 = np.empty(tq.shape[0] if nn > 0 else 0, dtype=np.float32)
-    have = min(nn, NEAR_FIRST)
-    f = np.empty(12)
-    if nn > 0:
-        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
-        for r in range(3):
-            for c in range(3):
-                f[3 + 3 * r + c] = wf * T[r, c]
-        for j in range(12):
-            f[j] = f[j] * fmask[j]
-        _screen32(table, f, v32)
-        _near_rows(table, f, v32, tq, near[:have])
-    best = np.empty(n)
-    used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, f, v32, tq, seed, 0, budget, tp, tr,
-                               iterations, damping, down, up, step_cap, slo, shi, lo, hi, best)
-    t = np.empty(n)
-    inside = True
-    for i in range(n):
-        v = best[i] * r2d if angle[i] else best[i]
-        if periodic[i]:
-            v = (v + 180.0) % 360.0 - 180.0
-        v = min(max(v, blo[i]), bhi[i])
-        out[i] = v
-        inside = inside and blo[i] <= v <= bhi[i]
-        t[i] = v * d2r if angle[i] else v
-    prismatic, C, v_, var, mult, off, tC, tv = chain
-    p, R, J, ax, e = np.empty(3), np.empty((3, 3)), np.empty((6, n)), np.empty((prismatic.shape[0], 6)), np.empty(3)
-    _walk(prismatic, C, v_, var, mult, off, tC, tv, t, p, R, J, ax)
-    _rotation_error(R, T, e)
-    d0, d1, d2 = (p[0] - pt[0]) * W[0], (p[1] - pt[1]) * W[1], (p[2] - pt[2]) * W[2]
-    e0, e1, e2 = e[0] * W[3], e[1] * W[4], e[2] * W[5]
-    info[0] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-    info[1] = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-    info[2] = 1.0 if inside else 0.0
-    info[3] = used
-    info[4] = evals
-
-
-def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
-    """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
-    :func:`fkopt.kinematics.solvers._fast_context`) and the options bound once: a function
-    (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
-    kernel's arguments; a prepared solver (:class:`fkopt.kinematics.solvers.InverseSolver`) keeps it, so
-    a control loop's call does no dictionary lookups."""
-    chain, n = ctx["chain"], ctx["n"]
-    head = (L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn)
-    tail = (budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"], ctx["lo"],
-            ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
-
-    def call(pose, seed):
-        out, info = np.empty(n), np.empty(5)
-        _inverse_pose(chain, pose, *head, seed, *tail, out, info)
-        return out, info
-    return call
-
-
-def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
-    """One pose through :func:`_inverse_pose` (:func:`bound_inverse_pose`, bound for this call):
-    (public joints (n,), info (5,))."""
-    return bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap)(pose, seed)
-
-
-@njit(cache=True, nogil=True)
-def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
-    """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
-    ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
-    share a batch (:func:`inverse_rows`)."""
-    for k in range(first, poses.shape[0], step):
-        _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, table, wf, fmask, nn, seed, budget, tp, tr,
-                      iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
-                      out[k], info[k])
-
-
-#: Batches from this many rows are shared by one thread per core.
-THREAD_ROWS = 64
-
-
-def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
-    """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5)). From
-    :data:`THREAD_ROWS` rows, one Python thread per core takes every t-th row (interleaved, so
-    that the rows needing restarts spread evenly): plain threads rather than numba's parallel
-    layer, whose OpenMP runtime does not survive a fork and whose fallback is not thread-safe."""
-    import os
-    k = poses.shape[0]
-    out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
-    args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn,
-            seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
-            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
-    threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
-    if k < THREAD_ROWS or threads < 2:
-        _inverse_rows(*args, 0, 1)
-        return out, info
-    from concurrent.futures import ThreadPoolExecutor
-    with ThreadPoolExecutor(threads) as pool:
-        for f in [pool.submit(_inverse_rows, *args, t, threads) for t in range(threads)]:
-            f.result()
-    return out, info
 
 
 @intrinsic

@@ -12,11 +12,15 @@ operation in the same order.
 * convergence: position error <= tol[0] and geodesic rotation error <= tol[1]; a candidate stops
   after ``iterations`` steps, when lambda exceeds 1e6 (stalled) or when the system is singular;
 * restarts: candidates one after another in the order of their starts, stopping at the first that
-  converges; the best (smallest max(pe / tol[0], re / tol[1])) is kept.
+  converges; the best (smallest max(pe / tol[0], re / tol[1])) is kept: the one restart loop,
+  :func:`fkopt.numerics.restart_loop.restart`, with this module's candidate search as its search.
 """
 from __future__ import annotations
 
 import math
+
+from fkopt.numerics.restart_loop import restart
+from fkopt.numerics.rotations import rotation_error1
 
 #: lambda above this: the candidate stalled and restarts.
 LAMBDA_STALL = 1e6
@@ -111,42 +115,6 @@ def saturate(q, qn, J, r, mu, lo, hi):
     return [min(max(v, a), b) for v, a, b in zip(qn, lo, hi)]
 
 
-def rotation_error1(R, T):
-    """Rotation vector of R T^T (base frame, angle in [0, pi]) for rotations given as 3 rows of
-    3 floats."""
-    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
-    (t00, t01, t02), (t10, t11, t12), (t20, t21, t22) = T
-    v0 = (r20 * t10 + r21 * t11 + r22 * t12) - (r10 * t20 + r11 * t21 + r12 * t22)
-    v1 = (r00 * t20 + r01 * t21 + r02 * t22) - (r20 * t00 + r21 * t01 + r22 * t02)
-    v2 = (r10 * t00 + r11 * t01 + r12 * t02) - (r00 * t10 + r01 * t11 + r02 * t12)
-    s = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
-    c = 0.5 * ((r00 * t00 + r01 * t01 + r02 * t02) + (r10 * t10 + r11 * t11 + r12 * t12)
-               + (r20 * t20 + r21 * t21 + r22 * t22) - 1.0)
-    if s > 1e-12 or c > 0.0:
-        k = math.atan2(s, c) / (2.0 * s) if s > 1e-12 else 0.5
-        return v0 * k, v1 * k, v2 * k
-    return half_turn(r00 * t00 + r01 * t01 + r02 * t02, r10 * t10 + r11 * t11 + r12 * t12,
-                     r20 * t20 + r21 * t21 + r22 * t22, r00 * t10 + r01 * t11 + r02 * t12,
-                     r00 * t20 + r01 * t21 + r02 * t22, r10 * t20 + r11 * t21 + r12 * t22)
-
-
-def half_turn(m00, m11, m22, m01, m02, m12):
-    """Rotation vector of a half turn M = R T^T = 2 a a^T - I (sin = 0, cos = -1), where the
-    antisymmetric part that gives the axis elsewhere vanishes: pi times the axis read from the
-    symmetric part (a_i^2 = (M_ii + 1) / 2 from the largest diagonal, a_j = M_ij / (2 a_i)). Without
-    it the error vector of an answer a half turn off was zero, and such an answer counted as solved."""
-    if m00 >= m11 and m00 >= m22:
-        a0 = math.sqrt(max(0.5 * (m00 + 1.0), 0.0))
-        a1, a2 = m01 / (2.0 * a0), m02 / (2.0 * a0)
-    elif m11 >= m22:
-        a1 = math.sqrt(max(0.5 * (m11 + 1.0), 0.0))
-        a0, a2 = m01 / (2.0 * a1), m12 / (2.0 * a1)
-    else:
-        a2 = math.sqrt(max(0.5 * (m22 + 1.0), 0.0))
-        a0, a1 = m02 / (2.0 * a2), m12 / (2.0 * a2)
-    return math.pi * a0, math.pi * a1, math.pi * a2
-
-
 def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping, down, up, step_cap,
                        lo, hi, W=None):
     """The iteration of the module docstring for one pose: ``fj(q)`` -> (p, R, J) on floats
@@ -156,7 +124,6 @@ def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping,
     Returns (best joints (list, internal units), starts used, evaluations)."""
     tp, tr = tol
     t0, t1, t2 = pt
-    evals = 0
 
     def evaluate(q):
         p, R, J = fj(q)
@@ -172,11 +139,10 @@ def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping,
         return (r, J, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), math.sqrt(e0 * e0 + e1 * e1 + e2 * e2),
                 d0 * d0 + d1 * d1 + d2 * d2 + r[3] * r[3] + r[4] * r[4] + r[5] * r[5])
 
-    best_q, best_m = None, math.inf
-    for j in range(budget):
-        q = start_of(j)
+    def search(q):
+        """One candidate: the damped least-squares steps from start q; (q, pe, re), its evaluations counted."""
         r, J, pe, re, S = evaluate(q)
-        evals += 1
+        ne = 1
         lam = damping
         for _ in range(iterations):
             if pe <= tp and re <= tr:
@@ -190,7 +156,7 @@ def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping,
                 d = [v * (step_cap / big) for v in d]
             qn = saturate(q, [a + b for a, b in zip(q, d)], J, r, mu, lo, hi)
             rn, Jn, pen, ren, Sn = evaluate(qn)
-            evals += 1
+            ne += 1
             if Sn < S:
                 q, r, J, pe, re, S = qn, rn, Jn, pen, ren, Sn
                 lam = max(lam * down, LAMBDA_MIN)
@@ -198,9 +164,10 @@ def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping,
                 lam *= up
                 if lam > LAMBDA_STALL:
                     break
-        merit = max(pe / tp, re / tr)
-        if merit < best_m:
-            best_q, best_m = q, merit
-        if pe <= tp and re <= tr:
-            return best_q, j + 1, evals
-    return best_q, budget, evals
+        counted[0] += ne
+        return q, pe, re
+
+    counted = [0]
+    (best_q, _, _), _, used = restart(start_of, search, lambda a: a[1] <= tp and a[2] <= tr,
+                                      merit=lambda a: max(a[1] / tp, a[2] / tr), budget=budget)
+    return best_q, used, counted[0]

@@ -78,6 +78,14 @@ def compiled(want: bool | None = None):
     return mod
 
 
+def compiled_ik(want: bool | None = None):
+    """:mod:`fkopt.numerics.compiled_ik` (the compiled one-pose IK) when :func:`compiled` runs, else None."""
+    if compiled(want) is None:
+        return None
+    from fkopt.numerics import compiled_ik as mod       # numba, an optional package: imported on first use
+    return mod
+
+
 def _load():
     """(module, None) when numba imports and compiles, else (None, the reason in words)."""
     try:

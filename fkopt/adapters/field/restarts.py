@@ -1,5 +1,5 @@
-"""The one restart loop of kinbench's board, for every outside entry whose package has none of its
-own: pinocchio's CLIK (``pin-clik``), ikpy, pink and the black-box optimisers (cma-es,
+"""The restart loop of kinbench's board, for every outside entry whose package has none of its
+own (fkopt's one restart loop, :func:`fkopt.numerics.restart_loop.restart`, with a deadline): pinocchio's CLIK (``pin-clik``), ikpy, pink and the black-box optimisers (cma-es,
 scipy-lbfgsb, nevergrad-ngopt). TRAC-IK, optik and roboticstoolbox restart inside their own
 calls and keep their own loops; EAIK is analytic; fkopt.inverse is the organiser's.
 
@@ -27,6 +27,8 @@ from typing import Callable
 
 import numpy as np
 
+from fkopt.numerics.restart_loop import restart as one_loop
+
 #: The board's rung (m, rad): every entry's stopping test implies it (docs/kinbench.md).
 RUNG = 1e-5
 #: A stepped search restarts when its error has not halved within this many steps.
@@ -48,21 +50,14 @@ class Stall:
 
 def restart(search: Callable[[np.ndarray, float], tuple[np.ndarray, float, bool]],
             start: Callable[[], np.ndarray], timeout: float) -> tuple[np.ndarray, bool, int]:
-    """The restart loop: ``search(x0, deadline)`` -> (answer, error, met its stopping test) from
+    """The restart loop (:func:`fkopt.numerics.restart_loop.restart`): ``search(x0, deadline)`` -> (answer, error, met its stopping test) from
     starts ``start()`` until one meets its test or ``timeout`` (s) has passed. Returns the best
     answer (the met one, else the smallest error), whether it met the test, and the number of
     starts."""
     deadline = time.perf_counter() + timeout
-    best_x, best_err, starts = None, np.inf, 0
-    while True:
-        x, err, ok = search(start(), deadline)
-        starts += 1
-        if ok:
-            return x, True, starts
-        if err < best_err or best_x is None:
-            best_x, best_err = x, err
-        if time.perf_counter() > deadline:
-            return best_x, False, starts
+    (x, _, _), ok, starts = one_loop(lambda j: start(), lambda x0: search(x0, deadline), lambda got: got[2],
+                                     merit=lambda got: got[1], give_up=lambda: time.perf_counter() > deadline)
+    return x, ok, starts
 
 
 def pose_error(F: np.ndarray, T: np.ndarray) -> tuple[float, float]:

@@ -9,12 +9,11 @@ Jacobian is scipy's own ('2-point' differences, so fkopt's analytic Jacobians do
 Settings: ``method`` = 'trf' with the mechanism's bounds, ``x_scale`` = 'jac', ``ftol`` =
 ``xtol`` = ``gtol`` = 1e-15, ``max_nfev`` = 100 x dim per start, random starts uniform in the
 bounds from the wrapper's generator until max |relative residual| <= 1e-12 or the wall-clock
-``timeout`` (checked between starts). An answer may be another assembly mode:
+``timeout`` (checked between starts): the board's restart loop,
+:func:`fkopt.adapters.field.restarts.restart`. An answer may be another assembly mode:
 :func:`fkopt.kinbench.physical.fk_verdicts` counts those apart.
 """
 from __future__ import annotations
-
-import time
 
 import numpy as np
 
@@ -39,19 +38,17 @@ class LeastSquaresFK:
                          "start": "uniform in bounds (wrapper's generator)"}
 
     def solve1(self, legs: np.ndarray) -> tuple[np.ndarray | None, bool]:
+        from fkopt.adapters.field.restarts import restart
         legs = np.asarray(legs, dtype=float)
-        deadline = time.perf_counter() + self.timeout
         dim = len(self.lo)
 
         def residual(x):
             return (self.mechanism.ik(x[None])[0] - legs) / legs
-        best, best_r = None, np.inf
-        while True:
-            x0 = self.lo + self.rng.random(dim) * (self.hi - self.lo)
+
+        def search(x0, deadline):
             res = self._ls(residual, x0, method="trf", bounds=(self.lo, self.hi), x_scale="jac", ftol=self.TOL,
                            xtol=self.TOL, gtol=self.TOL, max_nfev=self.NFEV_PER_DIM * dim)
             r = float(np.max(np.abs(res.fun)))
-            if r < best_r:
-                best, best_r = np.asarray(res.x), r
-            if best_r <= self.ACCEPT or time.perf_counter() > deadline:
-                return best, bool(best_r <= self.ACCEPT)
+            return np.asarray(res.x), r, r <= self.ACCEPT
+        x, ok, _ = restart(search, lambda: self.lo + self.rng.random(dim) * (self.hi - self.lo), self.timeout)
+        return x, ok

@@ -15,7 +15,7 @@ timing rules).
 Inside the timed call only pytracik's call, pinned to the caller's core
 (:func:`fkopt.adapters.field.cores.pinned`: its two threads share that core, as every entry of the
 clock track runs on one core), and the target's quaternion by Shepperd's method on floats
-(:func:`quat_xyzw`, a few microseconds; the first wrapper's scipy conversion took 50-107 us,
+(:func:`fkopt.numerics.rotations.quaternion_xyzw1`, a few microseconds; the first wrapper's scipy conversion took 50-107 us,
 20-35 % of a call).
 
 Quirks worked around: pytracik reads some URDF limits as [0, 0] (the Panda: KDL's URDF parser
@@ -34,29 +34,7 @@ import numpy as np
 from fkopt.errors import FkoptError
 from fkopt.adapters.field import FieldIK, arm_urdf
 from fkopt.adapters.field.cores import pinned
-
-
-def quat_xyzw(R) -> tuple[float, float, float, float]:
-    """Unit quaternion (x, y, z, w) of a rotation matrix by Shepperd's method (Shepperd, J.
-    Guidance and Control 1(3), 1978): the largest of w, x, y, z taken from the diagonal, the others
-    from the off-diagonal sums, so no division by a small number."""
-    (a, b, c), (d, e, f), (g, h, i) = R[0][:3], R[1][:3], R[2][:3]
-    tr = a + e + i
-    if tr >= a and tr >= e and tr >= i:
-        w = 0.5 * math.sqrt(max(0.0, 1.0 + tr))
-        s = 0.25 / w
-        return (h - f) * s, (c - g) * s, (d - b) * s, w
-    if a >= e and a >= i:
-        x = 0.5 * math.sqrt(max(0.0, 1.0 + a - e - i))
-        s = 0.25 / x
-        return x, (b + d) * s, (c + g) * s, (h - f) * s
-    if e >= i:
-        y = 0.5 * math.sqrt(max(0.0, 1.0 - a + e - i))
-        s = 0.25 / y
-        return (b + d) * s, y, (f + h) * s, (c - g) * s
-    z = 0.5 * math.sqrt(max(0.0, 1.0 - a - e + i))
-    s = 0.25 / z
-    return (c + g) * s, (f + h) * s, z, (d - b) * s
+from fkopt.numerics.rotations import quaternion_xyzw1
 
 
 class TracIK(FieldIK):
@@ -82,7 +60,7 @@ class TracIK(FieldIK):
                              threads="two per call, pinned to the caller's core", quaternion="Shepperd, on floats")
 
     def solve1(self, T):
-        x, y, z, w = quat_xyzw(T.tolist())
+        x, y, z, w = quaternion_xyzw1(T.tolist())
         with pinned(whole_process=False):   # per call: only its own two threads
             out = self._pt.ik(self._solver, self.random_start(), T[0, 3], T[1, 3], T[2, 3], x, y, z, w)
         if out[0] <= 0:

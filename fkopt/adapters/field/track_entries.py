@@ -43,10 +43,12 @@ import numpy as np
 from fkopt.adapters.field.cores import pinned
 from fkopt.adapters.field.eaik import EAIK
 from fkopt.adapters.field.rtb import RtbLM
-from fkopt.adapters.field.tracik import TracIK, quat_xyzw
+from fkopt.adapters.field.tracik import TracIK
 from fkopt.errors import FkoptError
 from fkopt.mechanisms.urdf import URDFArm
-from fkopt.mechanisms.urdf_writer import _rpy, _rz, chain_urdf
+from fkopt.mechanisms.urdf_writer import chain_urdf
+from fkopt.numerics import rotations
+from fkopt.numerics.rotations import quaternion_xyzw1
 
 #: The tracks' tolerance (m, rad): TRAC-IK's eps follows from it by the board's rule.
 TRACK_TOL = 1e-6
@@ -72,8 +74,8 @@ def locked_arm(arm, fixed: dict[str, float]):
         j = root.find(f"joint[@name='{w.joint_names[k]}']")
         o, axis = j.find("origin"), j.find("axis")
         R = Rotation.from_euler("xyz", [float(v) for v in o.get("rpy").split()]).as_matrix() \
-            @ _rz(float(axis.get("xyz").split()[2]) * math.radians(float(value)))
-        o.set("rpy", " ".join(repr(float(a)) for a in _rpy(R)))
+            @ rotations.rz1(float(axis.get("xyz").split()[2]) * math.radians(float(value)))
+        o.set("rpy", " ".join(repr(float(a)) for a in rotations.zyx_angles1(R)))
         j.set("type", "fixed")
         j.remove(axis)
         if j.find("limit") is not None:
@@ -182,7 +184,7 @@ class TracIKSeeded(TracIK):
         out = np.empty((len(T), self.arm.dof))
         with pinned():
             for k, t in enumerate(T):
-                x, y, z, w = quat_xyzw(t.tolist())
+                x, y, z, w = quaternion_xyzw1(t.tolist())
                 got = self._pt.ik(self._solver, q, t[0, 3], t[1, 3], t[2, 3], x, y, z, w)
                 if got[0] > 0:
                     q = list(got[1:])

@@ -1,7 +1,7 @@
 """Compiled kernels of :mod:`fkopt.kinematics.branches`: every IK solution of one pose by seeded restarts of
 the one-pose loop, and branch following along a path.
 
-Both are built on :func:`fkopt.numerics.compiled._inverse_one` (the damped least-squares loop of
+Both are built on :func:`fkopt.numerics.compiled_ik._inverse_one` (the damped least-squares loop of
 ``fkopt.inverse``), one start per call:
 
 * :func:`search` -- starts from the start table's configurations nearest to the target, then
@@ -24,7 +24,8 @@ import math
 
 import numpy as np
 
-from fkopt.numerics.compiled import _evaluate, _inverse_one, _nearest_into, _uniform_hash
+from fkopt.numerics.compiled import _evaluate, _geodesic, _rotation_target, _uniform_hash
+from fkopt.numerics.compiled_ik import _inverse_one, _nearest_into, _table_features
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 TWO_PI = 2.0 * math.pi
@@ -37,41 +38,9 @@ def _wrap(x):
 
 
 @njit(cache=True)
-def _geodesic(R, T):
-    """The angle of R T^T in [0, pi] from both its skew part and its trace: the rotation vector
-    of :func:`fkopt.numerics.compiled._rotation_error` is zero at exactly pi (its skew part
-    vanishes there), so a turn by pi about the tool axis would pass a check on it."""
-    v0 = (R[2, 0] * T[1, 0] + R[2, 1] * T[1, 1] + R[2, 2] * T[1, 2]) - (R[1, 0] * T[2, 0] + R[1, 1] * T[2, 1] + R[1, 2] * T[2, 2])
-    v1 = (R[0, 0] * T[2, 0] + R[0, 1] * T[2, 1] + R[0, 2] * T[2, 2]) - (R[2, 0] * T[0, 0] + R[2, 1] * T[0, 1] + R[2, 2] * T[0, 2])
-    v2 = (R[1, 0] * T[0, 0] + R[1, 1] * T[0, 1] + R[1, 2] * T[0, 2]) - (R[0, 0] * T[1, 0] + R[0, 1] * T[1, 1] + R[0, 2] * T[1, 2])
-    c = 0.0
-    for a in range(3):
-        for b in range(3):
-            c += R[a, b] * T[a, b]
-    return math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (c - 1.0))
-
-
-@njit(cache=True)
-def _rotation_target(pose, T):
-    """The target rotation of a pose row into T: ZYZ Euler angles in deg (6,) as
-    :func:`fkopt.kinematics._zyz_matrix1`, or a frame row (12,) row-major as given."""
-    if pose.shape[0] == 12:
-        for r in range(3):
-            for c in range(3):
-                T[r, c] = pose[3 + 3 * r + c]
-    else:
-        d2r = math.pi / 180.0
-        a, b, g = pose[3] * d2r, pose[4] * d2r, pose[5] * d2r
-        ca, sa, cb, sb, cg, sg = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(g), math.sin(g)
-        T[0, 0], T[0, 1], T[0, 2] = ca * cb * cg - sa * sg, -ca * cb * sg - sa * cg, ca * sb
-        T[1, 0], T[1, 1], T[1, 2] = sa * cb * cg + ca * sg, -sa * cb * sg + ca * cg, sa * sb
-        T[2, 0], T[2, 1], T[2, 2] = -sb * cg, sb * sg, cb
-
-
-@njit(cache=True)
 def _no_start_table(n):
     """_inverse_one's start arguments with no start table (these loops give their own starts):
-    no neighbour rows, the table's arrays empty (compiled.NO_TABLE), no features, screen or joints."""
+    no neighbour rows, the table's arrays empty (compiled_ik.NO_TABLE), no features, screen or joints."""
     no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
                 0.0)
     return np.empty((0, n)), no_table, np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
@@ -93,12 +62,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
     near_idx = np.empty(nn, dtype=np.int64)
     if nn > 0:
         f = np.empty(12)
-        f[0], f[1], f[2] = pt[0], pt[1], pt[2]
-        for r in range(3):
-            for c in range(3):
-                f[3 + 3 * r + c] = wf * T[r, c]
-        for j in range(12):
-            f[j] = f[j] * fmask[j]
+        _table_features(pt, T, wf, fmask, f)
         _nearest_into(Ft, norms, f, near_idx, np.empty(nn))
     q0, best, u, w = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     empty, no_table, no_feat, no_v32, no_tq = _no_start_table(n)
@@ -212,7 +176,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
 def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up, step_cap,
            glo, ghi, revolute, merge_tol, cap, growth, windows, held_draws=4):
     """:func:`_search` of one pose row with the per-arm constants ``ctx``
-    (:func:`fkopt.kinematics._fast_context`) and the unlimited saturation bounds of the search:
+    (:func:`fkopt.kinematics.inverse_pose._fast_context`) and the unlimited saturation bounds of the search:
     (solutions (k, n) internal units, the start that found each (k,), info (5,))."""
     n = ctx["n"]
     wfirst = np.array([w[0] for w in windows], dtype=np.int64)
