@@ -88,8 +88,7 @@ from fkopt.algorithms.pso import PSO
 from fkopt.errors import FkoptError, did_you_mean
 from fkopt.files import did_you_mean as closest
 from fkopt.kinematics.as_algorithms import Exact, Forward, Inverse
-from fkopt.kinematics.clock_entries import FkoptForward, FkoptInverse
-from fkopt.kinematics.track_entries import FkoptAllSolutions, FkoptPath
+from fkopt.kinematics.kinbench_entries import FkoptAllSolutions, FkoptForward, FkoptInverse, FkoptPath
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism, SerialMechanism
 from fkopt.mechanisms.catalog import MECHANISMS
 
