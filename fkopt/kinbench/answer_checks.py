@@ -17,8 +17,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from fkopt.files import csv_numbers
-from fkopt.kinbench.clock import ANSWER_COLUMNS  # noqa: F401 (the one list of answers columns)
+from fkopt.files import csv_numbers, MAX_MAGNITUDE
+from fkopt.kinbench.clock import (ANSWER_COLUMNS, answer_prefix, entry_of, is_ik, targets_of, track_arm,
+                                  track_settings, verdicts)
+from fkopt.kinbench.config import suite_from_dict
 
 #: Relative tolerance of recomputed floats against the stored CSV's (written with 10 digits;
 #: answers with 17).
@@ -93,7 +95,6 @@ def key_problems(g: pd.DataFrame, robot: str, n: int, solvers, timeouts, optiona
 
 def expected_solvers(clock, mechanism) -> list[str]:
     """The solvers the clock track runs on ``mechanism``, the reference first."""
-    from fkopt.kinbench.clock import track_settings
     solvers, reference, _ = track_settings(clock, mechanism)
     return list(dict.fromkeys([reference, *solvers]))
 
@@ -115,9 +116,6 @@ def clock_record_problem(task, rec: dict) -> str | None:
     the times positive and finite; every verdict recomputed from the stored joints or pose with
     kinbench's own FK/IK (:func:`fkopt.kinbench.clock.verdicts`) -- joints moved with their
     verdicts kept are caught; the throughput rows' robots, solvers, batches and rates."""
-    from fkopt.files import MAX_MAGNITUDE
-    from fkopt.kinbench.clock import answer_prefix, entry_of, targets_of, track_arm, track_settings, verdicts
-    from fkopt.kinbench.config import suite_from_dict
     payload = task.payload
     from pathlib import Path
     config = suite_from_dict(payload["config"], "suite task")
@@ -177,7 +175,6 @@ def clock_record_problem(task, rec: dict) -> str | None:
 
 
 def _throughput_problem(config, arm, robot: str, rate) -> str | None:
-    from fkopt.kinbench.clock import is_ik, track_settings
     tp = config.tracks.throughput
     if tp is None:
         return None if rate is None else "throughput: present, but the config has no throughput track"

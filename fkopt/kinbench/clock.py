@@ -42,6 +42,8 @@ from fkopt.kinbench.physical import LADDER, fk_verdicts, ik_verdicts, rung_label
 from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
 from fkopt.run.config_base import files_folder
 from fkopt.registry import FK_SOLVERS, clock_solver  # noqa: F401 (FK_SOLVERS: the FK solvers on the clock)
+from fkopt.adapters.field import NotApplicable
+from fkopt.adapters.field.cores import pinned
 
 #: Timeouts of the clock track (ms): IK of serial arms, FK of parallel mechanisms.
 TIMEOUTS_MS = (1.0, 5.0, 20.0)
@@ -127,8 +129,6 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
     cannot take the mechanism by design (:class:`fkopt.adapters.field.NotApplicable`) gets rows
     without answers that say why (``not_applicable``). ``settings``, when given, is filled with
     each solver's settings (its wrapper at the largest timeout)."""
-    from fkopt.adapters.field import NotApplicable
-    from fkopt.adapters.field.cores import pinned
     targets = targets_of(mechanism, queries)
     runs: list[tuple[str, float | None, object]] = []         # (solver name, timeout given, wrapper)
     not_applicable: dict[str, str] = {}                       # solver -> why (a cell, never a zero)
@@ -300,7 +300,6 @@ def run_throughput(arm, robot: str, queries: np.ndarray, solvers: list[str], *, 
     ref = make_solver(reference, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, reference, -1, 0))
     rows = []
     m = min(reference_queries, len(targets))
-    from fkopt.adapters.field import NotApplicable
     for name in solvers:
         try:
             solver = make_solver(name, arm, timeout=max(TIMEOUTS_MS) / 1e3, rng=query_rng(seed, robot, name, -1, 0))

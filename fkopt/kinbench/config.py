@@ -47,6 +47,8 @@ from fkopt.errors import FkoptError
 from fkopt.registry import ALL_SOLUTIONS_SOLVERS, IK_SOLVERS, PATH_SOLVERS, track_of
 from fkopt.run.config_base import MAX_RUNS, AlgorithmSpec, Located, MechanismSpec, Seed, Strict, unique_labels
 from fkopt.files import error_line, load_mapping
+from fkopt.kinbench import instances     # instances.expand read at call time: tests stand in for it
+from fkopt.kinbench.instances import MAX_SUITE_INSTANCES
 
 #: Pose sets of kinbench v1 (see :mod:`fkopt.kinbench.posesets`).
 SETS = ("uniform", "near-singular", "boundary", "printed")
@@ -367,7 +369,6 @@ class SuiteConfig(Located):
         problems = [p.model_dump(mode="json") if isinstance(p, SuiteProblem) else p for p in data["problems"]]
         if not any(isinstance(p, dict) and p.get("instances") for p in problems):
             return data
-        from fkopt.kinbench.instances import MAX_SUITE_INSTANCES
         counts = [p.get("instances") for p in problems if isinstance(p, dict)]
         total = sum(c for c in counts if isinstance(c, int) and not isinstance(c, bool) and c > 0)
         if total > MAX_SUITE_INSTANCES:     # bounded before any geometry is drawn (~0.3 s per instance)
@@ -386,9 +387,8 @@ class SuiteConfig(Located):
                 raise ValueError(f"problems[{i}].{error_line(err, None, p)}") from None
             if not isinstance(seed, int) or isinstance(seed, bool):
                 raise ValueError("seed: an integer (instances are drawn from it)")
-            from fkopt.kinbench.instances import expand
             try:
-                out += expand(checked, seed, f"problems[{i}]")
+                out += instances.expand(checked, seed, f"problems[{i}]")
             except FkoptError as err:
                 raise ValueError(str(err)) from None
         return {**data, "problems": out}

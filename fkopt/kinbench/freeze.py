@@ -18,28 +18,30 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from fkopt.errors import FkoptError
+from fkopt.files import stored_sha256
+from fkopt.kinbench.config import load_suite
+from fkopt.kinbench.paths import write_path_set
+from fkopt.kinbench.posesets import pose_set_folder, write_pose_sets
+from fkopt.kinbench.releases import release_files
+from fkopt.kinbench.robots import write_robots
+from fkopt.problems import FITNESS_VERSION
+from fkopt.run.config_base import files_folder
+
 USAGE = ("usage: python -m fkopt.kinbench.freeze pose-sets SUITE.yaml [POSES [condition|sigma]] | "
          "robots FOLDER | release SUITE.yaml | paths SUITE.yaml [PATHS]")
 
 
 def main(argv: list[str]) -> int:
-    from fkopt.errors import FkoptError
     try:
         if len(argv) >= 2 and argv[0] == "pose-sets":
-            from fkopt.kinbench.config import load_suite
-            from fkopt.kinbench.posesets import pose_set_folder, write_pose_sets
             cfg = load_suite(argv[1])
             extra = [int(argv[2])] + argv[3:4] if len(argv) > 2 else []
             print(write_pose_sets(cfg, pose_set_folder(cfg), *extra))
         elif len(argv) in (2, 3) and argv[0] == "paths":
-            from fkopt.kinbench.config import load_suite
-            from fkopt.kinbench.paths import write_path_set
-            from fkopt.run.config_base import files_folder
             cfg = load_suite(argv[1])
             if cfg.tracks is None or cfg.tracks.paths is None:
                 raise FkoptError(f"{argv[1]}: tracks.paths: missing; the path set is that track's")
-            from fkopt.files import stored_sha256
-            from fkopt.problems import FITNESS_VERSION
             folder = write_path_set(cfg, files_folder(cfg) / cfg.tracks.paths.path_set,
                                     int(argv[2]) if len(argv) == 3 else 20)
             print(f'    "{folder.name}": Release(fitness={FITNESS_VERSION}, files={{')     # its RELEASES entry
@@ -47,13 +49,9 @@ def main(argv: list[str]) -> int:
                 print(f'        "{folder.name}/{path.name}": "{stored_sha256(path)}",')
             print("    }),")
         elif len(argv) == 2 and argv[0] == "robots":
-            from fkopt.kinbench.robots import write_robots
             for path in write_robots(Path(argv[1])):
                 print(path)
         elif len(argv) == 2 and argv[0] == "release":
-            from fkopt.problems import FITNESS_VERSION
-            from fkopt.kinbench.config import load_suite
-            from fkopt.kinbench.releases import release_files
             cfg = load_suite(argv[1])
             print(f'    "{cfg.pose_sets}": Release(fitness={FITNESS_VERSION}, files={{')
             for name, digest in release_files(cfg).items():

@@ -36,6 +36,9 @@ from types import SimpleNamespace
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt import registry
+from fkopt.kinbench.posesets import condition_numbers, problem_mechanism
+from fkopt.run.config_base import MechanismSpec
 
 #: Parameters drawn per mechanism (module docstring); a mechanism not listed takes no instances.
 SPREADS: dict[str, dict[str, tuple[str, float]]] = {
@@ -68,7 +71,6 @@ def _sig(v: float) -> float:
 
 def draw_geometry(mechanism: str, geometry: dict, rng: np.random.Generator) -> dict:
     """One draw of the parameters of :data:`SPREADS` around ``geometry`` (mechanism defaults filled in)."""
-    from fkopt import registry
     spreads = SPREADS[mechanism]
     cls = registry.mechanism_class(mechanism)
     base = {**cls.Geometry().model_dump(mode="json"), **geometry}
@@ -89,7 +91,6 @@ def draw_geometry(mechanism: str, geometry: dict, rng: np.random.Generator) -> d
 
 def degeneracy(spec, rng: np.random.Generator) -> str | None:
     """Why the instance ``spec`` (a MechanismSpec with bounds) is degenerate, or None (module docstring)."""
-    from fkopt.kinbench.posesets import condition_numbers, problem_mechanism
     problem = SimpleNamespace(mechanism=spec, objective=None)
     try:
         mech, _ = problem_mechanism(problem)
@@ -107,8 +108,6 @@ def degeneracy(spec, rng: np.random.Generator) -> str | None:
 
 def expand(problem: dict, seed: int, where: str) -> list[dict]:
     """The K instance problems (dicts of SuiteProblem fields) of a problem with ``instances: K``."""
-    from fkopt.run.config_base import MechanismSpec
-    from fkopt.kinbench.posesets import problem_mechanism
     k_total = problem["instances"]
     if len(f"{problem['name']}-i{k_total}") > 64:
         raise FkoptError(f"{where}.name: '{problem['name']}' is too long for its instance names (64 characters)")

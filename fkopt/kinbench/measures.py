@@ -38,6 +38,7 @@ import pandas as pd
 from fkopt.kinds.study.statistics import ecdf_table as ecdf_steps
 from fkopt.kinds.study.statistics import holm
 from fkopt.kinbench.budget import target_column
+from fkopt.errors import FkoptError
 
 INSTANCE = ["problem", "set", "pose"]
 
@@ -278,7 +279,6 @@ def unit_free_jacobian(mech, points: np.ndarray, length: float) -> np.ndarray:
     points = np.asarray(points, dtype=float)
     if mech.kind == "serial":
         if not hasattr(mech, "frame_jacobian"):
-            from fkopt.errors import FkoptError
             raise FkoptError(f"{mech.name}: the unit-free singularity measure needs a frame Jacobian "
                              "(a frame arm: DH, URDF, MJCF)")
         _, _, J = mech.frame_jacobian(points)

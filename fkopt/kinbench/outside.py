@@ -45,6 +45,7 @@ from fkopt.files import MAX_INPUT_BYTES, csv_numbers, read_csv, read_input
 from fkopt.run.config_base import files_folder
 from fkopt.run.record import run_record
 from fkopt.kinbench.budget import at_budget, budget_of
+from fkopt.tools.iohformat import read_ioh
 
 COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
 IOH_SEPARATOR = "__"
@@ -92,7 +93,6 @@ def _csv_log(path: Path, where: str) -> pd.DataFrame:
 
 
 def _ioh_log(path: Path, where: str, algorithm: str | None) -> pd.DataFrame:
-    from fkopt.tools.iohformat import read_ioh
     if not path.is_dir():
         raise FkoptError(f"{where}: not a folder")
     data = read_ioh(path)

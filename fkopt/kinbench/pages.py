@@ -29,10 +29,21 @@ import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.files import parse_json, read_stored, read_stored_csv
+from fkopt.files import file_names, parse_json, read_stored, read_stored_csv
 from fkopt.run.kinds import KINDS
 from fkopt.kinbench import html as H
 from fkopt.kinbench.runner import SuiteOwn
+from fkopt.kinbench.advice import class_advice, family_advice, fk_robots, summarise_board
+from fkopt.kinbench.clock import entry_of
+from fkopt.kinbench.config import SuiteConfig
+from fkopt.kinbench.physical import LADDER, rung_label
+from fkopt.kinbench.reports import (boards_preamble, ERT_RATIO_NOTE, ert_ratio_sections, leaderboard_columns,
+                                    leaderboard_sections, meta, PER_PROBLEM, preamble, robot_columns,
+                                    ROBOTS_PREAMBLE, SCALING, scaling_target, split_scope)
+from fkopt.registry import solver_entry
+from fkopt.run.pipeline import from_dict
+from fkopt.run.provenance import environment
+from fkopt.run.writers import FIGURE
 
 #: Every page's size in bytes stays below this (issue 37: a page loads in a moment).
 PAGE_LIMIT = 500_000
@@ -66,7 +77,6 @@ def meta_of(sr) -> dict:
     if isinstance(stored, dict):
         return stored
     try:
-        from fkopt.kinbench.reports import meta
         return meta(sr)
     except Exception:        # a result without a manifest (a test's stand-in): nothing recorded
         return {}
@@ -77,7 +87,6 @@ def env_of(sr) -> dict:
     if isinstance(stored, dict):
         return stored
     try:
-        from fkopt.run.provenance import environment
         return environment()
     except Exception:
         return {}
@@ -125,7 +134,6 @@ def documented_settings(name: str) -> str:
     fkopt's source through the solver registry, or "" when fkopt has no solver of that name."""
     import importlib
     import inspect
-    from fkopt.registry import solver_entry
     entry = solver_entry(name)
     if entry is None:
         return ""
@@ -156,8 +164,6 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
     recorded = meta.get("settings") if isinstance(meta.get("settings"), dict) else {}
     names = list(dict.fromkeys([clock.reference, *clock.solvers, clock.fk_reference, *clock.fk_solvers]
                                + ([] if answers is None else list(answers["solver"].unique()))))
-    from fkopt.kinbench.clock import entry_of
-    from fkopt.registry import solver_entry
     rows = []
     for name in names:
         if answers is not None and name not in set(answers["solver"]):
@@ -186,7 +192,6 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
 
 def suite_settings_section(sr) -> Section:
     """Every solver of an evaluations board with its settings (the stored config's)."""
-    from fkopt.kinbench.reports import boards_preamble, preamble
     c = sr.config
     rows = []
     for s in c.solvers:
@@ -206,7 +211,6 @@ def suite_settings_section(sr) -> Section:
 
 
 def _rung_label(rung: int) -> str:
-    from fkopt.kinbench.physical import LADDER, rung_label
     return rung_label(LADDER[rung])
 
 
@@ -217,7 +221,6 @@ def _families(c) -> dict[str, str]:
 
 def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
     """(which solver per arm family, summary per solver, the lead figure's file name)."""
-    from fkopt.kinbench.advice import family_advice, fk_robots, summarise_board
     clock = sr.config.tracks.clock
     fam = family_advice(board, _families(sr.config))
     success = [col for col in board.columns if col.startswith("success_")]
@@ -262,8 +265,6 @@ def _targets(c) -> list[str]:
 def evaluations_lead(sr, tables: dict) -> tuple[Section, Section, str]:
     """(which solver per problem class, summary per solver, the lead figure's file name) of an
     evaluations board."""
-    from fkopt.kinbench.advice import class_advice
-    from fkopt.kinbench.reports import scaling_target, split_scope
     c = sr.config
     targets = _targets(c)
     target = "1e-06" if "1e-06" in targets else f"{scaling_target(c.targets):.0e}"   # advice_table's, docs/robots.md
@@ -330,8 +331,6 @@ def detail_page(folder: Path, name: str, title: str, intro: str, sections: list[
 
 
 def arm_sections(sr, folder: Path, board: pd.DataFrame) -> list[Section]:
-    from fkopt.files import file_names
-    from fkopt.kinbench.reports import robot_columns
     fam = _families(sr.config)
     stems = file_names(board["robot"].unique(), reserved=("all",))
     ids = file_names(board["robot"].unique(), allowed="A-Za-z0-9_-")
@@ -356,8 +355,6 @@ def arm_sections(sr, folder: Path, board: pd.DataFrame) -> list[Section]:
 def ranking_sections(sr, tables: dict) -> list[Section]:
     """Every scope's ranking, the ERT ratios, the scaling tables and (suites without boards)
     the per-problem tables."""
-    from fkopt.kinbench.reports import (ERT_RATIO_NOTE, PER_PROBLEM, SCALING, ert_ratio_sections, leaderboard_columns,
-                          leaderboard_sections, scaling_target)
     c = sr.config
     lb = tables["leaderboard.csv"]
     cols = leaderboard_columns(lb)
@@ -385,7 +382,6 @@ def ranking_sections(sr, tables: dict) -> list[Section]:
 # -- the pages -------------------------------------------------------------------------------------
 def write_pages(sr, folder: Path, tables: dict) -> list[str]:
     """index.html and its detail pages (the names written)."""
-    from fkopt.kinbench.reports import ROBOTS_PREAMBLE
     lb = tables.get("leaderboard.csv")
     if lb is None:
         return []
@@ -452,9 +448,7 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
 def stored_suite(folder: str | Path):
     """(result, tables) of a stored suite folder: its config (meta.json), meta.json and env.json,
     and every table file it holds, read back -- what the figures and pages are made of."""
-    from fkopt.kinbench.config import SuiteConfig
     OUTPUTS = KINDS["suite"].outputs        # the suite kind's files (registered by fkopt.kinbench)
-    from fkopt.run.writers import FIGURE
     folder = Path(folder)
     where = folder / "meta.json"
     if not where.is_file():
@@ -463,7 +457,6 @@ def stored_suite(folder: str | Path):
     if not isinstance(meta, dict) or meta.get("kind") != "suite":
         raise FkoptError(f"{where}: kind: {meta.get('kind') if isinstance(meta, dict) else None!r} "
                          "(allowed: suite; pages are a kinbench suite's)")
-    from fkopt.run.pipeline import from_dict
     config = from_dict(meta.get("config") or {}, f"{where}: config")
     if not isinstance(config, SuiteConfig):
         raise FkoptError(f"{where}: config: not a suite's")
@@ -494,7 +487,6 @@ def regenerate(folder: str | Path, figures: bool = True) -> list[str]:
     """Rewrite a stored suite folder's figures (``figures``) and pages from its stored tables;
     no solver runs, no table is written. Returns the names written."""
     OUTPUTS = KINDS["suite"].outputs        # the suite kind's files (registered by fkopt.kinbench)
-    from fkopt.run.writers import FIGURE
     folder = Path(folder)
     sr, tables = stored_suite(folder)
     written = []

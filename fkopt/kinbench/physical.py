@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fkopt.numerics.rotations import geodesic_angle
+from fkopt.numerics.rotations import geodesic_angle, to_array, zyx
 
 #: (position m, rotation rad) rungs, loosest first.
 LADDER = ((5e-3, 0.05), (1e-3, 0.01), (1e-5, 1e-5), (1e-8, 1e-8))
@@ -103,7 +103,6 @@ def _pose_frames(x: np.ndarray) -> np.ndarray:
     """4x4 frames of parallel-mechanism poses (x, y, z, alpha, beta, gamma deg) with
     R = Rz(gamma) Ry(beta) Rx(alpha) (:func:`fkopt.numerics.rotations.zyx`, the convention of every
     6-DOF parallel mechanism in fkopt)."""
-    from fkopt.numerics.rotations import to_array, zyx
     T = np.zeros(x.shape[:-1] + (4, 4))
     T[..., :3, :3] = to_array(zyx(*np.radians(np.moveaxis(x[..., 3:6], -1, 0))))
     T[..., :3, 3] = x[..., :3]

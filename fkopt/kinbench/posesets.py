@@ -35,7 +35,12 @@ from pathlib import Path
 import numpy as np
 
 from fkopt.errors import FkoptError
-from fkopt.run.config_base import files_folder
+from fkopt.run.config_base import files_folder, RunConfig
+from fkopt.files import check_csv_shape, parse_json, read_input, short_token
+from fkopt.kinbench.measures import characteristic_length, unit_free_sigma_min
+from fkopt.kinbench.releases import check_release
+from fkopt.mechanisms.urdf import URDFArm
+from fkopt.run.solving import build_mechanism, make_problem
 
 VERSION = "kinbench-v1"
 #: Poses per generated set.
@@ -68,8 +73,6 @@ def problem_mechanism(problem, folder: Path | None = None):
     """The mechanism of a suite problem (the experiment layer's builder) and the RunConfig it
     was built from (its objective is what :func:`fkopt.kinds.experiment.runner.make_problem` reads; the
     one algorithm entry only satisfies the schema)."""
-    from fkopt.run.config_base import RunConfig
-    from fkopt.run.solving import build_mechanism
     cfg = RunConfig(name="pose-set", mechanism=problem.mechanism, objective=problem.objective,
                     algorithms=[{"name": "lm"}])
     return build_mechanism(cfg, folder), cfg
@@ -82,7 +85,6 @@ def targets_of(mech, points: np.ndarray) -> np.ndarray:
 
 def condition_numbers(problem, folder: Path | None, points: np.ndarray) -> np.ndarray:
     """kappa of the residual Jacobian at the true solution of each point (inf where singular)."""
-    from fkopt.run.solving import make_problem
     mech, cfg = problem_mechanism(problem, folder)
     prob = make_problem(cfg, mech, targets_of(mech, points))
     x = points[:, None, :]
@@ -112,7 +114,6 @@ def drawing_box(mech) -> tuple[np.ndarray, np.ndarray]:
     point in the sliver between the two (at most 5e-10 deg wide) moves onto the limit. No
     frozen set holds one (tests/test_newcomer.py checks every frozen joint against the limits)."""
     lo, hi = mech.bounds[:, 0].copy(), mech.bounds[:, 1].copy()
-    from fkopt.mechanisms.urdf import URDFArm
     if isinstance(mech, URDFArm):             # URDF and MJCF arms (MJCFArm reads its limits the same way)
         for i, unit in enumerate(mech.unknown_units):
             if unit == "deg":
@@ -143,7 +144,6 @@ def generate(problem, seed: int, n: int = POSES, folder: Path | None = None,
                                  "bound": float(f"{bound:.6g}"), "quantile": SINGULAR_QUANTILE,
                                  "candidates": CANDIDATES}
     elif measure == "sigma":
-        from fkopt.kinbench.measures import characteristic_length, unit_free_sigma_min
         length = characteristic_length(mech, cand)
         sigma = unit_free_sigma_min(mech, cand, length)
         bound = float(np.quantile(sigma[np.isfinite(sigma)], 1.0 - SINGULAR_QUANTILE))
@@ -262,7 +262,6 @@ def parse_set_csv(data: bytes, path: Path, unknowns: list[str]) -> np.ndarray:
     """The points of a pose-set CSV: ASCII, a header of exactly ``unknowns``, every row that
     many finite numbers; anything else one line naming the file, the line and what is allowed
     (no cell of the file is quoted beyond a short sanitised token)."""
-    from fkopt.files import check_csv_shape, short_token
     check_csv_shape(data, str(path))        # line length and fields bounded before any split
     try:
         text = data.decode("ascii")
@@ -297,7 +296,6 @@ def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, s
     the manifest's shape and every set file's contents are checked (a digest proves a file is
     the one the manifest names, not that either is well-formed): one line naming the file.
     ``files``: where the suite's relative files are (:func:`pose_set_folder`)."""
-    from fkopt.files import parse_json, read_input
     folder = pose_set_folder(config, files)
     mpath = folder / MANIFEST
     if not mpath.exists() and not mpath.is_symlink():
@@ -325,6 +323,5 @@ def load_pose_sets(config, files: Path | None = None) -> tuple[dict[tuple[str, s
             if meta.get("poses") is not None and meta["poses"] != len(pts):
                 raise FkoptError(f"{where}.sets.{name}.poses: {meta['poses']}, but {path} has {len(pts)} poses")
             out[(problem.name, name)] = pts[: config.poses] if config.poses else pts
-    from fkopt.kinbench.releases import check_release
     check_release(config, manifest, files)      # a released version: every file as released, not only as its manifest says
     return out, manifest

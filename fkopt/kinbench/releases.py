@@ -27,6 +27,8 @@ from pathlib import Path
 from fkopt.errors import FkoptError
 from fkopt.files import MAX_INPUT_BYTES, stored_sha256
 from fkopt.problems import FITNESS_VERSION
+from fkopt import registry
+from fkopt.run.config_base import files_folder
 
 
 @dataclass(frozen=True)
@@ -516,14 +518,12 @@ RELEASES: dict[str, Release] = {
 
 def _base(config, files) -> Path:
     """Where the suite's relative files are: ``files``, else the suite file's folder."""
-    from fkopt.run.config_base import files_folder
     base = files if files is not None else files_folder(config)
     return Path(base if base is not None else ".")
 
 
 def problem_files(config) -> list[str]:
     """The files the suite's problems read (mechanism file fields), relative to the suite's folder."""
-    from fkopt import registry
     out = []
     for problem in config.problems:
         cls = registry.mechanism_class(problem.mechanism.name)

@@ -18,6 +18,10 @@ from fkopt.files import file_names, md_text, read_stored_csv
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.outside import digest
 from fkopt.kinbench.submissions import submission_digest
+from fkopt.kinbench.clock import clock_board, rung_success
+from fkopt.kinbench.html import rung_words
+from fkopt.kinbench.physical import LADDER, rung_label
+from fkopt.kinbench.releases import board_version
 
 
 BOARD_PREFIX = "board:"
@@ -123,8 +127,6 @@ def robots_board(config, answers: pd.DataFrame | None, tp: pd.DataFrame | None) 
     (queries/s and its ratio to the reference's rate; empty for solvers that take no batches)
     and the entry (organiser / outside). Sorted per robot and timeout by success at the rung,
     then by median ratio."""
-    from fkopt.kinbench.clock import clock_board
-    from fkopt.kinbench.physical import LADDER, rung_label
     if answers is None or answers.empty:
         return None
     clock = config.tracks.clock
@@ -201,7 +203,6 @@ def pooled_clock_curves(answers: pd.DataFrame, clock) -> tuple[list, float, int]
     """Per solver over every IK arm at the largest timeout: the sorted times (ms) of answers
     right at the board's rung within the timeout, and the number of queries it was given;
     the virtual best (per query the fastest right answer of any solver) last."""
-    from fkopt.kinbench.clock import rung_success
     ik = answers
     if "leg_residual" in answers:           # FK of parallel mechanisms: another ladder of timeouts
         fk = answers.groupby("problem", sort=False)["leg_residual"].transform(lambda v: v.notna().any())
@@ -224,9 +225,6 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     one step line per solver and the virtual best solver (per query the fastest right answer of
     any solver run here), the timeout marked; names at the right end, spread apart."""
     from fkopt.run.plotting import plt, save
-    from fkopt.kinbench.clock import rung_success
-    from fkopt.kinbench.html import rung_words
-    from fkopt.kinbench.physical import LADDER, rung_label
     answers = tables.get("answers.csv.gz")
     if answers is None or answers.empty:
         return []
@@ -579,7 +577,6 @@ def board_meta(sr) -> dict:
     clock track's start and end, and every entry's settings."""
     if sr.own.answers is None:
         return {}
-    from fkopt.kinbench.releases import board_version
     out = {"board_version": board_version(sr.config.name)}
     if sr.own.load_avg:
         out["load_avg"] = sr.own.load_avg

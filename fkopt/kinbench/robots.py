@@ -28,6 +28,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fkopt.errors import FkoptError
+from fkopt.files import read_input
+from fkopt.mechanisms.mjcf import MAX_MJCF_BYTES
+from fkopt.mechanisms.urdf import example_robots_folder, load_urdf, urdf_chain
 
 
 @dataclass(frozen=True)
@@ -116,7 +119,6 @@ def package_version(package: str) -> str | None:
 def package_folder(package: str) -> Path | None:
     """The robots folder of ``package`` as installed, or None."""
     if package == _ERD:
-        from fkopt.mechanisms.urdf import example_robots_folder
         return example_robots_folder()
     if package == _RS:
         from importlib.util import find_spec
@@ -163,7 +165,6 @@ def cut_urdf(path: Path, base: str, tip: str) -> ET.Element:
     """The ``<robot>`` of the chain ``base`` -> ``tip`` of URDF ``path``, kinematics only: the
     chain as fkopt's URDF arm reads it (:func:`fkopt.mechanisms.urdf.load_urdf`, bounded, and
     :func:`~fkopt.mechanisms.urdf.urdf_chain`), each joint's parts copied from its XML element."""
-    from fkopt.mechanisms.urdf import load_urdf, urdf_chain
     robot = load_urdf(path)
     out = ET.Element("robot", name=robot.name)
     ET.SubElement(out, "link", name=base)
@@ -202,8 +203,6 @@ def _cut_defaults(default: ET.Element) -> ET.Element:
 def cut_mjcf(path: Path, base: str, tip: str) -> ET.Element:
     """The ``<mujoco>`` of the chain ``base`` -> ``tip`` (a body or a site) of MJCF ``path``,
     kinematics only (module docstring)."""
-    from fkopt.files import read_input
-    from fkopt.mechanisms.mjcf import MAX_MJCF_BYTES
     try:
         root = ET.fromstring(read_input(path, MAX_MJCF_BYTES, field="robots"))
     except ET.ParseError as err:

@@ -31,11 +31,12 @@ import pandas as pd
 from fkopt.errors import FkoptError
 from fkopt.run.record import BATCH, concat, run_record, timing_record
 from fkopt.run.result import RunResult
-from fkopt.run.config_base import RunConfig, files_folder
+from fkopt.run.config_base import files_folder, numeric_fields, RunConfig
 from fkopt.run.solving import make_problem, solve_cases, start_point, task_seed
 from fkopt.run.tasks import Plan, Ran, Task, run_tasks
 from fkopt.solve import chunk_size
-from fkopt.kinbench.clock import track_arm, track_cases  # noqa: F401 (the clock track's arms; tests)
+from fkopt.kinbench.clock import (is_ik, make_solver, run_clock, run_throughput, track_arm, track_cases,
+                                  track_settings)
 from fkopt.kinbench import branch_tracks
 from fkopt.kinbench.answer_checks import clock_record_problem
 from fkopt.kinbench.budget import at_budget, budget_of, target_column
@@ -43,6 +44,8 @@ from fkopt.kinbench.config import SuiteConfig, suite_from_dict
 from fkopt.kinbench.outside import digest, read_outside
 from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism, targets_of
 from fkopt.kinbench.traces import suite_trace, task_trace
+from fkopt.adapters.field import NotApplicable
+from fkopt.kinbench.submissions import read_submission
 
 
 def task_config(config: SuiteConfig, problem, solver, dim: int) -> RunConfig:
@@ -138,7 +141,6 @@ def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> 
     own FK or IK (answers rows)."""
     if not tracks or not config.tracks.clock.submissions:
         return None
-    from fkopt.kinbench.submissions import read_submission
     # every arm of the track: IK answers (joints) and FK answers of parallel mechanisms (poses)
     arms = {config.problems[p].name: (track_arm(config, p, files), queries) for p, queries in tracks}
     return pd.concat([read_submission(config, k, arms, files) for k in range(len(config.tracks.clock.submissions))],
@@ -148,8 +150,6 @@ def read_submissions(config: SuiteConfig, tracks, files: Path | None = None) -> 
 def validate_track(config: SuiteConfig, p: int, files: Path | None = None) -> None:
     """Every clock-track solver built once on arm ``p``: a missing package or an arm a package
     misreads is one line before any work."""
-    from fkopt.adapters.field import NotApplicable
-    from fkopt.kinbench.clock import make_solver, track_settings
     arm = track_arm(config, p, files)
     solvers, reference, timeouts = track_settings(config.tracks.clock, arm)
     for name in dict.fromkeys([reference, *solvers]):
@@ -163,7 +163,6 @@ def validate_track(config: SuiteConfig, p: int, files: Path | None = None) -> No
 
 def solve_track(payload: dict) -> dict:
     """Worker: the clock (and throughput) track on one arm; returns every answer, JSON-able."""
-    from fkopt.kinbench.clock import run_clock, run_throughput, track_settings
     config = suite_from_dict(payload["config"], "suite task")
     files = Path(payload["folder"]) if payload["folder"] else None
     p, clock, tp = payload["problem"], config.tracks.clock, config.tracks.throughput
@@ -179,7 +178,6 @@ def solve_track(payload: dict) -> dict:
     answers.insert(1, "set", clock.set)
     rate = None
     if tp is not None:
-        from fkopt.kinbench.clock import is_ik
         batches = tp.batches if is_ik(arm) else tp.fk_batches
         batched = list(dict.fromkeys([*solvers, *(tp.solvers if is_ik(arm) else [])]))
         rate = run_throughput(arm, name, queries, batched, batches=tuple(batches), repeats=tp.repeats,
@@ -250,7 +248,6 @@ def rows_of(record: dict) -> pd.DataFrame:
 def fingerprint(config: SuiteConfig, manifest: dict) -> str:
     """Hash of everything that changes a task's numbers: the config's result-changing fields and
     the pose sets (a resumed suite must match it)."""
-    from fkopt.run.config_base import numeric_fields
     text = json.dumps([numeric_fields(config.stored_dump()), manifest], sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

@@ -33,8 +33,9 @@ import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.run.trace import FILE, run_trace
+from fkopt.run.trace import FILE, history_events, run_trace
 from fkopt.kinbench.budget import budget_of, last_within
+from fkopt.kinbench.outside import in_suite_order, logged_runs
 
 __all__ = ["FILE", "COLUMNS", "budget_trace", "task_trace", "outside_trace", "suite_trace"]
 
@@ -71,7 +72,6 @@ def task_trace(result, budget: int) -> dict:
     """The trace of every (case, run) row of a suite task's batched ``result``, JSON-able (the
     task record's ``"trace"``): ``row`` (case x runs + run, the row of the task's run rows),
     ``evaluations``, ``best_fitness``."""
-    from fkopt.run.trace import history_events
     ev = np.asarray(result.evaluation_history).reshape(-1, result.evaluation_history.shape[-1])
     events = result.events if result.events is not None else history_events(
         np.asarray(result.history).reshape(ev.shape), ev)
@@ -83,7 +83,6 @@ def outside_trace(config, k: int, dims: dict[str, int], instances: set[tuple[str
                   files=None) -> pd.DataFrame:
     """The trace rows (:mod:`fkopt.kinbench.traces`) of ``config.outside[k]``'s runs, cut at the
     budget as :func:`~fkopt.kinbench.outside.read_outside`'s measures are."""
-    from fkopt.kinbench.outside import in_suite_order, logged_runs
     entry = config.outside[k]
     frames = []
     for problem, name, pose, run, ev, hist in logged_runs(config, k, instances, files):

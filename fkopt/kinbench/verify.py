@@ -14,8 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
-from fkopt.kinbench.answer_checks import RTOL, _close, differing_numbers  # noqa: F401 (RTOL: the recomputation's tolerance)
-from fkopt.kinbench.clock import OLD_ANSWER_COLUMNS
+from fkopt.kinbench.answer_checks import _close, differing_numbers, expected_solvers, key_problems, RTOL, RULE
+from fkopt.kinbench.clock import (answer_prefix, OLD_ANSWER_COLUMNS, targets_of, track_arm, track_cases,
+                                  track_settings, verdicts)
+from fkopt.errors import FkoptError
+from fkopt.files import csv_numbers, read_stored_csv
+from fkopt.kinbench.branch_tracks import reverify as reverify_branch_tracks
+from fkopt.kinbench.posesets import load_pose_sets
+from fkopt.kinbench.reports import robots_board
 
 
 def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
@@ -25,7 +31,6 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
     config implies, so a failure deleted, a success repeated or a solver dropped is a mismatch
     naming answers.csv.gz, as is a missing or unreadable file (read bounded, :func:`read_stored_csv`).
     The all-solutions and paths tracks: :func:`fkopt.kinbench.branch_tracks.reverify`."""
-    from fkopt.kinbench.branch_tracks import reverify as reverify_branch_tracks
     folder = Path(folder)
     if config.tracks is None:
         return []
@@ -34,12 +39,6 @@ def reverify(folder: Path, config) -> list[tuple[str, str, str, object, object, 
 
 def _reverify_clock(folder: Path, config) -> list[tuple[str, str, str, object, object, str]]:
     """:func:`reverify` of the clock track (module docstring)."""
-    from fkopt.errors import FkoptError
-    from fkopt.files import csv_numbers, read_stored_csv
-    from fkopt.kinbench.answer_checks import RULE, expected_solvers, key_problems
-    from fkopt.kinbench.clock import answer_prefix, targets_of, track_arm, track_cases, track_settings, verdicts
-    from fkopt.kinbench.posesets import load_pose_sets
-    from fkopt.kinbench.reports import robots_board
     if config.tracks.clock is None:
         return []
     clock = config.tracks.clock
