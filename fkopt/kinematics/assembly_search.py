@@ -14,6 +14,7 @@ from fkopt.errors import FkoptError
 from fkopt.mechanisms.base import Mechanism
 from fkopt.numerics import rotations
 from fkopt.problems import FKProblem
+from fkopt.mechanisms.sps6 import SixSPS
 
 
 # ------------------------------------------------------------------------------------------
@@ -478,7 +479,6 @@ def _into_bounds(mechanism: Mechanism, x: np.ndarray, triple) -> np.ndarray | No
 
 
 def _model_for(mechanism, joints):
-    from fkopt.mechanisms.sps6 import SixSPS
     if isinstance(mechanism, SixSPS):
         if np.any(joints <= 0):
             raise FkoptError(f"{mechanism.name} joints: leg lengths must be positive, got {joints.tolist()}")

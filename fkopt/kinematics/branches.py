@@ -68,8 +68,9 @@ from fkopt.kinematics.results import INVERSE_TOL
 from fkopt.kinematics.solvers import inverse
 from fkopt.kinematics.start_tables import _sumsq, _uniform_hash
 from fkopt.mechanisms.base import SerialMechanism
-from fkopt.numerics import rotations
+from fkopt.numerics import path as numerics_path, rotations
 from fkopt.numerics.rotations import rotation_error1
+from fkopt.numerics.chain import Chain
 
 #: Tolerances of the solutions returned by ``solutions="all"`` unless ``tol`` is given
 #: (position in the arm's length unit, geodesic rotation in radians).
@@ -192,7 +193,6 @@ def _reduced_chain(chain, locked: dict[int, float]):
     """The chain with unknowns ``locked`` {index: internal value} turned into constants: every
     moving joint driven by a locked unknown gets multiplier 0 and offset mult * value + offset,
     the remaining unknowns renumbered in order."""
-    from fkopt.numerics.chain import Chain
     if not locked:
         return chain
     keep = [k for k in range(chain.dof) if k not in locked]
@@ -260,11 +260,10 @@ def _context(m, locked: dict[int, float], W) -> dict:
 
 
 def _kernels():
-    from fkopt.numerics import path as numerics_path
     if numerics_path.compiled(True) is None:          # FKOPT_NUMERICS=numpy
         raise FkoptError("inverse solutions='all' and inverse_path run on the compiled kernels; "
                          "they need numba (pip install numba) and FKOPT_NUMERICS other than numpy")
-    from fkopt.numerics import compiled_branches     # numba, an optional package: imported on first use
+    from fkopt.numerics import compiled_branches     # lazy: numba, an optional package
     return compiled_branches
 
 

@@ -136,7 +136,7 @@ def _fast_context(m, table: int, W) -> dict:
             "angle": np.array(c["angle"], dtype=np.bool_), "periodic": np.array(c["periodic"], dtype=np.bool_),
             "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
             "mid": np.array(c["mid"], dtype=float)}
-        from fkopt.numerics.compiled_ik import start_screen  # the compiled nearest-neighbour search's arguments
+        from fkopt.numerics.compiled_ik import start_screen  # lazy: numba (the compiled nearest-neighbour search)
         got["table"] = start_screen(got["Ft"], got["norms"])
     return got
 

@@ -5,6 +5,7 @@ import numbers
 from dataclasses import asdict, dataclass, fields
 
 from fkopt.errors import FkoptError
+from fkopt.api_bounds import check_options
 
 
 
@@ -38,7 +39,6 @@ class InverseOptions:
         """These options when every one is of its type and range, else FkoptError naming the
         first bad one and what it allows; the ranges, upper bounds included, are
         :mod:`fkopt.api_bounds`'s (``table`` at most 1,000,000: its memory)."""
-        from fkopt.api_bounds import check_options
         for f in fields(self):
             v = getattr(self, f.name)
             if f.name in ("exact_rotation",):

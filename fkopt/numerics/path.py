@@ -17,6 +17,7 @@ import threading
 from contextlib import contextmanager
 
 from fkopt.errors import FkoptError
+from fkopt.numerics.notice import notice
 
 ENV = "FKOPT_NUMERICS"
 _STATE: dict = {}
@@ -82,14 +83,14 @@ def compiled_ik(want: bool | None = None):
     """:mod:`fkopt.numerics.compiled_ik` (the compiled one-pose IK) when :func:`compiled` runs, else None."""
     if compiled(want) is None:
         return None
-    from fkopt.numerics import compiled_ik as mod       # numba, an optional package: imported on first use
+    from fkopt.numerics import compiled_ik as mod       # lazy: numba, an optional package
     return mod
 
 
 def _load():
     """(module, None) when numba imports and compiles, else (None, the reason in words)."""
     try:
-        from fkopt.numerics import compiled as mod
+        from fkopt.numerics import compiled as mod     # lazy: numba, an optional package
     except ImportError as err:
         missing = getattr(err, "name", None) or ""
         if missing.split(".")[0] in ("numba", "llvmlite"):
@@ -107,7 +108,6 @@ def _load():
 
 
 def _say_fallback(reason: str) -> None:
-    from fkopt.numerics.notice import notice
     notice("fallback", f"compiled numerics unavailable ({reason}); running the numpy path, which is "
                        f"slower (pip install numba to restore it; {ENV}=numpy silences this)")
 

@@ -69,6 +69,7 @@ from fkopt.errors import FkoptError
 from fkopt.run.writers import (ENV_FILE, RUNS, STEPS, TIMING, deterministic_files, file_digests, files_with,  # noqa: F401
                       files_with_rows, sha256)
 from fkopt.run.provenance import ANY, BLAS, EXACT  # noqa: F401
+from fkopt.files import csv_numbers, parse_csv, read_stored, read_stored_csv
 
 #: Family-wise significance level of the rank and Fisher tests of one experiment (Holm-corrected):
 #: over the 23 stored experiments a false alarm somewhere stays below 23 x 0.001 = 2.3 %.
@@ -149,12 +150,10 @@ def _py(v):
 
 def _read(path: Path) -> pd.DataFrame:
     """A CSV (or gzip'ed CSV) as text cells, so 'identical' means identical as written."""
-    from fkopt.files import parse_csv
     return parse_csv(_bytes(path), str(path), dtype=str, keep_default_na=False)
 
 
 def _stored_csv(folder: Path, name: str) -> pd.DataFrame:
-    from fkopt.files import read_stored_csv
     return read_stored_csv(folder, name)
 
 
@@ -215,7 +214,6 @@ def compare_tables(name: str, file: str, stored: pd.DataFrame, rerun: pd.DataFra
 
 # -- distributions of path-dependent runs --------------------------------------------------------
 def _numbers(series: pd.Series) -> np.ndarray:
-    from fkopt.files import csv_numbers
     return csv_numbers(series)           # never raises (a 400-digit integer is inf)
 
 
@@ -401,7 +399,6 @@ def first_difference(name: str, file: str, stored: bytes, rerun: bytes) -> Misma
 def _bytes(path: Path) -> bytes:
     """The (unpacked) bytes of a result file, bounded: inside its folder, a regular file, a gzip
     bomb one line, not the memory (:func:`fkopt.files.read_stored`)."""
-    from fkopt.files import read_stored
     return read_stored(path.parent, path.name)
 
 

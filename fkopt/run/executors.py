@@ -29,6 +29,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Callable
 
 from fkopt.errors import FkoptError
+from fkopt.files import available_cpus
 
 EXECUTORS = ("local", "dask")
 #: A Dask scheduler address: ``[tcp|tls]://host:port`` (or ``host:port``).
@@ -69,7 +70,6 @@ def check_scheduler(executor: str, scheduler: str | None) -> None:
 
 def worker_count(jobs: int, tasks: int) -> int:
     """Processes worth starting: at most ``jobs``, the CPUs available and the tasks."""
-    from fkopt.files import available_cpus
     return max(1, min(int(jobs), available_cpus(), int(tasks)))
 
 

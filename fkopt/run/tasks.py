@@ -32,6 +32,7 @@ from typing import Any, Callable
 from fkopt.errors import FkoptError
 from fkopt.files import inside, parse_json, read_stored, stored_sha256, write_file_atomically, write_json_atomically
 from fkopt.progress import listening
+from fkopt.run.executors import execute, worker_count
 
 TASKS = "tasks"
 MANIFEST = "manifest.json"
@@ -300,7 +301,6 @@ def run_tasks(plan: Plan, *, executor: str = "local", jobs: int = 1, scheduler: 
     reproduce``'s worker pool) nor reusable from ``store`` (``resume``); ``progress(label, done,
     total)`` after each. An exception (a failed task, KeyboardInterrupt, one raised by
     ``progress``) stops the run; with a store, every task finished so far stays on disk."""
-    from fkopt.run.executors import execute, worker_count
     start = time.perf_counter()
     timed = {t.id for t in plan.timed}
     # timings are measured by this run, never taken from elsewhere

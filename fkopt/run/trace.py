@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.files import MAX_UNPACKED, check_csv_shape, csv_numbers, read_input
+from fkopt.errors import FkoptError
 
 FILE = "trace.csv.gz"
 COLUMNS = ("case", "algorithm", "run", "iteration", "evaluations", "best_fitness")
@@ -116,7 +117,6 @@ def read_trace(folder: Path, limit: int = MAX_BYTES, columns: tuple[str, ...] = 
     (measured before parsing, so memory stays bounded), the ``columns`` (an experiment's
     :data:`COLUMNS` by default; a suite's trace has others), integer counts (evaluations >= 1)
     and numeric fitness values. Anything else is an FkoptError naming the file and what is wrong."""
-    from fkopt.errors import FkoptError
     path = Path(folder) / FILE
     labels = [c for c in columns if c not in INTEGER_COLUMNS and c != "best_fitness"]
     # bounded: a regular file inside the folder, unpacked size measured by streaming before parsing

@@ -30,6 +30,7 @@ from fkopt.run.config_base import MAX_ITERATIONS, MAX_POPULATION, Located, Mecha
 from fkopt.run.kinds import register
 from fkopt.run.solving import build_mechanism
 from fkopt.run.writers import CURVES, RUNS, TABLE, TIMING, Output
+from fkopt.kinematics.assembly_modes import all_solutions, solutions_to_dict
 
 KIND = "assembly"
 
@@ -78,7 +79,6 @@ def search(config: AssemblyConfig, source: str | None = None, mech=None) -> dict
     """The search; its record, JSON-able: every solution found (pose, residual, hits), the
     search's counts and its wall time. ``mech``: the config's mechanism, already built (else
     built here, its relative files beside ``source``)."""
-    from fkopt.kinematics.assembly_modes import all_solutions, solutions_to_dict
     mech = build_mechanism(config, files_folder(config, source)) if mech is None else mech
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,

@@ -24,7 +24,7 @@ from fkopt.run.record import ALONE, BATCH, concat, run_record, timing_record
 from fkopt.run.result import RunResult, dataclass_from_json, dataclass_to_json
 from fkopt.run.trace import COLUMNS as TRACE_COLUMNS, case_trace, concat_traces, trace_frame
 from fkopt.solve import Result, chunk_size, make_algorithm
-from fkopt.kinds.experiment.config import ExperimentConfig, RandomCases
+from fkopt.kinds.experiment.config import experiment_from_dict, ExperimentConfig, RandomCases
 from fkopt.run.config_base import AlgorithmSpec, files_folder, numeric_fields
 from fkopt.run.solving import (_check_in_bounds, build_mechanism, make_problem, outputs_of, pose_error, solve_cases,  # noqa: F401
                                start_point, task_seed)
@@ -248,7 +248,6 @@ def _time_one(config: ExperimentConfig, cases: list[Case], problems: list, c: in
 
 def solve_task(payload: dict) -> dict:
     """Worker: one algorithm of an experiment on all its cases, rebuilt from the payload."""
-    from fkopt.kinds.experiment.config import experiment_from_dict
     config = experiment_from_dict(json.loads(payload["config"]), "experiment task")
     mech, cases, problems, batched = _prepare(config, Path(payload["folder"]) if payload.get("folder") else None)
     return _solve_one(config, mech, cases, problems, batched, payload["algorithm"], payload["fingerprint"])

@@ -42,6 +42,7 @@ from fkopt.run.result import RunResult
 from fkopt.run.plotting import plt as _plt, save as _save
 from fkopt.files import nanmedian as _nanmedian
 from fkopt.kinds.study.statistics import ecdf_table, pairwise_tests
+from fkopt.problems import fk_problem, ik_problem
 
 
 def _algorithms(sr: RunResult) -> list[SimpleNamespace]:
@@ -339,7 +340,6 @@ def meta(sr: RunResult) -> dict:
     """What the config and the seed fix (the environment goes to env.json)."""
     objective = sr.config.objective
     if objective is None:
-        from fkopt.problems import fk_problem, ik_problem
         make = ik_problem if sr.own.mechanism.kind == "serial" else fk_problem
         objective = getattr(make(sr.own.mechanism, sr.own.poses.inputs[0]), "objective", None)
     return {

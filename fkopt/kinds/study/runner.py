@@ -30,7 +30,8 @@ from typing import Callable
 import numpy as np
 
 from fkopt.run.config_base import files_folder
-from fkopt.run.solving import build_mechanism, make_problem, solve_cases, start_point, task_seed
+from fkopt.run.solving import (build_mechanism, make_problem, outputs_of, pose_error, solve_cases, start_point,
+                               task_seed)
 from fkopt.problems import BoxedProblem
 from fkopt.run.record import BATCH, concat, run_record, timing_record
 from fkopt.run.result import RunResult
@@ -261,7 +262,6 @@ class StudyOwn:
 def study_tables(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]):
     """The run record, the timing record and each algorithm's wall time, from the task records:
     algorithm by algorithm, pose by pose (from 0, the index its seed takes), run by run."""
-    from fkopt.run.solving import outputs_of, pose_error
     n, runs, dim = len(poses), config.runs, len(mech.unknown_names)
     tasks = plan_tasks(config, n)
     case = "trajectory" if config.mode == "tracking" else "all"
