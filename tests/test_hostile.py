@@ -956,8 +956,12 @@ def test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it(tmp_pat
     _, err = p.communicate(timeout=60)
     assert p.returncode == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err[-500:]
     assert not (out / "studies" / "cut").exists()
-    kept = json.loads(manifest.read_text())["tasks"]
-    assert 2 <= len(kept) < 12
+    # the manifest names a task's digest before its file appears (fkopt.run.tasks.TaskStore.add), so a
+    # Ctrl-C between the two leaves a named task without a file, which --resume recomputes: the tasks
+    # kept are the named ones whose file is on disk
+    named = json.loads(manifest.read_text())["tasks"]
+    kept = [k for k in named if (manifest.parent / f"{k}.json").exists()]
+    assert 2 <= len(named) < 12 and len(named) - 1 <= len(kept) <= len(named)
     proc = subprocess.run([*run[:-1], "--out", str(out), "--resume"], capture_output=True, text=True, timeout=300,
                           env=env)
     assert proc.returncode == 0, proc.stderr
