@@ -392,14 +392,16 @@ def test_ikpy_tutorial_protocol_on_baxter():
 def test_clock_pin_holds_threads_started_before_it_and_the_blas_pool():
     """The clock track's one core (fkopt/adapters/field/cores.py): a thread that existed before the
     block (as OpenBLAS's pool or a Rust package's workers do) runs on the caller's core inside it,
-    the BLAS pool has one thread, and both are restored after."""
+    the BLAS pool has one thread, and both are restored after; a thread started inside the block
+    gets, after it, the affinity it would have inherited without the block."""
     import os
     import threading
+    import time
     from threadpoolctl import threadpool_info
     from fkopt.adapters.field.cores import pinned
     if not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2:
         pytest.skip("needs Linux affinity and two allowed cores")
-    ready, stop, tid = threading.Event(), threading.Event(), []
+    ready, stop, tid, late = threading.Event(), threading.Event(), [], None
 
     def worker():
         tid.append(threading.get_native_id())
@@ -415,9 +417,17 @@ def test_clock_pin_holds_threads_started_before_it_and_the_blas_pool():
             core = os.sched_getaffinity(0)
             assert len(core) == 1 and os.sched_getaffinity(tid[0]) == core
             assert all(i["num_threads"] == 1 for i in threadpool_info() if i.get("user_api") == "blas")
+            late = threading.Thread(target=worker)          # a pool a package starts inside the block
+            late.start()
+            while len(tid) < 2:
+                time.sleep(0.001)
+            assert os.sched_getaffinity(tid[1]) == core
         assert os.sched_getaffinity(0) == allowed and os.sched_getaffinity(tid[0]) == allowed
+        assert os.sched_getaffinity(tid[1]) == allowed     # what it would have inherited without the block
         with pinned(whole_process=False):       # a wrapper's per-call pin: the caller's thread only
             assert len(os.sched_getaffinity(0)) == 1 and os.sched_getaffinity(tid[0]) == allowed
     finally:
         stop.set()
         t.join()
+        if late is not None:
+            late.join()

@@ -14,14 +14,15 @@ afterwards inherit; the caller's core is ``sched_getcpu`` (glibc). Threads a pac
 both cores: a board stored with only the caller pinned showed entries using more CPU than wall
 time (CMA-ES 40 ms of CPU in a 20 ms call, OptIK 8x). So :func:`pinned` pins every thread of the
 process (``/proc/self/task``) and limits the BLAS and OpenMP pools to one thread
-(threadpoolctl) for the block, and restores both after. Where affinity is not available (not
+(threadpoolctl) for the block, and restores both after (threads started inside the block get
+the affinity they would have inherited without it). Where affinity is not available (not
 Linux) the block runs unpinned and :func:`pinned` says so (False).
 """
 from __future__ import annotations
 
 import ctypes
 import os
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 
 from threadpoolctl import threadpool_limits
 
@@ -52,7 +53,7 @@ def _threads() -> list[int]:
         return [0]
 
 
-def _set(tid: int, cores) -> dict | None:
+def _set(tid: int, cores) -> set[int] | None:
     """``tid``'s affinity before it is set to ``cores``; None when the thread is gone or not ours."""
     try:
         before = os.sched_getaffinity(tid)
@@ -79,12 +80,14 @@ def pinned(whole_process: bool = True):
     core = {caller_core(allowed)}
     before = {tid: _set(tid, core) for tid in (_threads() if whole_process else [0])}
     try:
-        if whole_process:
-            with threadpool_limits(limits=1):
-                yield True
-        else:
+        with threadpool_limits(limits=1) if whole_process else nullcontext():
             yield True
     finally:
         for tid, cores in before.items():
             if cores is not None:
                 _set(tid, cores)
+        # a thread started inside the block (a pool a package made lazily) inherited the one core:
+        # it gets the affinity it would have inherited without the block
+        for tid in (_threads() if whole_process else []):
+            if tid not in before:
+                _set(tid, allowed)

@@ -182,7 +182,7 @@ class TracIKSeeded(TracIK):
     def path(self, T: np.ndarray, start: np.ndarray) -> np.ndarray:
         q = (np.asarray(start, float) * self.arm._to_si).tolist()
         out = np.empty((len(T), self.arm.dof))
-        with pinned():
+        with pinned(whole_process=False):    # as TracIK.solve1: its own two threads on the caller's core
             for k, t in enumerate(T):
                 x, y, z, w = quaternion_xyzw1(t.tolist())
                 got = self._pt.ik(self._solver, q, t[0, 3], t[1, 3], t[2, 3], x, y, z, w)
