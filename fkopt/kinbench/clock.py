@@ -113,6 +113,22 @@ def query_rng(seed: int, robot: str, solver: str, timeout_ms: float | None, quer
     return np.random.default_rng(np.random.SeedSequence([int(seed), key, int(query)]))
 
 
+def timed(call, *args):
+    """``call(*args)`` with its wall time (``perf_counter``) and the CPU time of the whole process
+    (``process_time``: every thread a package starts): (result, wall s, CPU s). The one stopwatch
+    of the clock, all-solutions and paths tracks."""
+    c0 = time.process_time()
+    t0 = time.perf_counter()
+    out = call(*args)
+    dt = time.perf_counter() - t0
+    return out, dt, time.process_time() - c0
+
+
+def rotated(names: list, i: int) -> np.ndarray:
+    """``names`` rotated by ``i`` places: query i's order, so no entry always runs first."""
+    return np.roll(np.array(names, dtype=object), -(i % max(len(names), 1)))
+
+
 def _uses_timeout(solver) -> bool:
     return solver.settings.get("wall_clock_limit", True) is not False
 
@@ -181,11 +197,7 @@ def _clock_loop(runs, targets, seed, robot, j_ref, reference_repeats, answers, s
         for j, rep in order:
             name, t, solver = runs[j]
             solver.rng = query_rng(seed, robot, name, t, i)                # the reference: the same start
-            c0 = time.process_time()
-            t0 = time.perf_counter()
-            q, ok = solver.solve1(targets[i])
-            dt = time.perf_counter() - t0
-            dc = time.process_time() - c0
+            (q, ok), dt, dc = timed(solver.solve1, targets[i])
             if rep == 0:
                 seconds[i, j], cpu_seconds[i, j], claimed[i, j] = dt, dc, bool(ok)
                 if q is not None:

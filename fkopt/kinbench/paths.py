@@ -33,7 +33,6 @@ every path, with its verdict and joint step; ``fkopt check`` judges them again a
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +43,7 @@ from fkopt.adapters.field.cores import pinned
 from fkopt.errors import FkoptError
 from fkopt.files import csv_numbers, parse_json, read_input
 from fkopt.kinbench.answer_checks import _close
+from fkopt.kinbench.clock import rotated, timed
 from fkopt.kinbench.physical import ik_verdicts
 from fkopt.kinbench.posesets import csv_bytes, parse_set_csv, problem_mechanism, set_rng, sha256_bytes
 from fkopt.kinbench.releases import check_folder_release
@@ -182,11 +182,9 @@ def run_paths(arm, problem: str, ends: np.ndarray, solvers: list[str], *, refere
     order = list(entries)
     with pinned():
         for k in range(n):
-            for name in np.roll(np.array(order, dtype=object), -(k % max(len(order), 1))):
+            for name in rotated(order, k):
                 entries[name].rng = pose_rng(seed, problem, name, k)
-                c0, t0 = time.process_time(), time.perf_counter()
-                J[name][k] = entries[name].path(T[k], Q[k, 0])
-                secs[name][k], cpus[name][k] = time.perf_counter() - t0, time.process_time() - c0
+                J[name][k], secs[name][k], cpus[name][k] = timed(entries[name].path, T[k], Q[k, 0])
     rows = []
     for name in names:
         for k in range(n):

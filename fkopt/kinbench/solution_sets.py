@@ -37,7 +37,6 @@ with fkopt's FK and recomputes the board (``leaderboard-solutions.csv``) from th
 """
 from __future__ import annotations
 
-import time
 import zlib
 from pathlib import Path
 
@@ -50,6 +49,7 @@ from fkopt.adapters.field.track_entries import locked_arm
 from fkopt.errors import FkoptError
 from fkopt.files import csv_numbers, read_stored_csv
 from fkopt.kinbench.answer_checks import _close, differing_numbers
+from fkopt.kinbench.clock import rotated, timed
 from fkopt.kinbench.physical import ik_verdicts
 from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
 from fkopt.registry import clock_solver
@@ -192,9 +192,7 @@ def run_solutions(arm, solved, fixed: dict, problem: str, queries: np.ndarray, s
 
     def call(entry, name, i):
         entry.rng = pose_rng(seed, problem, name, i)
-        c0, t0 = time.process_time(), time.perf_counter()
-        Q = entry.solutions(T[i])
-        secs[name][i], cpus[name][i] = time.perf_counter() - t0, time.process_time() - c0
+        Q, secs[name][i], cpus[name][i] = timed(entry.solutions, T[i])
         found[name][i] = np.asarray(Q, float).reshape(-1, solved.dof)
 
     with pinned():
@@ -215,7 +213,7 @@ def run_solutions(arm, solved, fixed: dict, problem: str, queries: np.ndarray, s
             settings.update({name: {"not_applicable": w} for name, w in why.items()})
         order = list(entries)
         for i in range(n):
-            for name in np.roll(np.array(order, dtype=object), -(i % max(len(order), 1))):
+            for name in rotated(order, i):
                 call(entries[name], name, i)
     rows = []
     for name in names:
