@@ -1,5 +1,6 @@
 import os
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -196,3 +197,18 @@ def pytest_sessionfinish(session, exitstatus):
             "fast tier imports no test of these fkopt modules (add a small fast test): " + ", ".join(missing),
             red=True)
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def wait_while_running(proc, ready, timeout: float) -> None:
+    """Poll ``ready()`` every 50 ms until it holds, ``proc`` (a Popen) has ended or ``timeout`` s have
+    passed: the interruption tests' wait for a run to reach the point where they send it SIGINT. A
+    file that is being written (``OSError``, ``ValueError``, ``KeyError`` while reading it) is not
+    ready yet. The caller asserts that ``proc`` still runs."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None:
+        try:
+            if ready():
+                return
+        except (OSError, ValueError, KeyError):
+            pass
+        time.sleep(0.05)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from conftest import wait_while_running
 
 
 BASE = {
@@ -901,9 +902,7 @@ def _interrupt(tmp_path, prev, slow, command, how):
                          start_new_session=True, env=env)
     # interrupt once it computes: its lock file (OUT/<paper>/.<name>.lock) appears after imports and
     # validation (about a second on an idle machine, far longer on a loaded one), then half a second
-    deadline = time.monotonic() + 240
-    while not list(out.glob(f"*/.{slow['name']}.lock")) and p.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_while_running(p, lambda: list(out.glob(f"*/.{slow['name']}.lock")), 240)
     time.sleep(0.5)
     assert p.poll() is None, "the rerun finished before it could be interrupted; make SLOW slower"
     os.killpg(p.pid, how)
@@ -943,14 +942,8 @@ def test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it(tmp_pat
     manifest = out / "studies" / ".cut.partial" / "tasks" / "manifest.json"
     p = subprocess.Popen([*run, "--out", str(out), "--jobs", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          text=True, start_new_session=True, env=env)
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and p.poll() is None:     # until some, not all, tasks are on disk
-        try:
-            if len(json.loads(manifest.read_text())["tasks"]) >= 2:
-                break
-        except (OSError, ValueError, KeyError):
-            pass
-        time.sleep(0.05)
+    # until some, not all, tasks are on disk
+    wait_while_running(p, lambda: len(json.loads(manifest.read_text())["tasks"]) >= 2, 120)
     assert p.poll() is None, "the run finished before it could be interrupted"
     os.killpg(p.pid, signal.SIGINT)
     _, err = p.communicate(timeout=60)

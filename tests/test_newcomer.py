@@ -5,6 +5,7 @@ import hashlib
 from pathlib import Path
 
 import yaml
+from conftest import wait_while_running
 
 
 def _tree(root: Path) -> dict[str, str]:
@@ -58,9 +59,7 @@ def _interrupted(tmp_path, command, config, *extra):
     out = tmp_path / "out"
     p = subprocess.Popen([sys.executable, "-m", "fkopt.cli", command, str(cfg), "--out", str(out), "-q", *extra],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True, env=env)
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and p.poll() is None and not list(out.glob("*/.*.lock")):
-        time.sleep(0.05)                 # until it computes (it holds OUT/<paper>/.<name>.lock)
+    wait_while_running(p, lambda: list(out.glob("*/.*.lock")), 120)   # until it computes (it holds OUT/<paper>/.<name>.lock)
     time.sleep(0.5)
     assert p.poll() is None, "the run finished before it could be interrupted; make it slower"
     os.killpg(p.pid, signal.SIGINT)

@@ -5,7 +5,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +17,7 @@ from fkopt.run.pipeline import from_dict, plan_config, run_config, run_in_memory
 from fkopt.run.result import RunResult, dataclass_from_json, dataclass_to_json, from_json, to_json
 from fkopt.run.tasks import TASKS, run_tasks
 from fkopt.solve import Result
+from conftest import wait_while_running
 
 ROOT = Path(__file__).resolve().parents[1]
 EXPERIMENT = {"name": "two", "paper": "test", "mechanism": {"name": "3-rps"}, "seed": 3,
@@ -133,14 +133,8 @@ def test_ctrl_c_of_an_experiment_keeps_its_tasks_and_resume_finishes_it(tmp_path
     manifest = out / "test" / ".cut.partial" / TASKS / "manifest.json"
     p = subprocess.Popen([*run, "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                          start_new_session=True, env=env)
-    deadline = time.monotonic() + 240
-    while time.monotonic() < deadline and p.poll() is None:     # until the first task is on disk
-        try:
-            if (manifest.parent / "a00.json").exists() and "a00" in json.loads(manifest.read_text())["tasks"]:
-                break
-        except (OSError, ValueError, KeyError):
-            pass
-        time.sleep(0.05)
+    wait_while_running(p, lambda: (manifest.parent / "a00.json").exists()        # the first task on disk
+                       and "a00" in json.loads(manifest.read_text())["tasks"], 240)
     assert p.poll() is None, "the run finished before it could be interrupted; make abc slower"
     os.killpg(p.pid, signal.SIGINT)
     _, err = p.communicate(timeout=60)
