@@ -81,6 +81,20 @@ def reflow_help() -> None:
             info.help = "\n\n".join(" ".join(p.split()) for p in paragraphs)
 
 
+def exit_interrupted(message: str) -> None:
+    """Print ``message`` and exit with status 130 (Ctrl-C handled), never by the signal itself.
+
+    CPython (3.11) marks a KeyboardInterrupt raised inside ``exec``/``eval`` of a *string*
+    (numba, dataclasses and namedtuple build code that way while a run starts) as unhandled in
+    ``run_eval_code_obj``, and that mark survives our ``except``: the interpreter then ends by
+    re-raising SIGINT (status -2) after printing our line. The mark is cleared at the start of the
+    next string ``exec``, so one empty ``exec`` forgets it (tests/test_hostile.py sends SIGINT
+    inside such an ``exec``; CI once saw -2 from a real run interrupted at that moment)."""
+    print(message, file=sys.stderr)
+    exec("pass")   # noqa: S102 -- a constant string: clears CPython's unhandled-interrupt mark
+    sys.exit(130)
+
+
 def main() -> None:
     """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
     def interrupted() -> str:
@@ -98,8 +112,7 @@ def main() -> None:
     except FkoptError as err:
         fail(str(err))
     except KeyboardInterrupt:
-        print(interrupted(), file=sys.stderr)
-        sys.exit(130)
+        exit_interrupted(interrupted())
     except MemoryError:
         fail("out of memory; reduce runs, population, iterations or cases")
     except RecursionError:
@@ -114,13 +127,11 @@ def main() -> None:
         if kind == "Abort" and isinstance(err.__cause__, EOFError):   # click turns EOFError into Abort
             fail(f"unexpected end of a file (truncated input?): {err.__cause__ or 'EOFError'}")
         if kind == "Abort":
-            print(interrupted(), file=sys.stderr)
-            sys.exit(130)
+            exit_interrupted(interrupted())
         if callable(getattr(err, "format_message", None)):
             fail(f"{err.format_message()} (see fkopt --help)")
         raise
     if code == 130:   # typer (>= 0.12) turns Ctrl-C into a returned 130 when not standalone
-        print(interrupted(), file=sys.stderr)
-        sys.exit(130)
+        exit_interrupted(interrupted())
     if isinstance(code, int) and code:
         sys.exit(code)
