@@ -188,6 +188,53 @@ def test_numpy_tan_layout_is_the_numpy_fitness_call_and_the_libm_tan_differs():
     assert 0.0 <= differ < 0.05          # ~0.7 % with AVX-512 SVML, 0 with libm
 
 
+def test_numpys_tan_loop_called_from_compiled_code_is_np_tan_bit_for_bit():
+    """numpy's own float64 tan loop, read from the ufunc object and called from compiled code
+    (fkopt.numerics.ufunc_loop), gives np.tan's bits on every length (SIMD bodies and tails) and
+    offset, values from tiny to huge and the specials; rps3_kernels.numpy_tan_loop cuts a fitness
+    call's blocks as numpy_tan does and writes nothing outside its range."""
+    from fkopt.numerics import ufunc_loop
+    loop = rps3_kernels.numpy_tan_address()
+    assert loop is not None                      # CPython with numpy's ufunc layout: read and verified
+    rng = np.random.default_rng(8)
+    for n in range(0, 140):
+        a = rng.uniform(-1, 1, n + 6) * 10.0 ** rng.uniform(-6, 6, n + 6)
+        a[rng.integers(0, n + 6, 2)] = (np.nan, -np.inf)
+        start = int(rng.integers(0, 6))
+        want, got = np.full(n + 6, 5.0), np.full(n + 6, 5.0)
+        with np.errstate(all="ignore"):
+            np.tan(a[start:start + n], out=want[start:start + n])
+        ufunc_loop.call_unary_loop(loop[0], loop[1], a, got, start, n)
+        assert np.array_equal(want.view(np.int64), got.view(np.int64)), n
+    arg = rng.uniform(-0.2, 0.2, 2 * 40)
+    for s0, sl, block in ((0, 40, 7), (3, 20, 7), (5, 0, 7), (0, 40, 64)):
+        want, got = np.full(80, 5.0), np.full(80, 5.0)
+        rps3_kernels.numpy_tan(arg, want, ((s0, sl),), block)
+        rps3_kernels.numpy_tan_loop(loop[0], loop[1], arg, got, s0, sl, block)
+        assert np.array_equal(want, got), (s0, sl, block)
+    with pytest.raises(IndexError):
+        ufunc_loop.call_unary_loop(loop[0], loop[1], arg, got, 70, 20)
+
+
+def test_a_ufunc_loop_that_is_not_the_ufuncs_own_is_refused(monkeypatch):
+    """unary_loop checks the loop it read against the ufunc itself: np.sin's loop offered as
+    np.tan's is refused (None: the iterations call np.tan from Python), as are a two-argument
+    ufunc and anything that is not a numpy ufunc."""
+    from fkopt.numerics import ufunc_loop
+    sin = ufunc_loop._read_loop(np.sin)
+    assert sin is not None and sin != ufunc_loop._read_loop(np.tan)
+    monkeypatch.setattr(ufunc_loop, "_read_loop", lambda ufunc: sin)
+    ufunc_loop.unary_loop.cache_clear()
+    try:
+        assert ufunc_loop.unary_loop(np.tan) is None
+        assert ufunc_loop.unary_loop(np.sin) == sin
+    finally:
+        monkeypatch.undo()
+        ufunc_loop.unary_loop.cache_clear()
+    assert ufunc_loop.unary_loop(np.add) is None and ufunc_loop.unary_loop(abs) is None
+    assert ufunc_loop.unary_loop(np.tan) is not None
+
+
 SWARM_CASES = [("pso", {}, 10, {}), ("abc", {}, 10, {}), ("abc", {"limit": 3}, 10, {}), ("gabc", {}, 10, {}),
                ("gabc", {"rule": "zhu2010", "limit": 4}, 10, {}),
                ("gabc", {}, 40, {}),        # 40 > 32 bees: the roulette's binary search (abc.DENSE_ROULETTE)
@@ -207,7 +254,9 @@ def test_compiled_swarms_give_the_numpy_paths_runs_bit_for_bit(monkeypatch, algo
     (fkopt.algorithms.pso_kernels / abc_kernels on fkopt.mechanisms.rps3_kernels, around numpy's np.tan); through the real solver,
     every record equals FKOPT_NUMERICS=numpy's bit for bit -- points, fitness, histories,
     evaluation counts and the evaluation log -- on two seeds, one and three cases (a target
-    per row: the scouts' own fitness call), scouts included (small limits make them fly)."""
+    per row: the scouts' own fitness call), scouts included (small limits make them fly). fkopt's
+    own ABC and GABC run many iterations per compiled call there (numpy's tan loop called from
+    compiled code, ABC.compiled_advance) unless a run may stop at its target."""
     from fkopt.algorithms.abc import ABC
     from fkopt.algorithms.pso import PSO
     m = fkopt.mechanism("3-rps")
@@ -216,8 +265,10 @@ def test_compiled_swarms_give_the_numpy_paths_runs_bit_for_bit(monkeypatch, algo
     options = dict(options)
     p = fkopt.fk_problem(m, joints[0] if cases == 1 else joints, objective=options.pop("objective", "squared"))
     ran = []
-    spy = rps3_kernels.numpy_tan
-    monkeypatch.setattr(rps3_kernels, "numpy_tan", lambda *a: ran.append(1) or spy(*a))
+    spy, spy_advance = rps3_kernels.numpy_tan, ABC._advance_compiled
+    monkeypatch.setattr(rps3_kernels, "numpy_tan", lambda *a: ran.append("tan") or spy(*a))
+    monkeypatch.setattr(ABC, "_advance_compiled", lambda *a: ran.append("advance") or spy_advance(*a))
+    several = algorithm in ("abc", "gabc") and "stop_at_target" not in options
     for seed in (3, 4):
         got = {}
         for mode in (None, "numpy"):
@@ -229,6 +280,7 @@ def test_compiled_swarms_give_the_numpy_paths_runs_bit_for_bit(monkeypatch, algo
             got[mode] = fkopt.solve(p, algorithm, population=population, iterations=100, runs=6, seed=seed,
                                     params=params, **options)
             assert bool(ran) == (mode is None)           # the compiled iteration ran by default only
+            assert ("advance" in ran) == (several and mode is None)
         fused, ref = got[None], got["numpy"]
         for name in ("x", "fitness", "history", "evaluation_history", "evaluations", "iterations_done"):
             assert np.array_equal(getattr(fused, name), getattr(ref, name)), (name, seed)
@@ -238,6 +290,35 @@ def test_compiled_swarms_give_the_numpy_paths_runs_bit_for_bit(monkeypatch, algo
         assert (fused.iterations_done < 100).any()
     kind = PSO._compiled_step(p) if algorithm == "pso" else ABC()._compiled_iteration(p)
     assert kind is None                                    # FKOPT_NUMERICS=numpy (still set): the reference
+
+
+@pytest.mark.parametrize("algorithm,params", [("abc", {"limit": 3}), ("gabc", {}), ("gabc", {"rule": "zhu2010"})])
+def test_compiled_abc_without_numpys_tan_loop_takes_one_iteration_per_call_with_the_same_bits(monkeypatch, algorithm,
+                                                                                            params):
+    """Where numpy's tan loop cannot be called from compiled code (numpy_tan_address None), ABC
+    and GABC offer no compiled_advance and run one compiled iteration per call around np.tan
+    from Python: the numpy path's runs all the same, snapshots and best points per iteration too;
+    with the loop, several iterations per call give the same records."""
+    from fkopt.algorithms.abc import ABC
+    m = fkopt.mechanism("3-rps")
+    targets = m.bounds[:, 0] + np.random.default_rng(5).random((3, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    p_loop, p_none = (fkopt.fk_problem(m, m.ik(targets)) for _ in range(2))
+    options = dict(population=10, iterations=80, runs=4, seed=2, params=params, x_history=True, snapshots=(0, 7, 80))
+    got = {}
+    for mode, p in (("numpy", p_none), ("loop", p_loop), ("none", p_none)):
+        monkeypatch.setenv(numerics_path.ENV, "numpy" if mode == "numpy" else "auto")
+        if mode == "none":
+            monkeypatch.setattr(rps3_kernels, "numpy_tan_address", lambda: None)
+            assert ABC().compiled_advance(p) is None and ABC()._compiled_iteration(p) is not None
+        if mode == "loop":
+            assert ABC().compiled_advance(p) is not None
+        got[mode] = fkopt.solve(p, algorithm, **options)
+    for mode in ("loop", "none"):
+        for name in ("x", "fitness", "history", "evaluation_history", "x_history", "evaluations"):
+            assert np.array_equal(getattr(got[mode], name), getattr(got["numpy"], name)), (mode, name)
+        assert all(np.array_equal(a, b) for a, b in zip(got[mode].events, got["numpy"].events))
+        assert sorted(got[mode].snapshots) == [0, 7, 80]
+        assert all(np.array_equal(got[mode].snapshots[t], got["numpy"].snapshots[t]) for t in (0, 7, 80))
 
 
 def test_compiled_swarms_span_the_numpy_fitness_blocks(monkeypatch):

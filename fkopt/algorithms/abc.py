@@ -211,6 +211,13 @@ def _compiled_iteration(fitness):
     return abc_iteration(fitness)
 
 
+def _compiled_iterations(fitness):
+    """:func:`fkopt.algorithms.abc_kernels.abc_iterations` on a mechanism's compiled fitness (None
+    without numpy's ufunc loop)."""
+    from fkopt.algorithms.abc_kernels import abc_iterations  # imports numba: only once the compiled path runs
+    return abc_iterations(fitness)
+
+
 class ABC(Algorithm):
     name = "abc"
     blas_free = True          # elementwise numpy only: no BLAS kernel decides its bits
@@ -276,6 +283,49 @@ class ABC(Algorithm):
         log_kept(state, kept)
         state.best_x, state.best_f, state.best_folded = best_x, best_f, True
         state.evaluations = evaluations         # + 2 SN, + 1 where a scout flew
+
+    def compiled_advance(self, problem):
+        """Several iterations per compiled call (:meth:`fkopt.algorithms.base.Algorithm.compiled_advance`)
+        where the iteration is compiled (:meth:`compiled_rule`, :func:`compiled_step`) and numpy's
+        ufunc loop is callable from compiled code (:func:`fkopt.algorithms.abc_kernels.abc_iterations`),
+        else None (minimize then calls :meth:`iterate`)."""
+        rule = self.compiled_rule()
+        got = None if rule is None else compiled_step(problem, _compiled_iterations)
+        if got is None or got[0] is None:
+            return None
+        kernel, absolute = got
+        return lambda state, streams, first, last, history, evaluations, x_history: self._advance_compiled(
+            state, problem, streams, first, last, history, evaluations, x_history, kernel, absolute, rule)
+
+    def _advance_compiled(self, state, problem, streams, first, last, history, evaluations, x_history, kernel,
+                          absolute, rule):
+        """Iterations first..k in one compiled call (k <= last: as many as
+        :data:`fkopt.algorithms.abc_kernels.ITERATIONS_UNIFORMS` uniforms allow, at least one); the
+        draws of iteration t are the block :meth:`_iterate_compiled` draws, taken for all k in one
+        call (the same values: a stream hands out its values in order). Returns k."""
+        from fkopt.algorithms.abc_kernels import ITERATIONS_UNIFORMS
+        _aux(state, problem)                        # x, f, trial: C-contiguous arrays of our own
+        runs, population, dim = state.x.shape
+        width = dim + 2 * (4 if rule == 2 else 3) * population + population
+        k = max(1, min(last + 1 - first, ITERATIONS_UNIFORMS // (runs * width)))
+        u = streams.uniform(k * width)
+        if problem.cases is not None:
+            problem._check_cases(state.x)
+        J = problem._joint_rows(state.x.shape[:-1])
+        # written in place by the kernel: new arrays, as update_best makes
+        best_x, best_f = state.best_x.copy(), state.best_f.copy()
+        evals = np.array(state.evaluations, dtype=np.int64)
+        C = getattr(self.params, "C", 0.0)
+        log = log_arrays(state, runs)
+        done = 0
+        while done < k:                             # more than one call only when the log's arrays fill up
+            n, kept = kernel(state.x, state.f, state.trial, best_x, best_f, u[:, done * width:], width, state.limit,
+                             rule, C, problem.bounds, J, absolute, log, problem.cases is not None, evals, history,
+                             evaluations, x_history, first + done)
+            log_kept(state, kept)
+            done += n
+        state.best_x, state.best_f, state.evaluations = best_x, best_f, evals
+        return first + k - 1
 
     def step(self, state, xs, xk, phi, streams):
         """The move added to the chosen coordinate, on whole rows (overridden by GABC).

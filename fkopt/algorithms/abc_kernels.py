@@ -108,13 +108,14 @@ def _kernels(prepare, value):
 
     @njit(cache=True, error_model="numpy")
     def employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, params, absolute, separate, ns, jj, mv,
-                        scout, out, fe, fo_src, fo_jj, fo_mv, arg, lbest, lcount, lactive, hr, he, hf, block):
+                        scout, out, fe, fo_src, fo_jj, fo_mv, arg, lbest, lcount, lactive, hr, he, hf, nh, block):
         """After the ufunc on :func:`employed_move`'s arguments, for every run: the fitness of the
         fresh scout and of the employed candidates (NaN read as +inf, as ``np.fmin(f, inf)``) into
         fe, the greedy selection, the reports to the evaluation log held as arrays (employed, then
         the scout: :func:`log_points`), GABC's best-so-far (rules 1, 2), the onlookers' roulette
         into fo_src and their moves into fo_jj, fo_mv with their arguments in ``arg`` (one call of
-        runs SN poses). Returns the number of improvements the log keeps."""
+        runs SN poses). ``nh``: the improvements kept so far in hr, he, hf; returns their number after
+        this phase."""
         runs, pop, dim = x.shape
         n = runs * pop
         one = J.shape[1] == 1
@@ -122,7 +123,6 @@ def _kernels(prepare, value):
         cdf = np.empty(pop)
         fs = np.empty(1)
         y = np.empty(3)
-        nh = 0
         c_scout = n
         sl = n if separate else n + ns                     # as employed_move: outside the loops
         s0, sl_scout = (n, ns) if separate else (0, n + ns)
@@ -277,10 +277,124 @@ def abc_iteration(fitness):
         ns = employed_move(x, trial, best_x, u, limit, rule, C, lo, hi, separate, jj, mv, scout, arg, block)
         ufunc(arg, out, ((0, n), (n, ns)) if separate else ((0, n + ns),), block)
         nh = employed_finish(x, f, trial, best_x, best_f, u, rule, C, lo, hi, J, params, absolute, separate, ns, jj,
-                             mv, scout, out, fe, fo_src, fo_jj, fo_mv, arg, best, count, active, hr, he, hf, block)
+                             mv, scout, out, fe, fo_src, fo_jj, fo_mv, arg, best, count, active, hr, he, hf, 0, block)
         ufunc(arg, out, ((0, n),), block)
         new_evals = np.empty(runs, dtype=np.int64)
         nh = onlooker_finish(x, f, trial, J, params, absolute, fo_src, fo_jj, fo_mv, out, fo, best_x, best_f, best,
                              count, active, hr, he, hf, nh, block, scout, evaluations, new_evals)
         return new_evals, kept(hr, he, hf, nh)
     return step
+
+
+#: The uniforms one :func:`abc_iterations` call takes at most, over all runs (values; 256 kB): the
+#: block stays in cache beside the state, and at many rows a call is one iteration anyway.
+ITERATIONS_UNIFORMS = 1 << 15
+
+
+@lru_cache(maxsize=8)
+def _iterations_kernel(prepare, value, ufunc_compiled):
+    """Several whole iterations in one compiled call: :func:`_kernels`' phases with numpy's ufunc
+    loop called from compiled code (``ufunc_compiled``: :class:`fkopt.mechanisms.base.CompiledFitness`),
+    and what :meth:`fkopt.algorithms.base.Algorithm.minimize` does after each iteration (the log's
+    start and finish, the records)."""
+    employed_move, employed_finish, onlooker_finish = _kernels(prepare, value)
+
+    @njit(cache=True, error_model="numpy")
+    def ufunc_calls(loop, data, arg, out, separate, n, ns, block):
+        """The ufunc on the candidates' arguments as the numpy path's fitness calls see them:
+        poses [0, n) then the ns scouts in a call of their own (``separate``), or [0, n + ns)."""
+        if separate:
+            ufunc_compiled(loop, data, arg, out, 0, n, block)
+            ufunc_compiled(loop, data, arg, out, n, ns, block)
+        else:
+            ufunc_compiled(loop, data, arg, out, 0, n + ns, block)
+
+    @njit(cache=True, error_model="numpy")
+    def iterations(x, f, trial, best_x, best_f, u, width, limit, rule, C, lo, hi, J, params, absolute, separate,
+                   evaluations, lbest, lcount, lactive, hr, he, hf, jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg,
+                   out, loop, data, history, ev_history, x_history, t0, block):
+        """Iterations t0, t0 + 1, ... of every run, one per ``width`` uniforms of ``u`` (runs,
+        k width), as :func:`abc_iteration`'s step followed by minimize's bookkeeping: the log's
+        count set to the runs' evaluations (EvaluationLog.start), the iteration, an improvement of
+        best_f that no reported value reached kept at the iteration's last evaluation
+        (EvaluationLog.finish), and best_f, the evaluations and (x_history not empty) best_x
+        recorded in column t of the histories. Stops early when the log's arrays hr, he, hf might
+        not hold another iteration's improvements. Returns (iterations done, improvements kept)."""
+        runs, pop, dim = x.shape
+        n = runs * pop
+        most = runs * (2 * pop + 1)
+        keep_x = x_history.shape[1] > 0
+        nh = 0
+        count = u.shape[1] // width
+        for it in range(count):
+            if nh + most > hr.shape[0]:
+                return it, nh
+            ui = u[:, it * width:(it + 1) * width]
+            for a in range(runs):
+                lcount[a] = evaluations[a]
+            ns = employed_move(x, trial, best_x, ui, limit, rule, C, lo, hi, separate, jj, mv, scout, arg, block)
+            ufunc_calls(loop, data, arg, out, separate, n, ns, block)
+            nh = employed_finish(x, f, trial, best_x, best_f, ui, rule, C, lo, hi, J, params, absolute, separate, ns,
+                                 jj, mv, scout, out, fe, fo_src, fo_jj, fo_mv, arg, lbest, lcount, lactive, hr, he, hf,
+                                 nh, block)
+            ufunc_calls(loop, data, arg, out, False, n, 0, block)
+            nh = onlooker_finish(x, f, trial, J, params, absolute, fo_src, fo_jj, fo_mv, out, fo, best_x, best_f,
+                                 lbest, lcount, lactive, hr, he, hf, nh, block, scout, evaluations, evaluations)
+            t = t0 + it
+            for a in range(runs):
+                if best_f[a] < lbest[a] and lactive[a]:       # EvaluationLog.finish
+                    hr[nh] = a
+                    he[nh] = evaluations[a]
+                    hf[nh] = best_f[a]
+                    nh += 1
+                    lbest[a] = best_f[a]
+                history[a, t] = best_f[a]
+                ev_history[a, t] = evaluations[a]
+                if keep_x:
+                    for d in range(dim):
+                        x_history[a, t, d] = best_x[a, d]
+        return count, nh
+
+    return iterations
+
+
+def abc_iterations(fitness):
+    """Several ABC or GABC iterations per call on ``fitness`` (a :class:`fkopt.mechanisms.base.CompiledFitness`
+    whose ufunc loop numpy's object gave, ``fitness.ufunc_loop``), or None without that loop:
+    ``advance(x, f, trial, best_x, best_f, u, width, limit, rule, C, bounds, J, absolute, log, separate,
+    evaluations, history, ev_history, x_history, t0)`` runs iterations t0, t0 + 1, ... on ``width``
+    uniforms each of ``u`` (:func:`abc_iteration`'s arguments; x, f, trial, best_x, best_f,
+    evaluations and the log's arrays updated in place) and records them in the histories
+    (:meth:`fkopt.algorithms.base.Algorithm.minimize`'s arrays; x_history None: not kept). Returns
+    (iterations done, which may be fewer than u holds: call again on the rest; (rows, evaluation
+    numbers, values) of the improvements the log keeps). Same draws, same operations, same bits
+    as :func:`abc_iteration` followed by minimize's bookkeeping (tests/test_numerics.py)."""
+    if fitness.ufunc_loop is None or fitness.ufunc_compiled is None:
+        return None
+    kernel = _iterations_kernel(fitness.prepare, fitness.value, fitness.ufunc_compiled)
+    width_f, block, params = fitness.width, fitness.block, fitness.params
+    loop, data = fitness.ufunc_loop
+
+    def advance(x, f, trial, best_x, best_f, u, width, limit, rule, C, bounds, J, absolute, log, separate,
+                evaluations, history, ev_history, x_history, t0):
+        runs, pop, dim = x.shape
+        n = runs * pop
+        most = runs * (2 * pop + 1)
+
+        def make():
+            room = 2 * most + 4096         # improvements are rare after the first iterations
+            return ([np.empty((runs, pop), dtype=np.int64) for _ in range(3)]
+                    + [np.empty((runs, pop)) for _ in range(4)]
+                    + [np.empty(runs, dtype=np.int64), np.empty(width_f * (n + runs)), np.empty(width_f * (n + runs)),
+                       np.empty(room, dtype=np.intp), np.empty(room, dtype=np.int64), np.empty(room),
+                       np.ascontiguousarray(bounds[:, 0], dtype=float),
+                       np.ascontiguousarray(bounds[:, 1], dtype=float), np.empty((runs, 0, dim))])
+        jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out, hr, he, hf, lo, hi, no_x = scratch_arrays(
+            ("abc-iterations", runs, pop, width_f, bounds.tobytes()), make)
+        best, count, active = log
+        done, nh = kernel(x, f, trial, best_x, best_f, u, int(width), int(limit), int(rule), float(C), lo, hi,
+                          np.ascontiguousarray(J, dtype=float), params, bool(absolute), bool(separate), evaluations,
+                          best, count, active, hr, he, hf, jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out,
+                          loop, data, history, ev_history, no_x if x_history is None else x_history, int(t0), block)
+        return done, kept(hr, he, hf, nh)
+    return advance

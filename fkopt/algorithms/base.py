@@ -288,6 +288,16 @@ class Algorithm:
     def iterate(self, state: State, problem, streams: RunStreams) -> None:
         raise NotImplementedError
 
+    def compiled_advance(self, problem):
+        """None, or ``advance(state, streams, first, last, history, evaluations, x_history)`` that runs
+        iterations first..k (first <= k <= last) in one compiled call and returns k: each iteration
+        with everything :meth:`minimize` does around :meth:`iterate` (the log's start and finish,
+        the best-so-far, the records: column t of ``history``, ``evaluations`` and, when not None,
+        ``x_history``), the same bits. Offered by an algorithm without :meth:`extras`; minimize
+        takes it when no run can stop at a target (fkopt's ABC and GABC on a compiled fitness:
+        :meth:`fkopt.algorithms.abc.ABC.compiled_advance`)."""
+        return None
+
     def extras(self, state: State) -> dict[str, np.ndarray]:
         """Extra per-run scalars to record each iteration (e.g. ACO pheromone)."""
         return {}
@@ -403,7 +413,17 @@ class Algorithm:
         record(0)
         last = iterations
         watch = stop_at_target and target is not None
-        for t in range(1, iterations + 1):
+        advance = None if watch or plugin else self.compiled_advance(problem)
+        t = 1
+        while advance is not None and t <= iterations:   # several iterations per compiled call
+            stop = min([s for s in wanted if s >= t] + [iterations])
+            t = advance(state, streams, t, stop, history, evals, xs)
+            final_x = state.best_x
+            if t in wanted:
+                snaps[t] = np.array(state.x, copy=True)
+            tick(t, iterations)
+            t += 1
+        for t in range(t, iterations + 1):
             if watch:
                 newly = ~done & (history[:, t - 1] < target)
                 if newly.any():

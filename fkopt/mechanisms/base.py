@@ -280,6 +280,11 @@ class CompiledFitness(NamedTuple):
     width: int          # ufunc arguments per pose (the buffers hold width * poses values)
     block: int          # poses per block of the numpy fitness
     params: tuple       # the geometry's floats ``value`` reads
+    #: ``ufunc`` from compiled code: njit (loop, data, arg, out, s0, sl, block), numpy's own loop of
+    #: the ufunc called by address (:mod:`fkopt.numerics.ufunc_loop`), and that (loop, data); None
+    #: where numpy's loop cannot be read (then the iterations call ``ufunc`` from Python)
+    ufunc_compiled: Callable | None = None
+    ufunc_loop: tuple | None = None
 
 
 class ParallelMechanism(Mechanism):

@@ -236,7 +236,8 @@ class ThreeRPS(ParallelMechanism):
         from fkopt.mechanisms import rps3_kernels      # imports numba: only once the compiled path runs
         k = rps3_kernels
         return CompiledFitness(prepare=k.prepare, ufunc=k.numpy_tan, value=k.value, width=2, block=BLOCK,
-                               params=(float(self.geometry.ra), float(self.geometry.rb)))
+                               params=(float(self.geometry.ra), float(self.geometry.rb)),
+                               ufunc_compiled=k.numpy_tan_loop, ufunc_loop=k.numpy_tan_address())
 
     def jacobian(self, poses) -> np.ndarray:
         """d(d_1, d_2, d_3)/d(alpha, beta, z), shaped (..., 3, 3): mm per degree and mm per mm.

@@ -20,7 +20,9 @@ the same lengths: the numpy path's bits, whether its SIMD loop has a scalar tail
 * :func:`fitness` -- the fitness of a batch of poses (``FKOPT_NUMERICS=compiled``'s single calls);
 * :func:`prepare`, :func:`numpy_tan`, :func:`value` -- the three stages the compiled swarm
   iterations of :mod:`fkopt.algorithms.pso_kernels` and :mod:`fkopt.algorithms.abc_kernels` take
-  (wired as function objects: :class:`fkopt.mechanisms.base.CompiledFitness`);
+  (wired as function objects: :class:`fkopt.mechanisms.base.CompiledFitness`); :func:`numpy_tan_loop`
+  -- :func:`numpy_tan` from compiled code, numpy's own loop called by address
+  (:mod:`fkopt.numerics.ufunc_loop`), so several iterations run in one compiled call;
 * :func:`point_fitness` -- one pose with the C library's ``tan`` (pygmo's one-point fitness in
   ``fkopt bench``).
 """
@@ -31,6 +33,7 @@ import math
 import numpy as np
 
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
+from fkopt.numerics.ufunc_loop import call_unary_loop, unary_loop
 
 #: Degrees -> half-angle in radians (the factor :meth:`fkopt.mechanisms.rps3.ThreeRPS._legs` uses).
 HALF_DEG = math.pi / 360.0
@@ -108,6 +111,25 @@ def numpy_tan(arg, out, segments, block):
         for b0 in range(0, sl, block):
             s, e = 2 * (s0 + b0), 2 * (s0 + min(b0 + block, sl))
             tan(arg[s:e], out[s:e])
+
+
+@njit(cache=True)
+def numpy_tan_loop(loop, data, arg, out, s0, sl, block):
+    """:func:`numpy_tan` of one fitness call (poses [s0, s0 + sl)) from compiled code: numpy's own
+    ``np.tan`` loop (``loop``, ``data``: :func:`fkopt.numerics.ufunc_loop.unary_loop`) on the same
+    blocks, the same values at the same positions of runs of the same lengths -- np.tan's bits."""
+    if sl <= block:                    # one block (the usual case)
+        call_unary_loop(loop, data, arg, out, 2 * s0, 2 * sl)
+        return
+    for b0 in range(0, sl, block):
+        s, e = 2 * (s0 + b0), 2 * (s0 + min(b0 + block, sl))
+        call_unary_loop(loop, data, arg, out, s, e - s)
+
+
+def numpy_tan_address():
+    """(loop, data) of numpy's float64 ``np.tan`` loop for :func:`numpy_tan_loop`, or None where it
+    cannot be read or differs from ``np.tan`` on the probe (:func:`fkopt.numerics.ufunc_loop.unary_loop`)."""
+    return unary_loop(np.tan)
 
 
 @njit(cache=True, error_model="numpy")
