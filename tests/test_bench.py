@@ -35,6 +35,12 @@ def test_quick_run_writes_csv_and_plot(tmp_path):
         assert note.endswith("fkopt reported solved but not: 0"), note
     if len(batch):
         assert "rtb DHRobot FK" in batch.note[batch.item == "wang7dof"].iloc[0]
+    # the swarms section (with a C compiler and numba): every compiled run equals the numpy path's,
+    # and ABC and GABC say that they ran many iterations per compiled call
+    fast = csv[(csv.section == "swarms") & csv.note.str.startswith("default path")]
+    for item, note in zip(fast.item, fast.note):
+        assert "runs bit-identical to FKOPT_NUMERICS=numpy" in note, item
+        assert ("many iterations per call" in note) == (not item.startswith("pso")), item
 
 
 def test_batched_lm_solves_many_poses_as_cases():
