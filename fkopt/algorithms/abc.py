@@ -61,8 +61,10 @@ integers either way). ``fkopt bench`` measures what an evaluation costs.
 On a 3-RPS FK problem with numba installed (unless ``FKOPT_NUMERICS=numpy``), fkopt's own ABC and
 GABC (raw selection) run each iteration compiled instead (:func:`fkopt.algorithms.abc_kernels.abc_iteration`:
 the same draws in one block per iteration, the same operations, numpy's own ``np.tan``, the
-evaluation log's bookkeeping and the best-so-far inside); its records equal these phases bit for
-bit (tests/test_numerics.py).
+evaluation log's bookkeeping and the best-so-far inside); under :meth:`Algorithm.minimize` many
+iterations per compiled call where numpy's tan loop can be called from compiled code
+(:meth:`ABC.compiled_advance`, :func:`fkopt.algorithms.abc_kernels.abc_iterations`). Its records
+equal these phases bit for bit (tests/test_numerics.py).
 """
 from __future__ import annotations
 
