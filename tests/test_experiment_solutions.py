@@ -16,6 +16,7 @@ from fkopt.kinematics.assembly_modes import all_solutions as assembly_modes
 from fkopt.run.pipeline import from_dict, plan_config, run_config
 from fkopt.run.solving import task_seed
 from fkopt.run.tasks import TASKS
+from conftest import interrupted_after_first_task
 
 UR5 = {"name": "urdf", "geometry": {"file": str(Path(__file__).resolve().parents[1] / "configs" / "suites" / "robots"
                                                 / "ur5.urdf"), "base": "base_link", "tip": "tool0"}}
@@ -141,12 +142,7 @@ def test_resume_reuses_a_finished_search_and_writes_the_same_file(tmp_path):
                            {"name": "inverse", "label": "b", "params": {"solutions": "all", "patience": 16}}]}
     config = from_dict(data, "t")
     whole = run_config(config, tmp_path / "whole")
-
-    def stop_after_one(label, done, total):
-        if done == 1:
-            raise KeyboardInterrupt
-    with pytest.raises(KeyboardInterrupt):
-        run_config(config, tmp_path / "out", progress=stop_after_one)
+    interrupted_after_first_task(config, tmp_path / "out")
     tasks = tmp_path / "out" / "test" / ".two.partial" / TASKS
     assert sorted(p.name for p in tasks.iterdir()) == ["a00.json", "manifest.json"]
     again = run_config(config, tmp_path / "out", resume=True)
