@@ -113,7 +113,8 @@ def test_a_redundant_arm_with_fixed_and_spread_beside_a_one_answer_entry(cli, tm
 
 def test_forward_with_every_solution_is_the_assembly_mode_search(cli, tmp_path):
     """On a parallel mechanism forward/exact with solutions: all route to the assembly-mode search:
-    its poses, residuals and hits with the case's seed."""
+    its poses, residuals and hits with the case's seed; fkopt check reruns the file and fails an
+    edited residual."""
     config = {"name": "modes", "mechanism": {"name": "3-rps"}, "seed": 2,
               "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}, {"joints": {"d1": 598.85, "d2": 671.92,
                                                                                   "d3": 629.16}}],
@@ -131,6 +132,15 @@ def test_forward_with_every_solution_is_the_assembly_mode_search(cli, tmp_path):
         np.testing.assert_allclose(rows[list(m.pose_names)].to_numpy(), poses[order], rtol=1e-11)
         assert rows["hits"].tolist() == [direct[i].hits for i in order]
         assert (rows["starts"] == direct.starts).all()
+    code, out, err = cli("check", folder)                 # fkopt check reruns it and compares solutions.csv
+    assert code == 0, out + err
+    path = folder / "solutions.csv"
+    lines = path.read_text().splitlines()
+    cells = lines[1].split(",")
+    cells[lines[0].split(",").index("residual")] = "0.001"
+    path.write_text("\n".join([lines[0], ",".join(cells), *lines[2:]]) + "\n")
+    code, out, err = cli("check", folder)
+    assert code == 1 and "solutions.csv" in out + err
 
 
 def test_resume_reuses_a_finished_search_and_writes_the_same_file(tmp_path):
