@@ -321,6 +321,31 @@ def test_compiled_abc_without_numpys_tan_loop_takes_one_iteration_per_call_with_
         assert all(np.array_equal(got[mode].snapshots[t], got["numpy"].snapshots[t]) for t in (0, 7, 80))
 
 
+def test_compiled_abc_calls_again_where_the_logs_arrays_fill_up(monkeypatch):
+    """The log's improvements of one several-iteration call are held in arrays of
+    abc_kernels.LOG_ROOM places; made one iteration's worth, a call ends after any iteration that
+    kept one, and the caller calls again on the rest of the draws: more calls, the same records."""
+    from fkopt.algorithms import abc_kernels
+    m = fkopt.mechanism("3-rps")
+    p = fkopt.fk_problem(m, m.ik(np.array([4.0, -7.0, 480.0])))
+    options = dict(population=10, iterations=60, runs=5, seed=6)
+    monkeypatch.setenv(numerics_path.ENV, "numpy")
+    ref = fkopt.solve(p, "gabc", **options)
+    monkeypatch.setenv(numerics_path.ENV, "auto")
+    for room, more in (((2, 4096), False), ((1, 0), True)):
+        monkeypatch.setattr(abc_kernels, "LOG_ROOM", room)
+        calls = []
+        kernel = abc_kernels._iterations_kernel
+        monkeypatch.setattr(abc_kernels, "_iterations_kernel",
+                            lambda *a: (lambda *b: calls.append(1) or kernel(*a)(*b)))
+        got = fkopt.solve(fkopt.fk_problem(m, p.joints), "gabc", **options)
+        monkeypatch.setattr(abc_kernels, "_iterations_kernel", kernel)
+        assert len(calls) > 10 if more else len(calls) == 1    # 5 runs: all 60 iterations' draws fit one call
+        for name in ("x", "fitness", "history", "evaluation_history", "evaluations"):
+            assert np.array_equal(getattr(got, name), getattr(ref, name)), (room, name)
+        assert all(np.array_equal(a, b) for a, b in zip(got.events, ref.events))
+
+
 def test_compiled_swarms_span_the_numpy_fitness_blocks(monkeypatch):
     """More poses per fitness call than ThreeRPS.BLOCK (here made 7): the compiled iterations cut
     their np.tan calls as the numpy fitness cuts its blocks, and the runs stay bit for bit."""

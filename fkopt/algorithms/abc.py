@@ -266,17 +266,9 @@ class ABC(Algorithm):
         """:meth:`iterate` in one compiled pass (:func:`fkopt.algorithms.abc_kernels.abc_iteration`): the
         same draws (one block per iteration holding the phases' draws in their order), the same
         operations (numpy's ``np.tan`` included), the same log reports, the best-so-far folded in."""
-        _aux(state, problem)                        # x, f, trial: C-contiguous arrays of our own
-        runs, population, dim = state.x.shape
-        per_phase = (4 if rule == 2 else 3) * population
-        u = streams.uniform(dim + 2 * per_phase + population)
-        if problem.cases is not None:
-            problem._check_cases(state.x)
-        J = problem._joint_rows(state.x.shape[:-1])
-        # the best-so-far is refreshed in the pass (GABC's between the phases and minimize's
-        # update_best after them): new arrays, as update_best makes
-        best_x, best_f = state.best_x.copy(), state.best_f.copy()
-        C = getattr(self.params, "C", 0.0)
+        width, J, best_x, best_f, C = self._compiled_inputs(state, problem, rule)
+        runs = state.f.shape[0]
+        u = streams.uniform(width)
         # the evaluation log's bookkeeping runs in the same pass (EvaluationLog.add value by value)
         # (a target per row: the numpy path evaluates the fresh scouts in a fitness call of their own)
         evaluations, kept = step(state.x, state.f, state.trial, best_x, best_f, u, state.limit, rule, C,
@@ -285,6 +277,20 @@ class ABC(Algorithm):
         log_kept(state, kept)
         state.best_x, state.best_f, state.best_folded = best_x, best_f, True
         state.evaluations = evaluations         # + 2 SN, + 1 where a scout flew
+
+    def _compiled_inputs(self, state, problem, rule):
+        """What the compiled iterations take besides the state (x, f, trial made C-contiguous arrays
+        of our own first): the uniforms one iteration draws (scout dim, then per phase 3 SN, 4 with
+        zhu2010's psi, and the onlookers' SN), the target rows J, copies of the best-so-far (the
+        kernels refresh it in place -- GABC's between the phases, minimize's update_best after
+        them -- so new arrays, as update_best makes) and zhu2010's C."""
+        _aux(state, problem)
+        runs, population, dim = state.x.shape
+        if problem.cases is not None:
+            problem._check_cases(state.x)
+        width = dim + 2 * (4 if rule == 2 else 3) * population + population
+        return (width, problem._joint_rows(state.x.shape[:-1]), state.best_x.copy(), state.best_f.copy(),
+                getattr(self.params, "C", 0.0))
 
     def compiled_advance(self, problem):
         """Several iterations per compiled call (:meth:`fkopt.algorithms.base.Algorithm.compiled_advance`)
@@ -306,18 +312,11 @@ class ABC(Algorithm):
         draws of iteration t are the block :meth:`_iterate_compiled` draws, taken for all k in one
         call (the same values: a stream hands out its values in order). Returns k."""
         from fkopt.algorithms.abc_kernels import ITERATIONS_UNIFORMS
-        _aux(state, problem)                        # x, f, trial: C-contiguous arrays of our own
-        runs, population, dim = state.x.shape
-        width = dim + 2 * (4 if rule == 2 else 3) * population + population
+        width, J, best_x, best_f, C = self._compiled_inputs(state, problem, rule)
+        runs = state.f.shape[0]
         k = max(1, min(last + 1 - first, ITERATIONS_UNIFORMS // (runs * width)))
         u = streams.uniform(k * width)
-        if problem.cases is not None:
-            problem._check_cases(state.x)
-        J = problem._joint_rows(state.x.shape[:-1])
-        # written in place by the kernel: new arrays, as update_best makes
-        best_x, best_f = state.best_x.copy(), state.best_f.copy()
         evals = np.array(state.evaluations, dtype=np.int64)
-        C = getattr(self.params, "C", 0.0)
         log = log_arrays(state, runs)
         done = 0
         while done < k:                             # more than one call only when the log's arrays fill up

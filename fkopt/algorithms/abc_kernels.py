@@ -246,6 +246,17 @@ def _kernels(prepare, value):
     return employed_move, employed_finish, onlooker_finish
 
 
+def _phase_arrays(runs, pop, width, bounds, room):
+    """The phase kernels' scratch (jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, the ufunc's argument and
+    value buffers, the log's improvements hr, he, hf with ``room`` places, lo, hi)."""
+    n = runs * pop
+    return ([np.empty((runs, pop), dtype=np.int64) for _ in range(3)]
+            + [np.empty((runs, pop)) for _ in range(4)]
+            + [np.empty(runs, dtype=np.int64), np.empty(width * (n + runs)), np.empty(width * (n + runs)),
+               np.empty(room, dtype=np.intp), np.empty(room, dtype=np.int64), np.empty(room),
+               np.ascontiguousarray(bounds[:, 0], dtype=float), np.ascontiguousarray(bounds[:, 1], dtype=float)])
+
+
 def abc_iteration(fitness):
     """One ABC or GABC iteration on ``fitness`` (a :class:`fkopt.mechanisms.base.CompiledFitness`):
     ``step(x, f, trial, best_x, best_f, u, limit, rule, C, bounds, J, absolute, log, separate, evaluations)`` runs
@@ -267,16 +278,9 @@ def abc_iteration(fitness):
         J = np.ascontiguousarray(J, dtype=float)
         absolute, C, limit, rule = bool(absolute), float(C), int(limit), int(rule)
 
-        def make():
-            most = runs * (2 * pop + 1)
-            return ([np.empty((runs, pop), dtype=np.int64) for _ in range(3)]
-                    + [np.empty((runs, pop)) for _ in range(4)]
-                    + [np.empty(runs, dtype=np.int64), np.empty(width * (n + runs)), np.empty(width * (n + runs)),
-                       np.empty(most, dtype=np.intp), np.empty(most, dtype=np.int64), np.empty(most),
-                       np.ascontiguousarray(bounds[:, 0], dtype=float),
-                       np.ascontiguousarray(bounds[:, 1], dtype=float)])
         jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out, hr, he, hf, lo, hi = scratch_arrays(
-            ("abc", runs, pop, width, bounds.tobytes()), make)
+            ("abc", runs, pop, width, bounds.tobytes()),
+            lambda: _phase_arrays(runs, pop, width, bounds, runs * (2 * pop + 1)))
         best, count, active = log
         ns = employed_move(x, trial, best_x, u, limit, rule, C, lo, hi, separate, jj, mv, scout, arg, block)
         ufunc(arg, out, ((0, n), (n, ns)) if separate else ((0, n + ns),), block)
@@ -289,6 +293,13 @@ def abc_iteration(fitness):
         return new_evals, kept(hr, he, hf, nh)
     return step
 
+
+#: Places for the log's improvements in one :func:`abc_iterations` call: (iterations' worth of
+#: evaluations, plus); improvements are rare after the first iterations, and a call ends early
+#: (the caller calls again) when the next iteration's might not fit.
+LOG_ROOM = (2, 4096)
+#: x_history of a solve that keeps none (the kernel writes it only when it has columns).
+_NO_X = np.empty((1, 0, 3))
 
 #: The uniforms one :func:`abc_iterations` call takes at most, over all runs (values; 256 kB): the
 #: block stays in cache beside the state, and at many rows a call is one iteration anyway.
@@ -381,24 +392,17 @@ def abc_iterations(fitness):
 
     def advance(x, f, trial, best_x, best_f, u, width, limit, rule, C, bounds, J, absolute, log, separate,
                 evaluations, history, ev_history, x_history, t0):
-        runs, pop, dim = x.shape
-        n = runs * pop
-        most = runs * (2 * pop + 1)
+        runs, pop = f.shape
 
-        def make():
-            room = 2 * most + 4096         # improvements are rare after the first iterations
-            return ([np.empty((runs, pop), dtype=np.int64) for _ in range(3)]
-                    + [np.empty((runs, pop)) for _ in range(4)]
-                    + [np.empty(runs, dtype=np.int64), np.empty(width_f * (n + runs)), np.empty(width_f * (n + runs)),
-                       np.empty(room, dtype=np.intp), np.empty(room, dtype=np.int64), np.empty(room),
-                       np.ascontiguousarray(bounds[:, 0], dtype=float),
-                       np.ascontiguousarray(bounds[:, 1], dtype=float), np.empty((runs, 0, dim))])
-        jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out, hr, he, hf, lo, hi, no_x = scratch_arrays(
-            ("abc-iterations", runs, pop, width_f, bounds.tobytes()), make)
+        per, extra = LOG_ROOM
+        room = per * runs * (2 * pop + 1) + extra
+        jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out, hr, he, hf, lo, hi = scratch_arrays(
+            ("abc-iterations", runs, pop, width_f, room, bounds.tobytes()),
+            lambda: _phase_arrays(runs, pop, width_f, bounds, room))
         best, count, active = log
         done, nh = kernel(x, f, trial, best_x, best_f, u, int(width), int(limit), int(rule), float(C), lo, hi,
                           np.ascontiguousarray(J, dtype=float), params, bool(absolute), bool(separate), evaluations,
                           best, count, active, hr, he, hf, jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out,
-                          loop, data, history, ev_history, no_x if x_history is None else x_history, int(t0), block)
+                          loop, data, history, ev_history, _NO_X if x_history is None else x_history, int(t0), block)
         return done, kept(hr, he, hf, nh)
     return advance
