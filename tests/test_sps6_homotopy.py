@@ -102,3 +102,12 @@ def test_method_is_checked(monkeypatch):
         all_solutions(m, DIETMAIER_LEGS, method="homotopy")
     # explicit starts run the restart search
     assert all_solutions(m, DIETMAIER_LEGS, starts=50).method == "restarts"
+
+
+def test_without_a_start_system_the_restart_search_runs(monkeypatch):
+    def broken(_kernel):
+        raise RuntimeError("the 6-SPS start system has 39 roots after monodromy, not 40")
+    monkeypatch.setattr(hm, "start_system", broken)
+    m = fkopt.mechanism("6-sps")
+    got = all_solutions(m, DIETMAIER_LEGS, seed=0)
+    assert got.method == "restarts" and "39 roots" in got.settings["homotopy"] and len(got) == 40

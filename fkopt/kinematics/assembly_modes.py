@@ -79,6 +79,18 @@ after every round.
 On Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``) all 40 real
 solutions are found on every seed tried, almost always within the first round of 2000 starts
 (counts and times: ``bench/targets.csv`` and ``fkopt bench``, section kinematics).
+
+**A 6-SPS platform on the compiled path** (``method="auto"``, the default, without ``starts``)
+is solved instead by a parameter homotopy (:mod:`fkopt.kinematics.sps6_homotopy`): the 40
+complex roots of a start system, found once per process, are tracked to the platform's, and the
+real ones go through steps 3 and 4 above (those whose residual is not within ``tol`` first
+through the real Newton steps of step 2). The search knows it has them all when the 40 paths
+end at 40 distinct nonsingular roots, the generic number (``Solutions.certificate`` says so;
+``hits`` is 1 per solution and ``starts`` the 40 paths). Where they do not (a special geometry
+with fewer than 40 finite roots, e.g. 6-sps-cmm's similar hexagons, or a failed path) the
+restart search above runs and ``settings["homotopy"]`` says why; its stopping rule is what
+``Solutions.certificate`` then reports. ``FKOPT_NUMERICS=numpy`` runs the restart search (the
+reference the homotopy is tested against).
 """
 from __future__ import annotations
 
