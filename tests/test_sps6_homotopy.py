@@ -111,3 +111,13 @@ def test_without_a_start_system_the_restart_search_runs(monkeypatch):
     m = fkopt.mechanism("6-sps")
     got = all_solutions(m, DIETMAIER_LEGS, seed=0)
     assert got.method == "restarts" and "39 roots" in got.settings["homotopy"] and len(got) == 40
+
+
+def test_an_experiment_files_every_solution_entry_reports_the_certificate():
+    from fkopt.solve import make_algorithm
+    solver = make_algorithm("forward", {"solutions": "all"})
+    m = fkopt.mechanism("6-sps")
+    solver.prepare_solution_set(m)
+    found = solver.solution_set(m, np.asarray(DIETMAIER_LEGS, dtype=float), 5)
+    assert found.values.shape == (40, 6) and found.search["starts"] == 40
+    assert found.search["stopping_rule"].startswith("complete: 40 homotopy paths")
