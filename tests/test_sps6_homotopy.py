@@ -8,9 +8,12 @@ from fkopt.errors import FkoptError
 from fkopt.kinematics import sps6_homotopy as hm
 from fkopt.kinematics.assembly_modes import all_solutions, pose_distance, solutions_to_dict
 from fkopt.mechanisms.sps6 import DIETMAIER_LEGS
+from fkopt.numerics import path as numerics_path
 from fkopt.tools.bench.fksgp import _cayley
 
 kernel = pytest.importorskip("fkopt.numerics.compiled_homotopy")
+# the homotopy runs on the compiled path; FKOPT_NUMERICS=numpy runs the restart search (tests/test_assembly.py)
+pytestmark = pytest.mark.skipif(numerics_path.requested() == "numpy", reason="FKOPT_NUMERICS=numpy: no homotopy")
 
 
 def _general_platform(rng, scale=1.0):
