@@ -104,7 +104,7 @@ def _track(kernel, p0, p1, h, gamma, Z0):
     n = len(Z0)
     Z = np.empty((n, 8), dtype=complex)
     status, steps, first = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n)
-    kernel.track(*_segment(p0, p1), np.ascontiguousarray(h, dtype=complex), complex(gamma),
+    kernel.track_paths(*_segment(p0, p1), np.ascontiguousarray(h, dtype=complex), complex(gamma),
                  np.ascontiguousarray(Z0, dtype=complex), Z, status, steps, first, _MAX_STEPS, _PREDICTOR_ERROR)
     return Z, status, steps
 

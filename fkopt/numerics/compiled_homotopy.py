@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
+from numba import prange, set_parallel_chunksize
 
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
@@ -319,3 +319,13 @@ def track(P0, DP, h, gamma, Z0, Z, status, steps, first_error, max_steps, predic
         status[p] = state
         steps[p] = taken
         first_error[p] = worst
+
+
+def track_paths(*args):
+    """:func:`track`, its paths handed one at a time to whichever thread is free (numba's chunk
+    size 1 for this call: a path's cost varies ~5x, so equal blocks of paths leave a thread idle)."""
+    previous = set_parallel_chunksize(1)
+    try:
+        track(*args)
+    finally:
+        set_parallel_chunksize(previous)
