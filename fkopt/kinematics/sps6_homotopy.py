@@ -40,7 +40,7 @@ from fkopt.numerics import path as numerics_path, rotations
 GENERIC_ROOTS = 40
 #: Seed of the one start system (its geometry and roots; any seed serves).
 _START_SEED = 66
-#: Endpoints closer than this (relative, in the chart's coordinates) are one root.
+#: Endpoints closer than this (relative to 1 + |z|, in the chart's coordinates) are one root.
 _DISTINCT = 1e-7
 #: An endpoint is real when its imaginary part, after the phase that makes its largest
 #: coordinate real, is at most this fraction of its size (a real root of a generic platform
@@ -100,12 +100,13 @@ def _residual(Z, p, h):
 
 
 def _track(kernel, p0, p1, h, gamma, Z0):
-    """Endpoints (n, 8) and status (n,) of the roots Z0 of p0 tracked to p1."""
+    """Endpoints (n, 8), status (n,) and accepted steps (n,) of the roots Z0 of p0 tracked to p1
+    along the gamma arc (:func:`fkopt.numerics.compiled_homotopy.track`)."""
     n = len(Z0)
     Z = np.empty((n, 8), dtype=complex)
     status, steps, first = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n)
     kernel.track_paths(*_segment(p0, p1), np.ascontiguousarray(h, dtype=complex), complex(gamma),
-                 np.ascontiguousarray(Z0, dtype=complex), Z, status, steps, first, _MAX_STEPS, _PREDICTOR_ERROR)
+                       np.ascontiguousarray(Z0, dtype=complex), Z, status, steps, first, _MAX_STEPS, _PREDICTOR_ERROR)
     return Z, status, steps
 
 
@@ -118,6 +119,7 @@ def _distinct(Z: np.ndarray, known: np.ndarray) -> np.ndarray:
 
 
 def _random_parameters(rng):
+    """Random complex geometry (a (6, 3), b (6, 3), d (6,)), standard normal parts."""
     def c(*shape):
         return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
     return c(6, 3), c(6, 3), c(6)
