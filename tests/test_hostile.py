@@ -432,7 +432,7 @@ def test_resume_refuses_an_edited_task_file(finished_study, cli):
     cfg, out, final, _ = finished_study
     task = next((final / "tasks").glob("a*.json"))
     rec = json.loads(task.read_text())
-    rec["fitness"][0][0] = 0.0                     # a better-looking result, written by hand
+    rec["rows"]["final_fitness"][0] = 0.0           # a better-looking result, written by hand
     task.write_text(json.dumps(rec))
     before = snapshot(final)
     one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), task.name, "changed since")
@@ -444,7 +444,7 @@ def test_check_fails_on_an_edited_study_task_file(finished_study, cli):
     assert cli("check", out, "-q")[0] == 0
     task = next((final / "tasks").glob("a*.json"))
     rec = json.loads(task.read_text())
-    rec["fitness"][0][0] = 0.0
+    rec["rows"]["final_fitness"][0] = 0.0
     task.write_text(json.dumps(rec))
     code, _, err = cli("check", out, "-q")
     assert code == 1 and f"tasks/{task.name}" in err and "changed since written" in err, err
@@ -475,13 +475,14 @@ def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli
     elif edit == "no-id":
         del rec["id"]
     elif edit == "shape":
-        rec["fitness"] = rec["fitness"][:1]
+        rec["rows"]["final_fitness"] = rec["rows"]["final_fitness"][:1]
     elif edit == "strings":
-        rec["x"] = "abc"
+        rec["rows"][next(k for k in rec["rows"] if k.startswith("x_"))] = "abc"
     elif edit.startswith("fitness-"):           # issue 30: a value of the wrong type or range
-        rec["fitness"][0][0] = {"fitness-text": "x", "fitness-nan": float("nan"), "fitness-inf": float("inf")}[edit]
+        rec["rows"]["final_fitness"][0] = {"fitness-text": "x", "fitness-nan": float("nan"),
+                                           "fitness-inf": float("inf")}[edit]
     elif edit == "evaluations-negative":
-        rec["evaluations"][0][0] = -5
+        rec["rows"]["evaluations"][0] = -5
     elif edit == "wall-inf":
         rec["wall_s"] = float("inf")
     else:

@@ -49,10 +49,10 @@ from it (:mod:`fkopt.kinbench.measures`). Measured times are a second table next
 timing record (:data:`TIMING_COLUMNS`), which :func:`timing_table` and
 :func:`timing_runs_table` write for every kind.
 
-Every worker returns JSON (a task file): an experiment's and a suite's solve task its rows of the
-record (columns of lists) and trace, a study's task the same numbers under the names its stored
-task files use (per pose and run), a clock-track task its answers, an assembly search its
-solutions; every kind's merge puts the record in one :class:`~fkopt.run.result.RunResult`, so a study's
+Every worker returns JSON (a task file): an experiment's, a study's and a suite's solve task its
+rows of the record (columns of lists; a study's and an experiment's also their rows of the timing
+record, an experiment's and a suite's their trace), a clock-track task its answers, an assembly
+search its solutions; every kind's merge puts the record in one :class:`~fkopt.run.result.RunResult`, so a study's
 poses/heatmap/tracking tables are read from the record too. Still read from a kind's own slot
 (``RunResult.own``): an experiment's inputs, its values, convergence table and figures (the
 per-iteration curves of each (case, algorithm), which the flat record does not hold, and its
