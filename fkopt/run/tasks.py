@@ -105,6 +105,16 @@ class Kind:
     #: (result, folder) -> what the command line prints after a run: a summary table, or lines
     #: (the first continues the folder's line); None: the folder alone
     console: Callable[[Any, Any], Any] | None = None
+    #: does ``fkopt reproduce`` run its files? (a suite: no; ``fkopt suite`` / ``make bench-suite``)
+    reproduced: bool = True
+    #: (config, runs.csv frame) -> [(where, rows of that problem, make the problem)]: the problems
+    #: whose fitness ``fkopt check`` recomputes from the stored ``x`` (None: no such check)
+    stored_problems: Callable[[Any, Any], list] | None = None
+    #: (folder, config, meta) -> [(file, where, column, stored, recomputed, rule)]: what ``fkopt
+    #: check`` judges again in a stored folder besides rerunning it (a suite: its clock answers)
+    recheck: Callable[[Any, Any, dict], list] | None = None
+    #: (stored result, results root) -> its section of REPORT.md (None: the experiment section)
+    report_section: Callable[[Any, Any], str] | None = None
 
 
 @dataclass

@@ -4,10 +4,12 @@ from __future__ import annotations
 from fkopt.run.memory import algorithm_resources
 from fkopt.kinds.study import reports
 from fkopt.run.kinds import register
+from fkopt.run.solving import build_mechanism, make_problem
 from fkopt.run.tasks import Kind
 from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, Output
 from fkopt.solve import batch_bytes, chunk_size
 from fkopt.kinds.study.config import StudyConfig, study_from_dict
+from fkopt.kinds.study.poses import build_poses
 from fkopt.kinds.study.runner import merge_study, study_plan
 
 
@@ -28,6 +30,16 @@ def _validate(config: StudyConfig, plan) -> int:
     return work + kept
 
 
+def _stored_problems(config: StudyConfig, runs) -> list:
+    """``fkopt check``'s recomputed fitness: one problem per pose of the pose set, and its rows."""
+    mech = build_mechanism(config)
+    poses = build_poses(config, mech)
+    # poses count from 0 (fkopt.run.record); a folder written before the run record counted from 1
+    first = 1 if len(runs) and runs["pose"].min() >= 1 else 0
+    return [(f"pose {i}", runs["pose"] == i + first, lambda i=i: make_problem(config, mech, poses.inputs[i]))
+            for i in range(len(poses))]
+
+
 #: The files of a study's folder, in the order they are written.
 OUTPUTS = (
     Output("summary.csv", reports.summary_table, TABLE),
@@ -46,4 +58,4 @@ OUTPUTS = (
 )
 
 STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig,
-                      console=lambda result, folder: reports.summary_table(result)))
+                      console=lambda result, folder: reports.summary_table(result), stored_problems=_stored_problems))
