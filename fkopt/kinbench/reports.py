@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from fkopt.run import record
+from fkopt.run.plotting import legend_off_data, plt, save     # matplotlib itself only when plt() is called
 from fkopt.files import file_names, md_table, md_text, read_stored_csv
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.outside import digest
@@ -224,7 +225,6 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     answered at the track's rung (kinbench's verdict) against the time to the answer (ms, log),
     one step line per solver and the virtual best solver (per query the fastest right answer of
     any solver run here), the timeout marked; names at the right end, spread apart."""
-    from fkopt.run.plotting import plt, save     # lazy: matplotlib
     answers = tables.get("answers.csv.gz")
     if answers is None or answers.empty:
         return []
@@ -327,7 +327,6 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
     named at its right end as COCO does; tracks told apart by line style."""
-    from fkopt.run.plotting import plt, save     # lazy: matplotlib
     df = tables.get("ecdf.csv")
     if df is None or df.empty:
         return []
@@ -388,7 +387,6 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
     df = tables.get("scaling.csv")
     if df is None or df.empty:
         return []
-    from fkopt.run.plotting import legend_off_data, plt, save     # lazy: matplotlib
     pyplot = plt()
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     target = scaling_target(sr.config.targets)
