@@ -27,7 +27,7 @@ import shutil
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Mapping
 
 from fkopt.errors import FkoptError
 from fkopt.files import inside, parse_json, read_stored, stored_sha256, write_file_atomically, write_json_atomically
@@ -115,6 +115,12 @@ class Kind:
     recheck: Callable[[Any, Any, dict], list] | None = None
     #: (stored result, results root) -> its section of REPORT.md (None: the experiment section)
     report_section: Callable[[Any, Any], str] | None = None
+    #: record columns its runs.csv leaves out: those its folder fixes (one kind, one problem) and
+    #: those it names otherwise (:func:`fkopt.run.record.runs_table`)
+    not_in_runs: frozenset = frozenset()
+    #: record column -> the name its files give it (experiment and study folders: ``solver`` is
+    #: ``algorithm``, :data:`fkopt.run.record.ALGORITHM_NAMES`)
+    file_names: Mapping[str, str] = field(default_factory=dict, hash=False)
 
 
 @dataclass

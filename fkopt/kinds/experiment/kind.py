@@ -7,6 +7,7 @@ from fkopt.kinds.experiment.config import ExperimentConfig, experiment_from_dict
 from fkopt.kinds.experiment.runner import build_cases, build_problem, experiment_plan, keeps_x_history, merge_experiment
 from fkopt.kinds.experiment import reports
 from fkopt.run.kinds import register
+from fkopt.run.record import ALGORITHM_NAMES
 from fkopt.run.solving import build_mechanism
 from fkopt.run.tasks import Kind
 from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, TIMING_RUNS_FILE, TRACE_FILE, Output
@@ -61,4 +62,6 @@ OUTPUTS = (
 EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
                            merge_experiment, OUTPUTS, reports.meta, ExperimentConfig,
                            console=lambda result, folder: reports.summary_table(result),
-                           stored_problems=_stored_problems))
+                           stored_problems=_stored_problems,
+                           # runs.csv: its case label names the pose; one problem per folder
+                           not_in_runs=frozenset({"kind", "problem", "pose"}), file_names=ALGORITHM_NAMES))

@@ -77,7 +77,7 @@ def timing_table(er: RunResult) -> pd.DataFrame:
         "runs": er.config.runs, "total_s": er.own.solve_s[spec.key],
         **{f"printed_{k}": v for k, v in sorted(spec.printed.items()) if k.endswith("_ms")}}
         for case in er.own.cases for spec in er.config.algorithms}
-    return record.timing_table(er.timing, settings, names=record.FILE_NAMES["experiment"], timed_alone=True)
+    return record.timing_table(er.timing, settings, names=record.ALGORITHM_NAMES, timed_alone=True)
 
 
 def values_table(er: RunResult) -> pd.DataFrame:

@@ -4,6 +4,7 @@ from __future__ import annotations
 from fkopt.run.memory import algorithm_resources
 from fkopt.kinds.study import reports
 from fkopt.run.kinds import register
+from fkopt.run.record import ALGORITHM_NAMES
 from fkopt.run.solving import build_mechanism, make_problem
 from fkopt.run.tasks import Kind
 from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, Output
@@ -58,4 +59,6 @@ OUTPUTS = (
 )
 
 STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig,
-                      console=lambda result, folder: reports.summary_table(result), stored_problems=_stored_problems))
+                      console=lambda result, folder: reports.summary_table(result), stored_problems=_stored_problems,
+                      # runs.csv: a study has poses, not cases; one problem per folder
+                      not_in_runs=frozenset({"kind", "problem", "case"}), file_names=ALGORITHM_NAMES))
