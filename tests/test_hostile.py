@@ -462,7 +462,7 @@ def test_resume_refuses_corrupt_task_files(finished_study, cli, content):
 
 
 @pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task", "fitness-text", "fitness-nan",
-                                  "fitness-inf", "evaluations-negative", "wall-inf"])
+                                  "fitness-inf", "evaluations-negative", "wall-inf", "pose-twice"])
 def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli, edit):
     """Someone who also rewrote manifest.json's digests still cannot slip a malformed record in."""
     import hashlib
@@ -485,6 +485,8 @@ def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli
         rec["rows"]["evaluations"][0] = -5
     elif edit == "wall-inf":
         rec["wall_s"] = float("inf")
+    elif edit == "pose-twice":                 # one pose's rows in place of another's
+        rec["rows"]["pose"] = [rec["rows"]["pose"][0]] * len(rec["rows"]["pose"])
     else:
         rec["task"]["stop"] = 1
     task.write_text(json.dumps(rec))

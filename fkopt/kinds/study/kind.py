@@ -26,8 +26,9 @@ def _validate(config: StudyConfig, plan) -> int:
         size = chunk_size(cases, config.runs, pop, its, dim)      # refuses a solve over the per-solve limit
         work = max(work, batch_bytes(cases * config.runs, size, pop, its, dim)
                    + algorithm_resources(spec, pop, its, dim))
-        # kept for every (pose, run): fitness, counts, solution, as JSON task records (~10x)
-        kept += n * config.runs * (dim + 6) * 8 * 10
+        # kept for every (pose, run): its row of the run record (10 fixed columns, the solution, its
+        # start when tracking, its error per pose variable) as JSON task records (~10x)
+        kept += n * config.runs * (10 + 2 * dim + len(mech.pose_names)) * 8 * 10
     return work + kept
 
 
