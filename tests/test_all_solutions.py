@@ -66,7 +66,56 @@ def test_every_answer_is_verified_distinct_inside_the_limits_and_holds_the_gener
             assert not len(others) or turns_gap(others, r.solutions[i]).min() > 1e-4
         gap = np.abs(r.solutions - nearest_zero_copy(m, q[k])).max(axis=1)
         assert gap.min() < 1e-6
-        assert r.search["starts"] >= r.search["patience"] and "consecutive starts" in r.search["rule"]
+        # the search ends by Pieper's bound (8 distinct before the limits) or by the patience rule
+        assert (r.search["distinct"] == 8 and r.search["rule"].startswith("certificate")) or \
+            (r.search["starts"] >= r.search["patience"] and "consecutive starts" in r.search["rule"])
+
+
+def test_the_chain_geometry_gives_pieper_bound_and_two_solution_windows():
+    """From the chain's axes alone: the UR5's joints 2-4 are parallel, the Kinova j2s6s200's
+    last three meet in a point, the Panda with joint 7 locked has its first three meeting; the
+    xArm 7 with joint 3 locked and the 5-joint SO-101 have no Pieper triple, hence no bound."""
+    from fkopt.kinematics.branch_structure import structure
+    from fkopt.kinematics.branches import _context
+    ur = _context(stored("ur5"), {}, None)["structure"]
+    assert ur["bound"] == 8 and ur["triple"] == (1, 2, 3, "parallel") and ur["pair_window"] == (1, 3)
+    assert ur["windows"][0] == (1, 3) and ur["two_solution"][0]
+    kin = _context(stored("kinova-j2s6s200"), {}, None)["structure"]
+    assert kin["triple"] == (3, 4, 5, "concurrent") and kin["free_window"] == (0, 2)
+    panda = stored("panda")
+    assert _context(panda, {6: 0.3}, None)["structure"]["triple"] == (0, 1, 2, "concurrent")
+    xarm = stored("xarm7")
+    assert _context(xarm, {2: 0.3}, None)["structure"]["bound"] == 0
+    assert _context(stored("so101"), {}, None)["structure"]["bound"] == 0
+    # a masked pose has fewer equations: no bound
+    assert _context(stored("ur5"), {}, np.array([1, 1, 1, 1, 1, 0.0]))["structure"]["bound"] == 0
+    assert structure(panda.chain(), [], panda.reach)["bound"] == 0          # 7 unknowns
+
+
+def test_the_certificate_is_never_claimed_short_and_an_odd_count_is_searched_on():
+    """Pieper's bound as certificate: on UR5 and Kinova poses, the union of the sets found with
+    four seeds never exceeds 8 distinct solutions, and whenever one run claims the certificate its
+    set is that union; a run stopped by the patience rule on these chains has an even count
+    (the quartic's real roots pair up) unless it used up max_starts."""
+    for name in ("ur5", "kinova-j2s6s200"):
+        m = stored(name)
+        rng = np.random.default_rng(8)
+        q = m.bounds[:, 0] + (m.bounds[:, 1] - m.bounds[:, 0]) * rng.random((8, m.dof))
+        T = m.fk_matrix(q)
+        claimed = 0
+        for k in range(len(q)):
+            runs = [fkopt.inverse(m, T[k], solutions="all", copies=True, seed=s) for s in range(4)]
+            union = np.concatenate([r.solutions for r in runs])
+            distinct = [row for i, row in enumerate(union) if i == 0 or turns_gap(union[:i], row).min() > 1e-4]
+            assert len(distinct) <= 8 * 2 ** 5                         # copies: at most 8 solutions' turns
+            for r in runs:
+                if r.search["rule"].startswith("certificate"):
+                    claimed += 1
+                    assert r.search["distinct"] == 8
+                    assert all(turns_gap(r.solutions, row).min() < 1e-6 for row in distinct)
+                elif r.search["starts"] < r.search["max_starts"]:
+                    assert r.search["distinct"] % 2 == 0
+        assert claimed >= 8
 
 
 def test_a_dh_arm_in_mm_with_one_joint_fixed_gives_its_generating_configuration():

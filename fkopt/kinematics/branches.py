@@ -62,6 +62,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.kinematics.branch_structure import structure
 from fkopt.kinematics.inputs import (_internal, _inverse_arm, _public, _targets, _task_mask, _tolerance,
                                      _unreachable, _values)
 from fkopt.kinematics.results import INVERSE_TOL
@@ -84,8 +85,11 @@ ACCEPT_TOL = (1e-10, 1e-10)
 #: loop's answers of one solution scatter by a few 1e-6 rad while still verifying at 1e-9, and the
 #: two solutions on either side of it are ~1e-4 rad apart (EAIK's pair on the Kinova, docs/robots.md).
 MERGE_TOL = 1e-5
-#: Stopping rule defaults: consecutive starts without a new solution, most starts per pose.
+#: Stopping rule defaults: consecutive starts without a new solution, most starts per pose; on a
+#: chain with Pieper's bound (branch_structure) a pose with all its solutions stops at the bound, so
+#: the larger patience there costs only on the poses with fewer.
 PATIENCE = 32
+PIEPER_PATIENCE = 128
 #: ... and at least this many times the starts it took to find the last new solution.
 GROWTH = 0.0
 MAX_STARTS = 400
@@ -93,6 +97,13 @@ MAX_STARTS = 400
 NEIGHBOURS = 16
 #: Loop iterations per start (a far start needs more than inverse's 10).
 ITERATIONS = 20
+#: Derived starts: draws per (solution, window) pair (a two-solution window / the others) and loop
+#: iterations of each (a held start either lies in a sibling's basin, reached in a few, or in none).
+TWO_DRAWS = 2
+#: ... the window of a Pieper triple, whose other solution always exists (branch_structure)
+PAIR_DRAWS = 12
+HELD_DRAWS = 4
+HELD_ITERATIONS = 10
 #: Most distinct solutions kept per pose (a generic 6R arm has at most 16).
 CAP = 64
 #: inverse_path: default largest joint step between waypoints (rad / length unit), intermediate
@@ -248,7 +259,22 @@ def _context(m, locked: dict[int, float], W) -> dict:
     fmask = np.concatenate([Wf[:3], np.full(9, float(Wf[3:].all()))])
     feats = feats * fmask
     tq = full[:, free]
-    got = cache[key] = {
+    windows = _windows(len(free))
+    shape = structure(chain, windows, m.reach)
+    # the windows whose subproblem has two solutions first (a wrist or elbow flip, one start), then
+    # the wide ones (the other shoulder side, the solutions sharing the base joint), the rest last
+    rank = [0 if two else (1 if b - a > 2 else 2) for (a, b), two in zip(windows, shape["two_solution"])]
+    order = sorted(range(len(windows)), key=lambda i: (rank[i], -windows[i][1] + windows[i][0], i))
+    shape["windows"] = [windows[i] for i in order]
+    shape["two_solution"] = [shape["two_solution"][i] for i in order]
+    shape["hold"] = [True] * len(order)
+    if shape["free_window"] is not None:
+        shape["windows"].append(shape["free_window"])
+        shape["two_solution"].append(False)
+        shape["hold"].append(False)
+    if not Wf.all():
+        shape["bound"] = 0                        # a masked pose: fewer equations, Pieper's count does not hold
+    got = cache[key] = {"structure": shape,
         "n": len(free), "chain": chain.arrays(), "chain_obj": chain, "free": free, "locked": dict(locked),
         "tq": np.ascontiguousarray(tq), "Ft": np.ascontiguousarray(feats.T), "norms": _sumsq(feats),
         "w": float(wf), "fmask": fmask, "W": Wf,
@@ -347,13 +373,14 @@ def _spread_locks(m, spread, spread_joints, redundancy: int) -> list[dict[int, f
 
 
 def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol=None, mask=None, seed: int = 0,
-                  patience: int = PATIENCE, growth: float = GROWTH, max_starts: int = MAX_STARTS, copies: bool = False,
+                  patience: int | None = None, growth: float = GROWTH, max_starts: int = MAX_STARTS, copies: bool = False,
                   orientation_scale: float | None = None) -> AllSolutions:
     """Every solution of one pose (6,) or tip frame (4, 4): see the module docstring.
     ``fixed``: {joint name: value} locked joints (public units); ``spread``: K samples per locked
     joint of a redundant arm's self-motion (``spread_joints`` names them); ``tol``: the
     verification tolerances (default :data:`ALL_TOL`); ``seed``: the hash draws' stream;
-    ``patience`` / ``max_starts``: the stopping rule (``growth`` > 0 also asks for at least
+    ``patience`` / ``max_starts``: the stopping rule (``patience`` by default :data:`PATIENCE`,
+    :data:`PIEPER_PATIENCE` on a chain with Pieper's bound; ``growth`` > 0 also asks for at least
     ``growth`` times the starts that found the last new solution; 0 by default, measured no
     better); ``copies``: list every in-limit copy of a
     joint whose limits span more than 2 pi."""
@@ -363,7 +390,7 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     if P.ndim != 1:
         raise FkoptError(f"{m.name} all solutions: one pose at a time here (got shape {np.shape(pose)}); "
                          "fkopt.inverse(arm, poses, solutions='all') takes a batch")
-    for name, v, low in (("patience", patience, 1), ("max_starts", max_starts, 1)):
+    for name, v, low in (("patience", 1 if patience is None else patience, 1), ("max_starts", max_starts, 1)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
             raise FkoptError(f"{m.name} all solutions {name}: expected an integer >= {low}, got {v!r}")
     x, y, z = P[:3].tolist()
@@ -391,19 +418,27 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     row = np.ascontiguousarray(P, dtype=float)
     rows, perr, rerr, fixed_rows = [], [], [], []
     stats = {"starts": 0, "converged": 0, "evaluations": 0, "distinct": 0, "out_of_limits": 0, "unverified": 0,
-             "since_last_new": [], "last_new_start": [], "found_at": []}
+             "since_last_new": [], "last_new_start": [], "found_at": [], "complete": []}
+    if patience is None:
+        patience = PIEPER_PATIENCE if _context(m, locks[0], W)["structure"]["bound"] else PATIENCE
     for lk in locks:
         ctx = _context(m, lk, W)
         nn = min(NEIGHBOURS, len(ctx["tq"]))
         sols, found_at, info = kern.search(ctx, row, L, ctx["W"], nn, int(seed), int(max_starts), int(patience), SEARCH_TOL,
                                  ACCEPT_TOL, ITERATIONS, 0.01, 0.1, 10.0, 2.0, ctx["glo"], ctx["ghi"],
-                                 ctx["revolute"], MERGE_TOL, CAP, float(growth), _windows(ctx["n"]))
+                                 ctx["revolute"], MERGE_TOL, CAP, float(growth), ctx["structure"]["windows"],
+                                 ctx["structure"]["two_solution"], ctx["structure"]["bound"],
+                                 [PAIR_DRAWS if w == ctx["structure"]["pair_window"] else TWO_DRAWS if two else
+                                  HELD_DRAWS for w, two in zip(ctx["structure"]["windows"],
+                                                               ctx["structure"]["two_solution"])],
+                                 HELD_ITERATIONS, ctx["structure"]["hold"])
         stats["starts"] += int(info[0])
         stats["converged"] += int(info[1])
         stats["evaluations"] += int(info[2])
         stats["since_last_new"].append(int(info[3]))
         stats["last_new_start"].append(int(info[4]))
         stats["distinct"] += len(sols)
+        stats["complete"].append(bool(info[5]))
         stats["found_at"].append(found_at.tolist())
         full = np.empty(m.dof)
         for k, v in lk.items():
@@ -426,10 +461,17 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
                 rerr.append(re)
                 fixed_rows.append([pub[k] for k in sorted(lk)])
     if len(locks) == 1:
-        for key in ("since_last_new", "last_new_start", "found_at"):
+        for key in ("since_last_new", "last_new_start", "found_at", "complete"):
             stats[key] = stats[key][0]
-    stats["rule"] = (f"stopped after {patience} consecutive starts without a new solution "
-                     f"(or {max_starts} starts); no certificate: the miss rate is measured in docs/robots.md")
+    shape = _context(m, locks[0], W)["structure"]
+    done = stats["complete"] if isinstance(stats["complete"], list) else [stats["complete"]]
+    if shape["bound"] and all(done):
+        i, j, k, kind = shape["triple"]
+        stats["rule"] = (f"certificate: {shape['bound']} distinct solutions found, Pieper's bound for a 6R chain "
+                         f"whose joints {i + 1}, {j + 1}, {k + 1} have {kind} axes: there are no more")
+    else:
+        stats["rule"] = (f"stopped after {patience} consecutive starts without a new solution "
+                         f"(or {max_starts} starts); no certificate: the miss rate is measured in docs/robots.md")
     stats["patience"], stats["max_starts"] = int(patience), int(max_starts)
     n = m.dof
     sol = np.array(rows).reshape(-1, n)

@@ -49,11 +49,15 @@ def _no_start_table(n):
 @njit(cache=True)
 def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, patience, tp, tr, accept_p,
             accept_r, iterations, damping, down, up, step_cap, slo, shi, glo, ghi, revolute, merge_tol, growth,
-            wfirst, wlast, held_draws, sols, found_at, info):
+            wfirst, wlast, hold, two_solution, bound, held_draws, held_iterations, sols, found_at, info):
     """Distinct converged solutions of one pose (internal units, revolute joints wrapped into
     [-pi, pi)) into ``sols`` (cap, n); returns how many. ``info`` = (starts run, converged
     starts, evaluations, starts after the last new solution, the start that found the last new
-    one); ``found_at[s]`` the start that found solution s (its gaps measure the stopping rule)."""
+    one, 1 when ``bound`` > 0 distinct solutions were found -- all there are -- else 0);
+    ``found_at[s]`` the start that found solution s (its gaps measure the stopping rule).
+    ``two_solution[w]``: window w's subproblem has at most two solutions, so its derived starts from
+    a solution are skipped once another known solution shares its held joints
+    (:mod:`fkopt.kinematics.branch_structure`)."""
     n = glo.shape[0]
     m = chain[0].shape[0]
     T = np.empty((3, 3))
@@ -77,12 +81,26 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
     runs = 0
     nw = wfirst.shape[0]                         # windows: joints wfirst[w] .. wlast[w] drawn afresh
     hlo, hhi = np.empty(n), np.empty(n)
-    derived = 0                                  # (solution, window) pairs done
+    wdone = np.zeros(nw, dtype=np.int64)         # per window: the solutions whose derived starts are done
+    cs, cw = -1, -1                              # the current (solution, window) pair; -1: none
     tries = 0                                    # draws of the current pair
     nb = 0                                       # table neighbours run so far
     draw = 0
+    complete = 0
     for j in range(max_starts):
-        held = derived < k * nw
+        if tries == 0:
+            # the next pair: the first window (in the caller's order) with a solution not done, so
+            # that a new solution takes the flips that reach most in one start before the rest;
+            # a two-solution window whose other solution is known has nothing left to reach
+            cs = -1
+            for v in range(nw):
+                while wdone[v] < k and two_solution[v] and _sibling_known(sols, k, wdone[v], wfirst[v], wlast[v],
+                                                                           revolute, merge_tol):
+                    wdone[v] += 1
+                if wdone[v] < k:
+                    cs, cw = wdone[v], v
+                    break
+        held = cs >= 0
         if held:
             # a found solution with one window of joints drawn afresh and the others held at its
             # values (their limits set to the value): the solutions that share the held joints
@@ -90,7 +108,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
             # small subproblem, reached in a few steps, where uniform starts rarely land
             # (the window's values: the farthest from the solution's of 4 hash draws, so that the
             # start leaves its basin)
-            s_, w_ = derived // nw, derived % nw
+            s_, w_ = cs, cw
             far = -1.0
             for c in range(4):
                 _uniform_hash(seed, 1 + w_ + nw * (4 * tries + c), s_, u)
@@ -109,7 +127,10 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
                     hlo[i], hhi[i] = slo[i], shi[i]
                 else:
                     q0[i] = sols[s_, i]
-                    hlo[i], hhi[i] = q0[i], q0[i]
+                    if hold[w_]:
+                        hlo[i], hhi[i] = q0[i], q0[i]
+                    else:
+                        hlo[i], hhi[i] = slo[i], shi[i]
             if wfirst[w_] == 0 and wlast[w_] == n - 1 and revolute[0]:
                 # the whole arm free, from the solution's first joint turned by pi: the other
                 # shoulder side (its solutions share no joint with this one)
@@ -125,7 +146,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
                 q0[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
         if held:
             _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
-                                 tp, tr, iterations, damping, down,
+                                 tp, tr, held_iterations, damping, down,
                                  up, step_cap, hlo, hhi, glo, ghi, best)
         else:
             _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
@@ -160,34 +181,68 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
                 k += 1
                 new = True
                 last_new = j
-        if held and (new or tries >= held_draws):     # next pair after a new solution or held_draws draws
-            derived += 1
+                if bound > 0 and k >= bound:
+                    complete = 1
+                    break
+        if held and (new or tries >= held_draws[cw]):  # next pair after a new solution or the window's draws
+            wdone[cw] += 1
             tries = 0
         # the stopping rule counts the neighbour and hash-draw starts only: the derived starts are
         # bounded (windows per solution) and run before them
         since = 0 if new else (since if held else since + 1)
         # nothing found yet: four times the patience before giving a pose up
-        if since >= (patience if k > 0 else 4 * patience) and since >= growth * (last_new + 1):
+        # a chain with Pieper's bound has an even number of distinct solutions (the position
+        # quartic's real roots pair up, each gives two orientations): an odd count has one missing,
+        # so its search goes on (to max_starts)
+        if since >= (patience if k > 0 else 4 * patience) and since >= growth * (last_new + 1) and \
+                not (bound > 0 and k % 2 == 1):
             break
-    info[0], info[1], info[2], info[3], info[4] = runs, converged, evals, since, last_new
+    info[0], info[1], info[2], info[3], info[4], info[5] = runs, converged, evals, since, last_new, complete
     return k
 
 
+@njit(cache=True)
+def _sibling_known(sols, k, s, first, last, revolute, merge_tol):
+    """Whether a known solution other than s agrees with s on every joint outside first..last."""
+    n = sols.shape[1]
+    for o in range(k):
+        if o == s:
+            continue
+        same = True
+        for i in range(n):
+            if first <= i <= last:
+                continue
+            d = sols[o, i] - sols[s, i]
+            if revolute[i]:
+                d = _wrap(d)
+            if abs(d) > merge_tol:
+                same = False
+                break
+        if same:
+            return True
+    return False
+
+
 def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up, step_cap,
-           glo, ghi, revolute, merge_tol, cap, growth, windows, held_draws=4):
+           glo, ghi, revolute, merge_tol, cap, growth, windows, two_solution=None, bound=0, held_draws=(4,),
+           held_iterations=None, hold=None):
     """:func:`_search` of one pose row with the per-arm constants ``ctx``
     (:func:`fkopt.kinematics.inverse_pose._fast_context`) and the unlimited saturation bounds of the search:
-    (solutions (k, n) internal units, the start that found each (k,), info (5,))."""
+    (solutions (k, n) internal units, the start that found each (k,), info (6,))."""
     n = ctx["n"]
     wfirst = np.array([w[0] for w in windows], dtype=np.int64)
     wlast = np.array([w[1] for w in windows], dtype=np.int64)
-    sols, info, found_at = np.empty((cap, n)), np.zeros(5), np.zeros(cap, dtype=np.int64)
+    two = np.zeros(len(windows), dtype=np.bool_) if two_solution is None else np.asarray(two_solution, dtype=np.bool_)
+    held = np.ones(len(windows), dtype=np.bool_) if hold is None else np.asarray(hold, dtype=np.bool_)
+    draws = np.resize(np.asarray(held_draws, dtype=np.int64), max(len(windows), 1))
+    sols, info, found_at = np.empty((cap, n)), np.zeros(6), np.zeros(cap, dtype=np.int64)
     slo = np.where(revolute, -np.inf, ctx["lo"])
     shi = np.where(revolute, np.inf, ctx["hi"])
     k = _search(ctx["chain"], pose, float(L), W, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], int(nn),
                 int(seed), int(max_starts), int(patience), float(tol[0]), float(tol[1]), float(accept[0]),
                 float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap), slo, shi,
-                glo, ghi, revolute, float(merge_tol), float(growth), wfirst, wlast, int(held_draws), sols,
+                glo, ghi, revolute, float(merge_tol), float(growth), wfirst, wlast, held, two, int(bound), draws,
+                int(iterations if held_iterations is None else held_iterations), sols,
                 found_at, info)
     return sols[:k].copy(), found_at[:k].copy(), info
 
