@@ -281,7 +281,8 @@ def _context(m, locked: dict[int, float], W) -> dict:
         "lo": np.ascontiguousarray(lo[free]), "hi": np.ascontiguousarray(hi[free]),
         "glo": np.ascontiguousarray(glo[free]), "ghi": np.ascontiguousarray(ghi[free]),
         "revolute": np.ascontiguousarray(revolute[free]), "angle": angle,
-        "periodic": m.periodic_mask()[free], "full_lo": lo, "full_hi": hi}
+        "periodic": np.ascontiguousarray(m.periodic_mask()[free]), "full_lo": lo, "full_hi": hi,
+        "full_chain": m.chain().arrays()}
     return got
 
 
@@ -424,14 +425,17 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     for lk in locks:
         ctx = _context(m, lk, W)
         nn = min(NEIGHBOURS, len(ctx["tq"]))
-        sols, found_at, info = kern.search(ctx, row, L, ctx["W"], nn, int(seed), int(max_starts), int(patience), SEARCH_TOL,
-                                 ACCEPT_TOL, ITERATIONS, 0.01, 0.1, 10.0, 2.0, ctx["glo"], ctx["ghi"],
-                                 ctx["revolute"], MERGE_TOL, CAP, float(growth), ctx["structure"]["windows"],
-                                 ctx["structure"]["two_solution"], ctx["structure"]["bound"],
-                                 [PAIR_DRAWS if w == ctx["structure"]["pair_window"] else TWO_DRAWS if two else
-                                  HELD_DRAWS for w, two in zip(ctx["structure"]["windows"],
-                                                               ctx["structure"]["two_solution"])],
-                                 HELD_ITERATIONS, ctx["structure"]["hold"])
+        plan = ctx.get("plan")
+        if plan is None:
+            shape = ctx["structure"]
+            draws = [PAIR_DRAWS if w == shape["pair_window"] else TWO_DRAWS if two else HELD_DRAWS
+                     for w, two in zip(shape["windows"], shape["two_solution"])]
+            plan = ctx["plan"] = kern.search_plan(shape["windows"], shape["hold"], shape["two_solution"], draws,
+                                                  shape["bound"], HELD_ITERATIONS, ctx["revolute"], ctx["lo"],
+                                                  ctx["hi"])
+        sols, found_at, info = kern.search(ctx, plan, row, L, ctx["W"], nn, int(seed), int(max_starts), int(patience),
+                                           SEARCH_TOL, ACCEPT_TOL, ITERATIONS, 0.01, 0.1, 10.0, 2.0, ctx["glo"],
+                                           ctx["ghi"], ctx["revolute"], MERGE_TOL, CAP, float(growth))
         stats["starts"] += int(info[0])
         stats["converged"] += int(info[1])
         stats["evaluations"] += int(info[2])
@@ -440,9 +444,22 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
         stats["distinct"] += len(sols)
         stats["complete"].append(bool(info[5]))
         stats["found_at"].append(found_at.tolist())
-        full = np.empty(m.dof)
+        full = np.zeros(m.dof)
         for k, v in lk.items():
             full[k] = v
+        if not copies:
+            # compiled: each solution's in-limit copy nearest 0, verified (as the loop below)
+            pub_rows, errs, status = kern.into_limits(sols, ctx["free"], full, ctx["angle"], ctx["revolute"],
+                                                      ctx["periodic"], ctx["lo"], ctx["hi"], m.bounds[:, 0],
+                                                      m.bounds[:, 1], ctx["full_chain"], row, ctx["W"])
+            stats["out_of_limits"] += int((status == 1).sum())
+            ok = (status == 0) & (errs[:, 0] <= tp) & (errs[:, 1] <= tr)
+            stats["unverified"] += int(((status == 0) & ~ok).sum())
+            rows.extend(pub_rows[ok])
+            perr.extend(errs[ok, 0].tolist())
+            rerr.extend(errs[ok, 1].tolist())
+            fixed_rows.extend(pub_rows[ok][:, sorted(lk)].tolist())
+            sols = sols[:0]
         for w in sols:
             reps = _in_limit_copies(w, ctx, copies)
             if not reps:

@@ -223,28 +223,100 @@ def _sibling_known(sols, k, s, first, last, revolute, merge_tol):
     return False
 
 
-def search(ctx, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up, step_cap,
-           glo, ghi, revolute, merge_tol, cap, growth, windows, two_solution=None, bound=0, held_draws=(4,),
-           held_iterations=None, hold=None):
+def search_plan(windows, hold, two_solution, draws, bound, held_iterations, revolute, lo, hi) -> dict:
+    """The per-arm arrays of :func:`search`, built once per arm context: windows (first, last joint
+    drawn afresh), whether the others are held, whether its subproblem has two solutions, draws
+    per (solution, window) pair, Pieper's bound (0: none), iterations of a derived start, and the
+    unlimited saturation bounds of revolute joints (the search solves modulo 2 pi)."""
+    return {"wfirst": np.array([w[0] for w in windows], dtype=np.int64),
+            "wlast": np.array([w[1] for w in windows], dtype=np.int64),
+            "hold": np.array(hold, dtype=np.bool_).reshape(len(windows)),
+            "two": np.array(two_solution, dtype=np.bool_).reshape(len(windows)),
+            "draws": np.array(draws, dtype=np.int64).reshape(len(windows)), "bound": int(bound),
+            "held_iterations": int(held_iterations),
+            "slo": np.where(revolute, -np.inf, lo), "shi": np.where(revolute, np.inf, hi)}
+
+
+def search(ctx, plan, pose, L, W, nn, seed, max_starts, patience, tol, accept, iterations, damping, down, up,
+           step_cap, glo, ghi, revolute, merge_tol, cap, growth):
     """:func:`_search` of one pose row with the per-arm constants ``ctx``
-    (:func:`fkopt.kinematics.inverse_pose._fast_context`) and the unlimited saturation bounds of the search:
+    (:func:`fkopt.kinematics.branches._context`) and its :func:`search_plan`:
     (solutions (k, n) internal units, the start that found each (k,), info (6,))."""
     n = ctx["n"]
-    wfirst = np.array([w[0] for w in windows], dtype=np.int64)
-    wlast = np.array([w[1] for w in windows], dtype=np.int64)
-    two = np.zeros(len(windows), dtype=np.bool_) if two_solution is None else np.asarray(two_solution, dtype=np.bool_)
-    held = np.ones(len(windows), dtype=np.bool_) if hold is None else np.asarray(hold, dtype=np.bool_)
-    draws = np.resize(np.asarray(held_draws, dtype=np.int64), max(len(windows), 1))
     sols, info, found_at = np.empty((cap, n)), np.zeros(6), np.zeros(cap, dtype=np.int64)
-    slo = np.where(revolute, -np.inf, ctx["lo"])
-    shi = np.where(revolute, np.inf, ctx["hi"])
     k = _search(ctx["chain"], pose, float(L), W, ctx["tq"], ctx["Ft"], ctx["norms"], ctx["w"], ctx["fmask"], int(nn),
                 int(seed), int(max_starts), int(patience), float(tol[0]), float(tol[1]), float(accept[0]),
-                float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap), slo, shi,
-                glo, ghi, revolute, float(merge_tol), float(growth), wfirst, wlast, held, two, int(bound), draws,
-                int(iterations if held_iterations is None else held_iterations), sols,
-                found_at, info)
+                float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap),
+                plan["slo"], plan["shi"], glo, ghi, revolute, float(merge_tol), float(growth), plan["wfirst"],
+                plan["wlast"], plan["hold"], plan["two"], plan["bound"], plan["draws"], plan["held_iterations"],
+                sols, found_at, info)
     return sols[:k].copy(), found_at[:k].copy(), info
+
+
+@njit(cache=True)
+def _into_limits(sols, k, free, full, angle, revolute, periodic, lo, hi, blo, bhi, chain, pose, W, rows, errs,
+                 status):
+    """Each of the first k wrapped solutions (free joints, internal units) as one public row
+    (deg / length unit, the locked joints' values from ``full``) into ``rows``: every revolute
+    joint moved by whole turns to its in-limit value nearest 0 (a periodic joint as it is), then
+    verified by FK of that public row against ``pose`` -- (position, rotation) errors into
+    ``errs``, the rotation error the larger of the rotation vector's norm and the geodesic angle
+    when the whole rotation is asked for. ``status``: 0 a row, 1 out of the limits (a joint with
+    no in-limit copy). :func:`fkopt.kinematics.branches._in_limit_copies` and ``_verify`` do the
+    same in Python for ``copies=True``."""
+    n = full.shape[0]
+    m = chain[0].shape[0]
+    T = np.empty((3, 3))
+    _rotation_target(pose, T)
+    pt = pose[:3].copy()
+    t = np.empty(n)
+    r, J = np.empty(6), np.empty((6, n))
+    p, R, ax, e = np.empty(3), np.empty((3, 3)), np.empty((m, 6)), np.empty(3)
+    d2r, r2d = math.pi / 180.0, 180.0 / math.pi
+    for s in range(k):
+        status[s] = 0
+        for i in range(free.shape[0]):
+            v = sols[s, i]
+            if periodic[i]:
+                x = v
+            elif not revolute[i]:
+                if not (lo[i] - 1e-12 <= v <= hi[i] + 1e-12):
+                    status[s] = 1
+                    break
+                x = v
+            else:
+                k0 = math.ceil((lo[i] - v) / TWO_PI - 1e-12)
+                k1 = math.floor((hi[i] - v) / TWO_PI + 1e-12)
+                if k1 < k0:
+                    status[s] = 1
+                    break
+                x = min(max(v + TWO_PI * k0, lo[i]), hi[i])
+                for c in range(k0 + 1, k1 + 1):
+                    y = min(max(v + TWO_PI * c, lo[i]), hi[i])
+                    if abs(y) < abs(x):
+                        x = y
+            full[free[i]] = x
+        if status[s] == 1:
+            continue
+        for i in range(n):
+            u = full[i] * r2d if angle[i] else full[i]
+            u = min(max(u, blo[i]), bhi[i])
+            rows[s, i] = u
+            t[i] = u * d2r if angle[i] else u
+        pe, re, _ = _evaluate(chain, t, pt, T, 1.0, W, r, J, p, R, ax, e)
+        if W[3] * W[4] * W[5] != 0.0:
+            re = max(re, _geodesic(R, T))
+        errs[s, 0], errs[s, 1] = pe, re
+    return 0
+
+
+def into_limits(sols, free, full, angle, revolute, periodic, lo, hi, blo, bhi, chain, pose, W):
+    """:func:`_into_limits` of the solutions ``sols`` (k, free): (rows (k, n) public, errors (k, 2), status (k,))."""
+    k = len(sols)
+    rows, errs, status = np.empty((k, len(full))), np.zeros((k, 2)), np.zeros(k, dtype=np.int64)
+    _into_limits(np.ascontiguousarray(sols), k, free, full.copy(), angle, revolute, periodic, lo, hi, blo, bhi, chain,
+                 pose, W, rows, errs, status)
+    return rows, errs, status
 
 
 @njit(cache=True)
