@@ -62,7 +62,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fkopt.errors import FkoptError
-from fkopt.kinematics.branch_structure import structure
+from fkopt.kinematics.branch_structure import reversed_chain, structure
 from fkopt.kinematics.inputs import (_internal, _inverse_arm, _public, _targets, _task_mask, _tolerance,
                                      _unreachable, _values)
 from fkopt.kinematics.results import INVERSE_TOL
@@ -102,6 +102,8 @@ ITERATIONS = 20
 TWO_DRAWS = 2
 #: ... the window of a Pieper triple, whose other solution always exists (branch_structure)
 PAIR_DRAWS = 12
+POLISH = 1e-3
+POLISH_ITERATIONS = 100
 HELD_DRAWS = 4
 HELD_ITERATIONS = 10
 #: Most distinct solutions kept per pose (a generic 6R arm has at most 16).
@@ -259,8 +261,40 @@ def _context(m, locked: dict[int, float], W) -> dict:
     fmask = np.concatenate([Wf[:3], np.full(9, float(Wf[3:].all()))])
     feats = feats * fmask
     tq = full[:, free]
-    windows = _windows(len(free))
-    shape = structure(chain, windows, m.reach)
+    shape = _shape(chain, m.reach, Wf)
+    got = {"structure": shape, "n": len(free), "chain": chain.arrays(), "chain_obj": chain, "free": free,
+           "locked": dict(locked), "tq": np.ascontiguousarray(tq), "Ft": np.ascontiguousarray(feats.T),
+           "norms": _sumsq(feats), "w": float(wf), "fmask": fmask, "W": Wf,
+           "lo": np.ascontiguousarray(lo[free]), "hi": np.ascontiguousarray(hi[free]),
+           "glo": np.ascontiguousarray(glo[free]), "ghi": np.ascontiguousarray(ghi[free]),
+           "revolute": np.ascontiguousarray(revolute[free]), "angle": angle,
+           "periodic": np.ascontiguousarray(m.periodic_mask()[free]), "full_lo": lo, "full_hi": hi,
+           "full_chain": m.chain().arrays(), "reversed": False}
+    if shape["bound"] and shape["triple"][0] == 0:
+        # the Pieper triple at the base (the Panda with joint 7 locked): the search runs on the
+        # chain walked from the tool (branch_structure.reversed_chain), where it is a wrist, and
+        # the derived starts (the wrist's flip, the solutions sharing the first joint, the other
+        # side of it) reach the branches as on a wrist-partitioned arm; the target is the inverse
+        # pose, the start table's features those of the inverse frames, the unknowns reversed
+        back = reversed_chain(chain)
+        Ri = np.swapaxes(rotations.to_array(R).reshape(TABLE, 3, 3), 1, 2)
+        pi = -np.einsum("kij,kj->ki", Ri, np.stack(p, axis=-1))
+        fb = np.concatenate([pi, wf * Ri.reshape(TABLE, 9)], axis=-1) * fmask
+        rev = {key: np.ascontiguousarray(got[key][::-1]) for key in ("lo", "hi", "glo", "ghi", "revolute", "periodic")}
+        got["search"] = dict(got, **rev, structure=_shape(back, m.reach, Wf), chain=back.arrays(), chain_obj=back,
+                             tq=np.ascontiguousarray(tq[:, ::-1]), Ft=np.ascontiguousarray(fb.T), norms=_sumsq(fb),
+                             reversed=True)
+    else:
+        got["search"] = got
+    cache[key] = got
+    return got
+
+
+def _shape(chain, reach: float, Wf: np.ndarray) -> dict:
+    """The chain's structure (branch_structure.structure) with the derived starts' windows in the
+    order the search takes them."""
+    windows = _windows(chain.dof)
+    shape = structure(chain, windows, reach)
     # the windows whose subproblem has two solutions first (a wrist or elbow flip, one start), then
     # the wide ones (the other shoulder side, the solutions sharing the base joint), the rest last
     rank = [0 if two else (1 if b - a > 2 else 2) for (a, b), two in zip(windows, shape["two_solution"])]
@@ -274,16 +308,7 @@ def _context(m, locked: dict[int, float], W) -> dict:
         shape["hold"].append(False)
     if not Wf.all():
         shape["bound"] = 0                        # a masked pose: fewer equations, Pieper's count does not hold
-    got = cache[key] = {"structure": shape,
-        "n": len(free), "chain": chain.arrays(), "chain_obj": chain, "free": free, "locked": dict(locked),
-        "tq": np.ascontiguousarray(tq), "Ft": np.ascontiguousarray(feats.T), "norms": _sumsq(feats),
-        "w": float(wf), "fmask": fmask, "W": Wf,
-        "lo": np.ascontiguousarray(lo[free]), "hi": np.ascontiguousarray(hi[free]),
-        "glo": np.ascontiguousarray(glo[free]), "ghi": np.ascontiguousarray(ghi[free]),
-        "revolute": np.ascontiguousarray(revolute[free]), "angle": angle,
-        "periodic": np.ascontiguousarray(m.periodic_mask()[free]), "full_lo": lo, "full_hi": hi,
-        "full_chain": m.chain().arrays()}
-    return got
+    return shape
 
 
 def _kernels():
@@ -337,6 +362,12 @@ def _verify(m, ctx, pose_row: np.ndarray, public_full: np.ndarray, W) -> tuple[f
         s = 0.5 * math.sqrt((M[2][1] - M[1][2]) ** 2 + (M[0][2] - M[2][0]) ** 2 + (M[1][0] - M[0][1]) ** 2)
         re = max(re, math.atan2(s, 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)))
     return math.hypot(*dp), re
+
+
+def _inverse_row(row: np.ndarray) -> np.ndarray:
+    """The inverse of a target (a pose row (6,) in ZYZ degrees or a frame row (12,)) as a frame row."""
+    R = np.array(rotations.zyz1(*row[3:].tolist())) if len(row) == 6 else row[3:].reshape(3, 3)
+    return np.ascontiguousarray(np.concatenate([-R.T @ row[:3], R.T.reshape(9)]))
 
 
 def _windows(n: int) -> list[tuple[int, int]]:
@@ -425,17 +456,21 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     for lk in locks:
         ctx = _context(m, lk, W)
         nn = min(NEIGHBOURS, len(ctx["tq"]))
-        plan = ctx.get("plan")
+        side = ctx["search"]
+        plan = side.get("plan")
         if plan is None:
-            shape = ctx["structure"]
+            shape = side["structure"]
             draws = [PAIR_DRAWS if w == shape["pair_window"] else TWO_DRAWS if two else HELD_DRAWS
                      for w, two in zip(shape["windows"], shape["two_solution"])]
-            plan = ctx["plan"] = kern.search_plan(shape["windows"], shape["hold"], shape["two_solution"], draws,
-                                                  shape["bound"], HELD_ITERATIONS, ctx["revolute"], ctx["lo"],
-                                                  ctx["hi"])
-        sols, found_at, info = kern.search(ctx, plan, row, L, ctx["W"], nn, int(seed), int(max_starts), int(patience),
-                                           SEARCH_TOL, ACCEPT_TOL, ITERATIONS, 0.01, 0.1, 10.0, 2.0, ctx["glo"],
-                                           ctx["ghi"], ctx["revolute"], MERGE_TOL, CAP, float(growth))
+            plan = side["plan"] = kern.search_plan(shape["windows"], shape["hold"], shape["two_solution"], draws,
+                                                   shape["bound"], shape["multiple"], HELD_ITERATIONS, POLISH,
+                                                   POLISH_ITERATIONS, side["revolute"], side["lo"], side["hi"])
+        sols, found_at, info = kern.search(side, plan, _inverse_row(row) if side["reversed"] else row, L, side["W"],
+                                           nn, int(seed), int(max_starts), int(patience), SEARCH_TOL, ACCEPT_TOL,
+                                           ITERATIONS, 0.01, 0.1, 10.0, 2.0, side["glo"], side["ghi"],
+                                           side["revolute"], MERGE_TOL, CAP, float(growth))
+        if side["reversed"]:
+            sols = np.ascontiguousarray(sols[:, ::-1])
         stats["starts"] += int(info[0])
         stats["converged"] += int(info[1])
         stats["evaluations"] += int(info[2])

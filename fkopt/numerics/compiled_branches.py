@@ -49,7 +49,8 @@ def _no_start_table(n):
 @njit(cache=True)
 def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, patience, tp, tr, accept_p,
             accept_r, iterations, damping, down, up, step_cap, slo, shi, glo, ghi, revolute, merge_tol, growth,
-            wfirst, wlast, hold, two_solution, bound, held_draws, held_iterations, sols, found_at, info):
+            wfirst, wlast, hold, two_solution, bound, multiple, held_draws, held_iterations, polish,
+            polish_iterations, sols, found_at, info):
     """Distinct converged solutions of one pose (internal units, revolute joints wrapped into
     [-pi, pi)) into ``sols`` (cap, n); returns how many. ``info`` = (starts run, converged
     starts, evaluations, starts after the last new solution, the start that found the last new
@@ -156,6 +157,17 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
         if W[3] * W[4] * W[5] != 0.0:
             re = max(re, _geodesic(R, T))
         evals += ev + 1
+        if not (pe <= accept_p and re <= accept_r) and pe + Lw * re <= polish * Lw:
+            # close but not converged: a solution next to a singular configuration, where the
+            # loop's steps shrink (two joints nearly aligned, a solution nearly double); the
+            # loop goes on from there, unlimited (held joints freed: the answer is checked the same)
+            q0[:] = best
+            _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
+                                 tp, tr, polish_iterations, damping, down, up, step_cap, slo, shi, glo, ghi, best)
+            pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
+            if W[3] * W[4] * W[5] != 0.0:
+                re = max(re, _geodesic(R, T))
+            evals += ev + 1
         runs += 1
         new = False
         if pe <= accept_p and re <= accept_r:
@@ -191,11 +203,11 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
         # bounded (windows per solution) and run before them
         since = 0 if new else (since if held else since + 1)
         # nothing found yet: four times the patience before giving a pose up
-        # a chain with Pieper's bound has an even number of distinct solutions (the position
-        # quartic's real roots pair up, each gives two orientations): an odd count has one missing,
-        # so its search goes on (to max_starts)
+        # a chain with Pieper's bound has a multiple of ``multiple`` distinct solutions
+        # (branch_structure.structure): a count that is not has some missing, so its search goes on
+        # (to max_starts)
         if since >= (patience if k > 0 else 4 * patience) and since >= growth * (last_new + 1) and \
-                not (bound > 0 and k % 2 == 1):
+                not (multiple > 1 and k % multiple != 0):
             break
     info[0], info[1], info[2], info[3], info[4], info[5] = runs, converged, evals, since, last_new, complete
     return k
@@ -223,17 +235,22 @@ def _sibling_known(sols, k, s, first, last, revolute, merge_tol):
     return False
 
 
-def search_plan(windows, hold, two_solution, draws, bound, held_iterations, revolute, lo, hi) -> dict:
+def search_plan(windows, hold, two_solution, draws, bound, multiple, held_iterations, polish, polish_iterations,
+                revolute, lo, hi) -> dict:
     """The per-arm arrays of :func:`search`, built once per arm context: windows (first, last joint
     drawn afresh), whether the others are held, whether its subproblem has two solutions, draws
-    per (solution, window) pair, Pieper's bound (0: none), iterations of a derived start, and the
-    unlimited saturation bounds of revolute joints (the search solves modulo 2 pi)."""
+    per (solution, window) pair, Pieper's bound (0: none) and the number the count of solutions is
+    a multiple of (1: none known), iterations of a derived start, the residual below which a start
+    that did not converge is iterated on (``polish``, in length units: position + scaled
+    rotation) and how far, and the unlimited saturation bounds of revolute joints (the search
+    solves modulo 2 pi)."""
     return {"wfirst": np.array([w[0] for w in windows], dtype=np.int64),
             "wlast": np.array([w[1] for w in windows], dtype=np.int64),
             "hold": np.array(hold, dtype=np.bool_).reshape(len(windows)),
             "two": np.array(two_solution, dtype=np.bool_).reshape(len(windows)),
             "draws": np.array(draws, dtype=np.int64).reshape(len(windows)), "bound": int(bound),
-            "held_iterations": int(held_iterations),
+            "multiple": int(multiple), "held_iterations": int(held_iterations), "polish": float(polish),
+            "polish_iterations": int(polish_iterations),
             "slo": np.where(revolute, -np.inf, lo), "shi": np.where(revolute, np.inf, hi)}
 
 
@@ -248,8 +265,9 @@ def search(ctx, plan, pose, L, W, nn, seed, max_starts, patience, tol, accept, i
                 int(seed), int(max_starts), int(patience), float(tol[0]), float(tol[1]), float(accept[0]),
                 float(accept[1]), int(iterations), float(damping), float(down), float(up), float(step_cap),
                 plan["slo"], plan["shi"], glo, ghi, revolute, float(merge_tol), float(growth), plan["wfirst"],
-                plan["wlast"], plan["hold"], plan["two"], plan["bound"], plan["draws"], plan["held_iterations"],
-                sols, found_at, info)
+                plan["wlast"], plan["hold"], plan["two"], plan["bound"], plan["multiple"], plan["draws"],
+                plan["held_iterations"],
+                plan["polish"], plan["polish_iterations"], sols, found_at, info)
     return sols[:k].copy(), found_at[:k].copy(), info
 
 
