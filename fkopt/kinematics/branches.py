@@ -7,14 +7,25 @@ configurations nearest to the target in tool pose, then counter-based hash draws
 joints over one turn, prismatic joints inside their limits); each start runs the damped
 least-squares loop without revolute limits to ``SEARCH_TOL`` (a solution is one modulo 2 pi per
 revolute joint), converged answers are wrapped and merged when every joint agrees within
-``MERGE_TOL``. Each solution found adds *derived* starts (:func:`_windows`): a window of joints
-drawn afresh with the others held at its values, which reach the solutions sharing those joints
-with it (wrist and elbow flips, the other shoulder side) where uniform starts rarely land.
-**Stopping rule**: the search stops after ``patience`` consecutive table or hash starts that
-found nothing new (four times that while none is found), or after ``max_starts``. It is a rule, not a certificate: a branch whose basin
-of attraction is small can be missed; its measured miss rate against EAIK's analytic sets is in
-docs/robots.md, and ``result.search`` reports the starts run and the starts since the last new
-solution, so a caller can ask for a larger ``patience``.
+``MERGE_TOL``; a start that ends close to a solution without converging (next to a singular
+configuration, where the loop's steps shrink) is iterated on (``POLISH``). Each solution found
+adds *derived* starts (:func:`_windows`): a window of joints drawn afresh with the others held at
+its values, which reach the solutions sharing those joints with it (wrist and elbow flips, the
+other shoulder side) where uniform starts rarely land; they run window by window across the
+solutions (the flips that reach most in one start first), and a window whose subproblem has at
+most two solutions is skipped once both are known (:mod:`fkopt.kinematics.branch_structure`
+detects these from the chain's axes). A chain whose Pieper triple is at the base (the Panda with
+joint 7 locked) is searched walked from the tool, where the triple is a wrist.
+**When it stops.** A 6R chain with three consecutive axes parallel or meeting in a point has at
+most 8 solutions (Pieper): when 8 distinct ones are found the search stops with a *certificate*.
+Otherwise it stops after ``patience`` consecutive table or hash starts that found nothing new
+(four times that while none is found; ``PIEPER_PATIENCE`` on such a chain, whose complete poses
+end at the bound anyway), unless the count is not a multiple of what such a chain's counts are
+(4 with a concurrent triple, 2 with a parallel one: some are missing), or after ``max_starts``.
+That rule is not a certificate: a branch whose basin of attraction is small can be missed; its
+measured miss rate against EAIK's analytic sets is in docs/robots.md, and ``result.search``
+reports the rule that ended it, the starts run and the starts since the last new solution, so a
+caller can ask for a larger ``patience``.
 
 Each distinct solution is then mapped into the limits: every revolute joint takes the in-limit
 value congruent modulo 2 pi that is nearest 0 (a continuous joint: its value wrapped into
@@ -295,9 +306,11 @@ def _shape(chain, reach: float, Wf: np.ndarray) -> dict:
     order the search takes them."""
     windows = _windows(chain.dof)
     shape = structure(chain, windows, reach)
-    # the windows whose subproblem has two solutions first (a wrist or elbow flip, one start), then
-    # the wide ones (the other shoulder side, the solutions sharing the base joint), the rest last
-    rank = [0 if two else (1 if b - a > 2 else 2) for (a, b), two in zip(windows, shape["two_solution"])]
+    # the Pieper triple's window first (its flip always exists), then the wide ones (the other
+    # shoulder side, the solutions sharing the base joint), then the other windows whose subproblem
+    # has two solutions (a wrist or elbow flip, one start), the rest last
+    rank = [0 if w == shape["pair_window"] else 1 if w[1] - w[0] > 2 else 2 if two else 3
+            for w, two in zip(windows, shape["two_solution"])]
     order = sorted(range(len(windows)), key=lambda i: (rank[i], -windows[i][1] + windows[i][0], i))
     shape["windows"] = [windows[i] for i in order]
     shape["two_solution"] = [shape["two_solution"][i] for i in order]

@@ -8,9 +8,12 @@ Both are built on :func:`fkopt.numerics.compiled_ik._inverse_one` (the damped le
   seeded hash draws (revolute joints over one turn, prismatic joints inside their limits); each
   start runs the loop without revolute limits (a solution is a solution modulo 2 pi; the limits
   are applied by the caller, which maps every solution into them), converged answers are wrapped
-  into [-pi, pi) and merged when every joint agrees within ``merge_tol``; the search stops after
-  ``patience`` consecutive starts that found nothing new (the stopping rule, whose miss rate
-  docs/robots.md measures against EAIK's analytic sets), or after ``max_starts``.
+  into [-pi, pi) and merged when every joint agrees within ``merge_tol``; derived starts from
+  each solution found (a window of joints drawn afresh, the others held) run window by window;
+  the search stops at Pieper's bound (a certificate), or after ``patience`` consecutive starts
+  that found nothing new when the count is a multiple of the chain's (the stopping rule, whose
+  miss rate docs/robots.md measures against EAIK's analytic sets), or after ``max_starts``.
+* :func:`into_limits` -- each solution's in-limit copy nearest 0, verified by FK of its public row.
 * :func:`track` -- one path: each waypoint's loop starts at the previous answer (no table, no
   restarts), a waypoint passes when it converges and no joint moved more than ``max_step``; the
   first waypoint that does not pass is returned for the caller to explain (limit, singularity,
