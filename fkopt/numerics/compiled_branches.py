@@ -179,15 +179,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
                 w[i] = _wrap(best[i]) if revolute[i] else best[i]
             dup = False
             for s in range(k):
-                same = True
-                for i in range(n):
-                    d = w[i] - sols[s, i]
-                    if revolute[i]:
-                        d = _wrap(d)
-                    if abs(d) > merge_tol:
-                        same = False
-                        break
-                if same:
+                if _agree(w, sols[s], revolute, merge_tol, n, n):
                     dup = True
                     break
             if not dup and k < cap:
@@ -217,23 +209,24 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
 
 
 @njit(cache=True)
+def _agree(a, b, revolute, merge_tol, first, last):
+    """Whether joints a and b agree within merge_tol (revolute ones modulo 2 pi) outside first..last."""
+    for i in range(a.shape[0]):
+        if first <= i <= last:
+            continue
+        d = a[i] - b[i]
+        if revolute[i]:
+            d = _wrap(d)
+        if abs(d) > merge_tol:
+            return False
+    return True
+
+
+@njit(cache=True)
 def _sibling_known(sols, k, s, first, last, revolute, merge_tol):
     """Whether a known solution other than s agrees with s on every joint outside first..last."""
-    n = sols.shape[1]
     for o in range(k):
-        if o == s:
-            continue
-        same = True
-        for i in range(n):
-            if first <= i <= last:
-                continue
-            d = sols[o, i] - sols[s, i]
-            if revolute[i]:
-                d = _wrap(d)
-            if abs(d) > merge_tol:
-                same = False
-                break
-        if same:
+        if o != s and _agree(sols[o], sols[s], revolute, merge_tol, first, last):
             return True
     return False
 
