@@ -544,8 +544,10 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
         stats["rule"] = (f"certificate: {shape['bound']} distinct solutions found, Pieper's bound for a 6R chain "
                          f"whose joints {i + 1}, {j + 1}, {k + 1} have {kind} axes: there are no more")
     else:
-        stats["rule"] = (f"stopped after {patience} consecutive starts without a new solution "
-                         f"(or {max_starts} starts); no certificate: the miss rate is measured in docs/robots.md")
+        quiet = stats["since_last_new"] if isinstance(stats["since_last_new"], list) else [stats["since_last_new"]]
+        how = (f"stopped after {patience} consecutive starts without a new solution" if min(quiet) >= patience else
+               f"stopped at {max_starts} starts, before {patience} consecutive ones without a new solution")
+        stats["rule"] = f"{how}; no certificate: the miss rate is measured in docs/robots.md"
     stats["patience"], stats["max_starts"] = int(patience), int(max_starts)
     n = m.dof
     sol = np.array(rows).reshape(-1, n)
