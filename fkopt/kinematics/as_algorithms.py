@@ -244,7 +244,8 @@ class InverseParams(Params):
     spread_joints: list[str] | None = Field(None, min_length=1, description="solutions: all with spread: "
                                                                             "the locked joints")
     patience: int | None = Field(None, ge=1, description="solutions: all: consecutive starts without a new "
-                                                         "solution before the search stops (default 32)")
+                                                         "solution before the search stops (default 128 on a "
+                                                         "6R chain with Pieper's bound, else 32)")
     max_starts: int | None = Field(None, ge=1, description="solutions: all: most starts per pose "
                                                            "(default 400)")
 
