@@ -294,9 +294,9 @@ def abc_iteration(fitness):
     return step
 
 
-#: Places for the log's improvements in one :func:`abc_iterations` call: (iterations' worth of
-#: evaluations, plus); improvements are rare after the first iterations, and a call ends early
-#: (the caller calls again) when the next iteration's might not fit.
+#: Places for the log's improvements in one :func:`abc_iterations` call, (per, extra): per times
+#: one iteration's evaluations of every run, plus extra. Improvements are rare after the first
+#: iterations; a call ends early (the caller calls again) when the next iteration's might not fit.
 LOG_ROOM = (2, 4096)
 #: x_history of a solve that keeps none (the kernel writes it only when it has columns).
 _NO_X = np.empty((1, 0, 3))
@@ -393,7 +393,6 @@ def abc_iterations(fitness):
     def advance(x, f, trial, best_x, best_f, u, width, limit, rule, C, bounds, J, absolute, log, separate,
                 evaluations, history, ev_history, x_history, t0):
         runs, pop = f.shape
-
         per, extra = LOG_ROOM
         room = per * runs * (2 * pop + 1) + extra
         jj, fo_jj, fo_src, mv, fo_mv, fe, fo, scout, arg, out, hr, he, hf, lo, hi = scratch_arrays(
