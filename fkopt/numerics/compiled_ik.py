@@ -10,15 +10,16 @@ in the reference's order. Importing this module imports numba.
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
-from fkopt.numerics.compiled import (_dls_step, _dls_step_all, _evaluate, _rotation_error, _rotation_target,
-                                     _uniform_hash, _walk)
+from fkopt.numerics.compiled import (_dls_step, _dls_step_all, _evaluate, _fetch_add, _rotation_error,
+                                     _rotation_target, _uniform_hash, _walk)
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 
-@njit(inline="always")      # inlined into the loop: no call per start (the one-pose path is per-call cost)
+@njit(cache=True, _nrt=False)   # no reference counts: it only reads and writes the arrays it is given
 def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap, lo, hi, work):
     """One candidate of the one restart loop: the damped least-squares steps from start q (updated
     in place) -- :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, compiled,
@@ -82,9 +83,12 @@ def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, do
         pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e, wone)
         evals += 1
         if Sn < S:
-            q[:] = qn
-            r[:] = rn
-            J[:, :] = Jn
+            for i in range(n):
+                q[i] = qn[i]
+            for a in range(6):
+                r[a] = rn[a]
+                for i in range(n):
+                    J[a, i] = Jn[a, i]
             pe, re, S = pen, ren, Sn
             lam = max(lam * down, 1e-12)
         else:
@@ -269,14 +273,63 @@ def _screen32(table, f, v32):
         v32[i] = n32[i] - two * v32[i]
 
 
+#: Rows of the start table per screen group in :func:`_nearest_screened`: group g holds rows g, g + G,
+#: g + 2G, ... (G = :data:`SCREEN_GROUPS`), so that the groups' minima are one vectorised pass.
+SCREEN_GROUPS = 256
+
+
+@njit(inline="always")
+def _insert_by_row(best, idx, m, x, i):
+    """:func:`_insert` for rows arriving in any order: the k = len(idx) smallest (value, row) pairs
+    so far, sorted (ties: the lower row first, as rows inserted in row order by :func:`_insert`)."""
+    k = idx.shape[0]
+    if m < k:
+        pos = m
+        m += 1
+    elif x < best[k - 1] or (x == best[k - 1] and i < idx[k - 1]):
+        pos = k - 1
+    else:
+        return m
+    while pos > 0 and (best[pos - 1] > x or (best[pos - 1] == x and idx[pos - 1] > i)):
+        best[pos] = best[pos - 1]
+        idx[pos] = idx[pos - 1]
+        pos -= 1
+    best[pos] = x
+    idx[pos] = i
+    return m
+
+
+@njit(cache=True)
+def _group_minima(v32, gm):
+    """gm[g] = the smallest screen value of group g (rows g, g + G, ...; G = len(gm)), NaN rows
+    left out (+inf for a group without a number): lane by lane over the table, one vectorised pass."""
+    G = gm.shape[0]
+    N = v32.shape[0]
+    for g in range(G):
+        gm[g] = np.inf
+    full = N - N % G
+    for s in range(0, full, G):
+        row = v32[s:s + G]                          # a view: plain range indices vectorise, s + g does not
+        for g in range(G):
+            x = row[g]
+            gm[g] = x if x < gm[g] else gm[g]
+    rest = v32[full:]
+    for g in range(N - full):
+        x = rest[g]
+        gm[g] = x if x < gm[g] else gm[g]
+
+
 @njit(cache=True)
 def _nearest_screened(table, f, v32, idx, best):
     """:func:`_nearest_into`'s k = len(idx) nearest rows, the same rows in the same order: the
     float32 screen v32 (:func:`_screen32`) bounds every row's float64 value v within B (sizes
     times :data:`SCREEN_ROUNDOFF`), so with s_k the k-th smallest screen value, the k-th smallest
     v is at most s_k + B and a row of the k nearest has v32 <= s_k + 2B; only those rows get the
-    float64 value of :func:`_table_distances` (the same operations), in row order, and the same
-    sorted insertion (ties: the lower row first)."""
+    float64 value of :func:`_table_distances` (the same operations) and a sorted insertion by
+    (value, row) (ties: the lower row first). s_k is found without a scalar pass over every row:
+    the k-th smallest of the groups' minima (:func:`_group_minima`) is at least s_k (k groups, k
+    rows at or below it), so the k smallest screen values are all in the groups whose minimum is
+    at most it, and the rows at most s_k + 2B in the groups whose minimum is."""
     Ft, norms, _, _, nmax = table
     k = idx.shape[0]
     c, N = Ft.shape
@@ -284,40 +337,65 @@ def _nearest_screened(table, f, v32, idx, best):
     for j in range(c):
         ff += f[j] * f[j]
     B = SCREEN_ROUNDOFF * (1.0 + nmax + 2.0 * math.sqrt(nmax * ff) + ff)
-    # the k smallest screen values (sorted insertion; k is small). Written out rather than through
-    # _insert: this pass runs over every row of the table, and with _insert it took 4x the time (measured)
-    sk = np.empty(k)
+    G = min(SCREEN_GROUPS, N)
+    gm = np.empty(G, dtype=np.float32)
+    _group_minima(v32, gm)
+    # U: the k-th smallest group minimum (+inf with fewer than k groups holding a number)
+    gk = np.empty(k)
     m = 0
-    for i in range(N):
-        x = np.float64(v32[i])
+    for g in range(G):
+        x = np.float64(gm[g])
         if m < k:
             pos = m
             m += 1
-        elif x < sk[k - 1]:
+        elif x < gk[k - 1]:
             pos = k - 1
         else:
             continue
-        while pos > 0 and sk[pos - 1] > x:
-            sk[pos] = sk[pos - 1]
+        while pos > 0 and gk[pos - 1] > x:
+            gk[pos] = gk[pos - 1]
             pos -= 1
-        sk[pos] = x
+        gk[pos] = x
+    U = gk[k - 1] if m == k else math.inf
+    # s_k: the k-th smallest screen value, from the rows of the groups at most U
+    sk = np.empty(k)
+    m = 0
+    for g in range(G):
+        if not np.float64(gm[g]) <= U:
+            continue
+        for i in range(g, N, G):
+            x = np.float64(v32[i])
+            if m < k:
+                pos = m
+                m += 1
+            elif x < sk[k - 1]:
+                pos = k - 1
+            else:
+                continue
+            while pos > 0 and sk[pos - 1] > x:
+                sk[pos] = sk[pos - 1]
+                pos -= 1
+            sk[pos] = x
     limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
     m = 0
-    for i in range(N):
-        if not np.float64(v32[i]) <= limit:
+    for g in range(G):
+        if not np.float64(gm[g]) <= limit:
             continue
-        acc = 0.0
-        first = True
-        for j in range(c):
-            fj = f[j]
-            if fj == 0.0:
+        for i in range(g, N, G):
+            if not np.float64(v32[i]) <= limit:
                 continue
-            # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
-            # |F_i|^2 - 2 d2 does not see)
-            acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
-            first = False
-        x = norms[i] - 2.0 * acc
-        m = _insert(best, idx, m, x, i)
+            acc = 0.0
+            first = True
+            for j in range(c):
+                fj = f[j]
+                if fj == 0.0:
+                    continue
+                # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
+                # |F_i|^2 - 2 d2 does not see)
+                acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
+                first = False
+            x = norms[i] - 2.0 * acc
+            m = _insert_by_row(best, idx, m, x, i)
 
 
 @njit(cache=True)
@@ -410,37 +488,57 @@ def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, d
 
 @njit(cache=True, nogil=True)
 def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
-    """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
-    ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
-    share a batch (:func:`inverse_rows`)."""
-    for k in range(first, poses.shape[0], step):
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, next_row):
+    """:func:`_inverse_pose` of rows of ``poses`` (k, 6) from start rows ``q0[k]``: each row the
+    one it takes from the shared count ``next_row[0]`` (:func:`fkopt.numerics.compiled._fetch_add`)
+    until none is left; row k's answer is the one-pose call's, whoever takes it. Runs without the
+    GIL, so that threads can share a batch (:func:`inverse_rows`)."""
+    k = _fetch_add(next_row, 1)
+    while k < poses.shape[0]:
         _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, table, wf, fmask, nn, seed, budget, tp, tr,
                       iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
                       out[k], info[k])
+        k = _fetch_add(next_row, 1)
 
 
-#: Batches from this many rows are shared by one thread per core.
+#: Batches from this many rows are shared by threads (below, a thread costs more than it saves).
 THREAD_ROWS = 64
 
 
-def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap,
+                 threads):
     """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5)). From
-    :data:`THREAD_ROWS` rows, one Python thread per core takes every t-th row (interleaved, so
-    that the rows needing restarts spread evenly): plain threads rather than numba's parallel
-    layer, whose OpenMP runtime does not survive a fork and whose fallback is not thread-safe."""
-    import os
+    :data:`THREAD_ROWS` rows, ``threads`` threads (this one and threads - 1 more; at most one per
+    :data:`THREAD_ROWS` // 2 rows) share them, each taking the next row not yet taken: a row that
+    needs many restarts holds up one thread, not a fixed share of the batch. Plain threads rather
+    than numba's parallel layer, whose OpenMP runtime does not survive a fork and whose fallback
+    is not thread-safe. Every row's answer depends only on its pose, start and the seed, so the
+    answers are the same bits for any ``threads`` (1: this thread alone)."""
     k = poses.shape[0]
     out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
+    next_row = np.zeros(1, dtype=np.int64)
     args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn,
             seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
-            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
-    threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
-    if k < THREAD_ROWS or threads < 2:
-        _inverse_rows(*args, 0, 1)
+            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info, next_row)
+    helpers = min(int(threads), max(1, k // (THREAD_ROWS // 2))) - 1 if k >= THREAD_ROWS else 0
+    if helpers < 1:
+        _inverse_rows(*args)
         return out, info
-    from concurrent.futures import ThreadPoolExecutor
-    with ThreadPoolExecutor(threads) as pool:
-        for f in [pool.submit(_inverse_rows, *args, t, threads) for t in range(threads)]:
-            f.result()
+    failures = []
+
+    def helper():
+        try:
+            _inverse_rows(*args)
+        except BaseException as err:            # noqa: BLE001 - handed to the calling thread below
+            failures.append(err)
+    started = [threading.Thread(target=helper, name=f"fkopt-inverse-{i}", daemon=True) for i in range(helpers)]
+    for t in started:
+        t.start()
+    try:
+        _inverse_rows(*args)
+    finally:
+        for t in started:
+            t.join()
+    if failures:
+        raise failures[0]
     return out, info
