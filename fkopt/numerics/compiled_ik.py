@@ -276,6 +276,8 @@ def _screen32(table, f, v32):
 #: Rows of the start table per screen group in :func:`_nearest_screened`: group g holds rows g, g + G,
 #: g + 2G, ... (G = :data:`SCREEN_GROUPS`), so that the groups' minima are one vectorised pass.
 SCREEN_GROUPS = 256
+#: Up to this many neighbours, :func:`_nearest_screened` visits the rows group by group; beyond, in row order.
+GROUP_SCAN_K = 8
 
 
 @njit(inline="always")
@@ -329,7 +331,8 @@ def _nearest_screened(table, f, v32, idx, best):
     (value, row) (ties: the lower row first). s_k is found without a scalar pass over every row:
     the k-th smallest of the groups' minima (:func:`_group_minima`) is at least s_k (k groups, k
     rows at or below it), so the k smallest screen values are all in the groups whose minimum is
-    at most it, and the rows at most s_k + 2B in the groups whose minimum is."""
+    at most it, and the rows at most s_k + 2B in the groups whose minimum is (for more than
+    :data:`GROUP_SCAN_K` neighbours the rows are visited in row order instead, same rows)."""
     Ft, norms, _, _, nmax = table
     k = idx.shape[0]
     c, N = Ft.shape
@@ -344,58 +347,68 @@ def _nearest_screened(table, f, v32, idx, best):
     gk = np.empty(k)
     m = 0
     for g in range(G):
-        x = np.float64(gm[g])
-        if m < k:
-            pos = m
-            m += 1
-        elif x < gk[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and gk[pos - 1] > x:
-            gk[pos] = gk[pos - 1]
-            pos -= 1
-        gk[pos] = x
+        m = _insert_value(gk, m, np.float64(gm[g]))
     U = gk[k - 1] if m == k else math.inf
-    # s_k: the k-th smallest screen value, from the rows of the groups at most U
+    # s_k: the k-th smallest screen value, from the rows at most U: for a few neighbours those of the
+    # few groups at most U; for many (more groups, each row in another cache line) a pass in row order
     sk = np.empty(k)
     m = 0
-    for g in range(G):
-        if not np.float64(gm[g]) <= U:
-            continue
-        for i in range(g, N, G):
-            x = np.float64(v32[i])
-            if m < k:
-                pos = m
-                m += 1
-            elif x < sk[k - 1]:
-                pos = k - 1
-            else:
-                continue
-            while pos > 0 and sk[pos - 1] > x:
-                sk[pos] = sk[pos - 1]
-                pos -= 1
-            sk[pos] = x
+    if k <= GROUP_SCAN_K:
+        for g in range(G):
+            if np.float64(gm[g]) <= U:
+                for i in range(g, N, G):
+                    m = _insert_value(sk, m, np.float64(v32[i]))
+    else:
+        for i in range(N):
+            if np.float64(v32[i]) <= U:
+                m = _insert_value(sk, m, np.float64(v32[i]))
     limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
     m = 0
-    for g in range(G):
-        if not np.float64(gm[g]) <= limit:
+    if k <= GROUP_SCAN_K:
+        for g in range(G):
+            if np.float64(gm[g]) <= limit:
+                for i in range(g, N, G):
+                    if np.float64(v32[i]) <= limit:
+                        m = _insert_by_row(best, idx, m, _table_distance(Ft, norms, f, i), i)
+    else:
+        for i in range(N):
+            if np.float64(v32[i]) <= limit:
+                m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
+
+
+@njit(inline="always")
+def _insert_value(sk, m, x):
+    """x into the k = len(sk) smallest values so far (``m`` of them held, sorted); returns how
+    many are held after it."""
+    k = sk.shape[0]
+    if m < k:
+        pos = m
+        m += 1
+    elif x < sk[k - 1]:
+        pos = k - 1
+    else:
+        return m
+    while pos > 0 and sk[pos - 1] > x:
+        sk[pos] = sk[pos - 1]
+        pos -= 1
+    sk[pos] = x
+    return m
+
+
+@njit(inline="always")
+def _table_distance(Ft, norms, f, i):
+    """Row i's float64 value |F_i|^2 - 2 F_i . f, operation for operation :func:`_table_distances`'."""
+    acc = 0.0
+    first = True
+    for j in range(Ft.shape[0]):
+        fj = f[j]
+        if fj == 0.0:
             continue
-        for i in range(g, N, G):
-            if not np.float64(v32[i]) <= limit:
-                continue
-            acc = 0.0
-            first = True
-            for j in range(c):
-                fj = f[j]
-                if fj == 0.0:
-                    continue
-                # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
-                # |F_i|^2 - 2 d2 does not see)
-                acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
-                first = False
-            x = norms[i] - 2.0 * acc
-            m = _insert_by_row(best, idx, m, x, i)
+        # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
+        # |F_i|^2 - 2 d2 does not see)
+        acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
+        first = False
+    return norms[i] - 2.0 * acc
 
 
 @njit(cache=True)
