@@ -212,3 +212,15 @@ def wait_while_running(proc, ready, timeout: float) -> None:
         except (OSError, ValueError, KeyError):
             pass
         time.sleep(0.05)
+
+
+def interrupted_after_first_task(config, out) -> None:
+    """Run ``config`` into ``out`` and stop it (KeyboardInterrupt, as Ctrl-C) once its first task has
+    finished: what the resume tests resume from (the finished task's file stays in the work folder)."""
+    from fkopt.run.pipeline import run_config
+
+    def stop_after_one(label, done, total):
+        if done == 1:
+            raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt):
+        run_config(config, out, progress=stop_after_one)

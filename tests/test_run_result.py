@@ -17,7 +17,7 @@ from fkopt.run.pipeline import from_dict, plan_config, run_config, run_in_memory
 from fkopt.run.result import RunResult, dataclass_from_json, dataclass_to_json, from_json, to_json
 from fkopt.run.tasks import TASKS, run_tasks
 from fkopt.solve import Result
-from conftest import wait_while_running
+from conftest import interrupted_after_first_task, wait_while_running
 
 ROOT = Path(__file__).resolve().parents[1]
 EXPERIMENT = {"name": "two", "paper": "test", "mechanism": {"name": "3-rps"}, "seed": 3,
@@ -85,15 +85,7 @@ def test_experiment_resume_reuses_its_task_files(tmp_path):
     resume=True computes only the others and writes what an uninterrupted run writes."""
     config = from_dict(EXPERIMENT, "t")
     whole = run_config(config, tmp_path / "whole")
-    seen = []
-
-    def stop_after_one(label, done, total):
-        seen.append(label)
-        if done == 1:
-            raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        run_config(config, tmp_path / "out", progress=stop_after_one)
+    interrupted_after_first_task(config, tmp_path / "out")
     tasks = tmp_path / "out" / "test" / ".two.partial" / TASKS
     assert sorted(p.name for p in tasks.iterdir()) == ["a00.json", "manifest.json"]
     assert not (tmp_path / "out" / "test" / "two").exists()
@@ -106,12 +98,7 @@ def test_experiment_resume_reuses_its_task_files(tmp_path):
 
 def test_experiment_resume_refuses_a_changed_task_file(tmp_path):
     config = from_dict(EXPERIMENT, "t")
-
-    def stop(label, done, total):
-        if done == 1:
-            raise KeyboardInterrupt
-    with pytest.raises(KeyboardInterrupt):
-        run_config(config, tmp_path, progress=stop)
+    interrupted_after_first_task(config, tmp_path)
     path = tmp_path / "test" / ".two.partial" / TASKS / "a00.json"
     path.write_text(path.read_text().replace('"solver":"gabc"', '"solver":"gabc" '))
     with pytest.raises(FkoptError, match="changed since fkopt wrote it"):

@@ -13,17 +13,28 @@ evaluation, counted). An exact solver has no iterations: every record t = 0..ite
 the answer's fitness at the evaluations used, so a budget cut below them (a suite's ``B``)
 leaves the run with no answer -- the solver did not finish within the budget.
 
+**Every solution** (``params: {solutions: all}``): ``inverse`` (and ``exact`` on a serial arm)
+searches every IK solution of a pose (:func:`fkopt.kinematics.branches.inverse_all`, with ``fixed``
+/ ``spread`` for a redundant arm), ``forward`` (and ``exact`` on a parallel mechanism) every real
+assembly mode (:func:`fkopt.kinematics.assembly_modes.all_solutions`): once per pose, not once
+per run, so such an entry is no optimiser: :meth:`ExactSolver.solution_set` gives the set
+(an experiment file writes it to ``solutions.csv``), and ``minimize`` refuses it.
+
 This module sits beside :mod:`fkopt.kinematics.solvers` (which it wraps), not in :mod:`fkopt.algorithms`:
 an algorithm knows only the problem interface (docs/ARCHITECTURE: floor 1), and these know
 mechanisms. The registry names them like every algorithm.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from typing import Literal
+
 import numpy as np
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from fkopt.algorithms.base import Algorithm, Params, RunRecord
 from fkopt.errors import FkoptError
+from fkopt.kinematics.branches import ALL_TOL, inverse_all, locked_sets
 from fkopt.kinematics.solvers import forward, inverse
 from fkopt.progress import tick
 from fkopt.numerics.streams import RunStreams, run_seed_sequence
@@ -34,25 +45,118 @@ def row_seeds(streams: RunStreams) -> list[int]:
     return [int(run_seed_sequence(s, k).generate_state(1)[0]) for s, k in zip(streams.seeds, streams.run_ids)]
 
 
+@dataclass
+class SolutionSet:
+    """Every solution an exact solver found for one pose (``params: {solutions: all}``), in one
+    shape for both kinds: ``names`` of the unknowns and ``values`` (k, n) in the mechanism's public
+    units (an arm's joints, a parallel mechanism's pose); ``per_solution`` one column per solution
+    (an arm's position and geodesic rotation error; a parallel mechanism's residual and hits);
+    ``search`` how the search decided it had them all (scalars: its stopping rule's settings and
+    counts; no times, so the set is the same bits on every rerun)."""
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    per_solution: dict = field(default_factory=dict)
+    search: dict = field(default_factory=dict)
+
+
+#: The all-solutions search's options in :class:`InverseParams`, passed on as given.
+BRANCH_OPTIONS = ("fixed", "spread", "spread_joints", "patience", "max_starts")
+
+
+def _branch_options(p) -> dict:
+    return {k: getattr(p, k) for k in BRANCH_OPTIONS if getattr(p, k, None) is not None}
+
+
+#: What a solution set's search fields say the search stopped on (no search gives a certificate).
+STOPPING_RULE = {"serial": "patience", "parallel": "rounds without a new solution"}
+
+
+def _checked_kind(solver, mech) -> None:
+    if mech is None or getattr(mech, "kind", None) not in ((solver.family,) if solver.family else ("parallel", "serial")):
+        what = {"parallel": "forward kinematics of a parallel mechanism",
+                "serial": "inverse kinematics of a serial arm"}.get(solver.family, "FK or IK of a mechanism")
+        raise FkoptError(f"algorithm '{solver.name}' solves {what} only; this problem is not one "
+                         "(use 'exact', which picks forward or inverse by the mechanism's kind)")
+
+
 class ExactSolver(Algorithm):
     """An exact solver's one-shot records (module docstring); subclasses give ``solve_row``."""
 
     #: the mechanism family the solver takes ("parallel": FK, "serial": IK; None: both)
     family: str | None = None
 
+    @property
+    def every_solution(self) -> bool:
+        """Does this entry ask for every solution of a pose (``solutions: all``)?"""
+        return getattr(self.params, "solutions", "one") == "all"
+
     def solve_row(self, problem, row: int, seed: int) -> tuple[np.ndarray, int]:
         """The answer for row ``row`` of ``problem`` and the evaluations it cost."""
         raise NotImplementedError
+
+    def check_solution_set(self, mech) -> None:
+        """Refuse, without searching, what :meth:`solution_set` would refuse on ``mech``: the
+        wrong kind of mechanism, ``fixed``/``spread`` naming joints it does not have or leaving a
+        redundant arm's solutions infinite, ``fixed``/``spread`` on a parallel mechanism."""
+        _checked_kind(self, mech)
+        p = self.params
+        options = _branch_options(p)
+        if mech.kind == "parallel":
+            if options:
+                raise FkoptError(f"{', '.join(options)}: options of a serial arm's search; '{mech.name}' is a "
+                                 "parallel mechanism, whose search of every assembly mode takes tol only")
+            return
+        locked_sets(mech, **{k: v for k, v in options.items() if k in ("fixed", "spread", "spread_joints")})
+
+    def solution_set(self, mech, inputs: np.ndarray, seed: int) -> SolutionSet:
+        """Every solution of one case: a serial arm's pose ``inputs`` (x, y, z, Z-Y-Z angles) by
+        ``fkopt.inverse(arm, pose, solutions="all")``, a parallel mechanism's joints by
+        :func:`fkopt.kinematics.assembly_modes.all_solutions`, with ``seed`` and the entry's
+        options; tolerances not given in ``params`` are the search's own defaults."""
+        self.check_solution_set(mech)
+        p = self.params
+        if mech.kind == "serial":
+            set_ = p.model_fields_set
+            tol = (p.position_tol if "position_tol" in set_ else ALL_TOL[0],
+                   p.rotation_tol if "rotation_tol" in set_ else ALL_TOL[1])
+            r = inverse_all(mech, np.asarray(inputs, dtype=float), tol=tol, seed=int(seed), **_branch_options(p))
+            search = r.search
+            # spread: one search per locked set; the fewest starts since a new solution is the
+            # least evidence any of them stopped on
+            since = search["since_last_new"]
+            return SolutionSet(tuple(r.names), np.asarray(r.solutions, dtype=float).reshape(-1, len(r.names)),
+                               {"position_error": np.asarray(r.position_error, dtype=float),
+                                "rotation_error": np.asarray(r.rotation_error, dtype=float)},
+                               {"stopping_rule": STOPPING_RULE["serial"], "patience": int(search["patience"]),
+                                "max_starts": int(search["max_starts"]), "starts": int(search["starts"]),
+                                "converged": int(search["converged"]),
+                                "since_last_new": int(min(since) if isinstance(since, list) else since),
+                                "evaluations": int(search["evaluations"]), "distinct": int(search["distinct"]),
+                                "out_of_limits": int(search["out_of_limits"]),
+                                "unverified": int(search["unverified"])})
+        # start-up: the registry loads this module for every command; the search's ~10 ms of imports only here
+        from fkopt.kinematics.assembly_modes import all_solutions as assembly_modes
+        given = {"tol": p.tol} if "tol" in p.model_fields_set else {}
+        found = assembly_modes(mech, np.asarray(inputs, dtype=float), seed=int(seed), **given)
+        poses = found.poses()
+        order = np.lexsort(poses.T[::-1]) if len(poses) else np.arange(0)     # sorted by pose, as kind: assembly
+        return SolutionSet(tuple(found.names), poses[order],
+                           {"residual": np.array([s.residual for s in found], dtype=float)[order],
+                            "hits": np.array([s.hits for s in found], dtype=np.int64)[order]},
+                           {"stopping_rule": STOPPING_RULE["parallel"], "patience": int(found.settings["patience"]),
+                            "round_size": int(found.settings["round_size"]), "starts": int(found.starts),
+                            "outside_bounds": int(found.outside)})
 
     def minimize(self, problem, *, population: int, iterations: int, streams: RunStreams,
                  target: float | None = None, stop_at_target: bool = False,
                  x0: np.ndarray | None = None, snapshots=(), x_history: bool = True) -> RunRecord:
         mech = getattr(problem, "mechanism", None)
-        if mech is None or getattr(mech, "kind", None) not in ((self.family,) if self.family else ("parallel", "serial")):
-            what = {"parallel": "forward kinematics of a parallel mechanism",
-                    "serial": "inverse kinematics of a serial arm"}.get(self.family, "FK or IK of a mechanism")
-            raise FkoptError(f"algorithm '{self.name}' solves {what} only; this problem is not one "
-                             "(use 'exact', which picks forward or inverse by the mechanism's kind)")
+        _checked_kind(self, mech)
+        if self.every_solution:
+            raise FkoptError(f"algorithm '{self.name}' with solutions: all gives every solution of a pose, not one "
+                             "answer per run: it runs in experiment files (solutions.csv) or as "
+                             "fkopt.inverse(arm, pose, solutions='all'); use solutions: one here")
         runs = streams.runs
         rows = problem.repeat(runs)        # an experiment's one target: one row per run
         xs = np.empty((runs, problem.dim))
@@ -75,8 +179,15 @@ class ExactSolver(Algorithm):
                          events=(np.arange(runs), used.copy(), f.copy()))
 
 
+#: ``solutions``: one answer per run, or every solution of each pose once (module docstring).
+SOLUTIONS_FIELD = Field("one", description="one: one answer per run; all: every solution of each case "
+                                           "once (experiment files: solutions.csv)")
+
+
 class ForwardParams(Params):
-    tol: float = Field(1e-9, gt=0, description="largest accepted max |ik(pose) - joints|, joint units")
+    tol: float = Field(1e-9, gt=0, description="largest accepted max |ik(pose) - joints|, joint units "
+                                               "(solutions: all: relative to max(1, |joint|), the search's)")
+    solutions: Literal["one", "all"] = SOLUTIONS_FIELD
     global_search: bool = Field(True, description="fall back to fkopt.forward's global stage")
     # 0 by default: the stored paper and kinbench results were made without the start table
     table: int = Field(0, ge=0, description="fkopt.forward's start table size (0: none, the stored results' "
@@ -108,9 +219,30 @@ class Forward(ExactSolver):
 
 
 class InverseParams(Params):
-    position_tol: float = Field(1e-6, gt=0, description="position tolerance (arm's length unit)")
-    rotation_tol: float = Field(1e-6, gt=0, description="orientation tolerance (rad)")
+    position_tol: float = Field(1e-6, gt=0, description="position tolerance (arm's length unit; solutions: "
+                                                        "all: 1e-9 unless given)")
+    rotation_tol: float = Field(1e-6, gt=0, description="orientation tolerance (rad; solutions: all: 1e-9 "
+                                                        "unless given)")
     restarts: int = Field(200, ge=0, description="most random restarts per pose")
+    solutions: Literal["one", "all"] = SOLUTIONS_FIELD
+    # the all-solutions search's own options (fkopt.inverse(..., solutions="all"))
+    fixed: dict[str, float] | None = Field(None, description="solutions: all: joints locked at values "
+                                                             "(public units), a redundant arm's finite set")
+    spread: int | None = Field(None, ge=1, description="solutions: all: samples per locked joint of a "
+                                                       "redundant arm's self-motion")
+    spread_joints: list[str] | None = Field(None, min_length=1, description="solutions: all with spread: "
+                                                                            "the locked joints")
+    patience: int | None = Field(None, ge=1, description="solutions: all: consecutive starts without a new "
+                                                         "solution before the search stops (default 32)")
+    max_starts: int | None = Field(None, ge=1, description="solutions: all: most starts per pose "
+                                                           "(default 400)")
+
+    @field_validator(*BRANCH_OPTIONS)
+    @classmethod
+    def _only_with_all(cls, value, info):
+        if value is not None and info.data.get("solutions", "one") != "all":
+            raise ValueError("only with solutions: all (the search of every solution)")
+        return value
 
 
 class Inverse(ExactSolver):

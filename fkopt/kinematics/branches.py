@@ -346,6 +346,29 @@ def _spread_locks(m, spread, spread_joints, redundancy: int) -> list[dict[int, f
     return [dict(zip(idx, vals)) for vals in itertools.product(*axes)]
 
 
+def locked_sets(arm, *, fixed=None, spread=None, spread_joints=None, mask=None) -> list[dict[int, float]]:
+    """The sets of locked joints ({index: internal value}) the search runs once each: ``fixed``'s
+    one set, ``spread``'s every combination, or no lock; checked without searching (an unknown
+    joint, a value outside its limits, a redundant arm without either, both given), so a caller
+    can validate its options before any pose (an experiment file's plan)."""
+    m = _arm(arm)
+    W = _task_mask(mask)
+    tasks = 6 if W is None else int(W.sum())
+    locked = _locked(m, fixed)
+    redundancy = m.dof - len(locked) - tasks
+    if spread is not None:
+        if locked:
+            raise FkoptError(f"{m.name}: give fixed or spread, not both")
+        if redundancy <= 0:
+            raise FkoptError(f"{m.name} spread: the arm has no self-motion ({m.dof} joints, {tasks} task components)")
+        return _spread_locks(m, spread, spread_joints, redundancy)
+    if redundancy > 0:
+        raise FkoptError(f"{m.name} has {m.dof} joints for {tasks} task components: its solutions are "
+                         f"not finite; give fixed={{joint: value}} for {redundancy} joint(s) "
+                         f"(joints: {', '.join(m.joint_names)}) or spread=K to sample the self-motion")
+    return [locked]
+
+
 def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol=None, mask=None, seed: int = 0,
                   patience: int = PATIENCE, growth: float = GROWTH, max_starts: int = MAX_STARTS, copies: bool = False,
                   orientation_scale: float | None = None) -> AllSolutions:
@@ -371,21 +394,7 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     if dist > m.reach * (1.0 + 1e-12):
         raise _unreachable(m, x, y, z, dist)
     W = _task_mask(mask)
-    tasks = 6 if W is None else int(W.sum())
-    locked = _locked(m, fixed)
-    redundancy = m.dof - len(locked) - tasks
-    if spread is not None:
-        if locked:
-            raise FkoptError(f"{m.name}: give fixed or spread, not both")
-        if redundancy <= 0:
-            raise FkoptError(f"{m.name} spread: the arm has no self-motion ({m.dof} joints, {tasks} task components)")
-        locks = _spread_locks(m, spread, spread_joints, redundancy)
-    else:
-        if redundancy > 0:
-            raise FkoptError(f"{m.name} has {m.dof} joints for {tasks} task components: its solutions are "
-                             f"not finite; give fixed={{joint: value}} for {redundancy} joint(s) "
-                             f"(joints: {', '.join(m.joint_names)}) or spread=K to sample the self-motion")
-        locks = [locked]
+    locks = locked_sets(m, fixed=fixed, spread=spread, spread_joints=spread_joints, mask=W)
     kern = _kernels()
     L = float(orientation_scale) if orientation_scale else m.reach
     row = np.ascontiguousarray(P, dtype=float)

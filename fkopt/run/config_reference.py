@@ -126,7 +126,10 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "label": ("Name in the tables; needed when one algorithm appears twice. Default: the name.", "",
                   "gabc_zhu2010"),
         "params": ("The algorithm's parameters (`fkopt list --long` shows them with their defaults); unknown keys "
-                   "are refused.", "", {"rule": "zhu2010"}),
+                   "are refused. An experiment's exact solver with `solutions: all` (inverse or exact on a serial "
+                   "arm, with `fixed: {joint: value}` or `spread: K` for a redundant one; forward or exact on a "
+                   "parallel mechanism: its assembly modes) searches every solution of each case once, seeded "
+                   "like the case's runs, into solutions.csv (docs/experiment-files.md).", "", {"rule": "zhu2010"}),
         "population": ("This algorithm's population (number of starts for nr/lm), instead of the file's.",
                        "agents", 1),
         "iterations": ("This algorithm's iterations, instead of the file's.", "iterations", 50),

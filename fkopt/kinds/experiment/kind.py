@@ -4,18 +4,19 @@ from __future__ import annotations
 from fkopt.run.memory import algorithm_resources
 from fkopt.solve import batch_bytes, chunk_size
 from fkopt.kinds.experiment.config import ExperimentConfig, experiment_from_dict
-from fkopt.kinds.experiment.runner import experiment_plan, keeps_x_history, merge_experiment
+from fkopt.kinds.experiment.runner import experiment_plan, keeps_x_history, merge_experiment, one_answer_entries
 from fkopt.kinds.experiment import reports
 from fkopt.run.kinds import register
 from fkopt.run.tasks import Kind
-from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, TIMING_RUNS_FILE, TRACE_FILE, Output
+from fkopt.run.writers import (CURVES, FIGURE, RUNS, RUNS_FILE, STEPS, TABLE, TIMING, TIMING_RUNS_FILE, TRACE_FILE,
+                               Output)
 
 # -- experiments -----------------------------------------------------------------------------------
 def _experiment_validate(config, plan) -> int:
     mech, cases = plan.context.mech, plan.context.cases     # validated by experiment_plan
     dim, keep_x = len(mech.unknown_names), keeps_x_history(config, mech)
     need = 0   # every algorithm's records stay in memory until the folder is written: the solves' sum
-    for spec in config.algorithms:
+    for spec in one_answer_entries(config):      # a search of every solution keeps a few rows per case
         pop = spec.population or config.population
         its = spec.iterations or config.iterations
         size = chunk_size(len(cases), config.runs, pop, its, dim, batch=config.batch,
@@ -38,6 +39,7 @@ OUTPUTS = (
     TIMING_RUNS_FILE,
     Output("values.csv", reports.values_table, TABLE),
     Output("inputs.csv", reports.inputs_table, TABLE),
+    Output("solutions.csv", reports.solutions_table, CURVES, float_format="%.12g", rows=RUNS),
     RUNS_FILE,
     TRACE_FILE,
     Output("convergence.csv", reports.convergence_table, CURVES, rows=STEPS),
@@ -52,4 +54,4 @@ OUTPUTS = (
 
 EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
                            merge_experiment, OUTPUTS, reports.meta, ExperimentConfig,
-                           console=lambda result, folder: reports.summary_table(result)))
+                           console=reports.console))

@@ -16,6 +16,12 @@ the figures drawn from timings, ``cases_time.png``):
 * ``values.csv``      per variable: target, the median run's value and error (the run whose final
   fitness is the lower median), the best run's, and the mean absolute error over all runs;
 * ``inputs.csv``      (only when a case gives both joints and a pose) given vs computed inputs;
+* ``solutions.csv``   (only with an exact solver's ``solutions: all`` entry) one row per (case, entry,
+  solution): every solution of the case's pose in the mechanism's public units (an arm's joints,
+  a parallel mechanism's pose), its errors (position and geodesic rotation; residual and hits),
+  the case's seed and how the search decided it had them all (its stopping rule's settings and
+  counts); a case without a solution keeps one row, solution 0 with empty values. Such an entry
+  has no runs: the files above hold the other entries (none of them when there are none);
 * ``runs.csv``        one row per run (incl. ``iterations_to_best``: first iteration at which the
   run's final best-so-far fitness was reached);
 * ``trace.csv.gz``    per-run best-so-far fitness where it changed, with evaluations (equal-evaluation
@@ -48,7 +54,7 @@ from fkopt.run import record
 from fkopt.run.result import RunResult
 from fkopt.run.writers import FLOAT, write_outputs, write_result
 from fkopt.run import plotting
-from fkopt.kinds.experiment.runner import outputs_of, pose_error
+from fkopt.kinds.experiment.runner import one_answer_entries, outputs_of, pose_error
 from fkopt.run.solving import budget
 
 #: Fitness of exactly 0 cannot be drawn on a log axis; it is drawn at this floor (and said so).
@@ -59,9 +65,12 @@ MAX_CASE_CURVES = 6
 # -- tables ------------------------------------------------------------------------------------
 def summary_table(er: RunResult) -> pd.DataFrame:
     """Per case and algorithm, over its runs: the run record's (the one summary writer,
-    :func:`fkopt.run.record.summary_table`), with each algorithm's settings from the config."""
+    :func:`fkopt.run.record.summary_table`), with each algorithm's settings from the config; None
+    without runs (only ``solutions: all`` entries)."""
+    if er.record is None:
+        return None
     settings = {}
-    for spec in er.config.algorithms:
+    for spec in one_answer_entries(er.config):
         b = budget(er.config, spec)
         # sorted: a config reloaded from meta.json has sorted keys
         printed = {f"printed_{k}": v for k, v in sorted(spec.printed.items()) if not k.endswith("_ms")}
@@ -72,15 +81,25 @@ def summary_table(er: RunResult) -> pd.DataFrame:
 
 def timing_table(er: RunResult) -> pd.DataFrame:
     """Time per run measured one run at a time on a sample of runs (:mod:`.timing`), per timed
-    case and algorithm (the one timing writer, :func:`fkopt.run.record.timing_table`)."""
+    case and algorithm (the one timing writer, :func:`fkopt.run.record.timing_table`); then each
+    ``solutions: all`` entry's search of every case (its one batch: ``runs`` 1)."""
+    answering = one_answer_entries(er.config)
+    searching = [spec for spec in er.config.algorithms if spec not in answering]
     settings = {(case.label, spec.key): {
-        "runs": er.config.runs, "total_s": er.own.solve_s[spec.key],
+        "runs": er.config.runs if spec in answering else 1, "total_s": er.own.solve_s[spec.key],
         **{f"printed_{k}": v for k, v in sorted(spec.printed.items()) if k.endswith("_ms")}}
         for case in er.own.cases for spec in er.config.algorithms}
-    return record.timing_table(er.timing, settings, names=record.FILE_NAMES["experiment"], timed_alone=True)
+    names = record.FILE_NAMES["experiment"]
+    keys = {spec.key for spec in searching}
+    runs, sets = er.timing[~er.timing["solver"].isin(keys)], er.timing[er.timing["solver"].isin(keys)]
+    tables = [record.timing_table(runs, settings, names=names, timed_alone=True)] if len(runs) else []
+    tables += [record.timing_table(sets, settings, names=names)] if len(sets) else []
+    return pd.concat(tables, ignore_index=True)
 
 
-def values_table(er: RunResult) -> pd.DataFrame:
+def values_table(er: RunResult) -> pd.DataFrame | None:
+    if not er.own.solves:
+        return None
     mech = er.own.mechanism
     rows = []
     for rec in er.own.solves:
@@ -130,7 +149,27 @@ def inputs_table(er: RunResult) -> pd.DataFrame | None:
     return pd.DataFrame(rows) if rows else None
 
 
-def convergence_table(er: RunResult) -> pd.DataFrame:
+def solutions_table(er: RunResult) -> pd.DataFrame | None:
+    """``solutions.csv``: every ``solutions: all`` entry's solutions, case by case (module
+    docstring); None without such an entry."""
+    if not er.own.sets:
+        return None
+    frames = []
+    for s in er.own.sets:
+        found, k = s.found, len(s.found.values)
+        rows = max(k, 1)                                 # a case without a solution keeps its search's row
+        values = found.values if k else np.full((1, len(found.names)), np.nan)
+        cols = {"case": s.case.label, "algorithm": s.spec.key, "solution": np.arange(1, k + 1) if k else [0]}
+        cols.update({name: values[:, j] for j, name in enumerate(found.names)})
+        cols.update({name: v if k else [np.nan] for name, v in found.per_solution.items()})
+        cols.update({"seed": s.seed, **found.search})
+        frames.append(pd.DataFrame(cols, index=range(rows)))
+    return pd.concat(frames, ignore_index=True)
+
+
+def convergence_table(er: RunResult) -> pd.DataFrame | None:
+    if not er.own.solves:
+        return None
     frames = []
     for label, algo, hist, evals, pos in _curves(er):
         q25, med, q75 = np.percentile(hist, [25, 50, 75], axis=0)
@@ -151,7 +190,7 @@ def _curves(er: RunResult):
             yield (rec.case.label, rec.spec.key, rec.result.history, rec.result.evaluation_history,
                    rec.position_error_history)
         return
-    for spec in er.config.algorithms:
+    for spec in one_answer_entries(er.config):
         recs = [r for r in er.own.solves if r.spec.key == spec.key]
         pos = [r.position_error_history for r in recs]
         yield ("all", spec.key, np.concatenate([r.result.history for r in recs]),
@@ -187,7 +226,7 @@ def _curve_sets(er: RunResult):
     more than MAX_CASE_CURVES cases the runs of all cases are pooled per algorithm."""
     names = _spec_names(er)
     pooled = len(er.own.cases) > MAX_CASE_CURVES
-    for spec in er.config.algorithms:
+    for spec in one_answer_entries(er.config):
         recs = [r for r in er.own.solves if r.spec.key == spec.key]
         groups = [recs] if pooled else [[r] for r in recs]
         for grp in groups:
@@ -220,6 +259,8 @@ def convergence_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far fitness vs iteration and vs function evaluations (median and quartiles of the
     runs, or the run itself). Runs that stop at the threshold end where (the median run) stopped
     (a bar); P-ABC's switch from PSO to ABC is marked with a triangle."""
+    if not er.own.solves:
+        return []
     path = folder / figure_file(er, "convergence")
     plt = _plt()
     curves = list(_curve_sets(er))
@@ -270,6 +311,8 @@ def variables_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Best-so-far value of each unknown vs iteration for the median run (liu2008 Fig. 4a, wang7dof
     Fig. 4), with the true value dashed (for a redundant arm: the joints that defined the target,
     one of many solutions)."""
+    if not er.own.solves:
+        return []
     if "variables" not in er.config.figures:
         return []
     path = folder / figure_file(er, "variables")
@@ -335,6 +378,8 @@ def snapshot_figures(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Population at the snapshot iterations, first case, run 0 (wu2015 Figs. 4-6): two projections
     shaded by log10 of the fitness (minimised over the third variable), the true pose and, where the
     mechanism has several exact forward solutions, the mirror solution(s)."""
+    if not er.own.solves:
+        return []
     if "snapshots" not in er.config.figures:
         return []
     plt = _plt()
@@ -386,6 +431,8 @@ def snapshot_figures(er: RunResult, folder: Path, tables: dict) -> list[str]:
 def extras_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Median over runs of each algorithm record vs iteration (wu2015 Fig. 7). Pheromone is
     tau = -f <= 0, so it is drawn as -tau on a log axis (the best pheromone's -tau is the best f)."""
+    if not er.own.solves:
+        return []
     recs = [r for r in er.own.solves if r.case.index == 0 and r.result.extras]
     if "extras" not in er.config.figures or not recs:
         return []
@@ -452,6 +499,8 @@ def _case_axis(ax, n: int) -> None:
 def cases_figures(er: RunResult, folder: Path, tables: dict) -> list[str]:
     """Per case (independent poses: markers, no lines): final fitness (deterministic), time per run
     (timed single runs) and, for serial arms, the final position error (wang7dof Fig. 7)."""
+    if not er.own.solves:
+        return []
     if "cases" not in er.config.figures:
         return []
     summary, timing = tables["summary.csv"], tables.get("timing.csv")
@@ -492,7 +541,7 @@ def cases_figures(er: RunResult, folder: Path, tables: dict) -> list[str]:
     if er.own.mechanism.kind == "serial":   # wang7dof Fig. 7a: final position error per pose
         fig, ax = plt.subplots(figsize=(7, 3.4))
         ys = []
-        for n, spec in enumerate(er.config.algorithms):
+        for n, spec in enumerate(one_answer_entries(er.config)):
             recs = [r for r in er.own.solves if r.spec.key == spec.key and r.position_error_history is not None]
             if recs:
                 y = np.array([float(np.median(r.position_error_history[:, -1])) for r in recs])
@@ -521,12 +570,13 @@ def time_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
     plt = _plt()
     names = _spec_names(er)
     fig, ax = plt.subplots(figsize=(5, 3.4))
-    for n, spec in enumerate(er.config.algorithms):
+    timed = one_answer_entries(er.config)
+    for n, spec in enumerate(timed):
         ms = alone.loc[alone["solver"] == spec.key, "seconds"].to_numpy(float) * 1e3
         x = n + np.linspace(-0.15, 0.15, len(ms)) if len(ms) > 1 else np.array([float(n)])
         ax.plot(x, ms, ls="none", marker="o", ms=4, alpha=0.7)
         ax.plot([n - 0.25, n + 0.25], [np.median(ms)] * 2, color="k", lw=1.5)
-    ax.set_xticks(range(len(er.config.algorithms)), [names[s.key] for s in er.config.algorithms])
+    ax.set_xticks(range(len(timed)), [names[s.key] for s in timed])
     ax.set_ylabel("time per run, one run at a time (ms)")
     ax.set_ylim(bottom=0)                  # from 0: the ratio of two times is the ratio of their heights
     ax.set_title(f"{er.config.title or er.config.name}\n{len(ms)} of the {er.config.runs} runs per algorithm "
@@ -539,16 +589,27 @@ def time_figure(er: RunResult, folder: Path, tables: dict) -> list[str]:
 # -- folder --------------------------------------------------------------------------------------
 def meta(er: RunResult) -> dict:
     """What the config and the seed fix (nothing about the machine: that is :func:`environment`)."""
-    seeds = er.record.groupby(["pose", "solver"], sort=False)["task_seed"].first()
+    seeds = er.record.groupby(["pose", "solver"], sort=False)["task_seed"].first() if er.record is not None else {}
     return {
         "experiment": er.config.name, "paper": er.config.paper, "title": er.config.title,
         "config_file": er.source, "config": er.config.model_dump(mode="json"),
         "seed": er.config.seed,
         "task_seeds": [{"case": r.case.label, "algorithm": r.spec.key, "seed": int(seeds[(r.case.index, r.spec.key)])}
-                       for r in er.own.solves],
+                       for r in er.own.solves] + [{"case": s.case.label, "algorithm": s.spec.key, "seed": s.seed}
+                                                  for s in er.own.sets],
         "mechanism": er.own.mechanism.describe(),
-        "objective": getattr(er.own.solves[0].problem, "objective", None),
+        "objective": getattr(er.own.solves[0].problem, "objective", None) if er.own.solves else None,
     }
+
+
+def console(er: RunResult, folder) -> pd.DataFrame | list[str]:
+    """What ``fkopt run`` prints: the summary table, or (only ``solutions: all`` entries) the
+    count of solutions per case and entry."""
+    summary = summary_table(er)
+    if summary is not None:
+        return summary
+    return [""] + [f"  {s.case.label} · {s.spec.key}: {len(s.found.values)} solution(s), "
+                   f"{s.found.search.get('starts')} starts (solutions.csv)" for s in er.own.sets]
 
 
 def write_tables(er: RunResult, folder: Path, figures: bool = True) -> list[str]:

@@ -6,6 +6,9 @@ stream of that (see :mod:`fkopt.numerics.streams`). Reordering algorithms in a f
 algorithm alone therefore reproduces the same numbers -- and so does batching: each algorithm
 solves all cases of the experiment in one :func:`fkopt.solve` call (cases x runs rows), passing
 these per-case seeds, and the result is sliced back into one record per (case, algorithm).
+
+An exact solver's entry with ``params: {solutions: all}`` searches every solution of each case
+once instead, with the same per-case seed (:mod:`.solution_sets`; ``solutions.csv``).
 """
 from __future__ import annotations
 
@@ -20,11 +23,15 @@ from typing import Callable
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.kinematics.as_algorithms import ExactSolver
+from fkopt.registry import algorithm_class
 from fkopt.run.record import ALONE, BATCH, concat, run_record, timing_record
 from fkopt.run.result import RunResult, dataclass_from_json, dataclass_to_json
 from fkopt.run.trace import COLUMNS as TRACE_COLUMNS, case_trace, concat_traces, trace_frame
 from fkopt.solve import Result, chunk_size, make_algorithm
 from fkopt.kinds.experiment.config import experiment_from_dict, ExperimentConfig, RandomCases
+from fkopt.kinds.experiment.solution_sets import (CaseSet, merge_sets, search_cases, set_record_problem,
+                                                  wants_every_solution)
 from fkopt.run.config_base import AlgorithmSpec, files_folder, numeric_fields
 from fkopt.run.solving import (_check_in_bounds, build_mechanism, make_problem, outputs_of, pose_error, solve_cases,  # noqa: F401
                                start_point, task_seed)
@@ -65,12 +72,14 @@ class CaseSolve:
 class ExperimentOwn:
     """What only an experiment has (the :attr:`fkopt.run.result.RunResult.own` slot): its
     mechanism, its cases and every (case, algorithm)'s curves, case by case (every algorithm of
-    case 1, then case 2, ...), and each algorithm's solve time per case (amortised)."""
+    case 1, then case 2, ...), each algorithm's solve time per case (amortised), and the solution
+    sets of its ``solutions: all`` entries (:mod:`.solution_sets`), case by case too."""
 
     mechanism: object
     cases: list[Case]
     solves: list[CaseSolve]
     solve_s: dict[str, float]
+    sets: list[CaseSet] = field(default_factory=list)
 
     @property
     def compared_names(self) -> tuple[str, ...]:
@@ -131,10 +140,10 @@ def validate_experiment(config: ExperimentConfig, folder: Path | None = None):
     mech = build_mechanism(config, folder)
     cases = build_cases(config, mech)
     for spec in config.algorithms:
-        make_algorithm(spec.name, spec.params)   # unknown names/parameters fail here
+        _check_every_solution(spec, mech)         # unknown names/parameters fail here
         start_point(spec, mech)
     problems = [build_problem(config, mech, c) for c in cases]
-    for spec in config.algorithms:       # a batch that cannot fit in memory fails here, not midway
+    for spec in one_answer_entries(config):  # a batch that cannot fit in memory fails here, not midway
         try:
             chunk_size(len(cases), config.runs, spec.population or config.population,
                        spec.iterations or config.iterations, len(mech.unknown_names), batch=config.batch,
@@ -142,6 +151,30 @@ def validate_experiment(config: ExperimentConfig, folder: Path | None = None):
         except FkoptError as err:
             raise FkoptError(f"algorithms[{spec.key}]: {err}") from None
     return mech, cases, problems
+
+
+def _check_every_solution(spec: AlgorithmSpec, mech) -> None:
+    """An entry's algorithm built from its params; ``solutions`` on an algorithm that is no exact
+    solver, or a ``solutions: all`` entry this mechanism cannot take (wrong kind, unknown joints in
+    ``fixed``, a redundant arm without ``fixed``/``spread``), is one line naming the entry."""
+    where = f"algorithms[{spec.key}]"
+    if "solutions" in spec.params and not issubclass(algorithm_class(spec.name), ExactSolver):
+        raise FkoptError(f"{where}.params.solutions: only the exact solvers give every solution of a pose "
+                         f"(inverse or exact on a serial arm, forward or exact on a parallel mechanism); "
+                         f"'{spec.name}' gives one answer per run")
+    algorithm = make_algorithm(spec.name, spec.params)
+    if getattr(algorithm, "every_solution", False):
+        if spec.start is not None:
+            raise FkoptError(f"{where}.start: a search of every solution (solutions: all) takes no start")
+        try:
+            algorithm.check_solution_set(mech)
+        except FkoptError as err:
+            raise FkoptError(f"{where}: {err}") from None
+
+
+def one_answer_entries(config: ExperimentConfig) -> list[AlgorithmSpec]:
+    """The entries that solve one answer per run (every entry but the ``solutions: all`` ones)."""
+    return [spec for spec in config.algorithms if not wants_every_solution(spec)]
 
 
 def keeps_x_history(config: ExperimentConfig, mech) -> bool:
@@ -222,14 +255,14 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None, timing:
              for a, spec in enumerate(config.algorithms)]
     timed_cases, per = sample_plan(len(cases), config.runs)
     timed = [Task(f"t{c:02d}", {"timing": c, "runs": per}, f"timing · {cases[c].label}")
-             for c in range(timed_cases)] if timing else []
+             for c in range(timed_cases)] if timing and one_answer_entries(config) else []
 
     def local(payload: dict):
         if "timing" in payload:
             return _time_one(config, cases, problems, payload["timing"], payload["runs"])
-        return _solve_one(config, mech, cases, problems, batched, payload["algorithm"], fp)
+        return _task(config, mech, cases, problems, batched, payload["algorithm"], fp)
     return Plan(tasks, solve_task, fingerprint=fp, stored=True,
-                check=lambda task, rec: record_problem(task, rec, config, len(cases)),
+                check=lambda task, rec: record_problem(task, rec, config, cases),
                 local=local, anywhere=True, timed=timed,
                 context=_Context(mech, cases, problems, batched, time.perf_counter() - started),
                 name=f"experiment '{config.name}'")
@@ -238,28 +271,42 @@ def experiment_plan(config: ExperimentConfig, source: str | None = None, timing:
 def _time_one(config: ExperimentConfig, cases: list[Case], problems: list, c: int, per: int) -> dict:
     """A timing task: every algorithm's runs ``0 .. per-1`` of case ``c`` solved alone,
     interleaved (:func:`fkopt.run.timing.time_case`); its rows of the timing record."""
-    entries = [(spec, problems[c], task_seed(config.seed, cases[c].index, spec.key)) for spec in config.algorithms]
+    specs = one_answer_entries(config)
+    entries = [(spec, problems[c], task_seed(config.seed, cases[c].index, spec.key)) for spec in specs]
     seconds = time_case(config, entries, per)
     return concat([timing_record("experiment", {"problem": config.name, "case": cases[c].label, "pose": cases[c].index,
                                                 "solver": spec.key, "run": np.arange(len(s)), "runs": 1,
                                                 "seconds": np.asarray(s, dtype=float), "mode": ALONE})
-                   for spec, s in zip(config.algorithms, seconds)]).to_dict(orient="list")
+                   for spec, s in zip(specs, seconds)]).to_dict(orient="list")
+
+
+def _task(config: ExperimentConfig, mech, cases, problems, batched, a: int, fp: str) -> dict:
+    """Entry ``a``'s task: its runs on every case, or (``solutions: all``) every case's solution set."""
+    if wants_every_solution(config.algorithms[a]):
+        return search_cases(config, mech, cases, a, fp)
+    return _solve_one(config, mech, cases, problems, batched, a, fp)
 
 
 def solve_task(payload: dict) -> dict:
     """Worker: one algorithm of an experiment on all its cases, rebuilt from the payload."""
     config = experiment_from_dict(json.loads(payload["config"]), "experiment task")
     mech, cases, problems, batched = _prepare(config, Path(payload["folder"]) if payload.get("folder") else None)
-    return _solve_one(config, mech, cases, problems, batched, payload["algorithm"], payload["fingerprint"])
+    return _task(config, mech, cases, problems, batched, payload["algorithm"], payload["fingerprint"])
 
 
-def record_problem(task: Task, rec, config: ExperimentConfig, n_cases: int) -> str | None:
+def record_problem(task: Task, rec, config: ExperimentConfig, cases: list[Case]) -> str | None:
     """Why ``rec`` (a task file read back by ``--resume``) is not the finished record of
     ``task``: its algorithm, one table of run rows and one trace per case, each row this
     task's case, solver and run, and per-iteration arrays of the runs' shape."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
-    return reason_or_none(lambda: _record_problem(task, rec, config, n_cases))
+    return reason_or_none(lambda: _sets_or_runs_problem(task, rec, config, cases))
+
+
+def _sets_or_runs_problem(task: Task, rec: dict, config: ExperimentConfig, cases: list[Case]) -> str | None:
+    if wants_every_solution(config.algorithms[task.payload["algorithm"]]):
+        return set_record_problem(task, rec, config, cases)
+    return _record_problem(task, rec, config, len(cases))
 
 
 def _record_problem(task: Task, rec: dict, config: ExperimentConfig, n_cases: int) -> str | None:
@@ -296,15 +343,22 @@ def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: 
     """The experiment's :class:`~fkopt.run.result.RunResult` from its tasks' records: the run
     record and the trace, case by case (every algorithm of case 1, then case 2, ...), the
     timing record (each batch's share per run and the runs its timing tasks timed alone; none
-    when the plan has none: ``fkopt check``) and the curves (:class:`ExperimentOwn`)."""
+    when the plan has none: ``fkopt check``) and the curves (:class:`ExperimentOwn`). The
+    ``solutions: all`` entries add no runs: their sets go to ``own.sets`` (case by case), each
+    search's time to the timing record as one batch; an experiment of only such entries has no
+    run record and no trace (None)."""
     merging = time.perf_counter()
     ctx: _Context = plan.context
     mech, cases, problems = ctx.mech, ctx.cases, ctx.problems
     done = [ran.records[t.id] for t in plan.tasks]                  # one per algorithm, in config order
-    results = [dataclass_from_json(Result, rec["curves"]) for rec in done]
+    every = [wants_every_solution(spec) for spec in config.algorithms]
+    answered = [(spec, rec, dataclass_from_json(Result, rec["curves"]))
+                for spec, rec, e in zip(config.algorithms, done, every) if not e]
+    searched = [merge_sets(config, cases, rec) for rec, e in zip(done, every) if e]
+    sets = [entry[i] for i in range(len(cases)) for entry in searched]      # case-major too
     solves, rows, traces = [], [], []
     for i, (case, problem) in enumerate(zip(cases, problems)):    # case-major, as the reports expect
-        for spec, rec, result in zip(config.algorithms, done, results):
+        for spec, rec, result in answered:
             r = result if len(cases) == 1 else result.case(i)
             pos = problem.position_error(r.x_history) if hasattr(problem, "position_error") else None
             solves.append(CaseSolve(case, spec, problem, r, pos))
@@ -313,14 +367,18 @@ def merge_experiment(config: ExperimentConfig, plan: Plan, ran: Ran, *, source: 
     batches = [timing_record("experiment", {"problem": config.name, "case": s.case.label, "pose": s.case.index,
                                             "solver": s.spec.key, "run": s.result.run_ids, "runs": 1,
                                             "seconds": s.result.time_per_run, "mode": BATCH}) for s in solves]
+    searches = [timing_record("experiment", {"problem": config.name, "case": s.case.label, "pose": s.case.index,
+                                             "solver": s.spec.key, "run": [0], "runs": 1, "seconds": [s.wall_s],
+                                             "mode": BATCH}) for s in sets]
     alone = [timing_record("experiment", {k: v for k, v in ran.records[t.id].items() if k != "kind"})
              for t in plan.timed]
     # the run's own time, wherever and however long before the plan was built
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)
     # solves computed elsewhere (fkopt reproduce's workers) or resumed: their own time, measured where they ran
     wall += sum(ran.records[t.id]["wall_s"] * len(cases) for t in plan.tasks if t.id not in ran.computed)
-    own = ExperimentOwn(mech, cases, solves, {rec["solver"]: float(rec["wall_s"]) for rec in done})
-    return RunResult(config, concat(rows), _timing_in_order(alone, batches, solves), concat_traces(traces), own,
+    own = ExperimentOwn(mech, cases, solves, {rec["solver"]: float(rec["wall_s"]) for rec in done}, sets)
+    timing = concat([_timing_in_order(alone, batches, solves), *searches]) if solves else concat(searches)
+    return RunResult(config, concat(rows) if rows else None, timing, concat_traces(traces) if traces else None, own,
                      wall, source, list(ran.computed))
 
 

@@ -29,6 +29,7 @@ from typing import Callable
 
 import numpy as np
 
+from fkopt.errors import FkoptError
 from fkopt.run.config_base import files_folder
 from fkopt.run.solving import (build_mechanism, make_problem, outputs_of, pose_error, solve_cases, start_point,
                                task_seed)
@@ -74,7 +75,10 @@ def validate_study(config: StudyConfig, folder: Path | None = None):
     mech = build_mechanism(config, folder)
     poses = build_poses(config, mech)
     for spec in config.algorithms:
-        make_algorithm(spec.name, spec.params)
+        if getattr(make_algorithm(spec.name, spec.params), "every_solution", False):
+            raise FkoptError(f"algorithms[{spec.key}].params.solutions: 'all' (every solution of a pose) runs in "
+                             "experiment files, which write solutions.csv; a study takes one answer per run "
+                             "(allowed here: one)")
         start_point(spec, mech)
     make_problem(config, mech, poses.inputs[0])
     return mech, poses
