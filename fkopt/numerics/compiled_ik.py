@@ -183,17 +183,18 @@ def _table_distances(Ft, norms, f, v):
 
 @njit(inline="always")
 def _insert(best, idx, m, x, i):
-    """Row i of value x into the k = len(idx) smallest so far (``m`` of them held, sorted; ties: the
-    earlier row first); returns how many are held after it."""
+    """Row i of value x into the k = len(idx) smallest (value, row) pairs so far (``m`` of them
+    held, sorted; ties: the lower row first, in whatever order the rows arrive); returns how many
+    are held after it."""
     k = idx.shape[0]
     if m < k:
         pos = m
         m += 1
-    elif x < best[k - 1]:
+    elif x < best[k - 1] or (x == best[k - 1] and i < idx[k - 1]):
         pos = k - 1
     else:
         return m
-    while pos > 0 and best[pos - 1] > x:
+    while pos > 0 and (best[pos - 1] > x or (best[pos - 1] == x and idx[pos - 1] > i)):
         best[pos] = best[pos - 1]
         idx[pos] = idx[pos - 1]
         pos -= 1
@@ -280,27 +281,6 @@ SCREEN_GROUPS = 256
 GROUP_SCAN_K = 8
 
 
-@njit(inline="always")
-def _insert_by_row(best, idx, m, x, i):
-    """:func:`_insert` for rows arriving in any order: the k = len(idx) smallest (value, row) pairs
-    so far, sorted (ties: the lower row first, as rows inserted in row order by :func:`_insert`)."""
-    k = idx.shape[0]
-    if m < k:
-        pos = m
-        m += 1
-    elif x < best[k - 1] or (x == best[k - 1] and i < idx[k - 1]):
-        pos = k - 1
-    else:
-        return m
-    while pos > 0 and (best[pos - 1] > x or (best[pos - 1] == x and idx[pos - 1] > i)):
-        best[pos] = best[pos - 1]
-        idx[pos] = idx[pos - 1]
-        pos -= 1
-    best[pos] = x
-    idx[pos] = i
-    return m
-
-
 @njit(cache=True)
 def _group_minima(v32, gm):
     """gm[g] = the smallest screen value of group g (rows g, g + G, ...; G = len(gm)), NaN rows
@@ -344,10 +324,10 @@ def _nearest_screened(table, f, v32, idx, best):
     gm = np.empty(G, dtype=np.float32)
     _group_minima(v32, gm)
     # U: the k-th smallest group minimum (+inf with fewer than k groups holding a number)
-    gk = np.empty(k)
+    gk, held = np.empty(k), np.empty(k, dtype=np.int64)   # held: which group or row (not needed, only kept)
     m = 0
     for g in range(G):
-        m = _insert_value(gk, m, np.float64(gm[g]))
+        m = _insert(gk, held, m, np.float64(gm[g]), g)
     U = gk[k - 1] if m == k else math.inf
     # s_k: the k-th smallest screen value, from the rows at most U: for a few neighbours those of the
     # few groups at most U; for many (more groups, each row in another cache line) a pass in row order
@@ -357,11 +337,11 @@ def _nearest_screened(table, f, v32, idx, best):
         for g in range(G):
             if np.float64(gm[g]) <= U:
                 for i in range(g, N, G):
-                    m = _insert_value(sk, m, np.float64(v32[i]))
+                    m = _insert(sk, held, m, np.float64(v32[i]), i)
     else:
         for i in range(N):
             if np.float64(v32[i]) <= U:
-                m = _insert_value(sk, m, np.float64(v32[i]))
+                m = _insert(sk, held, m, np.float64(v32[i]), i)
     limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
     m = 0
     if k <= GROUP_SCAN_K:
@@ -369,30 +349,11 @@ def _nearest_screened(table, f, v32, idx, best):
             if np.float64(gm[g]) <= limit:
                 for i in range(g, N, G):
                     if np.float64(v32[i]) <= limit:
-                        m = _insert_by_row(best, idx, m, _table_distance(Ft, norms, f, i), i)
+                        m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
     else:
         for i in range(N):
             if np.float64(v32[i]) <= limit:
                 m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
-
-
-@njit(inline="always")
-def _insert_value(sk, m, x):
-    """x into the k = len(sk) smallest values so far (``m`` of them held, sorted); returns how
-    many are held after it."""
-    k = sk.shape[0]
-    if m < k:
-        pos = m
-        m += 1
-    elif x < sk[k - 1]:
-        pos = k - 1
-    else:
-        return m
-    while pos > 0 and sk[pos - 1] > x:
-        sk[pos] = sk[pos - 1]
-        pos -= 1
-    sk[pos] = x
-    return m
 
 
 @njit(inline="always")
