@@ -1,6 +1,6 @@
 """``fkopt.inverse`` of a batch of poses (or of one pose with ``rest`` > 0 or ``exact_rotation``):
 every row as its compiled one-pose call when it can (:func:`fkopt.numerics.compiled_ik.inverse_rows`,
-rows on all cores), else the vectorised damped least-squares loop on numpy, candidates of many
+rows shared by ``threads`` threads), else the vectorised damped least-squares loop on numpy, candidates of many
 rows side by side (see :mod:`fkopt.kinematics.solvers`).
 
 Its restarts are the one restart loop's (:mod:`fkopt.numerics.restart_loop`) -- a row's starts in the
@@ -41,7 +41,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
     reach = m.reach
     fast = numerics_path.compiled_ik(compiled) if hasattr(m, "chain") else None
     if fast is not None and rest <= 0 and not exact_rotation and (start is None or (n <= 6 and W is None)):
-        # every row as its one-pose call (same starts, restarts and answer), rows on all cores
+        # every row as its one-pose call (same starts, restarts and answer), rows shared by threads
         own0 = 1 if (start is not None or not table) else 0
         first = max(1, int(starts), fill)
         nn = min(int(table), first - own0 + int(neighbours)) if table else 0

@@ -3,7 +3,7 @@
 :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, :func:`_dls_candidate`),
 the start table's nearest-neighbour search (a float32 screen, then the float64 rows it cannot rule
 out: :func:`_nearest_screened`), one pose from the public target to the public answer
-(:func:`inverse_pose`, :func:`bound_inverse_pose`) and rows on all cores (:func:`inverse_rows`).
+(:func:`inverse_pose`, :func:`bound_inverse_pose`) and rows shared by threads (:func:`inverse_rows`).
 Built on :mod:`fkopt.numerics.compiled`'s chain, rotation and step kernels, operation for operation
 in the reference's order. Importing this module imports numba.
 """
