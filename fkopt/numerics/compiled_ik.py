@@ -258,20 +258,33 @@ def start_screen(Ft, norms):
 @njit(cache=True)
 def _screen32(table, f, v32):
     """v32[i] = |F_i|^2 - 2 F_i . f in float32 for every row (half the bytes of the float64 pass,
-    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values."""
+    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values. The 12
+    features in two passes of six, each summed in registers by pairs (two loads and stores of a
+    row where a pass per feature made twelve; measured 0.75x the time); a masked-out feature adds
+    F_ij * 0. Any order of the 12-term sum is within :data:`SCREEN_ROUNDOFF`'s bound."""
     Ft32, n32 = table[2], table[3]
     c, N = Ft32.shape
-    for i in range(N):
-        v32[i] = 0.0
-    for j in range(c):
-        fj = np.float32(f[j])
-        if f[j] == 0.0:
-            continue
-        for i in range(N):
-            v32[i] += Ft32[j, i] * fj
     two = np.float32(2.0)
+    if c != 12:                                     # not a start table's 12 features: feature by feature
+        for i in range(N):
+            v32[i] = 0.0
+        for j in range(c):
+            fj = np.float32(f[j])
+            for i in range(N):
+                v32[i] += Ft32[j, i] * fj
+        for i in range(N):
+            v32[i] = n32[i] - two * v32[i]
+        return
+    f0, f1, f2, f3 = np.float32(f[0]), np.float32(f[1]), np.float32(f[2]), np.float32(f[3])
+    f4, f5, f6, f7 = np.float32(f[4]), np.float32(f[5]), np.float32(f[6]), np.float32(f[7])
+    f8, f9, f10, f11 = np.float32(f[8]), np.float32(f[9]), np.float32(f[10]), np.float32(f[11])
+    F0, F1, F2, F3, F4, F5 = Ft32[0], Ft32[1], Ft32[2], Ft32[3], Ft32[4], Ft32[5]
     for i in range(N):
-        v32[i] = n32[i] - two * v32[i]
+        v32[i] = (F0[i] * f0 + F1[i] * f1) + (F2[i] * f2 + F3[i] * f3) + (F4[i] * f4 + F5[i] * f5)
+    F6, F7, F8, F9, F10, F11 = Ft32[6], Ft32[7], Ft32[8], Ft32[9], Ft32[10], Ft32[11]
+    for i in range(N):
+        v32[i] = n32[i] - two * (v32[i] + ((F6[i] * f6 + F7[i] * f7) + (F8[i] * f8 + F9[i] * f9)
+                                           + (F10[i] * f10 + F11[i] * f11)))
 
 
 #: Rows of the start table per screen group in :func:`_nearest_screened`: group g holds rows g, g + G,
