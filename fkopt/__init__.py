@@ -76,7 +76,7 @@ def mechanism(name: str, **geometry):
 
 def algorithm(name: str, **params):
     """A registered algorithm with validated parameters."""
-    from fkopt.registry import algorithm_class
+    from fkopt.registry import algorithm_class     # the same: on first use
     return algorithm_class(name)(**params)
 
 

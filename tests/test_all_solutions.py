@@ -66,7 +66,56 @@ def test_every_answer_is_verified_distinct_inside_the_limits_and_holds_the_gener
             assert not len(others) or turns_gap(others, r.solutions[i]).min() > 1e-4
         gap = np.abs(r.solutions - nearest_zero_copy(m, q[k])).max(axis=1)
         assert gap.min() < 1e-6
-        assert r.search["starts"] >= r.search["patience"] and "consecutive starts" in r.search["rule"]
+        # the search ends by Pieper's bound (8 distinct before the limits) or by the patience rule
+        assert (r.search["distinct"] == 8 and r.search["rule"].startswith("certificate")) or \
+            (r.search["starts"] >= r.search["patience"] and "consecutive starts" in r.search["rule"])
+
+
+def test_the_chain_geometry_gives_pieper_bound_and_two_solution_windows():
+    """From the chain's axes alone: the UR5's joints 2-4 are parallel, the Kinova j2s6s200's
+    last three meet in a point, the Panda with joint 7 locked has its first three meeting; the
+    xArm 7 with joint 3 locked and the 5-joint SO-101 have no Pieper triple, hence no bound."""
+    from fkopt.kinematics.branch_structure import structure
+    from fkopt.kinematics.branches import _context
+    ur = _context(stored("ur5"), {}, None)["structure"]
+    assert ur["bound"] == 8 and ur["triple"] == (1, 2, 3, "parallel") and ur["pair_window"] == (1, 3)
+    assert ur["windows"][0] == (1, 3) and ur["two_solution"][0]
+    kin = _context(stored("kinova-j2s6s200"), {}, None)["structure"]
+    assert kin["triple"] == (3, 4, 5, "concurrent") and kin["free_window"] == (0, 2)
+    panda = stored("panda")
+    assert _context(panda, {6: 0.3}, None)["structure"]["triple"] == (0, 1, 2, "concurrent")
+    xarm = stored("xarm7")
+    assert _context(xarm, {2: 0.3}, None)["structure"]["bound"] == 0
+    assert _context(stored("so101"), {}, None)["structure"]["bound"] == 0
+    # a masked pose has fewer equations: no bound
+    assert _context(stored("ur5"), {}, np.array([1, 1, 1, 1, 1, 0.0]))["structure"]["bound"] == 0
+    assert structure(panda.chain(), [], panda.reach)["bound"] == 0          # 7 unknowns
+
+
+def test_the_certificate_is_never_claimed_short_and_an_odd_count_is_searched_on():
+    """Pieper's bound as certificate: on UR5 and Kinova poses, the union of the sets found with
+    four seeds never exceeds 8 distinct solutions, and whenever one run claims the certificate its
+    set is that union; a run stopped by the patience rule on these chains has a count that is a
+    multiple of 2 (UR5: parallel triple) or 4 (Kinova: concurrent wrist) unless it used up max_starts."""
+    for name, multiple in (("ur5", 2), ("kinova-j2s6s200", 4)):
+        m = stored(name)
+        rng = np.random.default_rng(8)
+        q = m.bounds[:, 0] + (m.bounds[:, 1] - m.bounds[:, 0]) * rng.random((8, m.dof))
+        T = m.fk_matrix(q)
+        claimed = 0
+        for k in range(len(q)):
+            runs = [fkopt.inverse(m, T[k], solutions="all", copies=True, seed=s) for s in range(4)]
+            union = np.concatenate([r.solutions for r in runs])
+            distinct = [row for i, row in enumerate(union) if i == 0 or turns_gap(union[:i], row).min() > 1e-4]
+            assert len(distinct) <= 8 * 2 ** 5                         # copies: at most 8 solutions' turns
+            for r in runs:
+                if r.search["rule"].startswith("certificate"):
+                    claimed += 1
+                    assert r.search["distinct"] == 8
+                    assert all(turns_gap(r.solutions, row).min() < 1e-6 for row in distinct)
+                elif r.search["starts"] < r.search["max_starts"]:
+                    assert r.search["distinct"] % multiple == 0
+        assert claimed >= 8
 
 
 def test_a_dh_arm_in_mm_with_one_joint_fixed_gives_its_generating_configuration():
@@ -201,3 +250,38 @@ def test_without_the_compiled_path_it_refuses_with_one_line(monkeypatch):
         fkopt.inverse(m, T, solutions="all")
     with pytest.raises(FkoptError, match="need numba"):
         fkopt.inverse_path(m, T[None], start=[20.0, -70.0, 60.0, 30.0, 40.0, 50.0])
+
+
+def test_the_reversed_chain_gives_the_inverse_frame():
+    """branch_structure.reversed_chain: FK of the chain walked from the tool at the reversed joints
+    is the inverse of the tool frame, on a URDF arm with a locked joint and on a DH arm with offsets."""
+    from fkopt.kinematics.branch_structure import reversed_chain
+    from fkopt.kinematics.branches import _reduced_chain
+    from fkopt.numerics.chain import frame_jacobian1
+    rng = np.random.default_rng(3)
+    for chain in (_reduced_chain(stored("panda").chain(), {6: 0.3}), fkopt.mechanism("7dof-arm").chain()):
+        back = reversed_chain(chain)
+        for _ in range(5):
+            t = rng.uniform(-3, 3, chain.dof)
+            p, R, _ = frame_jacobian1(chain, t.tolist())
+            pb, Rb, _ = frame_jacobian1(back, t[::-1].tolist())
+            R = np.array(R)
+            assert np.abs(np.array(Rb) - R.T).max() < 1e-12
+            assert np.abs(np.array(pb) + R.T @ np.array(p)).max() < 1e-9 * max(1.0, np.abs(p).max())
+
+
+def test_the_panda_with_joint_7_locked_gives_every_generating_configuration():
+    """The 6R chain left of the Panda (its Pieper triple at the base, searched from the tool): for
+    FK of 20 in-limit configurations, among them near-singular ones whose loop converges slowly,
+    the generating configuration is always among the verified rows."""
+    m = stored("panda")
+    rng = np.random.default_rng(2026)
+    q = m.bounds[:, 0] + (m.bounds[:, 1] - m.bounds[:, 0]) * rng.random((20, m.dof))
+    v = float(m.bounds[6, 0] + 0.3 * (m.bounds[6, 1] - m.bounds[6, 0]))
+    q[:, 6] = v
+    T = m.fk_matrix(q)
+    for k in range(len(q)):
+        r = fkopt.inverse(m, T[k], solutions="all", fixed={"panda_joint7": v})
+        dp, dr = frame_errors(m, r.solutions, T[k])
+        assert (dp <= 1e-9).all() and (dr <= 1e-9).all()
+        assert turns_gap(r.solutions, q[k]).min() < 1e-6, k

@@ -3,6 +3,7 @@ snapshot on random general 6-6 platforms, or a one-line skip without it."""
 import numpy as np
 import pytest
 
+from fkopt.numerics import path as numerics_path
 from fkopt.tools.bench import fksgp
 from fkopt.tools.bench.measuring import Rows
 
@@ -24,6 +25,9 @@ def test_beside_fksgp_every_platform_gives_the_same_real_solutions(monkeypatch):
     ratio = got["6-6 all real solutions / fkSGP"]
     assert np.isfinite(ratio["value"]) and ratio["value"] > 0 and "load average" in ratio["note"]
     assert got["platforms with the same real solution set"]["value"] == 2, got
+    assert got["6-6 all real solutions / fkSGP, CPU time"]["value"] > 0
+    if numerics_path.compiled() is not None:          # the certified homotopy ran on both platforms
+        assert "2 homotopy" in ratio["note"], ratio["note"]
     assert not msgs
 
 

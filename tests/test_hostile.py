@@ -432,7 +432,7 @@ def test_resume_refuses_an_edited_task_file(finished_study, cli):
     cfg, out, final, _ = finished_study
     task = next((final / "tasks").glob("a*.json"))
     rec = json.loads(task.read_text())
-    rec["fitness"][0][0] = 0.0                     # a better-looking result, written by hand
+    rec["rows"]["final_fitness"][0] = 0.0           # a better-looking result, written by hand
     task.write_text(json.dumps(rec))
     before = snapshot(final)
     one_line_error(cli("study", cfg, "--out", out, "-q", "--resume"), task.name, "changed since")
@@ -444,7 +444,7 @@ def test_check_fails_on_an_edited_study_task_file(finished_study, cli):
     assert cli("check", out, "-q")[0] == 0
     task = next((final / "tasks").glob("a*.json"))
     rec = json.loads(task.read_text())
-    rec["fitness"][0][0] = 0.0
+    rec["rows"]["final_fitness"][0] = 0.0
     task.write_text(json.dumps(rec))
     code, _, err = cli("check", out, "-q")
     assert code == 1 and f"tasks/{task.name}" in err and "changed since written" in err, err
@@ -462,7 +462,7 @@ def test_resume_refuses_corrupt_task_files(finished_study, cli, content):
 
 
 @pytest.mark.parametrize("edit", ["list", "no-id", "shape", "strings", "other-task", "fitness-text", "fitness-nan",
-                                  "fitness-inf", "evaluations-negative", "wall-inf"])
+                                  "fitness-inf", "evaluations-negative", "wall-inf", "pose-twice"])
 def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli, edit):
     """Someone who also rewrote manifest.json's digests still cannot slip a malformed record in."""
     import hashlib
@@ -475,15 +475,18 @@ def test_resume_checks_records_even_when_digests_were_forged(finished_study, cli
     elif edit == "no-id":
         del rec["id"]
     elif edit == "shape":
-        rec["fitness"] = rec["fitness"][:1]
+        rec["rows"]["final_fitness"] = rec["rows"]["final_fitness"][:1]
     elif edit == "strings":
-        rec["x"] = "abc"
+        rec["rows"][next(k for k in rec["rows"] if k.startswith("x_"))] = "abc"
     elif edit.startswith("fitness-"):           # issue 30: a value of the wrong type or range
-        rec["fitness"][0][0] = {"fitness-text": "x", "fitness-nan": float("nan"), "fitness-inf": float("inf")}[edit]
+        rec["rows"]["final_fitness"][0] = {"fitness-text": "x", "fitness-nan": float("nan"),
+                                           "fitness-inf": float("inf")}[edit]
     elif edit == "evaluations-negative":
-        rec["evaluations"][0][0] = -5
+        rec["rows"]["evaluations"][0] = -5
     elif edit == "wall-inf":
         rec["wall_s"] = float("inf")
+    elif edit == "pose-twice":                 # one pose's rows in place of another's
+        rec["rows"]["pose"] = [rec["rows"]["pose"][0]] * len(rec["rows"]["pose"])
     else:
         rec["task"]["stop"] = 1
     task.write_text(json.dumps(rec))

@@ -24,7 +24,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
 from fkopt.errors import FkoptError
-from fkopt.files import no_quoted_numbers
+from fkopt.files import did_you_mean, field_path, no_quoted_numbers
 from fkopt.numerics import path as numerics_path
 from fkopt.progress import tick
 from fkopt.numerics.streams import RunStreams
@@ -264,7 +264,6 @@ class Algorithm:
         try:
             self.params = self.Params(**params)
         except ValidationError as err:
-            from fkopt.files import did_you_mean, field_path
             first = err.errors()[0]
             loc = field_path(first["loc"])
             allowed = ", ".join(self.Params.model_fields) or "(none)"

@@ -189,7 +189,9 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
         raise FkoptError(f"--tolerance: must be a positive number, got {tolerance}")
     if all_solutions:
         from fkopt.kinematics.assembly_modes import all_solutions as find_all, solutions_to_dict
-        found = find_all(m, values, seed=seed)
+        # One search per process: the homotopy's compiled tracker and start system (~1 s to load)
+        # cost more than the restart search takes (~0.2 s), so a one-shot call runs the restarts.
+        found = find_all(m, values, seed=seed, method="restarts")
         data = solutions_to_dict(found)
         if as_json:
             typer.echo(strict_json(data))

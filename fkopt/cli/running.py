@@ -57,6 +57,16 @@ def run(configs: list[Path] = typer.Argument(..., help="config file(s) of any ki
                scheduler=scheduler, resume=resume, force=force, quiet=quiet)
 
 
+def _file_of_kind(command: str, path: Path):
+    """The config of ``path`` when it is a file of the kind the command is named after (``fkopt
+    study``, ``fkopt suite``): the registry's kind of that name, not a test of the file's text."""
+    pipeline = _engine()
+    config = pipeline.load_any(path)
+    if pipeline.config_kind(config) is not pipeline.kind_of(command):
+        raise FkoptError(f"{path}: not a {command} file (kind: {command}); run it with: fkopt run {path}")
+    return config
+
+
 def resume_hint(command: str, path, config, out: Path, quick: bool = False, stored: bool = True) -> str:
     """The command that continues an interrupted run of ``config``, as it works: a kind whose plan
     keeps task files (``stored``: experiments, studies, suites; ``.<name>.partial``) reuses them with
@@ -122,9 +132,7 @@ def study(config: Path = typer.Argument(..., help="study YAML file (kind: study)
     of 2-D grids and pairwise rank tests; mode: tracking solves trajectories step by step, each
     step warm-started from the previous one. Fields: docs/config-reference.md (study);
     examples: configs/studies/."""
-    cfg = _engine().load_any(config)
-    if getattr(cfg, "kind", None) != "study":
-        raise FkoptError(f"{config}: not a study file (kind: study); run it with: fkopt run {config}")
+    cfg = _file_of_kind("study", config)
     _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler,
                resume=resume, force=force, quiet=quiet, command="study")
 
@@ -141,9 +149,7 @@ def suite(config: Path = typer.Argument(..., help="suite YAML file (kind: suite)
           quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress")):
     """Run a benchmark suite (kinbench): problems x pose sets x solvers x runs; leaderboard files
     (= fkopt run on it; --quick picks the file's quick tier)."""
-    cfg = _engine().load_any(config)
-    if getattr(cfg, "kind", None) != "suite":
-        raise FkoptError(f"{config}: not a suite file (kind: suite); run it with: fkopt run {config}")
+    cfg = _file_of_kind("suite", config)
     if quick:
         cfg = cfg.quick_tier(str(config))
     _run_files([(config, cfg)], out, jobs=jobs, executor=executor, scheduler=scheduler, resume=resume,

@@ -34,7 +34,7 @@ from fkopt.files.numbers import nanmedian
 from fkopt.files.reading import (MAX_INPUT_BYTES, MAX_UNPACKED, MAX_XML_DEPTH, MAX_YAML_BYTES, check_geometry_file,
                                  check_within, odd_entries, open_input, parse_json, parse_xml, read_input, read_json,
                                  read_stored, read_text, stored_sha256, where_named)
-from fkopt.files.text import md_text, one_line, short_token, strict_json
+from fkopt.files.text import md_table, md_text, one_line, short_token, strict_json
 from fkopt.files.validation import (COMPONENT_PATTERN, MAX_COMPONENT, MAX_MAGNITUDE, check_component, did_you_mean,
                                     error_line, field_names_at, field_path, models_in, no_quoted_numbers)
 from fkopt.files.writing import (file_names, inside, naming_the_file, no_empty_folders_left, output_folder, run_lock,
@@ -46,7 +46,7 @@ __all__ = ["COMPONENT_PATTERN", "MAX_COMPONENT", "MAX_CSV_CELLS", "MAX_CSV_COLUM
            "MAX_INPUT_BYTES", "MAX_MAGNITUDE", "MAX_UNPACKED", "MAX_XML_DEPTH", "MAX_YAML_BYTES", "MAX_YAML_DEPTH",
            "available_cpus", "check_component", "check_csv_shape", "check_geometry_file", "check_within",
            "csv_numbers", "did_you_mean", "error_line", "field_names_at", "field_path", "file_names", "inside",
-           "load_mapping", "load_yaml", "md_text", "models_in", "nanmedian", "naming_the_file",
+           "load_mapping", "load_yaml", "md_table", "md_text", "models_in", "nanmedian", "naming_the_file",
            "no_empty_folders_left", "no_quoted_numbers", "odd_entries", "one_line", "open_input", "output_folder",
            "parse_csv", "parse_json", "parse_xml", "read_csv", "read_input", "read_json", "read_stored",
            "read_stored_csv", "read_text", "run_lock", "short_token", "stored_sha256", "strict_json",

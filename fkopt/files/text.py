@@ -74,3 +74,10 @@ def one_line(text: str, limit: int = 2000) -> str:
     """``text`` safe to print as one line: control characters escaped, long text cut."""
     text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def md_table(df) -> str:
+    """A pandas table as a Markdown table (4 significant digits; ``_(empty)_`` when it has no rows)."""
+    if df.empty:
+        return "_(empty)_"
+    return df.to_markdown(index=False, floatfmt=".4g")

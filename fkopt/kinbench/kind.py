@@ -10,6 +10,7 @@ from fkopt.run.tasks import work_folder  # noqa: F401 (where a suite's task file
 from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, TRACE_FILE, Output
 from fkopt.kinbench.config import SuiteConfig, suite_from_dict
 from fkopt.kinbench.runner import merge_suite, suite_plan, validate_suite
+from fkopt.kinbench.verify import reverify
 
 
 def _from_dict(data: dict, where: str) -> SuiteConfig:
@@ -50,5 +51,18 @@ def _console(result, folder: Path) -> list[str]:
     return [": leaderboard.md, index.html", *reports.board_top_lines(folder)]
 
 
+def _recheck(folder: Path, config: SuiteConfig, meta: dict) -> list[tuple]:
+    """``fkopt check`` of a v3 suite: every stored answer judged again with fkopt's FK and the
+    per-robot board recomputed from them (:func:`fkopt.kinbench.verify.reverify`)."""
+    if config.tracks is None:
+        return []
+    if config._folder is None and meta.get("config_file"):
+        config._folder = Path(meta["config_file"]).parent
+    return reverify(folder, config)
+
+
 SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig,
-                      _console))
+                      _console, reproduced=False, recheck=_recheck, report_section=reports.report_section,
+                      # runs.csv keeps the layout of the frozen kinbench releases, whose stored folders
+                      # are not rerun to add a column: a suite's seeds stay in its task files
+                      not_in_runs=frozenset({"kind", "case", "task_seed"})))

@@ -43,13 +43,13 @@ from fkopt.adapters.field.cores import pinned
 from fkopt.errors import FkoptError
 from fkopt.files import csv_numbers, parse_json, read_input
 from fkopt.kinbench.answer_checks import _close
-from fkopt.kinbench.clock import rotated, timed
+from fkopt.kinbench.clock import query_rng, rotated, timed
 from fkopt.kinbench.physical import ik_verdicts
 from fkopt.kinbench.posesets import csv_bytes, parse_set_csv, problem_mechanism, set_rng, sha256_bytes
 from fkopt.kinbench.releases import check_folder_release
 from fkopt.registry import clock_solver
 from fkopt.run.config_base import files_folder
-from fkopt.kinbench.solution_sets import TOL, entry_of, not_applicable_of, pose_rng
+from fkopt.kinbench.solution_sets import TOL, entry_of, not_applicable_of
 
 #: Waypoints per path, largest joint step of the generating segment (rad), the margin kept
 #: from the limits at its start (rad), and the step bound of a successful path (rad).
@@ -183,7 +183,7 @@ def run_paths(arm, problem: str, ends: np.ndarray, solvers: list[str], *, refere
     with pinned():
         for k in range(n):
             for name in rotated(order, k):
-                entries[name].rng = pose_rng(seed, problem, name, k)
+                entries[name].rng = query_rng(seed, problem, name, None, k)
                 J[name][k], secs[name][k], cpus[name][k] = timed(entries[name].path, T[k], Q[k, 0])
     rows = []
     for name in names:

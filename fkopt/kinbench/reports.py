@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from fkopt.run import record
-from fkopt.files import file_names, md_text, read_stored_csv
+from fkopt.run.plotting import legend_off_data, plt, save     # matplotlib itself only when plt() is called
+from fkopt.files import file_names, md_table, md_text, read_stored_csv
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.outside import digest
 from fkopt.kinbench.submissions import submission_digest
@@ -224,7 +225,6 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
     answered at the track's rung (kinbench's verdict) against the time to the answer (ms, log),
     one step line per solver and the virtual best solver (per query the fastest right answer of
     any solver run here), the timeout marked; names at the right end, spread apart."""
-    from fkopt.run.plotting import plt, save     # lazy: matplotlib
     answers = tables.get("answers.csv.gz")
     if answers is None or answers.empty:
         return []
@@ -327,7 +327,6 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
     """One ECDF figure per scope (all problems, each class): the share of (problem, pose,
     target, run) reached against log10(evaluations / dimension), one step line per solver,
     named at its right end as COCO does; tracks told apart by line style."""
-    from fkopt.run.plotting import plt, save     # lazy: matplotlib
     df = tables.get("ecdf.csv")
     if df is None or df.empty:
         return []
@@ -388,7 +387,6 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
     df = tables.get("scaling.csv")
     if df is None or df.empty:
         return []
-    from fkopt.run.plotting import legend_off_data, plt, save     # lazy: matplotlib
     pyplot = plt()
     styles = {"black-box": "-", "jacobian": "--", "exact": ":"}
     target = scaling_target(sr.config.targets)
@@ -592,3 +590,24 @@ def submissions_meta(c, files=None) -> dict:
         return {}
     return {"submissions": {s.solver: {"sha256": submission_digest(c, s, files), "machine": s.machine, "file": s.file,
                                        "description": s.description} for s in subs}}
+
+
+def report_section(exp, root: Path) -> str:
+    """A stored suite's section of REPORT.md (:attr:`fkopt.run.tasks.Kind.report_section`; ``exp``: a
+    :class:`fkopt.reproduce.store.Experiment`): its overall leaderboard, linked to its page and tables."""
+    rel = exp.folder.relative_to(root)
+    lines = [f"### {exp.title}", "",
+             f"Results: [`results/{rel}/`]({rel}/) · page: [`index.html`]({rel}/index.html) · "
+             f"leaderboards: [`leaderboard.md`]({rel}/leaderboard.md) · seed {exp.config.get('seed')}, "
+             f"{exp.config.get('runs')} runs per pose, {exp.config.get('budget_per_dim')} x dimension "
+             "evaluations ([docs/kinbench.md](../docs/kinbench.md)).", ""]
+    if exp.has("leaderboard.csv"):
+        board = exp.table("leaderboard")
+        # a suite with subsets has one overall ranking per board ("board:<name>/overall")
+        overall = board[board["scope"].astype(str).str.split("/").str[-1] == "overall"] if "scope" in board.columns else board
+        cols = [c for c in ("rank", "solver", "track", "score", "ci_low", "ci_high", "better_than") if c in board.columns]
+        if "scope" in overall.columns and overall["scope"].nunique() > 1:
+            cols = ["scope", *cols]
+        lines += ["Overall (tracks mixed, for reference; each track is ranked on its own in the leaderboard):", "",
+                  md_table(overall[cols].astype(object).fillna("")), ""]
+    return "\n".join(lines)

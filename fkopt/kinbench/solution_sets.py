@@ -37,7 +37,6 @@ with fkopt's FK and recomputes the board (``leaderboard-solutions.csv``) from th
 """
 from __future__ import annotations
 
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -49,7 +48,7 @@ from fkopt.adapters.field.track_entries import locked_arm
 from fkopt.errors import FkoptError
 from fkopt.files import csv_numbers, read_stored_csv
 from fkopt.kinbench.answer_checks import _close, differing_numbers
-from fkopt.kinbench.clock import rotated, timed
+from fkopt.kinbench.clock import query_rng, rotated, timed
 from fkopt.kinbench.physical import ik_verdicts
 from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
 from fkopt.registry import clock_solver
@@ -75,11 +74,6 @@ def not_applicable_of(rows: pd.DataFrame) -> str:
     """Why an entry's rows hold no answers ('' when it ran; a column read back empty is NaN)."""
     why = rows["not_applicable"].iloc[0] if len(rows) else ""
     return why if isinstance(why, str) else ""
-
-
-def pose_rng(seed: int, problem: str, solver: str, pose: int) -> np.random.Generator:
-    key = zlib.crc32(f"{problem}/{solver}".encode())
-    return np.random.default_rng(np.random.SeedSequence([int(seed), key, int(pose)]))
 
 
 # -- joints modulo 2 pi -------------------------------------------------------------------------
@@ -191,7 +185,7 @@ def run_solutions(arm, solved, fixed: dict, problem: str, queries: np.ndarray, s
     names = list(dict.fromkeys([reference, *solvers]))
 
     def call(entry, name, i):
-        entry.rng = pose_rng(seed, problem, name, i)
+        entry.rng = query_rng(seed, problem, name, None, i)     # no timeout: the clock's stream per (arm, entry, pose)
         Q, secs[name][i], cpus[name][i] = timed(entry.solutions, T[i])
         found[name][i] = np.asarray(Q, float).reshape(-1, solved.dof)
 

@@ -68,8 +68,10 @@ def _branch_options(p) -> dict:
     return {k: getattr(p, k) for k in BRANCH_OPTIONS if getattr(p, k, None) is not None}
 
 
-#: What a solution set's search fields say the search stopped on (no search gives a certificate).
-STOPPING_RULE = {"serial": "patience", "parallel": "rounds without a new solution"}
+#: What a solution set's search fields say the search stopped on: a stopping rule, except a 6-6
+#: platform's homotopy (all_solutions' method "homotopy"), which is complete by its certificate.
+STOPPING_RULE = {"serial": "patience", "parallel": "rounds without a new solution",
+                 "homotopy": "complete: 40 homotopy paths at 40 distinct nonsingular roots"}
 
 
 def _checked_kind(solver, mech) -> None:
@@ -109,6 +111,14 @@ class ExactSolver(Algorithm):
             return
         locked_sets(mech, **{k: v for k, v in options.items() if k in ("fixed", "spread", "spread_joints")})
 
+    def prepare_solution_set(self, mech) -> None:
+        """Load what :meth:`solution_set` runs on ``mech`` before its searches are timed: a 6-6
+        platform's compiled homotopy tracker and start system (a serial arm's kernels load on its
+        first search, as before)."""
+        if mech.kind == "parallel":
+            from fkopt.kinematics.assembly_modes import prepare
+            prepare(mech)
+
     def solution_set(self, mech, inputs: np.ndarray, seed: int) -> SolutionSet:
         """Every solution of one case: a serial arm's pose ``inputs`` (x, y, z, Z-Y-Z angles) by
         ``fkopt.inverse(arm, pose, solutions="all")``, a parallel mechanism's joints by
@@ -144,7 +154,8 @@ class ExactSolver(Algorithm):
         return SolutionSet(tuple(found.names), poses[order],
                            {"residual": np.array([s.residual for s in found], dtype=float)[order],
                             "hits": np.array([s.hits for s in found], dtype=np.int64)[order]},
-                           {"stopping_rule": STOPPING_RULE["parallel"], "patience": int(found.settings["patience"]),
+                           {"stopping_rule": STOPPING_RULE["homotopy" if found.method == "homotopy" else "parallel"],
+                            "patience": int(found.settings["patience"]),
                             "round_size": int(found.settings["round_size"]), "starts": int(found.starts),
                             "outside_bounds": int(found.outside)})
 
@@ -233,7 +244,8 @@ class InverseParams(Params):
     spread_joints: list[str] | None = Field(None, min_length=1, description="solutions: all with spread: "
                                                                             "the locked joints")
     patience: int | None = Field(None, ge=1, description="solutions: all: consecutive starts without a new "
-                                                         "solution before the search stops (default 32)")
+                                                         "solution before the search stops (default 128 on a "
+                                                         "6R chain with Pieper's bound, else 32)")
     max_starts: int | None = Field(None, ge=1, description="solutions: all: most starts per pose "
                                                            "(default 400)")
 

@@ -79,6 +79,18 @@ after every round.
 On Dietmaier's platform (default "6-sps" geometry and legs ``DIETMAIER_LEGS``) all 40 real
 solutions are found on every seed tried, almost always within the first round of 2000 starts
 (counts and times: ``bench/targets.csv`` and ``fkopt bench``, section kinematics).
+
+**A 6-SPS platform on the compiled path** (``method="auto"``, the default, without ``starts``)
+is solved instead by a parameter homotopy (:mod:`fkopt.kinematics.sps6_homotopy`): the 40
+complex roots of a start system, found once per process, are tracked to the platform's, and the
+real ones go through steps 3 and 4 above (those whose residual is not within ``tol`` first
+through the real Newton steps of step 2). The search knows it has them all when the 40 paths
+end at 40 distinct nonsingular roots, the generic number (``Solutions.certificate`` says so;
+``hits`` is 1 per solution and ``starts`` the 40 paths). Where they do not (a special geometry
+with fewer than 40 finite roots, e.g. 6-sps-cmm's similar hexagons, or a failed path) the
+restart search above runs and ``settings["homotopy"]`` says why; its stopping rule is what
+``Solutions.certificate`` then reports. ``FKOPT_NUMERICS=numpy`` runs the restart search (the
+reference the homotopy is tested against).
 """
 from __future__ import annotations
 
@@ -90,6 +102,8 @@ import numpy as np
 
 from fkopt.errors import FkoptError
 from fkopt.mechanisms.base import Mechanism, ParallelMechanism
+from fkopt.mechanisms.sps6 import SixSPS
+from fkopt.kinematics import sps6_homotopy
 from fkopt.kinematics.assembly_search import (_cluster, _euler_triple, _into_bounds, _kronecker, _model_for, _newton,
                                              _SixSPSModel)
 from fkopt.numerics.restart_loop import restart
@@ -120,6 +134,9 @@ class Solutions(list):
     outside: int = 0
     #: (starts so far, seconds so far, solutions in the bounds so far) after every round
     history: list[tuple[int, float, int]]
+    #: "homotopy" or "restarts" (all_solutions' ``method``), and how the search decided it had them all
+    method: str = "restarts"
+    certificate: str = ""
     settings: dict[str, Any]
 
     def poses(self) -> np.ndarray:
@@ -128,7 +145,8 @@ class Solutions(list):
 
 
 def solutions_to_dict(solutions: Solutions) -> dict[str, Any]:
-    """JSON-able form: ``{"solutions": [{"pose", "residual", "hits"}], "starts", "time_s", ...}``."""
+    """JSON-able form: ``{"solutions": [{"pose", "residual", "hits"}], "starts", "time_s", ...,
+    "method", "certificate"}``."""
     return {
         "solutions": [{"pose": {k: float(v) for k, v in s.pose.items()}, "residual": float(s.residual),
                        "hits": int(s.hits)} for s in solutions],
@@ -136,6 +154,8 @@ def solutions_to_dict(solutions: Solutions) -> dict[str, Any]:
         "time_s": float(getattr(solutions, "time_s", 0.0)),
         "outside": int(getattr(solutions, "outside", 0)),
         "history": [list(h) for h in getattr(solutions, "history", [])],
+        "method": getattr(solutions, "method", "restarts"),
+        "certificate": getattr(solutions, "certificate", ""),
     }
 
 
@@ -154,11 +174,20 @@ def pose_distance(mechanism: ParallelMechanism, a, b) -> np.ndarray:
     return np.abs(ka - kb).max(-1).reshape(shape)
 
 
+def prepare(mechanism: Mechanism, method: str = "auto") -> None:
+    """Load what :func:`all_solutions` with this ``method`` will run on ``mechanism``, so that a
+    timed call does not include it: for a 6-SPS platform on the compiled path, numba's compiled
+    tracker (from its cache, or compiled once) and the homotopy's start system (once per process)."""
+    if isinstance(mechanism, SixSPS) and method != "restarts" and sps6_homotopy.available():
+        sps6_homotopy.prepare()
+
+
 def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = None, seed: int = 0,
                   tol: float = 1e-9, dedup: float = 1e-6, round_size: int | None = None,
                   patience: int = 1, min_starts: int | None = None, max_starts: int = 200_000,
                   iterations: int = 60, maximum: int | None = None, pool: int | None = 512,
-                  line_search: bool | None = None, capture: tuple[float, float] | None = (1e-4, 1e-3), qmc: bool = True) -> Solutions:
+                  line_search: bool | None = None, capture: tuple[float, float] | None = (1e-4, 1e-3), qmc: bool = True,
+                  method: str = "auto") -> Solutions:
     """Every distinct real forward solution of ``mechanism`` for ``joints`` inside its bounds.
 
     ``starts``: run exactly this many starts (one round); by default rounds of ``round_size``
@@ -178,6 +207,13 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     that many distinct real solutions (inside or outside the bounds) are found, since no more
     can exist. Default 40 for a 6-SPS platform (the number of complex solutions of the general
     6-6 Stewart-Gough platform: Raghavan 1993, Ronga & Vust 1995), none otherwise.
+    ``method``: "restarts" (the search above), "homotopy" (6-SPS only, on the compiled path: all
+    40 complex roots by a parameter homotopy, :mod:`fkopt.kinematics.sps6_homotopy`; the real
+    ones kept, certified complete when the 40 paths end at 40 distinct nonsingular roots, else
+    the restart search runs and ``settings["homotopy"]`` says why) or "auto" (the homotopy for a
+    6-SPS platform when the compiled path runs and ``starts`` is not given, else the restarts).
+    ``Solutions.method`` and ``Solutions.certificate`` say which ran and how it decided it had
+    every solution.
     """
     if not isinstance(mechanism, ParallelMechanism):
         raise FkoptError(f"all_solutions needs a parallel mechanism; '{mechanism.name}' is {mechanism.kind}")
@@ -190,6 +226,13 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
             raise FkoptError(f"all_solutions {name}: must be positive, got {value}")
     if starts is not None and int(starts) < 1:
         raise FkoptError(f"all_solutions starts: must be at least 1, got {starts}")
+    if method not in ("auto", "homotopy", "restarts"):
+        raise FkoptError(f"all_solutions method: allowed values auto, homotopy, restarts; got {method!r}")
+    if method == "homotopy" and not isinstance(mechanism, SixSPS):
+        raise FkoptError(f"all_solutions method 'homotopy' is for a 6-SPS platform; '{mechanism.name}' is not one")
+    if method == "homotopy" and not sps6_homotopy.available():
+        raise FkoptError("all_solutions method 'homotopy' runs on the compiled path; it needs numba (pip install "
+                         "numba) and FKOPT_NUMERICS other than numpy")
 
     t0 = time.perf_counter()
     model = _model_for(mechanism, joints)
@@ -199,7 +242,7 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     else:
         size = int(round_size or (2000 if isinstance(model, _SixSPSModel) else 200))
         limit, need = int(max_starts), int(min_starts if min_starts is not None else 2 * size)
-    streams = RunStreams(seed, [0])
+    streams = []                                      # RunStreams(seed, [0]), made by the first round
     cap = maximum if maximum is not None else (40 if isinstance(model, _SixSPSModel) else None)
     search = (not isinstance(model, _SixSPSModel)) if line_search is None else bool(line_search)
     jscale = np.maximum(1.0, np.abs(joints))
@@ -285,11 +328,13 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     def round_starts(j):
         """The next round's starts: points used .. used + n - 1 of the shifted Kronecker sequence."""
         n = min(size, limit - used)
+        if not streams:
+            streams.append(RunStreams(seed, [0]))
         if qmc:
             if not shift:
-                shift.append(streams.uniform(1, model.draws)[0][0])
+                shift.append(streams[0].uniform(1, model.draws)[0][0])
             return model.starts(_kronecker(shift[0], used, n, model.draws))
-        return model.starts(streams.uniform(n, model.draws)[0])
+        return model.starts(streams[0].uniform(n, model.draws)[0])
 
     def run_round(S0):
         """Newton from every start of a round (pooled), then the round's new solutions checked;
@@ -310,8 +355,32 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
         """The stopping rule: ``patience`` quiet rounds after ``min_starts``, or every assembly mode found."""
         return (used >= need and quiet >= patience) or (cap is not None and len(found) >= cap)
 
-    # rounds of starts through the one restart loop: a round is one start, the rule its stopping test
-    restart(round_starts, run_round, enough, budget=None if limit > 0 else 0, give_up=lambda: used >= limit)
+    homotopy = None
+    if isinstance(model, _SixSPSModel) and (method == "homotopy" or (method == "auto" and starts is None
+                                                                     and sps6_homotopy.available())):
+        base, platform, probe = mechanism.points()
+        homotopy = sps6_homotopy.solve(base, platform - probe, joints, seed=seed)
+    if homotopy is not None and homotopy["certified"]:
+        # the real roots, polished by the real Newton steps (a root that is not real stays unconverged)
+        S = homotopy["states"]
+        rough = ~(np.abs(model.residual(S)) / jscale <= tol).all(-1)
+        add(S[~rough])
+        if rough.any():          # an ill-conditioned root, or one not real: the real Newton steps decide
+            with np.errstate(all="ignore"):
+                S, conv, _ = _newton(model, S[rough], ftol=ftol, iterations=iterations, line_search=False)
+            add(S[conv])
+        settle()
+        used = homotopy["paths"]
+        history.append((used, time.perf_counter() - t0, sum(bool(f) for f in found)))
+        certificate = (f"complete: {homotopy['paths']} homotopy paths ended at {homotopy['roots']} distinct "
+                       f"nonsingular complex roots, the generic number of a 6-6 platform")
+    else:
+        # rounds of starts through the one restart loop: a round is one start, the rule its stopping test
+        restart(round_starts, run_round, enough, budget=None if limit > 0 else 0, give_up=lambda: used >= limit)
+        certificate = (f"complete: {cap} distinct real solutions, the most there can be" if cap is not None
+                       and len(found) >= cap else f"stopping rule: {quiet} round(s) of {size} starts without a "
+                       f"new solution after {used} starts" if starts is None and quiet >= patience
+                       else f"{used} starts, as asked" if starts is not None else f"max_starts ({limit}) spent")
 
     out = Solutions(sorted((Solution(pose=dict(zip(mechanism.pose_names, map(float, f[0]))), residual=f[1], hits=h)
                             for f, h in zip(found, hits) if f), key=lambda s: -s.hits))
@@ -320,8 +389,12 @@ def all_solutions(mechanism: ParallelMechanism, joints, *, starts: int | None = 
     out.starts = used
     out.time_s = time.perf_counter() - t0
     out.history = history
+    out.method = "homotopy" if homotopy is not None and homotopy["certified"] else "restarts"
+    out.certificate = certificate
     out.settings = dict(seed=seed, tol=tol, dedup=dedup, round_size=size, patience=patience,
-                        iterations=iterations, maximum=cap, pool=pool, line_search=search)
+                        iterations=iterations, maximum=cap, pool=pool, line_search=search, method=out.method)
+    if homotopy is not None and not homotopy["certified"]:
+        out.settings["homotopy"] = homotopy["reason"]
     return out
 
 

@@ -7,14 +7,25 @@ configurations nearest to the target in tool pose, then counter-based hash draws
 joints over one turn, prismatic joints inside their limits); each start runs the damped
 least-squares loop without revolute limits to ``SEARCH_TOL`` (a solution is one modulo 2 pi per
 revolute joint), converged answers are wrapped and merged when every joint agrees within
-``MERGE_TOL``. Each solution found adds *derived* starts (:func:`_windows`): a window of joints
-drawn afresh with the others held at its values, which reach the solutions sharing those joints
-with it (wrist and elbow flips, the other shoulder side) where uniform starts rarely land.
-**Stopping rule**: the search stops after ``patience`` consecutive table or hash starts that
-found nothing new (four times that while none is found), or after ``max_starts``. It is a rule, not a certificate: a branch whose basin
-of attraction is small can be missed; its measured miss rate against EAIK's analytic sets is in
-docs/robots.md, and ``result.search`` reports the starts run and the starts since the last new
-solution, so a caller can ask for a larger ``patience``.
+``MERGE_TOL``; a start that ends close to a solution without converging (next to a singular
+configuration, where the loop's steps shrink) is iterated on (``POLISH``). Each solution found
+adds *derived* starts (:func:`_windows`): a window of joints drawn afresh with the others held at
+its values, which reach the solutions sharing those joints with it (wrist and elbow flips, the
+other shoulder side) where uniform starts rarely land; they run window by window across the
+solutions (the flips that reach most in one start first), and a window whose subproblem has at
+most two solutions is skipped once both are known (:mod:`fkopt.kinematics.branch_structure`
+detects these from the chain's axes). A chain whose Pieper triple is at the base (the Panda with
+joint 7 locked) is searched walked from the tool, where the triple is a wrist.
+**When it stops.** A 6R chain with three consecutive axes parallel or meeting in a point has at
+most 8 solutions (Pieper): when 8 distinct ones are found the search stops with a *certificate*.
+Otherwise it stops after ``patience`` consecutive table or hash starts that found nothing new
+(four times that while none is found; ``PIEPER_PATIENCE`` on such a chain, whose complete poses
+end at the bound anyway), unless the count is not a multiple of what such a chain's counts are
+(4 with a concurrent triple, 2 with a parallel one: some are missing), or after ``max_starts``.
+That rule is not a certificate: a branch whose basin of attraction is small can be missed; its
+measured miss rate against EAIK's analytic sets is in docs/robots.md, and ``result.search``
+reports the rule that ended it, the starts run and the starts since the last new solution, so a
+caller can ask for a larger ``patience``.
 
 Each distinct solution is then mapped into the limits: every revolute joint takes the in-limit
 value congruent modulo 2 pi that is nearest 0 (a continuous joint: its value wrapped into
@@ -62,6 +73,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.kinematics.branch_structure import reversed_chain, structure
 from fkopt.kinematics.inputs import (_internal, _inverse_arm, _public, _targets, _task_mask, _tolerance,
                                      _unreachable, _values)
 from fkopt.kinematics.results import INVERSE_TOL
@@ -84,8 +96,11 @@ ACCEPT_TOL = (1e-10, 1e-10)
 #: loop's answers of one solution scatter by a few 1e-6 rad while still verifying at 1e-9, and the
 #: two solutions on either side of it are ~1e-4 rad apart (EAIK's pair on the Kinova, docs/robots.md).
 MERGE_TOL = 1e-5
-#: Stopping rule defaults: consecutive starts without a new solution, most starts per pose.
+#: Stopping rule defaults: consecutive starts without a new solution, most starts per pose; on a
+#: chain with Pieper's bound (branch_structure) a pose with all its solutions stops at the bound, so
+#: the larger patience there costs only on the poses with fewer.
 PATIENCE = 32
+PIEPER_PATIENCE = 128
 #: ... and at least this many times the starts it took to find the last new solution.
 GROWTH = 0.0
 MAX_STARTS = 400
@@ -93,6 +108,15 @@ MAX_STARTS = 400
 NEIGHBOURS = 16
 #: Loop iterations per start (a far start needs more than inverse's 10).
 ITERATIONS = 20
+#: Derived starts: draws per (solution, window) pair (a two-solution window / the others) and loop
+#: iterations of each (a held start either lies in a sibling's basin, reached in a few, or in none).
+TWO_DRAWS = 2
+#: ... the window of a Pieper triple, whose other solution always exists (branch_structure)
+PAIR_DRAWS = 12
+POLISH = 1e-3
+POLISH_ITERATIONS = 100
+HELD_DRAWS = 4
+HELD_ITERATIONS = 10
 #: Most distinct solutions kept per pose (a generic 6R arm has at most 16).
 CAP = 64
 #: inverse_path: default largest joint step between waypoints (rad / length unit), intermediate
@@ -248,15 +272,56 @@ def _context(m, locked: dict[int, float], W) -> dict:
     fmask = np.concatenate([Wf[:3], np.full(9, float(Wf[3:].all()))])
     feats = feats * fmask
     tq = full[:, free]
-    got = cache[key] = {
-        "n": len(free), "chain": chain.arrays(), "chain_obj": chain, "free": free, "locked": dict(locked),
-        "tq": np.ascontiguousarray(tq), "Ft": np.ascontiguousarray(feats.T), "norms": _sumsq(feats),
-        "w": float(wf), "fmask": fmask, "W": Wf,
-        "lo": np.ascontiguousarray(lo[free]), "hi": np.ascontiguousarray(hi[free]),
-        "glo": np.ascontiguousarray(glo[free]), "ghi": np.ascontiguousarray(ghi[free]),
-        "revolute": np.ascontiguousarray(revolute[free]), "angle": angle,
-        "periodic": m.periodic_mask()[free], "full_lo": lo, "full_hi": hi}
+    shape = _shape(chain, m.reach, Wf)
+    got = {"structure": shape, "n": len(free), "chain": chain.arrays(), "chain_obj": chain, "free": free,
+           "locked": dict(locked), "tq": np.ascontiguousarray(tq), "Ft": np.ascontiguousarray(feats.T),
+           "norms": _sumsq(feats), "w": float(wf), "fmask": fmask, "W": Wf,
+           "lo": np.ascontiguousarray(lo[free]), "hi": np.ascontiguousarray(hi[free]),
+           "glo": np.ascontiguousarray(glo[free]), "ghi": np.ascontiguousarray(ghi[free]),
+           "revolute": np.ascontiguousarray(revolute[free]), "angle": angle,
+           "periodic": np.ascontiguousarray(m.periodic_mask()[free]), "full_lo": lo, "full_hi": hi,
+           "full_chain": m.chain().arrays(), "reversed": False}
+    if shape["bound"] and shape["triple"][0] == 0:
+        # the Pieper triple at the base (the Panda with joint 7 locked): the search runs on the
+        # chain walked from the tool (branch_structure.reversed_chain), where it is a wrist, and
+        # the derived starts (the wrist's flip, the solutions sharing the first joint, the other
+        # side of it) reach the branches as on a wrist-partitioned arm; the target is the inverse
+        # pose, the start table's features those of the inverse frames, the unknowns reversed
+        back = reversed_chain(chain)
+        Ri = np.swapaxes(rotations.to_array(R).reshape(TABLE, 3, 3), 1, 2)
+        pi = -np.einsum("kij,kj->ki", Ri, np.stack(p, axis=-1))
+        fb = np.concatenate([pi, wf * Ri.reshape(TABLE, 9)], axis=-1) * fmask
+        rev = {key: np.ascontiguousarray(got[key][::-1]) for key in ("lo", "hi", "glo", "ghi", "revolute", "periodic")}
+        got["search"] = dict(got, **rev, structure=_shape(back, m.reach, Wf), chain=back.arrays(), chain_obj=back,
+                             tq=np.ascontiguousarray(tq[:, ::-1]), Ft=np.ascontiguousarray(fb.T), norms=_sumsq(fb),
+                             reversed=True)
+    else:
+        got["search"] = got
+    cache[key] = got
     return got
+
+
+def _shape(chain, reach: float, Wf: np.ndarray) -> dict:
+    """The chain's structure (branch_structure.structure) with the derived starts' windows in the
+    order the search takes them."""
+    windows = _windows(chain.dof)
+    shape = structure(chain, windows, reach)
+    # the Pieper triple's window first (its flip always exists), then the wide ones (the other
+    # shoulder side, the solutions sharing the base joint), then the other windows whose subproblem
+    # has two solutions (a wrist or elbow flip, one start), the rest last
+    rank = [0 if w == shape["pair_window"] else 1 if w[1] - w[0] > 2 else 2 if two else 3
+            for w, two in zip(windows, shape["two_solution"])]
+    order = sorted(range(len(windows)), key=lambda i: (rank[i], -windows[i][1] + windows[i][0], i))
+    shape["windows"] = [windows[i] for i in order]
+    shape["two_solution"] = [shape["two_solution"][i] for i in order]
+    shape["hold"] = [True] * len(order)
+    if shape["free_window"] is not None:
+        shape["windows"].append(shape["free_window"])
+        shape["two_solution"].append(False)
+        shape["hold"].append(False)
+    if not Wf.all():
+        shape["bound"] = 0                        # a masked pose: fewer equations, Pieper's count does not hold
+    return shape
 
 
 def _kernels():
@@ -310,6 +375,12 @@ def _verify(m, ctx, pose_row: np.ndarray, public_full: np.ndarray, W) -> tuple[f
         s = 0.5 * math.sqrt((M[2][1] - M[1][2]) ** 2 + (M[0][2] - M[2][0]) ** 2 + (M[1][0] - M[0][1]) ** 2)
         re = max(re, math.atan2(s, 0.5 * (M[0][0] + M[1][1] + M[2][2] - 1.0)))
     return math.hypot(*dp), re
+
+
+def _inverse_row(row: np.ndarray) -> np.ndarray:
+    """The inverse of a target (a pose row (6,) in ZYZ degrees or a frame row (12,)) as a frame row."""
+    R = np.array(rotations.zyz1(*row[3:].tolist())) if len(row) == 6 else row[3:].reshape(3, 3)
+    return np.ascontiguousarray(np.concatenate([-R.T @ row[:3], R.T.reshape(9)]))
 
 
 def _windows(n: int) -> list[tuple[int, int]]:
@@ -370,13 +441,14 @@ def locked_sets(arm, *, fixed=None, spread=None, spread_joints=None, mask=None) 
 
 
 def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol=None, mask=None, seed: int = 0,
-                  patience: int = PATIENCE, growth: float = GROWTH, max_starts: int = MAX_STARTS, copies: bool = False,
+                  patience: int | None = None, growth: float = GROWTH, max_starts: int = MAX_STARTS, copies: bool = False,
                   orientation_scale: float | None = None) -> AllSolutions:
     """Every solution of one pose (6,) or tip frame (4, 4): see the module docstring.
     ``fixed``: {joint name: value} locked joints (public units); ``spread``: K samples per locked
     joint of a redundant arm's self-motion (``spread_joints`` names them); ``tol``: the
     verification tolerances (default :data:`ALL_TOL`); ``seed``: the hash draws' stream;
-    ``patience`` / ``max_starts``: the stopping rule (``growth`` > 0 also asks for at least
+    ``patience`` / ``max_starts``: the stopping rule (``patience`` by default :data:`PATIENCE`,
+    :data:`PIEPER_PATIENCE` on a chain with Pieper's bound; ``growth`` > 0 also asks for at least
     ``growth`` times the starts that found the last new solution; 0 by default, measured no
     better); ``copies``: list every in-limit copy of a
     joint whose limits span more than 2 pi."""
@@ -386,7 +458,7 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     if P.ndim != 1:
         raise FkoptError(f"{m.name} all solutions: one pose at a time here (got shape {np.shape(pose)}); "
                          "fkopt.inverse(arm, poses, solutions='all') takes a batch")
-    for name, v, low in (("patience", patience, 1), ("max_starts", max_starts, 1)):
+    for name, v, low in (("patience", 1 if patience is None else patience, 1), ("max_starts", max_starts, 1)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
             raise FkoptError(f"{m.name} all solutions {name}: expected an integer >= {low}, got {v!r}")
     x, y, z = P[:3].tolist()
@@ -400,23 +472,51 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
     row = np.ascontiguousarray(P, dtype=float)
     rows, perr, rerr, fixed_rows = [], [], [], []
     stats = {"starts": 0, "converged": 0, "evaluations": 0, "distinct": 0, "out_of_limits": 0, "unverified": 0,
-             "since_last_new": [], "last_new_start": [], "found_at": []}
+             "since_last_new": [], "last_new_start": [], "found_at": [], "complete": []}
+    if patience is None:
+        patience = PIEPER_PATIENCE if _context(m, locks[0], W)["structure"]["bound"] else PATIENCE
     for lk in locks:
         ctx = _context(m, lk, W)
         nn = min(NEIGHBOURS, len(ctx["tq"]))
-        sols, found_at, info = kern.search(ctx, row, L, ctx["W"], nn, int(seed), int(max_starts), int(patience), SEARCH_TOL,
-                                 ACCEPT_TOL, ITERATIONS, 0.01, 0.1, 10.0, 2.0, ctx["glo"], ctx["ghi"],
-                                 ctx["revolute"], MERGE_TOL, CAP, float(growth), _windows(ctx["n"]))
+        side = ctx["search"]
+        plan = side.get("plan")
+        if plan is None:
+            shape = side["structure"]
+            draws = [PAIR_DRAWS if w == shape["pair_window"] else TWO_DRAWS if two else HELD_DRAWS
+                     for w, two in zip(shape["windows"], shape["two_solution"])]
+            plan = side["plan"] = kern.search_plan(shape["windows"], shape["hold"], shape["two_solution"], draws,
+                                                   shape["bound"], shape["multiple"], HELD_ITERATIONS, POLISH,
+                                                   POLISH_ITERATIONS, side["revolute"], side["lo"], side["hi"])
+        sols, found_at, info = kern.search(side, plan, _inverse_row(row) if side["reversed"] else row, L, side["W"],
+                                           nn, int(seed), int(max_starts), int(patience), SEARCH_TOL, ACCEPT_TOL,
+                                           ITERATIONS, 0.01, 0.1, 10.0, 2.0, side["glo"], side["ghi"],
+                                           side["revolute"], MERGE_TOL, CAP, float(growth))
+        if side["reversed"]:
+            sols = np.ascontiguousarray(sols[:, ::-1])
         stats["starts"] += int(info[0])
         stats["converged"] += int(info[1])
         stats["evaluations"] += int(info[2])
         stats["since_last_new"].append(int(info[3]))
         stats["last_new_start"].append(int(info[4]))
         stats["distinct"] += len(sols)
+        stats["complete"].append(bool(info[5]))
         stats["found_at"].append(found_at.tolist())
-        full = np.empty(m.dof)
+        full = np.zeros(m.dof)
         for k, v in lk.items():
             full[k] = v
+        if not copies:
+            # compiled: each solution's in-limit copy nearest 0, verified (as the loop below)
+            pub_rows, errs, status = kern.into_limits(sols, ctx["free"], full, ctx["angle"], ctx["revolute"],
+                                                      ctx["periodic"], ctx["lo"], ctx["hi"], m.bounds[:, 0],
+                                                      m.bounds[:, 1], ctx["full_chain"], row, ctx["W"])
+            stats["out_of_limits"] += int((status == 1).sum())
+            ok = (status == 0) & (errs[:, 0] <= tp) & (errs[:, 1] <= tr)
+            stats["unverified"] += int(((status == 0) & ~ok).sum())
+            rows.extend(pub_rows[ok])
+            perr.extend(errs[ok, 0].tolist())
+            rerr.extend(errs[ok, 1].tolist())
+            fixed_rows.extend(pub_rows[ok][:, sorted(lk)].tolist())
+            sols = sols[:0]
         for w in sols:
             reps = _in_limit_copies(w, ctx, copies)
             if not reps:
@@ -435,10 +535,19 @@ def all_solutions(arm, pose, *, fixed=None, spread=None, spread_joints=None, tol
                 rerr.append(re)
                 fixed_rows.append([pub[k] for k in sorted(lk)])
     if len(locks) == 1:
-        for key in ("since_last_new", "last_new_start", "found_at"):
+        for key in ("since_last_new", "last_new_start", "found_at", "complete"):
             stats[key] = stats[key][0]
-    stats["rule"] = (f"stopped after {patience} consecutive starts without a new solution "
-                     f"(or {max_starts} starts); no certificate: the miss rate is measured in docs/robots.md")
+    shape = _context(m, locks[0], W)["structure"]
+    done = stats["complete"] if isinstance(stats["complete"], list) else [stats["complete"]]
+    if shape["bound"] and all(done):
+        i, j, k, kind = shape["triple"]
+        stats["rule"] = (f"certificate: {shape['bound']} distinct solutions found, Pieper's bound for a 6R chain "
+                         f"whose joints {i + 1}, {j + 1}, {k + 1} have {kind} axes: there are no more")
+    else:
+        quiet = stats["since_last_new"] if isinstance(stats["since_last_new"], list) else [stats["since_last_new"]]
+        how = (f"stopped after {patience} consecutive starts without a new solution" if min(quiet) >= patience else
+               f"stopped at {max_starts} starts, before {patience} consecutive ones without a new solution")
+        stats["rule"] = f"{how}; no certificate: the miss rate is measured in docs/robots.md"
     stats["patience"], stats["max_starts"] = int(patience), int(max_starts)
     n = m.dof
     sol = np.array(rows).reshape(-1, n)

@@ -40,12 +40,8 @@ from fkopt.run.compare import Mismatch, Rules, compare_folders, deterministic_fi
 from fkopt.errors import FkoptError
 from fkopt.files import odd_entries, parse_json, read_stored, read_stored_csv
 import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
-from fkopt.kinbench.verify import reverify
-from fkopt.kinds.experiment.runner import build_cases, build_problem
-from fkopt.kinds.study.poses import build_poses
 from fkopt.registry import algorithm_class, mechanism_class, registered_only
 from fkopt.run.pipeline import config_kind, from_dict, rerun_files
-from fkopt.run.solving import build_mechanism, make_problem
 from fkopt.run.tasks import task_file_problems
 from fkopt.numerics import path as numerics_path
 from fkopt.run.provenance import ANY, BLAS, ENV_FILE, EXACT, platform_tier
@@ -136,24 +132,15 @@ def recomputed_fitness(exp: Experiment, config) -> list[Mismatch]:
     f(x)|, |f(x - d_i e_i) - f(x)|) (first order, with a factor 2 for the curvature of a squared
     residual and 2 for safety), plus the stored fitness' own rounding (5e-10 relative).
     """
-    kind = config_kind(config).name
-    if kind not in ("experiment", "study") or not (exp.folder / "runs.csv").is_file():
+    stored_problems = config_kind(config).stored_problems
+    if stored_problems is None or not (exp.folder / "runs.csv").is_file():
         return []
     label = _label(exp)
     try:
         runs = read_stored_csv(exp.folder, "runs.csv")
     except (OSError, ValueError, pd.errors.ParserError, UnicodeDecodeError, FkoptError) as err:
         return [Mismatch(label, "runs.csv", "-", "file", f"unreadable ({err})", "readable", "readable CSV")]
-    mech = build_mechanism(config)
-    if kind == "experiment":
-        groups = [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
-                  for case in build_cases(config, mech)]
-    else:                               # a study: one problem per pose of its pose set
-        poses = build_poses(config, mech)
-        # poses count from 0 (fkopt.run.record); a folder written before the run record counted from 1
-        first = 1 if len(runs) and runs["pose"].min() >= 1 else 0
-        groups = [(f"pose {i}", runs["pose"] == i + first, lambda i=i: make_problem(config, mech, poses.inputs[i]))
-                  for i in range(len(poses))]
+    groups = stored_problems(config, runs)
     out = []
     for where, sel, make in groups:
         rows = runs[sel]
@@ -242,14 +229,12 @@ def _check_experiment(exp: Experiment, config, exact: bool | None, tier: str | N
 
 
 def board_from_answers(label: str, exp: Experiment, config) -> list[Mismatch]:
-    """A kinbench v3 suite: every stored answer judged again with fkopt's FK and the per-robot
-    board recomputed from them (:func:`fkopt.kinbench.verify.reverify`); the timing files
-    themselves are never compared with a rerun's."""
-    if getattr(config, "kind", None) != "suite" or getattr(config, "tracks", None) is None:
-        return []
-    if config._folder is None and exp.meta.get("config_file"):
-        config._folder = Path(exp.meta["config_file"]).parent
-    return [Mismatch(label, *row) for row in reverify(exp.folder, config)]
+    """What the kind judges again in a stored folder besides the rerun (:attr:`fkopt.run.tasks.Kind.recheck`:
+    a kinbench v3 suite's stored answers judged again with fkopt's FK and its per-robot board
+    recomputed from them, :func:`fkopt.kinbench.verify.reverify`); timing files themselves are
+    never compared with a rerun's."""
+    recheck = config_kind(config).recheck
+    return [] if recheck is None else [Mismatch(label, *row) for row in recheck(exp.folder, config, exp.meta)]
 
 
 #: The engine's verdict files of a paper folder, judged once per check however many of its experiments

@@ -11,23 +11,18 @@ from pathlib import Path
 
 import pandas as pd
 
-from fkopt.files import inside
+from fkopt.files import inside, md_table
 from fkopt.reproduce import PAPERS, paper_module  # noqa: F401 (paper_module re-exported)
 from fkopt.reproduce.changes import Snapshot, write_changes
 from fkopt.reproduce.claims import CLAIMS_FILE, RULES, TIMING_CLAIMS_FILE, Claim, claims_frame
 from fkopt.reproduce.engine import claim_experiments, info, judge_paper
 from fkopt.run.timing import TIMING_BUDGET_S, TIMING_MIN_RUNS, TIMING_RUNS
 from fkopt.reproduce.store import Experiment, Store
+from fkopt.run.kinds import stored_kind
 
 MAX_VALUE_ROWS = 60
 #: The id prefix of fkopt's own findings among a paper's claims (not claims of the paper: docs/claims.md).
 FKOPT_OWN = "fkopt-"
-
-
-def md_table(df: pd.DataFrame) -> str:
-    if df.empty:
-        return "_(empty)_"
-    return df.to_markdown(index=False, floatfmt=".4g")
 
 
 def _summary_view(exp: Experiment) -> pd.DataFrame:
@@ -64,29 +59,10 @@ def _values_view(exp: Experiment) -> pd.DataFrame | None:
     return v.dropna(axis=1, how="all")
 
 
-def suite_section(exp: Experiment, root: Path) -> str:
-    """A benchmark suite (kinbench): its overall leaderboard, linked to its page and tables."""
-    rel = exp.folder.relative_to(root)
-    lines = [f"### {exp.title}", "",
-             f"Results: [`results/{rel}/`]({rel}/) · page: [`index.html`]({rel}/index.html) · "
-             f"leaderboards: [`leaderboard.md`]({rel}/leaderboard.md) · seed {exp.config.get('seed')}, "
-             f"{exp.config.get('runs')} runs per pose, {exp.config.get('budget_per_dim')} x dimension "
-             "evaluations ([docs/kinbench.md](../docs/kinbench.md)).", ""]
-    if exp.has("leaderboard.csv"):
-        board = exp.table("leaderboard")
-        # a suite with subsets has one overall ranking per board ("board:<name>/overall")
-        overall = board[board["scope"].astype(str).str.split("/").str[-1] == "overall"] if "scope" in board.columns else board
-        cols = [c for c in ("rank", "solver", "track", "score", "ci_low", "ci_high", "better_than") if c in board.columns]
-        if "scope" in overall.columns and overall["scope"].nunique() > 1:
-            cols = ["scope", *cols]
-        lines += ["Overall (tracks mixed, for reference; each track is ranked on its own in the leaderboard):", "",
-                  md_table(overall[cols].astype(object).fillna("")), ""]
-    return "\n".join(lines)
-
-
 def experiment_section(exp: Experiment, root: Path) -> str:
-    if exp.meta.get("kind") == "suite":
-        return suite_section(exp, root)
+    kind = stored_kind(exp.meta)
+    if kind is not None and kind.report_section is not None:      # a suite: its leaderboard
+        return kind.report_section(exp, root)
     cfg = exp.config
     rel = exp.folder.relative_to(root)
     lines = [f"### {exp.title}", ""]

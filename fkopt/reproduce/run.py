@@ -51,7 +51,7 @@ def plan(configs: str | Path, out: str | Path) -> list[Planned]:
     output_folder(out)
     for f in files:
         config = load_any(f)
-        if getattr(config, "kind", None) == "suite":    # benchmark suites: fkopt suite / make bench-suite
+        if not config_kind(config).reproduced:        # benchmark suites: fkopt suite / make bench-suite
             continue
         config_plan = plan_config(config, str(f), str(f))       # the one validation of this config
         tasks = len(config_plan.tasks) + len(config_plan.timed)

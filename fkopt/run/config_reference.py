@@ -206,6 +206,10 @@ FIELDS: dict[str, dict[str, tuple[str, str, Any]]] = {
         "dedup": ("Two solutions closer than this (in the pose space normalised by the bounds) are one.",
                   "normalised pose distance", 1e-6),
         "expected": ("Known number of real solutions, for the report.", "solutions", 40),
+        "method": ("How every solution is searched: homotopy (a general 6-6 platform: the 40 roots of a start "
+                   "platform followed to this one; a certificate when 40 distinct roots arrive), restarts (the "
+                   "multi-start Newton and its stopping rule), or auto (homotopy where it applies, restarts "
+                   "otherwise or when a path fails).", "", "auto"),
     },
     "SuiteConfig": {
         "kind": ("Marks the file as a benchmark suite.", "", "suite"),

@@ -35,3 +35,9 @@ def kind_of(name: str | None) -> Kind:
 def config_kind(config) -> Kind:
     """The kind of a validated config object."""
     return kind_of(getattr(config, "kind", None))
+
+
+def stored_kind(meta: dict) -> Kind | None:
+    """The kind of a stored result from its meta.json (None: a kind not registered here)."""
+    config = meta.get("config") if isinstance(meta.get("config"), dict) else {}
+    return KINDS.get(meta.get("kind") or config.get("kind") or "experiment")

@@ -41,18 +41,18 @@ final_<extra>               float64   an algorithm's own record at the last iter
 Index columns count from 0 everywhere (``pose``, ``run``, ``trajectory``, ``step``,
 ``iteration``); labels (``case-1``, ``pose-1``) are names, not indices.
 
-``runs.csv`` is the record with the columns its folder fixes left out (:data:`NOT_IN_RUNS`)
-and ``solver`` under the name its kind's readers know (:data:`FILE_NAMES`); ``summary.csv``
+``runs.csv`` is the record with the columns its folder fixes left out and ``solver`` under the
+name its kind's readers know (the kind's ``not_in_runs`` and ``file_names``); ``summary.csv``
 (experiments, studies) is :func:`summary_table` over it; a study's ``ecdf.csv`` and
 ``stats.csv`` pool its columns per solver, a suite's measures, ECDF and leaderboard are computed
 from it (:mod:`fkopt.kinbench.measures`). Measured times are a second table next to it, the
 timing record (:data:`TIMING_COLUMNS`), which :func:`timing_table` and
 :func:`timing_runs_table` write for every kind.
 
-Every worker returns JSON (a task file): an experiment's and a suite's solve task its rows of the
-record (columns of lists) and trace, a study's task the same numbers under the names its stored
-task files use (per pose and run), a clock-track task its answers, an assembly search its
-solutions; every kind's merge puts the record in one :class:`~fkopt.run.result.RunResult`, so a study's
+Every worker returns JSON (a task file): an experiment's, a study's and a suite's solve task its
+rows of the record (columns of lists; a study's and an experiment's also their rows of the timing
+record, an experiment's and a suite's their trace), a clock-track task its answers, an assembly
+search its solutions; every kind's merge puts the record in one :class:`~fkopt.run.result.RunResult`, so a study's
 poses/heatmap/tracking tables are read from the record too. Still read from a kind's own slot
 (``RunResult.own``): an experiment's inputs, its values, convergence table and figures (the
 per-iteration curves of each (case, algorithm), which the flat record does not hold, and its
@@ -61,12 +61,14 @@ solutions, a suite's clock-track answers.
 """
 from __future__ import annotations
 
+from types import MappingProxyType
 from typing import Mapping
 
 import numpy as np
 import pandas as pd
 
 from fkopt.files import nanmedian
+from fkopt.run.kinds import kind_of
 
 KINDS = ("experiment", "study", "suite")
 
@@ -83,22 +85,11 @@ COLUMNS: tuple[tuple[str, str], ...] = (
 )
 FAMILIES = tuple(name for name, _ in COLUMNS if name.endswith("_"))
 
-#: Columns a kind's runs.csv leaves out: those its folder fixes (one kind, one problem) and those
-#: it names otherwise (an experiment's case index: its ``case`` label; a study's ``case``: it has
-#: poses). A suite's seeds stay in its task files: its runs.csv layout is that of the frozen
-#: kinbench releases, whose stored folders are not rerun to add a column.
-NOT_IN_RUNS: dict[str, frozenset[str]] = {
-    "experiment": frozenset({"kind", "problem", "pose"}),
-    "study": frozenset({"kind", "problem", "case"}),
-    "suite": frozenset({"kind", "case", "task_seed"}),
-}
-#: Column names a kind's files use for a record column: experiment and study folders (and the
-#: claims, reports and checks that read them) call the solver ``algorithm``.
-FILE_NAMES: dict[str, dict[str, str]] = {
-    "experiment": {"solver": "algorithm"},
-    "study": {"solver": "algorithm"},
-    "suite": {},
-}
+#: The names experiment and study folders (and the claims, reports and checks that read them) give
+#: a record column: the solver is their ``algorithm``. Which names a kind's files use, and which
+#: columns its runs.csv leaves out, are fields of its :class:`~fkopt.run.tasks.Kind`
+#: (``file_names``, ``not_in_runs``).
+ALGORITHM_NAMES: Mapping[str, str] = MappingProxyType({"solver": "algorithm"})
 
 
 def _place(name: str) -> int:
@@ -151,10 +142,11 @@ def concat(records: list[pd.DataFrame]) -> pd.DataFrame:
 # -- writers -------------------------------------------------------------------------------------
 def runs_table(record: pd.DataFrame) -> pd.DataFrame:
     """``runs.csv`` of any kind: one row per run, the record's columns in schema order without
-    those the kind's folder fixes (:data:`NOT_IN_RUNS`), under the kind's file names."""
-    kind = str(record["kind"].iloc[0])
-    keep = [c for c in record.columns if c not in NOT_IN_RUNS[kind]]
-    return record[keep].rename(columns=FILE_NAMES[kind])
+    those the kind's folder fixes, under the kind's file names (its ``Kind.not_in_runs`` and
+    ``Kind.file_names``: the registry's kind named in the record's ``kind`` column)."""
+    kind = kind_of(str(record["kind"].iloc[0]))
+    keep = [c for c in record.columns if c not in kind.not_in_runs]
+    return record[keep].rename(columns=dict(kind.file_names))
 
 
 def summary_table(record: pd.DataFrame, settings: Mapping[str, Mapping], threshold: float | None,

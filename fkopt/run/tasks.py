@@ -27,7 +27,7 @@ import shutil
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Mapping
 
 from fkopt.errors import FkoptError
 from fkopt.files import inside, parse_json, read_stored, stored_sha256, write_file_atomically, write_json_atomically
@@ -105,6 +105,22 @@ class Kind:
     #: (result, folder) -> what the command line prints after a run: a summary table, or lines
     #: (the first continues the folder's line); None: the folder alone
     console: Callable[[Any, Any], Any] | None = None
+    #: does ``fkopt reproduce`` run its files? (a suite: no; ``fkopt suite`` / ``make bench-suite``)
+    reproduced: bool = True
+    #: (config, runs.csv frame) -> [(where, rows of that problem, make the problem)]: the problems
+    #: whose fitness ``fkopt check`` recomputes from the stored ``x`` (None: no such check)
+    stored_problems: Callable[[Any, Any], list] | None = None
+    #: (folder, config, meta) -> [(file, where, column, stored, recomputed, rule)]: what ``fkopt
+    #: check`` judges again in a stored folder besides rerunning it (a suite: its clock answers)
+    recheck: Callable[[Any, Any, dict], list] | None = None
+    #: (stored result, results root) -> its section of REPORT.md (None: the experiment section)
+    report_section: Callable[[Any, Any], str] | None = None
+    #: record columns its runs.csv leaves out: those its folder fixes (one kind, one problem) and
+    #: those it names otherwise (:func:`fkopt.run.record.runs_table`)
+    not_in_runs: frozenset = frozenset()
+    #: record column -> the name its files give it (experiment and study folders: ``solver`` is
+    #: ``algorithm``, :data:`fkopt.run.record.ALGORITHM_NAMES`)
+    file_names: Mapping[str, str] = field(default_factory=dict, hash=False)
 
 
 @dataclass

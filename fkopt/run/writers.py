@@ -48,7 +48,7 @@ from typing import Any, Callable
 
 from fkopt.files import naming_the_file, output_folder, stored_sha256, write_atomically, write_json
 from fkopt.run import record
-from fkopt.run.kinds import KINDS
+from fkopt.run.kinds import KINDS, config_kind
 from fkopt.run.provenance import environment
 
 TABLE, CURVES, TIMING, FIGURE = "table", "curves", "timing", "figure"
@@ -83,7 +83,7 @@ def timing_runs_file(result):
     (:func:`fkopt.run.record.timing_runs_table`); None when the result has no timing record."""
     if result.timing is None:
         return None
-    return record.timing_runs_table(result.timing, names=record.FILE_NAMES.get(result.kind))
+    return record.timing_runs_table(result.timing, names=config_kind(result.config).file_names)
 
 
 #: The shared files, each made by one function for every kind whose result has what it reads;

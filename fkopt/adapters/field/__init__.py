@@ -46,7 +46,9 @@ import numpy as np
 from fkopt.errors import FkoptError
 from fkopt.files import MAX_XML_DEPTH, read_text
 from fkopt.mechanisms.urdf import MAX_URDF_BYTES
+from fkopt.mechanisms.urdf_writer import chain_urdf
 from fkopt.numerics.rotations import geodesic_angle
+from fkopt.adapters.field.restarts import restart, SETTINGS
 
 
 class NotApplicable(FkoptError):
@@ -166,7 +168,6 @@ def arm_urdf(arm) -> ArmURDF:
     (:func:`fkopt.mechanisms.urdf_writer.chain_urdf`, names made safe, FK-checked against MuJoCo
     in tests/test_urdf_writer.py), never the robot's own file (module docstring); checked once
     more by :func:`check_expression_free` before any package sees it."""
-    from fkopt.mechanisms.urdf_writer import chain_urdf   # only when an outside package reads an arm (start-up)
     w = chain_urdf(arm)
     source = f"written from fkopt's chain of {getattr(arm, 'path', arm.name)}"
     check_expression_free(w.text, source)
@@ -232,14 +233,12 @@ class BlackBoxIK(FieldIK):
 
     def __init__(self, arm, *, timeout, rng):
         super().__init__(arm, timeout=timeout, rng=rng)
-        from fkopt.adapters.field.restarts import SETTINGS
         self.settings.update(SETTINGS, objective="|dp|^2 (m^2) + angle^2 (rad^2) on fkopt's FK", ftarget=self.FTARGET)
 
     def search(self, f, x0: np.ndarray, deadline: float) -> tuple[np.ndarray, float]:
         raise NotImplementedError
 
     def solve1(self, T):
-        from fkopt.adapters.field.restarts import restart
         f = pose_objective(self.arm, T)
 
         def one(x0, deadline):

@@ -29,6 +29,7 @@ import numpy as np
 
 from fkopt.errors import FkoptError
 from fkopt.adapters.field import FieldIK, arm_urdf
+from fkopt.adapters.field.restarts import pose_error, restart, RUNG, SETTINGS
 
 
 def chain_path(urdf) -> list[str]:
@@ -69,15 +70,12 @@ class IkPy(FieldIK):
             raise FkoptError(f"ikpy: its chain of {urdf.source} moves {names}, fkopt's {list(urdf.joint_names)}")
         self._active = np.flatnonzero(mask)
         self._full = np.zeros(len(self.chain.links))
-        from fkopt.adapters.field.restarts import RUNG, SETTINGS
         self.settings.update(SETTINGS, urdf=urdf.source, symbolic=True, backend="numpy", optimizer="least_squares",
                              tol="ikpy's default (scipy's)", optimizer_budget="ikpy's default (scipy's)",
                              orientation_mode="all", accept=f"({RUNG} m, {RUNG} rad) on ikpy's FK",
                              version=ikpy.__version__, deadline="checked between starts")
 
     def solve1(self, T):
-        from fkopt.adapters.field.restarts import pose_error, restart, RUNG
-
         def one(q0, deadline):
             x0 = self._full.copy()
             x0[self._active] = q0

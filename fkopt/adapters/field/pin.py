@@ -36,6 +36,7 @@ import numpy as np
 
 from fkopt.errors import FkoptError
 from fkopt.adapters.field import FieldIK, arm_urdf
+from fkopt.adapters.field.restarts import restart, SETTINGS, Stall
 
 
 class PinCLIK(FieldIK):
@@ -71,7 +72,6 @@ class PinCLIK(FieldIK):
         pin.framesForwardKinematics(model, self.data, pin.neutral(model))
         self._oMbase = self.data.oMf[self._base].copy()
         self._per = arm.periodic_mask()
-        from fkopt.adapters.field.restarts import SETTINGS
         self.settings.update(SETTINGS, urdf=urdf.source, dt=self.DT, damp=self.DAMP, eps=self.EPS, it_max=self.IT_MAX,
                              step_max=self.STEP_MAX, stall="error not halved in 10 steps", version=pin.__version__,
                              limits="q clipped into fkopt's limits after each step")
@@ -89,7 +89,6 @@ class PinCLIK(FieldIK):
         return np.array([np.arctan2(x[i + 1], x[i]) if nq == 2 else x[i] for i, nq in zip(self._idx_q, self._nq)])
 
     def solve1(self, T):
-        from fkopt.adapters.field.restarts import restart
         oMdes = self._oMbase * self._pin.SE3(np.asarray(T[:3, :3], float), np.asarray(T[:3, 3], float))
         q, ok, _ = restart(lambda q0, deadline: self.clik(oMdes, q0, deadline), self.random_start, self.timeout)
         return self.public(q), ok
@@ -100,7 +99,6 @@ class PinCLIK(FieldIK):
         """One start of the CLIK loop (module docstring): (joints, |log6|, converged). The keyword
         arguments replace the board's settings (the documented example: dt 0.1, damp 1e-12, eps
         1e-4, it_max 1000, no cap, no stall test, no limits)."""
-        from fkopt.adapters.field.restarts import Stall
         pin, model, data = self._pin, self.model, self.data
         dt, damp = self.DT if dt is None else dt, self.DAMP if damp is None else damp
         eps, it_max = self.EPS if eps is None else eps, self.IT_MAX if it_max is None else it_max

@@ -26,6 +26,7 @@ import time
 import numpy as np
 
 from fkopt.adapters.field.pin import PinCLIK
+from fkopt.adapters.field.restarts import restart, Stall
 
 
 class Pink(PinCLIK):
@@ -49,7 +50,6 @@ class Pink(PinCLIK):
                          "eps": self.EPS, "it_max": self.IT_MAX, "stall": "error not halved in 10 steps"}
 
     def solve1(self, T):
-        from fkopt.adapters.field.restarts import restart
         oMdes = self._oMbase * self._pin.SE3(np.asarray(T[:3, :3], float), np.asarray(T[:3, 3], float))
         self._task.set_target(oMdes)
         q, ok, _ = restart(self._steps, self.random_start, self.timeout)
@@ -57,7 +57,6 @@ class Pink(PinCLIK):
 
     def _steps(self, q_si: np.ndarray, deadline: float) -> tuple[np.ndarray, float, bool]:
         """One start of pink's loop: (joints, |error|, converged)."""
-        from fkopt.adapters.field.restarts import Stall
         conf = self._pink.Configuration(self.model, self.data, self._to_pin(q_si))
         stalled = Stall()
         err = np.inf

@@ -16,6 +16,7 @@ bounds from the wrapper's generator until max |relative residual| <= 1e-12 or th
 from __future__ import annotations
 
 import numpy as np
+from fkopt.adapters.field.restarts import restart
 
 
 class LeastSquaresFK:
@@ -38,7 +39,6 @@ class LeastSquaresFK:
                          "start": "uniform in bounds (wrapper's generator)"}
 
     def solve1(self, legs: np.ndarray) -> tuple[np.ndarray | None, bool]:
-        from fkopt.adapters.field.restarts import restart
         legs = np.asarray(legs, dtype=float)
         dim = len(self.lo)
 

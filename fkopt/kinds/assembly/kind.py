@@ -5,7 +5,8 @@ settings of :func:`fkopt.kinematics.assembly_modes.all_solutions`, and optionall
 solutions (``expected``; e.g. 40 for Dietmaier's 6-6 platform). The folder gets
 
 * ``solutions.csv`` -- every solution found inside the bounds, sorted by pose, with its residual
-  ``max |ik(pose) - joints|`` (relative to max(1, |joint|)) and how many starts reached it;
+  ``max |ik(pose) - joints|`` (relative to max(1, |joint|)) and how many starts (or homotopy
+  paths, for a 6-6 platform on the compiled path) reached it;
 * ``summary.csv``   -- the count against ``expected`` and the residual statistics, in the column
   names experiments use (so ``fkopt check`` and the report read it the same way);
 * ``timing.csv``    -- wall time of the search (the only non-deterministic file);
@@ -30,7 +31,7 @@ from fkopt.run.config_base import MAX_ITERATIONS, MAX_POPULATION, Located, Mecha
 from fkopt.run.kinds import register
 from fkopt.run.solving import build_mechanism
 from fkopt.run.writers import CURVES, RUNS, TABLE, TIMING, Output
-from fkopt.kinematics.assembly_modes import all_solutions, solutions_to_dict
+from fkopt.kinematics.assembly_modes import all_solutions, prepare, solutions_to_dict
 
 KIND = "assembly"
 
@@ -48,6 +49,9 @@ class AssemblyConfig(Located):
     runs: Literal[1] = 1
     tol: float = Field(1e-9, gt=0)
     dedup: float = Field(1e-6, gt=0)
+    #: ``all_solutions``' method: auto (the certified homotopy for a 6-SPS platform on the compiled
+    #: path, else the multi-start Newton), homotopy or restarts.
+    method: Literal["auto", "homotopy", "restarts"] = "auto"
     #: Known number of real solutions, for the report.
     expected: int | None = Field(None, ge=0)
     printed: dict[str, Any] = Field(default_factory=dict)
@@ -73,6 +77,7 @@ class AssemblyOwn:
     outside: int                    # distinct real solutions found outside the bounds
     round_size: int
     solver_time_s: float            # the search's own account of its time
+    method: str = "restarts"        # all_solutions' method that ran: homotopy or restarts
 
 
 def search(config: AssemblyConfig, source: str | None = None, mech=None) -> dict:
@@ -80,14 +85,15 @@ def search(config: AssemblyConfig, source: str | None = None, mech=None) -> dict
     search's counts and its wall time. ``mech``: the config's mechanism, already built (else
     built here, its relative files beside ``source``)."""
     mech = build_mechanism(config, files_folder(config, source)) if mech is None else mech
+    prepare(mech, config.method)          # compiled code and start system loaded outside the timed search
     start = time.perf_counter()
     sols = all_solutions(mech, config.joints, seed=config.seed, round_size=config.population,
-                         tol=config.tol, dedup=config.dedup, iterations=config.iterations)
+                         tol=config.tol, dedup=config.dedup, iterations=config.iterations, method=config.method)
     wall = time.perf_counter() - start
     found = solutions_to_dict(sols)
     return {"solutions": [{**s["pose"], "residual": s["residual"], "hits": s["hits"]} for s in found["solutions"]],
             "starts": found["starts"], "outside": found["outside"], "time_s": found["time_s"],
-            "round_size": int(sols.settings["round_size"]), "wall_s": wall}
+            "round_size": int(sols.settings["round_size"]), "wall_s": wall, "method": sols.method}
 
 
 # -- files (listed in OUTPUTS below) -------------------------------------------
@@ -103,7 +109,8 @@ def summary_table(ar: RunResult) -> pd.DataFrame:
     res = own.solutions["residual"].to_numpy(float)
     res = res if len(res) else np.array([np.nan])
     return pd.DataFrame([{
-        "case": "given joints", "algorithm": "all_solutions", "method": "newton-multistart",
+        "case": "given joints", "algorithm": "all_solutions",
+        "method": "homotopy" if own.method == "homotopy" else "newton-multistart",
         "population": own.round_size,
         "iterations": config.iterations, "runs": 1,
         "solutions_found": len(own.solutions), "expected": config.expected if config.expected is not None else np.nan,
@@ -127,7 +134,8 @@ def meta(ar: RunResult) -> dict:
     config = ar.config
     return {"experiment": config.name, "paper": config.paper, "title": config.title, "kind": KIND,
             "config_file": ar.source, "config": config.model_dump(mode="json"), "seed": config.seed,
-            "mechanism": ar.own.mechanism.describe(), "objective": "all real solutions (multi-start Newton)"}
+            "mechanism": ar.own.mechanism.describe(),
+            "objective": f"all real solutions ({'parameter homotopy' if ar.own.method == 'homotopy' else 'multi-start Newton'})"}
 
 
 # -- the pipeline kind (fkopt.run.pipeline) ------------------------------------------------------
@@ -161,7 +169,7 @@ def _merge(config: AssemblyConfig, plan, ran, *, source: str | None = None, **_)
     timing = timing_record(KIND, {"problem": config.name, "case": "given joints", "solver": "all_solutions",
                                   "runs": 1, "seconds": rec["wall_s"], "mode": BATCH})
     own = AssemblyOwn(mech, solutions, int(rec["starts"]), int(rec["outside"]), int(rec["round_size"]),
-                      float(rec["time_s"]))
+                      float(rec["time_s"]), rec.get("method", "restarts"))
     return RunResult(config, None, timing, None, own, rec["wall_s"], source, list(ran.computed))
 
 

@@ -4,9 +4,12 @@ from __future__ import annotations
 from fkopt.run.memory import algorithm_resources
 from fkopt.solve import batch_bytes, chunk_size
 from fkopt.kinds.experiment.config import ExperimentConfig, experiment_from_dict
-from fkopt.kinds.experiment.runner import experiment_plan, keeps_x_history, merge_experiment, one_answer_entries
+from fkopt.kinds.experiment.runner import (build_cases, build_problem, experiment_plan, keeps_x_history, merge_experiment,
+                                           one_answer_entries)
 from fkopt.kinds.experiment import reports
 from fkopt.run.kinds import register
+from fkopt.run.record import ALGORITHM_NAMES
+from fkopt.run.solving import build_mechanism
 from fkopt.run.tasks import Kind
 from fkopt.run.writers import (CURVES, FIGURE, RUNS, RUNS_FILE, STEPS, TABLE, TIMING, TIMING_RUNS_FILE, TRACE_FILE,
                                Output)
@@ -32,6 +35,13 @@ def _experiment_from_dict(data: dict, where: str):
     return experiment_from_dict(data, where)
 
 
+def _stored_problems(config, runs) -> list:
+    """``fkopt check``'s recomputed fitness: each case's rows of runs.csv and its problem."""
+    mech = build_mechanism(config)
+    return [(case.label, runs["case"].astype(str) == case.label, lambda c=case: build_problem(config, mech, c))
+            for case in build_cases(config, mech)]
+
+
 #: The files of an experiment's folder, in the order they are written.
 OUTPUTS = (
     Output("summary.csv", reports.summary_table, TABLE),
@@ -54,4 +64,6 @@ OUTPUTS = (
 
 EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
                            merge_experiment, OUTPUTS, reports.meta, ExperimentConfig,
-                           console=reports.console))
+                           console=reports.console, stored_problems=_stored_problems,
+                           # runs.csv: its case label names the pose; one problem per folder
+                           not_in_runs=frozenset({"kind", "problem", "pose"}), file_names=ALGORITHM_NAMES))

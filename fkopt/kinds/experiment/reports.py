@@ -89,7 +89,7 @@ def timing_table(er: RunResult) -> pd.DataFrame:
         "runs": er.config.runs if spec in answering else 1, "total_s": er.own.solve_s[spec.key],
         **{f"printed_{k}": v for k, v in sorted(spec.printed.items()) if k.endswith("_ms")}}
         for case in er.own.cases for spec in er.config.algorithms}
-    names = record.FILE_NAMES["experiment"]
+    names = record.ALGORITHM_NAMES
     keys = {spec.key for spec in searching}
     runs, sets = er.timing[~er.timing["solver"].isin(keys)], er.timing[er.timing["solver"].isin(keys)]
     tables = [record.timing_table(runs, settings, names=names, timed_alone=True)] if len(runs) else []

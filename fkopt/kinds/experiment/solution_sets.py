@@ -47,6 +47,7 @@ def search_cases(config, mech, cases: list, a: int, fp: str) -> dict:
     """The task of entry ``a``: every case's set, JSON-able (a task file)."""
     spec = config.algorithms[a]
     solver = make_algorithm(spec.name, spec.params)
+    solver.prepare_solution_set(mech)          # compiled code and start tables loaded outside the timed searches
     sets = []
     for i, case in enumerate(cases):
         seed = task_seed(config.seed, case.index, spec.key)

@@ -4,10 +4,13 @@ from __future__ import annotations
 from fkopt.run.memory import algorithm_resources
 from fkopt.kinds.study import reports
 from fkopt.run.kinds import register
+from fkopt.run.record import ALGORITHM_NAMES
+from fkopt.run.solving import build_mechanism, make_problem
 from fkopt.run.tasks import Kind
 from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, Output
 from fkopt.solve import batch_bytes, chunk_size
 from fkopt.kinds.study.config import StudyConfig, study_from_dict
+from fkopt.kinds.study.poses import build_poses
 from fkopt.kinds.study.runner import merge_study, study_plan
 
 
@@ -23,9 +26,20 @@ def _validate(config: StudyConfig, plan) -> int:
         size = chunk_size(cases, config.runs, pop, its, dim)      # refuses a solve over the per-solve limit
         work = max(work, batch_bytes(cases * config.runs, size, pop, its, dim)
                    + algorithm_resources(spec, pop, its, dim))
-        # kept for every (pose, run): fitness, counts, solution, as JSON task records (~10x)
-        kept += n * config.runs * (dim + 6) * 8 * 10
+        # kept for every (pose, run): its row of the run record (10 fixed columns, the solution, its
+        # start when tracking, its error per pose variable) as JSON task records (~10x)
+        kept += n * config.runs * (10 + 2 * dim + len(mech.pose_names)) * 8 * 10
     return work + kept
+
+
+def _stored_problems(config: StudyConfig, runs) -> list:
+    """``fkopt check``'s recomputed fitness: one problem per pose of the pose set, and its rows."""
+    mech = build_mechanism(config)
+    poses = build_poses(config, mech)
+    # poses count from 0 (fkopt.run.record); a folder written before the run record counted from 1
+    first = 1 if len(runs) and runs["pose"].min() >= 1 else 0
+    return [(f"pose {i}", runs["pose"] == i + first, lambda i=i: make_problem(config, mech, poses.inputs[i]))
+            for i in range(len(poses))]
 
 
 #: The files of a study's folder, in the order they are written.
@@ -46,4 +60,6 @@ OUTPUTS = (
 )
 
 STUDY = register(Kind("study", study_from_dict, study_plan, _validate, merge_study, OUTPUTS, reports.meta, StudyConfig,
-                      console=lambda result, folder: reports.summary_table(result)))
+                      console=lambda result, folder: reports.summary_table(result), stored_problems=_stored_problems,
+                      # runs.csv: a study has poses, not cases; one problem per folder
+                      not_in_runs=frozenset({"kind", "problem", "case"}), file_names=ALGORITHM_NAMES))

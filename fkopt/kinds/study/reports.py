@@ -107,7 +107,7 @@ def timing_table(sr: RunResult) -> pd.DataFrame:
     :func:`fkopt.run.record.timing_table`)."""
     settings = {(case_label(sr), ar.key): {"runs": sr.config.runs, "poses": len(sr.own.poses), "total_s": float(ar.wall_s)}
                 for ar in _algorithms(sr)}
-    return record.timing_table(sr.timing, settings, names=record.FILE_NAMES["study"])
+    return record.timing_table(sr.timing, settings, names=record.ALGORITHM_NAMES)
 
 
 def _per_algorithm(sr: RunResult, column: str) -> dict[str, np.ndarray]:

@@ -4,14 +4,15 @@
   in ``tracking`` mode. A chunk's poses are the cases of one solve through the experiment's
   solve path (:func:`fkopt.kinds.experiment.runner.solve_cases`): a study is an experiment whose
   cases come from a pose set. :func:`run_task` computes one from a JSON-able payload (so it runs in
-  another process or on a Dask worker) and returns plain lists; the seeds come from
+  another process or on a Dask worker) and returns JSON-able columns; the seeds come from
   :func:`fkopt.kinds.experiment.runner.task_seed` per pose (or step), so a task's numbers do not
   depend on where, when or next to what it ran.
 * :func:`study_plan` hands the tasks to the one runner (:mod:`fkopt.run.tasks`), which
   keeps each finished one as a task file in ``OUT/<paper>/.<name>.partial/tasks/`` with its
   SHA-256, resumes (``fkopt study --resume``) from the files that still pass
   :func:`record_problem`, and publishes them in the result's ``tasks/``.
-* :func:`merge_study` reads the records back into the run record of a
+* A task's record is its rows of the run record and of the timing record (:func:`task_rows`), as
+  an experiment's and a suite's are; :func:`merge_study` puts them, pose by pose, into the run record of a
   :class:`~fkopt.run.result.RunResult` (the pose set in its ``own`` slot, :class:`StudyOwn`),
   which :mod:`fkopt.kinds.study.reports` writes (through :mod:`fkopt.run.writers`).
 """
@@ -25,7 +26,6 @@ import time
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -38,7 +38,7 @@ from fkopt.run.record import BATCH, concat, run_record, timing_record
 from fkopt.run.result import RunResult
 from fkopt.solve import make_algorithm, pick_events
 from fkopt.numerics.streams import case_seed
-from fkopt.run.tasks import TASKS, Plan, Ran, Task as RunnerTask, work_folder  # noqa: F401 (tests, API)
+from fkopt.run.tasks import TASKS, Plan, Ran, Task as RunnerTask, reason_or_none, work_folder  # noqa: F401 (tests, API)
 from fkopt.kinds.study.config import StudyConfig
 from fkopt.kinds.study.poses import PoseSet, build_poses
 
@@ -97,48 +97,71 @@ def payload(config: StudyConfig, task: Task, folder: Path | None = None) -> dict
 
 
 def run_task(payload: dict) -> dict:
-    """Compute one task (in any process); returns a JSON-able record."""
+    """Compute one task (in any process); returns its JSON-able record: its rows of the run record
+    (``rows``: :mod:`fkopt.run.record`'s columns, one row per (pose, run), poses in the order solved)
+    and of the timing record (``timing``: one row per pose, its share of the batched solve), as an
+    experiment's and a suite's tasks return theirs."""
     config, mech, poses = _context(payload["config"], payload.get("folder"))
     task = Task(**payload["task"])
     spec = config.algorithms[task.algorithm]
     start = time.perf_counter()
+    solved = (_track if config.mode == "tracking" else _independent)(config, mech, poses, spec, task)
+    rows, timing = task_rows(config, mech, poses, spec, solved)
+    return {"id": task.id, "task": task.__dict__.copy(), "fingerprint": config.fingerprint(),
+            "rows": rows, "timing": timing, "wall_s": time.perf_counter() - start, "pid": os.getpid()}
+
+
+@dataclass
+class Solved:
+    """One pose's (or tracking step's) runs as a task solved them."""
+
+    pose: int               # index in the pose set
+    seed: int               # its task seed
+    result: object          # the runs (:class:`fkopt.solve.Result` of one case)
+    seconds: float          # its share of the batched solve's wall time
+    start: np.ndarray | None = None     # tracking: where each run started, (runs, dim) (NaN: cold swarm)
+
+
+def task_rows(config: StudyConfig, mech, poses: PoseSet, spec, solved: list[Solved]) -> tuple[dict, dict]:
+    """The run record's and the timing record's rows of one task (columns of lists, JSON-able)."""
+    runs, m = config.runs, len(solved)
+    idx = np.array([s.pose for s in solved], dtype=np.int64)
+    stack = lambda f: np.array([f(s.result) for s in solved], dtype=float).reshape(m, runs, -1)   # noqa: E731
+    x = stack(lambda r: r.x)
+    errors = pose_error(mech, outputs_of(mech, x), poses.targets[idx][:, None, :])
+    thr = config.threshold
+    cols = {"problem": config.name, "pose": np.repeat(idx, runs), "solver": spec.key,
+            "run": np.tile(np.arange(runs), m), "task_seed": np.repeat([s.seed for s in solved], runs).astype(np.int64),
+            "final_fitness": stack(lambda r: r.fitness).ravel(), "evaluations": stack(lambda r: r.evaluations).ravel(),
+            "iterations_done": stack(lambda r: r.iterations_done).ravel(),
+            "iterations_to_threshold": stack(lambda r: r.iterations_to(thr)).ravel(),
+            "evaluations_to_threshold": stack(lambda r: r.evaluations_to(thr)).ravel()}
     if config.mode == "tracking":
-        rec = _track(config, mech, poses, spec, task)
-    else:
-        rec = _independent(config, mech, poses, spec, task)
-    rec.update({"id": task.id, "task": task.__dict__.copy(), "fingerprint": config.fingerprint(),
-                "wall_s": time.perf_counter() - start, "pid": os.getpid()})
-    return rec
+        start = np.array([np.broadcast_to(s.start, (runs, x.shape[2])) for s in solved], dtype=float).reshape(x.shape)
+        cols.update({f"start_{name}": start[:, :, j].ravel() for j, name in enumerate(poses.names)})
+    cols.update({f"x_{name}": x[:, :, j].ravel() for j, name in enumerate(poses.names)})
+    cols.update({f"abs_error_{name}": errors[:, :, j].ravel() for j, name in enumerate(mech.pose_names)})
+    case = "trajectory" if config.mode == "tracking" else "all"
+    timing = timing_record("study", {"problem": config.name, "case": case, "pose": idx, "solver": spec.key,
+                                     "runs": runs, "seconds": np.array([s.seconds for s in solved], dtype=float),
+                                     "mode": BATCH})
+    return _columns(run_record("study", cols)), _columns(timing)
 
 
-def _collect(rec: dict, r, thr: float, seconds: float) -> None:
-    rec["fitness"].append(r.fitness.tolist())
-    rec["evaluations"].append(r.evaluations.tolist())
-    rec["iterations_done"].append(r.iterations_done.tolist())
-    rec["iterations_to"].append(r.iterations_to(thr).tolist())
-    rec["evaluations_to"].append(r.evaluations_to(thr).tolist())
-    rec["x"].append(r.x.tolist())
-    rec["time_s"].append(seconds)
+def _columns(frame) -> dict:
+    """A record's rows as JSON-able columns of lists, without ``kind`` (the merge adds it back)."""
+    return {k: v for k, v in frame.to_dict(orient="list").items() if k != "kind"}
 
 
-def _empty(task: Task) -> dict:
-    return {"poses": list(range(task.start, task.stop)), "seeds": [], "fitness": [], "evaluations": [],
-            "iterations_done": [], "iterations_to": [], "evaluations_to": [], "x": [], "time_s": []}
-
-
-def _independent(config, mech, poses: PoseSet, spec, task: Task) -> dict:
+def _independent(config, mech, poses: PoseSet, spec, task: Task) -> list[Solved]:
     """The chunk's poses are the cases of one experiment solve (poses x runs rows,
     :func:`fkopt.kinds.experiment.runner.solve_cases`), each pose with its own seed."""
-    rec = _empty(task)
     seeds = [task_seed(config.seed, i, spec.key) for i in range(task.start, task.stop)]
     problem = make_problem(config, mech, poses.inputs[task.start:task.stop])
     t0 = time.perf_counter()
     r = solve_cases(config, spec, problem, seeds, x0=start_point(spec, mech))
     seconds = (time.perf_counter() - t0) / len(seeds)     # amortised over the poses
-    rec["seeds"] = seeds
-    for j in range(len(seeds)):
-        _collect(rec, r.case(j), config.threshold, seconds)
-    return rec
+    return [Solved(task.start + j, seeds[j], r.case(j), seconds) for j in range(len(seeds))]
 
 
 def _warm_boxes(mech, prev: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
@@ -148,7 +171,7 @@ def _warm_boxes(mech, prev: np.ndarray, radius: float) -> tuple[np.ndarray, np.n
     return np.maximum(lo, prev - half), np.minimum(hi, prev + half)
 
 
-def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
+def _track(config, mech, poses: PoseSet, spec, task: Task) -> list[Solved]:
     """Solve every trajectory in order; each step warm-starts from the previous step's solution.
 
     Step t of all trajectories that have one is a single solve, trajectory j being case j with
@@ -160,8 +183,7 @@ def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
     ``case_seed(seed of j's step, k)`` -- so a trajectory gives the same numbers alone or
     batched with others.
     """
-    rec = _empty(task)
-    rec["poses"], rec["start"] = [], []
+    solved = []
     algo = make_algorithm(spec.name, spec.params)
     runs, dim = config.runs, len(mech.unknown_names)
     x0 = start_point(spec, mech)
@@ -188,12 +210,9 @@ def _track(config, mech, poses: PoseSet, spec, task: Task) -> dict:
             results = [_runs_of(rb, x[c], slice(c * runs, (c + 1) * runs)) for c in range(len(active))]
         seconds = (time.perf_counter() - t0) / len(active)    # amortised over the trajectories
         for c, (j, i, r) in enumerate(zip(active, idx, results)):
-            rec["poses"].append(i)
-            rec["seeds"].append(seeds[c])
-            rec["start"].append(np.asarray(starts[c], dtype=float).tolist())
-            _collect(rec, r, config.threshold, seconds)
+            solved.append(Solved(i, seeds[c], r, seconds, np.asarray(starts[c], dtype=float)))
             prev[j] = np.array(r.x, dtype=float)
-    return rec
+    return solved
 
 
 def _runs_of(r, x: np.ndarray, rows: slice):
@@ -208,46 +227,62 @@ def _runs_of(r, x: np.ndarray, rows: slice):
 
 
 # -- checking a reused record ------------------------------------------------------------------
-def record_problem(rec, ident: str, task: Task, config: StudyConfig, dim: int) -> str | None:
-    """Why ``rec`` (the task file ``ident``) is not the finished ``task`` of this study; None when it is."""
+#: Record columns that may be NaN: where a run never reached the threshold, a cold swarm's start.
+MAY_BE_NAN = ("iterations_to_threshold", "evaluations_to_threshold", "start_")
+#: Record columns that may be negative: points (the rest are fitnesses, counts and errors).
+SIGNED = ("x_", "start_")
+
+
+def record_problem(rec, ident: str, task: Task, config: StudyConfig, mech, poses: PoseSet) -> str | None:
+    """Why ``rec`` (the task file ``ident``) is not the finished ``task`` of this study; None when it is:
+    the run record's columns of this study, one row per (pose, run) of the task's poses (each once,
+    in order unless tracking), its solver, and numbers where numbers belong."""
     if not isinstance(rec, dict):
         return f"holds a JSON {type(rec).__name__}, not a task record"
     if rec.get("id") != ident:
         return f"its id {str(rec.get('id'))[:40]!r} is not its file name {ident!r}"
     if rec.get("task") != task.__dict__:
         return "its task (algorithm, poses) is not the one its id names"
-    n = task.stop - task.start if config.mode == "independent" else None
-    try:
-        poses = np.asarray(rec["poses"])
-        if poses.ndim != 1 or (n is not None and len(poses) != n) or not np.issubdtype(poses.dtype, np.integer):
-            return "poses: not the task's pose indices"
-        if poses.size and (poses.min() < task.start or poses.max() >= task.stop):
-            return "poses: outside the task's poses"
-        rows = len(poses)
-        shapes = {k: (rows, config.runs) for k in ("fitness", "evaluations", "iterations_done",
-                                                     "iterations_to", "evaluations_to")}
-        shapes["x"] = (rows, config.runs, dim)
-        shapes["time_s"] = (rows,)
-        shapes["seeds"] = (rows,)
-        if config.mode == "tracking":
-            shapes["start"] = (rows, config.runs, dim)
-        #: NaN only where a run never reached the threshold; every other number finite
-        may_be_nan = {"iterations_to", "evaluations_to", "start"}
-        for key, shape in shapes.items():
-            if any(isinstance(v, (str, bool)) for v in np.asarray(rec[key], dtype=object).ravel()):
-                return f"{key}: not numbers"
-            value = np.asarray(rec[key], dtype=float)
-            if value.shape != shape:
-                return f"{key}: shape {value.shape}, expected {shape}"
-            finite = np.isfinite(value) | (np.isnan(value) if key in may_be_nan else False)
-            if not finite.all() or (key != "x" and key != "start" and (value[np.isfinite(value)] < 0).any()):
-                return f"{key}: not non-negative finite numbers" + (" (or NaN)" if key in may_be_nan else "")
-        if not math.isfinite(float(rec["wall_s"])) or float(rec["wall_s"]) < 0:
-            return "wall_s: not a non-negative finite number"
-    except KeyError as err:
-        return f"field {err.args[0]!r} is missing"
-    except (TypeError, ValueError):
-        return f"{key}: not numbers" if "key" in locals() else "poses: not numbers"
+    return reason_or_none(lambda: _record_problem(rec, task, config, mech, poses))
+
+
+def _record_problem(rec: dict, task: Task, config: StudyConfig, mech, poses: PoseSet) -> str | None:
+    runs, n = config.runs, task.stop - task.start
+    rows, timing = rec["rows"], rec["timing"]
+    names = ["problem", "pose", "solver", "run", "task_seed", "final_fitness", "evaluations", "iterations_done",
+             "iterations_to_threshold", "evaluations_to_threshold",
+             *([f"start_{v}" for v in poses.names] if config.mode == "tracking" else []),
+             *(f"x_{v}" for v in poses.names), *(f"abs_error_{v}" for v in mech.pose_names)]
+    if not isinstance(rows, dict) or sorted(rows) != sorted(names):
+        return "rows: not the run record's columns of a study"
+    if any(not isinstance(v, list) or len(v) != n * runs for v in rows.values()):
+        return f"rows: not {n * runs} rows (one per pose and run)"
+    pose = rows["pose"]
+    order = pose[::runs]
+    if pose != [p for p in order for _ in range(runs)] or sorted(order) != list(range(task.start, task.stop)) \
+            or (config.mode == "independent" and order != sorted(order)):
+        return "pose: not the task's poses, each once"
+    if rows["run"] != list(range(runs)) * n or rows["solver"] != [task.label] * len(pose) \
+            or rows["problem"] != [config.name] * len(pose):
+        return "run, solver, problem: not this task's"
+    for key in ("pose", "run", "task_seed"):
+        if not all(type(v) is int for v in rows[key]):
+            return f"{key}: not integers"
+    for key in names[5:]:
+        if any(isinstance(v, (str, bool)) or v is None for v in rows[key]):
+            return f"{key}: not numbers"
+        value = np.asarray(rows[key], dtype=float)
+        nan_ok = key.startswith(MAY_BE_NAN)
+        finite = np.isfinite(value) | (np.isnan(value) if nan_ok else False)
+        if not finite.all() or (not key.startswith(SIGNED) and (value[np.isfinite(value)] < 0).any()):
+            return f"{key}: not non-negative finite numbers" + (" (or NaN)" if nan_ok else "")
+    if not isinstance(timing, dict) or timing.get("pose") != order:
+        return "timing: not one row per pose of the task"
+    seconds = np.asarray(timing["seconds"], dtype=float)
+    if seconds.shape != (n,) or not (np.isfinite(seconds) & (seconds >= 0)).all():
+        return "timing.seconds: not non-negative finite numbers"
+    if not math.isfinite(float(rec["wall_s"])) or float(rec["wall_s"]) < 0:
+        return "wall_s: not a non-negative finite number"
     return None
 
 
@@ -263,48 +298,18 @@ class StudyOwn:
     solve_s: dict[str, float]
 
 
-def study_tables(config: StudyConfig, mech, poses: PoseSet, records: dict[str, dict]):
-    """The run record, the timing record and each algorithm's wall time, from the task records:
-    algorithm by algorithm, pose by pose (from 0, the index its seed takes), run by run."""
-    n, runs, dim = len(poses), config.runs, len(mech.unknown_names)
-    tasks = plan_tasks(config, n)
-    case = "trajectory" if config.mode == "tracking" else "all"
+def study_tables(config: StudyConfig, records: dict[str, dict]):
+    """The run record, the timing record and each algorithm's wall time (the sum of its tasks'),
+    from the task records: algorithm by algorithm, pose by pose (from 0, the index its seed
+    takes), run by run."""
     frames, timings, walls = [], [], {}
     for a, spec in enumerate(config.algorithms):
-        arr = {k: np.full((n, runs), np.nan) for k in ("fitness", "evaluations", "iterations_done",
-                                                         "iterations_to", "evaluations_to")}
-        x = np.full((n, runs, dim), np.nan)
-        start = np.full((n, runs, dim), np.nan) if config.mode == "tracking" else None
-        seeds = np.zeros(n, dtype=np.int64)
-        time_s = np.zeros(n)
-        wall = 0.0
-        for task in (t for t in tasks if t.algorithm == a):
-            rec = records[task.id]
-            idx = np.asarray(rec["poses"], dtype=int)
-            for k in arr:
-                arr[k][idx] = np.asarray(rec[k], dtype=float)
-            x[idx] = np.asarray(rec["x"], dtype=float)
-            if start is not None:
-                start[idx] = np.asarray(rec["start"], dtype=float)
-            seeds[idx] = rec["seeds"]
-            time_s[idx] = rec["time_s"]
-            wall += rec["wall_s"]
-        errors = pose_error(mech, outputs_of(mech, x), poses.targets[:, None, :])
-        cols = {"problem": config.name, "pose": np.repeat(np.arange(n), runs), "solver": spec.key,
-                "run": np.tile(np.arange(runs), n), "task_seed": np.repeat(seeds, runs),
-                "final_fitness": arr["fitness"].ravel(), "evaluations": arr["evaluations"].ravel(),
-                "iterations_done": arr["iterations_done"].ravel(), "iterations_to_threshold": arr["iterations_to"].ravel(),
-                "evaluations_to_threshold": arr["evaluations_to"].ravel()}
-        if start is not None:
-            cols.update({f"start_{name}": start[:, :, j].ravel() for j, name in enumerate(poses.names)})
-        cols.update({f"x_{name}": x[:, :, j].ravel() for j, name in enumerate(poses.names)})
-        cols.update({f"abs_error_{name}": errors[:, :, j].ravel() for j, name in enumerate(mech.pose_names)})
-        frames.append(run_record("study", cols))
-        # each pose's (or tracking step's) wall time over its runs: its share of the chunk's batched solve
-        timings.append(timing_record("study", {"problem": config.name, "case": case, "pose": np.arange(n),
-                                               "solver": spec.key, "runs": config.runs, "seconds": time_s,
-                                               "mode": BATCH}))
-        walls[spec.key] = wall
+        mine = [rec for rec in records.values() if rec["task"]["algorithm"] == a]     # in plan order
+        rows = concat([run_record("study", rec["rows"]) for rec in mine])
+        frames.append(rows.sort_values(["pose", "run"], kind="stable"))
+        timing = concat([timing_record("study", rec["timing"]) for rec in mine])
+        timings.append(timing.sort_values("pose", kind="stable"))
+        walls[spec.key] = sum(float(rec["wall_s"]) for rec in mine)
     return concat(frames), concat(timings), walls
 
 
@@ -330,10 +335,9 @@ def study_plan(config: StudyConfig, source: str | None = None, timing: bool = Tr
     mech, poses = validate_study(config, folder)
     tasks = plan_tasks(config, len(poses))
     by_id = {t.id: t for t in tasks}
-    dim = len(mech.unknown_names)
     return Plan([RunnerTask(t.id, payload(config, t, folder), _label(config, t)) for t in tasks],
                 run_task, fingerprint=config.fingerprint(), stored=True, keep=True,
-                check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, dim),
+                check=lambda task, rec: record_problem(rec, task.id, by_id[task.id], config, mech, poses),
                 context=_Context(mech, poses, time.perf_counter() - started), name=f"study '{config.name}'")
 
 
@@ -342,7 +346,7 @@ def merge_study(config: StudyConfig, plan: Plan, ran: Ran, *, source: str | None
     records, its pose set in ``own`` (:class:`StudyOwn`)."""
     merging = time.perf_counter()
     ctx: _Context = plan.context
-    runs, timing, walls = study_tables(config, ctx.mech, ctx.poses, ran.records)
+    runs, timing, walls = study_tables(config, ran.records)
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
     return RunResult(config, runs, timing, None, StudyOwn(ctx.mech, ctx.poses, walls), wall, source,
                      list(ran.computed))

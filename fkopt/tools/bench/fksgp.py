@@ -14,7 +14,9 @@ position box of twice the mechanism's size, full-turn angles) and
 :func:`fkopt.kinematics.assembly_modes.all_solutions` with its defaults. fkSGP: ``solver66(X,
 x, L, realOnly=1)``, its random rotations drawn from numpy's global generator seeded per
 platform (the global state restored afterwards). The two alternate (which goes first
-alternates too), after one warm-up call each; times are wall clock per instance.
+alternates too), after one warm-up call each; times are wall clock per instance, and the
+process CPU time of each call (all threads: fkopt's tracker spreads its 40 paths over numba's
+threads, fkSGP's LAPACK calls may use BLAS threads) is reported beside it.
 
 The solution sets are compared as rigid motions (R, t): a solution of one matches one of the
 other when max |R - R'| and max |t - t'| / (1 + |t|) are below :data:`MATCH`. Rows: the median
@@ -98,8 +100,8 @@ def bench_fksgp(rows, quick: bool, messages: list[str]) -> None:
         sys.path.remove(str(folder))
     n = QUICK_PLATFORMS if quick else PLATFORMS
     rng = np.random.default_rng(20261206)
-    ratios, same, counts = [], 0, []
-    t_f, t_s = [], []
+    ratios, cpu_ratios, same, counts, methods = [], [], 0, [], []
+    t_f, t_s, c_f, c_s = [], [], [], []
     for k in range(n):
         X = np.vstack([np.zeros((1, 3)), 4 * rng.random((5, 3)) - 2])
         x = np.vstack([np.zeros((1, 3)), 4 * rng.random((5, 3)) - 2])
@@ -123,10 +125,12 @@ def bench_fksgp(rows, quick: bool, messages: list[str]) -> None:
             theirs(), ours()                         # warm-up: imports, compiled kernels, start tables
         got = {}
         for who in ((0, 1) if k % 2 else (1, 0)):
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.process_time()
             got[who] = (ours if who == 0 else theirs)()
             (t_f if who == 0 else t_s).append(time.perf_counter() - t)
+            (c_f if who == 0 else c_s).append(time.process_time() - c)
         sols = got[0]
+        methods.append(sols.method)
         Rt, err = got[1]
         mine = [_rigid(p) for p in sols.poses()]
         lo, hi = m.bounds[:, 0], m.bounds[:, 1]
@@ -143,14 +147,20 @@ def bench_fksgp(rows, quick: bool, messages: list[str]) -> None:
         same += extra == 0 and missing == 0
         counts.append((len(mine), len(other), matched))
         ratios.append(t_f[-1] / t_s[-1])
-    r = np.array(ratios)
+        cpu_ratios.append(c_f[-1] / max(c_s[-1], 1e-9))
+    r, rc = np.array(ratios), np.array(cpu_ratios)
     med = float(np.median(r))
     rows.add("fksgp", "6-6 all real solutions / fkSGP", med, "x",
              f"median over {n} random general 6-6 platforms of fkopt all_solutions' time over fkSGP solver66's "
              f"(realOnly), alternating; quartiles {np.quantile(r, 0.25):.2f}-{np.quantile(r, 0.75):.2f}, range "
              f"{r.min():.2f}-{r.max():.2f}; fkopt median {np.median(t_f) * 1e3:.1f} ms, fkSGP "
              f"{np.median(t_s) * 1e3:.1f} ms; load average {load_average()}; target <= {FKSGP_TARGET:g}: "
-             f"{'met' if med <= FKSGP_TARGET else 'NOT met'}")
+             f"{'met' if med <= FKSGP_TARGET else 'NOT met'}; fkopt's method: "
+             f"{', '.join(f'{methods.count(x)} {x}' for x in sorted(set(methods)))}")
+    rows.add("fksgp", "6-6 all real solutions / fkSGP, CPU time", float(np.median(rc)), "x",
+             f"median over the same platforms of fkopt's process CPU time (all threads) over fkSGP's, per call; "
+             f"quartiles {np.quantile(rc, 0.25):.2f}-{np.quantile(rc, 0.75):.2f}; fkopt median "
+             f"{np.median(c_f) * 1e3:.1f} ms, fkSGP {np.median(c_s) * 1e3:.1f} ms")
     rows.add("fksgp", "platforms with the same real solution set", same, "of " + str(n),
              f"solutions fkopt / fkSGP / matched per platform: "
              f"{', '.join(f'{a}/{b}/{c}' for a, b, c in counts)} (fkSGP's outside fkopt's bounds not counted)")
