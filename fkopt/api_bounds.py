@@ -14,7 +14,8 @@ The bounds (docs/python-api.md, docs/reliability.md):
   every number fkopt reads from a file);
 * ``seed``: an integer in [0, 2^63 - 1] (the compiled loops take it as a 64-bit integer);
 * the integer options: :data:`INTEGER_BOUNDS`. ``table`` is bounded by memory: the start table
-  holds ~0.4 kB per entry (``table=10**7`` took 4.1 GB), so its 1,000,000 keep it under ~0.5 GB.
+  holds ~0.4 kB per entry (``table=10**7`` took 4.1 GB), so its 1,000,000 keep it under ~0.5 GB;
+  ``threads`` (None: the CPUs the process may run on) at most 256, each a thread started per batch.
 """
 from __future__ import annotations
 
@@ -40,6 +41,7 @@ INTEGER_BOUNDS = {
     "neighbours": (0, 1_000_000),
     "tail": (1, 1_000_000),
     "candidates": (1, 10_000),         # forward: nearest table poses all run
+    "threads": (1, 256),               # inverse: threads sharing a batch (more than the CPUs only adds switching)
     "seed": (0, MAX_SEED),
 }
 

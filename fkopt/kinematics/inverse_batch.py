@@ -1,6 +1,6 @@
 """``fkopt.inverse`` of a batch of poses (or of one pose with ``rest`` > 0 or ``exact_rotation``):
 every row as its compiled one-pose call when it can (:func:`fkopt.numerics.compiled_ik.inverse_rows`,
-rows on all cores), else the vectorised damped least-squares loop on numpy, candidates of many
+rows shared by ``threads`` threads), else the vectorised damped least-squares loop on numpy, candidates of many
 rows side by side (see :mod:`fkopt.kinematics.solvers`).
 
 Its restarts are the one restart loop's (:mod:`fkopt.numerics.restart_loop`) -- a row's starts in the
@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from fkopt.files.host import available_cpus
 from fkopt.kinematics.inverse_pose import _I6, _fast_context, _toward_start
 from fkopt.kinematics.results import InverseResult
 from fkopt.kinematics.inputs import _internal, _public
@@ -29,16 +30,18 @@ from fkopt.numerics.rotations import rotation_error1, so3_right_jacobian_inverse
 
 def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, periodic, slo, shi, *, restarts, starts,
                   rest, orientation_scale, iterations, damping, step_cap, down, up, fill, exact_rotation, table,
-                  neighbours, tail, compiled) -> InverseResult:
+                  neighbours, tail, compiled, threads=None) -> InverseResult:
     """Rows P (N, 6 or 12) of checked targets (within reach) from start rows q0 (N, n) in internal
     units, task mask W (or None), limits and saturation bounds in internal units: the answer as
-    :func:`fkopt.kinematics.solvers.inverse` returns it, reshaped to ``shape``."""
+    :func:`fkopt.kinematics.solvers.inverse` returns it, reshaped to ``shape``. ``threads``: threads
+    sharing the rows of the compiled path (None: the CPUs this process may run on); the answers
+    do not depend on it, and the numpy path runs on this thread alone."""
     tp, tr = tol
     N, n = len(P), m.dof
     reach = m.reach
     fast = numerics_path.compiled_ik(compiled) if hasattr(m, "chain") else None
     if fast is not None and rest <= 0 and not exact_rotation and (start is None or (n <= 6 and W is None)):
-        # every row as its one-pose call (same starts, restarts and answer), rows on all cores
+        # every row as its one-pose call (same starts, restarts and answer), rows shared by threads
         own0 = 1 if (start is not None or not table) else 0
         first = max(1, int(starts), fill)
         nn = min(int(table), first - own0 + int(neighbours)) if table else 0
@@ -47,7 +50,8 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                                       float(orientation_scale) if orientation_scale else reach, ctx["W"],
                                       np.ascontiguousarray(q0, dtype=float), own0, nn, int(seed),
                                       first + max(0, int(restarts)), (tp, tr), int(iterations), float(damping),
-                                      float(down), float(up), float(step_cap))
+                                      float(down), float(up), float(step_cap),
+                                      available_cpus() if threads is None else int(threads))
         perr, rerr = info[:, 0], info[:, 1]
         ev = info[:, 4].astype(np.int64)
         return InverseResult(

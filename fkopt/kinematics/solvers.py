@@ -409,7 +409,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
             iterations: int = 10, damping: float = 0.01, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, fill: int = 32, exact_rotation: bool = False,
             table: int = 4096, neighbours: int = 32, tail: int = 256, compiled: bool | None = None,
-            options=None) -> InverseResult:
+            threads: int | None = None, options=None) -> InverseResult:
     """Inverse kinematics of a serial arm for poses (..., 6), batched over leading axes.
 
     ``arm``: a registered name or a frame arm (:class:`fkopt.mechanisms.base.FrameArm`: DH and
@@ -437,7 +437,10 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
     restarts beyond its first starts; ``fill`` / ``tail``: candidates side by side for small
     batches / when few remain. ``compiled``: one pose through the compiled loop
     (:mod:`fkopt.numerics.compiled`; None: when numba is there and ``FKOPT_NUMERICS`` is not
-    ``numpy``; same answers as the Python loop). ``options``: an
+    ``numpy``; same answers as the Python loop). ``threads``: threads sharing a batch's rows on the
+    compiled path, 1 to 256 (None: the CPUs this process may run on; 1: the calling thread alone;
+    batches under 64 rows run on it anyway); every row's answer is the same for any number.
+    ``options``: an
     :class:`fkopt.numerics.InverseOptions` holding all of the above at once (it replaces the
     keywords). See the module docstring.
     """
@@ -446,7 +449,7 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         restarts, starts, rest, orientation_scale = o["restarts"], o["starts"], o["rest"], o["orientation_scale"]
         iterations, damping, step_cap, down, up = o["iterations"], o["damping"], o["step_cap"], o["down"], o["up"]
         fill, exact_rotation, table, neighbours = o["fill"], o["exact_rotation"], o["table"], o["neighbours"]
-        tail, compiled = o["tail"], o["compiled"]
+        tail, compiled, threads = o["tail"], o["compiled"], o["threads"]
     m = _inverse_arm(arm)
     tp, tr = _tolerance(tol)
     seed = check_integer("seed", seed, "inverse")
@@ -455,11 +458,11 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
         # one pose: through the prepared solver (cached per arm, options, tol and mask), the one code path
         o = options if options is not None else (restarts, starts, rest, orientation_scale, iterations, damping,
                                                  step_cap, down, up, fill, exact_rotation, table, neighbours, tail,
-                                                 compiled)
+                                                 compiled, threads)
         return _solver_for(m, o, (tp, tr), _task_mask(mask))._one(P0, start, seed)
     if options is None:                                # the same checks as a one-pose call's solver
         InverseOptions(restarts, starts, rest, orientation_scale, iterations, damping, step_cap, down, up, fill,
-                       exact_rotation, table, neighbours, tail, compiled).validated()
+                       exact_rotation, table, neighbours, tail, compiled, threads).validated()
     else:
         options.validated()
     shape = P0.shape[:-1]
@@ -490,4 +493,4 @@ def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0
                          restarts=restarts, starts=starts, rest=rest, orientation_scale=orientation_scale,
                          iterations=iterations, damping=damping, step_cap=step_cap, down=down, up=up, fill=fill,
                          exact_rotation=exact_rotation, table=table, neighbours=neighbours, tail=tail,
-                         compiled=compiled)
+                         compiled=compiled, threads=threads)

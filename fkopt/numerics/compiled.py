@@ -39,9 +39,12 @@ _M2 = np.uint64(0xBF58476D1CE4E5B9)
 _M3 = np.uint64(0x94D049BB133111EB)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax):
-    """FK and Jacobian into p (3), R (3, 3) and J (6, n) (see :func:`fkopt.numerics.chain.frame_jacobian1`)."""
+    """FK and Jacobian into p (3), R (3, 3) and J (6, n) (see :func:`fkopt.numerics.chain.frame_jacobian1`).
+    The joints' cosines and sines come first, in a loop of their own (parked in ``ax``'s first
+    columns until the walk reaches their link): a call inside the walk would cut its chain of
+    products, registers saved and restored around every call; the same values either way."""
     x0, x1, x2, y0, y1, y2, z0, z1, z2 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     p0 = 0.0
     p1 = 0.0
@@ -49,6 +52,12 @@ def _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax):
     m = prismatic.shape[0]
     for i in range(m):
         q = t[var[i]] * mult[i] + off[i]
+        if prismatic[i]:
+            ax[i, 0] = q
+        else:
+            ax[i, 0], ax[i, 1] = math.cos(q), math.sin(q)
+    for i in range(m):
+        q_or_c, s = ax[i, 0], ax[i, 1]              # a prismatic joint's value, a revolute one's cos, sin
         v0, v1, v2 = v[i, 0], v[i, 1], v[i, 2]
         p0, p1, p2 = (p0 + (x0 * v0 + y0 * v1 + z0 * v2), p1 + (x1 * v0 + y1 * v1 + z1 * v2),
                       p2 + (x2 * v0 + y2 * v1 + z2 * v2))
@@ -61,9 +70,9 @@ def _walk(prismatic, C, v, var, mult, off, tC, tv, t, p, R, J, ax):
             x0 * c02 + y0 * c12 + z0 * c22, x1 * c02 + y1 * c12 + z1 * c22, x2 * c02 + y2 * c12 + z2 * c22)
         ax[i, 0], ax[i, 1], ax[i, 2], ax[i, 3], ax[i, 4], ax[i, 5] = z0, z1, z2, p0, p1, p2
         if prismatic[i]:
-            p0, p1, p2 = p0 + z0 * q, p1 + z1 * q, p2 + z2 * q
+            p0, p1, p2 = p0 + z0 * q_or_c, p1 + z1 * q_or_c, p2 + z2 * q_or_c
         else:
-            c, s = math.cos(q), math.sin(q)
+            c = q_or_c
             x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
                                       y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
     v0, v1, v2 = tv[0], tv[1], tv[2]
@@ -133,7 +142,7 @@ def frame_jacobian_rows(chain, t):
     return _frame_jacobian_rows(*chain.arrays(), np.ascontiguousarray(t, dtype=float), chain.dof)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _rotation_error(R, T, e):
     """:func:`fkopt.numerics.rotations.rotation_error1` into e, operation for operation."""
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2],
@@ -184,7 +193,7 @@ def _geodesic(R, T):
     return math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (c - 1.0))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _rotation_target(pose, T):
     """The target rotation of a pose row into T: ZYZ Euler angles in deg (6,) as
     :func:`fkopt.numerics.rotations.zyz1`, or a frame row (12,) row-major as given."""
@@ -247,7 +256,7 @@ def _cholesky_solve(J, r, A, L, y, x, d, free, masked):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _dls_step(J, r, mu, free, d, A, L, y, x):
     """:func:`fkopt.numerics.damped_least_squares.dls_step` into d; J's columns with free[i] = False count as zero.
     Returns False when not positive definite or not finite."""
@@ -261,7 +270,7 @@ def _dls_step(J, r, mu, free, d, A, L, y, x):
     return _cholesky_solve(J, r, A, L, y, x, d, free, True)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _dls_step_all(J, r, mu, free, d, A, L, y, x):
     """:func:`_dls_step` with every column free (``free`` is not read): the same operations
     without the masks (a free column's value is itself, so the bits are the same)."""
@@ -275,7 +284,7 @@ def _dls_step_all(J, r, mu, free, d, A, L, y, x):
     return _cholesky_solve(J, r, A, L, y, x, d, free, False)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _uniform_hash(seed, row, draw, out):
     """Row ``row``, draw ``draw`` of :func:`fkopt.kinematics.start_tables._uniform_hash` (SplitMix64's finaliser)."""
     c = (np.uint64(seed & 0xFFFFFFFF) * _M1) ^ (np.uint64(row) << np.uint64(20)) ^ (np.uint64(draw) << np.uint64(4))
@@ -287,7 +296,7 @@ def _uniform_hash(seed, row, draw, out):
         out[k] = np.float64(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _evaluate(chain, t, pt, T, Lw, W, r, J, p, R, ax, e, wone=False):
     """Residual r (6), scaled Jacobian J (6, n) at t; returns (pe, re, S). ``wone``: W is all
     ones, whose products change no bit (x * 1.0 == x), so they are skipped."""
@@ -318,6 +327,21 @@ def _mulhi(typingctx, a, b):
         i128 = ir.IntType(128)
         wide = builder.mul(builder.zext(args[0], i128), builder.zext(args[1], i128))
         return builder.trunc(builder.lshr(wide, ir.Constant(i128, 64)), ir.IntType(64))
+    return sig, codegen
+
+
+@intrinsic
+def _fetch_add(typingctx, counter, step):
+    """counter[0] += step as one atomic operation (LLVM's ``atomicrmw add``, monotonic: only the
+    count itself is shared); returns the value before. Threads that run one compiled loop over
+    shared rows take their next row with it (:func:`fkopt.numerics.compiled_ik.inverse_rows`)."""
+    if not (isinstance(counter, types.Array) and counter.dtype == types.int64 and counter.ndim == 1):
+        return None
+    sig = types.int64(counter, types.int64)
+
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        return builder.atomic_rmw("add", ary.data, args[1], "monotonic")
     return sig, codegen
 
 

@@ -3,22 +3,23 @@
 :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, :func:`_dls_candidate`),
 the start table's nearest-neighbour search (a float32 screen, then the float64 rows it cannot rule
 out: :func:`_nearest_screened`), one pose from the public target to the public answer
-(:func:`inverse_pose`, :func:`bound_inverse_pose`) and rows on all cores (:func:`inverse_rows`).
+(:func:`inverse_pose`, :func:`bound_inverse_pose`) and rows shared by threads (:func:`inverse_rows`).
 Built on :mod:`fkopt.numerics.compiled`'s chain, rotation and step kernels, operation for operation
 in the reference's order. Importing this module imports numba.
 """
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
-from fkopt.numerics.compiled import (_dls_step, _dls_step_all, _evaluate, _rotation_error, _rotation_target,
-                                     _uniform_hash, _walk)
+from fkopt.numerics.compiled import (_dls_step, _dls_step_all, _evaluate, _fetch_add, _rotation_error,
+                                     _rotation_target, _uniform_hash, _walk)
 from fkopt.numerics.jit import njit                 # numba.njit with a cache that a corrupted file cannot break
 
 
-@njit(inline="always")      # inlined into the loop: no call per start (the one-pose path is per-call cost)
+@njit(cache=True, _nrt=False)   # no reference counts: it only reads and writes the arrays it is given
 def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap, lo, hi, work):
     """One candidate of the one restart loop: the damped least-squares steps from start q (updated
     in place) -- :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, compiled,
@@ -82,9 +83,12 @@ def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, do
         pen, ren, Sn = _evaluate(chain, qn, pt, T, Lw, W, rn, Jn, p, R, ax, e, wone)
         evals += 1
         if Sn < S:
-            q[:] = qn
-            r[:] = rn
-            J[:, :] = Jn
+            for i in range(n):
+                q[i] = qn[i]
+            for a in range(6):
+                r[a] = rn[a]
+                for i in range(n):
+                    J[a, i] = Jn[a, i]
             pe, re, S = pen, ren, Sn
             lam = max(lam * down, 1e-12)
         else:
@@ -179,17 +183,18 @@ def _table_distances(Ft, norms, f, v):
 
 @njit(inline="always")
 def _insert(best, idx, m, x, i):
-    """Row i of value x into the k = len(idx) smallest so far (``m`` of them held, sorted; ties: the
-    earlier row first); returns how many are held after it."""
+    """Row i of value x into the k = len(idx) smallest (value, row) pairs so far (``m`` of them
+    held, sorted; ties: the lower row first, in whatever order the rows arrive); returns how many
+    are held after it."""
     k = idx.shape[0]
     if m < k:
         pos = m
         m += 1
-    elif x < best[k - 1]:
+    elif x < best[k - 1] or (x == best[k - 1] and i < idx[k - 1]):
         pos = k - 1
     else:
         return m
-    while pos > 0 and best[pos - 1] > x:
+    while pos > 0 and (best[pos - 1] > x or (best[pos - 1] == x and idx[pos - 1] > i)):
         best[pos] = best[pos - 1]
         idx[pos] = idx[pos - 1]
         pos -= 1
@@ -253,20 +258,60 @@ def start_screen(Ft, norms):
 @njit(cache=True)
 def _screen32(table, f, v32):
     """v32[i] = |F_i|^2 - 2 F_i . f in float32 for every row (half the bytes of the float64 pass,
-    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values."""
+    twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values. The 12
+    features in two passes of six, each summed in registers by pairs (two loads and stores of a
+    row where a pass per feature made twelve; measured 0.75x the time); a masked-out feature adds
+    F_ij * 0. Any order of the 12-term sum is within :data:`SCREEN_ROUNDOFF`'s bound."""
     Ft32, n32 = table[2], table[3]
     c, N = Ft32.shape
-    for i in range(N):
-        v32[i] = 0.0
-    for j in range(c):
-        fj = np.float32(f[j])
-        if f[j] == 0.0:
-            continue
-        for i in range(N):
-            v32[i] += Ft32[j, i] * fj
     two = np.float32(2.0)
+    if c != 12:                                     # not a start table's 12 features: feature by feature
+        for i in range(N):
+            v32[i] = 0.0
+        for j in range(c):
+            fj = np.float32(f[j])
+            for i in range(N):
+                v32[i] += Ft32[j, i] * fj
+        for i in range(N):
+            v32[i] = n32[i] - two * v32[i]
+        return
+    f0, f1, f2, f3 = np.float32(f[0]), np.float32(f[1]), np.float32(f[2]), np.float32(f[3])
+    f4, f5, f6, f7 = np.float32(f[4]), np.float32(f[5]), np.float32(f[6]), np.float32(f[7])
+    f8, f9, f10, f11 = np.float32(f[8]), np.float32(f[9]), np.float32(f[10]), np.float32(f[11])
+    F0, F1, F2, F3, F4, F5 = Ft32[0], Ft32[1], Ft32[2], Ft32[3], Ft32[4], Ft32[5]
     for i in range(N):
-        v32[i] = n32[i] - two * v32[i]
+        v32[i] = (F0[i] * f0 + F1[i] * f1) + (F2[i] * f2 + F3[i] * f3) + (F4[i] * f4 + F5[i] * f5)
+    F6, F7, F8, F9, F10, F11 = Ft32[6], Ft32[7], Ft32[8], Ft32[9], Ft32[10], Ft32[11]
+    for i in range(N):
+        v32[i] = n32[i] - two * (v32[i] + ((F6[i] * f6 + F7[i] * f7) + (F8[i] * f8 + F9[i] * f9)
+                                           + (F10[i] * f10 + F11[i] * f11)))
+
+
+#: Rows of the start table per screen group in :func:`_nearest_screened`: group g holds rows g, g + G,
+#: g + 2G, ... (G = :data:`SCREEN_GROUPS`), so that the groups' minima are one vectorised pass.
+SCREEN_GROUPS = 256
+#: Up to this many neighbours, :func:`_nearest_screened` visits the rows group by group; beyond, in row order.
+GROUP_SCAN_K = 8
+
+
+@njit(cache=True)
+def _group_minima(v32, gm):
+    """gm[g] = the smallest screen value of group g (rows g, g + G, ...; G = len(gm)), NaN rows
+    left out (+inf for a group without a number): lane by lane over the table, one vectorised pass."""
+    G = gm.shape[0]
+    N = v32.shape[0]
+    for g in range(G):
+        gm[g] = np.inf
+    full = N - N % G
+    for s in range(0, full, G):
+        row = v32[s:s + G]                          # a view: plain range indices vectorise, s + g does not
+        for g in range(G):
+            x = row[g]
+            gm[g] = x if x < gm[g] else gm[g]
+    rest = v32[full:]
+    for g in range(N - full):
+        x = rest[g]
+        gm[g] = x if x < gm[g] else gm[g]
 
 
 @njit(cache=True)
@@ -275,8 +320,12 @@ def _nearest_screened(table, f, v32, idx, best):
     float32 screen v32 (:func:`_screen32`) bounds every row's float64 value v within B (sizes
     times :data:`SCREEN_ROUNDOFF`), so with s_k the k-th smallest screen value, the k-th smallest
     v is at most s_k + B and a row of the k nearest has v32 <= s_k + 2B; only those rows get the
-    float64 value of :func:`_table_distances` (the same operations), in row order, and the same
-    sorted insertion (ties: the lower row first)."""
+    float64 value of :func:`_table_distances` (the same operations) and a sorted insertion by
+    (value, row) (ties: the lower row first). s_k is found without a scalar pass over every row:
+    the k-th smallest of the groups' minima (:func:`_group_minima`) is at least s_k (k groups, k
+    rows at or below it), so the k smallest screen values are all in the groups whose minimum is
+    at most it, and the rows at most s_k + 2B in the groups whose minimum is (for more than
+    :data:`GROUP_SCAN_K` neighbours the rows are visited in row order instead, same rows)."""
     Ft, norms, _, _, nmax = table
     k = idx.shape[0]
     c, N = Ft.shape
@@ -284,40 +333,56 @@ def _nearest_screened(table, f, v32, idx, best):
     for j in range(c):
         ff += f[j] * f[j]
     B = SCREEN_ROUNDOFF * (1.0 + nmax + 2.0 * math.sqrt(nmax * ff) + ff)
-    # the k smallest screen values (sorted insertion; k is small). Written out rather than through
-    # _insert: this pass runs over every row of the table, and with _insert it took 4x the time (measured)
+    G = min(SCREEN_GROUPS, N)
+    gm = np.empty(G, dtype=np.float32)
+    _group_minima(v32, gm)
+    # U: the k-th smallest group minimum (+inf with fewer than k groups holding a number)
+    gk, held = np.empty(k), np.empty(k, dtype=np.int64)   # held: which group or row (not needed, only kept)
+    m = 0
+    for g in range(G):
+        m = _insert(gk, held, m, np.float64(gm[g]), g)
+    U = gk[k - 1] if m == k else math.inf
+    # s_k: the k-th smallest screen value, from the rows at most U: for a few neighbours those of the
+    # few groups at most U; for many (more groups, each row in another cache line) a pass in row order
     sk = np.empty(k)
     m = 0
-    for i in range(N):
-        x = np.float64(v32[i])
-        if m < k:
-            pos = m
-            m += 1
-        elif x < sk[k - 1]:
-            pos = k - 1
-        else:
-            continue
-        while pos > 0 and sk[pos - 1] > x:
-            sk[pos] = sk[pos - 1]
-            pos -= 1
-        sk[pos] = x
+    if k <= GROUP_SCAN_K:
+        for g in range(G):
+            if np.float64(gm[g]) <= U:
+                for i in range(g, N, G):
+                    m = _insert(sk, held, m, np.float64(v32[i]), i)
+    else:
+        for i in range(N):
+            if np.float64(v32[i]) <= U:
+                m = _insert(sk, held, m, np.float64(v32[i]), i)
     limit = sk[m - 1] + 2.0 * B if m > 0 else math.inf
     m = 0
-    for i in range(N):
-        if not np.float64(v32[i]) <= limit:
+    if k <= GROUP_SCAN_K:
+        for g in range(G):
+            if np.float64(gm[g]) <= limit:
+                for i in range(g, N, G):
+                    if np.float64(v32[i]) <= limit:
+                        m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
+    else:
+        for i in range(N):
+            if np.float64(v32[i]) <= limit:
+                m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
+
+
+@njit(inline="always")
+def _table_distance(Ft, norms, f, i):
+    """Row i's float64 value |F_i|^2 - 2 F_i . f, operation for operation :func:`_table_distances`'."""
+    acc = 0.0
+    first = True
+    for j in range(Ft.shape[0]):
+        fj = f[j]
+        if fj == 0.0:
             continue
-        acc = 0.0
-        first = True
-        for j in range(c):
-            fj = f[j]
-            if fj == 0.0:
-                continue
-            # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
-            # |F_i|^2 - 2 d2 does not see)
-            acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
-            first = False
-        x = norms[i] - 2.0 * acc
-        m = _insert(best, idx, m, x, i)
+        # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
+        # |F_i|^2 - 2 d2 does not see)
+        acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
+        first = False
+    return norms[i] - 2.0 * acc
 
 
 @njit(cache=True)
@@ -410,37 +475,57 @@ def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, d
 
 @njit(cache=True, nogil=True)
 def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, first, step):
-    """:func:`_inverse_pose` of rows first, first + step, ... of ``poses`` (k, 6) from start rows
-    ``q0[k]``; row k's answer is the one-pose call's. Runs without the GIL, so that threads can
-    share a batch (:func:`inverse_rows`)."""
-    for k in range(first, poses.shape[0], step):
+                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, next_row):
+    """:func:`_inverse_pose` of rows of ``poses`` (k, 6) from start rows ``q0[k]``: each row the
+    one it takes from the shared count ``next_row[0]`` (:func:`fkopt.numerics.compiled._fetch_add`)
+    until none is left; row k's answer is the one-pose call's, whoever takes it. Runs without the
+    GIL, so that threads can share a batch (:func:`inverse_rows`)."""
+    k = _fetch_add(next_row, 1)
+    while k < poses.shape[0]:
         _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, table, wf, fmask, nn, seed, budget, tp, tr,
                       iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
                       out[k], info[k])
+        k = _fetch_add(next_row, 1)
 
 
-#: Batches from this many rows are shared by one thread per core.
+#: Batches from this many rows are shared by threads (below, a thread costs more than it saves).
 THREAD_ROWS = 64
 
 
-def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap,
+                 threads):
     """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5)). From
-    :data:`THREAD_ROWS` rows, one Python thread per core takes every t-th row (interleaved, so
-    that the rows needing restarts spread evenly): plain threads rather than numba's parallel
-    layer, whose OpenMP runtime does not survive a fork and whose fallback is not thread-safe."""
-    import os
+    :data:`THREAD_ROWS` rows, ``threads`` threads (this one and threads - 1 more; at most one per
+    :data:`THREAD_ROWS` // 2 rows) share them, each taking the next row not yet taken: a row that
+    needs many restarts holds up one thread, not a fixed share of the batch. Plain threads rather
+    than numba's parallel layer, whose OpenMP runtime does not survive a fork and whose fallback
+    is not thread-safe. Every row's answer depends only on its pose, start and the seed, so the
+    answers are the same bits for any ``threads`` (1: this thread alone)."""
     k = poses.shape[0]
     out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
+    next_row = np.zeros(1, dtype=np.int64)
     args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn,
             seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
-            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info)
-    threads = min(os.cpu_count() or 1, max(1, k // (THREAD_ROWS // 2)))
-    if k < THREAD_ROWS or threads < 2:
-        _inverse_rows(*args, 0, 1)
+            ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info, next_row)
+    helpers = min(int(threads), max(1, k // (THREAD_ROWS // 2))) - 1 if k >= THREAD_ROWS else 0
+    if helpers < 1:
+        _inverse_rows(*args)
         return out, info
-    from concurrent.futures import ThreadPoolExecutor
-    with ThreadPoolExecutor(threads) as pool:
-        for f in [pool.submit(_inverse_rows, *args, t, threads) for t in range(threads)]:
-            f.result()
+    failures = []
+
+    def helper():
+        try:
+            _inverse_rows(*args)
+        except BaseException as err:            # noqa: BLE001 - handed to the calling thread below
+            failures.append(err)
+    started = [threading.Thread(target=helper, name=f"fkopt-inverse-{i}", daemon=True) for i in range(helpers)]
+    for t in started:
+        t.start()
+    try:
+        _inverse_rows(*args)
+    finally:
+        for t in started:
+            t.join()
+    if failures:
+        raise failures[0]
     return out, info

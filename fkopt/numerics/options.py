@@ -13,7 +13,9 @@ from fkopt.api_bounds import check_options
 class InverseOptions:
     """``fkopt.inverse``'s keyword options with their defaults; ``fkopt.inverse(arm, poses,
     options=InverseOptions(restarts=50))`` equals ``fkopt.inverse(arm, poses, restarts=50)``.
-    ``compiled``: None (default path, see :mod:`fkopt.numerics.path`), True or False.
+    ``compiled``: None (default path, see :mod:`fkopt.numerics.path`), True or False. ``threads``:
+    threads sharing a batch on the compiled path (None: the CPUs the process may run on; 1: the
+    calling thread alone); the answers are the same for any number.
     :meth:`validated` checks them (``fkopt.InverseSolver`` does so once, when it is made)."""
 
     restarts: int = 200
@@ -31,6 +33,7 @@ class InverseOptions:
     neighbours: int = 32
     tail: int = 256
     compiled: bool | None = None
+    threads: int | None = None
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -44,6 +47,8 @@ class InverseOptions:
             if f.name in ("exact_rotation",):
                 if not isinstance(v, (bool, numbers.Integral)) or v not in (0, 1):
                     raise FkoptError(f"inverse options {f.name}: expected true or false, got {v!r}")
+            elif f.name == "threads" and v is None:
+                pass
             elif f.name == "compiled":
                 if v not in (None, True, False) or not isinstance(v, (bool, type(None))):
                     raise FkoptError(f"inverse options compiled: expected None, true or false, got {v!r}")
