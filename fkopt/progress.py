@@ -30,6 +30,12 @@ def tick(done: float, total: float) -> None:
         listener(min(max(done / total, 0.0), 1.0))
 
 
+def heard() -> bool:
+    """Is anyone listening? Loops that run many steps per compiled call cut their calls shorter
+    then, so the bar moves inside a task (:meth:`fkopt.algorithms.base.Algorithm.minimize`)."""
+    return _listener.get() is not None
+
+
 @contextmanager
 def listening(callback: Callable[[float], None] | None) -> Iterator[None]:
     """Within the block, ``callback(fraction)`` hears every :func:`tick` (fraction in [0, 1])."""

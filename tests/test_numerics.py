@@ -321,6 +321,26 @@ def test_compiled_abc_without_numpys_tan_loop_takes_one_iteration_per_call_with_
         assert all(np.array_equal(got[mode].snapshots[t], got["numpy"].snapshots[t]) for t in (0, 7, 80))
 
 
+@pytest.mark.parametrize("algorithm", ["abc", "gabc"])
+def test_compiled_abc_under_a_progress_listener_ticks_inside_the_run_with_the_same_bits(algorithm):
+    """A progress bar (fkopt run) listens: the several-iteration calls then end every
+    iterations/TICKS iterations so the bar moves inside a task, and the records stay the same."""
+    from fkopt.algorithms.base import TICKS
+    from fkopt.progress import listening
+    m = fkopt.mechanism("3-rps")
+    targets = m.bounds[:, 0] + np.random.default_rng(8).random((2, 3)) * (m.bounds[:, 1] - m.bounds[:, 0])
+    p = fkopt.fk_problem(m, m.ik(targets))
+    options = dict(population=10, iterations=90, runs=3, seed=4, x_history=True, snapshots=(0, 45, 90))
+    quiet = fkopt.solve(p, algorithm, **options)
+    heard = []
+    with listening(heard.append):
+        loud = fkopt.solve(p, algorithm, **options)
+    assert len(heard) >= TICKS and heard == sorted(heard) and heard[-1] == 1.0
+    for name in ("x", "fitness", "history", "evaluation_history", "x_history", "evaluations"):
+        assert np.array_equal(getattr(quiet, name), getattr(loud, name)), name
+    assert all(np.array_equal(quiet.snapshots[t], loud.snapshots[t]) for t in (0, 45, 90))
+
+
 def test_compiled_abc_calls_again_where_the_logs_arrays_fill_up(monkeypatch):
     """The log's improvements of one several-iteration call are held in arrays of
     abc_kernels.LOG_ROOM places; made one iteration's worth, a call ends after any iteration that

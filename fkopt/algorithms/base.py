@@ -26,8 +26,12 @@ from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 from fkopt.errors import FkoptError
 from fkopt.files import did_you_mean, field_path, no_quoted_numbers
 from fkopt.numerics import path as numerics_path
-from fkopt.progress import tick
+from fkopt.progress import heard, tick
 from fkopt.numerics.streams import RunStreams
+
+#: Ticks per run of the iteration loop that a progress listener hears at least, when the compiled
+#: path runs many iterations per call (a bar that jumps from 0 to done says nothing).
+TICKS = 20
 
 
 class Params(BaseModel):
@@ -414,8 +418,11 @@ class Algorithm:
         watch = stop_at_target and target is not None
         advance = None if watch or plugin else self.compiled_advance(problem)
         t = 1
+        # a listener hears at least TICKS ticks per run of the loop: the calls end there too (where a
+        # call ends never changes a number: the draws follow one stream order, tests/test_numerics.py)
+        span = max(1, iterations // TICKS) if heard() else iterations
         while advance is not None and t <= iterations:   # several iterations per compiled call
-            stop = min([s for s in wanted if s >= t] + [iterations])
+            stop = min([s for s in wanted if s >= t] + [iterations, t + span - 1])
             t = advance(state, streams, t, stop, history, evals, xs)
             final_x = state.best_x
             if t in wanted:
