@@ -10,13 +10,14 @@ from fkopt.reproduce.claims import HELD, NOT_CHECKABLE, NOT_HELD
 
 
 class Store:
-    def __init__(self, found):
-        self.found = found
+    def __init__(self, found, method="homotopy"):
+        self.found, self.method = found, method
 
     def get(self, paper, name):
         if self.found is None:
             return None
-        row = SimpleNamespace(solutions_found=self.found, starts=600, worst_fitness=1e-14, total_s=0.5)
+        row = SimpleNamespace(solutions_found=self.found, starts=600, worst_fitness=1e-14, total_s=0.5,
+                              method=self.method)
         return SimpleNamespace(row=lambda *a, **k: row)
 
 
@@ -25,6 +26,9 @@ def test_assembly_claim_holds_only_at_40_solutions_and_is_not_checkable_without_
     assert assembly_report.claims(Store(39))[0].verdict == NOT_HELD
     assert assembly_report.claims(Store(None))[0].verdict == NOT_CHECKABLE
     assert assembly_report.timing_claims(Store(None)) == []
+    # the condition says what the count came from: the certified homotopy's paths or the restarts' starts
+    assert "600 homotopy paths" in assembly_report.claims(Store(40))[0].evidence
+    assert "600 starts" in assembly_report.claims(Store(40, "restarts"))[0].evidence
 
 
 def test_reproduce_agreement_line_counts_moved_files_and_judges_them_by_the_cross_platform_rules(tmp_path):

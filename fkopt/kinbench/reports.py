@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from fkopt.run import record
-from fkopt.run.plotting import legend_off_data, plt, save     # matplotlib itself only when plt() is called
+from fkopt.run import plotting   # matplotlib itself only when plotting.plt() is called (save by module: tests watch it)
+from fkopt.run.plotting import legend_off_data, plt
 from fkopt.files import file_names, md_table, md_text, read_stored_csv
 from fkopt.kinbench import measures as M
 from fkopt.kinbench.outside import digest
@@ -245,7 +246,7 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
         fig = _clock_figure(pyplot, curves, t, f"share of {n} queries",
                             f"{sr.config.name}: {robot}, answers right at {rung_words(rung_label(LADDER[clock.rung]))} "
                             "(kinbench's FK)")
-        names += save(fig, folder / f"clock_{stems[robot]}.png")
+        names += plotting.save(fig, folder / f"clock_{stems[robot]}.png")
         pyplot.close(fig)
     curves, t, arms = pooled_clock_curves(answers, clock)
     if arms:
@@ -254,7 +255,7 @@ def clock_figures(sr, folder: Path, tables: dict) -> list[str]:
         fig = _clock_figure(pyplot, curves, t, "share of the queries it was given",
                             f"{sr.config.name}: IK of all {arms} arms, answers right at "
                             f"{rung_words(rung_label(LADDER[clock.rung]))} (kinbench's FK)")
-        names += save(fig, folder / "clock_all.png")
+        names += plotting.save(fig, folder / "clock_all.png")
         pyplot.close(fig)
     return names
 
@@ -375,7 +376,7 @@ def ecdf_figures(sr, folder: Path, tables: dict) -> list[str]:
         wrapped_title(ax, f"{sr.config.name}: {what}; targets {targets}")
         legend_below(ax)
         stem = "ecdf_all" if scope == "all" else f"ecdf_{stems[short(scope)]}"
-        names += save(fig, folder / f"{stem}.png")
+        names += plotting.save(fig, folder / f"{stem}.png")
         pyplot.close(fig)
     return names
 
@@ -410,7 +411,7 @@ def scaling_figures(sr, folder: Path, tables: dict) -> list[str]:
         ax.set_ylabel(f"log10(ERT / dimension) at {target:.0e}")
         ax.set_title(f"{sr.config.name}: {cls}, cost against dimension", fontsize=8)
         legend_off_data(ax, fontsize=7)
-        names += save(fig, folder / f"scaling_{stems[cls]}.png")
+        names += plotting.save(fig, folder / f"scaling_{stems[cls]}.png")
         pyplot.close(fig)
     return names
 
