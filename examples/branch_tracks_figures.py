@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import json
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,8 @@ def recall_figure(folder: Path, out: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     b = pd.read_csv(folder / "leaderboard-solutions.csv")
+    # the joint each 7-joint arm has locked, as the stored suite's config says
+    locked = json.loads((folder / "meta.json").read_text())["config"]["tracks"]["all-solutions"].get("locked", {})
     arms = list(dict.fromkeys(b["problem"]))
     solvers = list(dict.fromkeys(b["solver"]))
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.2), sharey=True)
@@ -44,15 +47,16 @@ def recall_figure(folder: Path, out: Path) -> None:
                 for xi, v, t in zip(x, 100 * r[col].to_numpy(float), r["time_ratio_median"].to_numpy(float)):
                     if np.isfinite(v):
                         ax.text(xi, v + 1, f"{t:.2g}x", ha="center", va="bottom", fontsize=6, rotation=90)
-        ax.set_xticks(np.arange(len(arms)), [a + (" (7th joint locked)" if a in ("panda", "iiwa-mj") else "")
-                                              for a in arms], rotation=30, ha="right", fontsize=8)
+        ax.set_xticks(np.arange(len(arms)), [a + (f" ({locked[a]} locked)" if a in locked else "") for a in arms],
+                      rotation=30, ha="right", fontsize=8)
         ax.set_title(title, fontsize=9)
         ax.set_ylim(0, 118)
     axes[0].set_ylabel("% of the reference set's solutions held")
-    axes[1].legend(fontsize=7, loc="lower right")
+    fig.legend(*axes[1].get_legend_handles_labels(), fontsize=7, loc="lower center", ncol=len(solvers),
+               frameon=False)   # below the axes: inside, it covered the last arms' bars
     fig.suptitle("kinbench all-solutions track: every IK solution of a pose (numbers on the right: median time "
                  "per pose / fkopt's; the restart entries get fkopt's median time)", fontsize=9)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
     fig.savefig(out / "tracks_all_solutions.png", dpi=110)
     plt.close(fig)
 
