@@ -68,9 +68,10 @@ def _branch_options(p) -> dict:
     return {k: getattr(p, k) for k in BRANCH_OPTIONS if getattr(p, k, None) is not None}
 
 
-#: What a solution set's search fields say the search stopped on: a stopping rule, except a 6-6
-#: platform's homotopy (all_solutions' method "homotopy"), which is complete by its certificate.
-STOPPING_RULE = {"serial": "patience", "parallel": "rounds without a new solution",
+#: What a parallel mechanism's solution set says its search stopped on: a stopping rule, except a
+#: 6-6 platform's homotopy (all_solutions' method "homotopy"), which is complete by its certificate.
+#: (A serial arm's search states its own: ``search["rule"]``, a certificate or its stopping rule.)
+STOPPING_RULE = {"parallel": "rounds without a new solution",
                  "homotopy": "complete: 40 homotopy paths at 40 distinct nonsingular roots"}
 
 
@@ -138,7 +139,7 @@ class ExactSolver(Algorithm):
             return SolutionSet(tuple(r.names), np.asarray(r.solutions, dtype=float).reshape(-1, len(r.names)),
                                {"position_error": np.asarray(r.position_error, dtype=float),
                                 "rotation_error": np.asarray(r.rotation_error, dtype=float)},
-                               {"stopping_rule": STOPPING_RULE["serial"], "patience": int(search["patience"]),
+                               {"stopping_rule": str(search["rule"]), "patience": int(search["patience"]),
                                 "max_starts": int(search["max_starts"]), "starts": int(search["starts"]),
                                 "converged": int(search["converged"]),
                                 "since_last_new": int(min(since) if isinstance(since, list) else since),
