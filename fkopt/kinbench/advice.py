@@ -87,6 +87,26 @@ def robots_summary(folder: str | Path, timeout_ms: float = 20.0) -> pd.DataFrame
     return summarise_board(read_stored_csv(folder, "leaderboard-robots.csv"), timeout_ms)
 
 
+def summarise_throughput(throughput: pd.DataFrame) -> pd.DataFrame:
+    """Per (solver, reference, batch size) of a board's ``throughput.csv``: the arms (or
+    mechanisms) it answered, its queries per second and its ratio to the reference's one-per-call
+    rate (median over the arms), and its success at each rung (mean over the arms, in per cent);
+    the solvers in the file's order, batches ascending. An entry on the throughput track only
+    (pytorch-kinematics) is on the page through this table."""
+    success = [c for c in throughput.columns if c.startswith("success_")]
+    g = throughput.groupby(["solver", "entry", "reference", "batch"], sort=False)
+    out = g[success].mean().mul(100)
+    out["arms"] = g["robot"].nunique()
+    out["queries_per_s"] = g["queries_per_s"].median()
+    out["reference_queries_per_s"] = g["reference_queries_per_s"].median()
+    out["ratio"] = g["ratio"].median()
+    order = {s: k for k, s in enumerate(throughput["solver"].unique())}
+    out = out.reset_index()
+    out = out.assign(_o=out["solver"].map(order)).sort_values(["_o", "reference", "batch"], kind="stable")
+    return out.drop(columns="_o").reset_index(drop=True)[
+        ["solver", "entry", "reference", "batch", "arms", "queries_per_s", "reference_queries_per_s", "ratio", *success]]
+
+
 def fk_robots(board: pd.DataFrame) -> set:
     """The parallel mechanisms of a per-robot board (FK rows: they count other assembly modes)."""
     if "other_mode" not in board:
