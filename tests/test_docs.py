@@ -91,3 +91,20 @@ def test_kinbench_docs_have_one_row_per_outside_entry_of_the_stored_board():
     named = {n for cell in first_cells for n in re.findall(r"`([^`]+)`", cell)}
     assert outside and outside <= named, sorted(outside - named)
     assert all(row.count(" | ") == 4 for row in rows)           # five cells each, none left out
+
+
+def test_citation_names_every_board_version_and_the_stored_boards_match_it():
+    """CITATION.cff names every frozen board version (fkopt/kinbench/releases.py BOARDS), and the
+    board version each stored per-robot board's meta.json names is among them: a paper cites the
+    board it compared against."""
+    import json
+    import yaml
+    from fkopt.kinbench.releases import BOARDS, board_version
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    named = set(cff["keywords"])
+    versions = {f"{board}/{v}" for board, vs in BOARDS.items() for v in vs}
+    assert versions <= named and all(v in cff["abstract"] for v in versions), sorted(versions - named)
+    stored = [json.loads(p.read_text()).get("board_version") for p in (ROOT / "results" / "kinbench").glob("*/meta.json")]
+    stored = {v for v in stored if v}
+    assert stored and stored <= versions, sorted(stored - versions)
+    assert all(board_version(board) in cff["message"] for board in BOARDS)      # the latest of each
