@@ -244,6 +244,7 @@ def test_the_stored_board_page_shows_every_entrys_recorded_settings_and_the_thro
     assert rows["pytorch-kinematics"][3].startswith("throughput track only")
     assert "PseudoInverseIK" in rows["pytorch-kinematics"][5]
     assert 'href="#throughput"' in index and 'id="throughput-table"' in index
+    assert "Outside entries: each as its authors run it" in unescape(index)     # where the reproductions are
     rates = summarise_throughput(tables["throughput.csv"])
     torch = rates[rates["solver"] == "pytorch-kinematics"]
     assert not torch.empty and (torch["arms"] == tables["throughput.csv"].query(

@@ -173,7 +173,10 @@ def clock_settings_section(sr, answers: pd.DataFrame | None, throughput: pd.Data
                f"{', '.join(f'{t:g}' for t in clock.fk_timeouts_ms)} ms (FK); times as ratios to {clock.reference} (IK) "
                f"and {clock.fk_reference} (FK) on the same query in the same process; the board's rung {rung}; "
                f"seed {c.seed}." + (f" Throughput track: batches {tp.batches} (FK {tp.fk_batches}), best of "
-                                    f"{tp.repeats} calls." if tp is not None else ""))]
+                                    f"{tp.repeats} calls." if tp is not None else "")),
+            _p("Each outside entry's own published protocol and figures, kinbench's reproduction of them on this "
+               "machine (or why a figure is not reproduced) and every difference from the package's defaults with its "
+               "reason: docs/kinbench.md, \"Outside entries: each as its authors run it\".", "note")]
     recorded = meta.get("entries") if isinstance(meta.get("entries"), dict) else {}
     names = list(dict.fromkeys([clock.reference, *clock.solvers, clock.fk_reference, *clock.fk_solvers]
                                + ([] if answers is None else list(answers["solver"].unique()))))
