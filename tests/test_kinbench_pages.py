@@ -275,7 +275,27 @@ def test_the_advice_per_family_is_the_summary_of_its_arms():
     for row in advice.itertuples():
         arms = row.arms.split(", ")
         best = summarise_board(board[board["robot"].isin(arms)], row.timeout_ms, fk=row.family.startswith("parallel"))
+        best = best[best["not_applicable"] == 0]          # an entry that cannot take one of the arms is no advice
         assert best.iloc[0]["solver"] == row.solver
+
+
+def test_the_advice_per_family_never_names_an_entry_that_cannot_take_one_of_its_arms():
+    """OptIK is "not applicable" on the TIAGo with its torso lift (8-10 joints) and would lead that family
+    on success then ratio; the family's advice is the best entry that takes every one of its arms."""
+    from fkopt.kinbench.advice import family_advice, summarise_board
+    board = pd.read_csv(ROOT / "results" / "kinbench" / "kinbench-v3-robots" / "leaderboard-robots.csv")
+    sr, _ = stored_suite(QUICK)
+    families = {p.name: p.problem_class for p in sr.config.problems}
+    family = [r for r, f in families.items() if f == "serial-ik-8to10dof" and r in set(board["robot"])]
+    assert "tiago-torso" in family
+    sub = board[board["robot"].isin(family)]
+    ranked = summarise_board(sub, 20.0)
+    leader = ranked.iloc[0]
+    advice = family_advice(sub, families).set_index("family").loc["serial-ik-8to10dof"]
+    if leader["not_applicable"] > 0:                  # the stored board: OptIK first on the arms it takes
+        assert advice["solver"] != leader["solver"]
+    assert advice["not_applicable"] == 0
+    assert advice["solver"] == ranked[ranked["not_applicable"] == 0].iloc[0]["solver"]
 
 
 def test_fkopt_pages_refuses_what_is_not_a_suite_in_one_line(tmp_path):

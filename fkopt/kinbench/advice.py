@@ -147,9 +147,12 @@ def summarise_board(board: pd.DataFrame, timeout_ms: float, fk: bool = False) ->
 
 def family_advice(board: pd.DataFrame, families: dict[str, str]) -> pd.DataFrame:
     """Per arm family (``families``: robot -> its problem class, e.g. serial-ik-7dof), the
-    solver to use at the family's largest timeout: the first row of :func:`summarise_board` over
-    the family's arms (success at the board's rung, mean over the arms, then median time ratio).
-    Columns family, arms (names), timeout_ms, then the summary's columns of that solver."""
+    solver to use at the family's largest timeout: among the entries that take every arm of the
+    family (a package that cannot take one of them, a "not applicable" cell, is no answer for
+    that arm's owner), the first row of :func:`summarise_board` over the family's arms (success
+    at the board's rung, mean over the arms, then median time ratio); the first row of all when
+    no entry takes every arm. Columns family, arms (names), timeout_ms, then the summary's
+    columns of that solver."""
     fk_set = fk_robots(board)
     rows = []
     for family in dict.fromkeys(families[r] for r in board["robot"].unique() if r in families):
@@ -159,7 +162,8 @@ def family_advice(board: pd.DataFrame, families: dict[str, str]) -> pd.DataFrame
         best = summarise_board(sub, timeout, fk=arms[0] in fk_set)
         if best.empty:
             continue
-        row = best.iloc[0].to_dict()
+        whole = best[best["not_applicable"] == 0]
+        row = (whole if not whole.empty else best).iloc[0].to_dict()
         rows.append({"family": family, "arms": ", ".join(arms), "timeout_ms": timeout,
                      **{k: v for k, v in row.items() if k != "arms"}})
     return pd.DataFrame(rows)

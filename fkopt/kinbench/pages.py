@@ -270,8 +270,9 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
     extra = ["cpu_ms_median"] if "cpu_ms_median" in fam else []
     rung = H.rung_words(str(board["rung"].iloc[0]))
     advice = Section("advice", "Which solver for my arm", [
-        _p(f"Best success at {rung} (mean over the family's arms), then median time ratio; answers checked by "
-           "kinbench's FK, a failure counted at the timeout.", "note"),
+        _p(f"Among the entries that take every arm of the family: best success at {rung} (mean over the family's "
+           "arms), then median time ratio; answers checked by kinbench's FK, a failure counted at the timeout.",
+           "note"),
         H.table_html(fam.assign(n_arms=fam["arms"].str.count(",") + 1),
                      ["family", "n_arms", "solver", "timeout_ms", *success, "median_ms", *extra, "median_ratio"],
                      "advice-table", shares=False, labels={"n_arms": "arms", "family": "arm family (joints)",
