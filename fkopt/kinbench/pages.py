@@ -230,7 +230,7 @@ def suite_settings_section(sr) -> Section:
     return Section("settings", "Settings of every entry", body)
 
 
-def throughput_section(sr, throughput: pd.DataFrame | None) -> Section | None:
+def throughput_section(throughput: pd.DataFrame | None) -> Section | None:
     """The throughput track on the page: per solver and batch size, queries per second beside the
     reference's one-query calls, over the arms (:func:`fkopt.kinbench.advice.summarise_throughput`);
     None when the board has no throughput table."""
@@ -475,7 +475,7 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
     files_sec = Section("files", "Files", [_p("The tables behind this page (column names as in the CSVs):", "note"),
                                           "<p>" + " · ".join(_link(f, f) for f in files) + "</p>"])
     machine = machine_section(sr)
-    rates = throughput_section(sr, tables.get("throughput.csv")) if robots is not None and not robots.empty else None
+    rates = throughput_section(tables.get("throughput.csv")) if robots is not None and not robots.empty else None
     sections = [advice, summary, figs, *([rates] if rates is not None else []), settings, machine, *details, files_sec]
     caption = ("Every IK arm pooled; each arm's on the Per arm page." if robots is not None and not robots.empty
                else "Every problem of the first board.")
