@@ -73,3 +73,38 @@ def test_readme_quotes_the_stored_v3_robot_board():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert robots_markdown(robots_summary(folder)) in readme
     assert fk_sentence(folder) in readme.splitlines()
+
+
+def test_kinbench_docs_have_one_row_per_outside_entry_of_the_stored_board():
+    """docs/kinbench.md's "Outside entries" table (the package's protocol and figures, kinbench's
+    reproduction, the board's settings, the differences and why) names every outside entry of the
+    stored per-robot board: its clock rows and its throughput-only entries."""
+    import pandas as pd
+    folder = ROOT / "results" / "kinbench" / "kinbench-v3-robots"
+    board = pd.read_csv(folder / "leaderboard-robots.csv")
+    rates = pd.read_csv(folder / "throughput.csv")
+    outside = set(board.loc[board["entry"] == "outside", "solver"]) | set(rates.loc[rates["entry"] == "outside", "solver"])
+    text = (ROOT / "docs" / "kinbench.md").read_text()
+    start = text.index("| entry | the package's own protocol and published numbers |")
+    rows = [line for line in text[start:].split("\n\n", 1)[0].splitlines()[2:]]
+    first_cells = [row.split(" | ", 1)[0] for row in rows]
+    named = {n for cell in first_cells for n in re.findall(r"`([^`]+)`", cell)}
+    assert outside and outside <= named, sorted(outside - named)
+    assert all(row.count(" | ") == 4 for row in rows)           # five cells each, none left out
+
+
+def test_citation_names_every_board_version_and_the_stored_boards_match_it():
+    """CITATION.cff names every frozen board version (fkopt/kinbench/releases.py BOARDS), and the
+    board version each stored per-robot board's meta.json names is among them: a paper cites the
+    board it compared against."""
+    import json
+    import yaml
+    from fkopt.kinbench.releases import BOARDS, board_version
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    named = set(cff["keywords"])
+    versions = {f"{board}/{v}" for board, vs in BOARDS.items() for v in vs}
+    assert versions <= named and all(v in cff["abstract"] for v in versions), sorted(versions - named)
+    stored = [json.loads(p.read_text()).get("board_version") for p in (ROOT / "results" / "kinbench").glob("*/meta.json")]
+    stored = {v for v in stored if v}
+    assert stored and stored <= versions, sorted(stored - versions)
+    assert all(board_version(board) in cff["message"] for board in BOARDS)      # the latest of each

@@ -46,6 +46,14 @@ def test_a_table_keeps_the_csv_name_in_the_tooltip_and_shows_shares_in_per_cent(
     assert ">97.5<" in text and ">0.1901<" in text
 
 
+def test_a_share_column_read_back_as_whole_numbers_is_shown_in_per_cent():
+    """A stored CSV whose success column holds only 0 and 1 reads back as integers: `fkopt pages`
+    showed them as 1 and 0 where the page made at the run showed 100 and 0."""
+    df = pd.DataFrame({"solver": ["a", "b"], "success_1e-02": np.array([1, 0], dtype=np.int64), "runs": [3, 4]})
+    text = H.table_html(df, list(df.columns), "t")
+    assert "<td>100</td><td>3</td>" in text and "<td>0</td><td>4</td>" in text
+
+
 # -- figures -------------------------------------------------------------------------------------
 def test_end_labels_stay_inside_the_axes_and_apart():
     from fkopt.kinbench.reports import spread_labels
@@ -193,14 +201,67 @@ def test_an_arm_a_package_cannot_take_is_left_out_not_counted_as_zero(tmp_path):
     assert "not applicable: no decomposition" in (tmp_path / "arms.html").read_text()
 
 
+def _settings_rows(index: str) -> dict:
+    """solver -> the cells of its row in the page's settings table."""
+    table = re.search(r'<table class="sortable" id="settings-table">(.*?)</table>', index, re.S).group(1)
+    rows = {}
+    for tr in re.findall(r"<tr>(.*?)</tr>", table, re.S)[1:]:
+        cells = [unescape(re.sub(r"<[^>]+>", "", c)) for c in re.findall(r"<td[^>]*>(.*?)</td>", tr, re.S)]
+        rows[cells[0]] = cells
+    return rows
+
+
 def test_the_page_shows_the_load_and_settings_a_board_recorded(tmp_path):
+    """meta.json's ``entries`` (what the runner writes) is what the page shows as the settings the
+    board ran with; an entry meta.json does not name says it was not recorded."""
     sr, tables = stored_suite(QUICK)
+    entries = {k: v for k, v in sr.meta["entries"].items() if k != "pin-clik"}
     sr.meta = {**sr.meta, "load_avg": {"start": [1.25, 0.5, 0.25], "end": [2.0, 1.0, 0.5]},
-               "settings": {"tracik": {"eps": 5.77e-06, "solve_type": "Speed"}}}
+               "entries": {**entries, "tracik": {"eps": 5.77e-06, "solve_type": "Speed"}}}
     write_pages(sr, tmp_path, tables)
     index = (tmp_path / "index.html").read_text()
     assert "at its start: 1.25 / 0.50 / 0.25; at its end: 2.00 / 1.00 / 0.50" in index
-    assert "eps = 5.77e-06; solve_type = Speed" in index and "recorded with the board (meta.json)" in index
+    rows = _settings_rows(index)
+    assert rows["tracik"][4] == "eps = 5.77e-06; solve_type = Speed"
+    assert rows["pin-clik"][4] == "not recorded with this board"
+    assert rows["pin-clik"][5].startswith("Settings: dt = 1")          # as its wrapper documents it
+
+
+def test_the_stored_board_page_shows_every_entrys_recorded_settings_and_the_throughput_track(tmp_path):
+    """The stored quick board (version 2, meta.json ``entries``): every entry it recorded shows
+    those settings, each beside its wrapper's documented ones; pytorch-kinematics, on the
+    throughput track only, has its row there and its rates in the throughput table."""
+    from fkopt.kinbench.advice import summarise_throughput
+    sr, tables = stored_suite(QUICK)
+    write_pages(sr, tmp_path, tables)
+    index = (tmp_path / "index.html").read_text()
+    rows = _settings_rows(index)
+    for name, settings in sr.meta["entries"].items():
+        assert rows[name][4] == "; ".join(f"{k} = {v}" for k, v in settings.items()), name
+        assert rows[name][5] not in ("", "-"), name
+    assert "One outside IK solver" not in rows["ikpy"][5] and "symbolic=True" in rows["ikpy"][5]
+    assert rows["optik"][5].rstrip().endswith("deterministic results.")     # the list after "except:"
+    assert rows["pytorch-kinematics"][3].startswith("throughput track only")
+    assert "PseudoInverseIK" in rows["pytorch-kinematics"][5]
+    assert 'href="#throughput"' in index and 'id="throughput-table"' in index
+    assert "Outside entries: each as its authors run it" in unescape(index)     # where the reproductions are
+    rates = summarise_throughput(tables["throughput.csv"])
+    torch = rates[rates["solver"] == "pytorch-kinematics"]
+    assert not torch.empty and (torch["arms"] == tables["throughput.csv"].query(
+        "solver == 'pytorch-kinematics'")["robot"].nunique()).all()
+
+
+def test_the_throughput_summary_is_the_medians_and_means_over_the_arms():
+    from fkopt.kinbench.advice import summarise_throughput
+    tp = pd.DataFrame({"solver": ["a", "a", "a", "b"], "robot": ["r1", "r2", "r3", "r1"], "entry": ["outside"] * 4,
+                       "batch": [10, 10, 10, 10], "queries_per_s": [100.0, 300.0, 200.0, 50.0],
+                       "reference": ["ref"] * 4, "reference_queries_per_s": [10.0, 20.0, 30.0, 10.0],
+                       "ratio": [10.0, 15.0, 6.0, 5.0], "success_1e-05m_1e-05rad": [1.0, 0.5, 0.0, 1.0]})
+    out = summarise_throughput(tp).set_index("solver")
+    assert out.loc["a", "arms"] == 3 and out.loc["a", "queries_per_s"] == 200.0
+    assert out.loc["a", "ratio"] == 10.0 and out.loc["a", "reference_queries_per_s"] == 20.0
+    assert out.loc["a", "success_1e-05m_1e-05rad"] == pytest.approx(50.0)
+    assert out.loc["b", "arms"] == 1 and out.loc["b", "success_1e-05m_1e-05rad"] == 100.0
 
 
 def test_the_advice_per_family_is_the_summary_of_its_arms():
@@ -214,7 +275,27 @@ def test_the_advice_per_family_is_the_summary_of_its_arms():
     for row in advice.itertuples():
         arms = row.arms.split(", ")
         best = summarise_board(board[board["robot"].isin(arms)], row.timeout_ms, fk=row.family.startswith("parallel"))
+        best = best[best["not_applicable"] == 0]          # an entry that cannot take one of the arms is no advice
         assert best.iloc[0]["solver"] == row.solver
+
+
+def test_the_advice_per_family_never_names_an_entry_that_cannot_take_one_of_its_arms():
+    """OptIK is "not applicable" on the TIAGo with its torso lift (8-10 joints) and would lead that family
+    on success then ratio; the family's advice is the best entry that takes every one of its arms."""
+    from fkopt.kinbench.advice import family_advice, summarise_board
+    board = pd.read_csv(ROOT / "results" / "kinbench" / "kinbench-v3-robots" / "leaderboard-robots.csv")
+    sr, _ = stored_suite(QUICK)
+    families = {p.name: p.problem_class for p in sr.config.problems}
+    family = [r for r, f in families.items() if f == "serial-ik-8to10dof" and r in set(board["robot"])]
+    assert "tiago-torso" in family
+    sub = board[board["robot"].isin(family)]
+    ranked = summarise_board(sub, 20.0)
+    leader = ranked.iloc[0]
+    advice = family_advice(sub, families).set_index("family").loc["serial-ik-8to10dof"]
+    if leader["not_applicable"] > 0:                  # the stored board: OptIK first on the arms it takes
+        assert advice["solver"] != leader["solver"]
+    assert advice["not_applicable"] == 0
+    assert advice["solver"] == ranked[ranked["not_applicable"] == 0].iloc[0]["solver"]
 
 
 def test_fkopt_pages_refuses_what_is_not_a_suite_in_one_line(tmp_path):

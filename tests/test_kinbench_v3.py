@@ -646,3 +646,15 @@ def test_check_compares_meta_json_but_for_the_machines_load_during_the_run(tmp_p
     assert compare_meta("x", a, b, variable=META_RUN) == []
     b.write_text(json.dumps({**meta, "board_version": "kinbench-v3-robots/1"}))
     assert [m.column for m in compare_meta("x", a, b, variable=META_RUN)] == ["board_version"]
+
+
+def test_meta_json_records_an_entrys_settings_from_an_arm_it_ran_on_not_a_not_applicable_one():
+    """meta.json's ``entries``: an entry that cannot take the first arm (EAIK on a 7-joint arm first)
+    records the settings of the first arm it ran on; only an entry that ran on no arm keeps why."""
+    from fkopt.kinbench.runner import entry_settings
+    tracked = [{"settings": {"eaik": {"not_applicable": "7 joints"}, "tracik": {"eps": 1e-5, "urdf": "panda.urdf"}}},
+               {"settings": {"eaik": {"version": "1.2.2", "urdf": "ur5.urdf"}, "tracik": {"eps": 2e-5},
+                             "optik": {"not_applicable": "prismatic joint"}}},
+               {"settings": {"eaik": {"version": "9"}, "optik": {"not_applicable": "another"}}}]
+    assert entry_settings(tracked) == {"eaik": {"version": "1.2.2"}, "tracik": {"eps": 1e-5},
+                                       "optik": {"not_applicable": "prismatic joint"}}

@@ -87,6 +87,26 @@ def robots_summary(folder: str | Path, timeout_ms: float = 20.0) -> pd.DataFrame
     return summarise_board(read_stored_csv(folder, "leaderboard-robots.csv"), timeout_ms)
 
 
+def summarise_throughput(throughput: pd.DataFrame) -> pd.DataFrame:
+    """Per (solver, reference, batch size) of a board's ``throughput.csv``: the arms (or
+    mechanisms) it answered, its queries per second and its ratio to the reference's one-per-call
+    rate (median over the arms), and its success at each rung (mean over the arms, in per cent);
+    the solvers in the file's order, batches ascending. An entry on the throughput track only
+    (pytorch-kinematics) is on the page through this table."""
+    success = [c for c in throughput.columns if c.startswith("success_")]
+    g = throughput.groupby(["solver", "entry", "reference", "batch"], sort=False)
+    out = g[success].mean().mul(100)
+    out["arms"] = g["robot"].nunique()
+    out["queries_per_s"] = g["queries_per_s"].median()
+    out["reference_queries_per_s"] = g["reference_queries_per_s"].median()
+    out["ratio"] = g["ratio"].median()
+    order = {s: k for k, s in enumerate(throughput["solver"].unique())}
+    out = out.reset_index()
+    out = out.assign(_o=out["solver"].map(order)).sort_values(["_o", "reference", "batch"], kind="stable")
+    return out.drop(columns="_o").reset_index(drop=True)[
+        ["solver", "entry", "reference", "batch", "arms", "queries_per_s", "reference_queries_per_s", "ratio", *success]]
+
+
 def fk_robots(board: pd.DataFrame) -> set:
     """The parallel mechanisms of a per-robot board (FK rows: they count other assembly modes)."""
     if "other_mode" not in board:
@@ -127,9 +147,12 @@ def summarise_board(board: pd.DataFrame, timeout_ms: float, fk: bool = False) ->
 
 def family_advice(board: pd.DataFrame, families: dict[str, str]) -> pd.DataFrame:
     """Per arm family (``families``: robot -> its problem class, e.g. serial-ik-7dof), the
-    solver to use at the family's largest timeout: the first row of :func:`summarise_board` over
-    the family's arms (success at the board's rung, mean over the arms, then median time ratio).
-    Columns family, arms (names), timeout_ms, then the summary's columns of that solver."""
+    solver to use at the family's largest timeout: among the entries that take every arm of the
+    family (a package that cannot take one of them, a "not applicable" cell, is no answer for
+    that arm's owner), the first row of :func:`summarise_board` over the family's arms (success
+    at the board's rung, mean over the arms, then median time ratio); the first row of all when
+    no entry takes every arm. Columns family, arms (names), timeout_ms, then the summary's
+    columns of that solver."""
     fk_set = fk_robots(board)
     rows = []
     for family in dict.fromkeys(families[r] for r in board["robot"].unique() if r in families):
@@ -139,7 +162,8 @@ def family_advice(board: pd.DataFrame, families: dict[str, str]) -> pd.DataFrame
         best = summarise_board(sub, timeout, fk=arms[0] in fk_set)
         if best.empty:
             continue
-        row = best.iloc[0].to_dict()
+        whole = best[best["not_applicable"] == 0]
+        row = (whole if not whole.empty else best).iloc[0].to_dict()
         rows.append({"family": family, "arms": ", ".join(arms), "timeout_ms": timeout,
                      **{k: v for k, v in row.items() if k != "arms"}})
     return pd.DataFrame(rows)

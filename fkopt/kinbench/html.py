@@ -118,6 +118,8 @@ def words(col: str, reference: str | None = None) -> str:
 def _cell(v, percent: bool = False, scale: float = 1.0) -> str:
     if isinstance(v, (bool, np.bool_)):
         return f'<td class="t">{"yes" if v else "no"}</td>'
+    if percent and isinstance(v, (int, np.integer)):
+        v = float(v)          # a share column read back from a CSV of whole numbers (0 and 1) is int
     if isinstance(v, (float, np.floating)):
         v = float(v) * scale
         if np.isnan(v):

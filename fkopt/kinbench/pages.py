@@ -33,7 +33,7 @@ from fkopt.files import file_names, parse_json, read_stored, read_stored_csv
 from fkopt.run.kinds import KINDS
 from fkopt.kinbench import html as H
 from fkopt.kinbench.runner import SuiteOwn
-from fkopt.kinbench.advice import class_advice, family_advice, fk_robots, summarise_board
+from fkopt.kinbench.advice import class_advice, family_advice, fk_robots, summarise_board, summarise_throughput
 from fkopt.kinbench.clock import entry_of
 from fkopt.kinbench.config import SuiteConfig
 from fkopt.kinbench.physical import LADDER, rung_label
@@ -50,6 +50,11 @@ PAGE_LIMIT = 500_000
 #: Detail pages are filled up to this, leaving room for the page's frame.
 _FILL = PAGE_LIMIT - 40_000
 INDEX = "index.html"
+#: What the CPU column measures beside the time to an answer (the two differ by design at a timeout).
+CPU_NOTE = ("CPU time per call: the process's CPU time over the whole call (every thread a package starts), also "
+            "past the timeout when a package's call cannot be stopped (one ikpy call); the time to an answer "
+            "counts a failure at the timeout. On one core, CPU time far below the call's wall time would show a "
+            "run the scheduler distorted (answers.csv.gz has both per call).")
 
 
 @dataclass
@@ -129,9 +134,10 @@ def _settings_text(settings) -> str:
 
 
 def documented_settings(name: str) -> str:
-    """An entry's settings as its wrapper documents them (the "Settings:" paragraph of its
-    module's docstring, else its class's first paragraph: the organiser's entries), read from
-    fkopt's source through the solver registry, or "" when fkopt has no solver of that name."""
+    """An entry's settings as its wrapper documents them (from "Settings:" in its module's
+    docstring to the end of that paragraph, with the list that follows a paragraph ending in a
+    colon; else its class's first paragraph: the organiser's entries), read from fkopt's source
+    through the solver registry, or "" when fkopt has no solver of that name."""
     import importlib
     import inspect
     entry = solver_entry(name)
@@ -140,8 +146,14 @@ def documented_settings(name: str) -> str:
     paras = []
     for doc in (inspect.getdoc(importlib.import_module(entry.make.__module__)), inspect.getdoc(entry.make)):
         paras = [" ".join(p.split()) for p in (doc or "").split("\n\n")]
-        chosen = next((p for p in paras if p.startswith("Settings:")), None)
-        if chosen is not None:
+        at = next((k for k, p in enumerate(paras) if "Settings:" in p), None)
+        if at is not None:
+            chosen = paras[at][paras[at].index("Settings:"):]
+            if chosen.endswith(":"):         # "... except:" then its list as paragraphs of their own
+                for item in paras[at + 1:]:
+                    if not item.startswith("* "):
+                        break
+                    chosen += " " + item
             break
     else:
         chosen = paras[0] if paras else ""
@@ -149,9 +161,10 @@ def documented_settings(name: str) -> str:
     return chosen.replace("``", "").replace("`", "")
 
 
-def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
-    """Every clock-track entry's settings: recorded in meta.json (``settings``: solver -> its
-    settings) when the board recorded them, else as fkopt's wrapper documents them."""
+def clock_settings_section(sr, answers: pd.DataFrame | None, throughput: pd.DataFrame | None = None) -> Section:
+    """Every entry's settings, the clock track's and the throughput track's own (such as
+    pytorch-kinematics'): as recorded in meta.json (``entries``: solver -> the settings its wrapper
+    ran with) when the board recorded them, beside the wrapper's documented settings and reasons."""
     c, meta = sr.config, meta_of(sr)
     clock, tp = c.tracks.clock, c.tracks.throughput
     rung = H.rung_words(_rung_label(clock.rung))
@@ -160,33 +173,40 @@ def clock_settings_section(sr, answers: pd.DataFrame | None) -> Section:
                f"{', '.join(f'{t:g}' for t in clock.fk_timeouts_ms)} ms (FK); times as ratios to {clock.reference} (IK) "
                f"and {clock.fk_reference} (FK) on the same query in the same process; the board's rung {rung}; "
                f"seed {c.seed}." + (f" Throughput track: batches {tp.batches} (FK {tp.fk_batches}), best of "
-                                    f"{tp.repeats} calls." if tp is not None else ""))]
-    recorded = meta.get("settings") if isinstance(meta.get("settings"), dict) else {}
+                                    f"{tp.repeats} calls." if tp is not None else "")),
+            _p("Each outside entry's own published protocol and figures, kinbench's reproduction of them on this "
+               "machine (or why a figure is not reproduced) and every difference from the package's defaults with its "
+               "reason: docs/kinbench.md, \"Outside entries: each as its authors run it\".", "note")]
+    recorded = meta.get("entries") if isinstance(meta.get("entries"), dict) else {}
     names = list(dict.fromkeys([clock.reference, *clock.solvers, clock.fk_reference, *clock.fk_solvers]
                                + ([] if answers is None else list(answers["solver"].unique()))))
+    batched = [] if tp is None else [n for n in tp.solvers if n not in names]
+    if throughput is not None and "solver" in throughput:      # a throughput-only entry the table holds
+        batched = [n for n in batched if n in set(throughput["solver"])]
     rows = []
-    for name in names:
-        if answers is not None and name not in set(answers["solver"]):
+    for name in names + batched:
+        if name not in batched and answers is not None and name not in set(answers["solver"]):
             continue
         limit = "not run"
-        if answers is not None:
+        if name in batched:
+            limit = "throughput track only: each batch in one call, no timeout"
+        elif answers is not None:
             given = answers.loc[answers["solver"] == name, "given_timeout_ms"]
             limit = ("yes: run once per timeout, stopped by it" if given.notna().any()
                      else "no: run once to its own limits, judged at each timeout")
-        if name in recorded:
-            text, where = _settings_text(recorded[name]), "recorded with the board (meta.json)"
-        else:
-            text = documented_settings(name)
-            where = "fkopt's wrapper as documented in its source (not recorded with this board)" if text else "not recorded"
+        ran = _settings_text(recorded[name]) if name in recorded else "not recorded with this board"
+        documented = documented_settings(name) or "-"
         sub = next((s for s in clock.submissions if s.solver == name), None)
         if sub is not None:
-            text, where = f"submitted: {sub.description} (machine: {sub.machine})", "the submission (config)"
+            ran, documented = f"submitted: {sub.description} (machine: {sub.machine})", "the submission (config)"
         known = solver_entry(name)
         rows.append({"solver": name, "entry": entry_of(name), "package": known.package if known is not None else "-",
-                     "wall-clock limit": limit, "settings": text, "from": where})
-    body.append(H.table_html(pd.DataFrame(rows), ["solver", "entry", "package", "wall-clock limit", "settings", "from"],
-                             "settings-table", labels={"wall-clock limit": "wall-clock limit",
-                                                       "settings": "settings", "from": "settings from"}))
+                     "wall-clock limit": limit, "recorded": ran, "documented": documented})
+    cols = ["solver", "entry", "package", "wall-clock limit", "recorded", "documented"]
+    body.append(H.table_html(pd.DataFrame(rows), cols, "settings-table",
+                             labels={"wall-clock limit": "wall-clock limit",
+                                     "recorded": "settings the board ran with (meta.json entries)",
+                                     "documented": "settings and reasons as the wrapper documents them"}))
     return Section("settings", "Settings of every entry", body)
 
 
@@ -210,6 +230,29 @@ def suite_settings_section(sr) -> Section:
     return Section("settings", "Settings of every entry", body)
 
 
+def throughput_section(throughput: pd.DataFrame | None) -> Section | None:
+    """The throughput track on the page: per solver and batch size, queries per second beside the
+    reference's one-query calls, over the arms (:func:`fkopt.kinbench.advice.summarise_throughput`);
+    None when the board has no throughput table."""
+    if throughput is None or throughput.empty:
+        return None
+    table = summarise_throughput(throughput)
+    success = [col for col in table.columns if col.startswith("success_")]
+    note = ("Batched calls: each solver answers b queries in one call (best of the track's repeats), beside the "
+            "reference answering them one call each, timed right after on the same queries; median over the arms "
+            "of queries per second and of the ratio, success (kinbench's FK) mean over the arms. Every core "
+            "allowed (the clock track is one core). An entry that takes batches only (such as "
+            "pytorch-kinematics) is on this track alone.")
+    return Section("throughput", "Throughput (batched calls)", [
+        _p(note, "note"),
+        H.table_html(table, ["solver", "entry", "reference", "batch", "arms", "queries_per_s",
+                             "reference_queries_per_s", "ratio", *success], "throughput-table", shares=False,
+                     labels={"batch": "queries per call", "arms": "arms", "reference": "reference (one query per call)",
+                             "queries_per_s": "queries per second (median over arms)",
+                             "reference_queries_per_s": "reference's queries per second (median over arms)",
+                             "ratio": "ratio of the rates (median over arms)"})])
+
+
 def _rung_label(rung: int) -> str:
     return rung_label(LADDER[rung])
 
@@ -227,8 +270,9 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
     extra = ["cpu_ms_median"] if "cpu_ms_median" in fam else []
     rung = H.rung_words(str(board["rung"].iloc[0]))
     advice = Section("advice", "Which solver for my arm", [
-        _p(f"Best success at {rung} (mean over the family's arms), then median time ratio; answers checked by "
-           "kinbench's FK, a failure counted at the timeout.", "note"),
+        _p(f"Among the entries that take every arm of the family: best success at {rung} (mean over the family's "
+           "arms), then median time ratio; answers checked by kinbench's FK, a failure counted at the timeout.",
+           "note"),
         H.table_html(fam.assign(n_arms=fam["arms"].str.count(",") + 1),
                      ["family", "n_arms", "solver", "timeout_ms", *success, "median_ms", *extra, "median_ratio"],
                      "advice-table", shares=False, labels={"n_arms": "arms", "family": "arm family (joints)",
@@ -244,6 +288,8 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
             *(["cpu_ms_median"] if "cpu_ms_median" in summary else []), "median_ratio"]
     note = (f"FK at a {t:g} ms timeout, success mean over the mechanisms an entry ran." if fk_only else
             f"IK at a {t:g} ms timeout, success mean over the arms an entry ran (README's table).")
+    if "cpu_ms_median" in summary:
+        note += " " + CPU_NOTE
     body = [_p(note, "note"),
             H.table_html(summary, cols, "summary-table", shares=False,
                          labels={"median_ratio": f"median time ratio to {clock.reference}"})]
@@ -396,11 +442,12 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
         arms = pack("arms", arm_sections(sr, folder, robots))
         written += [detail_page(folder, name, f"{c.name}: every arm on the clock",
                                 "Per arm: every entry at every timeout (the rows of leaderboard-robots.csv), and "
-                                "its figure. " + ROBOTS_PREAMBLE, secs) for name, secs in arms]
+                                "its figure. " + ROBOTS_PREAMBLE
+                                + (" " + CPU_NOTE if "cpu_ms_median" in robots else ""), secs) for name, secs in arms]
         links = [f"{_link(f'{name}#{s.ident}', s.title)}" for name, secs in arms for s in secs]
         details.append(Section("arms", "Per arm", [_p("Every entry at every timeout on each arm, with its figure:", "note"),
                                                    "<p>" + " · ".join(links) + "</p>"]))
-        settings = clock_settings_section(sr, answers)
+        settings = clock_settings_section(sr, answers, tables.get("throughput.csv"))
         figures = [folder / "clock_all.png"] + sorted(p for p in folder.glob("ecdf_*.png"))
     else:
         advice, summary, lead_png = evaluations_lead(sr, tables)
@@ -428,7 +475,8 @@ def write_pages(sr, folder: Path, tables: dict) -> list[str]:
     files_sec = Section("files", "Files", [_p("The tables behind this page (column names as in the CSVs):", "note"),
                                           "<p>" + " · ".join(_link(f, f) for f in files) + "</p>"])
     machine = machine_section(sr)
-    sections = [advice, summary, figs, settings, machine, *details, files_sec]
+    rates = throughput_section(tables.get("throughput.csv")) if robots is not None and not robots.empty else None
+    sections = [advice, summary, figs, *([rates] if rates is not None else []), settings, machine, *details, files_sec]
     caption = ("Every IK arm pooled; each arm's on the Per arm page." if robots is not None and not robots.empty
                else "Every problem of the first board.")
     lead_fig = H.img(lead_path, caption, lazy=False) if lead_path.exists() else ""

@@ -189,6 +189,19 @@ def solve_track(payload: dict) -> dict:
             "settings": json.loads(json.dumps(settings, default=str))}
 
 
+def entry_settings(tracked: list[dict]) -> dict:
+    """meta.json's ``entries``: each entry's settings as on the first arm it ran on (less the arm's
+    own file); an arm it cannot take records only why (``not_applicable``), which stands only for
+    an entry that ran on no arm."""
+    entries: dict = {}
+    for r in tracked:
+        for solver, st in (r.get("settings") or {}).items():
+            if solver in entries and (set(st) == {"not_applicable"} or set(entries[solver]) != {"not_applicable"}):
+                continue
+            entries[solver] = {k: v for k, v in st.items() if k not in ("urdf", "urdf_note", "family")}
+    return entries
+
+
 def load_average() -> list[float] | None:
     """The machine's 1-, 5- and 15-minute load averages (None where the OS has none): stored in
     meta.json at the board's start and end, so anyone can see a run the scheduler distorted."""
@@ -418,10 +431,7 @@ def merge_suite(config: SuiteConfig, plan: Plan, ran: Ran, *, source: str | None
     wall = ctx.prepared_s + ran.wall_s + (time.perf_counter() - merging)   # however long before it was planned
     loads = [r["load_avg"] for r in tracked if r.get("load_avg")]
     load_avg = {"start": loads[0]["start"], "end": loads[-1]["end"]} if loads else None
-    entries: dict = {}                # each entry's settings as on its first arm (less the arm's own file)
-    for r in tracked:
-        for solver, st in (r.get("settings") or {}).items():
-            entries.setdefault(solver, {k: v for k, v in st.items() if k not in ("urdf", "urdf_note", "family")})
+    entries = entry_settings(tracked)
     own = SuiteOwn(ctx.manifest, ctx.files, answers, throughput, load_avg, entries or None,
                    branch_tracks.merge_tables(config, plan, ran))
     return RunResult(config, runs, tim, suite_trace(config, done, runs, ctx.files), own, wall, source,
