@@ -294,6 +294,11 @@ def test_the_advice_per_family_never_names_an_entry_that_cannot_take_one_of_its_
     advice = family_advice(sub, families).set_index("family").loc["serial-ik-8to10dof"]
     if leader["not_applicable"] > 0:                  # the stored board: OptIK first on the arms it takes
         assert advice["solver"] != leader["solver"]
+        # ... and named beside the advice with the arms it takes, not hidden
+        assert advice["leads_where_it_applies"].startswith(f"{leader['solver']}: ")
+        assert f"on {int(leader['arms'])} of {len(family)} arms" in advice["leads_where_it_applies"]
+    else:
+        assert advice["leads_where_it_applies"] == ""
     assert advice["not_applicable"] == 0
     assert advice["solver"] == ranked[ranked["not_applicable"] == 0].iloc[0]["solver"]
 

@@ -152,7 +152,9 @@ def family_advice(board: pd.DataFrame, families: dict[str, str]) -> pd.DataFrame
     that arm's owner), the first row of :func:`summarise_board` over the family's arms (success
     at the board's rung, mean over the arms, then median time ratio); the first row of all when
     no entry takes every arm. Columns family, arms (names), timeout_ms, then the summary's
-    columns of that solver."""
+    columns of that solver, then ``leads_where_it_applies``: the first row of all when it is
+    another entry (one that cannot take every arm), its success, median time and arm count, else
+    empty."""
     fk_set = fk_robots(board)
     rows = []
     for family in dict.fromkeys(families[r] for r in board["robot"].unique() if r in families):
@@ -164,8 +166,15 @@ def family_advice(board: pd.DataFrame, families: dict[str, str]) -> pd.DataFrame
             continue
         whole = best[best["not_applicable"] == 0]
         row = (whole if not whole.empty else best).iloc[0].to_dict()
+        top = best.iloc[0]
+        top_success = top[f"success_{sub['rung'].iloc[0]}"]
+        # the entry that leads on the arms it takes, when that is not every arm: named beside the
+        # advice, so that a faster package is not hidden by the arms it cannot take
+        partial = "" if top["solver"] == row["solver"] else (
+            f"{top['solver']}: {top_success:.1f} %, {top['median_ms']:.3g} ms "
+            f"on {int(top['arms'])} of {len(arms)} arms (not applicable on {int(top['not_applicable'])})")
         rows.append({"family": family, "arms": ", ".join(arms), "timeout_ms": timeout,
-                     **{k: v for k, v in row.items() if k != "arms"}})
+                     **{k: v for k, v in row.items() if k != "arms"}, "leads_where_it_applies": partial})
     return pd.DataFrame(rows)
 
 

@@ -274,8 +274,10 @@ def robots_lead(sr, board: pd.DataFrame) -> tuple[Section, Section, str]:
            "arms), then median time ratio; answers checked by kinbench's FK, a failure counted at the timeout.",
            "note"),
         H.table_html(fam.assign(n_arms=fam["arms"].str.count(",") + 1),
-                     ["family", "n_arms", "solver", "timeout_ms", *success, "median_ms", *extra, "median_ratio"],
+                     ["family", "n_arms", "solver", "timeout_ms", *success, "median_ms", *extra, "median_ratio",
+                      *(["leads_where_it_applies"] if "leads_where_it_applies" in fam else [])],
                      "advice-table", shares=False, labels={"n_arms": "arms", "family": "arm family (joints)",
+                                                     "leads_where_it_applies": "leads on the arms it takes",
                                                      "median_ratio": f"median time ratio to {clock.reference} "
                                                                      f"(FK: {clock.fk_reference})"}),
         "<details><summary>arms of each family</summary>" + "".join(
