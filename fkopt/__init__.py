@@ -70,13 +70,13 @@ sys.modules[__name__].__class__ = _Package
 
 def mechanism(name: str, **geometry):
     """A registered mechanism with optional geometry overrides (and ``bounds={var: [lo, hi]}``)."""
-    from fkopt.registry import mechanism_class    # the registry imports every built-in class: on first use
+    from fkopt.registry import mechanism_class    # lazy: the registry imports every built-in class: on first use
     return mechanism_class(name)(**geometry)
 
 
 def algorithm(name: str, **params):
     """A registered algorithm with validated parameters."""
-    from fkopt.registry import algorithm_class     # the same: on first use
+    from fkopt.registry import algorithm_class     # lazy: the same: on first use
     return algorithm_class(name)(**params)
 
 

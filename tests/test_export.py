@@ -248,6 +248,12 @@ HOSTILE = {
         {k: v for k, v in json.loads((d / "meta.json").read_text()).items() if k != "mechanism"})),
         ["meta.json", "no 'mechanism'"]),
     "meta not json": (lambda d: (d / "meta.json").write_text("{oops"), ["meta.json", "cannot read"]),
+    # the experiment's own loader (Kind.ioh_functions) names what is missing and what to do
+    "no trace": (lambda d: (d / "trace.csv.gz").unlink(), ["no trace.csv.gz", "rerun the experiment to export it"]),
+    # a kind no registered Kind answers to: one line, not the experiment's loader by default
+    "unknown kind": (lambda d: (d / "meta.json").write_text(json.dumps(
+        {**json.loads((d / "meta.json").read_text()), "kind": "board\n" + "x" * 80})),
+        ["meta.json", "kind 'board x", "is not one this fkopt knows"]),
     "decompression bomb": (lambda d: _bomb(d / "trace.csv.gz", MAX_BYTES + (1 << 20)),
                            ["trace.csv.gz", f"unpacks to more than {MAX_BYTES // 1024 ** 2} MB"]),
 }

@@ -1532,13 +1532,13 @@ def test_export_keeps_pso_plus_lm_and_an_outside_pso_minus_lm_apart(tmp_path, cl
 def test_export_writes_one_folder_per_label(tmp_path):
     """The fast form of the test above: the export's writer, two functions, colliding labels."""
     import numpy as np
-    from fkopt.tools.export import Function, _write_function, algorithm_folders
+    from fkopt.run.iohformat import Function, algorithm_folders, write_function
     runs = [(1, np.array([1, 6]), np.array([5.0, 1e-12]), [0.0])]
     fns = [Function(name=f"p{i}__uniform", dim=1, instances=["0"], attributes=[],
                     algorithms={"pso+lm": ({}, runs), "pso-lm": ({}, runs), "pso lm": ({}, runs)}) for i in (1, 2)]
     folders = algorithm_folders(label for fn in fns for label in fn.algorithms)
     for fid, fn in enumerate(fns, start=1):
-        _write_function(tmp_path, fid, fn, folders)
+        write_function(tmp_path, fid, fn, folders)
     indexes = sorted(tmp_path.glob("*/IOHprofiler_f*.json"))
     by_folder = {}
     for p in indexes:

@@ -34,7 +34,7 @@ def adapter_class(library: str, method: str):
     The library itself is imported here (so a missing optional install fails at validation,
     with the install hint), but no optimiser runs.
     """
-    from fkopt.adapters import base      # its pydantic models: not at every command's start-up (the registry)
+    from fkopt.adapters import base      # lazy: its pydantic models: not at every command's start-up (the registry)
     if library not in base.LIBRARY_MODULES:  # pragma: no cover - registry only routes the reserved prefixes here
         raise FkoptError(f"no adapter for '{library}:'")
     target = base.LIBRARY_MODULES[library].resolve(method)   # raises FkoptError for unknown names / missing installs

@@ -209,14 +209,14 @@ def _aux(state: ABCState, problem) -> _Aux:
 
 def _compiled_iteration(fitness):
     """:func:`fkopt.algorithms.abc_kernels.abc_iteration` on a mechanism's compiled fitness."""
-    from fkopt.algorithms.abc_kernels import abc_iteration   # imports numba: only once the compiled path runs
+    from fkopt.algorithms.abc_kernels import abc_iteration   # lazy: imports numba: only once the compiled path runs
     return abc_iteration(fitness)
 
 
 def _compiled_iterations(fitness):
     """:func:`fkopt.algorithms.abc_kernels.abc_iterations` on a mechanism's compiled fitness (None
     without numpy's ufunc loop)."""
-    from fkopt.algorithms.abc_kernels import abc_iterations  # imports numba: only once the compiled path runs
+    from fkopt.algorithms.abc_kernels import abc_iterations  # lazy: imports numba: only once the compiled path runs
     return abc_iterations(fitness)
 
 
@@ -311,7 +311,7 @@ class ABC(Algorithm):
         :data:`fkopt.algorithms.abc_kernels.ITERATIONS_UNIFORMS` uniforms allow, at least one); the
         draws of iteration t are the block :meth:`_iterate_compiled` draws, taken for all k in one
         call (the same values: a stream hands out its values in order). Returns k."""
-        from fkopt.algorithms.abc_kernels import ITERATIONS_UNIFORMS
+        from fkopt.algorithms.abc_kernels import ITERATIONS_UNIFORMS  # lazy: numba
         width, J, best_x, best_f, C = self._compiled_inputs(state, problem, rule)
         runs = state.f.shape[0]
         k = max(1, min(last + 1 - first, ITERATIONS_UNIFORMS // (runs * width)))

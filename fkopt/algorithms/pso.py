@@ -66,7 +66,7 @@ class PSOState(State):
 
 def _compiled_iteration(fitness):
     """:func:`fkopt.algorithms.pso_kernels.pso_iteration` on a mechanism's compiled fitness."""
-    from fkopt.algorithms.pso_kernels import pso_iteration   # imports numba: only once the compiled path runs
+    from fkopt.algorithms.pso_kernels import pso_iteration   # lazy: imports numba: only once the compiled path runs
     return pso_iteration(fitness)
 
 

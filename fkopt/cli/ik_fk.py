@@ -3,10 +3,9 @@
 algorithm), the answer printed as lines or one JSON object; exit 1 when it is not a solution
 within the tolerances, 2 for bad input.
 
-``fkopt.forward`` and ``fkopt.inverse`` are loaded with the registry anyway; the solvers by algorithm
-(:mod:`fkopt.kinematics.by_algorithm`) and all assembly modes (:mod:`fkopt.kinematics.assembly_modes`)
-are imported by the branch that uses them: ``fkopt --help`` and a parallel mechanism's closed-form
-``fkopt ik`` never load them (docs/design.md, "Start-up")."""
+``fkopt.forward``, ``fkopt.inverse`` and the assembly-mode search are loaded with the registry
+anyway; the solvers by algorithm (:mod:`fkopt.kinematics.by_algorithm`, ~2 ms of imports) are
+imported at the top too (docs/design.md, "Start-up")."""
 from __future__ import annotations
 
 import sys
@@ -21,6 +20,8 @@ from fkopt.cli.entry_point import app, console
 from fkopt.errors import FkoptError
 from fkopt.files import strict_json
 from fkopt.kinematics import inverse as inverse_solutions      # inverse(..., solutions="all")
+from fkopt.kinematics.assembly_modes import all_solutions as find_all, solutions_to_dict
+from fkopt.kinematics.by_algorithm import forward_by, inverse_by
 from fkopt.kinematics.solvers import forward, inverse
 from fkopt.numerics.rotations import zyz_angles
 
@@ -103,7 +104,6 @@ def ik(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
                 as_json)
         return
     if algorithm:
-        from fkopt.kinematics.by_algorithm import inverse_by
         if serial_frame:       # the swarms' objective takes Z-Y-Z angles: the target's, exactly as given
             R = target[:3, :3]
             values = np.concatenate([target[:3, 3], np.degrees(zyz_angles(tuple(tuple(r) for r in R)))])
@@ -188,7 +188,6 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise FkoptError(f"--tolerance: must be a positive number, got {tolerance}")
     if all_solutions:
-        from fkopt.kinematics.assembly_modes import all_solutions as find_all, solutions_to_dict
         # One search per process: the homotopy's compiled tracker and start system (~1 s to load)
         # cost more than the restart search takes (~0.2 s), so a one-shot call runs the restarts.
         found = find_all(m, values, seed=seed, method="restarts")
@@ -201,7 +200,6 @@ def fk(mech: str = typer.Argument(..., help="mechanism name (fkopt list)"),
                 console().print(s)
         return
     if algorithm:
-        from fkopt.kinematics.by_algorithm import forward_by
         r = forward_by(m, values, algorithm, tol=tolerance, seed=seed)
         out = r.as_dict()
         out.pop("stage")

@@ -21,8 +21,8 @@ from fkopt.files import no_empty_folders_left
 
 def _engine():
     """The engine (:mod:`fkopt.run.pipeline`) with every built-in kind of config registered."""
-    import fkopt.kinbench  # noqa: F401 (registers every built-in kind of config)
-    from fkopt.run import pipeline
+    import fkopt.kinbench  # lazy: noqa: F401 (registers every built-in kind of config)
+    from fkopt.run import pipeline  # lazy: the engine pulls pandas (start-up of the light commands)
     return pipeline
 
 
@@ -91,7 +91,7 @@ def _run_files(files, out: Path, *, jobs: int, executor: str, scheduler: str | N
 
 def _run_checked(files, out: Path, *, jobs: int, executor: str, scheduler: str | None, resume: bool,
                  force: bool, quiet: bool, command: str, quick: bool) -> None:
-    from fkopt.run.executors import validate_executor
+    from fkopt.run.executors import validate_executor  # lazy: the engine's executors (start-up)
     pipeline = _engine()
     validate_executor(executor, jobs, scheduler)
     planned, folders = [], {}
@@ -164,5 +164,5 @@ def schema(kind: str = typer.Argument("experiment", help="experiment | study | a
     file: the committed copies are docs/schema/<kind>.json) is validated and completed by editors
     using yaml-language-server. Every field is described in docs/config-reference.md."""
     _engine()                    # every built-in kind registered: each has its schema
-    from fkopt.run.config_reference import schema_text
+    from fkopt.run.config_reference import schema_text  # lazy: the config reference (pydantic models of every kind)
     typer.echo(schema_text(kind), nl=False)

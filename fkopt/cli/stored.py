@@ -40,9 +40,9 @@ def reproduce(configs: Path = typer.Option(Path("configs"), "--configs", help="f
     they are; the last line says how many deterministic files moved from the stored ones and
     whether fkopt check's cross-platform rules accept them. --out results rewrites the stored
     results (make reproduce)."""
-    from fkopt.reproduce.changes import agreement, snapshot
-    from fkopt.reproduce.report import write_report
-    from fkopt.reproduce.run import default_jobs, plan, run_all
+    from fkopt.reproduce.changes import agreement, snapshot  # lazy: reproduce pulls pandas and matplotlib (start-up)
+    from fkopt.reproduce.report import write_report  # lazy: as above
+    from fkopt.reproduce.run import default_jobs, plan, run_all  # lazy: as above
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
@@ -128,9 +128,9 @@ def report(results: Path = typer.Argument(Path("results"), help="results root"),
            changes_since: Optional[Path] = typer.Option(None, "--changes-since", help="also write CHANGES.md: "
                                                         "what moved since the state recorded in FILE")):
     """Regenerate REPORT.md, TIMING.md and index.csv from stored results (no rerun)."""
-    from fkopt.reproduce.changes import load_snapshot, save_snapshot, snapshot
-    from fkopt.reproduce.report import write_report
-    from fkopt.reproduce.store import Store
+    from fkopt.reproduce.changes import load_snapshot, save_snapshot, snapshot  # lazy: start-up (pandas)
+    from fkopt.reproduce.report import write_report  # lazy: as above
+    from fkopt.reproduce.store import Store  # lazy: as above
     Store(results).require_readable()
     if snapshot_to is not None:
         save_snapshot(snapshot(results), snapshot_to)
@@ -148,7 +148,7 @@ def pages(results: Path = typer.Argument(Path("results"), help="results root, or
                                        "(ECDFs, clock, scaling) from their stored tables")):
     """Rewrite every kinbench suite's pages (index.html, arms.html, rankings.html) and figures from
     its stored tables, config and meta.json: no solver runs, no table is written."""
-    from fkopt.kinbench.pages import regenerate, suite_folders
+    from fkopt.kinbench.pages import regenerate, suite_folders  # lazy: kinbench pulls pandas and matplotlib (start-up)
     for folder in suite_folders(results):
         names = regenerate(folder, figures=figures)
         typer.echo(f"{folder}: {len(names)} files ({', '.join(n for n in names if n.endswith('.html'))})")
@@ -175,8 +175,8 @@ def check(results: Path = typer.Argument(Path("results"), help="results root, a 
     rows no BLAS call touched stay exact and the rest follow the cross-platform rules of
     fkopt.run.compare (docs/regression.md). A missing or unreadable meta.json is a failure.
     """
-    from fkopt.reproduce.check import check_experiment, select, stored_tier
-    from fkopt.reproduce.store import locate
+    from fkopt.reproduce.check import check_experiment, select, stored_tier  # lazy: start-up (pandas)
+    from fkopt.reproduce.store import locate  # lazy: as above
     if tier not in ("auto", "exact", "blas", "any"):
         raise FkoptError(f"--tier: '{tier}' unknown; allowed: auto, exact, blas, any")
     if tolerant and tier not in ("auto", "blas"):

@@ -20,7 +20,7 @@ def export_cmd(results: Path = typer.Argument(..., help="results folder: one exp
                fmt: str = typer.Option("ioh", "--format", help="ioh: IOHprofiler data for IOHanalyzer"),
                out: Path = typer.Option(..., "--out", help="folder to write (outside RESULTS)")):
     """Export stored results for other tools (IOHanalyzer), without rerunning anything."""
-    from fkopt.tools.export import FORMATS, ioh_export
+    from fkopt.tools.export import FORMATS, ioh_export  # lazy: the export pulls pandas and kinbench (start-up)
     if fmt not in FORMATS:
         raise FkoptError(f"--format: unknown format '{fmt}'; allowed: {', '.join(FORMATS)}")
     files = ioh_export(results, out)
@@ -51,7 +51,7 @@ def bench(quick: bool = typer.Option(False, "--quick", help="short measurement (
     compiler is there), swarms (GABC, ABC, PSO at 1 and 100 cases beside the same C loop; pygmo's
     bee_colony with a numba fitness beside the batched ABC), scaling (population and runs; draws
     scaling.png). The last line gives the seconds per section."""
-    from fkopt.tools.bench.sections import SECTIONS, run as run_bench
+    from fkopt.tools.bench.sections import SECTIONS, run as run_bench  # lazy: start-up (every section)
     bad = [s for s in section if s not in SECTIONS]
     if bad:
         raise typer.BadParameter(f"unknown section {bad[0]!r}; allowed: {', '.join(SECTIONS)}",

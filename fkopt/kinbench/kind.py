@@ -10,6 +10,7 @@ from fkopt.run.tasks import work_folder  # noqa: F401 (where a suite's task file
 from fkopt.run.writers import CURVES, FIGURE, RUNS_FILE, STEPS, TABLE, TIMING, TRACE_FILE, Output
 from fkopt.kinbench.config import SuiteConfig, suite_from_dict
 from fkopt.kinbench.runner import merge_suite, suite_plan, validate_suite
+from fkopt.kinbench.traces import suite_functions
 from fkopt.kinbench.verify import reverify
 
 
@@ -63,6 +64,7 @@ def _recheck(folder: Path, config: SuiteConfig, meta: dict) -> list[tuple]:
 
 SUITE = register(Kind("suite", _from_dict, suite_plan, validate_suite, merge_suite, OUTPUTS, reports.meta, SuiteConfig,
                       _console, reproduced=False, recheck=_recheck, report_section=reports.report_section,
+                      ioh_functions=suite_functions,
                       # runs.csv keeps the layout of the frozen kinbench releases, whose stored folders
                       # are not rerun to add a column: a suite's seeds stay in its task files
                       not_in_runs=frozenset({"kind", "case", "task_seed"})))

@@ -19,7 +19,7 @@ best_so_far     the best fitness found so far, on the problem's fitness (see doc
 ==============  ==========================================================================
 
 **IOH** (what IOHexperimenter's ``Analyzer`` logger writes, read by
-:func:`fkopt.tools.iohformat.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
+:func:`fkopt.run.iohformat.read_ioh`): ``ioh`` is the logger's ``root`` (a folder of run folders, each
 with its ``IOHprofiler_f*.json`` index and ``.dat`` files); the function name is ``<problem>__<set>`` (two underscores),
 the instance is the pose index + 1, each logged run one run; the ``.dat`` lines are
 ``evaluations raw_y`` with raw_y the problem's fitness (minimised). ``algorithm`` picks one
@@ -45,7 +45,7 @@ from fkopt.files import MAX_INPUT_BYTES, csv_numbers, read_csv, read_input
 from fkopt.run.config_base import files_folder
 from fkopt.run.record import run_record
 from fkopt.kinbench.budget import at_budget, budget_of
-from fkopt.tools.iohformat import read_ioh
+from fkopt.run.iohformat import read_ioh
 
 COLUMNS = ("problem", "set", "pose", "run", "evaluations", "best_so_far")
 IOH_SEPARATOR = "__"

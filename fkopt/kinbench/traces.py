@@ -3,7 +3,7 @@
 One row per improvement of a run's best-so-far fitness within the suite's budget, at the exact
 evaluation at which it happened, as far as the solver reports it (the rules of an experiment's
 trace, :mod:`fkopt.run.trace`, whose :func:`~fkopt.run.trace.run_trace` builds
-the rows) -- what :func:`fkopt.tools.export.ioh_export` turns into IOHprofiler data:
+the rows) -- what :func:`suite_functions` turns into IOHprofiler data for ``fkopt export``:
 
 =============  ==========================================================================
 problem        problem name
@@ -29,15 +29,18 @@ get rows from their logged (evaluations, best so far) pairs the same way, an eva
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
-from fkopt.run.trace import FILE, history_events, run_trace
+from fkopt.run.iohformat import Function, stored_runs, trace_runs
+from fkopt.run.trace import FILE, history_events, read_trace, run_trace
 from fkopt.kinbench.budget import budget_of, last_within
 from fkopt.kinbench.outside import in_suite_order, logged_runs
 
-__all__ = ["FILE", "COLUMNS", "budget_trace", "task_trace", "outside_trace", "suite_trace"]
+__all__ = ["FILE", "COLUMNS", "budget_trace", "task_trace", "outside_trace", "suite_trace", "suite_functions"]
 
 COLUMNS = ("problem", "set", "pose", "solver", "run", "evaluations", "best_fitness")
 #: the columns that name a run
@@ -116,3 +119,48 @@ def suite_trace(config, done: list[dict], runs: pd.DataFrame, files=None) -> pd.
     if not frames:
         return pd.DataFrame(columns=list(COLUMNS))
     return pd.concat(frames, ignore_index=True)[list(COLUMNS)]
+
+
+def suite_functions(folder: Path, meta: dict) -> list[Function]:
+    """A suite folder as IOH functions for ``fkopt export`` (``Kind.ioh_functions``; the layout:
+    :mod:`fkopt.tools.export`): one function per problem, in the suite's order, one instance per
+    (set, pose) in set-then-pose order, one algorithm per solver (outside solvers included)."""
+    path, config = folder / "meta.json", meta["config"]
+    problems, sets = config.get("problems"), config.get("sets")
+    if not (isinstance(problems, list) and all(isinstance(p, dict) and isinstance(p.get("name"), str) for p in problems)
+            and isinstance(sets, list) and isinstance(config.get("name"), str)):
+        raise FkoptError(f"{path}: 'config' lacks the suite's 'name', 'problems' or 'sets'")
+    if not (folder / FILE).is_file():
+        raise FkoptError(f"{folder}: no {FILE} (suite results written before fkopt kept run traces); "
+                         "rerun the suite to export it")
+    trace = read_trace(folder, columns=COLUMNS)
+    runs = stored_runs(folder, KEYS + ["dim", "track"], ("problem", "set", "solver", "track"))
+    groups = trace_runs(folder, trace, runs, KEYS, lambda k: f"run {k[4]} of solver '{k[3]}', problem "
+                        f"'{k[0]}', set '{k[1]}', pose {k[2]}")
+    specs = {(s.get("label") or s.get("name")): s for s in config.get("solvers") or [] if isinstance(s, dict)}
+    outside = {o.get("solver"): o for o in config.get("outside") or [] if isinstance(o, dict)}
+    set_order = {s: j for j, s in enumerate(sets)}
+    out = []
+    for problem in problems:
+        rp = runs[runs["problem"] == problem["name"]]
+        if rp.empty:
+            continue
+        inst = sorted(set(zip(rp["set"], rp["pose"])), key=lambda sp: (set_order.get(sp[0], len(sets)), sp[0], sp[1]))
+        number = {sp: i for i, sp in enumerate(inst, start=1)}
+        fn = Function(problem["name"], int(rp["dim"].iloc[0]), [f"{s}/{p}" for s, p in inst],
+                      [{"benchmark": f"{config.get('paper') or 'kinbench'}/{config['name']}"},
+                       {"problem_class": str(problem.get("problem_class", ""))}, {"source": str(folder)}])
+        for label in dict.fromkeys(rp["solver"]):
+            rs = rp[rp["solver"] == label]
+            spec = specs.get(label)
+            info = ({"name": spec.get("name", label), "params": spec.get("params", {})} if spec is not None else
+                    {"name": label, "outside": outside.get(label, {}).get("file") or outside.get(label, {}).get("ioh")})
+            info.update(track=str(rs["track"].iloc[0]))
+            order = sorted(zip(rs["set"], rs["pose"], rs["run"]), key=lambda k: (number[k[:2]], k[2]))
+            runs_l = []
+            for s, p, r in order:
+                rows = groups[(problem["name"], s, p, label, r)]
+                runs_l.append((number[(s, p)], rows["evaluations"].to_numpy(), rows["best_fitness"].to_numpy(), []))
+            fn.algorithms[label] = (info, runs_l)
+        out.append(fn)
+    return out

@@ -34,6 +34,7 @@ from pydantic import Field, field_validator
 
 from fkopt.algorithms.base import Algorithm, Params, RunRecord
 from fkopt.errors import FkoptError
+from fkopt.kinematics.assembly_modes import all_solutions as assembly_modes, prepare
 from fkopt.kinematics.branches import ALL_TOL, inverse_all, locked_sets
 from fkopt.kinematics.solvers import forward, inverse
 from fkopt.progress import tick
@@ -117,7 +118,6 @@ class ExactSolver(Algorithm):
         platform's compiled homotopy tracker and start system (a serial arm's kernels load on its
         first search, as before)."""
         if mech.kind == "parallel":
-            from fkopt.kinematics.assembly_modes import prepare
             prepare(mech)
 
     def solution_set(self, mech, inputs: np.ndarray, seed: int) -> SolutionSet:
@@ -146,8 +146,6 @@ class ExactSolver(Algorithm):
                                 "evaluations": int(search["evaluations"]), "distinct": int(search["distinct"]),
                                 "out_of_limits": int(search["out_of_limits"]),
                                 "unverified": int(search["unverified"])})
-        # start-up: the registry loads this module for every command; the search's ~10 ms of imports only here
-        from fkopt.kinematics.assembly_modes import all_solutions as assembly_modes
         given = {"tol": p.tol} if "tol" in p.model_fields_set else {}
         found = assembly_modes(mech, np.asarray(inputs, dtype=float), seed=int(seed), **given)
         poses = found.poses()

@@ -221,7 +221,7 @@ class ThreeRPS(ParallelMechanism):
         if numerics_path.requested() != "compiled":
             return None
         numerics_path.compiled(True)
-        from fkopt.mechanisms import rps3_kernels      # imports numba: only once the compiled path runs
+        from fkopt.mechanisms import rps3_kernels      # lazy: imports numba: only once the compiled path runs
         return rps3_kernels.fitness(poses, rows, self.geometry.ra, self.geometry.rb, absolute, BLOCK)
 
     def compiled_swarm_fitness(self) -> CompiledFitness | None:
@@ -233,7 +233,7 @@ class ThreeRPS(ParallelMechanism):
         first swarm iteration on this mechanism, never for a single fitness call."""
         if numerics_path.compiled() is None:
             return None
-        from fkopt.mechanisms import rps3_kernels      # imports numba: only once the compiled path runs
+        from fkopt.mechanisms import rps3_kernels      # lazy: imports numba: only once the compiled path runs
         k = rps3_kernels
         return CompiledFitness(prepare=k.prepare, ufunc=k.numpy_tan, value=k.value, width=2, block=BLOCK,
                                params=(float(self.geometry.ra), float(self.geometry.rb)),

@@ -38,6 +38,8 @@ def config_kind(config) -> Kind:
 
 
 def stored_kind(meta: dict) -> Kind | None:
-    """The kind of a stored result from its meta.json (None: a kind not registered here)."""
+    """The kind of a stored result from its meta.json (None: a kind not registered here, or a
+    ``kind`` that is not a name)."""
     config = meta.get("config") if isinstance(meta.get("config"), dict) else {}
-    return KINDS.get(meta.get("kind") or config.get("kind") or "experiment")
+    name = meta.get("kind") or config.get("kind") or "experiment"
+    return KINDS.get(name) if isinstance(name, str) else None

@@ -115,6 +115,9 @@ class Kind:
     recheck: Callable[[Any, Any, dict], list] | None = None
     #: (stored result, results root) -> its section of REPORT.md (None: the experiment section)
     report_section: Callable[[Any, Any], str] | None = None
+    #: (folder, meta) -> the IOH functions of a stored folder (:class:`fkopt.run.iohformat.Function`)
+    #: that ``fkopt export`` writes; None: no per-run trace to export (a study, an assembly search)
+    ioh_functions: Callable[[Any, dict], list] | None = None
     #: record columns its runs.csv leaves out: those its folder fixes (one kind, one problem) and
     #: those it names otherwise (:func:`fkopt.run.record.runs_table`)
     not_in_runs: frozenset = frozenset()

@@ -7,6 +7,7 @@ from fkopt.kinds.experiment.config import ExperimentConfig, experiment_from_dict
 from fkopt.kinds.experiment.runner import (build_cases, build_problem, experiment_plan, keeps_x_history, merge_experiment,
                                            one_answer_entries)
 from fkopt.kinds.experiment import reports
+from fkopt.kinds.experiment.ioh_functions import experiment_functions
 from fkopt.run.kinds import register
 from fkopt.run.record import ALGORITHM_NAMES
 from fkopt.run.solving import build_mechanism
@@ -65,5 +66,6 @@ OUTPUTS = (
 EXPERIMENT = register(Kind("experiment", _experiment_from_dict, experiment_plan, _experiment_validate,
                            merge_experiment, OUTPUTS, reports.meta, ExperimentConfig,
                            console=reports.console, stored_problems=_stored_problems,
+                           ioh_functions=experiment_functions,
                            # runs.csv: its case label names the pose; one problem per folder
                            not_in_runs=frozenset({"kind", "problem", "pose"}), file_names=ALGORITHM_NAMES))

@@ -168,6 +168,16 @@ def solutions_table(er: RunResult) -> pd.DataFrame | None:
 
 
 def convergence_table(er: RunResult) -> pd.DataFrame | None:
+    """``convergence.csv``: per (case, algorithm) and iteration, the median, quartiles, min and max
+    over the runs of the best-so-far fitness the algorithm *keeps* (each solve's ``history``: the
+    papers' curve), the mean evaluations, and a serial arm's median position error.
+
+    Not computed from ``trace.csv.gz``, on purpose: the trace is the evaluation log (IOHprofiler's
+    best *evaluated* fitness at logged evaluation counts) and the two differ where an algorithm
+    discards a better evaluated point -- ABC with ``selection: karaboga`` compares 1/(1+f), which is
+    1.0 for every f below ~1.1e-16, so it keeps an older source (``mao2017/tab3_floor``: kept
+    4e-18..1.1e-16, evaluated 1e-19..1.6e-17 in its 90 runs; the paper's printed floor is the kept one).
+    docs/design.md, "The trace and the curves are two records"."""
     if not er.own.solves:
         return None
     frames = []

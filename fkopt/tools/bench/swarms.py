@@ -111,7 +111,7 @@ def bench_pygmo_abc(rows: Rows, quick: bool, messages: list[str]) -> None:
     without pygmo or numba."""
     try:
         import pygmo  # noqa: F401
-        from fkopt.mechanisms import rps3_kernels      # its kernels import numba, which may not load
+        from fkopt.mechanisms import rps3_kernels      # lazy: its kernels import numba, which may not load
     except Exception as err:                        # pragma: no cover - depends on the machine
         messages.append(f"swarms: pygmo bee_colony row skipped: {err}; pip install 'fkopt[bench,fast]'")
         return
