@@ -8,7 +8,7 @@ solves all cases of the experiment in one :func:`fkopt.solve` call (cases x runs
 these per-case seeds, and the result is sliced back into one record per (case, algorithm).
 
 An exact solver's entry with ``params: {solutions: all}`` searches every solution of each case
-once instead, with the same per-case seed (:mod:`.solution_sets`; ``solutions.csv``).
+once instead, with the same per-case seed (:mod:`.case_solutions`; ``solutions.csv``).
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ from fkopt.run.result import RunResult, dataclass_from_json, dataclass_to_json
 from fkopt.run.trace import COLUMNS as TRACE_COLUMNS, case_trace, concat_traces, trace_frame
 from fkopt.solve import Result, chunk_size, make_algorithm
 from fkopt.kinds.experiment.config import experiment_from_dict, ExperimentConfig, RandomCases
-from fkopt.kinds.experiment.solution_sets import (CaseSet, merge_sets, search_cases, set_record_problem,
+from fkopt.kinds.experiment.case_solutions import (CaseSet, merge_sets, search_cases, set_record_problem,
                                                   wants_every_solution)
 from fkopt.run.config_base import AlgorithmSpec, files_folder, numeric_fields
 from fkopt.run.solving import (_check_in_bounds, build_mechanism, make_problem, outputs_of, pose_error, solve_cases,  # noqa: F401
@@ -73,7 +73,7 @@ class ExperimentOwn:
     """What only an experiment has (the :attr:`fkopt.run.result.RunResult.own` slot): its
     mechanism, its cases and every (case, algorithm)'s curves, case by case (every algorithm of
     case 1, then case 2, ...), each algorithm's solve time per case (amortised), and the solution
-    sets of its ``solutions: all`` entries (:mod:`.solution_sets`), case by case too."""
+    sets of its ``solutions: all`` entries (:mod:`.case_solutions`), case by case too."""
 
     mechanism: object
     cases: list[Case]
