@@ -59,6 +59,22 @@ def cli(monkeypatch, capsys):
     return run
 
 
+@pytest.fixture
+def fkopt_run(cli, monkeypatch):
+    """``cli`` read like ``subprocess.run(["fkopt", ...])`` (returncode, stdout, stderr), run from ``cwd``
+    on a terminal ``columns`` wide: for tests whose subject is fkopt's text, files and exit status, not
+    its start-up (those keep a subprocess), without an interpreter start-up per call."""
+    from types import SimpleNamespace
+
+    def run(*args, cwd=None, columns=200):
+        monkeypatch.setenv("COLUMNS", str(columns))
+        if cwd is not None:
+            monkeypatch.chdir(cwd)
+        code, out, err = cli(*args)
+        return SimpleNamespace(returncode=code, stdout=out, stderr=err)
+    return run
+
+
 # --- Test tiers -------------------------------------------------------------------------------
 # README's `python -m pytest` runs everything (CI). `make test-fast` runs
 #   python -m pytest -m "not slow and not stored and not external and not browser"

@@ -5,7 +5,6 @@ import os
 import subprocess
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import pytest
 import typer.main
@@ -29,17 +28,10 @@ def fkopt_process(*args, env=None):
 
 
 @pytest.fixture
-def fkopt(cli, monkeypatch):
-    """``fkopt ARGS`` in this process (conftest's ``cli``: the console script's main) on a terminal
-    ``columns`` wide, from ``cwd``; the result reads like subprocess.run's. In-process because what
-    these tests check is the text and exit status, not the start-up (test_version keeps a process)."""
-    def run(*args, cwd=None, columns=200):
-        monkeypatch.setenv("COLUMNS", str(columns))
-        if cwd is not None:
-            monkeypatch.chdir(cwd)
-        code, out, err = cli(*args)
-        return SimpleNamespace(returncode=code, stdout=out, stderr=err)
-    return run
+def fkopt(fkopt_run):
+    """``fkopt ARGS`` in this process (conftest's ``fkopt_run``): these tests check the text and exit
+    status, not the start-up (test_version keeps a process)."""
+    return fkopt_run
 
 
 def test_version():
