@@ -46,6 +46,14 @@ def test_version():
     assert proc.stdout.strip() == f"fkopt {package.__version__}; numerics: numpy (FKOPT_NUMERICS=numpy)"
 
 
+def test_python_dash_m_runs_the_console_scripts_main():
+    """`python -m fkopt.cli` (the Makefile's and the subprocess tests' way in) is the console script's
+    main; imported here so the fast tier reaches fkopt/cli/__main__.py in-process too."""
+    import fkopt.cli.__main__ as dash_m
+    from fkopt.cli.entry_point import main
+    assert dash_m.main is main
+
+
 def test_bare_fkopt_prints_help_and_succeeds(fkopt):
     proc = fkopt()
     assert proc.returncode == 0, proc.stderr
