@@ -59,6 +59,22 @@ def cli(monkeypatch, capsys):
     return run
 
 
+@pytest.fixture
+def fkopt_run(cli, monkeypatch):
+    """``cli`` read like ``subprocess.run(["fkopt", ...])`` (returncode, stdout, stderr), run from ``cwd``
+    on a terminal ``columns`` wide: for tests whose subject is fkopt's text, files and exit status, not
+    its start-up (those keep a subprocess), without an interpreter start-up per call."""
+    from types import SimpleNamespace
+
+    def run(*args, cwd=None, columns=200):
+        monkeypatch.setenv("COLUMNS", str(columns))
+        if cwd is not None:
+            monkeypatch.chdir(cwd)
+        code, out, err = cli(*args)
+        return SimpleNamespace(returncode=code, stdout=out, stderr=err)
+    return run
+
+
 # --- Test tiers -------------------------------------------------------------------------------
 # README's `python -m pytest` runs everything (CI). `make test-fast` runs
 #   python -m pytest -m "not slow and not stored and not external and not browser"
@@ -140,6 +156,31 @@ TIERS = {
     "tests/test_export.py::test_export_refuses_what_it_must_not_touch": ("slow",),
 }
 TIER_MARKERS = ("slow", "stored", "external", "browser")
+
+# Files whose module-scoped fixtures cost seconds (stored claims judged, small runs of every config of a
+# paper, a small suite or experiment written once and copied): xdist's default scheduling would deal
+# their tests to both workers and each would make the fixture; pytest_xdist_make_scheduler below sends a
+# file of this set to one worker as one unit. (xdist's own --dist loadgroup cannot: it renames node ids,
+# which pytest >= 9.2 no longer lets it do.)
+ONE_WORKER_FILES = {"tests/test_paper_claims.py", "tests/test_paper_wang7dof.py", "tests/test_paper_liu2008.py",
+                    "tests/test_paper_wu2015.py", "tests/test_paper_chang2024.py", "tests/test_hostile.py",
+                    "tests/test_hostile_readers.py", "tests/test_kinbench_ioh.py", "tests/test_export.py",
+                    "tests/test_kinbench_subsets.py", "tests/test_assembly.py", "tests/test_inverse_solver.py"}
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """`-n 2` (xdist's `load`): tests dealt out one by one, except each ONE_WORKER_FILES file as one unit
+    (largest units first: xdist's loadscope order)."""
+    if config.getvalue("dist") != "load":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class OneWorkerFiles(LoadScopeScheduling):
+        def _split_scope(self, nodeid):
+            path = nodeid.split("::", 1)[0]
+            return path if path in ONE_WORKER_FILES else nodeid
+    return OneWorkerFiles(config, log)
 
 
 def _tier_key(item):

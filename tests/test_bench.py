@@ -60,11 +60,8 @@ def test_sections_select_what_runs(tmp_path):
     assert not (tmp_path / "e" / "scaling.png").exists()
 
 
-def test_bench_cli_refuses_unknown_section(tmp_path):
-    import subprocess
-    import sys
-    p = subprocess.run([sys.executable, "-m", "fkopt.cli", "bench", "--section", "nope", "--out", str(tmp_path / "x")],
-                       capture_output=True, text=True, timeout=120)
+def test_bench_cli_refuses_unknown_section(tmp_path, fkopt_run):
+    p = fkopt_run("bench", "--section", "nope", "--out", str(tmp_path / "x"))
     assert p.returncode == 2 and "kinematics" in p.stderr and "Traceback" not in p.stderr
     assert not (tmp_path / "x").exists()
 

@@ -1,18 +1,16 @@
 """CLI: JSON outputs, one-line errors, and `fkopt run` writing every promised file."""
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
-FKOPT = [sys.executable, "-m", "fkopt.cli"]
-
-
-def cli(*args, cwd=None):
-    return subprocess.run([*FKOPT, *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+@pytest.fixture
+def fkopt(fkopt_run):
+    """``fkopt ARGS`` in this process (conftest's ``fkopt_run``, read like subprocess.run): these tests
+    check outputs, files and exit statuses, not the interpreter's start-up."""
+    return fkopt_run
 
 
 def assert_one_line_error(proc, *fragments):
@@ -26,37 +24,37 @@ def assert_one_line_error(proc, *fragments):
         assert f in err, err
 
 
-def test_list_json():
-    out = json.loads(cli("list", "--json").stdout)
+def test_list_json(fkopt):
+    out = json.loads(fkopt("list", "--json").stdout)
     assert {"3-rps"} <= set(out["mechanisms"])
     assert {"abc", "gabc"} <= set(out["algorithms"])
 
 
-def test_ik_json_matches_spec():
-    out = json.loads(cli("ik", "3-rps", "--pose", "alpha=9,beta=13,z=622", "--json").stdout)
+def test_ik_json_matches_spec(fkopt):
+    out = json.loads(fkopt("ik", "3-rps", "--pose", "alpha=9,beta=13,z=622", "--json").stdout)
     np.testing.assert_allclose([out["joints"][k] for k in ("d1", "d2", "d3")],
                                [598.8458, 671.9171, 629.1616], atol=5e-5)
 
 
-def test_fk_json_recovers_pose():
-    proc = cli("fk", "3-rps", "--joints", "d1=598.84582586,d2=671.91712863,d3=629.16156603", "--json")
+def test_fk_json_recovers_pose(fkopt):
+    proc = fkopt("fk", "3-rps", "--joints", "d1=598.84582586,d2=671.91712863,d3=629.16156603", "--json")
     out = json.loads(proc.stdout)
     np.testing.assert_allclose([out["pose"][k] for k in ("alpha", "beta", "z")], [9, 13, 622], atol=1e-5)
     assert out["fitness"] < 1e-10
 
 
-def test_fk_reports_unreachable_joints():
-    proc = cli("fk", "3-rps", "--joints", "d1=100,d2=900,d3=600", "--json")
+def test_fk_reports_unreachable_joints(fkopt):
+    proc = fkopt("fk", "3-rps", "--joints", "d1=100,d2=900,d3=600", "--json")
     assert_one_line_error(proc, "no pose within the bounds reproduces these joints", "best residual")
 
 
-def test_errors_are_one_line():
-    assert_one_line_error(cli("ik", "nope", "--pose", "a=1"), "unknown mechanism 'nope'", "3-rps")
-    assert_one_line_error(cli("ik", "3-rps", "--pose", "alpha=9,beta=13"), "missing z")
-    assert_one_line_error(cli("ik", "3-rps", "--pose", "alpha=x"), "needs a number")
-    assert_one_line_error(cli("fk", "3-rps", "--joints", "d1=1,d2=2,d3=3", "--algorithm", "zzz"),
+def test_errors_are_one_line(fkopt):
+    assert_one_line_error(fkopt("ik", "nope", "--pose", "a=1"), "unknown mechanism 'nope'", "3-rps")
+    assert_one_line_error(fkopt("ik", "3-rps", "--pose", "alpha=9,beta=13"), "missing z")
+    assert_one_line_error(fkopt("ik", "3-rps", "--pose", "alpha=x"), "needs a number")
+    assert_one_line_error(fkopt("fk", "3-rps", "--joints", "d1=1,d2=2,d3=3", "--algorithm", "zzz"),
                           "unknown algorithm 'zzz'", "gabc")
-    assert_one_line_error(cli("frobnicate"), "No such command")
+    assert_one_line_error(fkopt("frobnicate"), "No such command")
 
 
 SMALL = {
@@ -75,9 +73,9 @@ def write_config(tmp_path, data, name="exp.yaml"):
     return path
 
 
-def test_run_writes_all_files(tmp_path):
+def test_run_writes_all_files(tmp_path, fkopt):
     cfg = write_config(tmp_path, SMALL)
-    proc = cli("run", str(cfg), "--out", str(tmp_path / "res"), "--quiet")
+    proc = fkopt("run", str(cfg), "--out", str(tmp_path / "res"), "--quiet")
     assert proc.returncode == 0, proc.stderr
     folder = tmp_path / "res" / "test" / "small"
     for name in ("summary.csv", "timing.csv", "values.csv", "runs.csv", "convergence.csv",
@@ -101,12 +99,12 @@ def test_run_writes_all_files(tmp_path):
     assert not [p for p in (tmp_path / "res" / "test").iterdir() if p.name.startswith(".")]
 
 
-def test_run_is_deterministic(tmp_path):
+def test_run_is_deterministic(tmp_path, fkopt):
     """The same bytes twice, the second time with each algorithm's task in a worker process
     (rebuilt there from the config, not the live objects of this process)."""
     cfg = write_config(tmp_path, SMALL)
     for out, jobs in (("a", "1"), ("b", "2")):
-        assert cli("run", str(cfg), "--out", str(tmp_path / out), "--quiet", "--jobs", jobs).returncode == 0
+        assert fkopt("run", str(cfg), "--out", str(tmp_path / out), "--quiet", "--jobs", jobs).returncode == 0
     for name in ("summary.csv", "values.csv", "runs.csv", "convergence.csv"):
         a = (tmp_path / "a" / "test" / "small" / name).read_bytes()
         b = (tmp_path / "b" / "test" / "small" / name).read_bytes()
@@ -126,24 +124,24 @@ def test_run_is_deterministic(tmp_path):
     ({"cases": [{"pose": {"alpha": 9, "beta": 13}}]}, ["missing z"]),
     ({"stop_at_threshold": True, "threshold": None}, ["stop_at_threshold needs a threshold"]),
 ])
-def test_config_errors(tmp_path, change, fragments):
+def test_config_errors(tmp_path, change, fragments, fkopt):
     data = {**SMALL, **change}
     if data.get("threshold") is None:
         data.pop("threshold")
     cfg = write_config(tmp_path, data)
-    proc = cli("run", str(cfg), "--out", str(tmp_path / "res"), "--quiet")
+    proc = fkopt("run", str(cfg), "--out", str(tmp_path / "res"), "--quiet")
     assert_one_line_error(proc, str(cfg), *fragments)
     assert not (tmp_path / "res").exists() or not any((tmp_path / "res").rglob("*.csv"))
 
 
-def test_malformed_yaml_names_line(tmp_path):
+def test_malformed_yaml_names_line(tmp_path, fkopt):
     cfg = tmp_path / "bad.yaml"
     cfg.write_text("name: x\nmechanism: {name: 3-rps\nruns: 3\n")
-    assert_one_line_error(cli("run", str(cfg), "--quiet"), "bad.yaml", "malformed YAML at line")
+    assert_one_line_error(fkopt("run", str(cfg), "--quiet"), "bad.yaml", "malformed YAML at line")
 
 
-def test_missing_file():
-    assert_one_line_error(cli("run", "/nonexistent/x.yaml", "--quiet"), "cannot read")
+def test_missing_file(fkopt):
+    assert_one_line_error(fkopt("run", "/nonexistent/x.yaml", "--quiet"), "cannot read")
 
 
 def test_stored_configs_validate():

@@ -19,33 +19,49 @@ ROOT = Path(__file__).resolve().parent.parent
 COMMANDS = typer.main.get_command(cli.app).commands
 
 
-def fkopt(*args, cwd=None, columns=200, env=None):
-    env = dict(os.environ, **(env or {}), COLUMNS=str(columns), PYTHONPATH=os.pathsep.join(
+def fkopt_process(*args, env=None):
+    """``python -m fkopt.cli ARGS`` in a fresh interpreter (what a start-up reads: the environment)."""
+    env = dict(os.environ, **(env or {}), COLUMNS="200", PYTHONPATH=os.pathsep.join(
         filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
     return subprocess.run([sys.executable, "-m", "fkopt.cli", *args], capture_output=True, text=True,
-                          cwd=cwd, env=env, timeout=300)
+                          env=env, timeout=300)
+
+
+@pytest.fixture
+def fkopt(fkopt_run):
+    """``fkopt ARGS`` in this process (conftest's ``fkopt_run``): these tests check the text and exit
+    status, not the start-up (test_version keeps a process)."""
+    return fkopt_run
 
 
 def test_version():
     import fkopt as package
-    proc = fkopt("--version", env={"FKOPT_NUMERICS": "auto"})
+    proc = fkopt_process("--version", env={"FKOPT_NUMERICS": "auto"})
     from importlib.metadata import version
     assert proc.returncode == 0, proc.stderr
     # the version, the numerics path a default call takes here and the compiler's version (issue 38)
     assert proc.stdout.strip() == (f"fkopt {package.__version__}; numerics: compiled (numba {version('numba')}, "
                                    f"llvmlite {version('llvmlite')})")
-    proc = fkopt("--version", env={"FKOPT_NUMERICS": "numpy"})
+    proc = fkopt_process("--version", env={"FKOPT_NUMERICS": "numpy"})
     assert proc.stdout.strip() == f"fkopt {package.__version__}; numerics: numpy (FKOPT_NUMERICS=numpy)"
 
 
-def test_bare_fkopt_prints_help_and_succeeds():
+def test_python_dash_m_runs_the_console_scripts_main():
+    """`python -m fkopt.cli` (the Makefile's and the subprocess tests' way in) is the console script's
+    main; imported here so the fast tier reaches fkopt/cli/__main__.py in-process too."""
+    import fkopt.cli.__main__ as dash_m
+    from fkopt.cli.entry_point import main
+    assert dash_m.main is main
+
+
+def test_bare_fkopt_prints_help_and_succeeds(fkopt):
     proc = fkopt()
     assert proc.returncode == 0, proc.stderr
     assert "Usage" in proc.stdout and "run" in proc.stdout and proc.stderr == ""
 
 
 @pytest.mark.parametrize("command", [None, *COMMANDS])
-def test_help_tags_no_flag_with_a_type(command):
+def test_help_tags_no_flag_with_a_type(command, fkopt):
     proc = fkopt(*([command] if command else []), "--help")
     assert proc.returncode == 0
     assert "<bool>" not in proc.stdout
@@ -59,20 +75,20 @@ def test_every_option_and_argument_is_described(command):
     assert not undocumented, f"fkopt {command}: {undocumented} have no help text"
 
 
-def test_bench_help_lists_every_section():
+def test_bench_help_lists_every_section(fkopt):
     text = " ".join(fkopt("bench", "--help").stdout.split())
     for section in bench.SECTIONS:
         assert section in text
     assert "cases (N cases x 30 runs" in text
 
 
-def test_study_help_explains_instead_of_pointing_at_a_module():
+def test_study_help_explains_instead_of_pointing_at_a_module(fkopt):
     text = " ".join(fkopt("study", "--help").stdout.split())
     assert "see fkopt.kinds.study" not in text
     assert "kind: study" in text and "tracking" in text and "docs/config-reference.md" in text
 
 
-def test_ik_prints_its_residual_with_units():
+def test_ik_prints_its_residual_with_units(fkopt):
     parallel = fkopt("ik", "3-rps", "--pose", "alpha=9,beta=13,z=622")
     assert parallel.returncode == 0 and "residual: 0 (closed form" in parallel.stdout
     serial = fkopt("ik", "7dof-arm", "--pose", "x=-247.4874,y=1009.6194,z=500,alpha=-135,beta=90,gamma=-90")
@@ -82,7 +98,7 @@ def test_ik_prints_its_residual_with_units():
     assert any(l.startswith("rotation_error_rad:") and l.split()[2] == "rad" for l in serial.stdout.splitlines())
 
 
-def test_fk_says_which_stage_found_the_pose():
+def test_fk_says_which_stage_found_the_pose(fkopt):
     proc = fkopt("fk", "3-rps", "--joints", "d1=598.8458,d2=671.9171,d3=629.1616", "--json")
     out = json.loads(proc.stdout)
     assert "stage" not in out and out["found_by"] == "local newton"
@@ -90,7 +106,7 @@ def test_fk_says_which_stage_found_the_pose():
     assert "found_by: local newton" in text and "joint units" in text
 
 
-def test_list_fits_80_columns():
+def test_list_fits_80_columns(fkopt):
     for args in (["list"], ["list", "--long"]):
         proc = fkopt(*args, columns=80)
         assert proc.returncode == 0
@@ -106,7 +122,7 @@ def test_unit_groups():
     assert unit_groups(["q1", "q3", "q4"], ["deg"] * 3) == "q1, q3, q4 [deg]"
 
 
-def test_run_writes_under_fkopt_results_by_default(tmp_path):
+def test_run_writes_under_fkopt_results_by_default(tmp_path, fkopt):
     config = {"name": "tiny", "mechanism": {"name": "3-rps"},
               "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}],
               "algorithms": [{"name": "gabc"}], "population": 4, "iterations": 3, "runs": 2}
@@ -120,7 +136,7 @@ def test_run_writes_under_fkopt_results_by_default(tmp_path):
     assert "/fkopt-results/" in (ROOT / ".gitignore").read_text().splitlines()
 
 
-def test_schema_command_prints_the_committed_schemas():
+def test_schema_command_prints_the_committed_schemas(fkopt):
     for args, kind in (((), "experiment"), (("study",), "study"), (("assembly",), "assembly"), (("suite",), "suite")):
         proc = fkopt("schema", *args)
         assert proc.returncode == 0
@@ -130,6 +146,6 @@ def test_schema_command_prints_the_committed_schemas():
         "fkopt: error: schema: unknown kind 'nope'; allowed: experiment, study, assembly, suite"
 
 
-def test_help_paragraphs_are_wrapped_by_the_terminal_not_the_source():
+def test_help_paragraphs_are_wrapped_by_the_terminal_not_the_source(fkopt):
     text = fkopt("fk", "--help", columns=200).stdout
     assert "reproduces the joints within --tolerance (the best residual is reported)" in text

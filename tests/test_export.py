@@ -18,7 +18,7 @@ from fkopt.kinds.experiment.runner import run_experiment
 from fkopt.run.trace import MAX_BYTES, read_trace, run_trace
 from fkopt.tools.export import ATTRIBUTES, MARKER
 from fkopt.solve import solve
-from test_cli import assert_one_line_error, cli
+from test_cli import assert_one_line_error
 
 CONFIG = {
     "name": "ioh_demo", "paper": "demo", "mechanism": {"name": "3-rps"},
@@ -138,11 +138,11 @@ def _analyzer_reference(tmp_path):
     return json.loads(index.read_text()), index
 
 
-def test_ioh_export_has_the_analyzer_layout_and_loads_in_iohinspector(stored, tmp_path):
+def test_ioh_export_has_the_analyzer_layout_and_loads_in_iohinspector(stored, tmp_path, fkopt_run):
     import iohinspector  # a test dependency (pyproject: test extra)
     root, folder, er = stored
     out = tmp_path / "ioh"
-    proc = cli("export", str(root), "--format", "ioh", "--out", str(out))
+    proc = fkopt_run("export", str(root), "--format", "ioh", "--out", str(out))
     assert proc.returncode == 0, proc.stderr
     assert (out / MARKER).is_file() and not list(out.glob("*.json")) and not list(out.rglob("*.info"))
     ref, ref_file = _analyzer_reference(tmp_path / "ref")
@@ -190,22 +190,22 @@ def test_ioh_export_has_the_analyzer_layout_and_loads_in_iohinspector(stored, tm
     assert checked == 30
 
 
-def test_export_refuses_what_it_must_not_touch(stored, tmp_path):
+def test_export_refuses_what_it_must_not_touch(stored, tmp_path, fkopt_run):
     root, folder, er = stored
     out = tmp_path / "ioh"
-    assert cli("export", str(root), "--out", str(out)).returncode == 0
-    assert cli("export", str(folder), "--out", str(out)).returncode == 0       # over its own folder
+    assert fkopt_run("export", str(root), "--out", str(out)).returncode == 0
+    assert fkopt_run("export", str(folder), "--out", str(out)).returncode == 0       # over its own folder
     (tmp_path / "legacy").mkdir()
     (tmp_path / "legacy" / "fkopt-export.json").write_text("{}")               # an older release's export
-    assert cli("export", str(folder), "--out", str(tmp_path / "legacy")).returncode == 0
+    assert fkopt_run("export", str(folder), "--out", str(tmp_path / "legacy")).returncode == 0
     assert not (tmp_path / "legacy" / "fkopt-export.json").exists()
-    assert_one_line_error(cli("export", str(root), "--out", str(root / "x")), "must lie outside the results")
+    assert_one_line_error(fkopt_run("export", str(root), "--out", str(root / "x")), "must lie outside the results")
     (tmp_path / "other").mkdir()
     (tmp_path / "other" / "keep.txt").write_text("x")
-    assert_one_line_error(cli("export", str(root), "--out", str(tmp_path / "other")), "not written by fkopt export")
-    assert_one_line_error(cli("export", str(root), "--format", "csv", "--out", str(tmp_path / "y")),
+    assert_one_line_error(fkopt_run("export", str(root), "--out", str(tmp_path / "other")), "not written by fkopt export")
+    assert_one_line_error(fkopt_run("export", str(root), "--format", "csv", "--out", str(tmp_path / "y")),
                           "unknown format 'csv'; allowed: ioh")
-    assert_one_line_error(cli("export", str(tmp_path / "nothing"), "--out", str(tmp_path / "z")), "not a results folder")
+    assert_one_line_error(fkopt_run("export", str(tmp_path / "nothing"), "--out", str(tmp_path / "z")), "not a results folder")
 
 
 # -- hostile inputs (issue 19): one line naming the file, non-zero exit, nothing written ---------
@@ -270,13 +270,13 @@ def _set(t, i, col, value):
 
 
 @pytest.mark.parametrize("case", list(HOSTILE))
-def test_export_of_hostile_results_is_one_line_and_writes_nothing(stored, tmp_path, case):
+def test_export_of_hostile_results_is_one_line_and_writes_nothing(stored, tmp_path, case, fkopt_run):
     root, folder, er = stored
     bad = _copy(folder, tmp_path / "results" / "bad")
     spoil, fragments = HOSTILE[case]
     spoil(bad)
     out = tmp_path / "out"
-    proc = cli("export", str(tmp_path / "results"), "--out", str(out))
+    proc = fkopt_run("export", str(tmp_path / "results"), "--out", str(out))
     assert_one_line_error(proc, *fragments)
     assert proc.returncode == 2
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["results"]

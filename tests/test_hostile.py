@@ -220,12 +220,13 @@ def sandbox(tmp_path_factory):
     outside.mkdir()
     (outside / "important.txt").write_text("do not touch\n")
     (root / "afile").write_text("a file\n")
+    from fkopt.cli import main
     for name, data, cmd in (("small", BASE, "run"), ("small", STUDY, "study")):
         cfg = root / f"prev-{cmd}.yaml"
         cfg.write_text(yaml_of({**data, "name": name}))
-        proc = subprocess.run([sys.executable, "-m", "fkopt.cli", cmd, str(cfg), "--out", str(out), "-q"],
-                              capture_output=True, text=True, timeout=300)
-        assert proc.returncode == 0, proc.stderr
+        with pytest.MonkeyPatch.context() as patch:     # in this process: a second start-up checks nothing here
+            patch.setattr(sys, "argv", ["fkopt", cmd, str(cfg), "--out", str(out), "-q"])
+            main()                                      # returns on success, exits otherwise
     (out / "test" / "afile").write_text("a file where a result would go\n")
     (out / "test" / "notes").mkdir()
     (out / "test" / "notes" / "todo.txt").write_text("not a result\n")
@@ -297,17 +298,31 @@ def one_line_error(result, *fragments) -> str:
     return lines[0]
 
 
-@pytest.fixture
-def finished_study(tmp_path, cli):
-    """A finished study ``OUT/studies/small`` (2 poses, 1 task), its config, and an outside folder."""
-    cfg = tmp_path / "s.yaml"
+@pytest.fixture(scope="module")
+def finished_study_once(tmp_path_factory):
+    """The folder ``finished_study`` copies: ``fkopt study`` run once per module (the study and its
+    figures cost seconds; some 40 tests each spoil their own copy)."""
+    from fkopt.cli import main
+    root = tmp_path_factory.mktemp("finished-study")
+    cfg = root / "s.yaml"
     cfg.write_text(yaml_of({**STUDY, "name": "small"}))
-    out = tmp_path / "out"
-    assert cli("study", cfg, "--out", out, "-q")[0] == 0
-    outside = tmp_path / "outside"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(sys, "argv", ["fkopt", "study", str(cfg), "--out", str(root / "out"), "-q"])
+        main()                                  # returns on success, exits otherwise
+    outside = root / "outside"
     outside.mkdir()
     (outside / "keep.txt").write_text("outside --out\n")
-    return cfg, out, out / "studies" / "small", outside
+    return root
+
+
+@pytest.fixture
+def finished_study(tmp_path, finished_study_once):
+    """A finished study ``OUT/studies/small`` (2 poses, 1 task), its config, and an outside folder: a
+    fresh copy of ``finished_study_once`` in this test's ``tmp_path`` (its files hold no absolute path)."""
+    import shutil
+    shutil.copytree(finished_study_once, tmp_path, symlinks=True, dirs_exist_ok=True)
+    out = tmp_path / "out"
+    return tmp_path / "s.yaml", out, out / "studies" / "small", tmp_path / "outside"
 
 
 def _partial_with_a_task(out: Path, final: Path) -> Path:

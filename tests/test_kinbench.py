@@ -101,31 +101,31 @@ def test_pose_sets_measure_what_they_claim():
         assert len(sets[(problem.name, "printed")]) >= 1
 
 
-def test_a_changed_pose_file_is_refused_by_its_checksum(tmp_path):
+def test_a_changed_pose_file_is_refused_by_its_checksum(tmp_path, fkopt_run):
     path = tiny(tmp_path)
     f = tmp_path / "kinbench-v1" / "mao2017-3rps" / "uniform.csv"
     f.write_text(f.read_text().replace("1", "2", 1))
     out = tmp_path / "out"
-    r = cli("suite", path, "--out", out, "-q")
+    r = fkopt_run("suite", path, "--out", out, "-q")
     assert r.returncode == 2, r.stderr
     assert r.stderr.count("\n") == 1 and "uniform.csv: SHA-256" in r.stderr and "Traceback" not in r.stderr
     assert not (out / "kinbench").exists()
 
 
-def test_a_solver_that_cannot_take_a_problem_is_refused_before_solving(tmp_path):
+def test_a_solver_that_cannot_take_a_problem_is_refused_before_solving(tmp_path, fkopt_run):
     data = yaml.safe_load(SUITE.read_text())
     arm = [p for p in data["problems"] if p["name"] == "wang2020-7dof"]
     path = tiny(tmp_path, problems=arm, solvers=[{"name": "pso"}, {"name": "nr"}])
-    r = cli("suite", path, "--out", tmp_path / "out", "-q")
+    r = fkopt_run("suite", path, "--out", tmp_path / "out", "-q")
     assert r.returncode == 2 and r.stderr.startswith(f"fkopt: error: {path}: solvers[nr] on problems[wang2020-7dof]: nr needs")
     assert not (tmp_path / "out").exists() or not any(p.is_file() for p in (tmp_path / "out").rglob("*"))
 
 
-def test_an_exact_solver_of_the_wrong_kind_is_refused_in_one_line(tmp_path):
+def test_an_exact_solver_of_the_wrong_kind_is_refused_in_one_line(tmp_path, fkopt_run):
     data = yaml.safe_load(SUITE.read_text())
     arm = [p for p in data["problems"] if p["name"] == "wang2020-7dof"]
     path = tiny(tmp_path, problems=arm, solvers=[{"name": "forward"}])
-    r = cli("suite", path, "--out", tmp_path / "out", "-q")
+    r = fkopt_run("suite", path, "--out", tmp_path / "out", "-q")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
     assert "solvers[forward] on problems[wang2020-7dof]: algorithm 'forward' solves forward kinematics" in r.stderr
     assert "use 'exact'" in r.stderr
@@ -293,14 +293,14 @@ def test_outside_results_are_ranked_beside_fkopts(tmp_path):
     assert set(meta["outside"]) == {"ext-fast", "ext-slow"}
 
 
-def test_an_outside_file_missing_an_instance_is_refused_before_solving(tmp_path):
+def test_an_outside_file_missing_an_instance_is_refused_before_solving(tmp_path, fkopt_run):
     path = tiny(tmp_path)
     df = _outside_csv(path, lambda *a: [(1, 5.0)])
     df[~((df.problem == "wu2015-3ppr") & (df.set == "boundary") & (df.pose == 1))].to_csv(tmp_path / "x.csv",
                                                                                           index=False)
     path = tiny(tmp_path / "s", outside=[{"solver": "ext", "track": "exact", "file": "../x.csv"}])
     out = tmp_path / "out"
-    r = cli("suite", path, "--out", out, "-q")
+    r = fkopt_run("suite", path, "--out", out, "-q")
     assert r.returncode == 2 and "no run of problem wu2015-3ppr, set boundary, pose 1" in r.stderr
     assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
     assert not out.exists() or not any(p.is_file() for p in out.rglob("*"))

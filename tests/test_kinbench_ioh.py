@@ -11,7 +11,7 @@ from fkopt.run.pipeline import load_any, run_config
 from fkopt.kinbench.budget import at_budget
 from fkopt.kinbench.traces import COLUMNS, KEYS, budget_trace
 from test_cli import assert_one_line_error
-from test_kinbench import _outside_csv, cli, tiny
+from test_kinbench import _outside_csv, tiny
 
 SOLVERS = [{"name": "pso"}, {"name": "lm"}, {"name": "exact", "track": "exact"}]
 
@@ -55,11 +55,11 @@ def test_every_run_has_a_trace_ending_at_its_runs_csv_measures(suite):
     assert (ex.best_fitness == np.inf).all()
 
 
-def test_the_ioh_export_of_a_suite_loads_every_run_in_iohinspector(suite, tmp_path):
+def test_the_ioh_export_of_a_suite_loads_every_run_in_iohinspector(suite, tmp_path, fkopt_run):
     import iohinspector  # a test dependency (pyproject: test extra)
     path, folder = suite
     out = tmp_path / "ioh"
-    proc = cli("export", folder, "--format", "ioh", "--out", out)
+    proc = fkopt_run("export", folder, "--format", "ioh", "--out", out)
     assert proc.returncode == 0, proc.stderr
     runs = pd.read_csv(folder / "runs.csv")
     with warnings.catch_warnings():     # iohinspector warns (and skips) on a file it cannot read
@@ -98,7 +98,7 @@ def test_the_ioh_export_of_a_suite_loads_every_run_in_iohinspector(suite, tmp_pa
     assert index["scenarios"][0]["dimension"] == 3 and index["function_name"] == "mao2017-3rps"
 
 
-def test_a_mixed_tree_of_an_experiment_and_a_suite_exports_both(suite, tmp_path):
+def test_a_mixed_tree_of_an_experiment_and_a_suite_exports_both(suite, tmp_path, fkopt_run):
     import shutil
     from fkopt.kinds.experiment.config import ExperimentConfig
     from fkopt.kinds.experiment.reports import write_experiment
@@ -110,7 +110,7 @@ def test_a_mixed_tree_of_an_experiment_and_a_suite_exports_both(suite, tmp_path)
         name="e", paper="demo", mechanism={"name": "3-rps"}, cases=[{"pose": {"alpha": 9, "beta": 13, "z": 622}}],
         algorithms=[{"name": "pso"}], iterations=5, runs=2)), root)
     out = tmp_path / "ioh"
-    assert cli("export", root, "--out", out).returncode == 0
+    assert fkopt_run("export", root, "--out", out).returncode == 0
     names = {json.loads(p.read_text())["function_name"]: json.loads(p.read_text())["function_id"]
              for p in out.glob("pso/*.json")}
     assert names == {"demo_e": 1, "mao2017-3rps": 2, "wu2015-3ppr": 3}    # folders sorted by path
@@ -147,12 +147,12 @@ def _spoil_trace(folder, change):
         {**json.loads((d / "meta.json").read_text()), "config": {"kind": "suite", "name": "x"}})),
      ["meta.json", "'problems'"]),
 ])
-def test_export_of_a_damaged_suite_is_one_line(suite, tmp_path, case, spoil, fragments):
+def test_export_of_a_damaged_suite_is_one_line(suite, tmp_path, case, spoil, fragments, fkopt_run):
     import shutil
     _, folder = suite
     bad = tmp_path / "results" / "bad"
     shutil.copytree(folder, bad)
     spoil(bad)
-    proc = cli("export", tmp_path / "results", "--out", tmp_path / "out")
+    proc = fkopt_run("export", tmp_path / "results", "--out", tmp_path / "out")
     assert_one_line_error(proc, *fragments)
     assert proc.returncode == 2 and not (tmp_path / "out").exists()

@@ -303,13 +303,12 @@ def test_the_advice_per_family_never_names_an_entry_that_cannot_take_one_of_its_
     assert advice["solver"] == ranked[ranked["not_applicable"] == 0].iloc[0]["solver"]
 
 
-def test_fkopt_pages_refuses_what_is_not_a_suite_in_one_line(tmp_path):
+def test_fkopt_pages_refuses_what_is_not_a_suite_in_one_line(tmp_path, fkopt_run):
     (tmp_path / "exp").mkdir()
     (tmp_path / "exp" / "meta.json").write_text(json.dumps({"kind": "experiment"}))
     for target, fragment in ((tmp_path / "exp", "kind: 'experiment' (allowed: suite"),
                              (tmp_path / "none", "no such folder")):
-        proc = subprocess.run([sys.executable, "-m", "fkopt.cli", "pages", str(target)], capture_output=True,
-                              text=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+        proc = fkopt_run("pages", str(target))
         assert proc.returncode == 2 and fragment in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
         assert "Traceback" not in proc.stderr
 

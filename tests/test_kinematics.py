@@ -10,13 +10,6 @@ import pytest
 import fkopt
 from fkopt.errors import FkoptError
 
-FKOPT = [sys.executable, "-m", "fkopt.cli"]
-
-
-def cli(*args):
-    return subprocess.run([*FKOPT, *args], capture_output=True, text=True, timeout=300)
-
-
 def random_poses(m, n, seed=0):
     b = m.bounds
     return b[:, 0] + np.random.default_rng(seed).random((n, len(b))) * (b[:, 1] - b[:, 0])
@@ -101,34 +94,34 @@ def test_inverse_bad_input():
         fkopt.inverse("7dof-arm", [300, 300, 800, 0, 90, 0], start=[0, 100, 0, 0, 0, 0, 0])
 
 
-def test_fk_cli_exit_codes():
-    ok = cli("fk", "6-sps-cmm", "--joints", "l1=0.75,l2=0.78,l3=0.8,l4=0.9,l5=0.87,l6=0.85", "--json")
+def test_fk_cli_exit_codes(fkopt_run):
+    ok = fkopt_run("fk", "6-sps-cmm", "--joints", "l1=0.75,l2=0.78,l3=0.8,l4=0.9,l5=0.87,l6=0.85", "--json")
     assert ok.returncode == 0, ok.stderr
     out = json.loads(ok.stdout)
     assert out["solved"] and out["residual"] <= 1e-9
-    bad = cli("fk", "3-rps", "--joints", "d1=100,d2=900,d3=600")
+    bad = fkopt_run("fk", "3-rps", "--joints", "d1=100,d2=900,d3=600")
     assert bad.returncode == 1 and len(bad.stderr.strip().splitlines()) == 1
     assert "best residual" in bad.stderr
-    assert cli("fk", "3-rps", "--joints", "d1=nan,d2=900,d3=600").returncode == 2
-    swarm = cli("fk", "3-rps", "--joints", "d1=598.84582586,d2=671.91712863,d3=629.16156603",
+    assert fkopt_run("fk", "3-rps", "--joints", "d1=nan,d2=900,d3=600").returncode == 2
+    swarm = fkopt_run("fk", "3-rps", "--joints", "d1=598.84582586,d2=671.91712863,d3=629.16156603",
                 "--algorithm", "gabc+lm", "--tolerance", "1e-6", "--json")
     assert swarm.returncode == 0 and json.loads(swarm.stdout)["algorithm"] == "gabc+lm"
 
 
-def test_ik_cli_exit_codes():
+def test_ik_cli_exit_codes(fkopt_run):
     m = fkopt.mechanism("7dof-arm")
     pose = m.fk([45, 0, 45, 0, 45, 0, 0])
     arg = ",".join(f"{n}={v!r}" for n, v in zip(m.pose_names, pose.tolist()))
-    ok = cli("ik", "7dof-arm", "--pose", arg, "--json")
+    ok = fkopt_run("ik", "7dof-arm", "--pose", arg, "--json")
     assert ok.returncode == 0, ok.stderr
     q = np.array(list(json.loads(ok.stdout)["joints"].values()))
     assert np.all(m.in_bounds(q)) and np.abs(m.fk(q)[:3] - pose[:3]).max() < 1e-5
     # a swarm alone does not reach 1e-6 mm in its budget: reported, exit 1, one line
-    swarm = cli("ik", "7dof-arm", "--pose", arg, "--algorithm", "pso")
+    swarm = fkopt_run("ik", "7dof-arm", "--pose", arg, "--algorithm", "pso")
     assert swarm.returncode == 1 and len(swarm.stderr.strip().splitlines()) == 1
     assert "position error" in swarm.stderr
-    assert cli("ik", "7dof-arm", "--pose", "x=0,y=0,z=5000,alpha=0,beta=0,gamma=0").returncode == 2
-    assert cli("ik", "3-rps", "--pose", "alpha=50,beta=0,z=600").returncode == 2
+    assert fkopt_run("ik", "7dof-arm", "--pose", "x=0,y=0,z=5000,alpha=0,beta=0,gamma=0").returncode == 2
+    assert fkopt_run("ik", "3-rps", "--pose", "alpha=50,beta=0,z=600").returncode == 2
 
 
 @pytest.mark.parametrize("args", [["list", "--json"],

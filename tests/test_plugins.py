@@ -16,7 +16,7 @@ from fkopt import registry
 from fkopt.algorithms.base import Algorithm
 from fkopt.errors import FkoptError
 from fkopt.mechanisms.base import ParallelMechanism
-from test_cli import assert_one_line_error, cli
+from test_cli import assert_one_line_error
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "plugin"
@@ -60,30 +60,30 @@ def test_plugin_classes_missing_required_methods_are_named():
         registry.check_class(NoIk, "mechanism", "x:NoIk")
 
 
-def test_config_naming_a_function_is_one_line_error(tmp_path):
+def test_config_naming_a_function_is_one_line_error(tmp_path, fkopt_run):
     cfg = {"name": "evil", "mechanism": {"name": "3-rps"}, "cases": [{"pose": {"alpha": 9, "beta": 13, "z": 622}}],
            "algorithms": [{"name": "subprocess:run", "params": {"args": ["touch", str(tmp_path / "pwned")]}}],
            "runs": 1, "iterations": 2}
     path = tmp_path / "evil.yaml"
     path.write_text(yaml.safe_dump(cfg))
-    proc = cli("run", str(path), "--out", str(tmp_path / "out"))
+    proc = fkopt_run("run", str(path), "--out", str(tmp_path / "out"))
     assert_one_line_error(proc, "subprocess:run", "not a class")
     assert proc.returncode == 2
     assert not (tmp_path / "pwned").exists() and not (tmp_path / "out").exists()
 
 
-def test_list_shows_origins_and_a_mechanism_in_detail():
-    out = json.loads(cli("list", "--json").stdout)
+def test_list_shows_origins_and_a_mechanism_in_detail(fkopt_run):
+    out = json.loads(fkopt_run("list", "--json").stdout)
     assert out["origins"]["mechanisms"]["3-rps"] == "built-in"
     assert out["origins"]["algorithms"]["scipy:differential_evolution"].startswith("adapter (scipy")
-    detail = json.loads(cli("list", "6-sps-cmm", "--json").stdout)
+    detail = json.loads(fkopt_run("list", "6-sps-cmm", "--json").stdout)
     assert detail["bounds"]["z"] == [0.7, 1.1] and detail["bounds_units"]["z"] == "m"
     assert detail["pose"]["alpha"] == "deg" and list(detail["joints"]) == [f"l{i}" for i in range(1, 7)]
     assert detail["geometry"]["Rb"] == 0.5 and detail["from"] == "built-in"
-    text = cli("list", "6-sps-cmm").stdout
+    text = fkopt_run("list", "6-sps-cmm").stdout
     for fragment in ("x [m]", "alpha [deg]", "l1 [m]", "0.7", "1.1", "Rb", "default geometry"):
         assert fragment in text, fragment
-    assert_one_line_error(cli("list", "no-such-mech"), "unknown mechanism 'no-such-mech'")
+    assert_one_line_error(fkopt_run("list", "no-such-mech"), "unknown mechanism 'no-such-mech'")
 
 
 @pytest.fixture(scope="module")
@@ -115,14 +115,14 @@ def run_cli(env, *args, cwd=None):
                           env=env, cwd=cwd, timeout=600)
 
 
-def test_example_plugin_found_through_entry_points(installed_example):
+def test_example_plugin_found_through_entry_points(installed_example, fkopt_run):
     out = json.loads(run_cli(installed_example, "list", "--json").stdout)
     assert out["origins"]["mechanisms"]["five-bar"] == "entry point (fkopt-example-plugin 0.1.0)"
     assert out["origins"]["algorithms"]["de"] == "entry point (fkopt-example-plugin 0.1.0)"
     detail = json.loads(run_cli(installed_example, "list", "five-bar", "--json").stdout)
     assert detail["bounds"] == {"x": [-80.0, 80.0], "y": [80.0, 200.0]} and detail["joints"]["theta1"] == "deg"
     # without the package on the path the names are unknown again (nothing is built in)
-    assert "five-bar" not in json.loads(cli("list", "--json").stdout)["mechanisms"]
+    assert "five-bar" not in json.loads(fkopt_run("list", "--json").stdout)["mechanisms"]
 
 
 def test_example_plugin_runs_from_yaml_end_to_end(installed_example, tmp_path):

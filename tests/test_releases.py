@@ -49,15 +49,14 @@ def test_the_committed_released_suites_match_their_frozen_digests(version, suite
     assert release_files(cfg) == RELEASES[version].files
 
 
-def test_a_swapped_pose_set_with_a_resigned_manifest_is_refused_in_one_line(tmp_path):
+def test_a_swapped_pose_set_with_a_resigned_manifest_is_refused_in_one_line(tmp_path, fkopt_run):
     path = copy_suite(tmp_path)
     swap_and_resign(tmp_path)
     with pytest.raises(FkoptError, match=r"uniform.csv: differs from released kinbench-v1") as err:
         load_pose_sets(load_suite(path))
     assert "\n" not in str(err.value) and "new version" in str(err.value)
     out = tmp_path / "out"
-    r = subprocess.run([sys.executable, "-m", "fkopt.cli", "suite", str(path), "--quick", "--out", str(out)],
-                       capture_output=True, text=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    r = fkopt_run("suite", str(path), "--quick", "--out", str(out))
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "released kinbench-v1" in r.stderr, r.stderr
     assert "Traceback" not in r.stderr and not out.exists()
 

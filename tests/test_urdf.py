@@ -316,37 +316,30 @@ def test_mimic_coupling_limits_jacobian_and_refusal(tmp_path):
 
 
 # -- command line ----------------------------------------------------------------------------------
-def _cli(*args, cwd=None):
-    import subprocess
-    import sys
-    return subprocess.run([sys.executable, "-m", "fkopt.cli", *args], capture_output=True, text=True,
-                          cwd=cwd, timeout=300)
-
-
-def test_cli_list_and_ik_on_a_urdf_arm(tmp_path):
+def test_cli_list_and_ik_on_a_urdf_arm(tmp_path, fkopt_run):
     import json
     arm = tmp_path / "robot"
     arm.mkdir()
     (arm / "arm.urdf").write_text(DEFAULT_FILE.read_text())
     (arm / "arm.yaml").write_text("file: arm.urdf\ntip: tool\n")            # relative to the YAML
-    out = json.loads(_cli("list", "urdf", "--geometry", str(arm / "arm.yaml"), "--json", cwd=tmp_path).stdout)
+    out = json.loads(fkopt_run("list", "urdf", "--geometry", str(arm / "arm.yaml"), "--json", cwd=tmp_path).stdout)
     assert [j["name"] for j in out["chain_joints"]] == [f"q{i}" for i in range(1, 8)]
     assert out["chain_joints"][0]["type"] == "continuous" and out["chain_joints"][1]["limits"] is not None
-    direct = _cli("list", "urdf", "--geometry", str(arm / "arm.urdf"), cwd=tmp_path)
+    direct = fkopt_run("list", "urdf", "--geometry", str(arm / "arm.urdf"), cwd=tmp_path)
     assert direct.returncode == 0 and "chain joints" in direct.stdout
     m = fkopt.mechanism("urdf", file=str(arm / "arm.urdf"))
     q = [10, -20, 30, 40, -10, 20, 30]
     pose = ",".join(f"{k}={v!r}" for k, v in zip(m.pose_names, m.fk(q).tolist()))
     start = ",".join(f"q{i + 1}={v + 2}" for i, v in enumerate(q))
-    res = _cli("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose, "--start", start, "--json",
+    res = fkopt_run("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose, "--start", start, "--json",
                "--position-tol", "1e-6", "--orientation-tol", "1e-6")
     got = json.loads(res.stdout)
     assert got["solved"] and got["restarts"] == 0
     np.testing.assert_allclose(m.fk(list(got["joints"].values())), m.fk(q), atol=1e-6)
-    masked = json.loads(_cli("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose,
+    masked = json.loads(fkopt_run("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose,
                              "--mask", "x,y,z", "--json").stdout)
     assert masked["solved"] and "rotation_error_rad" not in masked     # no rotation sought, none reported
-    bad = _cli("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose, "--mask", "x,y,w")
+    bad = fkopt_run("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose, "--mask", "x,y,w")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "inverse mask" in bad.stderr
 
 
