@@ -141,7 +141,10 @@ def _claim_moves(before: str | None, after: str | None) -> list[str]:
         if by_id:   # the stable id (one per reading): a reworded claim or condition is no move
             return {str(i): str(v) for i, v in zip(df["id"], df["verdict"])}
         # older files without ids: one row per reading, the condition tells them apart
-        cond = df["condition"].fillna("").astype(str) if "condition" in df.columns else pd.Series([""] * len(df))
+        # an all-empty condition column reads back as float NaN: blank it as text (fillna("") on float64 is
+        # deprecated in pandas)
+        cond = ([("" if pd.isna(c) else str(c)) for c in df["condition"]] if "condition" in df.columns
+                else [""] * len(df))
         return {str(c) + (f" [under: {k}]" if k else ""): str(v)
                 for c, k, v in zip(df["claim"], cond, df["verdict"])}
     old, new = keyed(a), keyed(b)
