@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import time
 import zlib
+from importlib.metadata import PackageNotFoundError, version
 
 import numpy as np
 import pandas as pd
@@ -41,7 +42,7 @@ from fkopt.errors import FkoptError
 from fkopt.kinbench.physical import LADDER, fk_verdicts, ik_verdicts, rung_label
 from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
 from fkopt.run.config_base import files_folder
-from fkopt.registry import FK_SOLVERS, clock_solver  # noqa: F401 (FK_SOLVERS: the FK solvers on the clock)
+from fkopt.registry import FK_SOLVERS, clock_solver, solver_entry  # noqa: F401 (FK_SOLVERS: the FK solvers on the clock)
 from fkopt.adapters.field import NotApplicable
 from fkopt.adapters.field.cores import pinned
 
@@ -108,6 +109,18 @@ def entry_of(name: str) -> str:
     return "organiser" if name in ORGANISER else "outside"
 
 
+def package_of(name: str) -> str:
+    """The PyPI package a clock entry runs through and its installed version ("pytracik 0.0.3"),
+    recorded with the entry's settings in meta.json: which release of an outside solver a board
+    measured is part of what it measured."""
+    entry = solver_entry(name)
+    package = entry.package if entry is not None else "fkopt"
+    try:
+        return f"{package} {version(package)}"
+    except PackageNotFoundError:
+        return f"{package} (version unknown)"
+
+
 def query_rng(seed: int, robot: str, solver: str, timeout_ms: float | None, query: int) -> np.random.Generator:
     key = zlib.crc32(f"{robot}/{solver}/{timeout_ms}".encode())
     return np.random.default_rng(np.random.SeedSequence([int(seed), key, int(query)]))
@@ -162,7 +175,7 @@ def run_clock(mechanism, robot: str, queries: np.ndarray, solvers: list[str], *,
         else:
             runs.append((name, None, first))
         if settings is not None:
-            settings[name] = dict(runs[-1][2].settings)
+            settings[name] = {"package": package_of(name), **dict(runs[-1][2].settings)}
     n, k, dim = len(queries), len(runs), queries.shape[1]
     answers = np.full((n, k, dim), np.nan)
     seconds, cpu_seconds, claimed = np.zeros((n, k)), np.zeros((n, k)), np.zeros((n, k), bool)
