@@ -237,8 +237,13 @@ def test_the_stored_board_page_shows_every_entrys_recorded_settings_and_the_thro
     index = (tmp_path / "index.html").read_text()
     rows = _settings_rows(index)
     for name, settings in sr.meta["entries"].items():
+        settings = dict(settings)
+        package = settings.pop("package", None)          # its own column, with the version the board ran
+        if package is not None:
+            assert rows[name][2] == package, name
         assert rows[name][4] == "; ".join(f"{k} = {v}" for k, v in settings.items()), name
         assert rows[name][5] not in ("", "-"), name
+    assert rows["tracik"][2].startswith("pytracik ")            # the board recorded the packages' versions
     assert "One outside IK solver" not in rows["ikpy"][5] and "symbolic=True" in rows["ikpy"][5]
     assert rows["optik"][5].rstrip().endswith("deterministic results.")     # the list after "except:"
     assert rows["pytorch-kinematics"][3].startswith("throughput track only")

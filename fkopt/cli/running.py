@@ -21,7 +21,7 @@ from fkopt.files import no_empty_folders_left
 
 def _engine():
     """The engine (:mod:`fkopt.run.pipeline`) with every built-in kind of config registered."""
-    import fkopt.kinbench  # lazy: noqa: F401 (registers every built-in kind of config)
+    import fkopt.kinbench  # noqa: F401  # lazy: registers every built-in kind of config (start-up)
     from fkopt.run import pipeline  # lazy: the engine pulls pandas (start-up of the light commands)
     return pipeline
 

@@ -194,13 +194,16 @@ def clock_settings_section(sr, answers: pd.DataFrame | None, throughput: pd.Data
             given = answers.loc[answers["solver"] == name, "given_timeout_ms"]
             limit = ("yes: run once per timeout, stopped by it" if given.notna().any()
                      else "no: run once to its own limits, judged at each timeout")
-        ran = _settings_text(recorded[name]) if name in recorded else "not recorded with this board"
+        st = dict(recorded.get(name) or {})
+        package = st.pop("package", None)      # "pytracik 0.0.3": the package column, with its version
+        ran = _settings_text(st) if name in recorded else "not recorded with this board"
         documented = documented_settings(name) or "-"
         sub = next((s for s in clock.submissions if s.solver == name), None)
         if sub is not None:
             ran, documented = f"submitted: {sub.description} (machine: {sub.machine})", "the submission (config)"
         known = solver_entry(name)
-        rows.append({"solver": name, "entry": entry_of(name), "package": known.package if known is not None else "-",
+        rows.append({"solver": name, "entry": entry_of(name),
+                     "package": package or (known.package if known is not None else "-"),
                      "wall-clock limit": limit, "recorded": ran, "documented": documented})
     cols = ["solver", "entry", "package", "wall-clock limit", "recorded", "documented"]
     body.append(H.table_html(pd.DataFrame(rows), cols, "settings-table",
