@@ -82,7 +82,7 @@ def check_number(name: str, value, what: str, *, low: float = -MAX_API_VALUE, po
 def check_options(what: str, **options) -> dict:
     """The one check of an API entry's options (``what``: ``inverse``, ``forward``, ...): each
     integer option (:data:`INTEGER_BOUNDS`) and ``seed`` an integer in its range, each other
-    option a finite real number within :data:`MAX_API_VALUE` (``rest`` >= 0; ``tol`` and the
+    option a finite real number within :data:`MAX_API_VALUE` (``rest`` >= 0; ``stall`` in [0, 1]; ``tol`` and the
     rest > 0; ``orientation_scale`` also None). Returns the options as ints and floats."""
     out = {}
     for name, value in options.items():
@@ -90,6 +90,11 @@ def check_options(what: str, **options) -> dict:
             out[name] = check_integer(name, value, what)
         elif name == "rest":
             out[name] = check_number(name, value, what, low=0.0)
+        elif name == "stall":                          # a ratio of |r|^2: 0 (off) to 1 (never met)
+            v = check_number(name, value, what, low=0.0)
+            if v > 1.0:
+                raise FkoptError(f"{what} {name}: expected a number >= 0 and <= 1, got {value!r}")
+            out[name] = v
         else:
             out[name] = check_number(name, value, what, positive=True, none=name == "orientation_scale")
     return out

@@ -29,7 +29,7 @@ from fkopt.numerics.rotations import rotation_error1, so3_right_jacobian_inverse
 
 
 def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, periodic, slo, shi, *, restarts, starts,
-                  rest, orientation_scale, iterations, damping, step_cap, down, up, fill, exact_rotation, table,
+                  rest, orientation_scale, iterations, damping, step_cap, down, up, stall, fill, exact_rotation, table,
                   neighbours, tail, compiled, threads=None) -> InverseResult:
     """Rows P (N, 6 or 12) of checked targets (within reach) from start rows q0 (N, n) in internal
     units, task mask W (or None), limits and saturation bounds in internal units: the answer as
@@ -50,7 +50,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                                       float(orientation_scale) if orientation_scale else reach, ctx["W"],
                                       np.ascontiguousarray(q0, dtype=float), own0, nn, int(seed),
                                       first + max(0, int(restarts)), (tp, tr), int(iterations), float(damping),
-                                      float(down), float(up), float(step_cap),
+                                      float(down), float(up), float(step_cap), float(stall),
                                       available_cpus() if threads is None else int(threads))
         perr, rerr = info[:, 0], info[:, 1]
         ev = info[:, 4].astype(np.int64)
@@ -133,7 +133,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
             return starts_for(np.zeros(1, dtype=np.intp), np.array([j]))[0].tolist()
 
         bq, nused, ne = inverse_candidates(m.frame_jacobian1, pt[0].tolist(), Rt[0].tolist(), L, start_of, budget,
-                                           (tp, tr), iterations, damping, down, up, step_cap, slo.tolist(),
+                                           (tp, tr), iterations, damping, down, up, step_cap, stall, slo.tolist(),
                                            shi.tolist())
         bq = np.array(bq)
         best_q, used = bq[None], np.array([nused], dtype=np.int64)
@@ -174,6 +174,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
         q = starts_for(own, np.tile(np.arange(K), N))
         r, J, pe, re = evaluate(q, own)
         S = _sumsq(r)
+        s1, s2 = np.full(len(q), np.inf), np.full(len(q), np.inf)   # |r|^2 one and two evaluations before
         lam = np.full(len(q), damping)
         age = np.zeros(len(q), dtype=np.int64)
         fresh = np.zeros(len(q), dtype=bool)               # restarted: q set, r and J not yet
@@ -186,6 +187,8 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                     fold(cs)
                     done[own[cs]] = True
                 stuck = ((age >= iterations) | (lam > 1e6)) & ~fresh
+                if stall > 0:                              # the stall test, but not on a row's last start
+                    stuck |= (S > stall * s2) & (used[own] < budget) & ~fresh
                 if conv.any() or stuck.any():
                     live = ~done[own]
                     sl = np.flatnonzero(stuck & live)
@@ -200,8 +203,8 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                         q[sl] = starts_for(rows, j)
                         fresh[sl] = True
                     if not live.all():
-                        own, q, r, J, pe, re, lam, S, age, fresh = (
-                            a[live] for a in (own, q, r, J, pe, re, lam, S, age, fresh))
+                        own, q, r, J, pe, re, lam, S, s1, s2, age, fresh = (
+                            a[live] for a in (own, q, r, J, pe, re, lam, S, s1, s2, age, fresh))
                 if len(own) < tail:                        # few rows left: give each more candidates
                     rows_left = np.flatnonzero(~done & (used < budget))
                     extra = (tail - len(own)) // max(len(rows_left), 1)
@@ -216,6 +219,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                         r, J = np.concatenate([r, np.empty((k, 6))]), np.concatenate([J, np.empty((k, 6, n))])
                         pe, re = np.concatenate([pe, np.empty(k)]), np.concatenate([re, np.empty(k)])
                         lam, S = np.concatenate([lam, np.empty(k)]), np.concatenate([S, np.empty(k)])
+                        s1, s2 = np.concatenate([s1, np.empty(k)]), np.concatenate([s2, np.empty(k)])
                         age = np.concatenate([age, np.empty(k, dtype=np.int64)])
                         fresh = np.concatenate([fresh, np.ones(k, dtype=bool)])
                 if not len(own):
@@ -277,8 +281,10 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                 ok = (St < S) | fresh
                 lam = np.where(ok, np.maximum(lam * down, 1e-12), lam * up)
                 age += 1
+                s1, s2 = S.copy(), s1
                 if anyfresh:
                     lam[fresh], age[fresh] = damping, 0
+                    s1[fresh], s2[fresh] = np.inf, np.inf
                     fresh[:] = False
                 if ok.all():
                     q, r, J, pe, re, S = qe, rt, Jn, pet, ret, St

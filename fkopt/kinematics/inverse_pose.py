@@ -154,7 +154,7 @@ def _fast_result(m, answer, tp: float, tr: float) -> InverseResult:
 
 
 def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale, iterations, damping,
-                 down, up, step_cap, W=None, compiled=None) -> InverseResult:
+                 down, up, step_cap, stall, W=None, compiled=None) -> InverseResult:
     """:func:`inverse` of one pose (6,): the candidates of the batched loop one after another on
     Python floats (:func:`fkopt.numerics.damped_least_squares.inverse_candidates`, or its compiled twin), the same starts in the same order (``start``, then
     the table's ``kn`` configurations nearest to the target -- looked up only when a candidate
@@ -192,7 +192,7 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         ctx = _fast_context(m, int(table), W)
         return _fast_result(m, fast.inverse_pose(ctx, np.ascontiguousarray(pose, dtype=float), L, ctx["W"], np.array(q0), own0, nn, int(seed), int(budget),
                                                  tol, int(iterations), float(damping), float(down), float(up),
-                                                 float(step_cap)), tp, tr)
+                                                 float(step_cap), float(stall)), tp, tr)
     Rt = pose[3:].reshape(3, 3).tolist() if len(pose) == 12 else rotations.zyz1(*pose[3:].tolist())
     near: list[int] = []
 
@@ -222,10 +222,10 @@ def _inverse_one(m, pose, start, tol, seed, budget, table, kn, orientation_scale
         Wc = np.ones(6) if W is None else np.asarray(W, dtype=float)
         bq, used, ne = fast.inverse_one(m.chain(), np.asarray(pose[:3], dtype=float), np.array(Rt), L, Wc,
                                         np.asarray(q0, dtype=float), own0, near_q, seed, budget, tol, iterations,
-                                        damping, down, up, step_cap, c["slo"], c["shi"], lo, hi)
+                                        damping, down, up, step_cap, stall, c["slo"], c["shi"], lo, hi)
     else:
         bq, used, ne = inverse_candidates(m.frame_jacobian1, [float(v) for v in pose[:3]], Rt, L, start_of, budget,
-                                          tol, iterations, damping, down, up, step_cap, c["slo"].tolist(),
+                                          tol, iterations, damping, down, up, step_cap, stall, c["slo"].tolist(),
                                           c["shi"].tolist(), None if W is None else W.tolist())
         bq = np.array(bq)
     if start is not None and (n > 6 or W is not None):   # self-motion towards the start

@@ -151,11 +151,11 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
         if held:
             _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
                                  tp, tr, held_iterations, damping, down,
-                                 up, step_cap, hlo, hhi, glo, ghi, best)
+                                 up, step_cap, 0.0, hlo, hhi, glo, ghi, best)
         else:
             _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
                                  tp, tr, iterations, damping, down,
-                                 up, step_cap, slo, shi, glo, ghi, best)
+                                 up, step_cap, 0.0, slo, shi, glo, ghi, best)
         pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
         if W[3] * W[4] * W[5] != 0.0:
             re = max(re, _geodesic(R, T))
@@ -166,7 +166,7 @@ def _search(chain, pose, Lw, W, tq, Ft, norms, wf, fmask, nn, seed, max_starts, 
             # loop goes on from there, unlimited (held joints freed: the answer is checked the same)
             q0[:] = best
             _, ev = _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, seed, 0, 1,
-                                 tp, tr, polish_iterations, damping, down, up, step_cap, slo, shi, glo, ghi, best)
+                                 tp, tr, polish_iterations, damping, down, up, step_cap, 0.0, slo, shi, glo, ghi, best)
             pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
             if W[3] * W[4] * W[5] != 0.0:
                 re = max(re, _geodesic(R, T))
@@ -362,7 +362,7 @@ def _track(chain, poses, first, q, Lw, W, tp, tr, iterations, damping, down, up,
         for i in range(n):
             q0[i] = q[i] + vel[i]
         _inverse_one(chain, pt, T, Lw, W, q0, 1, empty, 0, no_table, no_feat, no_v32, no_tq, 0, 0, 1, tp, tr,
-                     iterations, damping, down, up, step_cap,
+                     iterations, damping, down, up, step_cap, 0.0,
                      slo, shi, lo, hi, best)
         pe, re, _ = _evaluate(chain, best, pt, T, Lw, W, r, J, p, R, ax, e)
         if W[3] * W[4] * W[5] != 0.0:

@@ -20,19 +20,25 @@ from fkopt.numerics.jit import njit                 # numba.njit with a cache th
 
 
 @njit(cache=True, _nrt=False)   # no reference counts: it only reads and writes the arrays it is given
-def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap, lo, hi, work):
+def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap, stall, lo, hi,
+                   work):
     """One candidate of the one restart loop: the damped least-squares steps from start q (updated
     in place) -- :func:`fkopt.numerics.damped_least_squares.inverse_candidates`' search, compiled,
-    with saturation in the null space; ``work`` the loop's scratch arrays. Returns (position error,
-    rotation error, evaluations)."""
+    with saturation in the null space and its stall test (|r|^2 above ``stall`` times its value two
+    evaluations before ends the candidate; 0: never); ``work`` the loop's scratch arrays. Returns
+    (position error, rotation error, evaluations)."""
     r, rn, rr, J, Jn, p, R, ax, e, A, Lc, y, x, qn, d, ds, fixed_val, fixed_order, free = work
     n = q.shape[0]
     pe, re, S = _evaluate(chain, q, pt, T, Lw, W, r, J, p, R, ax, e, wone)
     evals = 1
     lam = damping
+    s1 = s2 = math.inf                              # |r|^2 one and two evaluations before
     for _ in range(iterations):
         if pe <= tp and re <= tr:
             break
+        if stall > 0.0 and S > stall * s2:          # stalled: the next start is likelier to converge
+            break
+        s1, s2 = S, s1
         acc = 0.0
         for a in range(6):
             for i in range(n):
@@ -100,10 +106,11 @@ def _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, do
 
 @njit(cache=True)
 def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq, seed, row, budget, tp, tr, iterations,
-                 damping, down, up, step_cap, lo, hi, glo, ghi, best_q):
+                 damping, down, up, step_cap, stall, lo, hi, glo, ghi, best_q):
     """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
-    (seed, row) scaled into [glo, ghi]. Writes the best joints into best_q; returns
+    (seed, row) scaled into [glo, ghi]; every start but the last may end at the stall test
+    (``stall``, :func:`_dls_candidate`). Writes the best joints into best_q; returns
     (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
     called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``,
     features ``feat``, the screen ``v32``, joints ``tq``), looked up only if a start reaches them
@@ -138,7 +145,7 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq
             for i in range(n):
                 q[i] = glo[i] + (ghi[i] - glo[i]) * u[i]
         pe, re, ev = _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap,
-                                    lo, hi, work)
+                                    stall if j < budget - 1 else 0.0, lo, hi, work)
         evals += ev
         merit = max(pe / tp, re / tr)
         if merit < best_m or j == 0:                # the first answer is kept whatever its merit
@@ -150,14 +157,14 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq
 
 
 def inverse_one(chain, pt, T, L, W, q0, own0, near, seed, budget, tol, iterations, damping, down, up,
-                step_cap, lo, hi, glo, ghi):
+                step_cap, stall, lo, hi, glo, ghi):
     """One pose through :func:`_inverse_one`: (best joints (n,), starts used, evaluations)."""
     best = np.empty(chain.dof)
     used, evals = _inverse_one(chain.arrays(), pt, T, float(L), W, q0, int(own0), near, near.shape[0], NO_TABLE,
                                np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, chain.dof)), int(seed), 0,
                                int(budget),
                                float(tol[0]), float(tol[1]), int(iterations), float(damping), float(down),
-                               float(up), float(step_cap), lo, hi, glo, ghi, best)
+                               float(up), float(step_cap), float(stall), lo, hi, glo, ghi, best)
     return best, used, evals
 
 
@@ -414,7 +421,7 @@ def _near_rows(table, f, v32, tq, near):
 
 @njit(cache=True, nogil=True)
 def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
+                  damping, down, up, step_cap, stall, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info):
     """One pose of ``fkopt.inverse`` from the public pose to the public answer, all compiled:
     the target rotation (from ZYZ Euler angles in deg, :func:`fkopt.numerics.rotations.zyz1`, for
     a pose (6,); as given for a frame row (12,): x, y, z and the rotation row-major), the
@@ -442,7 +449,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
         _near_rows(table, f, v32, tq, near[:have])
     best = np.empty(n)
     used, evals = _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, f, v32, tq, seed, 0, budget, tp, tr,
-                               iterations, damping, down, up, step_cap, slo, shi, lo, hi, best)
+                               iterations, damping, down, up, step_cap, stall, slo, shi, lo, hi, best)
     t = np.empty(n)
     inside = True
     for i in range(n):
@@ -466,7 +473,7 @@ def _inverse_pose(chain, pose, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, 
     info[4] = evals
 
 
-def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap):
+def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap, stall):
     """:func:`_inverse_pose` with the per-arm constants ``ctx`` (see
     :func:`fkopt.kinematics.inverse_pose._fast_context`) and the options bound once: a function
     (pose, seed) -> (public joints (n,), info (5,)). The one place that lays ``ctx`` onto the
@@ -474,7 +481,7 @@ def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping
     a control loop's call does no dictionary lookups."""
     chain, n = ctx["chain"], ctx["n"]
     head = (L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn)
-    tail = (budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"], ctx["lo"],
+    tail = (budget, tol[0], tol[1], iterations, damping, down, up, step_cap, stall, ctx["slo"], ctx["shi"], ctx["lo"],
             ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"])
 
     def call(pose, seed):
@@ -484,15 +491,16 @@ def bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping
     return call
 
 
-def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap):
+def inverse_pose(ctx, pose, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap, stall):
     """One pose through :func:`_inverse_pose` (:func:`bound_inverse_pose`, bound for this call):
     (public joints (n,), info (5,))."""
-    return bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap)(pose, seed)
+    return bound_inverse_pose(ctx, L, W, q0, own0, nn, budget, tol, iterations, damping, down, up, step_cap,
+                              stall)(pose, seed)
 
 
 @njit(cache=True, nogil=True)
 def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed, budget, tp, tr, iterations,
-                  damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, next_row):
+                  damping, down, up, step_cap, stall, slo, shi, lo, hi, angle, periodic, blo, bhi, out, info, next_row):
     """:func:`_inverse_pose` of rows of ``poses`` (k, 6) from start rows ``q0[k]``: each row the
     one it takes from the shared count ``next_row[0]`` (:func:`fkopt.numerics.compiled._fetch_add`)
     until none is left; row k's answer is the one-pose call's, whoever takes it. Runs without the
@@ -500,7 +508,7 @@ def _inverse_rows(chain, poses, Lw, W, q0, own0, tq, table, wf, fmask, nn, seed,
     k = _fetch_add(next_row, 1)
     while k < poses.shape[0]:
         _inverse_pose(chain, poses[k], Lw, W, q0[k], own0, tq, table, wf, fmask, nn, seed, budget, tp, tr,
-                      iterations, damping, down, up, step_cap, slo, shi, lo, hi, angle, periodic, blo, bhi,
+                      iterations, damping, down, up, step_cap, stall, slo, shi, lo, hi, angle, periodic, blo, bhi,
                       out[k], info[k])
         k = _fetch_add(next_row, 1)
 
@@ -510,7 +518,7 @@ THREAD_ROWS = 64
 
 
 def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, damping, down, up, step_cap,
-                 threads):
+                 stall, threads):
     """Rows through :func:`_inverse_rows`: (public joints (k, n), info (k, 5)). From
     :data:`THREAD_ROWS` rows, ``threads`` threads (this one and threads - 1 more; at most one per
     :data:`THREAD_ROWS` // 2 rows) share them, each taking the next row not yet taken: a row that
@@ -522,7 +530,7 @@ def inverse_rows(ctx, poses, L, W, q0, own0, nn, seed, budget, tol, iterations, 
     out, info = np.empty((k, ctx["n"])), np.empty((k, 5))
     next_row = np.zeros(1, dtype=np.int64)
     args = (ctx["chain"], poses, L, W, q0, own0, ctx["tq"], ctx["table"], ctx["w"], ctx["fmask"], nn,
-            seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, ctx["slo"], ctx["shi"],
+            seed, budget, tol[0], tol[1], iterations, damping, down, up, step_cap, stall, ctx["slo"], ctx["shi"],
             ctx["lo"], ctx["hi"], ctx["angle"], ctx["periodic"], ctx["blo"], ctx["bhi"], out, info, next_row)
     helpers = min(int(threads), max(1, k // (THREAD_ROWS // 2))) - 1 if k >= THREAD_ROWS else 0
     if helpers < 1:

@@ -23,10 +23,11 @@ class InverseOptions:
     rest: float = 0.0
     orientation_scale: float | None = None
     iterations: int = 10
-    damping: float = 0.01
+    damping: float = 5e-4
     step_cap: float = 2.0
     down: float = 0.1
     up: float = 10.0
+    stall: float = 0.5
     fill: int = 32
     exact_rotation: bool = False
     table: int = 4096

@@ -1,7 +1,10 @@
 """Records tests/inverse_bits/one_pose.json: one-pose ``fkopt.inverse`` answers (joints as the
-hex of their float64 bytes, restarts, evaluations) of the code before ``fkopt.InverseSolver``
-(commit 255c592), for tests/test_inverse_solver.py to hold the solver and ``inverse`` to.
-Run from a checkout of that commit: ``PYTHONPATH=<it> python tests/inverse_bits/record.py OUT``.
+hex of their float64 bytes, restarts, evaluations), for tests/test_inverse_solver.py to hold the
+solver and ``inverse`` to: ``PYTHONPATH=<checkout> python tests/inverse_bits/record.py OUT``.
+First recorded with the code before ``fkopt.InverseSolver`` (commit 255c592). Every arm was
+re-recorded on 6 Dec 2026 (issue 38, fifth round) with the code that changed ``inverse``'s
+defaults (damping 0.01 -> 5e-4, the stall test at 0.5: every answer moved; the recording
+platform is platform.json's). The history below is that of the earlier recordings.
 
 ``python tests/inverse_bits/record.py OUT ARM...`` records only those arms into an existing OUT.
 The URDF and MJCF arms (``urdf``, ``mjcf``, ``panda``) were re-recorded so on 6 Dec 2026 with the
