@@ -335,7 +335,10 @@ def test_cli_list_and_ik_on_a_urdf_arm(tmp_path, fkopt_run):
                "--position-tol", "1e-6", "--orientation-tol", "1e-6")
     got = json.loads(res.stdout)
     assert got["solved"] and got["restarts"] == 0
-    np.testing.assert_allclose(m.fk(list(got["joints"].values())), m.fk(q), atol=1e-6)
+    # solved at 1e-6 m / 1e-6 rad: the tip frame within those (Euler angles in deg are no tolerance's unit)
+    T, Tq = m.fk_matrix(list(got["joints"].values())), m.fk_matrix(q)
+    assert np.linalg.norm(T[:3, 3] - Tq[:3, 3]) <= 1e-6 * (1 + 1e-9)
+    assert np.arccos(np.clip((np.trace(T[:3, :3].T @ Tq[:3, :3]) - 1) / 2, -1, 1)) <= 1e-6 + 1e-9
     masked = json.loads(fkopt_run("ik", "urdf", "--geometry", str(arm / "arm.yaml"), "--pose", pose,
                              "--mask", "x,y,z", "--json").stdout)
     assert masked["solved"] and "rotation_error_rad" not in masked     # no rotation sought, none reported
