@@ -1,7 +1,7 @@
 """``fkopt.InverseSolver``: the prepared one-pose IK of a control loop. Held to recorded one-pose
 answers of ``fkopt.inverse`` (tests/inverse_bits/one_pose.json, by tests/inverse_bits/record.py:
 first at commit 255c592, before the solver existed; every arm re-recorded when issue 38 changed
-the defaults, damping 5e-4 and the stall test, as record.py says), bit for bit, on a DH arm, URDF
+the defaults, damping 5e-4, the stall test and 20 iterations, as record.py says), bit for bit, on a DH arm, URDF
 arms and MJCF arms, through the solver and ``inverse`` on the default path and the Python
 reference alike; bad targets are one line; options are validated once, when it is made."""
 import importlib.util

@@ -56,7 +56,9 @@ geodesic orientation error, no Euler differences):
   |r|^2, x ``up`` = 10 otherwise; 5e-4 rather than 1e-2 since issue 38: 16 % fewer evaluations
   per pose over 14 arms, as many solved, docs/performance.md); the joint step is capped at ``step_cap`` radians; a
   candidate whose |r|^2 did not fall below ``stall`` (0.5) times its value two evaluations before
-  gives way to the next start (the stall test; 0: off; a row's last start runs to its end); the
+  gives way to the next start (the stall test; 0: off; a row's last start runs to its end), else
+  it ends after ``iterations`` (20) steps (10 before the stall test, which ends the stuck
+  candidates the cap had ended: 20 leaves fewer poses unsolved, docs/performance.md); the
   orientation rows use the angular velocity (the derivative of the rotation vector at zero
   error; ``exact_rotation=True`` applies the inverse left Jacobian of SO(3) -- measured: the
   same number of Jacobian evaluations on 1000 random poses, so the cheaper one is the default);
@@ -409,7 +411,7 @@ def _solver_for(m, options, tol: tuple[float, float], W) -> InverseSolver:
 
 def inverse(arm, poses, *, start=None, tol=INVERSE_TOL, mask=None, seed: int = 0, restarts: int = 200,
             starts: int = 1, rest: float = 0.0, orientation_scale: float | None = None,
-            iterations: int = 10, damping: float = 5e-4, step_cap: float = 2.0,
+            iterations: int = 20, damping: float = 5e-4, step_cap: float = 2.0,
             down: float = 0.1, up: float = 10.0, stall: float = 0.5, fill: int = 32, exact_rotation: bool = False,
             table: int = 4096, neighbours: int = 32, tail: int = 256, compiled: bool | None = None,
             threads: int | None = None, options=None) -> InverseResult:

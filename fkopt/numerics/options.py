@@ -22,7 +22,7 @@ class InverseOptions:
     starts: int = 1
     rest: float = 0.0
     orientation_scale: float | None = None
-    iterations: int = 10
+    iterations: int = 20
     damping: float = 5e-4
     step_cap: float = 2.0
     down: float = 0.1

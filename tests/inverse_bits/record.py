@@ -3,7 +3,7 @@ hex of their float64 bytes, restarts, evaluations), for tests/test_inverse_solve
 solver and ``inverse`` to: ``PYTHONPATH=<checkout> python tests/inverse_bits/record.py OUT``.
 First recorded with the code before ``fkopt.InverseSolver`` (commit 255c592). Every arm was
 re-recorded on 6 Dec 2026 (issue 38, fifth round) with the code that changed ``inverse``'s
-defaults (damping 0.01 -> 5e-4, the stall test at 0.5: every answer moved; the recording
+defaults (damping 0.01 -> 5e-4, the stall test at 0.5, iterations 10 -> 20: every answer moved; the recording
 platform is platform.json's). The history below is that of the earlier recordings.
 
 ``python tests/inverse_bits/record.py OUT ARM...`` records only those arms into an existing OUT.
