@@ -243,7 +243,8 @@ def _nearest_into(Ft, norms, f, idx, best):
 
 
 #: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
-NO_TABLE = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0)
+NO_TABLE = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0,
+            np.zeros((0, 12)))
 
 #: Neighbours looked up before the first start; the rest only when a start reaches them. Most
 #: poses are solved from their first or second start, and the nearest four cost about half of
@@ -257,9 +258,11 @@ SCREEN_ROUNDOFF = 2.0 ** -16
 
 def start_screen(Ft, norms):
     """The start table for :func:`_nearest_screened`: (Ft float64 (12, N), norms float64, Ft and
-    norms as float32, max |F_i|^2)."""
+    norms as float32, max |F_i|^2, F float64 (N, 12)). F is Ft row by row, for the float64 value
+    of the few rows the screen keeps: a row's 12 features in two cache lines, where a column of Ft
+    spreads them over 12 pages (measured on Panda: the nearest four 2.35 -> 2.1 µs a pose)."""
     return (Ft, norms, np.ascontiguousarray(Ft, dtype=np.float32), np.ascontiguousarray(norms, dtype=np.float32),
-            float(norms.max()) if norms.shape[0] else 0.0)
+            float(norms.max()) if norms.shape[0] else 0.0, np.ascontiguousarray(Ft.T))
 
 
 @njit(cache=True)
@@ -348,7 +351,7 @@ def _nearest_screened(table, f, v32, idx, best):
     rows at or below it), so the k smallest screen values are all in the groups whose minimum is
     at most it, and the rows at most s_k + 2B in the groups whose minimum is (for more than
     :data:`GROUP_SCAN_K` neighbours the rows are visited in row order instead, same rows)."""
-    Ft, norms, _, _, nmax = table
+    Ft, norms, _, _, nmax, F = table
     k = idx.shape[0]
     c, N = Ft.shape
     ff = 0.0
@@ -386,25 +389,26 @@ def _nearest_screened(table, f, v32, idx, best):
             if np.float64(gm[g]) <= limit:
                 for i in range(g, N, G):
                     if np.float64(v32[i]) <= limit:
-                        m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
+                        m = _insert(best, idx, m, _table_distance(F, norms, f, i), i)
     else:
         for i in range(N):
             if np.float64(v32[i]) <= limit:
-                m = _insert(best, idx, m, _table_distance(Ft, norms, f, i), i)
+                m = _insert(best, idx, m, _table_distance(F, norms, f, i), i)
 
 
 @njit(inline="always")
-def _table_distance(Ft, norms, f, i):
-    """Row i's float64 value |F_i|^2 - 2 F_i . f, operation for operation :func:`_table_distances`'."""
+def _table_distance(F, norms, f, i):
+    """Row i's float64 value |F_i|^2 - 2 F_i . f (F row by row), operation for operation
+    :func:`_table_distances`'."""
     acc = 0.0
     first = True
-    for j in range(Ft.shape[0]):
+    for j in range(F.shape[1]):
         fj = f[j]
         if fj == 0.0:
             continue
         # d2[i] starts at 0.0 in _table_distances: 0.0 + x is x (but for -0.0, whose sign
         # |F_i|^2 - 2 d2 does not see)
-        acc = Ft[j, i] * fj if first else acc + Ft[j, i] * fj
+        acc = F[i, j] * fj if first else acc + F[i, j] * fj
         first = False
     return norms[i] - 2.0 * acc
 
