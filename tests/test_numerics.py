@@ -1,6 +1,8 @@
 """The compiled numerics path (numba) held to the numpy/Python reference: the same chain FK and
 frame Jacobian to 1e-12, and the same one-pose ``fkopt.inverse`` answers (joints, restarts,
 evaluations) bit for bit, on real arms from example-robot-data and the DH arm of wang7dof."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -476,6 +478,57 @@ def test_compiled_refill_reuses_a_buffer_only_when_no_view_of_it_is_alive(monkey
     assert np.array_equal(kept, copy)
     assert 2 <= len(s._stores) <= 4
     assert np.array_equal(s.uniform(7)[3], _generator(5, 3).random(300 + 4000 + 7)[-7:])
+
+
+@pytest.mark.parametrize("arm_name", ["7dof-arm", "urdf"])
+def test_quaternion_screen_is_within_the_bound_and_keeps_the_full_passes_rows(arm_name):
+    """The start table's quaternion screen (7 numbers a row: position and the rotation's unit
+    quaternion, fkopt.numerics.compiled_ik._screen_quaternion) on real targets -- tip frames of
+    drawn joints, on and off the table's rows, rotations by pi included, where the quaternion's
+    largest component changes -- is within the float32 screen's error bound of the float64
+    values, and the screened lookup gives the full float64 pass's rows in the same order; a
+    feature vector that is not a rotation's falls back to the 12-feature screen."""
+    from fkopt.kinematics.inverse_pose import _fast_context
+    from fkopt.numerics import compiled_ik as c
+    arm = fkopt.mechanism(arm_name)
+    ctx = _fast_context(arm, 4096, None)
+    table, wf = ctx["table"], ctx["w"]
+    assert table[6].shape == (7, 4096)                  # the quaternions are kept
+    rng = np.random.default_rng(11)
+    lo, hi = arm.bounds[:, 0], arm.bounds[:, 1]
+    frames = arm.fk_matrix(lo + rng.random((60, arm.dof)) * (hi - lo))
+    half_turns = frames[:6].copy()
+    for i, axis in enumerate(np.eye(3)):                # R times a half turn about x, y, z
+        half_turns[i, :3, :3] = frames[i, :3, :3] @ (2 * np.outer(axis, axis) - np.eye(3))
+    tq = ctx["tq"]
+    on_rows = arm.fk_matrix(np.degrees(tq[:5]) if arm.angle_mask(arm.joint_units).all() else tq[:5])
+    for T in np.concatenate([frames, half_turns, on_rows]):
+        f = np.empty(12)
+        c._table_features(np.ascontiguousarray(T[:3, 3]), np.ascontiguousarray(T[:3, :3]), wf, ctx["fmask"], f)
+        v32 = np.empty(4096, np.float32)
+        assert c._screen_quaternion(table, f, v32)
+        v64 = ctx["norms"] - 2.0 * (ctx["Ft"].T @ f)
+        nmax, ff = ctx["norms"].max(), f @ f
+        bound = c.SCREEN_ROUNDOFF * (1 + nmax + 2 * np.sqrt(nmax * ff) + ff)
+        assert np.abs(v32 - v64).max() <= bound / 8            # the bound with room to spare
+        for k in (4, 64):
+            want, got = np.empty(k, np.int64), np.empty(k, np.int64)
+            c._nearest_into(table[0], table[1], f, want, np.empty(k))
+            c._screen32(table, f, v32)
+            c._nearest_screened(table, f, v32, got, np.empty(k))
+            assert np.array_equal(want, got)
+    bent = f.copy()
+    bent[3] *= 1 + 1e-6                                 # not a rotation: the 12-feature screen
+    assert not c._screen_quaternion(table, bent, v32)
+
+
+def test_kernel_modules_are_every_module_that_compiles_kernels():
+    """fkopt.numerics.jit.KERNEL_MODULES (whose files' stamps are part of every compiled kernel's
+    cache key) names exactly the package's modules that use its njit."""
+    from fkopt.numerics import jit
+    root = Path(fkopt.__file__).parent
+    using = sorted(str(p.relative_to(root)) for p in root.rglob("*.py") if "njit(" in p.read_text())
+    assert sorted(jit.KERNEL_MODULES) == using
 
 
 @pytest.mark.parametrize("k", [1, 4, 64])

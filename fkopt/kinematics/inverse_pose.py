@@ -137,7 +137,7 @@ def _fast_context(m, table: int, W) -> dict:
             "blo": np.array(c["blo"], dtype=float), "bhi": np.array(c["bhi"], dtype=float),
             "mid": np.array(c["mid"], dtype=float)}
         from fkopt.numerics.compiled_ik import start_screen  # lazy: numba (the compiled nearest-neighbour search)
-        got["table"] = start_screen(got["Ft"], got["norms"])
+        got["table"] = start_screen(got["Ft"], got["norms"], w)
     return got
 
 

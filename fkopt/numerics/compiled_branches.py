@@ -45,7 +45,7 @@ def _no_start_table(n):
     """_inverse_one's start arguments with no start table (these loops give their own starts):
     no neighbour rows, the table's arrays empty (compiled_ik.NO_TABLE), no features, screen or joints."""
     no_table = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32),
-                0.0)
+                0.0, np.zeros((0, 12)), np.zeros((7, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0)
     return np.empty((0, n)), no_table, np.zeros(12), np.zeros(0, dtype=np.float32), np.zeros((0, n))
 
 

@@ -244,7 +244,7 @@ def _nearest_into(Ft, norms, f, idx, best):
 
 #: A start table that holds nothing (:func:`inverse_one` is given all its neighbours).
 NO_TABLE = (np.zeros((12, 0)), np.zeros(0), np.zeros((12, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0,
-            np.zeros((0, 12)))
+            np.zeros((0, 12)), np.zeros((7, 0), dtype=np.float32), np.zeros(0, dtype=np.float32), 0.0)
 
 #: Neighbours looked up before the first start; the rest only when a start reaches them. Most
 #: poses are solved from their first or second start, and the nearest four cost about half of
@@ -256,13 +256,59 @@ NEAR_FIRST = 4
 SCREEN_ROUNDOFF = 2.0 ** -16
 
 
-def start_screen(Ft, norms):
+def start_screen(Ft, norms, wf=0.0):
     """The start table for :func:`_nearest_screened`: (Ft float64 (12, N), norms float64, Ft and
-    norms as float32, max |F_i|^2, F float64 (N, 12)). F is Ft row by row, for the float64 value
-    of the few rows the screen keeps: a row's 12 features in two cache lines, where a column of Ft
-    spreads them over 12 pages (measured on Panda: the nearest four 2.35 -> 2.1 µs a pose)."""
+    norms as float32, max |F_i|^2, F float64 (N, 12), PQ float32 (7, N), a float32 (N,), wf). F is
+    Ft row by row, for the float64 value of the few rows the screen keeps: a row's 12 features in
+    two cache lines, where a column of Ft spreads them over 12 pages (measured on Panda: the
+    nearest four 2.35 -> 2.1 µs a pose). PQ and a serve :func:`_screen32`'s quaternion screen:
+    each row's position and the unit quaternion of its rotation, a = |F_i|^2 + 2 wf^2; empty
+    (7, 0) unless every row is a start table's (position, ``wf`` times a rotation) -- a task
+    mask's table zeroes features, and is screened feature by feature."""
+    N = norms.shape[0]
+    F = np.ascontiguousarray(Ft.T)
+    PQ, a = np.zeros((7, 0), dtype=np.float32), np.zeros(0, dtype=np.float32)
+    if wf > 0.0 and Ft.shape[0] == 12 and N:
+        R = F[:, 3:].reshape(N, 3, 3) / wf
+        if np.abs(R @ np.swapaxes(R, 1, 2) - np.eye(3)).max() <= ROTATION_TOL:
+            PQ = np.ascontiguousarray(np.vstack([Ft[:3], _quaternions(R).T]), dtype=np.float32)
+            a = np.ascontiguousarray(norms + 2.0 * wf * wf, dtype=np.float32)
     return (Ft, norms, np.ascontiguousarray(Ft, dtype=np.float32), np.ascontiguousarray(norms, dtype=np.float32),
-            float(norms.max()) if norms.shape[0] else 0.0, np.ascontiguousarray(Ft.T))
+            float(norms.max()) if N else 0.0, F, PQ, a, float(wf))
+
+
+#: Largest |R R^T - I| of a rotation the quaternion screen takes (fkopt.inverse's own check of a
+#: target frame, :data:`fkopt.kinematics.inputs.FRAME_ORTHONORMAL_TOL`, is this one).
+ROTATION_TOL = 1e-9
+
+
+def _quaternions(R):
+    """Unit quaternions (N, 4) of rotations R (N, 3, 3), up to sign, by the largest of the trace
+    and the diagonal (Shepperd 1978): :func:`_quaternion`'s cases on every row."""
+    out = np.empty((len(R), 4))
+    for i in range(len(R)):                         # once per table, through the one compiled case split
+        _quaternion(np.ascontiguousarray(R[i]), out[i])
+    return out
+
+
+@njit(cache=True, _nrt=False)
+def _quaternion(T, q):
+    """The unit quaternion (w, x, y, z) of rotation T into q, up to sign, from the largest of its
+    trace and diagonal (Shepperd 1978: no square root of a small number)."""
+    m00, m11, m22 = T[0, 0], T[1, 1], T[2, 2]
+    t = m00 + m11 + m22
+    if t >= m00 and t >= m11 and t >= m22:
+        s = 2.0 * math.sqrt(max(1.0 + t, 0.0))
+        q[0], q[1], q[2], q[3] = 0.25 * s, (T[2, 1] - T[1, 2]) / s, (T[0, 2] - T[2, 0]) / s, (T[1, 0] - T[0, 1]) / s
+    elif m00 >= m11 and m00 >= m22:
+        s = 2.0 * math.sqrt(max(1.0 + m00 - m11 - m22, 0.0))
+        q[0], q[1], q[2], q[3] = (T[2, 1] - T[1, 2]) / s, 0.25 * s, (T[0, 1] + T[1, 0]) / s, (T[0, 2] + T[2, 0]) / s
+    elif m11 >= m22:
+        s = 2.0 * math.sqrt(max(1.0 + m11 - m00 - m22, 0.0))
+        q[0], q[1], q[2], q[3] = (T[0, 2] - T[2, 0]) / s, (T[0, 1] + T[1, 0]) / s, 0.25 * s, (T[1, 2] + T[2, 1]) / s
+    else:
+        s = 2.0 * math.sqrt(max(1.0 + m22 - m00 - m11, 0.0))
+        q[0], q[1], q[2], q[3] = (T[1, 0] - T[0, 1]) / s, (T[0, 2] + T[2, 0]) / s, (T[1, 2] + T[2, 1]) / s, 0.25 * s
 
 
 @njit(cache=True)
@@ -271,9 +317,15 @@ def _screen32(table, f, v32):
     twice the lanes): only a screen, :func:`_nearest_screened` decides on float64 values. The 12
     features in two passes of six, each summed in registers by pairs (two loads and stores of a
     row where a pass per feature made twelve; measured 0.75x the time); a masked-out feature adds
-    F_ij * 0. Any order of the 12-term sum is within :data:`SCREEN_ROUNDOFF`'s bound."""
+    F_ij * 0. Any order of the 12-term sum is within :data:`SCREEN_ROUNDOFF`'s bound.
+
+    When f is a start table's features of a rotation (position, wf R) and the table keeps its
+    rows' quaternions (:func:`start_screen`), the same values from 7 numbers a row instead of 12
+    (:func:`_screen_quaternion`)."""
     Ft32, n32 = table[2], table[3]
     c, N = Ft32.shape
+    if N > 0 and table[6].shape[1] == N and _screen_quaternion(table, f, v32):
+        return
     two = np.float32(2.0)
     if c != 12:                                     # not a start table's 12 features: feature by feature
         for i in range(N):
@@ -295,6 +347,37 @@ def _screen32(table, f, v32):
     for i in range(N):
         v32[i] = n32[i] - two * (v32[i] + ((F6[i] * f6 + F7[i] * f7) + (F8[i] * f8 + F9[i] * f9)
                                            + (F10[i] * f10 + F11[i] * f11)))
+
+
+@njit(cache=True)
+def _screen_quaternion(table, f, v32):
+    """:func:`_screen32`'s values from each row's position p_i and unit quaternion q_i: with f =
+    (p, wf R) and R of unit quaternion q, F_i . f = p_i . p + wf^2 tr(R_i^T R) and tr(R_i^T R) =
+    4 (q_i . q)^2 - 1, so |F_i|^2 - 2 F_i . f = a_i - 2 p_i . p - 8 wf^2 (q_i . q)^2 with a_i =
+    |F_i|^2 + 2 wf^2 -- 28 bytes a row read instead of 48 (measured on Panda: 2.45 -> 1.7 µs a
+    pose). Its float32 error, ~2^-24 (|F_i|^2 + 3 |p_i| |p| + 256 wf^2) with wf^2 <= |F_i|^2 / 3, is
+    within :data:`SCREEN_ROUNDOFF`'s bound as the 12-term sum's is. Returns False (nothing
+    written) when R = f[3:] / wf is not a rotation within :data:`ROTATION_TOL`."""
+    PQ, a, wf = table[6], table[7], table[8]
+    T = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            T[r, c] = f[3 + 3 * r + c] / wf
+    for r in range(3):
+        for c in range(3):
+            dot = T[r, 0] * T[c, 0] + T[r, 1] * T[c, 1] + T[r, 2] * T[c, 2]
+            if not abs(dot - (1.0 if r == c else 0.0)) <= ROTATION_TOL:
+                return False
+    q = np.empty(4)
+    _quaternion(T, q)
+    p0, p1, p2 = np.float32(2.0 * f[0]), np.float32(2.0 * f[1]), np.float32(2.0 * f[2])
+    q0, q1, q2, q3 = np.float32(q[0]), np.float32(q[1]), np.float32(q[2]), np.float32(q[3])
+    g = np.float32(8.0 * wf * wf)
+    P0, P1, P2, Q0, Q1, Q2, Q3 = PQ[0], PQ[1], PQ[2], PQ[3], PQ[4], PQ[5], PQ[6]
+    for i in range(v32.shape[0]):
+        cq = (Q0[i] * q0 + Q1[i] * q1) + (Q2[i] * q2 + Q3[i] * q3)
+        v32[i] = a[i] - (P0[i] * p0 + P1[i] * p1 + P2[i] * p2) - g * (cq * cq)
+    return True
 
 
 #: Rows of the start table per screen group in :func:`_nearest_screened`: group g holds rows g, g + G,
@@ -351,7 +434,7 @@ def _nearest_screened(table, f, v32, idx, best):
     rows at or below it), so the k smallest screen values are all in the groups whose minimum is
     at most it, and the rows at most s_k + 2B in the groups whose minimum is (for more than
     :data:`GROUP_SCAN_K` neighbours the rows are visited in row order instead, same rows)."""
-    Ft, norms, _, _, nmax, F = table
+    Ft, norms, nmax, F = table[0], table[1], table[4], table[5]
     k = idx.shape[0]
     c, N = Ft.shape
     ff = 0.0

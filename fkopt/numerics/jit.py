@@ -18,7 +18,13 @@ save. :func:`njit` compiles as ``numba.njit`` and caches through :class:`Guarded
 
 The cache object is numba's own ``FunctionCache`` (its locators, index keys and file format), set
 on the dispatcher as ``Dispatcher.enable_caching`` does (``dispatcher._cache``); only its load and
-save are guarded.
+save are guarded, and its index key also names the state of every module that holds compiled
+kernels (:data:`KERNEL_MODULES`, :func:`kernel_sources_stamp`). numba checks only the calling
+function's own file, but a kernel's compiled code includes the kernels it calls from other
+modules: an edit of ``compiled_ik.py`` (or an upgrade that changes only it) left
+``compiled_branches.py``'s cached kernels running the old ``compiled_ik`` code -- stale code, or in
+a fresh install a signature that no longer types. With the stamp, any change of a kernel module
+recompiles every kernel once.
 """
 from __future__ import annotations
 
@@ -33,6 +39,14 @@ from numba.core.dispatcher import Dispatcher
 from numba.core.serialize import dumps
 
 from fkopt.numerics.notice import notice
+
+#: The modules (relative to the fkopt package) that define kernels compiled through :func:`njit`;
+#: tests/test_numerics.py holds this list to the package's files.
+KERNEL_MODULES = ("algorithms/abc_kernels.py", "algorithms/kernels.py", "algorithms/pso_kernels.py",
+                  "mechanisms/rps3_kernels.py", "numerics/compiled.py", "numerics/compiled_branches.py",
+                  "numerics/compiled_homotopy.py", "numerics/compiled_ik.py", "numerics/jit.py",
+                  "numerics/ufunc_loop.py")
+_STAMP: list[str] = []
 
 _LOCK = threading.Lock()
 _ASIDE: dict[str, str] = {}          # cache folder -> the folder its bad files went to (this process)
@@ -57,7 +71,7 @@ class GuardedCache(FunctionCache):
             self._set_aside(err)
             return None
 
-    def _index_key(self, sig, codegen):
+    def _closure_key(self, sig, codegen):
         """numba's key, but with a closure's compiled functions described by what they are (module,
         name, bytecode, their source file's stamp, their own cells) where numba pickles them with
         a per-process id: a kernel built by a factory on another module's kernels
@@ -70,6 +84,11 @@ class GuardedCache(FunctionCache):
         cells = tuple(_stable(c.cell_contents) for c in closure)
         code = hashlib.sha256(self._py_func.__code__.co_code).hexdigest()
         return sig, codegen.magic_tuple(), (code, hashlib.sha256(dumps(cells)).hexdigest())
+
+    def _index_key(self, sig, codegen):
+        """:meth:`_closure_key` with :func:`kernel_sources_stamp` added."""
+        sig_, magic, hashes = self._closure_key(sig, codegen)
+        return sig_, magic, hashes + (kernel_sources_stamp(),)
 
     def save_overload(self, sig, data):
         try:
@@ -120,6 +139,21 @@ class GuardedCache(FunctionCache):
         notice("cache-bad", f"numba's compiled-code cache in {folder} held an unreadable file "
                             f"({os.path.basename(files[0]) if files else '?'}: {_describe(err)}); set aside in "
                             f"{aside}, compiling afresh (seconds, once)")
+
+
+def kernel_sources_stamp() -> str:
+    """SHA-256 of the (path, mtime, size) of every :data:`KERNEL_MODULES` file, once per process."""
+    if not _STAMP:
+        root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        parts = []
+        for rel in KERNEL_MODULES:
+            try:
+                st = os.stat(os.path.join(root, rel))
+                parts.append(f"{rel} {st.st_mtime_ns} {st.st_size}")
+            except OSError:
+                parts.append(f"{rel} -")
+        _STAMP.append(hashlib.sha256("\n".join(parts).encode()).hexdigest())
+    return _STAMP[0]
 
 
 def _stable(value):
