@@ -36,15 +36,17 @@ reproduce-peers:
 
 # kinbench (docs/kinbench.md): v1, v2 and v3's evaluations track in full (v3: exact and lm on every
 # problem, set and pose, the others on the subsets its YAML documents), v3's per-robot board on the
-# clock (one process: its times are ratios measured side by side), the quick tiers (which CI's
-# check reruns: v1, v2, v3 and v3's board) and the libraries subset into results/kinbench/, then
+# clock (one process: its times are ratios measured side by side), v3's all-solutions and paths
+# tracks, the quick tiers (which CI's check reruns: v1, v2, v3, v3's board and its solutions) and
+# the libraries subset into results/kinbench/, then
 # the report (~25 min on 2 cores before v3 in full, which adds ~12 min: measured 11 min 49 s, docs/kinbench.md). Not part of `make reproduce`.
 bench-suite:
 	$(FKOPT) report results --snapshot-to .bench-suite-before.json
 	for s in kinbench kinbench-v2 kinbench-v2-libraries kinbench-v3; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --jobs 2 -q || exit 1; done
 	$(FKOPT) suite configs/suites/kinbench-v3-robots.yaml --out results --force -q
-	for s in kinbench kinbench-v2 kinbench-v3 kinbench-v3-robots; do \
+	$(FKOPT) suite configs/suites/kinbench-v3-solutions.yaml --out results --force -q
+	for s in kinbench kinbench-v2 kinbench-v3 kinbench-v3-robots kinbench-v3-solutions; do \
 	  $(FKOPT) suite configs/suites/$$s.yaml --out results --force --quick -q || exit 1; done
 	$(FKOPT) report results --changes-since .bench-suite-before.json   # CHANGES.md: what the suites moved
 	rm -f .bench-suite-before.json
