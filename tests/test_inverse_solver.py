@@ -222,3 +222,9 @@ def test_inverse_checks_its_options_alike_for_one_pose_and_a_batch():
             fkopt.inverse(arm, target, damping=-1.0)
         with pytest.raises(FkoptError, match="inverse options restarts"):
             fkopt.inverse(arm, target, options=InverseOptions(restarts=-2))
+        for stall in (-0.1, 1.5, float("nan"), True):
+            with pytest.raises(FkoptError, match="inverse options stall: expected a number >= 0"):
+                fkopt.inverse(arm, target, stall=stall)
+    # stall 0 is the loop without the test, 1 a test no |r|^2 meets (it never rises): both the same answers
+    a, b = (fkopt.inverse(arm, frames, stall=s_, seed=3) for s_ in (0.0, 1.0))
+    assert np.array_equal(a.joints, b.joints) and np.array_equal(a.restarts, b.restarts)
