@@ -9,6 +9,7 @@ import pytest
 
 import fkopt
 from fkopt.errors import FkoptError
+from fkopt.mechanisms.urdf import example_robot, example_robots_folder
 
 def random_poses(m, n, seed=0):
     b = m.bounds
@@ -226,3 +227,34 @@ def test_an_answer_a_half_turn_off_is_not_solved(compiled):
     true_angle = float(geodesic_angle(soa(F[None, :3, :3]), soa(T[None, :3, :3]))[0])
     assert abs(float(r.rotation_error) - true_angle) < 1e-6       # the reported error is the real one
     assert not bool(r.solved) or true_angle < 1e-6                 # and "solved" means solved
+
+
+@pytest.mark.parametrize("compiled", [None, False], ids=["default-path", "numpy-path"])
+@pytest.mark.parametrize("name", ["7dof-arm", "urdf", "panda"])
+def test_stall_test_keeps_the_closest_approach_on_unreachable_targets(name, compiled):
+    """Where no start converges (targets beyond the workspace, inside the reach sphere), the best
+    answer by inverse's own merit, max(position error / tol[0], rotation error / tol[1]), goes on
+    without the stall test once every start has failed, so ending stuck candidates early does not
+    cost the closest approach: the median merit is at most a fifth above the loop's without the
+    test (stall=0), for fewer evaluations. On Panda (where it was measured) that last step is what
+    keeps the rotation error near: median 0.067 rad against 0.052 without the test, 0.19 without
+    the step."""
+    from scipy.spatial.transform import Rotation
+    if name == "panda":
+        if example_robots_folder() is None:
+            pytest.skip("example-robot-data is not installed")
+        arm = example_robot("panda", tip="panda_hand_tcp")
+    else:
+        arm = fkopt.mechanism(name)
+    rng = np.random.default_rng(8)
+    d = rng.normal(size=(40, 3))
+    T = np.tile(np.eye(4), (40, 1, 1))
+    T[:, :3, 3] = d / np.linalg.norm(d, axis=1)[:, None] * arm.reach * 0.95
+    T[:, :3, :3] = Rotation.random(40, random_state=9).as_matrix()
+    kw = dict(tol=(1e-6, 1e-6), restarts=30, compiled=compiled)
+    got, plain = fkopt.inverse(arm, T, **kw), fkopt.inverse(arm, T, stall=0.0, **kw)
+    assert not got.solved.any() and not plain.solved.any()
+    assert np.median(got.residual) <= 1.2 * np.median(plain.residual)
+    assert got.evaluations["jacobian"].sum() < plain.evaluations["jacobian"].sum()
+    if name == "panda":
+        assert np.median(got.rotation_error) <= 2.0 * np.median(plain.rotation_error)

@@ -128,6 +128,53 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
         J[:, 3:] *= L
         return r, J, np.sqrt(_sumsq(dp)), np.sqrt(_sumsq(e))
 
+    def trial(Js, rs, qs, lam_s, S_s):
+        """The damped least-squares trial points of slots (J, r, q, lambda, |r|^2): one step with
+        the null-space pull (``rest``), the step cap and saturation in the null space."""
+        Jt_ = np.swapaxes(Js, 1, 2)
+        A = Js @ Jt_
+        tr6 = np.trace(A, axis1=1, axis2=2) * (1.0 / 6.0)
+        if rest > 0:                               # projector onto the null space of J
+            # fading as |r| drops below 1 length unit: at the end the task alone converges
+            z = (rest * np.minimum(1.0, np.sqrt(S_s)))[:, None] * (mid - qs) / (half * half)
+            A[:, _I6, _I6] += 1e-9 * tr6[:, None]
+            dz = z - (Jt_ @ np.linalg.solve(A, Js @ z[..., None]))[..., 0]
+            A[:, _I6, _I6] -= 1e-9 * tr6[:, None]
+        mu = lam_s * tr6                           # damping scaled to J
+        A[:, _I6, _I6] += mu[:, None]
+        d = (Jt_ @ np.linalg.solve(A, -rs[..., None]))[..., 0]
+        if rest > 0:
+            d += dz
+        d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
+        qn = qs + d
+        out = (qn < slo) | (qn > shi)
+        sat = np.flatnonzero(out.any(axis=-1))
+        if len(sat):                               # saturation in the null space, those rows only
+            Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
+            free = (~outv).astype(float)
+            fixed = np.where(outv, np.clip(qn[sat], slo, shi) - qv, 0.0)
+            qv2 = np.empty_like(qv)
+            act = slice(None)                      # rows re-solved: all, then those with new violations
+            for _ in range(2):
+                Ja, fa = Jv[act], free[act]
+                Jf = Ja * fa[:, None, :]
+                rr = rv[act] + (Ja @ fixed[act][..., None])[..., 0]
+                Jft = np.swapaxes(Jf, 1, 2)
+                A = Jf @ Jft
+                A[:, _I6, _I6] += muv[act][:, None]
+                qa = qv[act] + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed[act]
+                qv2[act] = qa
+                outa = ((qa < slo) | (qa > shi)) & (fa > 0)
+                more = np.flatnonzero(outa.any(axis=-1))
+                if not len(more):
+                    break
+                act = more if isinstance(act, slice) else act[more]
+                outa = outa[more]
+                fixed[act] = np.where(outa, np.clip(qa[more], slo, shi) - qv[act], fixed[act])
+                free[act] = np.where(outa, 0.0, free[act])
+            qn[sat] = np.clip(qv2, slo, shi)
+        return qn
+
     if N == 1 and rest <= 0 and not exact_rotation and W is None:
         def start_of(j):
             return starts_for(np.zeros(1, dtype=np.intp), np.array([j]))[0].tolist()
@@ -228,48 +275,7 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                 anyfresh = fresh.any()
                 st = np.flatnonzero(~fresh) if anyfresh else slice(None)
                 Js, rs, qs = J[st], r[st], q[st]
-                Jt_ = np.swapaxes(Js, 1, 2)
-                A = Js @ Jt_
-                tr6 = np.trace(A, axis1=1, axis2=2) * (1.0 / 6.0)
-                if rest > 0:                               # projector onto the null space of J
-                    # fading as |r| drops below 1 length unit: at the end the task alone converges
-                    z = (rest * np.minimum(1.0, np.sqrt(S[st])))[:, None] * (mid - qs) / (half * half)
-                    A[:, _I6, _I6] += 1e-9 * tr6[:, None]
-                    dz = z - (Jt_ @ np.linalg.solve(A, Js @ z[..., None]))[..., 0]
-                    A[:, _I6, _I6] -= 1e-9 * tr6[:, None]
-                mu = lam[st] * tr6                         # damping scaled to J
-                A[:, _I6, _I6] += mu[:, None]
-                d = (Jt_ @ np.linalg.solve(A, -rs[..., None]))[..., 0]
-                if rest > 0:
-                    d += dz
-                d *= np.minimum(1.0, step_cap / np.abs(d).max(axis=-1))[:, None]
-                qn = qs + d
-                out = (qn < slo) | (qn > shi)
-                sat = np.flatnonzero(out.any(axis=-1))
-                if len(sat):                               # saturation in the null space, those rows only
-                    Jv, qv, rv, muv, outv = Js[sat], qs[sat], rs[sat], mu[sat], out[sat]
-                    free = (~outv).astype(float)
-                    fixed = np.where(outv, np.clip(qn[sat], slo, shi) - qv, 0.0)
-                    qv2 = np.empty_like(qv)
-                    act = slice(None)                      # rows re-solved: all, then those with new violations
-                    for _ in range(2):
-                        Ja, fa = Jv[act], free[act]
-                        Jf = Ja * fa[:, None, :]
-                        rr = rv[act] + (Ja @ fixed[act][..., None])[..., 0]
-                        Jft = np.swapaxes(Jf, 1, 2)
-                        A = Jf @ Jft
-                        A[:, _I6, _I6] += muv[act][:, None]
-                        qa = qv[act] + (Jft @ np.linalg.solve(A, -rr[..., None]))[..., 0] + fixed[act]
-                        qv2[act] = qa
-                        outa = ((qa < slo) | (qa > shi)) & (fa > 0)
-                        more = np.flatnonzero(outa.any(axis=-1))
-                        if not len(more):
-                            break
-                        act = more if isinstance(act, slice) else act[more]
-                        outa = outa[more]
-                        fixed[act] = np.where(outa, np.clip(qa[more], slo, shi) - qv[act], fixed[act])
-                        free[act] = np.where(outa, 0.0, free[act])
-                    qn[sat] = np.clip(qv2, slo, shi)
+                qn = trial(Js, rs, qs, lam[st], S[st])
                 # -- evaluate the trial points and the restarted slots in one call ----------------
                 if anyfresh:
                     qe = q.copy()
@@ -290,6 +296,28 @@ def inverse_batch(m, P, shape, q0, start, W, tol, seed, lo, hi, mid, half, perio
                     q, r, J, pe, re, S = qe, rt, Jn, pet, ret, St
                 else:
                     q[ok], r[ok], J[ok], pe[ok], re[ok], S[ok] = qe[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
+        fail = np.flatnonzero(~done)
+        if stall > 0 and budget > 1 and len(fail):
+            # every start of these rows failed: their best answers, most likely ended by the stall
+            # test, go on without it (the one-pose loop's last step, fkopt.numerics.compiled_ik)
+            q = best_q[fail].copy()
+            r, J, pe, re = evaluate(q, fail)
+            S, lam = _sumsq(r), np.full(len(fail), damping)
+            with np.errstate(all="ignore"):
+                for _ in range(iterations):
+                    a = np.flatnonzero(((pe > tp) | (re > tr)) & (lam <= 1e6))
+                    if not len(a):
+                        break
+                    qn = trial(J[a], r[a], q[a], lam[a], S[a])
+                    rt, Jn, pet, ret = evaluate(qn, fail[a])
+                    St = _sumsq(rt)
+                    ok = St < S[a]
+                    lam[a] = np.where(ok, np.maximum(lam[a] * down, 1e-12), lam[a] * up)
+                    u = a[ok]
+                    q[u], r[u], J[u], pe[u], re[u], S[u] = qn[ok], rt[ok], Jn[ok], pet[ok], ret[ok], St[ok]
+            merit = np.maximum(pe / tp, re / tr)
+            better = merit < best_m[fail]
+            best_q[fail[better]], best_m[fail[better]] = q[better], merit[better]
         ev_r = np.bincount(np.concatenate(evaluated), minlength=N).astype(np.int64)
         ev_j = ev_r.copy()
         if start is not None and (n > 6 or W is not None):   # self-motion towards the starts

@@ -110,7 +110,9 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq
     """:func:`fkopt.numerics.damped_least_squares.inverse_candidates` compiled; the j-th start is q0 (j < own0),
     near[j - own0] (j < own0 + len(near)), else draw j - own0 - len(near) of the hash for
     (seed, row) scaled into [glo, ghi]; every start but the last may end at the stall test
-    (``stall``, :func:`_dls_candidate`). Writes the best joints into best_q; returns
+    (``stall``, :func:`_dls_candidate`), and when no start converges the best answer goes on
+    from where it ended without the test (its evaluations counted, not a start). Writes the best
+    joints into best_q; returns
     (starts used, evaluations). Only the first ``have`` rows of ``near`` are filled when it is
     called: the rest are the start table's next nearest (:func:`_near_rows` on ``table``,
     features ``feat``, the screen ``v32``, joints ``tq``), looked up only if a start reaches them
@@ -153,6 +155,14 @@ def _inverse_one(chain, pt, T, Lw, W, q0, own0, near, have, table, feat, v32, tq
             best_q[:] = q
         if pe <= tp and re <= tr:
             return j + 1, evals
+    if stall > 0.0 and budget > 1:
+        # every start failed: the best answer, most likely ended by the stall test, goes on without it
+        q[:] = best_q
+        pe, re, ev = _dls_candidate(chain, q, pt, T, Lw, W, wone, tp, tr, iterations, damping, down, up, step_cap,
+                                    0.0, lo, hi, work)
+        evals += ev
+        if max(pe / tp, re / tr) < best_m:
+            best_q[:] = q
     return budget, evals
 
 

@@ -12,7 +12,8 @@ operation in the same order.
 * convergence: position error <= tol[0] and geodesic rotation error <= tol[1]; a candidate stops
   after ``iterations`` steps, when lambda exceeds 1e6 (stalled) or when the system is singular;
 * the stall test: a candidate whose |r|^2 is above ``stall`` times its value two evaluations before
-  gives way to the next start (0: never; the last start runs to its end). A start that converges
+  gives way to the next start (0: never; the last start runs to its end; when no start converges,
+  the best answer goes on from where it ended without the test, its evaluations counted). A start that converges
   does so fast, a damped least-squares step from near a solution cuts |r| by far more than
   sqrt(2) in two steps, and a start that does not is mostly stuck against joint limits (issue 38:
   in the sweep of docs/performance.md, 0.5 cut the evaluations per pose by 19 %, as many poses
@@ -180,6 +181,12 @@ def inverse_candidates(fj, pt, T, L, start_of, budget, tol, iterations, damping,
         return q, pe, re
 
     counted = [0, 0]                                   # evaluations, starts searched
-    (best_q, _, _), _, used = restart(start_of, search, lambda a: a[1] <= tp and a[2] <= tr,
-                                      merit=lambda a: max(a[1] / tp, a[2] / tr), budget=budget)
-    return best_q, used, counted[0]
+    merit = lambda a: max(a[1] / tp, a[2] / tr)        # noqa: E731 - the restart loop's and the polish's
+    best, met, used = restart(start_of, search, lambda a: a[1] <= tp and a[2] <= tr, merit=merit, budget=budget)
+    if not met and stall > 0.0 and budget > 1:
+        # every start failed: the best answer, most likely ended by the stall test, goes on without it
+        # (counted[1] is past the last start, so the search runs without the test)
+        polished = search(list(best[0]))
+        if merit(polished) < merit(best):
+            best = polished
+    return best[0], used, counted[0]
