@@ -521,6 +521,24 @@ def test_resume_reuses_verified_tasks(finished_study, cli):
         {k: v for k, v in before.items() if k.endswith(".csv") and "timing" not in k}
 
 
+def test_resume_drops_the_atomic_writers_leftover_temporaries(finished_study, cli):
+    """A Ctrl-C (or a killed worker) between an atomic write's temporary file and its rename leaves
+    ``.<name>.<random>.json`` beside the task files -- a parallel run under a real SIGINT did, and
+    ``--resume`` then refused it as a task file changed since written. They are never tasks: resume
+    removes them and reuses the real ones."""
+    cfg, out, final, _ = finished_study
+    tasks = final / "tasks"
+    before = snapshot(final)
+    for name in (".manifest.json.0d_0fy8a.json", ".a00.json.k3j9.json"):
+        (tasks / name).write_text('{"half": ')
+    code, stdout, err = cli("study", cfg, "--out", out, "--resume")
+    assert code == 0, err
+    assert "reused" in stdout
+    assert not list((final / "tasks").glob(".*.json")) and not list(final.parent.glob(".*.partial"))
+    assert {k: v for k, v in snapshot(final).items() if k.endswith(".csv") and "timing" not in k} == \
+        {k: v for k, v in before.items() if k.endswith(".csv") and "timing" not in k}
+
+
 @pytest.mark.parametrize("content", [b"claim,verdict\n\xff\xfe caf\xe9,holds\n", b"\x00\x01\x02garbage",
                                      b"a,b\n1,2\n"], ids=["latin1", "binary", "columns"])
 def test_check_with_a_corrupt_claims_csv_is_one_failure_line(finished_study, cli, content):

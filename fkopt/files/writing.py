@@ -240,8 +240,8 @@ def write_file_atomically(path: str | Path, write: Callable[[Path], Any]) -> Non
     """Call ``write(tmp)`` on a temporary file beside ``path``, fsync it, rename it into place."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
+    try:                                    # from the temporary's creation on, any exit removes it
+        os.close(fd)
         with naming_the_file(path):
             write(Path(tmp))
             with open(tmp, "rb") as fh:

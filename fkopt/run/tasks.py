@@ -42,6 +42,12 @@ OLD_MANIFESTS = ("study.json",)
 REDO = "delete it to recompute that task, or rerun without --resume to start over"
 
 
+def task_files(folder: Path) -> list[Path]:
+    """The JSON files of a task folder, sorted, but the atomic writer's hidden temporaries
+    (``.<name>.<random>.json``: a task id never starts with a dot)."""
+    return sorted(p for p in Path(folder).glob("*.json") if not p.name.startswith("."))
+
+
 @dataclass(frozen=True)
 class Task:
     id: str              # unique in its plan; the task file's name (letters, digits, ``_.+-``)
@@ -194,7 +200,7 @@ class TaskStore:
             shutil.rmtree(self.work, ignore_errors=True)
         elif not self.work.exists() and (self.final / TASKS).is_dir():
             # resume a finished run: start from a copy of its task files (the folder stays as it is)
-            sources = sorted((self.final / TASKS).glob("*.json"))
+            sources = task_files(self.final / TASKS)
             for path in sources:
                 inside(self.out, path)
             self.tasks.mkdir(parents=True)
@@ -220,7 +226,11 @@ class TaskStore:
         self.digests = {str(k): str(v) for k, v in digests.items()}
         planned = {t.id: t for t in plan.tasks}
         out = {}
-        for path in sorted(self.tasks.glob("*.json")):
+        for path in sorted(self.tasks.glob(".*.json")):
+            # an unfinished temporary of the atomic writer (fkopt.files.write_file_atomically: ".<name>.<random>.json"),
+            # left where an interrupt or a killed worker came between its creation and its rename: never a task
+            path.unlink(missing_ok=True)
+        for path in task_files(self.tasks):
             if path.name in (MANIFEST, *OLD_MANIFESTS):
                 continue
             inside(self.out, path, "--resume")
@@ -279,7 +289,7 @@ def task_file_problems(folder: Path) -> list[tuple[str, str]]:
     if not isinstance(digests, dict):
         return []
     out = []
-    files = {p.stem: p for p in tasks.glob("*.json") if p.name not in (MANIFEST, *OLD_MANIFESTS)}
+    files = {p.stem: p for p in task_files(tasks) if p.name not in (MANIFEST, *OLD_MANIFESTS)}
     for ident in sorted(set(files) | set(digests)):
         path = files.get(ident)
         if path is None:
