@@ -494,6 +494,10 @@ def test_quaternion_screen_is_within_the_bound_and_keeps_the_full_passes_rows(ar
     ctx = _fast_context(arm, 4096, None)
     table, wf = ctx["table"], ctx["w"]
     assert table[6].shape == (7, 4096)                  # the quaternions are kept
+    from scipy.spatial.transform import Rotation        # the rows' quaternions are scipy's, up to sign
+    R = (ctx["Ft"][3:].T / wf).reshape(-1, 3, 3)
+    ours, theirs = c._quaternions(R), Rotation.from_matrix(R).as_quat()[:, [3, 0, 1, 2]]
+    assert np.abs(np.abs(np.einsum("ij,ij->i", ours, theirs)) - 1).max() < 1e-12
     rng = np.random.default_rng(11)
     lo, hi = arm.bounds[:, 0], arm.bounds[:, 1]
     frames = arm.fk_matrix(lo + rng.random((60, arm.dof)) * (hi - lo))

@@ -296,9 +296,16 @@ def _quaternions(R):
     """Unit quaternions (N, 4) of rotations R (N, 3, 3), up to sign, by the largest of the trace
     and the diagonal (Shepperd 1978): :func:`_quaternion`'s cases on every row."""
     out = np.empty((len(R), 4))
-    for i in range(len(R)):                         # once per table, through the one compiled case split
-        _quaternion(np.ascontiguousarray(R[i]), out[i])
+    _quaternion_rows(np.ascontiguousarray(R, dtype=float), out)
     return out
+
+
+@njit(cache=True)
+def _quaternion_rows(R, out):
+    """:func:`_quaternion` of every row (compiled: the start table's 4096 rows are part of a
+    process's first call)."""
+    for i in range(R.shape[0]):
+        _quaternion(R[i], out[i])
 
 
 @njit(cache=True, _nrt=False)
