@@ -28,6 +28,7 @@ recompiles every kernel once.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import threading
@@ -46,7 +47,6 @@ KERNEL_MODULES = ("algorithms/abc_kernels.py", "algorithms/kernels.py", "algorit
                   "mechanisms/rps3_kernels.py", "numerics/compiled.py", "numerics/compiled_branches.py",
                   "numerics/compiled_homotopy.py", "numerics/compiled_ik.py", "numerics/jit.py",
                   "numerics/ufunc_loop.py")
-_STAMP: list[str] = []
 
 _LOCK = threading.Lock()
 _ASIDE: dict[str, str] = {}          # cache folder -> the folder its bad files went to (this process)
@@ -141,19 +141,18 @@ class GuardedCache(FunctionCache):
                             f"{aside}, compiling afresh (seconds, once)")
 
 
+@functools.cache
 def kernel_sources_stamp() -> str:
     """SHA-256 of the (path, mtime, size) of every :data:`KERNEL_MODULES` file, once per process."""
-    if not _STAMP:
-        root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-        parts = []
-        for rel in KERNEL_MODULES:
-            try:
-                st = os.stat(os.path.join(root, rel))
-                parts.append(f"{rel} {st.st_mtime_ns} {st.st_size}")
-            except OSError:
-                parts.append(f"{rel} -")
-        _STAMP.append(hashlib.sha256("\n".join(parts).encode()).hexdigest())
-    return _STAMP[0]
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    parts = []
+    for rel in KERNEL_MODULES:
+        try:
+            st = os.stat(os.path.join(root, rel))
+            parts.append(f"{rel} {st.st_mtime_ns} {st.st_size}")
+        except OSError:
+            parts.append(f"{rel} -")
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()
 
 
 def _stable(value):
