@@ -13,11 +13,11 @@ operation in the same order.
   after ``iterations`` steps, when lambda exceeds 1e6 (stalled) or when the system is singular;
 * the stall test: a candidate whose |r|^2 is above ``stall`` times its value two evaluations before
   gives way to the next start (0: never; the last start runs to its end; when no start converges,
-  the best answer goes on from where it ended without the test, its evaluations counted). A start that converges
-  does so fast, a damped least-squares step from near a solution cuts |r| by far more than
-  sqrt(2) in two steps, and a start that does not is mostly stuck against joint limits (issue 38:
-  in the sweep of docs/performance.md, 0.5 cut the evaluations per pose by 19 %, as many poses
-  solved);
+  the best answer goes on from where it ended without the test, its evaluations counted). A start
+  that converges does so fast, a damped least-squares step from near a solution cuts |r| by far
+  more than sqrt(2) in two steps, and a start that does not is mostly stuck against joint limits
+  (issue 38: in the sweep of docs/performance.md, 0.5 cut the evaluations per pose by 19 %, as
+  many poses solved);
 * restarts: candidates one after another in the order of their starts, stopping at the first that
   converges; the best (smallest max(pe / tol[0], re / tol[1])) is kept: the one restart loop,
   :func:`fkopt.numerics.restart_loop.restart`, with this module's candidate search as its search.
