@@ -1025,6 +1025,47 @@ def test_ctrl_c_of_a_parallel_run_keeps_its_tasks_and_resume_finishes_it(tmp_pat
                                                                  ).read_bytes(), name
 
 
+def test_worker_processes_leave_ctrl_c_to_the_parent():
+    """A terminal's Ctrl-C reaches every process of the group; a worker interrupted inside numba's
+    compiler printed llvmlite's finaliser traceback beside fkopt's one line (CI), so workers ignore
+    SIGINT and the parent, on its KeyboardInterrupt, terminates them."""
+    from fkopt.run.executors import _processes
+    seen = []
+    _processes(signal.getsignal, [signal.SIGINT] * 4, 2, seen.append)
+    assert seen == [signal.SIG_IGN] * 4
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler   # this process keeps its own
+
+
+def test_a_ctrl_c_inside_a_finaliser_is_delivered_again_without_a_traceback(monkeypatch, capsys):
+    """CPython cannot raise from ``__del__``: it printed "Exception ignored in" with a traceback and
+    lost the interrupt. fkopt's hook re-delivers it to the main thread and prints nothing; other
+    unraisable exceptions still reach Python's own hook."""
+    from fkopt.cli.entry_point import interrupt_not_swallowed
+    monkeypatch.setattr(sys, "unraisablehook", interrupt_not_swallowed)
+
+    class Finalised:
+        def __init__(self, error):
+            self.error = error
+
+        def __del__(self):
+            raise self.error
+
+    import threading
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        start = time.monotonic()
+        with pytest.raises(KeyboardInterrupt):
+            Finalised(KeyboardInterrupt())
+            threading.Event().wait(30)   # blocked, as a parent waiting for its workers' results
+        assert time.monotonic() - start < 20
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert capsys.readouterr().err == ""
+    Finalised(ValueError("not an interrupt"))
+    err = capsys.readouterr().err
+    assert "Exception ignored in" in err and "ValueError: not an interrupt" in err
+
+
 def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, cli):
     cfg = tmp_path / "c.yaml"
     out = tmp_path / "out"

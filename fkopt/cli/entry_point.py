@@ -95,8 +95,40 @@ def exit_interrupted(message: str) -> None:
     sys.exit(130)
 
 
+def interrupt_not_swallowed(args) -> None:
+    """``sys.unraisablehook`` while fkopt runs: a Ctrl-C that lands in a finaliser (``__del__``,
+    e.g. llvmlite disposing a module while numba compiles) cannot propagate, so CPython printed
+    "Exception ignored in ..." with a traceback and went on as if no key were pressed. The
+    interrupt is sent to the main thread again instead, silently; any other unraisable exception
+    goes to Python's own hook.
+
+    A short-lived thread sends a real SIGINT (``_thread.interrupt_main`` only sets a flag, which
+    a main thread blocked waiting for a worker's result would not see until the result came) a
+    moment later: an interrupt raised inside this hook would be "ignored" in turn, and if the
+    signal still lands here it is caught and sent again."""
+    if args.exc_type is None or not issubclass(args.exc_type, KeyboardInterrupt):
+        sys.__unraisablehook__(args)
+        return
+    import signal
+    import threading
+    if not callable(signal.getsignal(signal.SIGINT)):   # SIGINT ignored or fatal here: nothing to redo
+        return
+
+    def send() -> None:
+        signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+    try:
+        threading.Timer(REDELIVERY_DELAY, send).start()
+    except KeyboardInterrupt:
+        threading.Timer(REDELIVERY_DELAY, send).start()
+
+
+#: Seconds between a finaliser's swallowed Ctrl-C and its delivery to the main thread again.
+REDELIVERY_DELAY = 0.01
+
+
 def main() -> None:
     """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
+    sys.unraisablehook = interrupt_not_swallowed
     def interrupted() -> str:
         hint = INTERRUPTED["hint"]
         return "fkopt: interrupted (previous results are kept" + (f"; {hint})" if hint else ")")

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import multiprocessing
 import re
+import signal
 import socket
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Callable
@@ -109,8 +110,16 @@ def execute(fn: Callable[[Any], Any], payloads: list, *, executor: str = "local"
         _processes(fn, payloads, worker_count(jobs, len(payloads)), on_result)
 
 
+def _ignore_interrupts() -> None:
+    """A worker's start: Ctrl-C belongs to the parent. A terminal sends SIGINT to the whole process
+    group, and a worker interrupted inside numba's compiler printed llvmlite's "Exception ignored
+    in ... __del__" traceback beside fkopt's one line (seen in CI). The parent, on its
+    KeyboardInterrupt, terminates the workers (:func:`_processes`)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _processes(fn, payloads, jobs, on_result) -> None:
-    pool = ProcessPoolExecutor(max_workers=jobs,
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupts,
                                mp_context=multiprocessing.get_context("spawn"))
     futures = [pool.submit(fn, p) for p in payloads]
     try:
