@@ -579,8 +579,8 @@ def test_jobs_10000_starts_no_more_processes_than_cpus(tmp_path, monkeypatch):
     asked = []
 
     class Pool(concurrent.futures.ThreadPoolExecutor):
-        def __init__(self, max_workers, mp_context=None):
-            asked.append(max_workers)
+        def __init__(self, max_workers, mp_context=None, initializer=None):
+            asked.append(max_workers)   # the workers' initializer sets a signal handler: a thread cannot
             super().__init__(max_workers)
     monkeypatch.setattr(executors, "ProcessPoolExecutor", Pool)
     got = []
