@@ -40,11 +40,8 @@ def __getattr__(name: str):
         globals()[name] = value
         return value
     if name == "__version__":
-        from importlib.metadata import PackageNotFoundError, version
-        try:
-            value = version("fkopt")
-        except PackageNotFoundError:  # running from a source tree
-            value = "0.0.0+unknown"
+        from fkopt.files.host import installed_version
+        value = installed_version("fkopt") or "0.0.0+unknown"   # None: running from a source tree
         globals()[name] = value
         return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

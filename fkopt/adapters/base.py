@@ -45,14 +45,13 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass
-from importlib.metadata import version
 from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import ConfigDict, Field
 
 from fkopt.adapters import niapy_, pymoo_, scipy_
-from fkopt.adapters.libraries import DISTRIBUTIONS, library_version
+from fkopt.adapters.libraries import library_version
 from fkopt.algorithms.base import Algorithm, Params, RunRecord
 from fkopt.errors import FkoptError
 from fkopt.files import available_cpus
@@ -183,7 +182,7 @@ def run_one(library: str, method: str, params: dict, problem, population: int, b
         raise
     except Exception as err:   # the library failed: one line naming it
         msg = str(err).strip().splitlines()[0] if str(err).strip() else ""
-        raise FkoptError(f"algorithm '{library}:{method}' ({library} {version(DISTRIBUTIONS[library])}) "
+        raise FkoptError(f"algorithm '{library}:{method}' ({library} {library_version(library)}) "
                          f"raised {type(err).__name__}: {msg}") from None
     if counter.n > budget:   # pragma: no cover - Counter never lets it happen
         raise FkoptError(f"algorithm '{library}:{method}' used {counter.n} evaluations, budget {budget}")

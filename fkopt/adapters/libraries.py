@@ -3,9 +3,9 @@ optional imports. Shared by :mod:`fkopt.adapters` and the per-library modules (n
 from __future__ import annotations
 
 from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version
 
 from fkopt.errors import FkoptError
+from fkopt.files.host import installed_version
 
 #: Names listed by ``fkopt list`` (niapy accepts any algorithm class of niapy.algorithms).
 ADAPTERS: dict[str, dict[str, str]] = {
@@ -30,10 +30,7 @@ def ceil_div(a: int, b: int) -> int:
 
 
 def library_version(library: str) -> str:
-    try:
-        return version(DISTRIBUTIONS[library])
-    except PackageNotFoundError:
-        return "not installed"
+    return installed_version(DISTRIBUTIONS[library]) or "not installed"
 
 
 def require(library: str, module: str):

@@ -33,12 +33,12 @@ from __future__ import annotations
 
 import time
 import zlib
-from importlib.metadata import PackageNotFoundError, version
 
 import numpy as np
 import pandas as pd
 
 from fkopt.errors import FkoptError
+from fkopt.files.host import installed_version
 from fkopt.kinbench.physical import LADDER, fk_verdicts, ik_verdicts, rung_label
 from fkopt.kinbench.posesets import load_pose_sets, problem_mechanism
 from fkopt.run.config_base import files_folder
@@ -115,10 +115,8 @@ def package_of(name: str) -> str:
     measured is part of what it measured."""
     entry = solver_entry(name)
     package = entry.package if entry is not None else "fkopt"
-    try:
-        return f"{package} {version(package)}"
-    except PackageNotFoundError:
-        return f"{package} (version unknown)"
+    got = installed_version(package)
+    return f"{package} {got}" if got is not None else f"{package} (version unknown)"
 
 
 def query_rng(seed: int, robot: str, solver: str, timeout_ms: float | None, query: int) -> np.random.Generator:

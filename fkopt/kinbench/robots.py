@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fkopt.errors import FkoptError
-from fkopt.files import read_input
+from fkopt.files import installed_version, read_input
 from fkopt.mechanisms.mjcf import MAX_MJCF_BYTES
 from fkopt.mechanisms.urdf import example_robots_folder, load_urdf, urdf_chain
 
@@ -108,14 +108,6 @@ ARMS: tuple[Arm, ...] = (
 ARM_NAMES = {a.name: a for a in ARMS}
 
 
-def package_version(package: str) -> str | None:
-    from importlib import metadata
-    try:
-        return metadata.version(package)
-    except metadata.PackageNotFoundError:
-        return None
-
-
 def package_folder(package: str) -> Path | None:
     """The robots folder of ``package`` as installed, or None."""
     if package == _ERD:
@@ -153,7 +145,7 @@ def original_model(arm: Arm):
 
 def _header(arm: Arm, kept: str) -> str:
     return (f" {arm.title}, kinematics only ({kept}), cut by fkopt.kinbench.robots from {arm.source} of "
-            f"{arm.package} {package_version(arm.package)} (PyPI); upstream {arm.upstream}; licence {arm.licence} "
+            f"{arm.package} {installed_version(arm.package)} (PyPI); upstream {arm.upstream}; licence {arm.licence} "
             f"(as {arm.package} states it for this robot). Chain used by kinbench: {arm.base} to {arm.tip}. "
             "Lengths in m; angles in rad (URDF) or as the compiler says (MJCF). ")
 

@@ -17,6 +17,7 @@ import threading
 from contextlib import contextmanager
 
 from fkopt.errors import FkoptError
+from fkopt.files.host import installed_version
 from fkopt.numerics.notice import notice
 
 ENV = "FKOPT_NUMERICS"
@@ -121,17 +122,6 @@ def loaded():
     return _STATE.get("module")
 
 
-def _version(package: str) -> str | None:
-    try:
-        from importlib.metadata import PackageNotFoundError, version
-        try:
-            return version(package)
-        except PackageNotFoundError:
-            return None
-    except Exception:      # pragma: no cover - importlib.metadata is standard
-        return None
-
-
 def describe(check: bool = False) -> dict:
     """What ``env.json`` records (its ``numerics``): ``path``, the path a default ``fkopt.inverse``
     call takes in this process ('compiled' with numba, else 'numpy'); ``mode``, the
@@ -142,7 +132,7 @@ def describe(check: bool = False) -> dict:
     the compiled path was tried in this process and could not run, ``fallback``: why.
     ``check``: try the compiled path now (imports numba: ``fkopt --version``) rather than judge
     by the installed package when it was not tried yet."""
-    nv = _version("numba")
+    nv = installed_version("numba")
     mode = requested()
     if check and mode != "numpy" and nv is not None:
         try:
@@ -152,7 +142,7 @@ def describe(check: bool = False) -> dict:
     failure = _STATE.get("failure") if "module" in _STATE else None
     path = "numpy" if mode == "numpy" or nv is None or failure else "compiled"
     got = {"path": path, "mode": mode, "compiled_fitness": mode == "compiled" and path == "compiled", "numba": nv,
-           "llvmlite": _version("llvmlite"), "env": os.environ.get(ENV, "")}
+           "llvmlite": installed_version("llvmlite"), "env": os.environ.get(ENV, "")}
     if failure and mode != "numpy":
         got["fallback"] = failure
     return got

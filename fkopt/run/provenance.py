@@ -31,8 +31,9 @@ from __future__ import annotations
 import platform
 import sys
 from functools import lru_cache
-from importlib.metadata import PackageNotFoundError, version
 
+import fkopt
+from fkopt.files.host import installed_version
 from fkopt.numerics import path as numerics_path
 
 ENV_FILE = "env.json"
@@ -43,10 +44,8 @@ LIBRARIES = ("numpy", "scipy", "pandas", "matplotlib", "pydantic", "pyyaml", "ty
 def library_versions() -> dict[str, str]:
     out = {"python": sys.version.split()[0]}
     for lib in LIBRARIES:
-        try:
-            out[lib] = version(lib)
-        except PackageNotFoundError:
-            pass
+        if (got := installed_version(lib)) is not None:
+            out[lib] = got
     return out
 
 
@@ -132,11 +131,7 @@ def platform_tier(stored) -> str:
 
 def environment() -> dict:
     """The contents of ``env.json``."""
-    try:
-        fkopt_version = version("fkopt")
-    except PackageNotFoundError:
-        fkopt_version = "0.0.0+unknown"
-    return {"fkopt_version": fkopt_version, "libraries": library_versions(),
+    return {"fkopt_version": fkopt.__version__, "libraries": library_versions(),
             "platform": {"system": platform.system(), "machine": platform.machine(),
                          "python_implementation": platform.python_implementation(), "cpu": _cpu_model()},
             "fingerprint": fingerprint(), "numerics": numerics_path.describe()}

@@ -31,16 +31,16 @@ from __future__ import annotations
 
 import warnings
 import xml.etree.ElementTree as ET
-from importlib.metadata import version
 
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.files import installed_version
 from fkopt.adapters.field import FieldIK, NotApplicable, arm_urdf
 
 
 def optik_version() -> str:
-    return version("optik-py")
+    return installed_version("optik-py") or "(not installed)"
 
 
 def fold_fixed(text: str) -> str:

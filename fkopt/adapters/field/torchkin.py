@@ -26,11 +26,10 @@ torch's OpenMP threads wait for each other spinning, and on this shared 2-core m
 """
 from __future__ import annotations
 
-from importlib.metadata import version
-
 import numpy as np
 
 from fkopt.errors import FkoptError
+from fkopt.files import installed_version
 from fkopt.adapters.field import FieldIK, arm_urdf
 
 
@@ -53,7 +52,7 @@ class TorchIK(FieldIK):
             raise FkoptError(f"pytorch-kinematics: its chain of {urdf.source} moves {names}, "
                              f"fkopt's {list(urdf.joint_names)}")
         self._limits = torch.tensor(np.stack([self.lo_rad, self.hi_rad], axis=1), dtype=torch.float64)
-        self.settings.update(urdf=urdf.source, version=version("pytorch-kinematics"), torch=torch.__version__,
+        self.settings.update(urdf=urdf.source, version=installed_version("pytorch-kinematics"), torch=torch.__version__,
                              solver="PseudoInverseIK", num_retries=self.RETRIES, pos_tolerance=self.TOL,
                              rot_tolerance=self.TOL, dtype="float64", early_stopping_any_converged=True,
                              early_stopping_no_improvement="all", device="cpu",
