@@ -196,7 +196,9 @@ def test_clock_track_with_the_field_reference():
     b = clock_board(a)
     assert len(b) == 9 and set(b["entry"]) == {"organiser", "outside"}
     assert (b.loc[b.solver == "rtb-ik_LM", "time_ratio_median"] >= 1.0).all()     # first call / best of 3
-    assert (b.loc[b.solver == "fkopt.inverse", "success_1e-05m_1e-05rad"] == 1.0).all()
+    # judged at the 20 ms timeout: at 1 ms a success also needs the call inside 1 ms, which a loaded
+    # shared machine does not promise (the board measures time; this test checks the track's shape)
+    assert (b.loc[(b.solver == "fkopt.inverse") & (b.timeout_ms == 20.0), "success_1e-05m_1e-05rad"] == 1.0).all()
 
 
 @pytest.mark.parametrize("name", ["pr2-left", "tiago", "talos-left"])
