@@ -951,6 +951,50 @@ def _interrupt(tmp_path, prev, slow, command, how):
         assert p.returncode == 130 and "Traceback" not in err and len(err.strip().splitlines()) == 1
 
 
+AT_NUMBA_EVENT = """\
+import os, signal, sys
+from numba.core import event
+kind, n, sent = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+seen = [0]
+
+class Send(event.Listener):
+    def on_start(self, ev):
+        seen[0] += 1
+        if seen[0] == n:
+            open(sent, "w").close()
+            os.kill(os.getpid(), signal.SIGINT)
+
+    def on_end(self, ev):
+        pass
+
+event.register(kind, Send())
+from fkopt.cli import entry_point
+sys.argv = ["fkopt", *sys.argv[4:]]
+entry_point.main()
+"""
+
+
+@pytest.mark.parametrize("kind,n", [("numba:llvm_lock", 400)])
+def test_ctrl_c_inside_numbas_compiler_is_one_line_and_exit_130(tmp_path, kind, n):
+    """A SIGINT at the start of numba's n-th compiler event, with a cold cache (so the run compiles).
+    Raised inside llvmlite it had left an object half built, whose finaliser then printed a
+    traceback (llvm_lock 400, before the fix), and a CI run died of a segmentation fault: a Ctrl-C
+    now waits for the compile to end (fkopt.numerics.jit.interrupts_deferred). The marker file
+    shows the signal was sent."""
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml_of(SLOW))
+    (tmp_path / "at_numba_event.py").write_text(AT_NUMBA_EVENT)
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(Path(__file__).resolve().parents[1]), str(tmp_path),
+                                                       os.environ.get("PYTHONPATH")]))}
+    sent = tmp_path / "sent"
+    proc = subprocess.run([sys.executable, "-m", "at_numba_event", kind, str(n), str(sent), "run", str(cfg),
+                           "--out", str(tmp_path / "out"), "-q"], capture_output=True, text=True, timeout=300, env=env)
+    assert sent.exists(), "the run compiled fewer events than n: choose a smaller n"
+    assert proc.returncode == 130, (proc.returncode, proc.stderr[-800:])
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr[-800:]
+
+
 def test_ctrl_c_inside_a_string_exec_still_exits_130(tmp_path):
     """CI saw a real run end by the signal (-2) after printing its line: the SIGINT had landed inside
     an ``exec`` of a string (as numba and dataclasses build code), which CPython marks as unhandled

@@ -535,6 +535,72 @@ def test_kernel_modules_are_every_module_that_compiles_kernels():
     assert sorted(jit.KERNEL_MODULES) == using
 
 
+def test_a_ctrl_c_during_a_compile_is_raised_when_the_compile_has_finished():
+    """A SIGINT that arrives while numba compiles a kernel (here: sent when numba's compile event
+    starts) is held until the compile ends, then raised as KeyboardInterrupt: the kernel is whole
+    (compiled, callable, same answer) and SIGINT's handler is Python's again. Inside the compiler
+    it had left numba half done (a finaliser's traceback, a broken cache, a segmentation fault)."""
+    import os
+    import signal
+    from numba.core import event
+    from fkopt.numerics.jit import njit
+
+    @njit
+    def twice(x):
+        return 2.0 * x + 0.0 * np.sin(x)
+
+    class SendInterrupt(event.Listener):
+        def on_start(self, ev):
+            os.kill(os.getpid(), signal.SIGINT)
+
+        def on_end(self, ev):
+            pass
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with event.install_listener("numba:compile", SendInterrupt()):
+            with pytest.raises(KeyboardInterrupt):
+                twice(1.5)
+        assert twice.signatures and twice(1.5) == 3.0
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def test_interrupts_deferred_nests_and_leaves_other_threads_alone():
+    """The outermost block of the main thread holds the interrupt; a nested block's end does not
+    raise it; a block in another thread changes no handler (Python allows that in the main thread
+    only)."""
+    import os
+    import signal
+    import threading
+    from fkopt.numerics.jit import interrupts_deferred
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        reached = []
+        with pytest.raises(KeyboardInterrupt):
+            with interrupts_deferred():
+                with interrupts_deferred():
+                    os.kill(os.getpid(), signal.SIGINT)
+                    sum(range(1000))           # the handler runs here: it holds the interrupt
+                reached.append("inner block ended")
+        assert reached == ["inner block ended"]
+        errors = []
+
+        def elsewhere():
+            try:
+                with interrupts_deferred():
+                    pass
+            except Exception as err:       # noqa: BLE001 -- reported below
+                errors.append(err)
+        t = threading.Thread(target=elsewhere)
+        t.start()
+        t.join()
+        assert errors == [] and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 @pytest.mark.parametrize("k", [1, 4, 64])
 def test_screened_nearest_rows_are_the_full_passes_rows_ties_included(k):
     """The compiled one-pose IK's start-table lookup (float32 screen, then float64 distances of

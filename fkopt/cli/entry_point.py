@@ -116,10 +116,15 @@ def interrupt_not_swallowed(args) -> None:
 
     def send() -> None:
         signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+
+    def later() -> None:
+        timer = threading.Timer(REDELIVERY_DELAY, send)
+        timer.daemon = True          # a process on its way out does not wait for it
+        timer.start()
     try:
-        threading.Timer(REDELIVERY_DELAY, send).start()
+        later()
     except KeyboardInterrupt:
-        threading.Timer(REDELIVERY_DELAY, send).start()
+        later()
 
 
 #: Seconds between a finaliser's swallowed Ctrl-C and its delivery to the main thread again.

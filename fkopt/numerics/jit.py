@@ -25,14 +25,22 @@ modules: an edit of ``compiled_ik.py`` (or an upgrade that changes only it) left
 ``compiled_branches.py``'s cached kernels running the old ``compiled_ik`` code -- stale code, or in
 a fresh install a signature that no longer types. With the stamp, any change of a kernel module
 recompiles every kernel once.
+
+A Ctrl-C waits for the kernel being compiled or loaded (:func:`interrupts_deferred`, around every
+``Dispatcher.compile``): a KeyboardInterrupt raised inside numba's compiler or llvmlite's
+finalisers left them half done, and the process then printed a finaliser's traceback, reported a
+broken cache ("no compiled object yet") or died of a segmentation fault on its way out (CI, sixth
+round). The interrupt is raised as soon as that compile ends.
 """
 from __future__ import annotations
 
 import functools
 import hashlib
 import os
+import signal
 import threading
 import time
+from contextlib import contextmanager
 
 import numba
 from numba.core.caching import FunctionCache
@@ -171,11 +179,60 @@ def _stable(value):
     return "compiled function", py.__module__, py.__qualname__, code.co_code, stamp, cells
 
 
+_DEFERRING = {"depth": 0}            # nesting of interrupts_deferred in the main thread
+
+
+@contextmanager
+def interrupts_deferred():
+    """Hold a SIGINT that arrives inside the block and raise it (through the handler it was meant
+    for, Python's KeyboardInterrupt) when the block ends. Only the main thread runs Python's signal
+    handlers; in another thread, or where SIGINT is ignored or fatal (no Python handler), the block
+    runs as it is. Nested blocks defer to the outermost."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    if _DEFERRING["depth"]:
+        _DEFERRING["depth"] += 1
+        try:
+            yield
+        finally:
+            _DEFERRING["depth"] -= 1
+        return
+    meant_for = signal.getsignal(signal.SIGINT)
+    if not callable(meant_for):
+        yield
+        return
+    held = []
+    signal.signal(signal.SIGINT, lambda signum, frame: held.append((signum, frame)))
+    _DEFERRING["depth"] = 1
+    try:
+        yield
+    finally:
+        _DEFERRING["depth"] = 0
+        signal.signal(signal.SIGINT, meant_for)
+        if held:
+            meant_for(*held[0])
+
+
+def _compiled_whole(dispatcher) -> None:
+    """Run ``dispatcher.compile`` (numba's lazy compile and cache load, nested for the kernels a
+    kernel calls) with Ctrl-C deferred to its end (module docstring)."""
+    compile_ = dispatcher.compile
+
+    @functools.wraps(compile_)
+    def compile(sig):
+        with interrupts_deferred():
+            return compile_(sig)
+    dispatcher.compile = compile
+
+
 def njit(*args, cache: bool = False, **options):
     """``numba.njit(**options)``, with ``cache=True`` meaning :class:`GuardedCache`; used as
-    ``@njit`` or ``@njit(cache=True, ...)``."""
+    ``@njit`` or ``@njit(cache=True, ...)``. Its compiles finish before a Ctrl-C is raised
+    (:func:`interrupts_deferred`)."""
     def decorate(fn):
         dispatcher = numba.njit(**options)(fn)
+        _compiled_whole(dispatcher)
         if cache:
             try:
                 dispatcher._cache = GuardedCache(fn)
