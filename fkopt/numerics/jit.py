@@ -28,9 +28,9 @@ recompiles every kernel once.
 
 A Ctrl-C waits for the kernel being compiled or loaded (:func:`interrupts_deferred`, around every
 ``Dispatcher.compile``): a KeyboardInterrupt raised inside numba's compiler or llvmlite's
-finalisers left them half done, and the process then printed a finaliser's traceback, reported a
-broken cache ("no compiled object yet") or died of a segmentation fault on its way out (CI, sixth
-round). The interrupt is raised as soon as that compile ends.
+finalisers left them half done, and the process then printed a finaliser's traceback or reported
+a broken cache ("no compiled object yet"); a CI run interrupted while compiling died of a
+segmentation fault. The interrupt is raised as soon as that compile ends.
 """
 from __future__ import annotations
 
