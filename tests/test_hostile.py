@@ -1110,6 +1110,56 @@ def test_a_ctrl_c_inside_a_finaliser_is_delivered_again_without_a_traceback(monk
     assert "Exception ignored in" in err and "ValueError: not an interrupt" in err
 
 
+def test_the_finaliser_hook_chains_to_the_previous_one_and_main_puts_it_back(monkeypatch):
+    """Other unraisable exceptions go to the hook installed before fkopt's (pytest's, when the tests
+    call main in their own process), and main puts that hook back when it ends."""
+    import functools
+    from types import SimpleNamespace
+    from fkopt.cli import entry_point
+    seen = []
+    monkeypatch.setattr(sys, "unraisablehook", seen.append)
+    other = SimpleNamespace(exc_type=ValueError, exc_value=ValueError("x"), exc_traceback=None, err_msg=None,
+                            object=None)
+    entry_point.interrupt_not_swallowed(other, otherwise=seen.append)
+    assert seen == [other]
+    during = []
+    monkeypatch.setattr(entry_point, "_main", lambda: during.append(sys.unraisablehook))
+    entry_point.main()
+    assert isinstance(during[0], functools.partial) and during[0].func is entry_point.interrupt_not_swallowed
+    assert sys.unraisablehook == seen.append
+
+
+def test_a_ctrl_c_in_a_finaliser_at_shutdown_prints_nothing(tmp_path):
+    """While the interpreter shuts down no thread can start (nor should one): the hook stays silent
+    instead of printing its own "Exception ignored in sys.unraisablehook"."""
+    code = ("import sys\n"
+            "from fkopt.cli.entry_point import interrupt_not_swallowed\n"
+            "sys.unraisablehook = interrupt_not_swallowed\n"
+            "class Finalised:\n"
+            "    def __del__(self):\n"
+            "        raise KeyboardInterrupt\n"
+            "kept = Finalised()\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+
+
+def test_workers_are_born_ignoring_ctrl_c():
+    """Workers started while the parent ignores SIGINT keep ignoring it through spawn's exec, before
+    any initializer runs (a worker importing fkopt for 0.3 s printed a traceback when Ctrl-C came
+    then); the parent's own handler is back afterwards."""
+    import concurrent.futures
+    import multiprocessing
+    from fkopt.run.executors import _workers_born_ignoring_interrupts
+    before = signal.getsignal(signal.SIGINT)
+    with _workers_born_ignoring_interrupts():
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        pool = concurrent.futures.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))
+        futures = [pool.submit(signal.getsignal, signal.SIGINT) for _ in range(2)]
+    assert signal.getsignal(signal.SIGINT) is before
+    assert [f.result() for f in futures] == [signal.SIG_IGN] * 2
+    pool.shutdown()
+
+
 def test_fkopt_run_refuses_other_config_unless_forced(tmp_path, cli):
     cfg = tmp_path / "c.yaml"
     out = tmp_path / "out"

@@ -601,6 +601,51 @@ def test_interrupts_deferred_nests_and_leaves_other_threads_alone():
         signal.signal(signal.SIGINT, previous)
 
 
+def test_a_second_ctrl_c_during_a_compile_is_raised_at_once():
+    """Someone who presses Ctrl-C twice during a long compile is not kept waiting."""
+    import os
+    import signal
+    from fkopt.numerics.jit import interrupts_deferred
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        reached = []
+        with pytest.raises(KeyboardInterrupt):
+            with interrupts_deferred():
+                os.kill(os.getpid(), signal.SIGINT)
+                sum(range(1000))
+                reached.append("held")
+                os.kill(os.getpid(), signal.SIGINT)
+                sum(range(1000))
+                reached.append("not reached")
+        assert reached == ["held"] and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def test_interrupts_deferred_puts_the_handler_back_when_a_pending_handler_raises(monkeypatch):
+    """``signal.signal`` runs the handlers of pending signals before it swaps: one that raises (another
+    library's alarm) must not leave the holding handler in place, which would swallow every later Ctrl-C."""
+    import signal
+    from fkopt.numerics.jit import interrupts_deferred
+    real = signal.signal
+    previous = real(signal.SIGINT, signal.default_int_handler)
+    calls = []
+
+    def swap(signum, handler):
+        calls.append(handler)
+        if handler is signal.default_int_handler and len(calls) == 2:   # the first swap back
+            raise TimeoutError("another handler's alarm")
+        return real(signum, handler)
+    monkeypatch.setattr(signal, "signal", swap)
+    try:
+        with pytest.raises(TimeoutError):
+            with interrupts_deferred():
+                pass
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler and len(calls) == 3
+    finally:
+        real(signal.SIGINT, previous)
+
+
 @pytest.mark.parametrize("k", [1, 4, 64])
 def test_screened_nearest_rows_are_the_full_passes_rows_ties_included(k):
     """The compiled one-pose IK's start-table lookup (float32 screen, then float64 distances of

@@ -4,8 +4,11 @@ ends as one line ``fkopt: error: ...`` on stderr and exit status 2, Ctrl-C with 
 neither with a traceback."""
 from __future__ import annotations
 
+import functools
 import inspect
+import signal
 import sys
+import threading
 from pathlib import Path
 
 import typer
@@ -95,23 +98,22 @@ def exit_interrupted(message: str) -> None:
     sys.exit(130)
 
 
-def interrupt_not_swallowed(args) -> None:
-    """``sys.unraisablehook`` while fkopt runs: a Ctrl-C that lands in a finaliser (``__del__``,
-    e.g. llvmlite disposing a module while numba compiles) cannot propagate, so CPython printed
+def interrupt_not_swallowed(args, otherwise=None) -> None:
+    """``sys.unraisablehook`` while :func:`main` runs: a Ctrl-C that lands in a finaliser
+    (``__del__``, e.g. llvmlite disposing a module) cannot propagate, so CPython printed
     "Exception ignored in ..." with a traceback and went on as if no key were pressed. The
     interrupt is sent to the main thread again instead, silently; any other unraisable exception
-    goes to Python's own hook.
+    goes to ``otherwise`` (the hook that was installed before, else Python's own).
 
-    A short-lived thread sends a real SIGINT (``_thread.interrupt_main`` only sets a flag, which
-    a main thread blocked waiting for a worker's result would not see until the result came) a
-    moment later: an interrupt raised inside this hook would be "ignored" in turn, and if the
-    signal still lands here it is caught and sent again."""
+    A short-lived daemon thread sends a real SIGINT (``_thread.interrupt_main`` only sets a flag,
+    which a main thread blocked waiting for a worker's result would not see until the result came)
+    a moment later: an interrupt raised inside this hook would be "ignored" in turn, and a second
+    Ctrl-C that lands here is sent as well. While the interpreter shuts down nothing is sent (no
+    thread can start then, and the process is ending anyway)."""
     if args.exc_type is None or not issubclass(args.exc_type, KeyboardInterrupt):
-        sys.__unraisablehook__(args)
+        (otherwise or sys.__unraisablehook__)(args)
         return
-    import signal
-    import threading
-    if not callable(signal.getsignal(signal.SIGINT)):   # SIGINT ignored or fatal here: nothing to redo
+    if sys.is_finalizing() or not callable(signal.getsignal(signal.SIGINT)):   # ignored or fatal: nothing to redo
         return
 
     def send() -> None:
@@ -132,8 +134,19 @@ REDELIVERY_DELAY = 0.01
 
 
 def main() -> None:
-    """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130."""
-    sys.unraisablehook = interrupt_not_swallowed
+    """Entry point: user errors are one line and exit 2, drift exits 1, Ctrl-C exits 130. While it
+    runs, a Ctrl-C swallowed by a finaliser is sent again (:func:`interrupt_not_swallowed`); the
+    previous ``sys.unraisablehook`` is put back when it returns or exits (the tests call it in
+    their own process)."""
+    previous = sys.unraisablehook
+    sys.unraisablehook = functools.partial(interrupt_not_swallowed, otherwise=previous)
+    try:
+        _main()
+    finally:
+        sys.unraisablehook = previous
+
+
+def _main() -> None:
     def interrupted() -> str:
         hint = INTERRUPTED["hint"]
         return "fkopt: interrupted (previous results are kept" + (f"; {hint})" if hint else ")")

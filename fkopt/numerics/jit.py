@@ -40,6 +40,7 @@ import os
 import signal
 import threading
 import time
+import weakref
 from contextlib import contextmanager
 
 import numba
@@ -185,9 +186,14 @@ _DEFERRING = {"depth": 0}            # nesting of interrupts_deferred in the mai
 @contextmanager
 def interrupts_deferred():
     """Hold a SIGINT that arrives inside the block and raise it (through the handler it was meant
-    for, Python's KeyboardInterrupt) when the block ends. Only the main thread runs Python's signal
-    handlers; in another thread, or where SIGINT is ignored or fatal (no Python handler), the block
-    runs as it is. Nested blocks defer to the outermost."""
+    for, Python's KeyboardInterrupt) when the block ends; a second SIGINT inside the block is
+    raised at once (someone insists). Only the main thread runs Python's signal handlers; in
+    another thread, or where SIGINT is ignored or fatal (no Python handler), the block runs as it
+    is. Nested blocks defer to the outermost.
+
+    The original handler is put back whatever happens: ``signal.signal`` first runs the handlers
+    of signals already pending, and one of them (another library's SIGALRM or SIGTERM handler)
+    may raise; a handler left swapped would swallow every later Ctrl-C of the process."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -203,26 +209,41 @@ def interrupts_deferred():
         yield
         return
     held = []
-    signal.signal(signal.SIGINT, lambda signum, frame: held.append((signum, frame)))
+
+    def hold(signum, frame):
+        if held:
+            meant_for(signum, frame)
+        held.append((signum, frame))
     _DEFERRING["depth"] = 1
     try:
+        signal.signal(signal.SIGINT, hold)
         yield
     finally:
         _DEFERRING["depth"] = 0
-        signal.signal(signal.SIGINT, meant_for)
+        raised = None
+        while signal.getsignal(signal.SIGINT) is not meant_for:
+            try:
+                signal.signal(signal.SIGINT, meant_for)
+            except BaseException as err:     # a pending handler raised before the swap back
+                raised = raised or err
+        if raised is not None:
+            raise raised
         if held:
             meant_for(*held[0])
 
 
 def _compiled_whole(dispatcher) -> None:
     """Run ``dispatcher.compile`` (numba's lazy compile and cache load, nested for the kernels a
-    kernel calls) with Ctrl-C deferred to its end (module docstring)."""
-    compile_ = dispatcher.compile
+    kernel calls) with Ctrl-C deferred to its end (module docstring). The wrapper holds the
+    dispatcher weakly: a bound method would make a reference cycle, and a dropped kernel would
+    then be freed by the cyclic collector at any moment instead of at once."""
+    compile_ = type(dispatcher).compile
+    owner = weakref.ref(dispatcher)
 
     @functools.wraps(compile_)
     def compile(sig):
         with interrupts_deferred():
-            return compile_(sig)
+            return compile_(owner(), sig)
     dispatcher.compile = compile
 
 

@@ -26,6 +26,8 @@ import multiprocessing
 import re
 import signal
 import socket
+import threading
+from contextlib import contextmanager
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Callable
 
@@ -114,25 +116,46 @@ def _ignore_interrupts() -> None:
     """A worker's start: Ctrl-C belongs to the parent. A terminal sends SIGINT to the whole process
     group, and a worker interrupted inside numba's compiler printed llvmlite's "Exception ignored
     in ... __del__" traceback beside fkopt's one line (seen in CI). The parent, on its
-    KeyboardInterrupt, terminates the workers (:func:`_processes`)."""
+    KeyboardInterrupt, terminates the workers (:func:`_processes`). Workers started by the pool
+    later (after one died) get it here; the first ones are born ignoring SIGINT (below)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _processes(fn, payloads, jobs, on_result) -> None:
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupts,
-                               mp_context=multiprocessing.get_context("spawn"))
-    futures = [pool.submit(fn, p) for p in payloads]
+@contextmanager
+def _workers_born_ignoring_interrupts():
+    """SIGINT ignored in this process while the pool starts its workers: a spawned worker keeps an
+    ignored signal through its ``exec``, so a Ctrl-C while it still imports fkopt (before its
+    initializer runs) cannot print a traceback from it. A Ctrl-C to the parent in these few
+    milliseconds is ignored too. Only the main thread may set a handler; elsewhere nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _processes(fn, payloads, jobs, on_result) -> None:
+    pool = None
+    try:
+        with _workers_born_ignoring_interrupts():
+            pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupts,
+                                       mp_context=multiprocessing.get_context("spawn"))
+            futures = [pool.submit(fn, p) for p in payloads]
         for fut in as_completed(futures):
             on_result(fut.result())
     except BaseException:
         # Stop at once (Ctrl-C, a failed task): tasks already queued to a worker cannot be
-        # cancelled, so the workers are terminated (their results would be thrown away anyway).
-        procs = list((getattr(pool, "_processes", None) or {}).values())
-        pool.shutdown(wait=False, cancel_futures=True)
-        for proc in procs:
-            if proc.is_alive():
-                proc.terminate()
+        # cancelled, and the workers ignore SIGINT, so they are terminated (their results would be
+        # thrown away anyway).
+        if pool is not None:
+            procs = list((getattr(pool, "_processes", None) or {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            for proc in procs:
+                if proc.is_alive():
+                    proc.terminate()
         raise
     pool.shutdown(wait=True)
 
