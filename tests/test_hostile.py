@@ -1149,9 +1149,9 @@ def test_workers_are_born_ignoring_ctrl_c():
     then); the parent's own handler is back afterwards."""
     import concurrent.futures
     import multiprocessing
-    from fkopt.run.executors import _workers_born_ignoring_interrupts
+    from fkopt.files import sigint_handler
     before = signal.getsignal(signal.SIGINT)
-    with _workers_born_ignoring_interrupts():
+    with sigint_handler(signal.SIG_IGN):             # as fkopt.run.executors starts its pool
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
         pool = concurrent.futures.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))
         futures = [pool.submit(signal.getsignal, signal.SIGINT) for _ in range(2)]

@@ -19,7 +19,8 @@ and results folder of fkopt goes through this package, once:
   place), :func:`write_file_atomically`, :func:`run_lock`, :func:`file_names`.
 * :mod:`.text` -- :func:`strict_json` (every ``--json``), :func:`md_text`, :func:`one_line`,
   :func:`short_token`.
-* :mod:`.numbers` -- :func:`nanmedian`; :mod:`.host` -- :func:`available_cpus`, :func:`installed_version`.
+* :mod:`.numbers` -- :func:`nanmedian`; :mod:`.host` -- :func:`available_cpus`, :func:`installed_version`,
+  :func:`sigint_handler`.
 
 Every name is importable from ``fkopt.files`` itself (``from fkopt.files import read_input``),
 as callers have always written it; a test that replaces a bound patches the module that reads it
@@ -29,7 +30,7 @@ from __future__ import annotations
 
 from fkopt.files.csv_reading import (MAX_CSV_CELLS, MAX_CSV_COLUMNS, MAX_CSV_LINE, check_csv_shape, csv_numbers,
                                      parse_csv, read_csv, read_stored_csv)
-from fkopt.files.host import available_cpus, installed_version
+from fkopt.files.host import available_cpus, installed_version, sigint_handler
 from fkopt.files.numbers import nanmedian
 from fkopt.files.reading import (MAX_INPUT_BYTES, MAX_UNPACKED, MAX_XML_DEPTH, MAX_YAML_BYTES, check_geometry_file,
                                  check_within, odd_entries, open_input, parse_json, parse_xml, read_input, read_json,

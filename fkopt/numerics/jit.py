@@ -48,6 +48,7 @@ from numba.core.caching import FunctionCache
 from numba.core.dispatcher import Dispatcher
 from numba.core.serialize import dumps
 
+from fkopt.files.host import sigint_handler
 from fkopt.numerics.notice import notice
 
 #: The modules (relative to the fkopt package) that define kernels compiled through :func:`njit`;
@@ -189,11 +190,8 @@ def interrupts_deferred():
     for, Python's KeyboardInterrupt) when the block ends; a second SIGINT inside the block is
     raised at once (someone insists). Only the main thread runs Python's signal handlers; in
     another thread, or where SIGINT is ignored or fatal (no Python handler), the block runs as it
-    is. Nested blocks defer to the outermost.
-
-    The original handler is put back whatever happens: ``signal.signal`` first runs the handlers
-    of signals already pending, and one of them (another library's SIGALRM or SIGTERM handler)
-    may raise; a handler left swapped would swallow every later Ctrl-C of the process."""
+    is. Nested blocks defer to the outermost. The original handler is put back whatever happens
+    (:func:`fkopt.files.sigint_handler`)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -216,18 +214,10 @@ def interrupts_deferred():
         held.append((signum, frame))
     _DEFERRING["depth"] = 1
     try:
-        signal.signal(signal.SIGINT, hold)
-        yield
+        with sigint_handler(hold):
+            yield
     finally:
         _DEFERRING["depth"] = 0
-        raised = None
-        while signal.getsignal(signal.SIGINT) is not meant_for:
-            try:
-                signal.signal(signal.SIGINT, meant_for)
-            except BaseException as err:     # a pending handler raised before the swap back
-                raised = raised or err
-        if raised is not None:
-            raise raised
         if held:
             meant_for(*held[0])
 

@@ -26,13 +26,11 @@ import multiprocessing
 import re
 import signal
 import socket
-import threading
-from contextlib import contextmanager
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Callable
 
 from fkopt.errors import FkoptError
-from fkopt.files import available_cpus
+from fkopt.files import available_cpus, sigint_handler
 
 EXECUTORS = ("local", "dask")
 #: A Dask scheduler address: ``[tcp|tls]://host:port`` (or ``host:port``).
@@ -121,26 +119,13 @@ def _ignore_interrupts() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-@contextmanager
-def _workers_born_ignoring_interrupts():
-    """SIGINT ignored in this process while the pool starts its workers: a spawned worker keeps an
-    ignored signal through its ``exec``, so a Ctrl-C while it still imports fkopt (before its
-    initializer runs) cannot print a traceback from it. A Ctrl-C to the parent in these few
-    milliseconds is ignored too. Only the main thread may set a handler; elsewhere nothing changes."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
 def _processes(fn, payloads, jobs, on_result) -> None:
     pool = None
     try:
-        with _workers_born_ignoring_interrupts():
+        # SIGINT ignored while the pool starts its workers: a spawned worker keeps an ignored signal
+        # through its exec, so a Ctrl-C while it still imports fkopt (before its initializer) cannot
+        # print a traceback from it; a Ctrl-C to this process in these milliseconds is ignored too
+        with sigint_handler(signal.SIG_IGN):
             pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupts,
                                        mp_context=multiprocessing.get_context("spawn"))
             futures = [pool.submit(fn, p) for p in payloads]
