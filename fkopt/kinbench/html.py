@@ -46,7 +46,7 @@ th[data-dir=asc]::after { content: " \\25B2"; } th[data-dir=desc]::after { conte
 td.t { text-align: left; white-space: nowrap; } td.w { text-align: left; white-space: normal; max-width: 60em; }
 .lead { display: grid; grid-template-columns: minmax(0, auto) minmax(18em, 25em); gap: 1.2em; align-items: start; }
 .lead > div { min-width: 0; overflow-x: auto; } .lead > figure { margin: 0; }
-figure { margin: 0.3em 0; display: inline-block; max-width: 100%; } figure img { width: 100%; max-width: 42em; }
+figure { margin: 0.3em 0; display: inline-block; max-width: 100%; } figure img { width: 100%; max-width: 42em; height: auto; }
 figcaption { font-size: 0.8em; color: #444; } .figs figure { width: 32em; margin-right: 0.6em; }
 span.n { white-space: nowrap; } details { margin: 0.2em 0; } summary { cursor: pointer; } .note { font-size: 0.85em; color: #444; }
 """
@@ -155,12 +155,29 @@ def table_html(df, cols: list[str], ident: str, reference: str | None = None, la
             f"<tbody>{body}</tbody></table>")
 
 
+def png_size(path: Path) -> tuple[int, int] | None:
+    """(width, height) in pixels from a PNG's IHDR chunk, or None when the file is not a PNG."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(24)
+    except OSError:
+        return None
+    if len(head) < 24 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return None
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
 def img(path: Path, caption: str | None = None, lazy: bool = True) -> str:
-    """A figure: the PNG beside the page, by its relative name (never inlined: a page stays small)."""
+    """A figure: the PNG beside the page, by its relative name (never inlined: a page stays small).
+    Its pixel size is on the ``img``, so the browser reserves the figure's height before a lazy
+    figure loads: without it, a figure that loaded after a jump from the contents moved the section
+    out of view (a CI check on a loaded machine: 322 px)."""
     name = html.escape(Path(path).name)
     cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
     loading = ' loading="lazy"' if lazy else ""
-    return (f'<figure><a href="{name}"><img alt="{html.escape(Path(path).stem)}" src="{name}"{loading}></a>'
+    size = png_size(path)
+    dims = f' width="{size[0]}" height="{size[1]}"' if size else ""
+    return (f'<figure><a href="{name}"><img alt="{html.escape(Path(path).stem)}" src="{name}"{dims}{loading}></a>'
             f"{cap}</figure>")
 
 

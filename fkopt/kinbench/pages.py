@@ -111,7 +111,9 @@ def load_text(meta: dict) -> str:
             return ", ".join(f"{k} {one(x)}" for k, x in v.items())
         return f"{float(v):.2f}" if isinstance(v, (int, float)) else str(v)
     if isinstance(load, dict):
-        parts = [f"at its {k}: {one(v)}" for k, v in load.items()]
+        # start before end, whatever order meta.json keeps (read back by fkopt pages, its keys are sorted)
+        ordered = sorted(load.items(), key=lambda kv: {"start": 0, "end": 1}.get(kv[0], 2))
+        parts = [f"at its {k}: {one(v)}" for k, v in ordered]
         return "load average (1 / 5 / 15 min) " + "; ".join(parts)
     return f"load average {one(load)}"
 
@@ -128,8 +130,10 @@ def machine_section(sr) -> Section:
 
 
 def _settings_text(settings) -> str:
+    """An entry's settings, sorted by name: the run writes them in its own order, meta.json read back
+    (fkopt pages) in sorted order, and both must write the same page."""
     if isinstance(settings, dict):
-        return "; ".join(f"{k} = {v}" for k, v in settings.items())
+        return "; ".join(f"{k} = {v}" for k, v in sorted(settings.items()))
     return str(settings)
 
 
@@ -219,7 +223,9 @@ def suite_settings_section(sr) -> Section:
     rows = []
     for s in c.solvers:
         sub = c.subset_of(s.key)
-        params = ", ".join(f"{k} = {v}" for k, v in (s.params or {}).items()) or "defaults"
+        # sorted: the config read back from meta.json (fkopt pages) has its keys sorted, the running one the YAML's
+        # order, and both must write the same page
+        params = ", ".join(f"{k} = {v}" for k, v in sorted((s.params or {}).items())) or "defaults"
         rows.append({"solver": s.key, "track": s.track, "method": s.name, "settings": params,
                      "population": "default" if s.population is None else s.population,
                      "iterations": "from the budget" if s.iterations is None else s.iterations,
