@@ -33,7 +33,7 @@ from fkopt.files.csv_reading import (MAX_CSV_CELLS, MAX_CSV_COLUMNS, MAX_CSV_LIN
 from fkopt.files.host import available_cpus, installed_version, sigint_handler
 from fkopt.files.numbers import nanmedian
 from fkopt.files.reading import (MAX_INPUT_BYTES, MAX_UNPACKED, MAX_XML_DEPTH, MAX_YAML_BYTES, check_geometry_file,
-                                 check_within, odd_entries, open_input, parse_json, parse_xml, read_input, read_json,
+                                 check_within, odd_entries, open_input, parse_json, parse_xml, png_size, read_input, read_json,
                                  read_stored, read_text, stored_sha256, where_named)
 from fkopt.files.text import md_table, md_text, one_line, short_token, strict_json
 from fkopt.files.validation import (COMPONENT_PATTERN, MAX_COMPONENT, MAX_MAGNITUDE, check_component, did_you_mean,

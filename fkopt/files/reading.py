@@ -147,6 +147,14 @@ def read_text(path: str | Path, max_bytes: int = MAX_YAML_BYTES, *, field: str |
 MAX_XML_DEPTH = 256
 
 
+def png_size(head: bytes) -> tuple[int, int] | None:
+    """(width, height) in pixels from a file's first 24 bytes when they are a PNG's (its signature,
+    then the first chunk's length and tag, and IHDR's width and height), else None."""
+    if len(head) != 24 or head[:8] != b"\x89PNG\r\n\x1a\n":
+        return None
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
 def parse_xml(data: bytes | str, where: str, max_depth: int = MAX_XML_DEPTH):
     """The root element of an XML document (the standard library's parser, streamed), refused
     with one line naming ``where`` once an element lies deeper than ``max_depth`` (the rest is

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from fkopt.files import png_size
+
 SCRIPT = """
 function sortTable(th) {
   var table = th.closest('table'), body = table.tBodies[0];
@@ -155,16 +157,13 @@ def table_html(df, cols: list[str], ident: str, reference: str | None = None, la
             f"<tbody>{body}</tbody></table>")
 
 
-def png_size(path: Path) -> tuple[int, int] | None:
-    """(width, height) in pixels from a PNG's IHDR chunk, or None when the file is not a PNG."""
+def _figure_size(path: Path) -> tuple[int, int] | None:
+    """The pixel size of the PNG at ``path`` (a figure fkopt drew), or None."""
     try:
         with open(path, "rb") as f:
-            head = f.read(24)
+            return png_size(f.read(24))
     except OSError:
         return None
-    if len(head) < 24 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
-        return None
-    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
 
 
 def img(path: Path, caption: str | None = None, lazy: bool = True) -> str:
@@ -175,7 +174,7 @@ def img(path: Path, caption: str | None = None, lazy: bool = True) -> str:
     name = html.escape(Path(path).name)
     cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
     loading = ' loading="lazy"' if lazy else ""
-    size = png_size(path)
+    size = _figure_size(path)
     dims = f' width="{size[0]}" height="{size[1]}"' if size else ""
     return (f'<figure><a href="{name}"><img alt="{html.escape(Path(path).stem)}" src="{name}"{dims}{loading}></a>'
             f"{cap}</figure>")

@@ -129,11 +129,11 @@ def machine_section(sr) -> Section:
     return Section("machine", "Machine and load", [_p(t) for t in lines])
 
 
-def _settings_text(settings) -> str:
+def _settings_text(settings, sep: str = "; ") -> str:
     """An entry's settings, sorted by name: the run writes them in its own order, meta.json read back
     (fkopt pages) in sorted order, and both must write the same page."""
     if isinstance(settings, dict):
-        return "; ".join(f"{k} = {v}" for k, v in sorted(settings.items()))
+        return sep.join(f"{k} = {v}" for k, v in sorted(settings.items()))
     return str(settings)
 
 
@@ -223,9 +223,7 @@ def suite_settings_section(sr) -> Section:
     rows = []
     for s in c.solvers:
         sub = c.subset_of(s.key)
-        # sorted: the config read back from meta.json (fkopt pages) has its keys sorted, the running one the YAML's
-        # order, and both must write the same page
-        params = ", ".join(f"{k} = {v}" for k, v in sorted((s.params or {}).items())) or "defaults"
+        params = _settings_text(s.params or {}, ", ") or "defaults"
         rows.append({"solver": s.key, "track": s.track, "method": s.name, "settings": params,
                      "population": "default" if s.population is None else s.population,
                      "iterations": "from the budget" if s.iterations is None else s.iterations,

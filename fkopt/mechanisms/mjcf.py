@@ -47,7 +47,8 @@ import numpy as np
 from pydantic import Field
 
 from fkopt.errors import FkoptError, did_you_mean
-from fkopt.files import check_geometry_file, check_within, open_input, parse_xml, read_input, short_token
+from fkopt.files import (check_geometry_file, check_within, open_input, parse_xml, png_size, read_input,
+                         short_token)
 from fkopt.numerics import rotations
 from fkopt.mechanisms.urdf import URDFArm, URDFGeometry, check_numbers
 
@@ -162,8 +163,9 @@ def check_mjcf_files(path: Path) -> None:
                     if not candidate.exists() and not candidate.is_symlink():
                         continue
                     head = counted(open_input(candidate, MAX_MJCF_ASSET_BYTES, what, within=folder), what)
-                    if head[:8] == b"\x89PNG\r\n\x1a\n" and len(head) == 24:
-                        width, height = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+                    size = png_size(head)
+                    if size is not None:
+                        width, height = size
                         if width * height > MAX_PNG_PIXELS:
                             raise FkoptError(f"{what}: a PNG of {width} x {height} pixels; at most {MAX_PNG_PIXELS} "
                                              "pixels are accepted")
